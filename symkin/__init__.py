@@ -1,0 +1,35 @@
+"""symkin: symbolic code generation for the kinematic analysis of planar mechanisms.
+
+The public API (see DESIGN.md) is loaded lazily, so that running an already-compiled kernel
+does not pay for importing SymPy.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+__all__ = ["load", "from_dict", "derive", "generate", "compile", "solve", "SymkinError",
+           "MechanismError", "SolveError", "BuildError"]
+
+_EXPORTS = {
+    "load": ("symkin.model", "load"),
+    "from_dict": ("symkin.model", "from_dict"),
+    "Mechanism": ("symkin.model", "Mechanism"),
+    "derive": ("symkin.derivation", "derive"),
+    "System": ("symkin.derivation", "System"),
+    "generate": ("symkin.render", "generate"),
+    "compile": ("symkin.build", "compile"),
+    "solve": ("symkin.driver", "solve"),
+    "SymkinError": ("symkin.errors", "SymkinError"),
+    "MechanismError": ("symkin.errors", "MechanismError"),
+    "SolveError": ("symkin.errors", "SolveError"),
+    "BuildError": ("symkin.errors", "BuildError"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'symkin' has no attribute {name!r}")
+    module, attribute = _EXPORTS[name]
+    return getattr(importlib.import_module(module), attribute)

@@ -1,0 +1,154 @@
+"""Stage 2 — derivation: Phi(q, t), its sparse Jacobian Phi_q, Phi_t and Gamma with SymPy.
+
+Each row is derived from the few coordinates it touches (at most six for the chapter's pairs),
+so the cost grows linearly with the number of joints:
+
+    Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt                       (2.74)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import sympy as sp
+
+from symkin import constraints, model
+from symkin.model import Mechanism
+
+
+@dataclass(frozen=True)
+class Row:
+    """Which joint or driver owns a row of Phi, and which of its equations the row is."""
+
+    section: str  # "joints" or "drivers"
+    index: int
+    type: str
+    bodies: tuple[str, ...]
+    part: str
+    name: str | None = None
+
+    @property
+    def owner(self) -> str:
+        """``joints[1] revolute crank-rod`` (or the constraint's own name)."""
+        who = f" {self.name}" if self.name else ""
+        return f"{self.section}[{self.index}]{who} {self.type} {'-'.join(self.bodies)}".rstrip()
+
+    def __str__(self) -> str:
+        return f"{self.owner} ({self.part})"
+
+
+@dataclass(frozen=True)
+class System:
+    """The symbolic kinematics of one mechanism (see DESIGN.md, Python API)."""
+
+    mechanism: Mechanism
+    q: tuple[sp.Symbol, ...]
+    dq: tuple[sp.Symbol, ...]
+    t: sp.Symbol
+    p: tuple[sp.Symbol, ...]
+    p_values: tuple[float, ...]
+    coordinates: tuple[str, ...]
+    phi: sp.ImmutableMatrix
+    phi_q: sp.ImmutableSparseMatrix
+    phi_t: sp.ImmutableMatrix
+    gamma: sp.ImmutableMatrix
+    rows: tuple[Row, ...]
+    q0: tuple[float, ...]
+
+    @property
+    def name(self) -> str:
+        return self.mechanism.name
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(symbol.name for symbol in self.p)
+
+    @property
+    def dof(self) -> int:
+        return model.degrees_of_freedom(self.mechanism)
+
+    @property
+    def time_grid(self) -> tuple[float, float, float]:
+        """(t0, t1, dt) at the nominal parameter values."""
+        values = dict(zip(self.p, self.p_values))
+        parse = constraints.Context(self.mechanism, model.make_symbols(self.mechanism)).expr
+        grid = self.mechanism.time
+        return tuple(float(parse(raw).subs(values)) for raw in (grid.t0, grid.t1, grid.dt))
+
+    def pattern(self) -> list[tuple[int, int]]:
+        """Structural non-zeros of Phi_q as (row, column), row-major."""
+        return sorted(self.phi_q.todok())
+
+
+def derive(mech: Mechanism | str | Path) -> System:
+    """Derive Phi, Phi_q, Phi_t and Gamma of a mechanism (a Mechanism or a file path)."""
+    if not isinstance(mech, Mechanism):
+        mech = model.load(mech)
+    symbols = model.make_symbols(mech)
+    ctx = constraints.Context(mech, symbols)
+    phi, rows = _constraint_rows(mech, ctx)
+    column = {q: k for k, q in enumerate(symbols.q)}
+    jacobian: dict[tuple[int, int], sp.Expr] = {}
+    phi_t, gamma = [], []
+    for r, row in enumerate(phi):
+        entries = _row_jacobian(row, column, symbols.q)
+        jacobian.update({(r, k): value for k, value in entries.items()})
+        row_t = sp.diff(row, symbols.t)
+        phi_t.append(row_t)
+        gamma.append(_row_gamma(entries, row_t, symbols))
+    size = len(symbols.q)
+    values = mech.parameter_values()
+    return System(
+        mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,
+        p_values=tuple(values[s.name] for s in symbols.p), coordinates=symbols.coordinates,
+        phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
+        phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
+        q0=_initial_guess(mech, ctx, dict(zip(symbols.p, (values[s.name] for s in symbols.p)))),
+    )
+
+
+def _constraint_rows(mech: Mechanism, ctx: constraints.Context
+                     ) -> tuple[list[sp.Expr], tuple[Row, ...]]:
+    """Phi and its row labels: joints in file order, then drivers (DESIGN.md row order)."""
+    phi: list[sp.Expr] = []
+    rows: list[Row] = []
+    for section in ("joints", "drivers"):
+        for index, constraint in enumerate(getattr(mech, section)):
+            equations = constraints.equations(constraint, ctx)
+            parts = constraints.ROW_PARTS.get(constraint.type) or tuple(
+                f"equation {k}" for k in range(len(equations)))
+            bodies = constraints.bodies_of(constraint) or _bodies_touched(equations, ctx)
+            phi.extend(equations)
+            rows.extend(Row(section, index, constraint.type, bodies, part, constraint.name)
+                        for part in parts)
+    return phi, tuple(rows)
+
+
+def _bodies_touched(equations: list[sp.Expr], ctx: constraints.Context) -> tuple[str, ...]:
+    used = set().union(*(e.free_symbols for e in equations))
+    return tuple(dict.fromkeys(name.split(".")[0] for name, q in
+                               zip(ctx.symbols.coordinates, ctx.symbols.q) if q in used))
+
+
+def _row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
+                  q: tuple[sp.Symbol, ...]) -> dict[int, sp.Expr]:
+    """The structural non-zeros of one row of Phi_q, keyed by column."""
+    touched = sorted(column[s] for s in row.free_symbols if s in column)
+    derivatives = {k: sp.diff(row, q[k]) for k in touched}
+    return {k: value for k, value in derivatives.items() if value != 0}
+
+
+def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr, symbols: model.Symbols) -> sp.Expr:
+    """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt, from this row's columns."""
+    q, dq, t = symbols.q, symbols.dq, symbols.t
+    velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))
+    convective = sp.Add(*(sp.diff(velocity, q[k]) * dq[k] for k in entries))
+    mixed = sp.Add(*(sp.diff(value, t) * dq[k] for k, value in entries.items()))
+    return -convective - 2 * mixed - sp.diff(row_t, t)
+
+
+def _initial_guess(mech: Mechanism, ctx: constraints.Context,
+                   values: dict[sp.Symbol, float]) -> tuple[float, ...]:
+    return tuple(float(ctx.expr(raw).subs(values)) for body in mech.bodies.values()
+                 for raw in body.q0)

@@ -1,0 +1,58 @@
+"""The text and LaTeX report of a System, as ``symkin show`` prints it."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from symkin.derivation import System
+from symkin.model import degrees_of_freedom
+
+
+def _names(system: System) -> dict[sp.Symbol, sp.Symbol]:
+    """Readable names for printing: coordinates as ``crank.phi``, rates as ``crank.phi'``."""
+    return {dq: sp.Symbol(f"{name}'") for dq, name in zip(system.dq, system.coordinates)}
+
+
+def text(system: System) -> str:
+    """A plain-text report: coordinates, Phi, Phi_q (pattern and entries), Phi_t, Gamma, DOF."""
+    rename = _names(system)
+    show = lambda e: sp.sstr(e.xreplace(rename))  # noqa: E731
+    width = max(len(str(row)) for row in system.rows)
+    lines = [f"mechanism {system.name}: {len(system.q)} coordinates, {len(system.rows)} "
+             f"equations, {degrees_of_freedom(system.mechanism)} degree(s) of freedom",
+             "", "coordinates q:"]
+    lines += [f"  q[{k}] = {name}" for k, name in enumerate(system.coordinates)]
+    lines += ["", "parameters p:"]
+    lines += [f"  p[{k}] = {s.name} = {v:g}" for k, (s, v) in
+              enumerate(zip(system.p, system.p_values))]
+    for title, column in (("Phi", system.phi), ("Phi_t", system.phi_t), ("Gamma", system.gamma)):
+        lines += ["", f"{title}:"]
+        lines += [f"  [{r}] {str(row):<{width}}  {show(column[r])}"
+                  for r, row in enumerate(system.rows)]
+    entries = system.phi_q.todok()
+    lines += ["", f"Phi_q pattern ({len(entries)} non-zeros):"]
+    lines += [f"  [{r}] " + "".join("x" if (r, k) in entries else "."
+                                    for k in range(len(system.q))) for r in range(len(system.rows))]
+    lines += ["", "Phi_q entries:"]
+    lines += [f"  ({r},{k}) d/d {system.coordinates[k]}: {show(value)}"
+              for (r, k), value in sorted(entries.items())]
+    return "\n".join(lines) + "\n"
+
+
+def latex(system: System) -> str:
+    """A LaTeX fragment with the same content (an equation per matrix)."""
+    rename = {q: sp.Symbol(_latex_name(name)) for q, name in zip(system.q, system.coordinates)}
+    rename.update({dq: sp.Symbol(r"\dot{" + _latex_name(name) + "}")
+                   for dq, name in zip(system.dq, system.coordinates)})
+    parts = []
+    for title, matrix in (("\\Phi", system.phi), ("\\Phi_{\\mathbf{q}}", system.phi_q),
+                          ("\\Phi_t", system.phi_t), ("\\Gamma", system.gamma)):
+        body = sp.latex(sp.Matrix(matrix).xreplace(rename))
+        parts.append(f"\\begin{{equation}}\n{title} = {body}\n\\end{{equation}}")
+    return "\n".join(parts) + "\n"
+
+
+def _latex_name(coordinate: str) -> str:
+    body, part = coordinate.split(".")
+    symbol = {"x": "x", "y": "y", "phi": "\\varphi"}[part]
+    return f"{symbol}_{{\\mathrm{{{body.replace('_', '-')}}}}}"

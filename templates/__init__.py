@@ -1,0 +1,1 @@
+# symkin templates (a package only so that they ship inside the wheel)
