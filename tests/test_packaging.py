@@ -1,0 +1,60 @@
+"""The package installs with a plain (non-editable) `pip install .` and works from any folder.
+
+The install goes into a fresh virtual environment that sees the machine's site-packages (so no
+download is needed) and the package is installed without its dependencies: what is checked is
+the wheel's own content — modules, templates and the console script.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A venv with symkin installed from a copy of the source tree; returns its bin folder."""
+    work = tmp_path_factory.mktemp("packaging")
+    source = work / "source"
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(
+        ".git", "__pycache__", "*.egg-info", "build", ".pytest_cache", ".hypothesis"))
+    env_dir = work / "venv"
+    venv.create(env_dir, system_site_packages=True, with_pip=True)
+    bin_dir = env_dir / "bin"
+    subprocess.run([str(bin_dir / "python"), "-m", "pip", "install", "-q", "--no-deps",
+                    "--no-build-isolation", str(source)], check=True, cwd=work)
+    return bin_dir
+
+
+@pytest.mark.slow
+def test_console_script_runs_from_any_folder(installed: Path, tmp_path: Path) -> None:
+    mechanism = tmp_path / "mech.yaml"
+    shutil.copy(ROOT / "examples" / "crank_slider.yaml", mechanism)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    result = subprocess.run([str(installed / "symkin"), "show", str(mechanism)], cwd=tmp_path,
+                            capture_output=True, text=True, env=env)
+    assert result.returncode == 0, result.stderr
+    assert "1 degree(s) of freedom" in result.stdout
+
+
+@pytest.mark.slow
+def test_templates_ship_inside_the_package(installed: Path, tmp_path: Path) -> None:
+    code = ("import symkin.resources as r, pathlib, sys; root = r.template_root(); "
+            "print(root); print(sorted(str(p.relative_to(root)) for p in root.rglob('*.j2')))")
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    result = subprocess.run([str(installed / "python"), "-c", code], cwd=tmp_path,
+                            capture_output=True, text=True, env=env, check=True)
+    root, listing = result.stdout.splitlines()
+    assert "site-packages" in root
+    expected = sorted(str(p.relative_to(ROOT / "templates")) for p in
+                      (ROOT / "templates").rglob("*.j2"))
+    assert listing == repr(expected)
+    assert sys.version_info >= (3, 10)
