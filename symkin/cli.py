@@ -42,8 +42,65 @@ def _add_show(commands: argparse._SubParsersAction) -> None:
     schema.set_defaults(handler=_schema)
 
 
+def _verify(args: argparse.Namespace) -> int:
+    from symkin import verify
+
+    return verify.command(args.mechanism, args.against, samples=args.samples, seed=args.seed,
+                          spread=args.spread, tolerance=args.tolerance)
+
+
+def _add_verify(commands: argparse._SubParsersAction) -> None:
+    check = commands.add_parser(
+        "verify", help="check hand-written phi, phi_q, phi_t, gamma against the derived ones")
+    check.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
+    check.add_argument("--against", type=Path, required=True, metavar="HAND.py",
+                       help="Python file defining phi(q, t, p), phi_q(q, t, p), phi_t(q, t, p) "
+                            "and/or gamma(q, dq, t, p) in the order `symkin show` prints")
+    check.add_argument("--samples", type=int, default=50, help="random states (default 50)")
+    check.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    check.add_argument("--spread", type=float, default=0.3,
+                       help="relative spread of parameters around the nominal design "
+                            "(default 0.3; 0 keeps them nominal)")
+    check.add_argument("--tolerance", type=float, default=1e-8,
+                       help="largest accepted relative error (default 1e-8)")
+    check.set_defaults(handler=_verify)
+
+
 # Each entry adds one subcommand; its handler returns the exit status.
-SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [_add_show]
+def _generate(args: argparse.Namespace) -> int:
+    from symkin import derivation, render
+
+    if args.backend == "numpy" and args.real == "float":
+        print("symkin: error: --real float is for the C backend; the NumPy backend computes in "
+              "double precision", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    system = derivation.derive(args.mechanism)
+    paths = render.generate(system, backend=args.backend, out_dir=args.output, real=args.real,
+                            cse=not args.no_cse)
+    print("\n".join(str(path) for path in paths))
+    return EXIT_OK
+
+
+def _add_generate(commands: argparse._SubParsersAction) -> None:
+    generate = commands.add_parser("generate", help="write the C or NumPy source of a mechanism")
+    generate.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
+    generate.add_argument("--backend", choices=("c", "numpy"), default="c")
+    generate.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    generate.add_argument("--real", choices=("double", "float"), default="double",
+                          help="C real type (default double)")
+    generate.add_argument("--no-cse", action="store_true",
+                          help="do not eliminate common subexpressions")
+    generate.set_defaults(handler=_generate)
+
+
+def _add_run(commands: argparse._SubParsersAction) -> None:
+    from symkin import runner  # the `run` subcommand lives with the driver stream
+
+    runner.add_parser(commands)
+
+
+SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
+    _add_show, _add_verify, _add_generate, _add_run]
 
 
 def parser() -> argparse.ArgumentParser:

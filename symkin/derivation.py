@@ -74,7 +74,8 @@ class System:
         values = dict(zip(self.p, self.p_values))
         parse = constraints.Context(self.mechanism, model.make_symbols(self.mechanism)).expr
         grid = self.mechanism.time
-        return tuple(float(parse(raw).subs(values)) for raw in (grid.t0, grid.t1, grid.dt))
+        t0, t1, dt = (float(parse(raw).subs(values)) for raw in (grid.t0, grid.t1, grid.dt))
+        return t0, t1, dt
 
     def pattern(self) -> list[tuple[int, int]]:
         """Structural non-zeros of Phi_q as (row, column), row-major."""

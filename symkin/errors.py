@@ -61,7 +61,8 @@ class MechanismError(SymkinError):
             place = self.source + (f":{self.line}" if self.line else "") + ": "
         field = f"at {format_path(self.path)}: " if self.path else ""
         hint = f" {self.hint}" if self.hint else ""
-        return f"{place}{field}{self.message}.{hint}".replace("..", ".")
+        message = self.message if self.message.endswith((".", "?", "!")) else self.message + "."
+        return f"{place}{field}{message}{hint}"
 
 
 class SolveError(SymkinError):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ast
 import math
+import warnings
 from typing import Callable, Mapping, Sequence, Union
 
 import sympy as sp
@@ -130,6 +131,10 @@ class _Builder:
             key = (node.value.id, node.attr)
             if key in self.coordinates:
                 return self.coordinates[key]
+            if self.coordinates and node.attr in ("x", "y", "phi"):
+                bodies = ", ".join(dict.fromkeys(body for body, _ in self.coordinates))
+                raise self.fail(node, f"unknown coordinate '{key[0]}.{key[1]}'; use body.x, "
+                                      f"body.y or body.phi of a body among {bodies}")
         raise self.fail(node, "attribute access is not allowed (only body.x, body.y, "
                               "body.phi in custom constraints)")
 
@@ -190,7 +195,11 @@ class _Builder:
             pieces.append((self.build(value, depth), self._condition(condition, depth)))
         if not pieces:
             raise self.fail(node, "Piecewise needs at least one (value, condition) pair")
-        return sp.Piecewise(*pieces)
+        result = sp.Piecewise(*pieces)
+        if result is sp.nan:
+            raise self.fail(node, "no condition of this Piecewise can hold; end it with "
+                                  "(value, True)")
+        return result
 
     def _condition(self, node: ast.AST, depth: int) -> sp.Basic:
         if isinstance(node, ast.Constant) and node.value is True:
@@ -200,7 +209,11 @@ class _Builder:
             if relation is not None:
                 left = self.build(node.left, depth)
                 right = self.build(node.comparators[0], depth)
-                return relation(left, right)
+                try:
+                    return relation(left, right)
+                except TypeError:  # SymPy refuses to order complex numbers
+                    raise self.fail(node, "a Piecewise condition must compare real "
+                                          "values") from None
         raise self.fail(node, "a Piecewise condition must be one comparison "
                               "(<, <=, >, >=) or True")
 
@@ -230,15 +243,22 @@ def parse(
     if len(text) > MAX_LENGTH:
         raise ExpressionError(f"the expression is longer than {MAX_LENGTH} characters")
     try:
-        tree = ast.parse(text, mode="eval")
+        with warnings.catch_warnings():  # e.g. "1if": refused below, no warning on stderr
+            warnings.simplefilter("ignore", SyntaxWarning)
+            tree = ast.parse(text, mode="eval")
     except SyntaxError as error:
         column = (error.offset - 1) if error.offset else None
         raise ExpressionError("this is not a valid expression", text, column) from None
-    except (RecursionError, MemoryError, ValueError):
+    except (RecursionError, MemoryError):
         raise ExpressionError("this expression is too deeply nested", text) from None
+    except ValueError:  # e.g. a NUL character (Python 3.11)
+        raise ExpressionError("this is not a valid expression", text) from None
     expr = _Builder(text, symbols, coordinates or {}).build(tree.body)
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise ExpressionError("the expression is not finite (a division by zero?)", text)
+    if expr.has(sp.I):
+        raise ExpressionError("the expression is not real (the root or logarithm of a "
+                              "negative number?)", text)
     return expr
 
 

@@ -12,7 +12,7 @@ import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import yaml
 
@@ -65,18 +65,66 @@ def read(path: str | Path) -> Document:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as error:
         raise MechanismError(f"the file is not UTF-8 text (byte {error.start})",
-                             hint="Save it as UTF-8.", source=source) from None
+                             hint="Save it as UTF-8.", source=source,
+                             line=raw[:error.start].count(b"\n") + 1) from None
     if path.suffix.lower() == ".toml":
         return read_toml(text, source)
     return read_yaml(text, source)
 
 
 def read_toml(text: str, source: str) -> Document:
-    """Parse TOML text (line numbers are not tracked for TOML)."""
+    """Parse TOML text; field lines are found by a light scan of keys and table headers."""
     try:
-        return Document(tomllib.loads(text), source)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise MechanismError(f"this is not valid TOML: {error}", source=source) from None
+        # tomllib puts the place into its message: "... (at line 2, column 23)".
+        found = _TOML_PLACE.search(str(error))
+        message = _TOML_PLACE.sub("", str(error)).strip()
+        raise MechanismError(f"this is not valid TOML: {message}", source=source,
+                             line=int(found.group(1)) if found else None) from None
+    return Document(data, source, _toml_lines(text))
+
+
+_TOML_PLACE = re.compile(r"\(at line (\d+), column \d+\)")
+_TOML_HEADER = re.compile(r"\s*(\[\[?)\s*([A-Za-z0-9_.\s-]+?)\s*\]\]?\s*(#.*)?\Z")
+_TOML_KEY = re.compile(r"\s*([A-Za-z0-9_-]+(?:\s*\.\s*[A-Za-z0-9_-]+)*)\s*=(?!=)")
+
+
+def _toml_lines(text: str) -> dict[Path_, int]:
+    """The line of each table header and bare key (dotted keys and arrays of tables too).
+
+    Only line numbers for messages come from this scan; the data comes from tomllib.
+    """
+    lines: dict[Path_, int] = {}
+    arrays: dict[Path_, int] = {}  # array-of-tables path -> index of its last element
+    table: Path_ = ()
+    in_string = False
+    for number, line in enumerate(text.splitlines(), start=1):
+        opens_or_closes = bool(line.count('"""') % 2 or line.count("'''") % 2)
+        if not in_string:
+            header = _TOML_HEADER.match(line)
+            key = _TOML_KEY.match(line)
+            if header:
+                table = _toml_table(header.group(2).split("."), header.group(1) == "[[", arrays)
+                lines.setdefault(table, number)
+            elif key:
+                path = table + tuple(k.strip() for k in key.group(1).split("."))
+                lines.setdefault(path, number)
+        in_string ^= opens_or_closes  # inside a multi-line string nothing is a key
+    return lines
+
+
+def _toml_table(parts: list[str], is_array: bool, arrays: dict[Path_, int]) -> Path_:
+    """Resolve a table header to a field path; array elements get their index."""
+    path: Path_ = ()
+    for part in parts:
+        path += (part.strip(),)
+        if path in arrays and (path != tuple(p.strip() for p in parts) or not is_array):
+            path += (arrays[path],)
+    if is_array:
+        arrays[path] = arrays.get(path, -1) + 1
+        path += (arrays[path],)
+    return path
 
 
 def read_yaml(text: str, source: str) -> Document:
@@ -84,7 +132,9 @@ def read_yaml(text: str, source: str) -> Document:
     try:
         node = yaml.compose(text, Loader=_Loader)
     except yaml.MarkedYAMLError as error:
-        line = error.problem_mark.line + 1 if error.problem_mark else None
+        # A problem at the end of the stream is reported on the last line, not past it.
+        last = max(1, len(text.splitlines()))
+        line = min(error.problem_mark.line + 1, last) if error.problem_mark else None
         raise MechanismError(f"this is not valid YAML: {error.problem}",
                              source=source, line=line) from None
     except yaml.YAMLError as error:
@@ -172,11 +222,16 @@ def _tagged(node: yaml.ScalarNode, path: Path_, document: Document) -> Any:
     if node.tag in (_PLAIN, "!", "tag:yaml.org,2002:str"):
         return node.value
     value = _scalar(yaml.ScalarNode(_PLAIN, node.value, node.start_mark), path, document)
-    wanted = {"tag:yaml.org,2002:int": int, "tag:yaml.org,2002:float": (int, float),
-              "tag:yaml.org,2002:bool": bool, "tag:yaml.org,2002:null": type(None)}[node.tag]
-    if not isinstance(value, wanted):
+    wanted = _TAG_TYPES[node.tag]
+    # bool is an int to Python, not to YAML: `!!float true` is refused.
+    if not isinstance(value, wanted) or (isinstance(value, bool) and wanted is not bool):
         raise _fail(document, node, path, f"{node.value!r} does not match its tag {node.tag!r}")
-    return float(value) if node.tag.endswith("float") else value
+    return float(cast(float, value)) if node.tag.endswith("float") else value
 
+
+# What an explicit core tag accepts (``!!float 1`` is fine, ``!!int 1.5`` is not).
+_TAG_TYPES: dict[str, type | tuple[type, ...]] = {
+    "tag:yaml.org,2002:int": int, "tag:yaml.org,2002:float": (int, float),
+    "tag:yaml.org,2002:bool": bool, "tag:yaml.org,2002:null": type(None)}
 
 _Loader.add_implicit_resolver(_PLAIN, re.compile(r".*", re.DOTALL), None)

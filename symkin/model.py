@@ -22,7 +22,7 @@ from pydantic import (BaseModel, ConfigDict, Field, PlainValidator, ValidationEr
 from pydantic_core import PydanticCustomError
 
 from symkin import expressions, loader
-from symkin.errors import ExpressionError, MechanismError
+from symkin.errors import ExpressionError, MechanismError, format_path
 from symkin.names import name_problem
 
 GROUND = "ground"
@@ -62,7 +62,8 @@ def _point_ref(value: Any) -> Any:
 def _time_function(value: Any) -> Any:
     if isinstance(value, Mapping):
         if set(value) != {"poly"} or not isinstance(value["poly"], list) or not value["poly"]:
-            raise PydanticCustomError("time", "a polynomial is written {{poly: [a0, a1, ...]}}")
+            raise PydanticCustomError("time", "a polynomial is written {poly: [a0, a1, a2]} "
+                                              "for a0 + a1*t + a2*t**2 (eq. 2.75)")
         return {"poly": [_expr(item) for item in value["poly"]]}
     return _expr(value)
 
@@ -77,11 +78,13 @@ Vec3 = Annotated[list[Any], PlainValidator(_vector(3)),
                                  "minItems": 3, "maxItems": 3})]
 PointRef = Annotated[Any, PlainValidator(_point_ref),
                      WithJsonSchema({"anyOf": [{"type": "string"},
-                                               {"type": "array", "items": _EXPR_SCHEMA}]})]
+                                               {"type": "array", "items": _EXPR_SCHEMA,
+                                                "minItems": 2, "maxItems": 2}]})]
 TimeFunction = Annotated[Any, PlainValidator(_time_function),
                          WithJsonSchema({"anyOf": [*_EXPR_SCHEMA["anyOf"], {
                              "type": "object", "properties": {"poly": {
-                                 "type": "array", "items": _EXPR_SCHEMA}}}]})]
+                                 "type": "array", "items": _EXPR_SCHEMA, "minItems": 1}},
+                             "required": ["poly"], "additionalProperties": False}]})]
 
 
 class _Strict(BaseModel):
@@ -253,7 +256,8 @@ class Symbols:
     @property
     def by_coordinate(self) -> dict[tuple[str, str], sp.Symbol]:
         """``(body, "x"|"y"|"phi") -> q symbol``, for custom constraints."""
-        return {tuple(name.split(".")): q for name, q in zip(self.coordinates, self.q)}
+        pairs = (name.partition(".") for name in self.coordinates)
+        return {(body, part): q for (body, _, part), q in zip(pairs, self.q)}
 
     def body(self, name: str, velocities: bool = False) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         """(x, y, phi) of a body (or their rates); the ground is fixed at zero."""
@@ -283,7 +287,7 @@ def load(path: str | Path) -> Mechanism:
 
 def from_dict(data: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
     """Validate a mechanism given as plain Python data (the file's structure)."""
-    return _validate(loader.Document(dict(data), source))
+    return _validate(loader.Document(dict(data) if isinstance(data, Mapping) else data, source))
 
 
 def json_schema() -> dict[str, Any]:
@@ -312,7 +316,7 @@ def _translate(error: ValidationError, document: loader.Document) -> MechanismEr
     message, hint = first["msg"], ""
     if kind == "extra_forbidden":
         message = f"unknown key {path[-1]!r}"
-        hint = f"Allowed keys here: {', '.join(_allowed_keys(path))}."
+        hint = f"Allowed keys here: {', '.join(_allowed_keys(path, document.data))}."
     elif kind == "missing":
         message = f"the required key {path[-1]!r} is missing"
     elif kind == "union_tag_invalid":
@@ -324,7 +328,22 @@ def _translate(error: ValidationError, document: loader.Document) -> MechanismEr
         kinds = "revolute, prismatic, pin_slot, custom" if path[:1] == ("joints",) else \
             "displacement, displacement_local, trajectory, angle, slide, custom"
         hint = f"Add type: one of {kinds}."
+    elif kind in _PYDANTIC_MESSAGES:
+        message = _PYDANTIC_MESSAGES[kind].format(kind=_kind(first.get("input")),
+                                                  **first.get("ctx", {}))
     return MechanismError(message, path, hint, document.source, document.line_of(path))
+
+
+# pydantic's own wording for shape errors, said the way a mechanism file's reader thinks.
+_PYDANTIC_MESSAGES = {
+    "string_type": "expected a name (text), got {kind}",
+    "dict_type": "expected a mapping of keys to values, got {kind}",
+    "model_type": "expected a mapping of keys to values, got {kind}",
+    "model_attributes_type": "expected a mapping of keys to values, got {kind}",
+    "list_type": "expected a list, got {kind}",
+    "too_short": "needs at least {min_length} item(s), got {actual_length}",
+    "too_long": "takes at most {max_length} item(s), got {actual_length}",
+}
 
 
 def _data_path(data: Any, loc: tuple[Any, ...]) -> tuple[str | int, ...]:
@@ -344,7 +363,7 @@ def _data_path(data: Any, loc: tuple[Any, ...]) -> tuple[str | int, ...]:
     return tuple(path)
 
 
-def _allowed_keys(path: tuple[str | int, ...]) -> list[str]:
+def _allowed_keys(path: tuple[str | int, ...], data: Any) -> list[str]:
     section = path[0] if path else ""
     if len(path) <= 1:
         return list(Mechanism.model_fields)
@@ -352,7 +371,17 @@ def _allowed_keys(path: tuple[str | int, ...]) -> list[str]:
         return list(Body.model_fields)
     if section == "time":
         return list(TimeGrid.model_fields)
-    return ["type, name and the keys of that type (see the JSON Schema)"]
+    try:
+        model = _CONSTRAINT_MODELS[data[section][path[1]]["type"]]
+    except (KeyError, IndexError, TypeError):
+        return ["type, name and the keys of that type"]
+    return list(model.model_fields)
+
+
+_CONSTRAINT_MODELS: dict[str, type[BaseModel]] = {
+    model.model_fields["type"].annotation.__args__[0]: model  # type: ignore[union-attr]
+    for model in (Revolute, Prismatic, PinSlot, Custom, Displacement, DisplacementLocal,
+                  Trajectory, Angle, Slide)}
 
 
 _ALL_FIELDS = {name for model in (Mechanism, Body, Revolute, Prismatic, PinSlot, Custom,
@@ -366,16 +395,26 @@ def _check_semantics(mech: Mechanism) -> None:
     _check_names(mech)
     symbols = make_symbols(mech)
     values = _check_parameters(mech)
+    nominal = {symbols.parameters[name]: value for name, value in values.items()}
     for name, body in mech.bodies.items():
         for k, raw in enumerate(body.q0):
-            _expression(raw, symbols, ("bodies", name, "q0", k))
+            _expression(raw, symbols, ("bodies", name, "q0", k), values=nominal)
         for point, vector in body.points.items():
             for k, raw in enumerate(vector):
-                _expression(raw, symbols, ("bodies", name, "points", point, k))
+                _expression(raw, symbols, ("bodies", name, "points", point, k), values=nominal)
+    named: dict[str, tuple[str | int, ...]] = {}
     for section in ("joints", "drivers"):
         for index, constraint in enumerate(getattr(mech, section)):
-            _check_constraint(mech, constraint, symbols, (section, index))
-    _check_time(mech, symbols, values)
+            path = (section, index)
+            _check_constraint(mech, constraint, symbols, nominal, path)
+            if constraint.name in named:
+                raise MechanismError(f"the name {constraint.name!r} is already used by "
+                                     f"{format_path(named[constraint.name])}", path + ("name",),
+                                     "Joints and drivers need different names: each labels "
+                                     "rows of Phi.")
+            if constraint.name is not None:
+                named[constraint.name] = path
+    _check_time(mech, symbols, nominal)
     check_degrees_of_freedom(mech)
 
 
@@ -407,13 +446,38 @@ def _check_names(mech: Mechanism) -> None:
 def _check_parameters(mech: Mechanism) -> dict[str, float]:
     values = {}
     for name, raw in mech.parameters.items():
-        expr = _expression(raw, None, ("parameters", name))
-        values[name] = float(expr)
+        try:
+            expr = expressions.parse(raw, {})
+        except ExpressionError as error:
+            raise MechanismError(str(error), ("parameters", name),
+                                 "A parameter's value is a number or an expression of numbers, "
+                                 "pi and E; it cannot use t or other parameters.") from None
+        values[name] = _numeric(expr, {}, ("parameters", name))
     return values
 
 
+def _numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float],
+             path: tuple[str | int, ...]) -> float:
+    """The value of ``expr`` at the nominal parameters: a finite real number, or an error."""
+    try:
+        number = float(expr.subs(values))
+    except (TypeError, ValueError, OverflowError, ZeroDivisionError):
+        number = math.nan  # complex (sqrt(-1), asin(2)) or too large for a float
+    if not math.isfinite(number):
+        raise MechanismError(f"{sp.sstr(expr)} is not a finite real number at the nominal "
+                             f"parameter values", path,
+                             "Check the arguments of sqrt, log, asin, acos and the magnitudes.")
+    return number
+
+
 def _expression(raw: Any, symbols: Symbols | None, path: tuple[str | int, ...],
-                time: bool = False, coordinates: bool = False) -> sp.Expr:
+                time: bool = False, coordinates: bool = False,
+                values: Mapping[sp.Symbol, float] | None = None) -> sp.Expr:
+    """Parse a field; with ``values`` (a constant field) also check its nominal value."""
+    if values is not None:
+        expr = _expression(raw, symbols, path, time, coordinates)
+        _numeric(expr, values, path)
+        return expr
     names = dict(symbols.parameters) if symbols else {}
     if time and symbols:
         names["t"] = symbols.t
@@ -435,7 +499,7 @@ def _body_ref(mech: Mechanism, name: str, path: tuple[str | int, ...]) -> None:
 
 
 def _point(mech: Mechanism, body: str, ref: Any, symbols: Symbols,
-           path: tuple[str | int, ...]) -> None:
+           nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
     if isinstance(ref, str):
         points = mech.bodies[body].points if body != GROUND else {}
         if ref not in points:
@@ -444,34 +508,42 @@ def _point(mech: Mechanism, body: str, ref: Any, symbols: Symbols,
                                  f"Its points are: {known}; or give a vector [x, y].")
         return
     for k, raw in enumerate(ref):
-        _expression(raw, symbols, path + (k,))
+        _expression(raw, symbols, path + (k,), values=nominal)
 
 
 def _check_constraint(mech: Mechanism, constraint: Any, symbols: Symbols,
-                      path: tuple[str | int, ...]) -> None:
+                      nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
     if constraint.name is not None and name_problem(constraint.name):
         raise MechanismError(str(name_problem(constraint.name)), path + ("name",), "Rename it.")
     if isinstance(constraint, Custom):
         for k, text in enumerate(constraint.equations):
-            _expression(text, symbols, path + ("equations", k), time=True, coordinates=True)
+            expr = _expression(text, symbols, path + ("equations", k), time=True,
+                               coordinates=True)
+            if not expr.free_symbols & set(symbols.q):
+                raise MechanismError("this equation uses no coordinate, so it cannot "
+                                     "constrain the mechanism", path + ("equations", k),
+                                     "Use coordinates such as crank.phi or rod.x in it.")
         return
     bodies = [key for key in ("i", "j") if hasattr(constraint, key)]
     for key in bodies:
         _body_ref(mech, getattr(constraint, key), path + (key,))
+    if constraint.type == "trajectory" and constraint.j == GROUND:
+        raise MechanismError("a trajectory needs a moving body j, not the ground",
+                             path + ("j",), "Name the body whose point should follow f(t).")
     if len(bodies) == 2 and constraint.i == constraint.j:
         raise MechanismError(f"a {constraint.type} joins body {constraint.i!r} to itself",
                              path + ("j",), "A constraint needs two different bodies.")
     for key, body_key in (("sA", "i"), ("sB", "j")):
         if hasattr(constraint, key):
             _point(mech, getattr(constraint, body_key), getattr(constraint, key), symbols,
-                   path + (key,))
+                   nominal, path + (key,))
     for key in ("v", "u"):
         if hasattr(constraint, key):
-            vector = [_expression(raw, symbols, path + (key, k))
+            vector = [_expression(raw, symbols, path + (key, k), values=nominal)
                       for k, raw in enumerate(getattr(constraint, key))]
-            _nonzero_vector(mech, vector, path + (key,))
+            _nonzero_vector(vector, nominal, path + (key,))
     if hasattr(constraint, "phi0"):
-        _expression(constraint.phi0, symbols, path + ("phi0",))
+        _expression(constraint.phi0, symbols, path + ("phi0",), values=nominal)
     for key in ("f", "theta"):
         if hasattr(constraint, key):
             value = getattr(constraint, key)
@@ -481,20 +553,18 @@ def _check_constraint(mech: Mechanism, constraint: Any, symbols: Symbols,
                                                   isinstance(value, list) else (key,)), time=True)
 
 
-def _nonzero_vector(mech: Mechanism, vector: list[sp.Expr], path: tuple[str | int, ...]) -> None:
-    values = {sp.Symbol(name, real=True): value for name, value in
-              mech.parameter_values().items()}
-    if all(abs(float(component.subs(values))) == 0.0 for component in vector):
+def _nonzero_vector(vector: list[sp.Expr], nominal: Mapping[sp.Symbol, float],
+                    path: tuple[str | int, ...]) -> None:
+    if all(_numeric(component, nominal, path) == 0.0 for component in vector):
         raise MechanismError("the direction vector is zero", path,
                              "Give a non-zero vector, e.g. [0, 1].")
 
 
-def _check_time(mech: Mechanism, symbols: Symbols, values: dict[str, float]) -> None:
-    substitution = {symbols.parameters[name]: value for name, value in values.items()}
+def _check_time(mech: Mechanism, symbols: Symbols, nominal: Mapping[sp.Symbol, float]) -> None:
     grid = {}
     for key in ("t0", "t1", "dt"):
         expr = _expression(getattr(mech.time, key), symbols, ("time", key))
-        grid[key] = float(expr.subs(substitution))
+        grid[key] = _numeric(expr, nominal, ("time", key))
     if not grid["dt"] > 0:
         raise MechanismError(f"the time step dt = {grid['dt']} is not positive",
                              ("time", "dt"), "Use dt > 0.")

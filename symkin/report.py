@@ -44,12 +44,30 @@ def latex(system: System) -> str:
     rename = {q: sp.Symbol(_latex_name(name)) for q, name in zip(system.q, system.coordinates)}
     rename.update({dq: sp.Symbol(r"\dot{" + _latex_name(name) + "}")
                    for dq, name in zip(system.dq, system.coordinates)})
-    parts = []
+    parts = _latex_header(system, rename)
     for title, matrix in (("\\Phi", system.phi), ("\\Phi_{\\mathbf{q}}", system.phi_q),
                           ("\\Phi_t", system.phi_t), ("\\Gamma", system.gamma)):
         body = sp.latex(sp.Matrix(matrix).xreplace(rename))
         parts.append(f"\\begin{{equation}}\n{title} = {body}\n\\end{{equation}}")
     return "\n".join(parts) + "\n"
+
+
+def _latex_header(system: System, rename: dict[sp.Symbol, sp.Symbol]) -> list[str]:
+    """The DOF count, the coordinate vector and a table of row labels."""
+    q = sp.latex(sp.Matrix(system.q).xreplace(rename).T)
+    rows = "\n".join(rf"{r} & {_tex_text(str(row))} \\" for r, row in enumerate(system.rows))
+    summary = (rf"Mechanism \texttt{{{_tex_text(system.name)}}}: {len(system.q)} coordinates, "
+               rf"{len(system.rows)} equations, {degrees_of_freedom(system.mechanism)} "
+               "degree(s) of freedom.")
+    return [summary,
+            "\\begin{equation}\n" + rf"\mathbf{{q}} = {q}^T" + "\n\\end{equation}",
+            "\\begin{tabular}{rl}\n" + r"row & owner \\" + "\n\\hline\n" + rows
+            + "\n\\end{tabular}"]
+
+
+def _tex_text(text: str) -> str:
+    """Names are identifiers, so '_' is the only character that needs escaping in text."""
+    return text.replace("_", r"\_")
 
 
 def _latex_name(coordinate: str) -> str:

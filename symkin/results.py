@@ -1,12 +1,19 @@
-"""Stage 7 — results: point kinematics (2.14-2.16) and the outputs a run writes.
+"""Stage 7 — results: point kinematics (2.14-2.16), the Trajectory and the files a run writes.
 
-Imports only NumPy: it is part of the runtime.
+Imports only NumPy: it is part of the runtime. Plots and animation live in symkin.plots.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from pathlib import Path
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from symkin.errors import SymkinError
+
+SAVE_FORMATS = (".npz", ".csv")
 
 OMEGA = np.array([[0.0, -1.0], [1.0, 0.0]])
 
@@ -38,3 +45,82 @@ def point_kinematics(q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, s: ArrayLike
     dr = dq[..., :2] + ORs * dq[..., 2, None]
     ddr = ddq[..., :2] + ORs * ddq[..., 2, None] - Rs * dq[..., 2, None] ** 2
     return r, dr, ddr
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """The solved kinematics on a time grid (rows: time points; columns: coordinates).
+
+    Attributes:
+        t: the times, shape (T,).
+        q, dq, d2q: coordinates and their first and second time derivatives, shape (T, N).
+        coordinates: the coordinate names, ``crank.x``, ``crank.y``, ``crank.phi``, ...
+        points: the named points as (body, point), in file order.
+        point_vectors: their local vectors s at the solved parameter values, shape (P, 2).
+        params: the parameter values solved with.
+    """
+
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
+    dq: NDArray[np.float64]
+    d2q: NDArray[np.float64]
+    coordinates: tuple[str, ...]
+    points: tuple[tuple[str, str], ...] = ()
+    point_vectors: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
+    params: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        """The moving bodies, in coordinate order."""
+        return tuple(dict.fromkeys(name.rsplit(".", 1)[0] for name in self.coordinates))
+
+    def body(self, name: str
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """(q, dq, d2q) of one body, each shape (T, 3): x, y, phi."""
+        if name not in self.bodies:
+            raise SymkinError(f"no body {name!r}; the bodies are: {', '.join(self.bodies)}")
+        start = self.coordinates.index(f"{name}.x")
+        columns = slice(start, start + 3)
+        return self.q[:, columns], self.dq[:, columns], self.d2q[:, columns]
+
+    def point(self, body: str, name: str
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Position, velocity and acceleration of a named point (2.14-2.16), each (T, 2)."""
+        if (body, name) not in self.points:
+            known = ", ".join(f"{b}.{p}" for b, p in self.points) or "none"
+            raise SymkinError(f"no point {body}.{name}; the named points are: {known}")
+        s = self.point_vectors[self.points.index((body, name))]
+        return point_kinematics(*self.body(body), s)
+
+    def point_arrays(self) -> tuple[NDArray[np.float64], ...]:
+        """r, dr, ddr of every named point, each shape (T, P, 2)."""
+        shape = (self.t.size, len(self.points), 2)
+        r, dr, ddr = (np.zeros(shape) for _ in range(3))
+        for k, (body, name) in enumerate(self.points):
+            r[:, k], dr[:, k], ddr[:, k] = self.point(body, name)
+        return r, dr, ddr
+
+    def save(self, path: str | Path) -> Path:
+        """Write .npz (all arrays, see DESIGN.md) or .csv (t, q, q_t, q_tt columns)."""
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in SAVE_FORMATS:
+            raise SymkinError(f"cannot write {path.name}: the output must end in .npz or .csv")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        (self._save_npz if suffix == ".npz" else self._save_csv)(path)
+        return path
+
+    def _save_npz(self, path: Path) -> None:
+        r, dr, ddr = self.point_arrays()
+        names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
+        np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
+                 coordinates=np.array(self.coordinates, dtype=str), points=names,
+                 r=r, dr=dr, ddr=ddr)
+
+    def _save_csv(self, path: Path) -> None:
+        header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
+                  *(c + "_tt" for c in self.coordinates)]
+        table = np.column_stack([self.t, self.q, self.dq, self.d2q]) if self.t.size else \
+            np.zeros((0, len(header)))
+        np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
+                   fmt="%.17g")

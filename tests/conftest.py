@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -20,3 +22,16 @@ def crank_slider_system(crank_slider_path: Path):
     import symkin
 
     return symkin.derive(crank_slider_path)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def shared_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """One kernel cache for the whole run: tests never write to the user's ~/.cache/symkin."""
+    folder = tmp_path_factory.mktemp("symkin-cache")
+    before = os.environ.get("SYMKIN_CACHE_DIR")
+    os.environ["SYMKIN_CACHE_DIR"] = str(folder)
+    yield folder
+    if before is None:
+        os.environ.pop("SYMKIN_CACHE_DIR", None)
+    else:
+        os.environ["SYMKIN_CACHE_DIR"] = before

@@ -1,0 +1,215 @@
+"""Stage 5 — build: compile the generated code into a loadable Kernel, cached by content hash.
+
+The C backend uses cffi in API mode: cffi writes the extension's C wrapper, and this module
+compiles it with the generated sources itself, so a failure keeps the exact command and the
+compiler's output. Each build happens in a private temporary folder that is renamed into the
+cache in one step, so any number of processes building the same kernel at once all succeed and
+none ever sees a half-written one. The cache key covers everything that can change the binary:
+the sources, the cffi declarations, the compiler and flags, and the cffi and Python versions
+and platform.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import json
+import os
+import platform
+import shlex
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import warnings
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from symkin import codegen, kernel, render
+from symkin.derivation import System
+from symkin.errors import BuildError
+
+# Plain -O2: -ffast-math would break the NaN checks of the solver and reorder sums, and
+# -march=native would make a cached binary non-portable.
+C_FLAGS = ("-std=c99", "-O2", "-fPIC")
+WRAPPER_FLAGS = ("-O2", "-fPIC")
+
+
+def cache_root() -> Path:
+    """``$SYMKIN_CACHE_DIR``, else the user cache folder (``~/.cache/symkin`` on Linux)."""
+    explicit = os.environ.get("SYMKIN_CACHE_DIR")
+    if explicit:
+        return Path(explicit)
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "symkin"
+
+
+def compile(system: System, backend: str = "c", *, real: str = "double", cse: bool = True,
+            linalg: str = "dense", cache_dir: str | Path | None = None) -> kernel.Kernel:
+    """Generate, compile (or find in the cache) and load the kernel of ``system``.
+
+    Args:
+        system: the derived kinematics.
+        backend: ``"c"`` (cffi extension) or ``"numpy"`` (generated Python module). With no C
+            compiler, ``"c"`` warns once and falls back to ``"numpy"``.
+        real: the C real type, ``"double"`` or ``"float"``.
+        cse: eliminate common subexpressions.
+        linalg: the LU behind the C solver, ``"dense"`` or ``"sparse"``.
+        cache_dir: where built kernels are kept; default :func:`cache_root`.
+
+    Raises:
+        BuildError: the compiler failed (the message has the command and its output).
+    """
+    cache = Path(cache_dir) if cache_dir is not None else cache_root()
+    if backend == "c":
+        compiler = c_compiler()
+        if compiler is None:
+            warnings.warn(
+                f"no C compiler found (looked for {os.environ.get('CC') or 'cc'}); using the "
+                "NumPy backend instead. Install gcc or clang, or set CC to a C compiler.",
+                RuntimeWarning, stacklevel=2)
+            backend, real = "numpy", "double"
+        else:
+            return _compile_c(codegen.lower(system, "c", real, cse, linalg), cache, compiler)
+    return _load_numpy(codegen.lower(system, backend, real, cse), cache)
+
+
+def c_compiler() -> list[str] | None:
+    """The C compiler command (``$CC``, else Python's, else ``cc``), or None when missing."""
+    if os.name != "posix":
+        return None
+    command = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
+    return command if command and shutil.which(command[0]) else None
+
+
+# ----- C backend -----------------------------------------------------------------------------
+
+def _compile_c(code: codegen.Code, cache: Path, compiler: list[str]) -> kernel.Kernel:
+    files = render.render_sources(code)
+    files[render.MANIFEST] = render.manifest(code, files)
+    cdef = render.render_cdef(code)
+    key = _key({"files": files, "cdef": cdef, "compiler": compiler, "flags": C_FLAGS,
+                "wrapper_flags": WRAPPER_FLAGS, **_toolchain()})
+    module_name = f"_symkin_{code.name}_{key[:20]}"
+    folder = cache / module_name
+    library = folder / (module_name + _extension_suffix())
+    if not library.exists():
+        _publish(cache, folder, lambda build: _build_c(build, files, cdef, module_name,
+                                                        compiler, code.name))
+    module = _import_extension(module_name, library)
+    meta = json.loads(files[render.MANIFEST])
+    return kernel.from_cffi(module.ffi, module.lib, meta)
+
+
+def _build_c(build: Path, files: dict[str, str], cdef: str, module_name: str,
+             compiler: list[str], prefix: str) -> None:
+    import cffi
+    from cffi.recompiler import make_c_source
+
+    for name, text in files.items():
+        (build / name).write_text(text, encoding="utf-8")
+    headers = [f"{prefix}.h"] + sorted(n for n in files if n.endswith(".h") and n != f"{prefix}.h")
+    ffi = cffi.FFI()
+    ffi.cdef(cdef)
+    wrapper = build / f"{module_name}.c"
+    preamble = "".join(f'#include "{h}"\n' for h in headers)
+    make_c_source(ffi, module_name, preamble, str(wrapper), verbose=False)
+    include = [f"-I{build}"] + [f"-I{sysconfig.get_paths()[k]}" for k in ("include", "platinclude")]
+    objects = []
+    for source in sorted(n for n in files if n.endswith(".c")):
+        objects.append(_object(compiler, [*C_FLAGS, *include], build / source))
+    objects.append(_object(compiler, [*WRAPPER_FLAGS, *include], wrapper))
+    library = build / (module_name + _extension_suffix())
+    run([*compiler, *_link_flags(), "-o", str(library), *map(str, objects), "-lm"], build)
+
+
+def _object(compiler: list[str], flags: list[str], source: Path) -> Path:
+    target = source.with_suffix(".o")
+    run([*compiler, *flags, "-c", str(source), "-o", str(target)], source.parent)
+    return target
+
+
+def _link_flags() -> list[str]:
+    if sys.platform == "darwin":
+        return ["-bundle", "-undefined", "dynamic_lookup"]
+    return ["-shared"]
+
+
+class CompilerError(BuildError):
+    """The C compiler failed: ``command`` is what ran, ``stderr`` what it said."""
+
+    def __init__(self, command: list[str], returncode: int, stderr: str) -> None:
+        self.command = command
+        self.returncode = returncode
+        self.stderr = stderr
+        super().__init__(f"the C compiler failed (exit status {returncode}):\n"
+                         f"  {shlex.join(command)}\n{stderr.strip()}")
+
+
+def run(command: list[str], cwd: Path) -> None:
+    """Run a compiler command; on failure raise CompilerError with the command and its output."""
+    try:
+        result = subprocess.run(command, cwd=cwd, capture_output=True, text=True, check=False)
+    except OSError as error:
+        raise BuildError(f"could not run {shlex.join(command)}: {error}") from None
+    if result.returncode != 0:
+        raise CompilerError(command, result.returncode, result.stderr)
+
+
+def _import_extension(module_name: str, library: Path) -> ModuleType:
+    loader = importlib.machinery.ExtensionFileLoader(module_name, str(library))
+    return kernel.import_file(module_name, library, loader)
+
+
+# ----- NumPy backend -------------------------------------------------------------------------
+
+def _load_numpy(code: codegen.Code, cache: Path) -> kernel.Kernel:
+    files = render.render_sources(code)
+    key = _key({"files": files})
+    module_name = f"_symkin_{code.name}_py_{key[:20]}"
+    folder = cache / module_name
+    source = folder / f"{code.name}.py"
+    if not source.exists():
+        _publish(cache, folder, lambda build: render.write(code, build))
+    return kernel.from_module(kernel.import_file(module_name, source, None))
+
+
+# ----- cache ---------------------------------------------------------------------------------
+
+def _publish(cache: Path, folder: Path, fill: Any) -> None:
+    """Fill a private temporary folder and rename it to ``folder`` in one atomic step.
+
+    When another process published the same folder first, the rename fails; its result is
+    the same (same key, same inputs), so this build is discarded.
+    """
+    cache.mkdir(parents=True, exist_ok=True)
+    build = Path(tempfile.mkdtemp(dir=cache, prefix=f".{folder.name}."))
+    try:
+        fill(build)
+        try:
+            os.replace(build, folder)
+        except OSError:
+            if not folder.is_dir():
+                raise
+    finally:
+        if build.exists():
+            shutil.rmtree(build, ignore_errors=True)
+
+
+def _key(inputs: dict[str, Any]) -> str:
+    return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()
+
+
+def _toolchain() -> dict[str, str]:
+    import cffi
+
+    return {"cffi": cffi.__version__, "python": sys.version, "implementation":
+            sys.implementation.cache_tag or "", "platform": sysconfig.get_platform(),
+            "machine": platform.machine(), "suffix": _extension_suffix()}
+
+
+def _extension_suffix() -> str:
+    return sysconfig.get_config_var("EXT_SUFFIX") or ".so"

@@ -1,0 +1,451 @@
+"""Stage 6 — driver: position, velocity and acceleration analysis over a time grid.
+
+The chapter's algorithm (Example 2.6, section 2.7) on any compiled kernel:
+
+    q   = q + dq h + ddq h^2 / 2                 Taylor predictor                (2.76)
+    Newton-Raphson on Phi(q, t) = 0              test the residual of the iterate (2.72)
+    Phi_q dq  = -Phi_t                           velocity                         (2.73)
+    Phi_q ddq = Gamma                            acceleration                     (2.74)
+
+One LU factorization (partial pivoting) of the converged Phi_q serves both linear solves. The
+first point is assembled from the file's q0, which may be poor (the chapter starts from q = 0):
+plain Newton first, then Levenberg-Marquardt when Newton does not converge. Where several
+assemblies exist, the one reached from q0 is taken.
+
+With a C kernel that carries the generated solver, the grid loop runs in C: one call per
+trajectory. Imports NumPy and SciPy only: it is part of the runtime.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import lapack
+
+from symkin.errors import SolveError
+from symkin.results import Trajectory
+
+Array = NDArray[np.float64]
+Progress = Callable[[int, int], None]
+
+# Status codes shared with the generated C solver (templates/c/solver.h.j2).
+OK, NO_CONVERGENCE, SINGULAR = 0, 1, 2
+# Diagnosis only (never a stopping test): condition numbers of Phi_q taken as singular at a
+# failed iterate, and as "nearly singular" at the last point solved before a failure.
+ILL_CONDITIONED, NEARLY_SINGULAR = 1e8, 1e5
+
+
+@dataclass(frozen=True)
+class Options:
+    """Newton tolerances and the singularity test.
+
+    Args:
+        tol_phi: converged when max |Phi| of the current iterate is at most this...
+        tol_dq: ...and the last Newton step max |dq| is at most this.
+        max_iterations: Newton iterations allowed per time point.
+        min_pivot_ratio: Phi_q counts as singular when min |u_kk| / max |u_kk| of its LU
+            factors falls below this (a cheap estimate of the reciprocal condition number).
+    """
+
+    tol_phi: float = 1e-10
+    tol_dq: float = 1e-9
+    max_iterations: int = 25
+    min_pivot_ratio: float = 1e-10
+
+
+class SolveFailure(SolveError):
+    """A solve stopped early; carries what is needed to act on it and the rows solved so far.
+
+    Attributes:
+        trajectory: the time points solved before the failure.
+        t: the time at which it failed.
+        residual: max |Phi| of the last iterate.
+        iterations: Newton iterations spent at t.
+        rows: labels of the dependent equations when Phi_q was singular, else ().
+        reason: "singular", "no convergence" or "no assembly".
+    """
+
+    def __init__(self, message: str, trajectory: Trajectory, t: float, residual: float,
+                 iterations: int, rows: Sequence[str] = (), reason: str = "") -> None:
+        super().__init__(message)
+        self.trajectory = trajectory
+        self.t = t
+        self.residual = residual
+        self.iterations = iterations
+        self.rows = tuple(rows)
+        self.reason = reason
+
+
+# ----- the time grid -------------------------------------------------------------------------
+
+def grid(t0: float, t1: float, dt: float) -> Array:
+    """t0 + k dt for k = 0, 1, ... up to t1 included, computed per point (no drift).
+
+    The end point is snapped to t1 when the interval holds a whole number of steps, so that
+    0:0.05:1.5 ends at 1.5 exactly, as MATLAB's colon does.
+    """
+    if not (dt > 0 and t1 >= t0 and math.isfinite(t1 - t0)):
+        raise SolveError(f"bad time grid t0={t0}, t1={t1}, dt={dt}: need dt > 0 and t1 >= t0")
+    steps = math.floor((t1 - t0) / dt + 1e-9)
+    times = t0 + dt * np.arange(steps + 1, dtype=float)
+    if abs(times[-1] - t1) <= 1e-9 * dt:
+        times[-1] = t1
+    return times
+
+
+def _times(kernel: Any, t: ArrayLike | None) -> Array:
+    if t is None:
+        return grid(*kernel.time_grid)
+    times = np.atleast_1d(np.asarray(t, dtype=float))
+    if times.ndim != 1 or times.size == 0 or not np.all(np.isfinite(times)):
+        raise SolveError("t must be a non-empty 1-D sequence of finite times")
+    if np.any(np.diff(times) <= 0):
+        raise SolveError("t must be strictly increasing")
+    return times
+
+
+def _params(kernel: Any, params: Mapping[str, float] | ArrayLike | None) -> Array:
+    """Nominal parameter values, overridden by name (a mapping) or replaced (a sequence)."""
+    values = np.array(kernel.p_values, dtype=float)
+    if params is None:
+        return values
+    if isinstance(params, Mapping):
+        names = list(kernel.parameter_names)
+        for name, value in params.items():
+            if name not in names:
+                known = ", ".join(names) or "none"
+                raise SolveError(f"unknown parameter {name!r}; the mechanism has: {known}")
+            values[names.index(name)] = float(value)
+        return values
+    given = np.asarray(params, dtype=float)
+    if given.shape != values.shape:
+        raise SolveError(f"params has {given.size} values; the mechanism has {values.size}")
+    return given
+
+
+# ----- linear algebra ------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Factors:
+    """LU factors of Phi_q with partial pivoting, and the pivot-ratio singularity estimate."""
+
+    lu: Array
+    pivots: NDArray[np.int32]
+    pivot_ratio: float
+
+    def solve(self, b: Array) -> Array:
+        x, _ = lapack.dgetrs(self.lu, self.pivots, b)
+        return x
+
+
+def factor(jacobian: Array) -> Factors:
+    """Factor P Phi_q = L U (LAPACK getrf, as the C runtime does it: largest pivot in the column).
+
+    A zero pivot is not an error here: it gives ratio 0, which the caller judges.
+    """
+    lu, pivots, _ = lapack.dgetrf(jacobian)
+    magnitudes = np.abs(np.diag(lu))
+    largest = magnitudes.max(initial=0.0)
+    ratio = float(magnitudes.min() / largest) if largest > 0 else 0.0
+    return Factors(lu, pivots, ratio if math.isfinite(ratio) else 0.0)
+
+
+def dependent_rows(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8) -> list[str]:
+    """The equations whose rows of Phi_q are linearly dependent.
+
+    The left null space of Phi_q (left singular vectors with sigma <= rcond sigma_max) holds the
+    combinations y with y^T Phi_q = 0; a row takes part in a dependency when some y weighs it.
+    """
+    if not np.all(np.isfinite(jacobian)):
+        return list(labels)
+    u, sigma, _ = np.linalg.svd(jacobian)
+    null = u[:, sigma <= rcond * max(sigma[0], 1e-300)]
+    if null.shape[1] == 0:
+        null = u[:, -1:]  # ill-conditioned but above rcond: name the weakest direction
+    weight = np.abs(null).max(axis=1)
+    return [label for label, w in zip(labels, weight) if w > 1e-6]
+
+
+# ----- Newton-Raphson and assembly -----------------------------------------------------------
+
+@dataclass
+class Newton:
+    """The outcome of Newton-Raphson at one time point."""
+
+    q: Array
+    status: int
+    iterations: int
+    residual: float
+    factors: Factors | None
+
+
+def newton(kernel: Any, q: Array, t: float, p: Array, options: Options) -> Newton:
+    """Newton-Raphson that tests the residual of the current iterate (2.72).
+
+    Converged when max |Phi(q_k)| <= tol_phi and the step that led to q_k was at most tol_dq
+    (or no step was needed). The factors returned are those of Phi_q at the converged q, ready
+    for the velocity and acceleration solves.
+    """
+    q = np.array(q, dtype=float)
+    step = math.inf
+    for iteration in range(options.max_iterations + 1):
+        phi = kernel.phi(q, t, p)
+        residual = float(np.abs(phi).max(initial=0.0))
+        if not math.isfinite(residual):
+            return Newton(q, NO_CONVERGENCE, iteration, residual, None)
+        factors = factor(kernel.phi_q(q, t, p))
+        if factors.pivot_ratio < options.min_pivot_ratio:
+            return Newton(q, SINGULAR, iteration, residual, factors)
+        if residual <= options.tol_phi and (iteration == 0 or step <= options.tol_dq):
+            return Newton(q, OK, iteration, residual, factors)
+        if iteration == options.max_iterations:
+            break
+        delta = factors.solve(-phi)
+        q += delta
+        step = float(np.abs(delta).max(initial=0.0))
+    return Newton(q, NO_CONVERGENCE, options.max_iterations, residual, None)
+
+
+def levenberg_marquardt(kernel: Any, q: Array, t: float, p: Array, options: Options,
+                        max_iterations: int = 200) -> tuple[Array, float]:
+    """Minimise |Phi(q, t)|^2 from a poor guess; returns the best q and its max |Phi|.
+
+    Each step solves (J^T J + mu I) dq = -J^T Phi; mu shrinks after a step that lowers the
+    residual and grows otherwise, so the method moves like Newton near a solution and like
+    gradient descent far from one. It works where Phi_q is singular (e.g. q = 0).
+    """
+    q = np.array(q, dtype=float)
+    phi = kernel.phi(q, t, p)
+    cost = float(phi @ phi)
+    mu = 1e-3
+    for _ in range(max_iterations):
+        if math.sqrt(cost) <= options.tol_phi:
+            break
+        jacobian = kernel.phi_q(q, t, p)
+        normal = jacobian.T @ jacobian
+        gradient = jacobian.T @ phi
+        scale = mu * max(float(np.max(np.diag(normal))), 1.0)
+        delta = np.linalg.solve(normal + scale * np.eye(q.size), -gradient)
+        trial = q + delta
+        trial_phi = kernel.phi(trial, t, p)
+        trial_cost = float(trial_phi @ trial_phi)
+        if math.isfinite(trial_cost) and trial_cost < cost:
+            q, phi, cost, mu = trial, trial_phi, trial_cost, max(mu / 10, 1e-12)
+        else:
+            mu *= 10
+            if mu > 1e12:
+                break
+    return q, float(np.abs(phi).max(initial=0.0))
+
+
+def assemble(kernel: Any, q0: Array, t0: float, p: Array, options: Options) -> Newton:
+    """Assemble the mechanism at t0 from q0: Newton, else Levenberg-Marquardt then Newton."""
+    result = newton(kernel, q0, t0, p, options)
+    if result.status == OK:
+        return result
+    q, _ = levenberg_marquardt(kernel, q0, t0, p, options)
+    polished = newton(kernel, q, t0, p, options)
+    polished.iterations += result.iterations
+    return polished
+
+
+# ----- the time loop -------------------------------------------------------------------------
+
+@dataclass
+class _Run:
+    """Arrays filled point by point; ``done`` points are valid."""
+
+    t: Array
+    q: Array
+    dq: Array
+    d2q: Array
+    done: int = 0
+
+
+def _python_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
+                 progress: Progress | None) -> Newton:
+    """The grid loop in Python; returns the Newton outcome at the last point attempted."""
+    dq = np.zeros_like(q)
+    d2q = np.zeros_like(q)
+    result = Newton(q, OK, 0, 0.0, None)
+    for k, t in enumerate(run.t):
+        if k > 0:
+            h = t - run.t[k - 1]
+            q = q + dq * h + d2q * (h * h / 2)  # (2.76)
+        result = newton(kernel, q, t, p, options)
+        if result.status != OK:
+            return result
+        q, factors = result.q, result.factors
+        assert factors is not None  # newton returns the factors whenever it converges
+        dq = factors.solve(-kernel.phi_t(q, t, p))  # (2.73)
+        d2q = factors.solve(kernel.gamma(q, dq, t, p))  # (2.74)
+        run.q[k], run.dq[k], run.d2q[k] = q, dq, d2q
+        run.done = k + 1
+        if progress is not None:
+            progress(k + 1, run.t.size)
+    return result
+
+
+def default_options(kernel: Any) -> Options:
+    """Options() for double precision; looser ones for a C kernel computing in float."""
+    ffi = getattr(kernel, "ffi", None)
+    if ffi is not None and ffi.sizeof(f"{kernel.name}_real") == 4:
+        return Options(tol_phi=1e-5, tol_dq=1e-4, min_pivot_ratio=1e-6)
+    return Options()
+
+
+def _has_c_solver(kernel: Any) -> bool:
+    lib = getattr(kernel, "lib", None)
+    return lib is not None and hasattr(lib, f"{kernel.name}_solve_grid")
+
+
+def _c_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
+            progress: Progress | None) -> Newton:
+    """The grid loop in the generated C solver: one call per chunk (one chunk unless a
+    progress callback wants to hear in between)."""
+    ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
+    c_options = ffi.new(f"{name}_options *")
+    getattr(lib, f"{name}_default_options")(c_options)
+    c_options.tol_phi, c_options.tol_dq = options.tol_phi, options.tol_dq
+    c_options.max_iterations, c_options.min_pivot_ratio = options.max_iterations, \
+        options.min_pivot_ratio
+    state = ffi.new(f"{name}_state *")
+    work = ffi.new(f"{name}_workspace *")
+    report = ffi.new(f"{name}_report *")
+    dtype = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
+    pbuf = ffi.new(f"{name}_real[]", max(p.size, 1))
+    pbuf[0:p.size] = p.tolist()
+    state.q[0:q.size] = q.tolist()
+    chunk = run.t.size if progress is None else max(1, run.t.size // 100)
+    solve_grid = getattr(lib, f"{name}_solve_grid")
+    n = q.size
+    for start in range(0, run.t.size, chunk):
+        stop = min(start + chunk, run.t.size)
+        times = np.ascontiguousarray(run.t[start:stop], dtype=dtype)
+        out = [np.zeros((stop - start, n), dtype=dtype) for _ in range(3)]
+        ptrs = [ffi.cast(f"{name}_real *", ffi.from_buffer(a)) for a in (times, *out)]
+        solved = solve_grid(c_options, pbuf, stop - start, ptrs[0], state, ptrs[1], ptrs[2],
+                            ptrs[3], work, report)
+        for target, source in zip((run.q, run.dq, run.d2q), out):
+            target[start:start + solved] = source[:solved]
+        run.done = start + solved
+        if report.status != OK:
+            last = np.array(ffi.unpack(state.q, n), dtype=float)
+            factors = factor(kernel.phi_q(last, report.t, p)) if report.status == SINGULAR \
+                else None
+            return Newton(last, report.status, report.iterations, report.residual, factors)
+        if progress is not None:
+            progress(run.done, run.t.size)
+    return Newton(np.array(ffi.unpack(state.q, n)), OK, report.iterations, report.residual,
+                  None)
+
+
+def solve(kernel: Any, t: ArrayLike | None = None, q0: ArrayLike | None = None,
+          params: Mapping[str, float] | ArrayLike | None = None, *,
+          options: Options | None = None, progress: Progress | None = None,
+          use_c_solver: bool = True) -> Trajectory:
+    """Positions, velocities and accelerations of a mechanism over a time grid.
+
+    Args:
+        kernel: a compiled kernel (``symkin.compile``), NumPy or C.
+        t: the times to solve at, increasing; default: the file's grid t0 + k dt, t1 included.
+        q0: the first guess at t[0]; default: the file's q0.
+        params: parameter values by name (a mapping, others nominal) or all of them in order.
+        options: Newton tolerances and the singularity threshold; default: suited to the
+            kernel's real type (looser for a C kernel generated with float).
+        progress: called as progress(done, total) while the grid is solved.
+        use_c_solver: run the grid loop in the generated C solver when the kernel has one.
+
+    Returns:
+        The Trajectory.
+
+    Raises:
+        SolveFailure (a SolveError) with the partial trajectory when the mechanism cannot be
+        assembled at t[0], Newton does not converge, or Phi_q is singular.
+    """
+    times = _times(kernel, t)
+    p = _params(kernel, params)
+    options = options or default_options(kernel)
+    q = np.array(kernel.q0 if q0 is None else q0, dtype=float)
+    if q.shape != (len(kernel.coordinates),):
+        raise SolveError(f"q0 has {q.size} values; the mechanism has "
+                         f"{len(kernel.coordinates)} coordinates")
+    shape = (times.size, q.size)
+    run = _Run(times, np.zeros(shape), np.zeros(shape), np.zeros(shape))
+    start = assemble(kernel, q, float(times[0]), p, options)
+    if start.status != OK:
+        _fail(kernel, run, p, start, float(times[0]), assembling=True)
+    loop = _c_loop if use_c_solver and _has_c_solver(kernel) else _python_loop
+    result = loop(kernel, run, start.q, p, options, progress)
+    if result.status != OK:
+        _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
+    return _trajectory(kernel, run, p)
+
+
+def _trajectory(kernel: Any, run: _Run, p: Array) -> Trajectory:
+    done = run.done
+    return Trajectory(t=run.t[:done].copy(), q=run.q[:done].copy(), dq=run.dq[:done].copy(),
+                      d2q=run.d2q[:done].copy(), coordinates=tuple(kernel.coordinates),
+                      points=tuple(tuple(point) for point in kernel.points),
+                      point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
+                      params=p.copy())
+
+
+def _fail(kernel: Any, run: _Run, p: Array, result: Newton, t: float, assembling: bool) -> None:
+    """Raise SolveFailure with a message that says where, why and what to try."""
+    labels = list(kernel.rows)
+    rows, near = _singular_rows(kernel, run, p, result, t)
+    where = f"at t = {t:.10g}"
+    facts = f"(residual max|Phi| = {result.residual:.3g} after {result.iterations} iterations)"
+    if assembling and not rows:
+        reason = "no assembly"
+        worst = _worst_rows(kernel.phi(result.q, t, p), labels)
+        message = (f"the mechanism cannot be assembled {where} {facts}: no position satisfies "
+                   f"all constraints near q0; the largest violations are in {worst}. Check the "
+                   "link lengths (a chain too short to close cannot assemble), or give a better "
+                   "q0 in the mechanism file.")
+    elif rows:
+        reason = "singular"
+        when = where if near is None else (f"near t = {near:.10g}, the last point solved; "
+                                           f"Newton-Raphson then failed {where}")
+        message = (f"Phi_q is singular {when} {facts}: the equations of {'; '.join(rows)} are "
+                   "dependent. This is a dead-centre or toggle position, a redundant joint, or "
+                   "a driver that cannot move the mechanism here; end the time grid before it, "
+                   "or change the drivers.")
+    else:
+        reason = "no convergence"
+        message = (f"Newton-Raphson did not converge {where} {facts}. Try a smaller time step "
+                   "dt, or check that the drivers are smooth and reachable.")
+    raise SolveFailure(message, _trajectory(kernel, run, p), t, result.residual,
+                       result.iterations, rows, reason)
+
+
+def _singular_rows(kernel: Any, run: _Run, p: Array, result: Newton, t: float
+                   ) -> tuple[list[str], float | None]:
+    """Dependent equations at the failure, or at the last point solved when Newton failed just
+    past it (a mechanism driven through a dead centre has no solution beyond it).
+
+    Returns the row labels and, when they come from the last point solved, its time.
+    """
+    labels = list(kernel.rows)
+    jacobian = kernel.phi_q(result.q, t, p)
+    finite = bool(np.all(np.isfinite(jacobian)))
+    if result.status == SINGULAR or (finite and np.linalg.cond(jacobian) > ILL_CONDITIONED):
+        return dependent_rows(jacobian, labels), None
+    if result.status == NO_CONVERGENCE and run.done > 0:
+        last_t = float(run.t[run.done - 1])
+        jacobian = kernel.phi_q(run.q[run.done - 1], last_t, p)
+        if np.linalg.cond(jacobian) > NEARLY_SINGULAR:
+            return dependent_rows(jacobian, labels), last_t
+    return [], None
+
+
+def _worst_rows(phi: Array, labels: Sequence[str], count: int = 3) -> str:
+    magnitude = np.where(np.isfinite(phi), np.abs(phi), np.inf)
+    order = np.argsort(-magnitude, kind="stable")[:count]
+    return "; ".join(f"{labels[k]} ({magnitude[k]:.3g})" for k in order if magnitude[k] > 0)

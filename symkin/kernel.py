@@ -1,0 +1,221 @@
+"""The runtime kernel: one mechanism's compiled Phi, Phi_q, Phi_t and Gamma behind one API.
+
+A Kernel wraps either a generated NumPy module or a cffi extension built from the generated C,
+plus the metadata of the mechanism (coordinates, parameters, pattern, grid). It imports only
+NumPy, so running a compiled kernel never loads SymPy or jinja2.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import json
+import sys
+import sysconfig
+from collections.abc import Mapping
+from pathlib import Path
+from types import ModuleType
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Array = NDArray[np.float64]
+
+
+class _Functions(Protocol):
+    """What a backend evaluates: flat output arrays in the generated order."""
+
+    def phi(self, q: Array, t: float, p: Array) -> Array: ...
+    def phi_q_nz(self, q: Array, t: float, p: Array) -> Array: ...
+    def phi_t(self, q: Array, t: float, p: Array) -> Array: ...
+    def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array: ...
+    def points(self, p: Array) -> Array: ...
+
+
+class Kernel:
+    """The compiled kinematics of one mechanism (see CONTRACT.md, Python Kernel).
+
+    Every function takes ``p=None`` to mean the nominal parameter values.
+    """
+
+    def __init__(self, backend: str, meta: Mapping[str, Any], functions: _Functions,
+                 ffi: Any = None, lib: Any = None) -> None:
+        self.backend = backend
+        self.name: str = meta["name"]
+        self.coordinates: tuple[str, ...] = tuple(meta["coordinates"])
+        self.parameter_names: tuple[str, ...] = tuple(meta["parameter_names"])
+        self.p_values: Array = np.array(meta["p_values"], dtype=float)
+        self.q0: Array = np.array(meta["q0"], dtype=float)
+        self.time_grid: tuple[float, float, float] = tuple(meta["time_grid"])  # type: ignore
+        self.rows: tuple[str, ...] = tuple(meta["rows"])
+        self.pattern_rows = np.array(meta["pattern_rows"], dtype=np.intp)
+        self.pattern_cols = np.array(meta["pattern_cols"], dtype=np.intp)
+        self.points: tuple[tuple[str, str], ...] = tuple(tuple(p) for p in meta["points"])
+        self.ffi = ffi
+        self.lib = lib
+        self._functions = functions
+
+    @property
+    def nq(self) -> int:
+        return len(self.coordinates)
+
+    @property
+    def nnz(self) -> int:
+        return len(self.pattern_rows)
+
+    def __repr__(self) -> str:
+        return f"<symkin Kernel {self.name!r} backend={self.backend} nq={self.nq}>"
+
+    # -- evaluation ---------------------------------------------------------------------------
+    def phi(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """Phi(q, t), shape (N,)."""
+        return self._functions.phi(self._q(q), float(t), self._p(p))
+
+    def phi_q_nz(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """The non-zeros of Phi_q in the order of ``pattern_rows``/``pattern_cols``."""
+        return self._functions.phi_q_nz(self._q(q), float(t), self._p(p))
+
+    def phi_q(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """Phi_q as a dense N x N array."""
+        dense = np.zeros((self.nq, self.nq))
+        dense[self.pattern_rows, self.pattern_cols] = self.phi_q_nz(q, t, p)
+        return dense
+
+    def phi_t(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """Phi_t(q, t), shape (N,)."""
+        return self._functions.phi_t(self._q(q), float(t), self._p(p))
+
+    def gamma(self, q: ArrayLike, dq: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (N,)."""
+        return self._functions.gamma(self._q(q), self._q(dq, "dq"), float(t), self._p(p))
+
+    def point_vectors(self, p: ArrayLike | None = None) -> Array:
+        """Local vectors of the named points, shape (NPOINTS, 2), in ``points`` order."""
+        return self._functions.points(self._p(p)).reshape(len(self.points), 2)
+
+    # -- argument checks ----------------------------------------------------------------------
+    def _q(self, values: ArrayLike, what: str = "q") -> Array:
+        array = np.ascontiguousarray(values, dtype=float)
+        if array.shape != (self.nq,):
+            raise ValueError(f"{what} must have shape ({self.nq},) for {self.name}, "
+                             f"got {array.shape}")
+        return array
+
+    def _p(self, values: ArrayLike | None) -> Array:
+        if values is None:
+            return self.p_values
+        array = np.ascontiguousarray(values, dtype=float)
+        if array.shape != self.p_values.shape:
+            raise ValueError(f"p must have shape {self.p_values.shape} (parameters "
+                             f"{', '.join(self.parameter_names)}), got {array.shape}")
+        return array
+
+
+# ----- backends ------------------------------------------------------------------------------
+
+class _ModuleFunctions:
+    """Adapter over a generated NumPy module."""
+
+    def __init__(self, module: ModuleType) -> None:
+        self.phi = module.phi
+        self.phi_q_nz = module.phi_q_nz
+        self.phi_t = module.phi_t
+        self.gamma = module.gamma
+        self.points = module._points
+
+
+class _CFunctions:
+    """Adapter over a cffi extension: converts arrays to the generated real type and back."""
+
+    def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
+                 npoints: int) -> None:
+        self._ffi = ffi
+        self._dtype = np.float32 if real == "float" else np.float64
+        self._ctype = f"{real}[]"
+        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints}
+        self._c = {name: getattr(lib, f"{prefix}_{name}") for name in self._sizes}
+
+    def _in(self, array: Array) -> Any:
+        if array.size == 0:
+            return self._ffi.NULL
+        return self._ffi.from_buffer(self._ctype, np.ascontiguousarray(array, self._dtype))
+
+    def _call(self, name: str, *arguments: Any) -> Array:
+        out = np.zeros(self._sizes[name], dtype=self._dtype)
+        target = self._ffi.from_buffer(self._ctype, out) if out.size else self._ffi.NULL
+        self._c[name](*arguments, target)
+        return out.astype(np.float64, copy=False)
+
+    def phi(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi", self._in(q), t, self._in(p))
+
+    def phi_q_nz(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi_q", self._in(q), t, self._in(p))
+
+    def phi_t(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi_t", self._in(q), t, self._in(p))
+
+    def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array:
+        return self._call("gamma", self._in(q), self._in(dq), t, self._in(p))
+
+    def points(self, p: Array) -> Array:
+        return self._call("points", self._in(p))
+
+
+def from_module(module: ModuleType) -> Kernel:
+    """A Kernel over a generated NumPy module (its metadata comes from the module)."""
+    meta = {
+        "name": module.NAME, "coordinates": module.COORDINATES,
+        "parameter_names": module.PARAMETER_NAMES, "p_values": module.P_VALUES,
+        "q0": module.Q0, "time_grid": module.TIME_GRID, "rows": module.ROWS,
+        "pattern_rows": module.PATTERN_ROWS, "pattern_cols": module.PATTERN_COLS,
+        "points": module.POINTS,
+    }
+    return Kernel("numpy", meta, _ModuleFunctions(module))
+
+
+def from_cffi(ffi: Any, lib: Any, meta: Mapping[str, Any]) -> Kernel:
+    """A Kernel over a cffi extension built from the generated C; ``meta`` is the manifest."""
+    functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
+                            len(meta["pattern_rows"]), len(meta["points"]))
+    return Kernel("c", meta, functions, ffi=ffi, lib=lib)
+
+
+def load(folder: str | Path) -> Kernel:
+    """Load a built kernel from its folder (a cache entry, or a generated NumPy folder).
+
+    The folder's ``manifest.json`` says the backend and the mechanism; a C folder must also hold
+    the compiled extension. Needs only NumPy (and cffi for C), never SymPy.
+    """
+    folder = Path(folder)
+    meta = json.loads((folder / "manifest.json").read_text(encoding="utf-8"))
+    if meta["backend"] == "numpy":
+        source = folder / f"{meta['name']}.py"
+        digest = hashlib.sha256(source.read_bytes()).hexdigest()
+        module = import_file(f"_symkin_{meta['name']}_py_{digest[:20]}", source, None)
+        return from_module(module)
+    libraries = sorted(folder.glob(f"_symkin_{meta['name']}_*{_EXTENSION_SUFFIX}"))
+    if not libraries:
+        raise FileNotFoundError(f"{folder} holds no compiled extension; build it with "
+                                "symkin.compile")
+    name = libraries[0].name[: -len(_EXTENSION_SUFFIX)]
+    loader = importlib.machinery.ExtensionFileLoader(name, str(libraries[0]))
+    module = import_file(name, libraries[0], loader)
+    return from_cffi(module.ffi, module.lib, meta)
+
+
+def import_file(name: str, path: Path, loader: Any) -> ModuleType:
+    """Import a module from a file once per process (later calls reuse it)."""
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, path, loader=loader)
+        if spec is None or spec.loader is None:
+            raise ImportError(f"cannot import {path}")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        sys.modules[name] = module
+    return sys.modules[name]
+
+
+_EXTENSION_SUFFIX = sysconfig.get_config_var("EXT_SUFFIX") or ".so"

@@ -1,0 +1,235 @@
+"""Stage 4 — render: jinja2 templates turn the plain data of codegen into files.
+
+Every ``X.Y.j2`` in ``templates/<backend>/`` becomes one file of the generated folder:
+``kernel.h.j2 -> <prefix>.h``, ``kernel.c.j2 -> <prefix>.c``, ``kernel.py.j2 -> <prefix>.py``
+and any other ``X.Y.j2 -> <prefix>_X.Y`` (the solver runtime of the C backend). Templates
+whose name starts with ``_`` are partials and ``cdef.j2`` renders the cffi declarations, so
+neither is written out. The folder also gets ``manifest.json``: the files with their sha256,
+the op counts and the metadata a runtime needs. The output depends only on the input, so the
+same mechanism gives the same bytes on every run and machine.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+import jinja2
+
+from symkin import codegen, resources
+from symkin.codegen import Code, Routine
+from symkin.derivation import System
+from symkin.errors import BuildError
+
+CDEF_TEMPLATE = "cdef.j2"
+_LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
+MANIFEST = "manifest.json"
+
+_C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out"}
+_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points"}
+_PYTHON_DOC = {
+    "phi": "Phi(q, t), shape (NQ,).",
+    "phi_q": "The non-zeros of Phi_q in pattern order, shape (NNZ,).",
+    "phi_t": "Phi_t(q, t), shape (NQ,).",
+    "gamma": "Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,).",
+    "points": "Local vectors of the named points, flat (x, y) pairs in POINTS order.",
+}
+
+
+@functools.cache
+def environment(root: str | None = None) -> jinja2.Environment:
+    """The strict jinja2 environment over the template folder (cached per folder)."""
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(root or str(resources.template_root())),
+        undefined=jinja2.StrictUndefined, keep_trailing_newline=True, trim_blocks=True,
+        lstrip_blocks=True, autoescape=False)
+
+
+def template_names(backend: str, linalg: str = "dense") -> list[str]:
+    """The templates of ``backend`` that each render to one file, sorted.
+
+    ``linalg.*.j2`` (dense LU) and ``sparse_lu.*.j2`` define the same functions, so only the
+    chosen one is rendered.
+    """
+    folder = resources.template_root() / backend
+    left_out = _LINALG_TEMPLATES["sparse" if linalg == "dense" else "dense"]
+    return sorted(p.name for p in folder.glob("*.j2")
+                  if not p.name.startswith("_") and p.name != CDEF_TEMPLATE
+                  and p.name.split(".")[0] != left_out)
+
+
+def output_name(template: str, prefix: str) -> str:
+    """``kernel.h.j2 -> crank_slider.h``; ``solver.c.j2 -> crank_slider_solver.c``."""
+    stem, suffix = template.removesuffix(".j2").rsplit(".", 1)
+    return f"{prefix}.{suffix}" if stem == "kernel" else f"{prefix}_{stem}.{suffix}"
+
+
+def render_sources(code: Code) -> dict[str, str]:
+    """Render every template of the backend: ``{file name: text}``, sorted by name."""
+    context = template_context(code)
+    files = {}
+    for template in template_names(code.backend, code.linalg):
+        name = output_name(template, code.name)
+        files[name] = _render(f"{code.backend}/{template}",
+                              {**context, "template": template, "file_name": name})
+    return dict(sorted(files.items()))
+
+
+def render_cdef(code: Code) -> str:
+    """The cffi declarations of the C backend (plain C, concrete types, no macros)."""
+    context = template_context(code)
+    return _render(f"c/{CDEF_TEMPLATE}", {**context, "template": CDEF_TEMPLATE,
+                                          "file_name": "cdef"})
+
+
+def _render(template: str, context: dict[str, Any]) -> str:
+    try:
+        return environment().get_template(template).render(context)
+    except jinja2.TemplateError as error:
+        line = getattr(error, "lineno", None)
+        where = f" (line {line})" if line else ""
+        raise BuildError(f"template {template}{where} failed to render: {error}") from None
+
+
+def generate(system: System, backend: str = "c", out_dir: str | Path = "generated",
+             real: str = "double", cse: bool = True, linalg: str = "dense") -> list[Path]:
+    """Generate the source files of one backend into ``out_dir``.
+
+    Args:
+        system: the derived kinematics.
+        backend: ``"c"`` (a self-contained C99 folder) or ``"numpy"`` (one Python module).
+        out_dir: the folder to write; created when missing. Existing files of the same names
+            are replaced, other files are left alone.
+        real: the C real type, ``"double"`` or ``"float"``.
+        cse: eliminate common subexpressions.
+        linalg: the LU behind the C solver, ``"dense"`` or ``"sparse"``.
+
+    Returns:
+        The paths written, sorted, the manifest last.
+    """
+    code = codegen.lower(system, backend, real, cse, linalg)
+    return write(code, Path(out_dir))
+
+
+def write(code: Code, out_dir: Path) -> list[Path]:
+    """Write the rendered files of ``code`` and its manifest into ``out_dir``."""
+    files = render_sources(code)
+    files[MANIFEST] = manifest(code, files)
+    paths = [out_dir / name for name in files]
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        _remove_stale(out_dir, set(files))
+        for path, text in zip(paths, files.values()):
+            path.write_text(text, encoding="utf-8", newline="\n")
+    except OSError as error:
+        raise BuildError(f"cannot write the generated files into {out_dir}: {error.strerror}. "
+                         "Choose a folder you can write to.") from None
+    return paths
+
+
+def _remove_stale(out_dir: Path, keep: set[str]) -> None:
+    """Delete the files an earlier generation listed in its manifest and this one does not
+    write (e.g. the sparse LU after switching to dense), so the folder compiles on its own."""
+    try:
+        previous = json.loads((out_dir / MANIFEST).read_text(encoding="utf-8"))
+        listed = [name for name in previous.get("files", {}) if isinstance(name, str)]
+    except (OSError, ValueError, AttributeError):
+        return
+    for name in listed:
+        if name not in keep and Path(name).name == name:  # a plain name, never a path
+            (out_dir / name).unlink(missing_ok=True)
+
+
+def manifest(code: Code, files: dict[str, str]) -> str:
+    """The manifest: file hashes, op counts and the metadata a runtime needs, as JSON."""
+    data = {
+        "generator": "symkin", "backend": code.backend, "real": code.real, "cse": code.cse,
+        "name": code.name, "spec_sha256": code.spec_sha256,
+        "files": {name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()},
+        "ops": code.ops, "ops_before_cse": code.ops_before_cse, **metadata(code),
+    }
+    return json.dumps(data, indent=1, sort_keys=True) + "\n"
+
+
+def metadata(code: Code) -> dict[str, Any]:
+    """What the runtime Kernel needs besides the compiled functions (plain JSON data)."""
+    return {
+        "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
+        "p_values": list(code.p_values), "q0": list(code.q0), "time_grid": list(code.time_grid),
+        "rows": list(code.rows), "pattern_rows": list(code.pattern_rows),
+        "pattern_cols": list(code.pattern_cols), "points": [list(p) for p in code.points],
+        "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
+    }
+
+
+# ----- template context ----------------------------------------------------------------------
+
+def template_context(code: Code) -> dict[str, Any]:
+    """The plain data every template of ``code.backend`` receives (CONTRACT.md)."""
+    literal = _c_literal(code.real) if code.backend == "c" else repr
+    return {
+        "prefix": code.name, "PREFIX": code.name.upper(), "name_comment": codegen.comment(code.name),
+        "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
+        "real": code.real, "cse": code.cse, "spec_sha256": code.spec_sha256,
+        # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
+        "libm_suffix": "f" if code.real == "float" else "",
+        "literal_suffix": "F" if code.real == "float" else "",
+        "pattern_rows": list(code.pattern_rows), "pattern_cols": list(code.pattern_cols),
+        "ops": sorted(code.ops.items()),
+        "p_literals": [literal(v) for v in code.p_values],
+        "q0_literals": [literal(v) for v in code.q0],
+        "time_literals": [literal(v) for v in code.time_grid],
+        "coordinate_comments": [f"q[{k}] {codegen.comment(n)}"
+                                for k, n in enumerate(code.coordinates)],
+        "parameter_comments": [f"p[{k}] {codegen.comment(n)} = {v!r}" for k, (n, v)
+                               in enumerate(zip(code.parameter_names, code.p_values))],
+        "row_comments": [f"{k}: {codegen.comment(r)}" for k, r in enumerate(code.rows)],
+        "routines": [_routine_context(code, r) for r in code.routines],
+        # Python string literals: repr() of a str is always a valid, inert literal.
+        "name_literal": repr(code.name),
+        "coordinate_literals": [repr(n) for n in code.coordinates],
+        "parameter_literals": [repr(n) for n in code.parameter_names],
+        "row_literals": [repr(r) for r in code.rows],
+        "point_literals": [repr(tuple(p)) for p in code.points],
+        "linalg": code.linalg, **code.extra,
+    }
+
+
+def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
+    real = f"{code.name}_real"
+    output = _C_OUTPUT[routine.name]
+    arguments = [f"{real} t" if a == "t" else f"const {real} {a}[]" for a in routine.arguments]
+    python_arguments = [a for a in routine.arguments if a != "p"] + ["p=None"]
+    return {
+        "name": routine.name, "unused": list(routine.unused), "output": output,
+        "temporaries": list(routine.temporaries), "outputs": list(routine.outputs),
+        "signature": ", ".join([*arguments, f"{real} {output}[]"]),
+        "labels": _labels(code, routine.name),
+        "python_name": _PYTHON_NAME.get(routine.name, routine.name),
+        "python_signature": ", ".join(python_arguments), "doc": _PYTHON_DOC[routine.name],
+        "size": len(routine.outputs),
+    }
+
+
+def _labels(code: Code, routine: str) -> list[str]:
+    """A short comment per output slot: the row of Phi, or the (row, column) of Phi_q."""
+    if routine == "phi_q":
+        return [f"({r}, {c})" for r, c in zip(code.pattern_rows, code.pattern_cols)]
+    if routine == "points":
+        return [codegen.comment(f"{body}.{point}.{axis}") for body, point in code.points
+                for axis in "xy"]
+    return [codegen.comment(row) for row in code.rows]
+
+
+def _c_literal(real: str):
+    """A C literal of the real type: full precision for double, ``F`` suffix for float."""
+    suffix = "F" if real == "float" else ""
+
+    def literal(value: float) -> str:
+        text = repr(float(value))
+        return text + suffix if any(ch in text for ch in ".en") else text + ".0" + suffix
+
+    return literal

@@ -1,0 +1,153 @@
+"""``symkin run``: solve a mechanism over its time grid and write the results.
+
+A thin layer over symkin.derive -> symkin.compile -> symkin.solve -> Trajectory.save / plots.
+Exit status 0 on success; 1 when the solve fails (the rows solved so far are still written);
+2 for bad input (a message, never a traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import Any, TextIO
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png",), "animate": (".gif",)}
+
+
+def add_parser(commands: argparse._SubParsersAction) -> None:
+    """Add the ``run`` subcommand."""
+    run = commands.add_parser(
+        "run", help="solve positions, velocities and accelerations over the time grid")
+    run.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
+    run.add_argument("--backend", choices=("c", "numpy"), default="numpy",
+                     help="kernel to run (default numpy; c compiles the generated C)")
+    run.add_argument("--t0", type=float, help="first time (default: the file's)")
+    run.add_argument("--t1", type=float, help="last time, included (default: the file's)")
+    run.add_argument("--dt", type=float, help="time step (default: the file's)")
+    run.add_argument("-o", "--output", type=Path, help="results file, .npz or .csv")
+    run.add_argument("--plot", type=Path, help="PNG of coordinates and point paths against t")
+    run.add_argument("--animate", type=Path, help="GIF of the mechanism moving")
+    run.set_defaults(handler=handle)
+
+
+def _bad_usage(args: argparse.Namespace) -> str | None:
+    """What is wrong with the command line, before any work is done."""
+    for option, suffixes in SUFFIXES.items():
+        path = getattr(args, option)
+        if path is not None and path.suffix.lower() not in suffixes:
+            return (f"--{option} {path}: the file must end in {' or '.join(suffixes)}")
+    if args.dt is not None and not args.dt > 0:
+        return f"--dt {args.dt}: the time step must be positive"
+    return None
+
+
+def _times(kernel: Any, args: argparse.Namespace):
+    from symkin import driver
+
+    t0, t1, dt = kernel.time_grid
+    t0 = t0 if args.t0 is None else args.t0
+    t1 = t1 if args.t1 is None else args.t1
+    dt = dt if args.dt is None else args.dt
+    if t1 < t0:
+        return None, f"the time grid ends (t1 = {t1:g}) before it starts (t0 = {t0:g})"
+    return driver.grid(t0, t1, dt), None
+
+
+def handle(args: argparse.Namespace) -> int:
+    """Run the subcommand; returns the exit status."""
+    problem = _bad_usage(args)
+    if problem:
+        return _error(problem, EXIT_BAD_INPUT)
+    try:
+        return _solve_and_write(args)
+    except CannotWrite as error:
+        return _error(str(error), EXIT_BAD_INPUT)
+
+
+def _solve_and_write(args: argparse.Namespace) -> int:
+    import symkin
+    from symkin import driver
+
+    system = symkin.derive(args.mechanism)
+    kernel = symkin.compile(system, backend=args.backend)
+    times, problem = _times(kernel, args)
+    if problem:
+        return _error(f"{args.mechanism}: {problem}; change --t0/--t1", EXIT_BAD_INPUT)
+    progress = ProgressBar(sys.stderr) if sys.stderr.isatty() else None
+    try:
+        trajectory = driver.solve(kernel, t=times, progress=progress)
+    except driver.SolveFailure as failure:
+        if progress:
+            progress.finish()
+        _write(failure.trajectory, args, system)
+        return _error(f"{args.mechanism}: {failure} Solved {failure.trajectory.t.size} of "
+                      f"{times.size} time points; those are written.", EXIT_FAILED)
+    if progress:
+        progress.finish()
+    written = _write(trajectory, args, system)
+    print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
+          f"{trajectory.t[-1]:g} ({kernel.backend} backend)"
+          + "".join(f"; wrote {path}" for path in written))
+    return EXIT_OK
+
+
+def _write(trajectory: Any, args: argparse.Namespace, system: Any) -> list[Path]:
+    """Save the results, plot and animation asked for (a partial trajectory too)."""
+    try:
+        return _write_files(trajectory, args, system)
+    except OSError as error:
+        raise CannotWrite(f"cannot write {error.filename or 'the output'}: "
+                          f"{error.strerror or error}; check the path and its permissions"
+                          ) from None
+
+
+def _write_files(trajectory: Any, args: argparse.Namespace, system: Any) -> list[Path]:
+    from symkin import plots
+
+    written = []
+    if args.output:
+        written.append(trajectory.save(args.output))
+    if trajectory.t.size == 0:
+        return written
+    if args.plot:
+        written.append(plots.plot(trajectory, args.plot))
+    if args.animate:
+        written.append(plots.animate(trajectory, args.animate, plots.outlines(system)))
+    return written
+
+
+def _error(message: str, status: int) -> int:
+    print(f"symkin: error: {message}", file=sys.stderr)
+    return status
+
+
+class CannotWrite(Exception):
+    """An output file could not be written (a bad path, not a failed solve)."""
+
+
+class ProgressBar:
+    """A one-line progress bar on a terminal, redrawn at most ten times a second."""
+
+    def __init__(self, stream: TextIO, width: int = 40) -> None:
+        self.stream = stream
+        self.width = width
+        self.last = 0.0
+        self.drawn = False
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.monotonic()
+        if done < total and now - self.last < 0.1:
+            return
+        self.last = now
+        filled = self.width * done // max(total, 1)
+        self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total}")
+        self.stream.flush()
+        self.drawn = True
+
+    def finish(self) -> None:
+        if self.drawn:
+            self.stream.write("\n")
+            self.stream.flush()

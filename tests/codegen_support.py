@@ -1,0 +1,143 @@
+"""Helpers for the codegen, generated-code, build and embedded tests.
+
+The reference for every generated function is the System itself, evaluated by SymPy with
+mpmath at 30 digits: an evaluation path that shares no code with the printers under test.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+import shutil
+import subprocess
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+import symkin
+from symkin import codegen
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
+GENERATED = ROOT / "generated"
+BACKENDS = ("c", "numpy")
+STRICT_FLAGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
+N_STATES = 100
+
+
+def example_ids() -> list[str]:
+    return [path.stem for path in EXAMPLES]
+
+
+@functools.cache
+def system(name: str):
+    return symkin.derive(ROOT / "examples" / f"{name}.yaml")
+
+
+def golden_folder(name: str, backend: str) -> Path:
+    return GENERATED / name / backend
+
+
+def _heaviside(x, at_zero=0.5):
+    return mpmath.mpf(1) if x > 0 else mpmath.mpf(0) if x < 0 else mpmath.mpf(at_zero)
+
+
+# Step functions defined here, independently of the code generator's rewriting; the Dirac delta
+# is zero wherever a float can land.
+MPMATH = [{"DiracDelta": lambda *args: mpmath.mpf(0), "Heaviside": _heaviside,
+           "sign": mpmath.sign, "Min": min, "Max": max}, "mpmath"]
+
+
+class Reference:
+    """Phi, Phi_q, Phi_t, Gamma and the point vectors of a System, by SymPy + mpmath."""
+
+    def __init__(self, system) -> None:
+        q, dq, t, p = system.q, system.dq, system.t, system.p
+        self.nq = len(q)
+        dense = sp.Matrix(system.phi_q)
+        vectors = [component for vector in codegen.point_vectors(system) for component in vector]
+        self._phi = sp.lambdify((q, t, p), list(system.phi), MPMATH)
+        self._phi_q = sp.lambdify((q, t, p), list(dense), MPMATH)
+        self._phi_t = sp.lambdify((q, t, p), list(system.phi_t), MPMATH)
+        self._gamma = sp.lambdify((q, dq, t, p), list(system.gamma), MPMATH)
+        self._points = sp.lambdify((p,), vectors or [sp.Integer(0)], MPMATH)
+        self._n_points = len(vectors)
+
+    @staticmethod
+    def _floats(values) -> np.ndarray:
+        return np.array([float(mpmath.re(v)) for v in values], dtype=float)
+
+    def _call(self, function: Callable, *arrays) -> np.ndarray:
+        with mpmath.workdps(30):
+            arguments = [[mpmath.mpf(float(x)) for x in np.atleast_1d(a)] if np.ndim(a)
+                         else mpmath.mpf(float(a)) for a in arrays]
+            return self._floats(function(*arguments))
+
+    def phi(self, q, t, p):
+        return self._call(self._phi, q, t, p)
+
+    def phi_q(self, q, t, p):
+        return self._call(self._phi_q, q, t, p).reshape(self.nq, self.nq)
+
+    def phi_t(self, q, t, p):
+        return self._call(self._phi_t, q, t, p)
+
+    def gamma(self, q, dq, t, p):
+        return self._call(self._gamma, q, dq, t, p)
+
+    def points(self, p):
+        return self._call(self._points, p)[: self._n_points].reshape(-1, 2)
+
+
+def random_states(system, count: int = N_STATES, seed: int = 7
+                  ) -> Iterator[tuple[np.ndarray, np.ndarray, float, np.ndarray]]:
+    """(q, dq, t, p): coordinates in [-2, 2], velocities in [-3, 3], t on the grid's span,
+    parameters within 20 % of nominal."""
+    rng = np.random.default_rng(seed)
+    t0, t1, _ = system.time_grid
+    nominal = np.array(system.p_values, dtype=float)
+    for _ in range(count):
+        yield (rng.uniform(-2, 2, len(system.q)), rng.uniform(-3, 3, len(system.q)),
+               float(rng.uniform(t0, t1)), nominal * rng.uniform(0.8, 1.2, nominal.shape))
+
+
+def assert_close(actual, expected, rtol: float = 1e-12, what: str = "") -> None:
+    """Agreement to ``rtol`` relative to the magnitude of the reference vector (at least 1)."""
+    actual, expected = np.asarray(actual, dtype=float), np.asarray(expected, dtype=float)
+    assert actual.shape == expected.shape, what
+    scale = max(1.0, float(np.max(np.abs(expected), initial=0.0)))
+    error = float(np.max(np.abs(actual - expected), initial=0.0))
+    assert error <= rtol * scale, f"{what}: max error {error:.3e} > {rtol:g} x {scale:.3g}"
+
+
+def compilers() -> list[str]:
+    return [cc for cc in ("gcc", "clang") if shutil.which(cc)]
+
+
+def compile_object(compiler: str, source: Path, flags: list[str], out: Path
+                   ) -> subprocess.CompletedProcess:
+    return subprocess.run([compiler, *flags, "-c", str(source), "-o", str(out)],
+                          capture_output=True, text=True, check=False)
+
+
+def undefined_symbols(nm: str, objects: list[Path]) -> set[str]:
+    listing = subprocess.run([nm, "-u", *map(str, objects)], capture_output=True, text=True,
+                             check=True).stdout
+    return {line.split()[-1] for line in listing.splitlines()
+            if line.strip() and not line.endswith(":")}
+
+
+def code_without_comments(text: str) -> str:
+    """C source with its comments removed (block and line)."""
+    return re.sub(r"//[^\n]*", "", re.sub(r"/\*.*?\*/", "", text, flags=re.DOTALL))
+
+
+def env_without_hash_seed(seed: str) -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONHASHSEED"] = seed
+    return env
+

@@ -1,0 +1,84 @@
+"""Test helpers for the driver: kernels for a System, and mechanism files under mechanisms/.
+
+``LambdifyKernel`` has the Kernel interface but is built with sympy.lambdify straight from the
+System, bypassing codegen: a cross-check of the generated NumPy kernel. ``kernel_for`` is
+``symkin.compile``, falling back to the lambdify kernel only where symkin.build is missing.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import symkin
+from symkin import constraints, model
+
+MECHANISMS = Path(__file__).resolve().parent / "mechanisms"
+BACKENDS = ("numpy", "c")
+
+
+class LambdifyKernel:
+    """The Kernel interface (CONTRACT.md) evaluated with sympy.lambdify."""
+
+    backend = "lambdify"
+
+    def __init__(self, system) -> None:
+        args = (system.q, system.t, system.p)
+        self.name = system.name
+        self.coordinates = system.coordinates
+        self.parameter_names = system.parameter_names
+        self.p_values = np.array(system.p_values, dtype=float)
+        self.q0 = np.array(system.q0, dtype=float)
+        self.time_grid = system.time_grid
+        self.rows = tuple(str(row) for row in system.rows)
+        pattern = system.pattern()
+        self.pattern_rows = np.array([r for r, _ in pattern])
+        self.pattern_cols = np.array([c for _, c in pattern])
+        self._phi = sp.lambdify(args, system.phi, "numpy")
+        self._phi_q = sp.lambdify(args, sp.Matrix(system.phi_q), "numpy")
+        self._phi_t = sp.lambdify(args, system.phi_t, "numpy")
+        self._gamma = sp.lambdify((system.q, system.dq, system.t, system.p), system.gamma, "numpy")
+        mech = system.mechanism
+        ctx = constraints.Context(mech, model.make_symbols(mech))
+        self.points = tuple((b, n) for b, body in mech.bodies.items() for n in body.points)
+        vectors = [ctx.vector(mech.bodies[b].points[n]) for b, n in self.points]
+        self._points = sp.lambdify((system.p,), sp.Matrix([[v[0], v[1]] for v in vectors])
+                                   if vectors else sp.zeros(0, 2), "numpy")
+
+    def _p(self, p):
+        return self.p_values if p is None else np.asarray(p, dtype=float)
+
+    def phi(self, q, t, p=None):
+        return np.asarray(self._phi(q, t, self._p(p)), dtype=float).reshape(-1)
+
+    def phi_q(self, q, t, p=None):
+        return np.asarray(self._phi_q(q, t, self._p(p)), dtype=float)
+
+    def phi_t(self, q, t, p=None):
+        return np.asarray(self._phi_t(q, t, self._p(p)), dtype=float).reshape(-1)
+
+    def gamma(self, q, dq, t, p=None):
+        return np.asarray(self._gamma(q, dq, t, self._p(p)), dtype=float).reshape(-1)
+
+    def point_vectors(self, p=None):
+        return np.asarray(self._points(self._p(p)), dtype=float).reshape(-1, 2)
+
+
+def kernel_for(system, backend: str):
+    """symkin.compile(system, backend); the lambdify stand-in while codegen is not there."""
+    try:
+        import symkin.build
+    except ImportError:
+        if backend == "numpy":
+            return LambdifyKernel(system)
+        pytest.skip("symkin.build (the C backend) is not available yet")
+    return symkin.compile(system, backend=backend)
+
+
+def derive(name: str):
+    """The System of tests/mechanisms/<name>.yaml."""
+    return symkin.derive(MECHANISMS / f"{name}.yaml")
+
