@@ -9,8 +9,18 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-__all__ = ["load", "from_dict", "derive", "generate", "compile", "solve", "SymkinError",
-           "MechanismError", "SolveError", "BuildError"]
+__all__ = [
+    "BuildError",
+    "MechanismError",
+    "SolveError",
+    "SymkinError",
+    "compile",
+    "derive",
+    "from_dict",
+    "generate",
+    "load",
+    "solve",
+]
 
 _EXPORTS = {
     "load": ("symkin.model", "load"),

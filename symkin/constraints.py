@@ -8,8 +8,9 @@ Phi is written here; Phi_q, Phi_t and Gamma are derived from it symbolically in
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import sympy as sp
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 
 class SymkinError(Exception):
@@ -51,7 +51,7 @@ class MechanismError(SymkinError):
         self.line = line
         super().__init__(self._render())
 
-    def located(self, source: str | None, line: int | None) -> "MechanismError":
+    def located(self, source: str | None, line: int | None) -> MechanismError:
         """Return a copy of this error that names the file and line."""
         return MechanismError(self.message, self.path, self.hint, source, line)
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import ast
 import math
 import warnings
-from typing import Callable, Mapping, Sequence, Union
+from collections.abc import Callable, Mapping, Sequence
 
 import sympy as sp
 
@@ -22,7 +22,7 @@ MAX_EXPONENT = 64
 MAX_DIGITS = 300
 
 # What a number-or-expression field may hold in a mechanism file.
-RawExpr = Union[int, float, str]
+RawExpr = int | float | str
 
 _CONSTANTS: Mapping[str, sp.Expr] = {"pi": sp.pi, "E": sp.E}
 
@@ -76,7 +76,7 @@ _NODE_NAMES: Mapping[type, str] = {
 }
 
 
-def number(value: int | float) -> sp.Expr:
+def number(value: float) -> sp.Expr:
     """Turn a finite Python number into an exact SymPy number (0.05 -> 1/20)."""
     if isinstance(value, bool):
         raise ExpressionError(f"{value!r} is a boolean, not a number")

@@ -12,13 +12,21 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal, Mapping, Union
+from typing import Annotated, Any, Literal
 
 import sympy as sp
-from pydantic import (BaseModel, ConfigDict, Field, PlainValidator, ValidationError,
-                      WithJsonSchema, model_validator)
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PlainValidator,
+    ValidationError,
+    WithJsonSchema,
+    model_validator,
+)
 from pydantic_core import PydanticCustomError
 
 from symkin import expressions, loader
@@ -181,8 +189,8 @@ class Slide(_Pair):
     f: TimeFunction
 
 
-Joint = Annotated[Union[Revolute, Prismatic, PinSlot, Custom], Field(discriminator="type")]
-Driver = Annotated[Union[Displacement, DisplacementLocal, Trajectory, Angle, Slide, Custom],
+Joint = Annotated[Revolute | Prismatic | PinSlot | Custom, Field(discriminator="type")]
+Driver = Annotated[Displacement | DisplacementLocal | Trajectory | Angle | Slide | Custom,
                    Field(discriminator="type")]
 
 # Number of equations each constraint type contributes.
@@ -216,7 +224,7 @@ class Mechanism(_Strict):
     time: TimeGrid
 
     @model_validator(mode="after")
-    def _semantics(self) -> "Mechanism":
+    def _semantics(self) -> Mechanism:
         _check_semantics(self)
         return self
 
@@ -351,10 +359,7 @@ def _data_path(data: Any, loc: tuple[Any, ...]) -> tuple[str | int, ...]:
     path: list[str | int] = []
     node = data
     for part in loc:
-        if isinstance(node, dict) and part in node:
-            path.append(part)
-            node = node[part]
-        elif isinstance(node, list) and isinstance(part, int) and part < len(node):
+        if isinstance(node, dict) and part in node or isinstance(node, list) and isinstance(part, int) and part < len(node):
             path.append(part)
             node = node[part]
         elif isinstance(node, dict) and isinstance(part, str) and part in _ALL_FIELDS:

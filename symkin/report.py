@@ -16,18 +16,21 @@ def _names(system: System) -> dict[sp.Symbol, sp.Symbol]:
 def text(system: System) -> str:
     """A plain-text report: coordinates, Phi, Phi_q (pattern and entries), Phi_t, Gamma, DOF."""
     rename = _names(system)
-    show = lambda e: sp.sstr(e.xreplace(rename))  # noqa: E731
+
+    def show(expr: sp.Expr) -> str:
+        return sp.sstr(expr.xreplace(rename))
+
     width = max(len(str(row)) for row in system.rows)
-    lines = [f"mechanism {system.name}: {len(system.q)} coordinates, {len(system.rows)} "
-             f"equations, {degrees_of_freedom(system.mechanism)} degree(s) of freedom",
-             "", "coordinates q:"]
+    summary = (f"mechanism {system.name}: {len(system.q)} coordinates, {len(system.rows)} "
+               f"equations, {degrees_of_freedom(system.mechanism)} degree(s) of freedom")
+    lines = [summary, "", "coordinates q:"]
     lines += [f"  q[{k}] = {name}" for k, name in enumerate(system.coordinates)]
     lines += ["", "parameters p:"]
     lines += [f"  p[{k}] = {s.name} = {v:g}" for k, (s, v) in
               enumerate(zip(system.p, system.p_values))]
     for title, column in (("Phi", system.phi), ("Phi_t", system.phi_t), ("Gamma", system.gamma)):
         lines += ["", f"{title}:"]
-        lines += [f"  [{r}] {str(row):<{width}}  {show(column[r])}"
+        lines += [f"  [{r}] {row!s:<{width}}  {show(column[r])}"
                   for r, row in enumerate(system.rows)]
     entries = system.phi_q.todok()
     lines += ["", f"Phi_q pattern ({len(entries)} non-zeros):"]
