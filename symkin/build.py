@@ -29,6 +29,7 @@ from types import ModuleType
 from typing import Any
 
 from symkin import codegen, kernel, render
+from symkin.cache import cache_root  # one cache folder for the build cache and the index
 from symkin.derivation import System
 from symkin.errors import BuildError
 
@@ -38,17 +39,9 @@ C_FLAGS = ("-std=c99", "-O2", "-fPIC")
 WRAPPER_FLAGS = ("-O2", "-fPIC")
 
 
-def cache_root() -> Path:
-    """``$SYMKIN_CACHE_DIR``, else the user cache folder (``~/.cache/symkin`` on Linux)."""
-    explicit = os.environ.get("SYMKIN_CACHE_DIR")
-    if explicit:
-        return Path(explicit)
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "symkin"
-
-
 def compile(system: System, backend: str = "c", *, real: str = "double", cse: bool = True,
-            linalg: str = "dense", cache_dir: str | Path | None = None) -> kernel.Kernel:
+            linalg: str = codegen.DEFAULT_LINALG, cache_dir: str | Path | None = None
+            ) -> kernel.Kernel:
     """Generate, compile (or find in the cache) and load the kernel of ``system``.
 
     Args:
@@ -57,7 +50,7 @@ def compile(system: System, backend: str = "c", *, real: str = "double", cse: bo
             compiler, ``"c"`` warns once and falls back to ``"numpy"``.
         real: the C real type, ``"double"`` or ``"float"``.
         cse: eliminate common subexpressions.
-        linalg: the LU behind the C solver, ``"dense"`` or ``"sparse"``.
+        linalg: the LU behind the C solver, ``"sparse"`` (default) or ``"dense"``.
         cache_dir: where built kernels are kept; default :func:`cache_root`.
 
     Raises:
@@ -101,7 +94,7 @@ def _compile_c(code: codegen.Code, cache: Path, compiler: list[str]) -> kernel.K
                                                         compiler, code.name))
     module = _import_extension(module_name, library)
     meta = json.loads(files[render.MANIFEST])
-    return kernel.from_cffi(module.ffi, module.lib, meta)
+    return kernel.from_cffi(module.ffi, module.lib, meta, folder)
 
 
 def _build_c(build: Path, files: dict[str, str], cdef: str, module_name: str,
@@ -174,7 +167,7 @@ def _load_numpy(code: codegen.Code, cache: Path) -> kernel.Kernel:
     source = folder / f"{code.name}.py"
     if not source.exists():
         _publish(cache, folder, lambda build: render.write(code, build))
-    return kernel.from_module(kernel.import_file(module_name, source, None))
+    return kernel.from_module(kernel.import_file(module_name, source, None), folder)
 
 
 # ----- cache ---------------------------------------------------------------------------------

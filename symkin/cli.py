@@ -76,7 +76,7 @@ def _generate(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
     system = derivation.derive(args.mechanism)
     paths = render.generate(system, backend=args.backend, out_dir=args.output, real=args.real,
-                            cse=not args.no_cse)
+                            cse=not args.no_cse, linalg=args.linalg)
     print("\n".join(str(path) for path in paths))
     return EXIT_OK
 
@@ -90,6 +90,9 @@ def _add_generate(commands: argparse._SubParsersAction) -> None:
                           help="C real type (default double)")
     generate.add_argument("--no-cse", action="store_true",
                           help="do not eliminate common subexpressions")
+    generate.add_argument("--linalg", choices=("sparse", "dense"), default="sparse",
+                          help="LU behind the C solver: generated sparse LU with run-time pivot "
+                          "checks and a dense fall-back (default), or dense partial pivoting")
     generate.set_defaults(handler=_generate)
 
 

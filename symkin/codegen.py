@@ -16,6 +16,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 import sympy as sp
 from sympy.codegen.ast import float32, float64
 from sympy.codegen.ast import real as real_type
@@ -31,6 +32,7 @@ REAL_TYPES = ("double", "float")
 # The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
 # pivoting) or templates/c/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
 LINALG = ("dense", "sparse")
+DEFAULT_LINALG = "sparse"
 
 # The routines every backend emits, in output order, and the arguments each one takes.
 ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
@@ -89,7 +91,7 @@ class Code:
     points: tuple[tuple[str, str], ...]
     routines: tuple[Routine, ...]
     ops_before_cse: dict[str, int]
-    linalg: str = "dense"
+    linalg: str = DEFAULT_LINALG
     extra: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -183,7 +185,7 @@ def _printer(backend: str, real: str) -> C99CodePrinter | NumPyPrinter:
 # ----- lowering ------------------------------------------------------------------------------
 
 def lower(system: System, backend: str = "c", real: str = "double", cse: bool = True,
-          linalg: str = "dense") -> Code:
+          linalg: str = DEFAULT_LINALG) -> Code:
     """Turn a System into the plain data the templates of ``backend`` render.
 
     Args:
@@ -191,7 +193,7 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         backend: ``"c"`` or ``"numpy"``.
         real: ``"double"`` or ``"float"`` (C only).
         cse: eliminate common subexpressions within each routine.
-        linalg: ``"dense"`` or ``"sparse"``, the LU behind the C solver.
+        linalg: ``"sparse"`` (default) or ``"dense"``, the LU behind the C solver.
 
     Raises:
         BuildError: an unknown backend or real type, or an expression the printer cannot print.
@@ -214,7 +216,8 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         points=point_names(system), routines=routines,
         ops_before_cse={name: _count_ops(exprs) for name, exprs in expressions.items()},
         linalg=linalg,
-        extra={"lu": _sparse_lu_plan(system, pattern)} if linalg == "sparse" else {},
+        extra=({"lu": _sparse_lu_plan(system, pattern)}
+               if backend == "c" and linalg == "sparse" else {}),
     )
 
 
@@ -231,19 +234,76 @@ def _check_options(backend: str, real: str, linalg: str) -> None:
 
 
 def _sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> dict[str, Any]:
-    """The pivot order of the sparse LU, chosen on Phi_q at q0, t0 and the nominal parameters."""
+    """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration."""
     from symkin import sparse_lu
     from symkin.errors import SolveError
 
-    values = dict(zip(system.q, system.q0)) | dict(zip(system.p, system.p_values))
-    values[system.t] = system.time_grid[0]
-    sample = [float(system.phi_q[r, c].xreplace(values).evalf()) for r, c in pattern]
+    kernel = _SampleKernel(system, pattern)
+    sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
     try:
         plan = sparse_lu.analyse(len(system.q), [r for r, _ in pattern],
-                                 [c for _, c in pattern], sample)
+                                 [c for _, c in pattern], [float(v) for v in sample])
     except SolveError as error:
         raise BuildError(f"cannot plan the sparse LU of Phi_q: {error}") from None
     return sparse_lu.template_context(plan)
+
+
+def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...]:
+    """Where the pivot order of the sparse LU is chosen: the mechanism assembled at t0.
+
+    The file's q0 is only a first guess (the chapter starts from q = 0), and a pivot order
+    that is numerically good there may be poor on the motion itself; the assembled position
+    is the first point the solver factors. It is found numerically here with the driver's
+    own assembly (Newton, then Levenberg-Marquardt); when that fails, q0 is used and the
+    run-time pivot checks still guard every factorization.
+
+    Args:
+        system: the derived kinematics.
+        kernel: Phi and Phi_q as NumPy functions; built here when not given.
+    """
+    from symkin import driver
+    from symkin.errors import SolveError
+
+    q0 = np.array(system.q0, dtype=float)
+    kernel = kernel or _SampleKernel(system, system.pattern())
+    p = np.array(system.p_values, dtype=float)
+    try:
+        with np.errstate(all="ignore"):
+            start = driver.assemble(kernel, q0, float(system.time_grid[0]), p, driver.Options())
+    except (SolveError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+        return tuple(q0)
+    if start.status != driver.OK or not np.all(np.isfinite(start.q)):
+        return tuple(q0)
+    return tuple(float(v) for v in start.q)
+
+
+class _SampleKernel:
+    """Phi and the non-zeros of Phi_q as NumPy functions (sympy.lambdify over the internal
+    symbols), with the few Kernel attributes the driver's assembly reads."""
+
+    def __init__(self, system: System, pattern: Sequence[tuple[int, int]]) -> None:
+        internal = _internal_symbols(system)
+        arguments = ([internal[s] for s in system.q], internal[system.t],
+                     [internal[s] for s in system.p])
+        self.coordinates = system.coordinates
+        self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
+        self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
+        self._phi = sp.lambdify(arguments, [_prepare(e, internal) for e in system.phi],
+                                modules="numpy")
+        self._nz = sp.lambdify(arguments, [_prepare(system.phi_q[r, c], internal)
+                                           for r, c in pattern], modules="numpy")
+        self._p = np.array(system.p_values, dtype=float)
+
+    def phi(self, q: Any, t: float, p: Any = None) -> np.ndarray:
+        return np.array(self._phi(q, t, self._p if p is None else p), dtype=float)
+
+    def phi_q_nz(self, q: Any, t: float, p: Any = None) -> np.ndarray:
+        return np.array(self._nz(q, t, self._p if p is None else p), dtype=float)
+
+    def phi_q(self, q: Any, t: float, p: Any = None) -> np.ndarray:
+        dense = np.zeros((len(self.coordinates),) * 2)
+        dense[self.pattern_rows, self.pattern_cols] = self.phi_q_nz(q, t, p)
+        return dense
 
 
 def _internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:

@@ -130,6 +130,13 @@ def _params(kernel: Any, params: Mapping[str, float] | ArrayLike | None) -> Arra
 
 # ----- linear algebra ------------------------------------------------------------------------
 
+SPARSE_FROM = 100
+"""Phi_q with this many coordinates or more is factored as a sparse matrix (SuperLU through
+scipy.sparse.linalg.splu): a dense factorization costs O(N^3) and its N x N array O(N^2)
+memory, while Phi_q has at most about six non-zeros a row (chapter section 2.7). Below it,
+LAPACK on the dense matrix is faster than building a sparse one."""
+
+
 @dataclass(frozen=True)
 class Factors:
     """LU factors of Phi_q with partial pivoting, and the pivot-ratio singularity estimate."""
@@ -143,16 +150,57 @@ class Factors:
         return x
 
 
+@dataclass(frozen=True)
+class SparseFactors:
+    """Sparse LU factors of Phi_q (SuperLU, partial pivoting by rows, fill-reducing column
+    order) with the same pivot-ratio estimate; ``lu`` is None when a pivot vanished."""
+
+    lu: Any
+    pivot_ratio: float
+
+    def solve(self, b: Array) -> Array:
+        return self.lu.solve(np.asarray(b, dtype=float))
+
+
 def factor(jacobian: Array) -> Factors:
     """Factor P Phi_q = L U (LAPACK getrf, as the C runtime does it: largest pivot in the column).
 
     A zero pivot is not an error here: it gives ratio 0, which the caller judges.
     """
     lu, pivots, _ = lapack.dgetrf(jacobian)
-    magnitudes = np.abs(np.diag(lu))
+    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))))
+
+
+def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values: Array
+                  ) -> SparseFactors:
+    """Factor Phi_q given as its structural non-zeros (pattern order), in O(non-zeros + fill)."""
+    from scipy.sparse import csc_matrix
+    from scipy.sparse.linalg import splu
+
+    if not np.all(np.isfinite(values)):
+        return SparseFactors(None, 0.0)
+    matrix = csc_matrix((values, (rows, cols)), shape=(n, n))
+    try:
+        lu = splu(matrix)
+    except RuntimeError:  # SuperLU: "Factor is exactly singular"
+        return SparseFactors(None, 0.0)
+    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())))
+
+
+def factor_at(kernel: Any, q: Array, t: float, p: Array) -> Factors | SparseFactors:
+    """Factor Phi_q(q, t): dense below SPARSE_FROM coordinates, sparse from there on."""
+    n = len(kernel.coordinates)
+    if n < SPARSE_FROM:
+        return factor(kernel.phi_q(q, t, p))
+    return factor_sparse(n, kernel.pattern_rows, kernel.pattern_cols,
+                         np.asarray(kernel.phi_q_nz(q, t, p), dtype=float))
+
+
+def _ratio(magnitudes: Array) -> float:
+    """min |u_kk| / max |u_kk|; 0 when a pivot vanished or is not finite."""
     largest = magnitudes.max(initial=0.0)
     ratio = float(magnitudes.min() / largest) if largest > 0 else 0.0
-    return Factors(lu, pivots, ratio if math.isfinite(ratio) else 0.0)
+    return ratio if math.isfinite(ratio) else 0.0
 
 
 def dependent_rows(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8) -> list[str]:
@@ -181,7 +229,7 @@ class Newton:
     status: int
     iterations: int
     residual: float
-    factors: Factors | None
+    factors: Factors | SparseFactors | None
 
 
 def newton(kernel: Any, q: Array, t: float, p: Array, options: Options) -> Newton:
@@ -198,7 +246,7 @@ def newton(kernel: Any, q: Array, t: float, p: Array, options: Options) -> Newto
         residual = float(np.abs(phi).max(initial=0.0))
         if not math.isfinite(residual):
             return Newton(q, NO_CONVERGENCE, iteration, residual, None)
-        factors = factor(kernel.phi_q(q, t, p))
+        factors = factor_at(kernel, q, t, p)
         if factors.pivot_ratio < options.min_pivot_ratio:
             return Newton(q, SINGULAR, iteration, residual, factors)
         if residual <= options.tol_phi and (iteration == 0 or step <= options.tol_dq):
@@ -265,6 +313,7 @@ class _Run:
     dq: Array
     d2q: Array
     done: int = 0
+    fallbacks: int = 0  # the generated sparse LU's fall-backs to dense LU (C solver)
 
 
 def _python_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
@@ -315,9 +364,12 @@ def _c_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
     c_options.max_iterations, c_options.min_pivot_ratio = options.max_iterations, \
         options.min_pivot_ratio
     state = ffi.new(f"{name}_state *")
-    work = ffi.new(f"{name}_workspace *")
+    # The solver initialises its workspace on the first step, so it is not zero-filled here:
+    # with the sparse LU it holds an N x N dense fall-back buffer that is rarely touched.
+    work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
     report = ffi.new(f"{name}_report *")
     dtype = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
+    direct = dtype == np.float64  # the C solver writes straight into the result arrays
     pbuf = ffi.new(f"{name}_real[]", max(p.size, 1))
     pbuf[0:p.size] = p.tolist()
     state.q[0:q.size] = q.tolist()
@@ -327,16 +379,19 @@ def _c_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
     for start in range(0, run.t.size, chunk):
         stop = min(start + chunk, run.t.size)
         times = np.ascontiguousarray(run.t[start:stop], dtype=dtype)
-        out = [np.zeros((stop - start, n), dtype=dtype) for _ in range(3)]
+        out = [a[start:stop] if direct else np.zeros((stop - start, n), dtype=dtype)
+               for a in (run.q, run.dq, run.d2q)]
         ptrs = [ffi.cast(f"{name}_real *", ffi.from_buffer(a)) for a in (times, *out)]
         solved = solve_grid(c_options, pbuf, stop - start, ptrs[0], state, ptrs[1], ptrs[2],
                             ptrs[3], work, report)
-        for target, source in zip((run.q, run.dq, run.d2q), out):
-            target[start:start + solved] = source[:solved]
+        if not direct:
+            for target, source in zip((run.q, run.dq, run.d2q), out):
+                target[start:start + solved] = source[:solved]
         run.done = start + solved
+        run.fallbacks = int(report.fallbacks)
         if report.status != OK:
             last = np.array(ffi.unpack(state.q, n), dtype=float)
-            factors = factor(kernel.phi_q(last, report.t, p)) if report.status == SINGULAR \
+            factors = factor_at(kernel, last, report.t, p) if report.status == SINGULAR \
                 else None
             return Newton(last, report.status, report.iterations, report.residual, factors)
         if progress is not None:
@@ -376,7 +431,8 @@ def solve(kernel: Any, t: ArrayLike | None = None, q0: ArrayLike | None = None,
         raise SolveError(f"q0 has {q.size} values; the mechanism has "
                          f"{len(kernel.coordinates)} coordinates")
     shape = (times.size, q.size)
-    run = _Run(times, np.zeros(shape), np.zeros(shape), np.zeros(shape))
+    # Rows past run.done are never exposed, so the arrays need no zero-filling.
+    run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape))
     start = assemble(kernel, q, float(times[0]), p, options)
     if start.status != OK:
         _fail(kernel, run, p, start, float(times[0]), assembling=True)
@@ -389,11 +445,15 @@ def solve(kernel: Any, t: ArrayLike | None = None, q0: ArrayLike | None = None,
 
 def _trajectory(kernel: Any, run: _Run, p: Array) -> Trajectory:
     done = run.done
-    return Trajectory(t=run.t[:done].copy(), q=run.q[:done].copy(), dq=run.dq[:done].copy(),
-                      d2q=run.d2q[:done].copy(), coordinates=tuple(kernel.coordinates),
+
+    def solved(a: Array) -> Array:  # the run's own arrays (never the caller's): no copy
+        return a if done == a.shape[0] else a[:done].copy()
+
+    return Trajectory(t=run.t[:done].copy(), q=solved(run.q), dq=solved(run.dq),
+                      d2q=solved(run.d2q), coordinates=tuple(kernel.coordinates),
                       points=tuple(tuple(point) for point in kernel.points),
                       point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
-                      params=p.copy())
+                      params=p.copy(), lu_fallbacks=run.fallbacks)
 
 
 def _fail(kernel: Any, run: _Run, p: Array, result: Newton, t: float, assembling: bool) -> None:

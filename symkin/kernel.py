@@ -41,8 +41,10 @@ class Kernel:
     """
 
     def __init__(self, backend: str, meta: Mapping[str, Any], functions: _Functions,
-                 ffi: Any = None, lib: Any = None) -> None:
+                 ffi: Any = None, lib: Any = None, folder: Path | None = None) -> None:
         self.backend = backend
+        # The cache folder the kernel was loaded from (None for one built elsewhere).
+        self.folder = folder
         self.name: str = meta["name"]
         self.coordinates: tuple[str, ...] = tuple(meta["coordinates"])
         self.parameter_names: tuple[str, ...] = tuple(meta["parameter_names"])
@@ -164,7 +166,7 @@ class _CFunctions:
         return self._call("points", self._in(p))
 
 
-def from_module(module: ModuleType) -> Kernel:
+def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
     """A Kernel over a generated NumPy module (its metadata comes from the module)."""
     meta = {
         "name": module.NAME, "coordinates": module.COORDINATES,
@@ -173,14 +175,14 @@ def from_module(module: ModuleType) -> Kernel:
         "pattern_rows": module.PATTERN_ROWS, "pattern_cols": module.PATTERN_COLS,
         "points": module.POINTS,
     }
-    return Kernel("numpy", meta, _ModuleFunctions(module))
+    return Kernel("numpy", meta, _ModuleFunctions(module), folder=folder)
 
 
-def from_cffi(ffi: Any, lib: Any, meta: Mapping[str, Any]) -> Kernel:
+def from_cffi(ffi: Any, lib: Any, meta: Mapping[str, Any], folder: Path | None = None) -> Kernel:
     """A Kernel over a cffi extension built from the generated C; ``meta`` is the manifest."""
     functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
                             len(meta["pattern_rows"]), len(meta["points"]))
-    return Kernel("c", meta, functions, ffi=ffi, lib=lib)
+    return Kernel("c", meta, functions, ffi=ffi, lib=lib, folder=folder)
 
 
 def load(folder: str | Path) -> Kernel:
@@ -195,15 +197,30 @@ def load(folder: str | Path) -> Kernel:
         source = folder / f"{meta['name']}.py"
         digest = hashlib.sha256(source.read_bytes()).hexdigest()
         module = import_file(f"_symkin_{meta['name']}_py_{digest[:20]}", source, None)
-        return from_module(module)
-    libraries = sorted(folder.glob(f"_symkin_{meta['name']}_*{_EXTENSION_SUFFIX}"))
-    if not libraries:
-        raise FileNotFoundError(f"{folder} holds no compiled extension; build it with "
+        return from_module(module, folder)
+    library = extension_file(folder, meta["name"])
+    name = library.name[: -len(_EXTENSION_SUFFIX)]
+    loader = importlib.machinery.ExtensionFileLoader(name, str(library))
+    module = import_file(name, library, loader)
+    return from_cffi(module.ffi, module.lib, meta, folder)
+
+
+def extension_file(folder: Path, name: str | None = None) -> Path:
+    """The compiled extension in a C kernel folder.
+
+    A build-cache folder is named after its module, so that file is the one; any other folder
+    must hold exactly one ``_symkin_<name>_*`` extension.
+    """
+    own = folder / (folder.name + _EXTENSION_SUFFIX)
+    if own.is_file():
+        return own
+    pattern = f"_symkin_{name or ''}{'_' if name else ''}*{_EXTENSION_SUFFIX}"
+    libraries = sorted(folder.glob(pattern))
+    if len(libraries) != 1:
+        found = "no" if not libraries else "more than one"
+        raise FileNotFoundError(f"{folder} holds {found} compiled extension; build it with "
                                 "symkin.compile")
-    name = libraries[0].name[: -len(_EXTENSION_SUFFIX)]
-    loader = importlib.machinery.ExtensionFileLoader(name, str(libraries[0]))
-    module = import_file(name, libraries[0], loader)
-    return from_cffi(module.ffi, module.lib, meta)
+    return libraries[0]
 
 
 def import_file(name: str, path: Path, loader: Any) -> ModuleType:

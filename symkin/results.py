@@ -58,6 +58,8 @@ class Trajectory:
         points: the named points as (body, point), in file order.
         point_vectors: their local vectors s at the solved parameter values, shape (P, 2).
         params: the parameter values solved with.
+        lu_fallbacks: factorizations of the generated C solver whose sparse LU left its fixed
+            pivot order for the dense partial-pivoting path (always 0 elsewhere).
     """
 
     t: NDArray[np.float64]
@@ -68,6 +70,7 @@ class Trajectory:
     points: tuple[tuple[str, str], ...] = ()
     point_vectors: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
     params: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    lu_fallbacks: int = 0
 
     @property
     def bodies(self) -> tuple[str, ...]:

@@ -1,6 +1,8 @@
 """``symkin run``: solve a mechanism over its time grid and write the results.
 
 A thin layer over symkin.derive -> symkin.compile -> symkin.solve -> Trajectory.save / plots.
+The kernel comes through the index of symkin/cache.py: a second run of an unchanged file loads
+the cached kernel and its metadata directly, and never imports SymPy, pydantic or jinja2.
 Exit status 0 on success; 1 when the solve fails (the rows solved so far are still written);
 2 for bad input (a message, never a traceback).
 """
@@ -68,11 +70,11 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def _solve_and_write(args: argparse.Namespace) -> int:
-    import symkin
-    from symkin import driver
+    from symkin import cache, driver
 
-    system = symkin.derive(args.mechanism)
-    kernel = symkin.compile(system, backend=args.backend)
+    prepared = cache.prepare(args.mechanism, cache.Options(backend=args.backend),
+                             outlines=args.animate is not None)
+    kernel = prepared.kernel
     times, problem = _times(kernel, args)
     if problem:
         return _error(f"{args.mechanism}: {problem}; change --t0/--t1", EXIT_BAD_INPUT)
@@ -82,29 +84,38 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     except driver.SolveFailure as failure:
         if progress:
             progress.finish()
-        _write(failure.trajectory, args, system)
+        _write(failure.trajectory, args, prepared.outlines)
         return _error(f"{args.mechanism}: {failure} Solved {failure.trajectory.t.size} of "
                       f"{times.size} time points; those are written.", EXIT_FAILED)
     if progress:
         progress.finish()
-    written = _write(trajectory, args, system)
+    written = _write(trajectory, args, prepared.outlines)
+    origin = ", cached kernel" if prepared.hit else ""
     print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
-          f"{trajectory.t[-1]:g} ({kernel.backend} backend)"
+          f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
+          + _fallback_note(trajectory.lu_fallbacks)
           + "".join(f"; wrote {path}" for path in written))
     return EXIT_OK
 
 
-def _write(trajectory: Any, args: argparse.Namespace, system: Any) -> list[Path]:
+def _fallback_note(count: int) -> str:
+    """How often the generated sparse LU left its fixed pivot order (results stay exact)."""
+    if not count:
+        return ""
+    return f"; {count} pivot fall-back{'s' if count != 1 else ''} to dense LU"
+
+
+def _write(trajectory: Any, args: argparse.Namespace, outlines: Any) -> list[Path]:
     """Save the results, plot and animation asked for (a partial trajectory too)."""
     try:
-        return _write_files(trajectory, args, system)
+        return _write_files(trajectory, args, outlines)
     except OSError as error:
         raise CannotWrite(f"cannot write {error.filename or 'the output'}: "
                           f"{error.strerror or error}; check the path and its permissions"
                           ) from None
 
 
-def _write_files(trajectory: Any, args: argparse.Namespace, system: Any) -> list[Path]:
+def _write_files(trajectory: Any, args: argparse.Namespace, outlines: Any) -> list[Path]:
     from symkin import plots
 
     written = []
@@ -115,7 +126,7 @@ def _write_files(trajectory: Any, args: argparse.Namespace, system: Any) -> list
     if args.plot:
         written.append(plots.plot(trajectory, args.plot))
     if args.animate:
-        written.append(plots.animate(trajectory, args.animate, plots.outlines(system)))
+        written.append(plots.animate(trajectory, args.animate, outlines))
     return written
 
 

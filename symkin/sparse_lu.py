@@ -3,9 +3,10 @@
 The pattern of Phi_q is known exactly before any number exists, so the pivot order, the fill-in
 and every floating-point operation of the factorization can be fixed once, at generation time
 (the MA28 idea: analyse once, refactor cheaply at every step). This module chooses the order
-with Markowitz's rule under a threshold test on a numeric sample of the Jacobian (usually at q0)
-and returns plain data: the straight-line list of operations of the numeric factorization and
-of the two triangular solves, with the row and column permutations baked in. The C template
+with Markowitz's rule under a threshold test on a numeric sample of the Jacobian (codegen
+takes it at the mechanism assembled at t0) and returns plain data: the straight-line list of
+operations of the numeric factorization and of the two triangular solves, with the row and
+column permutations baked in. The C template
 ``sparse_lu.c.j2`` renders that data, as straight-line code or, for very large systems, as
 index tables walked by loops. At run time each pivot is checked again (|pivot| >= tau times
 the largest entry of its active column, and above NQ eps max |Phi_q|); a failure sends the
@@ -32,7 +33,8 @@ in the sample (MA28's default)."""
 
 RUNTIME_THRESHOLD = 0.01
 """Run-time relative pivot test tau. Looser than the generation threshold so that the order
-chosen at q0 survives the motion; element growth stays below 1 + 1/tau per elimination step."""
+chosen at the sample survives the motion; element growth stays below 1 + 1/tau per
+elimination step."""
 
 
 @dataclass(frozen=True)
@@ -152,8 +154,9 @@ def analyse(n: int, rows: Sequence[int], cols: Sequence[int], sample: Sequence[f
         n: the size N of the square matrix.
         rows, cols: the structural non-zeros, in the order the values will be passed at run
             time (the order of ``<prefix>_phi_q``'s output).
-        sample: the values of those non-zeros at a representative state (e.g. Phi_q at q0);
-            pivots are chosen so that each passes the threshold test on this sample.
+        sample: the values of those non-zeros at a representative state (e.g. Phi_q of the
+            mechanism assembled at t0); pivots are chosen so that each passes the threshold
+            test on this sample.
         generation_threshold: u of the threshold test used to choose the order.
         tau: the relative pivot test applied at run time (recorded in the plan).
 

@@ -2,13 +2,15 @@
 
 Checks: C grid loop vs the Python loop on the same compiled kernel and vs the NumPy backend
 (1e-12); one step at a time through <prefix>_solve_step gives the same as the whole grid; the
-singular status; the generated folder compiles on its own with -Werror, also for Cortex-M.
+singular status; the generated folder compiles on its own with -Werror, also for Cortex-M;
+the solver initialises its own workspace; sparse-LU fall-backs are counted up to the Trajectory.
 """
 
 from __future__ import annotations
 
 import shutil
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +21,7 @@ from symkin import driver
 
 MECHANISMS = ("four_bar_test", "offset_crank_slider", "slide_driven", "point_trajectory")
 WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
 def _agree(a, b, limit: float = 1e-12) -> None:
@@ -100,13 +103,15 @@ def test_generated_folder_compiles_alone(compiler, linalg, tmp_path, crank_slide
         assert result.returncode == 0, result.stderr
 
 
-def test_solver_objects_have_no_mutable_data_and_call_no_allocator(tmp_path,
+@pytest.mark.parametrize("linalg", ["dense", "sparse"])
+def test_solver_objects_have_no_mutable_data_and_call_no_allocator(linalg, tmp_path,
                                                                    crank_slider_system) -> None:
     """nm on the compiled runtime: nothing in .data/.bss, no malloc/free/stdio imported."""
     if shutil.which("nm") is None or shutil.which("gcc") is None:
         pytest.skip("gcc and nm are needed")
-    symkin.generate(crank_slider_system, backend="c", out_dir=tmp_path)
-    for name in ("crank_slider_solver", "crank_slider_linalg"):
+    symkin.generate(crank_slider_system, backend="c", out_dir=tmp_path, linalg=linalg)
+    lu = "crank_slider_linalg" if linalg == "dense" else "crank_slider_sparse_lu"
+    for name in ("crank_slider_solver", lu):
         obj = tmp_path / f"{name}.o"
         subprocess.run(["gcc", *WARNINGS, "-O2", "-c", str(tmp_path / f"{name}.c"), "-o",
                         str(obj)], check=True)
@@ -124,3 +129,61 @@ def test_float_kernel_runs_with_looser_tolerances(crank_slider_system) -> None:
     double = driver.solve(kernel_for(crank_slider_system, "numpy"))
     assert np.abs(single.q - double.q).max() < 1e-4
     assert np.abs(single.d2q - double.d2q).max() < 1e-3
+
+
+def _fresh(ffi, ctype: str, fill: bytes):
+    """A cffi object whose bytes are all ``fill`` (the solver must not rely on zeroed memory)."""
+    obj = ffi.new_allocator(should_clear_after_alloc=False)(ctype)
+    buffer = ffi.buffer(obj)
+    buffer[:] = fill * len(buffer)
+    return obj
+
+
+@pytest.mark.parametrize("linalg", ["dense", "sparse"])
+def test_solver_initialises_its_own_workspace(linalg, crank_slider_system) -> None:
+    """A workspace full of 0xFF bytes (NaN reals, huge counters) gives the very same grid as a
+    zeroed one, and no phantom fall-backs: the first step calls <prefix>_lu_init."""
+    kernel = symkin.compile(crank_slider_system, backend="c", linalg=linalg)
+    ffi, lib = kernel.ffi, kernel.lib
+    start = driver.solve(kernel, t=[0.0]).q[0]
+    times = driver.grid(0.0, 1.5, 0.01)
+    results = []
+    for fill in (b"\x00", b"\xff"):
+        options, report = ffi.new("crank_slider_options *"), ffi.new("crank_slider_report *")
+        lib.crank_slider_default_options(options)
+        state = ffi.new("crank_slider_state *")
+        state.q[0:9] = start.tolist()
+        work = _fresh(ffi, "crank_slider_workspace *", fill)
+        q_out = np.empty((times.size, 9))
+        solved = lib.crank_slider_solve_grid(
+            options, ffi.new("crank_slider_real[]", list(kernel.p_values)), times.size,
+            ffi.cast("crank_slider_real *", ffi.from_buffer(times)), state,
+            ffi.cast("crank_slider_real *", ffi.from_buffer(q_out)), ffi.NULL, ffi.NULL, work,
+            report)
+        assert solved == times.size and report.status == 0 and report.fallbacks == 0
+        results.append(q_out)
+    assert np.array_equal(results[0], results[1])
+
+
+def test_fallbacks_are_counted_and_reach_the_trajectory() -> None:
+    """The four-bar's plan pivots on c sin(rocker.phi) with -c cos(rocker.phi) below it. A first
+    guess with rocker.phi near 0 makes that pivot fail the run-time ratio test: the first
+    factorization falls back to dense LU, Newton still converges to the assembly that LAPACK's
+    Newton reaches from the same guess, and the count reaches report and Trajectory."""
+    system = symkin.derive(EXAMPLES / "four_bar.yaml")
+    kernel = symkin.compile(system, backend="c", linalg="sparse")
+    assembled = driver.solve(kernel, t=[0.0]).q[0]
+    guess = assembled.copy()
+    guess[8] = 1e-3  # rocker.phi: sin ~ 1e-3, cos ~ 1
+    p = np.array(kernel.p_values)
+    reference = driver.newton(kernel_for(system, "numpy"), guess, 0.0, p, driver.Options())
+    assert reference.status == driver.OK
+    times = np.array([0.0, 0.01, 0.02])
+    run = driver._Run(times, *(np.empty((3, 9)) for _ in range(3)))
+    result = driver._c_loop(kernel, run, guess, p, driver.Options(), None)
+    assert result.status == driver.OK and run.done == 3 and run.fallbacks >= 1
+    assert np.abs(run.q[0] - reference.q).max() <= 1e-10
+    assert np.abs(kernel.phi(run.q[0], 0.0)).max() <= 1e-10
+    assert driver._trajectory(kernel, run, p).lu_fallbacks == run.fallbacks
+    # the ordinary path, assembled first in Python, never needs the fall-back
+    assert driver.solve(kernel).lu_fallbacks == 0

@@ -18,7 +18,7 @@ const all_drivers_real all_drivers_q0[ALL_DRIVERS_NQ] = { 0.0, 0.0, -0.201, 1.96
     0.139, 0.0 };
 const all_drivers_real all_drivers_p_nominal[ALL_DRIVERS_NP] = { 2.0, 1.5, 2.0, 1.0, 0.5, 0.5, 0.3, 6.283185307179586 };
 
-void all_drivers_phi(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[], all_drivers_real out[])
+void all_drivers_phi(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[], all_drivers_real *restrict out)
 {
     const all_drivers_real w0 = sin(q[5]);
     const all_drivers_real w1 = q[3] - q[6];
@@ -46,7 +46,7 @@ void all_drivers_phi(const all_drivers_real q[], all_drivers_real t, const all_d
     out[14] = q[14] + (1.0/2.0)*(t*t) - w4;  /* drivers[5] spin angle tracer-ground (angle) */
 }
 
-void all_drivers_phi_q(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[], all_drivers_real nz[])
+void all_drivers_phi_q(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[], all_drivers_real *restrict nz)
 {
     (void)t;
     const all_drivers_real w0 = sin(q[5]);
@@ -98,7 +98,7 @@ void all_drivers_phi_q(const all_drivers_real q[], all_drivers_real t, const all
     nz[40] = 1;  /* (14, 14) */
 }
 
-void all_drivers_phi_t(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[], all_drivers_real out[])
+void all_drivers_phi_t(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[], all_drivers_real *restrict out)
 {
     (void)q;
     const all_drivers_real w0 = p[7]*t;
@@ -123,7 +123,7 @@ void all_drivers_phi_t(const all_drivers_real q[], all_drivers_real t, const all
     out[14] = -p[7] + t;  /* drivers[5] spin angle tracer-ground (angle) */
 }
 
-void all_drivers_gamma(const all_drivers_real q[], const all_drivers_real dq[], all_drivers_real t, const all_drivers_real p[], all_drivers_real out[])
+void all_drivers_gamma(const all_drivers_real q[], const all_drivers_real dq[], all_drivers_real t, const all_drivers_real p[], all_drivers_real *restrict out)
 {
     const all_drivers_real w0 = (dq[2]*dq[2])*p[0];
     const all_drivers_real w1 = cos(q[5]);
@@ -166,7 +166,7 @@ void all_drivers_gamma(const all_drivers_real q[], const all_drivers_real dq[], 
     out[14] = -1;  /* drivers[5] spin angle tracer-ground (angle) */
 }
 
-void all_drivers_points(const all_drivers_real p[], all_drivers_real out[])
+void all_drivers_points(const all_drivers_real p[], all_drivers_real *restrict out)
 {
     out[0] = p[0];  /* arm1.elbow.x */
     out[1] = 0;  /* arm1.elbow.y */

@@ -69,6 +69,8 @@ extern const all_drivers_real all_drivers_q0[ALL_DRIVERS_NQ];
 /* Nominal parameter values. */
 extern const all_drivers_real all_drivers_p_nominal[ALL_DRIVERS_NP];
 
+/* Every output array (out, nz) must not overlap an input array (q, dq, p). */
+
 /* Phi(q, t): out[NQ]. */
 void all_drivers_phi(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[], all_drivers_real out[]);
 

@@ -11,7 +11,7 @@
 #ifndef ALL_DRIVERS_SOLVER_H
 #define ALL_DRIVERS_SOLVER_H
 
-#include "all_drivers_linalg.h"
+#include "all_drivers_sparse_lu.h"
 
 #define ALL_DRIVERS_OK 0             /* converged */
 #define ALL_DRIVERS_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
@@ -30,10 +30,13 @@ typedef struct {
     all_drivers_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
     int pivot;                   /* singular: the zero pivot's column, else -1    */
+    unsigned long fallbacks;     /* factorizations since the first step that left */
+                                 /* the sparse LU's fixed pivot order (0 for dense) */
 } all_drivers_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
- * before the first step; the first step makes no prediction. */
+ * before the first step; the first step makes no prediction and initialises the workspace
+ * (all_drivers_lu_init), so the workspace needs no zero-filling by the caller. */
 typedef struct {
     all_drivers_real q[ALL_DRIVERS_NQ];
     all_drivers_real dq[ALL_DRIVERS_NQ];
@@ -45,8 +48,7 @@ typedef struct {
 typedef struct {
     all_drivers_lu lu;
     all_drivers_real nz[ALL_DRIVERS_NNZ];
-    all_drivers_real phi[ALL_DRIVERS_NQ];
-    all_drivers_real rhs[ALL_DRIVERS_NQ];
+    all_drivers_real phi[ALL_DRIVERS_NQ]; /* Phi, then the Newton step */
 } all_drivers_workspace;
 
 /* Tolerances suited to the real type. */

@@ -15,7 +15,7 @@ const int crank_slider_phi_q_col[CRANK_SLIDER_NNZ] = { 0, 1, 0, 2, 3, 1, 2, 4, 3
 const crank_slider_real crank_slider_q0[CRANK_SLIDER_NQ] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 };
 const crank_slider_real crank_slider_p_nominal[CRANK_SLIDER_NP] = { 1.0, 5.0, 4.0 };
 
-void crank_slider_phi(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[], crank_slider_real out[])
+void crank_slider_phi(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[], crank_slider_real *restrict out)
 {
     out[0] = -q[0];  /* joints[0] revolute ground-crank (x) */
     out[1] = -q[1];  /* joints[0] revolute ground-crank (y) */
@@ -28,7 +28,7 @@ void crank_slider_phi(const crank_slider_real q[], crank_slider_real t, const cr
     out[8] = q[2] - (t*t) - 1.0/2.0*3.141592653589793;  /* drivers[0] angle crank-ground (angle) */
 }
 
-void crank_slider_phi_q(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[], crank_slider_real nz[])
+void crank_slider_phi_q(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[], crank_slider_real *restrict nz)
 {
     (void)t;
     nz[0] = -1;  /* (0, 0) */
@@ -50,7 +50,7 @@ void crank_slider_phi_q(const crank_slider_real q[], crank_slider_real t, const 
     nz[16] = 1;  /* (8, 2) */
 }
 
-void crank_slider_phi_t(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[], crank_slider_real out[])
+void crank_slider_phi_t(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[], crank_slider_real *restrict out)
 {
     (void)q;
     (void)p;
@@ -65,7 +65,7 @@ void crank_slider_phi_t(const crank_slider_real q[], crank_slider_real t, const 
     out[8] = -2*t;  /* drivers[0] angle crank-ground (angle) */
 }
 
-void crank_slider_gamma(const crank_slider_real q[], const crank_slider_real dq[], crank_slider_real t, const crank_slider_real p[], crank_slider_real out[])
+void crank_slider_gamma(const crank_slider_real q[], const crank_slider_real dq[], crank_slider_real t, const crank_slider_real p[], crank_slider_real *restrict out)
 {
     (void)t;
     const crank_slider_real w0 = (dq[2]*dq[2])*p[0];
@@ -81,7 +81,7 @@ void crank_slider_gamma(const crank_slider_real q[], const crank_slider_real dq[
     out[8] = 2;  /* drivers[0] angle crank-ground (angle) */
 }
 
-void crank_slider_points(const crank_slider_real p[], crank_slider_real out[])
+void crank_slider_points(const crank_slider_real p[], crank_slider_real *restrict out)
 {
     out[0] = p[0];  /* crank.tip.x */
     out[1] = 0;  /* crank.tip.y */

@@ -52,6 +52,8 @@ extern const crank_slider_real crank_slider_q0[CRANK_SLIDER_NQ];
 /* Nominal parameter values. */
 extern const crank_slider_real crank_slider_p_nominal[CRANK_SLIDER_NP];
 
+/* Every output array (out, nz) must not overlap an input array (q, dq, p). */
+
 /* Phi(q, t): out[NQ]. */
 void crank_slider_phi(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[], crank_slider_real out[]);
 

@@ -11,7 +11,7 @@
 #ifndef CRANK_SLIDER_SOLVER_H
 #define CRANK_SLIDER_SOLVER_H
 
-#include "crank_slider_linalg.h"
+#include "crank_slider_sparse_lu.h"
 
 #define CRANK_SLIDER_OK 0             /* converged */
 #define CRANK_SLIDER_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
@@ -30,10 +30,13 @@ typedef struct {
     crank_slider_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
     int pivot;                   /* singular: the zero pivot's column, else -1    */
+    unsigned long fallbacks;     /* factorizations since the first step that left */
+                                 /* the sparse LU's fixed pivot order (0 for dense) */
 } crank_slider_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
- * before the first step; the first step makes no prediction. */
+ * before the first step; the first step makes no prediction and initialises the workspace
+ * (crank_slider_lu_init), so the workspace needs no zero-filling by the caller. */
 typedef struct {
     crank_slider_real q[CRANK_SLIDER_NQ];
     crank_slider_real dq[CRANK_SLIDER_NQ];
@@ -45,8 +48,7 @@ typedef struct {
 typedef struct {
     crank_slider_lu lu;
     crank_slider_real nz[CRANK_SLIDER_NNZ];
-    crank_slider_real phi[CRANK_SLIDER_NQ];
-    crank_slider_real rhs[CRANK_SLIDER_NQ];
+    crank_slider_real phi[CRANK_SLIDER_NQ]; /* Phi, then the Newton step */
 } crank_slider_workspace;
 
 /* Tolerances suited to the real type. */

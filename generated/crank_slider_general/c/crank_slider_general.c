@@ -16,7 +16,7 @@ const crank_slider_general_real crank_slider_general_q0[CRANK_SLIDER_GENERAL_NQ]
 const crank_slider_general_real crank_slider_general_p_nominal[CRANK_SLIDER_GENERAL_NP] = { 1.0, 5.0, 4.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0,
     0.0, 0.0 };
 
-void crank_slider_general_phi(const crank_slider_general_real q[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real out[])
+void crank_slider_general_phi(const crank_slider_general_real q[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real *restrict out)
 {
     const crank_slider_general_real w0 = sin(q[2]);
     const crank_slider_general_real w1 = cos(q[2]);
@@ -35,7 +35,7 @@ void crank_slider_general_phi(const crank_slider_general_real q[], crank_slider_
     out[8] = q[2] - (t*t) - 1.0/2.0*3.141592653589793;  /* drivers[0] angle crank-ground (angle) */
 }
 
-void crank_slider_general_phi_q(const crank_slider_general_real q[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real nz[])
+void crank_slider_general_phi_q(const crank_slider_general_real q[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real *restrict nz)
 {
     (void)t;
     const crank_slider_general_real w0 = sin(q[2]);
@@ -71,7 +71,7 @@ void crank_slider_general_phi_q(const crank_slider_general_real q[], crank_slide
     nz[24] = 1;  /* (8, 2) */
 }
 
-void crank_slider_general_phi_t(const crank_slider_general_real q[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real out[])
+void crank_slider_general_phi_t(const crank_slider_general_real q[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real *restrict out)
 {
     (void)q;
     (void)p;
@@ -86,7 +86,7 @@ void crank_slider_general_phi_t(const crank_slider_general_real q[], crank_slide
     out[8] = -2*t;  /* drivers[0] angle crank-ground (angle) */
 }
 
-void crank_slider_general_gamma(const crank_slider_general_real q[], const crank_slider_general_real dq[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real out[])
+void crank_slider_general_gamma(const crank_slider_general_real q[], const crank_slider_general_real dq[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real *restrict out)
 {
     (void)t;
     const crank_slider_general_real w0 = (dq[2]*dq[2]);
@@ -109,7 +109,7 @@ void crank_slider_general_gamma(const crank_slider_general_real q[], const crank
     out[8] = 2;  /* drivers[0] angle crank-ground (angle) */
 }
 
-void crank_slider_general_points(const crank_slider_general_real p[], crank_slider_general_real out[])
+void crank_slider_general_points(const crank_slider_general_real p[], crank_slider_general_real *restrict out)
 {
     out[0] = p[0];  /* crank.tip.x */
     out[1] = p[7];  /* crank.tip.y */

@@ -68,6 +68,8 @@ extern const crank_slider_general_real crank_slider_general_q0[CRANK_SLIDER_GENE
 /* Nominal parameter values. */
 extern const crank_slider_general_real crank_slider_general_p_nominal[CRANK_SLIDER_GENERAL_NP];
 
+/* Every output array (out, nz) must not overlap an input array (q, dq, p). */
+
 /* Phi(q, t): out[NQ]. */
 void crank_slider_general_phi(const crank_slider_general_real q[], crank_slider_general_real t, const crank_slider_general_real p[], crank_slider_general_real out[]);
 

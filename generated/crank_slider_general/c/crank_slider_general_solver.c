@@ -3,6 +3,7 @@
  * Mechanism spec sha256: d45e498d6e7303519fff54f59a37dbaf7775b167763481e16b0c13392ef1bd92
  */
 #include <math.h> /* fabs */
+#include <string.h> /* memcpy */
 
 #include "crank_slider_general_solver.h"
 
@@ -19,17 +20,17 @@ void crank_slider_general_default_options(crank_slider_general_options *options)
     options->min_pivot_ratio = single ? (real)1e-6 : (real)1e-10;
 }
 
+/* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static real max_abs(const real v[])
 {
     real largest = 0;
-    int i;
+    int i, nan = 0;
     for (i = 0; i < N; ++i) {
         real a = fabs(v[i]);
-        if (a > largest || a != a) { /* a NaN wins, so it is reported */
-            largest = a;
-        }
+        largest = a > largest ? a : largest; /* branch-free max */
+        nan |= a != a;
     }
-    return largest;
+    return nan ? (real)NAN : largest;
 }
 
 /* Factor Phi_q(q, t) into work->lu; SINGULAR when a pivot vanishes or the pivots spread too far. */
@@ -76,13 +77,13 @@ static int newton(const crank_slider_general_options *options, const real p[], r
             break;
         }
         for (i = 0; i < N; ++i) {
-            work->rhs[i] = -work->phi[i];
+            work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
-        crank_slider_general_lu_solve(&work->lu, work->rhs);
+        crank_slider_general_lu_solve(&work->lu, work->phi);
         for (i = 0; i < N; ++i) {
-            q[i] += work->rhs[i];
+            q[i] += work->phi[i];
         }
-        step = max_abs(work->rhs);
+        step = max_abs(work->phi);
     }
     return CRANK_SLIDER_GENERAL_NO_CONVERGENCE;
 }
@@ -103,36 +104,32 @@ int crank_slider_general_solve_step(const crank_slider_general_options *options,
     int i;
     if (state->started) {
         predict(t, state);
+    } else {
+        crank_slider_general_lu_init(&work->lu); /* the caller's workspace may hold anything */
     }
     report->status = newton(options, p, t, state->q, work, report);
+    report->fallbacks = crank_slider_general_lu_fallbacks(&work->lu);
     if (report->status != CRANK_SLIDER_GENERAL_OK) {
         return report->status;
     }
-    crank_slider_general_phi_t(state->q, t, p, work->rhs);
+    /* Both right-hand sides are formed and solved in place in the state: no copies. */
+    crank_slider_general_phi_t(state->q, t, p, state->dq);
     for (i = 0; i < N; ++i) {
-        work->rhs[i] = -work->rhs[i];
+        state->dq[i] = -state->dq[i];
     }
-    crank_slider_general_lu_solve(&work->lu, work->rhs); /* (2.73) */
-    for (i = 0; i < N; ++i) {
-        state->dq[i] = work->rhs[i];
-    }
-    crank_slider_general_gamma(state->q, state->dq, t, p, work->rhs);
-    crank_slider_general_lu_solve(&work->lu, work->rhs); /* (2.74), the same factors */
-    for (i = 0; i < N; ++i) {
-        state->ddq[i] = work->rhs[i];
-    }
+    crank_slider_general_lu_solve(&work->lu, state->dq); /* (2.73) */
+    crank_slider_general_gamma(state->q, state->dq, t, p, state->ddq);
+    crank_slider_general_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
     state->t = t;
     state->started = 1;
     return CRANK_SLIDER_GENERAL_OK;
 }
 
+/* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
 static void store(real out[], int k, const real v[])
 {
-    int i;
     if (out) {
-        for (i = 0; i < N; ++i) {
-            out[k * N + i] = v[i];
-        }
+        memcpy(out + (size_t)k * N, v, N * sizeof v[0]);
     }
 }
 

@@ -15,7 +15,7 @@ const int custom_driver_phi_q_col[CUSTOM_DRIVER_NNZ] = { 0, 1, 0, 2, 3, 1, 2, 4,
 const custom_driver_real custom_driver_q0[CUSTOM_DRIVER_NQ] = { 0.0, 0.0, 0.785, 0.707, 0.707, -0.203, 4.135, 0.0, 0.0 };
 const custom_driver_real custom_driver_p_nominal[CUSTOM_DRIVER_NP] = { 1.0, 3.5, 6.283185307179586, 0.2, 0.7853981633974483 };
 
-void custom_driver_phi(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real out[])
+void custom_driver_phi(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real *restrict out)
 {
     const custom_driver_real w0 = p[0]*cos(q[2]) + q[0];
     const custom_driver_real w1 = p[0]*sin(q[2]) + q[1];
@@ -32,7 +32,7 @@ void custom_driver_phi(const custom_driver_real q[], custom_driver_real t, const
     out[8] = w0*sin(w4) - w1*cos(w4);  /* drivers[0] slotted_guide custom crank (equation 0) */
 }
 
-void custom_driver_phi_q(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real nz[])
+void custom_driver_phi_q(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real *restrict nz)
 {
     const custom_driver_real w0 = p[0]*sin(q[2]);
     const custom_driver_real w1 = p[0]*cos(q[2]);
@@ -61,7 +61,7 @@ void custom_driver_phi_q(const custom_driver_real q[], custom_driver_real t, con
     nz[18] = -w0*w4 - w1*w5;  /* (8, 2) */
 }
 
-void custom_driver_phi_t(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real out[])
+void custom_driver_phi_t(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real *restrict out)
 {
     const custom_driver_real w0 = p[2]*t;
     const custom_driver_real w1 = p[2]*p[3]*cos(w0) + p[2];
@@ -77,7 +77,7 @@ void custom_driver_phi_t(const custom_driver_real q[], custom_driver_real t, con
     out[8] = w1*(p[0]*sin(q[2]) + q[1])*sin(w2) + w1*(p[0]*cos(q[2]) + q[0])*cos(w2);  /* drivers[0] slotted_guide custom crank (equation 0) */
 }
 
-void custom_driver_gamma(const custom_driver_real q[], const custom_driver_real dq[], custom_driver_real t, const custom_driver_real p[], custom_driver_real out[])
+void custom_driver_gamma(const custom_driver_real q[], const custom_driver_real dq[], custom_driver_real t, const custom_driver_real p[], custom_driver_real *restrict out)
 {
     const custom_driver_real w0 = (dq[2]*dq[2]);
     const custom_driver_real w1 = cos(q[2]);
@@ -107,7 +107,7 @@ void custom_driver_gamma(const custom_driver_real q[], const custom_driver_real 
     out[8] = -dq[0]*w10*w8 - dq[1]*w10*w11 - 2*dq[2]*(p[0]*w1*w11*w9 - w16*w9) + p[3]*w11*w12*w13*w6 + p[3]*w12*w14*w6*w8 - w0*(-w11*w2 + w16) + w11*w14*w15 - w13*w15*w8;  /* drivers[0] slotted_guide custom crank (equation 0) */
 }
 
-void custom_driver_points(const custom_driver_real p[], custom_driver_real out[])
+void custom_driver_points(const custom_driver_real p[], custom_driver_real *restrict out)
 {
     out[0] = p[0];  /* crank.A.x */
     out[1] = 0;  /* crank.A.y */

@@ -54,6 +54,8 @@ extern const custom_driver_real custom_driver_q0[CUSTOM_DRIVER_NQ];
 /* Nominal parameter values. */
 extern const custom_driver_real custom_driver_p_nominal[CUSTOM_DRIVER_NP];
 
+/* Every output array (out, nz) must not overlap an input array (q, dq, p). */
+
 /* Phi(q, t): out[NQ]. */
 void custom_driver_phi(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real out[]);
 

@@ -11,7 +11,7 @@
 #ifndef CUSTOM_DRIVER_SOLVER_H
 #define CUSTOM_DRIVER_SOLVER_H
 
-#include "custom_driver_linalg.h"
+#include "custom_driver_sparse_lu.h"
 
 #define CUSTOM_DRIVER_OK 0             /* converged */
 #define CUSTOM_DRIVER_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
@@ -30,10 +30,13 @@ typedef struct {
     custom_driver_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
     int pivot;                   /* singular: the zero pivot's column, else -1    */
+    unsigned long fallbacks;     /* factorizations since the first step that left */
+                                 /* the sparse LU's fixed pivot order (0 for dense) */
 } custom_driver_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
- * before the first step; the first step makes no prediction. */
+ * before the first step; the first step makes no prediction and initialises the workspace
+ * (custom_driver_lu_init), so the workspace needs no zero-filling by the caller. */
 typedef struct {
     custom_driver_real q[CUSTOM_DRIVER_NQ];
     custom_driver_real dq[CUSTOM_DRIVER_NQ];
@@ -45,8 +48,7 @@ typedef struct {
 typedef struct {
     custom_driver_lu lu;
     custom_driver_real nz[CUSTOM_DRIVER_NNZ];
-    custom_driver_real phi[CUSTOM_DRIVER_NQ];
-    custom_driver_real rhs[CUSTOM_DRIVER_NQ];
+    custom_driver_real phi[CUSTOM_DRIVER_NQ]; /* Phi, then the Newton step */
 } custom_driver_workspace;
 
 /* Tolerances suited to the real type. */

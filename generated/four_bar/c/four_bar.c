@@ -15,7 +15,7 @@ const int four_bar_phi_q_col[FOUR_BAR_NNZ] = { 0, 1, 0, 2, 3, 1, 2, 4, 3, 5, 6, 
 const four_bar_real four_bar_q0[FOUR_BAR_NQ] = { 0.0, 0.0, 1.571, 0.0, 1.0, 0.48, 4.5, 0.0, 1.89 };
 const four_bar_real four_bar_p_nominal[FOUR_BAR_NP] = { 1.0, 4.0, 3.0, 4.5, 6.283185307179586, 1.5707963267948966 };
 
-void four_bar_phi(const four_bar_real q[], four_bar_real t, const four_bar_real p[], four_bar_real out[])
+void four_bar_phi(const four_bar_real q[], four_bar_real t, const four_bar_real p[], four_bar_real *restrict out)
 {
     out[0] = -q[0];  /* joints[0] O2 revolute ground-crank (x) */
     out[1] = -q[1];  /* joints[0] O2 revolute ground-crank (y) */
@@ -28,7 +28,7 @@ void four_bar_phi(const four_bar_real q[], four_bar_real t, const four_bar_real 
     out[8] = -p[4]*t - p[5] + q[2];  /* drivers[0] crank_drive angle crank-ground (angle) */
 }
 
-void four_bar_phi_q(const four_bar_real q[], four_bar_real t, const four_bar_real p[], four_bar_real nz[])
+void four_bar_phi_q(const four_bar_real q[], four_bar_real t, const four_bar_real p[], four_bar_real *restrict nz)
 {
     (void)t;
     nz[0] = -1;  /* (0, 0) */
@@ -52,7 +52,7 @@ void four_bar_phi_q(const four_bar_real q[], four_bar_real t, const four_bar_rea
     nz[18] = 1;  /* (8, 2) */
 }
 
-void four_bar_phi_t(const four_bar_real q[], four_bar_real t, const four_bar_real p[], four_bar_real out[])
+void four_bar_phi_t(const four_bar_real q[], four_bar_real t, const four_bar_real p[], four_bar_real *restrict out)
 {
     (void)q;
     (void)t;
@@ -67,7 +67,7 @@ void four_bar_phi_t(const four_bar_real q[], four_bar_real t, const four_bar_rea
     out[8] = -p[4];  /* drivers[0] crank_drive angle crank-ground (angle) */
 }
 
-void four_bar_gamma(const four_bar_real q[], const four_bar_real dq[], four_bar_real t, const four_bar_real p[], four_bar_real out[])
+void four_bar_gamma(const four_bar_real q[], const four_bar_real dq[], four_bar_real t, const four_bar_real p[], four_bar_real *restrict out)
 {
     (void)t;
     const four_bar_real w0 = (dq[2]*dq[2])*p[0];
@@ -84,7 +84,7 @@ void four_bar_gamma(const four_bar_real q[], const four_bar_real dq[], four_bar_
     out[8] = 0;  /* drivers[0] crank_drive angle crank-ground (angle) */
 }
 
-void four_bar_points(const four_bar_real p[], four_bar_real out[])
+void four_bar_points(const four_bar_real p[], four_bar_real *restrict out)
 {
     out[0] = p[0];  /* crank.A.x */
     out[1] = 0;  /* crank.A.y */

@@ -55,6 +55,8 @@ extern const four_bar_real four_bar_q0[FOUR_BAR_NQ];
 /* Nominal parameter values. */
 extern const four_bar_real four_bar_p_nominal[FOUR_BAR_NP];
 
+/* Every output array (out, nz) must not overlap an input array (q, dq, p). */
+
 /* Phi(q, t): out[NQ]. */
 void four_bar_phi(const four_bar_real q[], four_bar_real t, const four_bar_real p[], four_bar_real out[]);
 

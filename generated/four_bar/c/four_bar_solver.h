@@ -11,7 +11,7 @@
 #ifndef FOUR_BAR_SOLVER_H
 #define FOUR_BAR_SOLVER_H
 
-#include "four_bar_linalg.h"
+#include "four_bar_sparse_lu.h"
 
 #define FOUR_BAR_OK 0             /* converged */
 #define FOUR_BAR_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
@@ -30,10 +30,13 @@ typedef struct {
     four_bar_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
     int pivot;                   /* singular: the zero pivot's column, else -1    */
+    unsigned long fallbacks;     /* factorizations since the first step that left */
+                                 /* the sparse LU's fixed pivot order (0 for dense) */
 } four_bar_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
- * before the first step; the first step makes no prediction. */
+ * before the first step; the first step makes no prediction and initialises the workspace
+ * (four_bar_lu_init), so the workspace needs no zero-filling by the caller. */
 typedef struct {
     four_bar_real q[FOUR_BAR_NQ];
     four_bar_real dq[FOUR_BAR_NQ];
@@ -45,8 +48,7 @@ typedef struct {
 typedef struct {
     four_bar_lu lu;
     four_bar_real nz[FOUR_BAR_NNZ];
-    four_bar_real phi[FOUR_BAR_NQ];
-    four_bar_real rhs[FOUR_BAR_NQ];
+    four_bar_real phi[FOUR_BAR_NQ]; /* Phi, then the Newton step */
 } four_bar_workspace;
 
 /* Tolerances suited to the real type. */

@@ -15,7 +15,7 @@ const int quick_return_phi_q_col[QUICK_RETURN_NNZ] = { 0, 1, 3, 4, 0, 1, 2, 3, 4
 const quick_return_real quick_return_q0[QUICK_RETURN_NQ] = { 0.0, 2.0, 0.0, 0.0, 0.0, 1.107, 2.236, 4.472, 0.54, 3.95, 5.5, 0.0 };
 const quick_return_real quick_return_p_nominal[QUICK_RETURN_NP] = { 1.0, 2.0, 5.0, 2.0, 5.5, 6.283185307179586 };
 
-void quick_return_phi(const quick_return_real q[], quick_return_real t, const quick_return_real p[], quick_return_real out[])
+void quick_return_phi(const quick_return_real q[], quick_return_real t, const quick_return_real p[], quick_return_real *restrict out)
 {
     const quick_return_real w2 = cos(q[5]);
     const quick_return_real w3 = sin(q[5]);
@@ -33,7 +33,7 @@ void quick_return_phi(const quick_return_real q[], quick_return_real t, const qu
     out[11] = -p[5]*t + q[2];  /* drivers[0] crank_drive angle crank-ground (angle) */
 }
 
-void quick_return_phi_q(const quick_return_real q[], quick_return_real t, const quick_return_real p[], quick_return_real nz[])
+void quick_return_phi_q(const quick_return_real q[], quick_return_real t, const quick_return_real p[], quick_return_real *restrict nz)
 {
     (void)t;
     const quick_return_real w0 = sin(q[5]);
@@ -67,7 +67,7 @@ void quick_return_phi_q(const quick_return_real q[], quick_return_real t, const 
     nz[24] = 1;  /* (11, 2) */
 }
 
-void quick_return_phi_t(const quick_return_real q[], quick_return_real t, const quick_return_real p[], quick_return_real out[])
+void quick_return_phi_t(const quick_return_real q[], quick_return_real t, const quick_return_real p[], quick_return_real *restrict out)
 {
     (void)q;
     (void)t;
@@ -85,7 +85,7 @@ void quick_return_phi_t(const quick_return_real q[], quick_return_real t, const 
     out[11] = -p[5];  /* drivers[0] crank_drive angle crank-ground (angle) */
 }
 
-void quick_return_gamma(const quick_return_real q[], const quick_return_real dq[], quick_return_real t, const quick_return_real p[], quick_return_real out[])
+void quick_return_gamma(const quick_return_real q[], const quick_return_real dq[], quick_return_real t, const quick_return_real p[], quick_return_real *restrict out)
 {
     (void)t;
     const quick_return_real w0 = cos(q[5]);
@@ -111,7 +111,7 @@ void quick_return_gamma(const quick_return_real q[], const quick_return_real dq[
     out[11] = 0;  /* drivers[0] crank_drive angle crank-ground (angle) */
 }
 
-void quick_return_points(const quick_return_real p[], quick_return_real out[])
+void quick_return_points(const quick_return_real p[], quick_return_real *restrict out)
 {
     out[0] = p[0];  /* crank.A.x */
     out[1] = 0;  /* crank.A.y */

@@ -61,6 +61,8 @@ extern const quick_return_real quick_return_q0[QUICK_RETURN_NQ];
 /* Nominal parameter values. */
 extern const quick_return_real quick_return_p_nominal[QUICK_RETURN_NP];
 
+/* Every output array (out, nz) must not overlap an input array (q, dq, p). */
+
 /* Phi(q, t): out[NQ]. */
 void quick_return_phi(const quick_return_real q[], quick_return_real t, const quick_return_real p[], quick_return_real out[]);
 

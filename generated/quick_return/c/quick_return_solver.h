@@ -11,7 +11,7 @@
 #ifndef QUICK_RETURN_SOLVER_H
 #define QUICK_RETURN_SOLVER_H
 
-#include "quick_return_linalg.h"
+#include "quick_return_sparse_lu.h"
 
 #define QUICK_RETURN_OK 0             /* converged */
 #define QUICK_RETURN_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
@@ -30,10 +30,13 @@ typedef struct {
     quick_return_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
     int pivot;                   /* singular: the zero pivot's column, else -1    */
+    unsigned long fallbacks;     /* factorizations since the first step that left */
+                                 /* the sparse LU's fixed pivot order (0 for dense) */
 } quick_return_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
- * before the first step; the first step makes no prediction. */
+ * before the first step; the first step makes no prediction and initialises the workspace
+ * (quick_return_lu_init), so the workspace needs no zero-filling by the caller. */
 typedef struct {
     quick_return_real q[QUICK_RETURN_NQ];
     quick_return_real dq[QUICK_RETURN_NQ];
@@ -45,8 +48,7 @@ typedef struct {
 typedef struct {
     quick_return_lu lu;
     quick_return_real nz[QUICK_RETURN_NNZ];
-    quick_return_real phi[QUICK_RETURN_NQ];
-    quick_return_real rhs[QUICK_RETURN_NQ];
+    quick_return_real phi[QUICK_RETURN_NQ]; /* Phi, then the Newton step */
 } quick_return_workspace;
 
 /* Tolerances suited to the real type. */

@@ -1,0 +1,327 @@
+"""The kernel index: from a mechanism file straight to its built kernel, without SymPy.
+
+The build cache (symkin/build.py) is keyed by the generated source, so finding a kernel there
+needs the derivation, and with it SymPy, pydantic and jinja2. This index sits in front of it:
+
+    sha256(file bytes, file format, backend, real, cse, linalg, symkin's code and templates,
+           interpreter and compiler)  ->  index/<key>.json  ->  the cache folder of the kernel
+
+Keying on the raw bytes, not on the validated spec, is what lets a warm run skip validation
+too: the same bytes read by the same symkin code validate and derive to the same kernel, so
+a file that was accepted once needs no second check. Anything else misses: an edited file,
+another backend or real type, a new symkin version or an edited template.
+
+An entry records the sha256 of every file a warm run loads. An entry that does not parse,
+does not match its key, or points at files whose hash changed is deleted (with the kernel
+folder it vouched for, so the build cache cannot hand the damaged kernel back) and the run
+takes the full pipeline again; it never fails and never loads a kernel that does not match.
+Entries are written to a temporary file and renamed, so concurrent runs see whole entries.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import os
+import shlex
+import shutil
+import sys
+import sysconfig
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin import kernel as kernel_module
+from symkin import resources
+from symkin.kernel import Kernel
+
+# Bump when the entry layout or the meaning of a key changes.
+FORMAT = 1
+INDEX_FOLDER = "index"
+MANIFEST = "manifest.json"
+_PACKAGE = Path(__file__).resolve().parent
+
+Outlines = dict[str, NDArray[np.float64]]
+
+
+@dataclass(frozen=True)
+class Options:
+    """What, besides the file, decides the kernel: see ``symkin.build.compile``."""
+
+    backend: str = "numpy"
+    real: str = "double"
+    cse: bool = True
+    linalg: str = "sparse"  # codegen.DEFAULT_LINALG (not imported: it would load SymPy)
+
+
+@dataclass
+class Prepared:
+    """A kernel ready to solve, and where it came from.
+
+    Attributes:
+        kernel: the loaded kernel.
+        hit: True when it came from the index (no validation, no derivation).
+        outlines: per body, the local vectors ``plots.animate`` draws, when asked for.
+        system: the derived System on a miss, None on a hit.
+    """
+
+    kernel: Kernel
+    hit: bool
+    outlines: Outlines | None = None
+    system: Any = None
+
+
+def prepare(mechanism: str | Path, options: Options = Options(), *, outlines: bool = False,
+            cache_dir: str | Path | None = None) -> Prepared:
+    """The kernel of a mechanism file: from the index when it can, else the full pipeline.
+
+    Args:
+        mechanism: the mechanism file (.yaml or .toml).
+        options: backend, real type, CSE and LU choice.
+        outlines: also return the body outlines for an animation (recorded in the entry, so
+            a warm run can draw without SymPy).
+        cache_dir: the cache folder; default ``$SYMKIN_CACHE_DIR`` or the user cache.
+
+    Raises:
+        MechanismError: the file is invalid (only ever on a miss: a hit was valid before).
+        BuildError: generating or compiling failed.
+    """
+    cache = Path(cache_dir) if cache_dir is not None else cache_root()
+    key = index_key(Path(mechanism), options)
+    if key is not None:
+        found = lookup(cache, key, options, need_outlines=outlines)
+        if found is not None:
+            return found
+    prepared = _full_pipeline(Path(mechanism), options, cache, outlines)
+    # Not recorded: a C request that fell back to NumPy (no compiler; the next run must try,
+    # and warn, again), and a file that changed while it was derived (the kernel may be of
+    # other bytes than the key's).
+    if (key is not None and prepared.kernel.backend == options.backend
+            and index_key(Path(mechanism), options) == key):
+        record(cache, key, prepared.kernel, prepared.outlines)
+    return prepared
+
+
+def cache_root() -> Path:
+    """``$SYMKIN_CACHE_DIR``, else the user cache folder (the same as symkin.build's)."""
+    explicit = os.environ.get("SYMKIN_CACHE_DIR")
+    if explicit:
+        return Path(explicit)
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "symkin"
+
+
+def _full_pipeline(mechanism: Path, options: Options, cache: Path,
+                   want_outlines: bool) -> Prepared:
+    from symkin import build, derivation, plots
+
+    system = derivation.derive(mechanism)
+    kernel = build.compile(system, backend=options.backend, real=options.real,
+                           cse=options.cse, linalg=options.linalg, cache_dir=cache)
+    drawn = plots.outlines(system) if want_outlines else None
+    return Prepared(kernel, hit=False, outlines=drawn, system=system)
+
+
+# ----- the key -------------------------------------------------------------------------------
+
+def index_key(mechanism: Path, options: Options) -> str | None:
+    """The index key of a file and options, or None when the file cannot be read (the full
+    pipeline then reports why)."""
+    try:
+        raw = mechanism.read_bytes()
+    except OSError:
+        return None
+    inputs = {
+        "format": FORMAT, "file_sha256": hashlib.sha256(raw).hexdigest(),
+        # The loader picks TOML or YAML by suffix: the same bytes may mean different things.
+        "file_format": "toml" if mechanism.suffix.lower() == ".toml" else "yaml",
+        "options": [options.backend, options.real, options.cse, options.linalg],
+        "code": code_version(), **environment(options.backend),
+    }
+    return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()
+
+
+@functools.cache
+def code_version() -> str:
+    """sha256 over symkin's own Python source and templates (names and contents).
+
+    Any edit to the pipeline or a template changes it, so every entry made by other code
+    misses. Hashing the source, not a version number, also covers a working tree.
+    """
+    digest = hashlib.sha256()
+    for root in sorted({_PACKAGE, resources.template_root()}):
+        for path in sorted(root.rglob("*")):
+            if path.is_file() and path.suffix != ".pyc" and "__pycache__" not in path.parts:
+                digest.update(path.relative_to(root).as_posix().encode() + b"\0")
+                digest.update(hashlib.sha256(path.read_bytes()).digest())
+    return digest.hexdigest()
+
+
+def environment(backend: str) -> dict[str, Any]:
+    """The interpreter and, for C, the compiler a kernel was built for.
+
+    The build cache keys its folders on these too; here they make sure a warm run never
+    reaches for a folder built for another interpreter or compiler.
+    """
+    found: dict[str, Any] = {"python": sys.version, "platform": sysconfig.get_platform(),
+                             "suffix": sysconfig.get_config_var("EXT_SUFFIX") or ".so"}
+    if backend == "c":
+        command = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
+        found["compiler"] = [shutil.which(command[0]) if command else None, *command]
+    return found
+
+
+# ----- entries -------------------------------------------------------------------------------
+
+def entry_path(cache: Path, key: str) -> Path:
+    return cache / INDEX_FOLDER / f"{key}.json"
+
+
+def lookup(cache: Path, key: str, options: Options, need_outlines: bool = False
+           ) -> Prepared | None:
+    """The kernel an entry points at, or None on a miss. A damaged entry is removed."""
+    path = entry_path(cache, key)
+    try:
+        entry = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):
+        _discard(path, None)
+        return None
+    folder = _named_folder(cache, entry) if _matches(entry, key, options) else None
+    if folder is None:
+        _discard(path, None)
+        return None
+    if not _intact(folder, entry["files"], options):
+        _discard(path, folder)  # the folder changed since it was recorded: never reuse it
+        return None
+    drawn = _outlines(entry.get("outlines"))
+    if need_outlines and drawn is None:
+        return None  # a valid entry without outlines: the full pipeline adds them
+    try:
+        loaded = kernel_module.load(folder)
+    except Exception:  # noqa: BLE001 — any failure to load a cached kernel means: rebuild it
+        _discard(path, folder)
+        return None
+    return Prepared(loaded, hit=True, outlines=drawn)
+
+
+def _matches(entry: Any, key: str, options: Options) -> bool:
+    """A well-formed entry of this format, key and backend."""
+    return (isinstance(entry, dict) and entry.get("format") == FORMAT
+            and entry.get("key") == key and entry.get("backend") == options.backend
+            and isinstance(entry.get("files"), dict) and MANIFEST in entry["files"])
+
+
+def _intact(folder: Path, files: dict[Any, Any], options: Options) -> bool:
+    """Every recorded file is still there with the recorded hash, and the manifest agrees."""
+    for name, expected in files.items():
+        if not (_plain_name(name) and isinstance(expected, str)
+                and _sha256(folder / name) == expected):
+            return False
+    return _manifest_matches(folder, options)
+
+
+def _manifest_matches(folder: Path, options: Options) -> bool:
+    try:
+        meta = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    wanted = {"backend": options.backend, "cse": options.cse}
+    if options.backend == "c":
+        wanted["real"] = options.real
+    return isinstance(meta, dict) and all(meta.get(k) == v for k, v in wanted.items())
+
+
+def _named_folder(cache: Path, entry: Any) -> Path | None:
+    name = entry.get("folder") if isinstance(entry, dict) else None
+    if not (isinstance(name, str) and _plain_name(name) and name.startswith("_symkin_")):
+        return None
+    return cache / name
+
+
+def _plain_name(name: Any) -> bool:
+    """A file name inside one folder: never a path, never hidden (an entry is data, not trust)."""
+    return isinstance(name, str) and name not in ("", ".", "..") and Path(name).name == name \
+        and not name.startswith(".")
+
+
+def _outlines(data: Any) -> Outlines | None:
+    if not isinstance(data, dict):
+        return None
+    try:
+        drawn = {str(body): np.array(v, dtype=float).reshape(-1, 2) for body, v in data.items()}
+    except (TypeError, ValueError):
+        return None
+    return drawn
+
+
+def record(cache: Path, key: str, built: Kernel, outlines: Outlines | None = None) -> None:
+    """Write the entry of ``key`` for a kernel the build cache holds (atomic replace).
+
+    Failing to write the index only costs the next run a derivation, so it is not an error.
+    """
+    folder = built.folder
+    if folder is None:
+        return
+    files = {name: _sha256(folder / name) for name in _loaded_files(built, folder)}
+    if any(digest is None for digest in files.values()):
+        return
+    entry = {"format": FORMAT, "key": key, "backend": built.backend, "folder": folder.name,
+             "files": files}
+    if outlines is not None:
+        entry["outlines"] = {body: np.asarray(v, dtype=float).tolist()
+                             for body, v in outlines.items()}
+    try:
+        _write_atomic(entry_path(cache, key), json.dumps(entry, indent=1, sort_keys=True))
+    except OSError:
+        pass
+
+
+def _loaded_files(built: Kernel, folder: Path) -> list[str]:
+    """The files ``kernel.load`` reads: the manifest and the module or extension."""
+    if built.backend == "numpy":
+        return [MANIFEST, f"{built.name}.py"]
+    return [MANIFEST, kernel_module.extension_file(folder).name]
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+
+
+def _discard(entry: Path, folder: Path | None) -> None:
+    """Remove a damaged entry and the kernel folder it vouched for.
+
+    The folder is renamed away first (one atomic step), so a concurrent build republishes a
+    whole folder instead of finding a half-deleted one.
+    """
+    entry.unlink(missing_ok=True)
+    if folder is None or not folder.is_dir():
+        return
+    trash = Path(tempfile.mkdtemp(dir=folder.parent, prefix=".discarded."))
+    try:
+        os.replace(folder, trash / folder.name)
+    except OSError:
+        pass
+    shutil.rmtree(trash, ignore_errors=True)
+
+
+def _sha256(path: Path) -> str | None:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
+
