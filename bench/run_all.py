@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import ctypes
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -223,6 +224,9 @@ def main(argv: list[str] | None = None) -> int:
         scaling_family.report_lu(scaling_family.measure_sparse_lu(sizes))
         print("\nchain of four-bar loops: symkin's generated C solver, sparse LU")
         scaling_family.report_solver(scaling_family.measure_solver(sizes))
+        print("\ncold and warm `symkin run` of the textbook example (fresh processes)", flush=True)
+        subprocess.run([sys.executable, str(Path(__file__).with_name("cold_warm.py"))],
+                       check=True)
     return 0
 
 

@@ -25,7 +25,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import lapack
 
 from symkin.errors import SolveError
 from symkin.results import Trajectory
@@ -146,6 +145,8 @@ class Factors:
     pivot_ratio: float
 
     def solve(self, b: Array) -> Array:
+        from scipy.linalg import lapack  # imported on use: a warm C run never needs SciPy
+
         x, _ = lapack.dgetrs(self.lu, self.pivots, b)
         return x
 
@@ -167,6 +168,8 @@ def factor(jacobian: Array) -> Factors:
 
     A zero pivot is not an error here: it gives ratio 0, which the caller judges.
     """
+    from scipy.linalg import lapack
+
     lu, pivots, _ = lapack.dgetrf(jacobian)
     return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))))
 
@@ -433,11 +436,16 @@ def solve(kernel: Any, t: ArrayLike | None = None, q0: ArrayLike | None = None,
     shape = (times.size, q.size)
     # Rows past run.done are never exposed, so the arrays need no zero-filling.
     run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape))
-    start = assemble(kernel, q, float(times[0]), p, options)
-    if start.status != OK:
-        _fail(kernel, run, p, start, float(times[0]), assembling=True)
-    loop = _c_loop if use_c_solver and _has_c_solver(kernel) else _python_loop
-    result = loop(kernel, run, start.q, p, options, progress)
+    in_c = use_c_solver and _has_c_solver(kernel)
+    # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
+    # the damped assembly in Python take over (and the grid is run again from its result).
+    result = _c_loop(kernel, run, q, p, options, progress) if in_c else None
+    if result is None or (result.status != OK and run.done == 0):
+        start = assemble(kernel, q, float(times[0]), p, options)
+        if start.status != OK:
+            _fail(kernel, run, p, start, float(times[0]), assembling=True)
+        loop = _c_loop if in_c else _python_loop
+        result = loop(kernel, run, start.q, p, options, progress)
     if result.status != OK:
         _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
     return _trajectory(kernel, run, p)
