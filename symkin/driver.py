@@ -143,11 +143,10 @@ class Factors:
     lu: Array
     pivots: NDArray[np.int32]
     pivot_ratio: float
+    getrs: Callable[..., Any]  # LAPACK's solve with these factors
 
     def solve(self, b: Array) -> Array:
-        from scipy.linalg import lapack  # imported on use: a warm C run never needs SciPy
-
-        x, _ = lapack.dgetrs(self.lu, self.pivots, b)
+        x, _ = self.getrs(self.lu, self.pivots, b)
         return x
 
 
@@ -168,10 +167,10 @@ def factor(jacobian: Array) -> Factors:
 
     A zero pivot is not an error here: it gives ratio 0, which the caller judges.
     """
-    from scipy.linalg import lapack
+    from scipy.linalg import lapack  # imported on use: a warm C run never needs SciPy
 
     lu, pivots, _ = lapack.dgetrf(jacobian)
-    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))))
+    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs)
 
 
 def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values: Array
