@@ -97,7 +97,7 @@ def _add_generate(commands: argparse._SubParsersAction) -> None:
 
 
 def _add_run(commands: argparse._SubParsersAction) -> None:
-    from symkin import runner  # the `run` subcommand lives with the driver stream
+    from symkin import runner  # the `run` subcommand lives in its own module
 
     runner.add_parser(commands)
 

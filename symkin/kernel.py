@@ -35,7 +35,7 @@ class _Functions(Protocol):
 
 
 class Kernel:
-    """The compiled kinematics of one mechanism (see CONTRACT.md, Python Kernel).
+    """The compiled kinematics of one mechanism (DESIGN.md, Python API).
 
     Every function takes ``p=None`` to mean the nominal parameter values.
     """

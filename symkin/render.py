@@ -170,7 +170,7 @@ def metadata(code: Code) -> dict[str, Any]:
 # ----- template context ----------------------------------------------------------------------
 
 def template_context(code: Code) -> dict[str, Any]:
-    """The plain data every template of ``code.backend`` receives (CONTRACT.md)."""
+    """The plain data every template of ``code.backend`` receives."""
     literal = _c_literal(code.real) if code.backend == "c" else repr
     return {
         "prefix": code.name, "PREFIX": code.name.upper(), "name_comment": codegen.comment(code.name),

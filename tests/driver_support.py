@@ -21,7 +21,7 @@ BACKENDS = ("numpy", "c")
 
 
 class LambdifyKernel:
-    """The Kernel interface (CONTRACT.md) evaluated with sympy.lambdify."""
+    """The Kernel interface evaluated with sympy.lambdify."""
 
     backend = "lambdify"
 
