@@ -100,12 +100,13 @@ def derive(mech: Mechanism | str | Path) -> System:
         gamma.append(_row_gamma(entries, row_t, symbols))
     size = len(symbols.q)
     values = mech.parameter_values()
+    p_values = tuple(values[s.name] for s in symbols.p)
     return System(
         mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,
-        p_values=tuple(values[s.name] for s in symbols.p), coordinates=symbols.coordinates,
+        p_values=p_values, coordinates=symbols.coordinates,
         phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
         phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
-        q0=_initial_guess(mech, ctx, dict(zip(symbols.p, (values[s.name] for s in symbols.p)))),
+        q0=_initial_guess(mech, ctx, dict(zip(symbols.p, p_values))),
     )
 
 

@@ -14,6 +14,7 @@ import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -257,21 +258,27 @@ class Symbols:
     p: tuple[sp.Symbol, ...]
     coordinates: tuple[str, ...]
 
-    @property
+    # Built once per Symbols: derivation asks for them for every constraint and expression.
+    @cached_property
     def parameters(self) -> dict[str, sp.Symbol]:
         return {symbol.name: symbol for symbol in self.p}
 
-    @property
+    @cached_property
     def by_coordinate(self) -> dict[tuple[str, str], sp.Symbol]:
         """``(body, "x"|"y"|"phi") -> q symbol``, for custom constraints."""
         pairs = (name.partition(".") for name in self.coordinates)
         return {(body, part): q for (body, _, part), q in zip(pairs, self.q)}
 
+    @cached_property
+    def _first_coordinate(self) -> dict[str, int]:
+        """Body name -> index of its x coordinate."""
+        return {name[:-2]: k for k, name in enumerate(self.coordinates) if name.endswith(".x")}
+
     def body(self, name: str, velocities: bool = False) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
         """(x, y, phi) of a body (or their rates); the ground is fixed at zero."""
         if name == GROUND:
             return (sp.Integer(0),) * 3
-        start = self.coordinates.index(f"{name}.x")
+        start = self._first_coordinate[name]
         source = self.dq if velocities else self.q
         return source[start], source[start + 1], source[start + 2]
 
