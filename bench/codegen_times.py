@@ -17,7 +17,10 @@ from pathlib import Path
 from typing import Any
 
 import symkin
-from symkin import build, codegen, model, render
+from symkin.build import compile as build
+from symkin.codegen import lower as codegen
+from symkin.codegen import render
+from symkin.spec import validate as model
 
 ROOT = Path(__file__).resolve().parent.parent
 

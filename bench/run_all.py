@@ -116,7 +116,7 @@ def symkin_solvers(times: np.ndarray, folder: Path) -> list[tuple[str, Callable[
     grid from q = 0, assembly included): built as symkin.compile builds it (-O2), and once more
     with -O3 (into a private cache folder) for the pair with the hand-written -O3 build."""
     import symkin
-    from symkin import build
+    from symkin.build import compile as build
 
     system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 import symkin
-from symkin import driver
+from symkin.runtime import driver
 
 ROOT = Path(__file__).resolve().parent.parent
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"

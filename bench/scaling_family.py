@@ -101,7 +101,8 @@ def to_yaml(mechanism: dict[str, Any]) -> str:
 def measure_derive(sizes: list[int]) -> list[tuple[int, int, float]]:
     """(bodies, N, CPU seconds) of validating and deriving each chain."""
     sys.path.insert(0, str(ROOT))
-    from symkin import derivation, model
+    from symkin.spec import validate as model
+    from symkin.symbolic import derivation
 
     rows = []
     for bodies in sizes:
@@ -124,7 +125,9 @@ def measure_sparse_lu(sizes: list[int], style: str | None = None) -> list[dict[s
     import sympy as sp
     from sparse_lu_harness import build
 
-    from symkin import derivation, model, sparse_lu
+    from symkin.codegen import lu_plan as sparse_lu
+    from symkin.spec import validate as model
+    from symkin.symbolic import derivation
 
     rows_out = []
     for bodies in sizes:
@@ -175,7 +178,8 @@ def measure_solver(sizes: list[int], steps: int = 2000) -> list[dict[str, float]
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     sys.path.insert(0, str(ROOT))
     import symkin
-    from symkin import derivation, model
+    from symkin.spec import validate as model
+    from symkin.symbolic import derivation
 
     out = []
     for bodies in sizes:

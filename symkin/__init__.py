@@ -23,14 +23,14 @@ __all__ = [
 ]
 
 _EXPORTS = {
-    "load": ("symkin.model", "load"),
-    "from_dict": ("symkin.model", "from_dict"),
-    "Mechanism": ("symkin.model", "Mechanism"),
-    "derive": ("symkin.derivation", "derive"),
-    "System": ("symkin.derivation", "System"),
-    "generate": ("symkin.render", "generate"),
-    "compile": ("symkin.build", "compile"),
-    "solve": ("symkin.driver", "solve"),
+    "load": ("symkin.spec.validate", "load"),
+    "from_dict": ("symkin.spec.validate", "from_dict"),
+    "Mechanism": ("symkin.spec.validate", "Mechanism"),
+    "derive": ("symkin.symbolic.derivation", "derive"),
+    "System": ("symkin.symbolic.derivation", "System"),
+    "generate": ("symkin.codegen.render", "generate"),
+    "compile": ("symkin.build.compile", "compile"),
+    "solve": ("symkin.runtime.driver", "solve"),
     "SymkinError": ("symkin.errors", "SymkinError"),
     "MechanismError": ("symkin.errors", "MechanismError"),
     "SolveError": ("symkin.errors", "SolveError"),

@@ -1,7 +1,8 @@
-"""Where the package's data lives: the jinja2 templates and the C runtime."""
+"""Where the package's data lives (the jinja2 templates) and the names of generated files."""
 
 from __future__ import annotations
 
+import sysconfig
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -13,3 +14,13 @@ def template_root() -> Path:
     if installed.is_dir():
         return installed
     return _PACKAGE.parent / "templates"
+
+
+# The file every generated folder carries: its files with their sha256 and the metadata a
+# runtime needs. Written by codegen.render, read by runtime.kernel and build.index.
+MANIFEST = "manifest.json"
+
+
+def extension_suffix() -> str:
+    """The file suffix of a compiled extension module for this interpreter."""
+    return sysconfig.get_config_var("EXT_SUFFIX") or ".so"

@@ -5,7 +5,7 @@
     def test_my_derivation():
         assert_kinematics_match("four_bar.yaml", "four_bar_hand.py")
 
-The comparison is :func:`symkin.verify.verify`; a mismatch fails with the report that
+The comparison is :func:`symkin.verify.numeric.verify`; a mismatch fails with the report that
 ``symkin verify`` prints (every differing entry, its joint or driver, both values).
 """
 
@@ -14,9 +14,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from symkin import verify as _verify
-from symkin.derivation import System
-from symkin.model import Mechanism
+from symkin.spec.validate import Mechanism
+from symkin.symbolic.derivation import System
+from symkin.verify import numeric as _verify
 
 
 def assert_kinematics_match(mechanism: Mechanism | System | _verify.Derived | str | Path,
@@ -26,17 +26,17 @@ def assert_kinematics_match(mechanism: Mechanism | System | _verify.Derived | st
     """Fail (AssertionError) unless the hand functions match the derived ones.
 
     Args:
-        mechanism: a mechanism file, Mechanism, System or :func:`symkin.verify.derived_functions`.
+        mechanism: a mechanism file, Mechanism, System or :func:`symkin.verify.numeric.derived_functions`.
         hand_module: a module (or any object) with some of ``phi``, ``phi_q``, ``phi_t``,
             ``gamma``, or the path of a Python file defining them.
-        samples, seed, spread, tolerance: as for :func:`symkin.verify.verify`.
+        samples, seed, spread, tolerance: as for :func:`symkin.verify.numeric.verify`.
 
     Returns:
         The report, when everything matches.
 
     Raises:
         AssertionError: some entries differ; the message is the full report.
-        symkin.verify.HandModuleError: the hand module cannot be loaded, raises or returns the
+        symkin.verify.numeric.HandModuleError: the hand module cannot be loaded, raises or returns the
             wrong shape (the original exception is its ``__cause__``).
     """
     __tracebackhide__ = True  # pytest shows the caller's line, not this helper's

@@ -19,7 +19,7 @@ import numpy as np
 import sympy as sp
 
 import symkin
-from symkin import codegen
+from symkin.codegen import lower as codegen
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))

@@ -2,7 +2,7 @@
 
 ``LambdifyKernel`` has the Kernel interface but is built with sympy.lambdify straight from the
 System, bypassing codegen: a cross-check of the generated NumPy kernel. ``kernel_for`` is
-``symkin.compile``, falling back to the lambdify kernel only where symkin.build is missing.
+``symkin.compile``, falling back to the lambdify kernel only where symkin.build.compile is missing.
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ import pytest
 import sympy as sp
 
 import symkin
-from symkin import constraints, model
+from symkin.symbolic import planar as constraints
+from symkin.symbolic import symbols as symbols_module
 
 MECHANISMS = Path(__file__).resolve().parent / "mechanisms"
 BACKENDS = ("numpy", "c")
@@ -42,7 +43,7 @@ class LambdifyKernel:
         self._phi_t = sp.lambdify(args, system.phi_t, "numpy")
         self._gamma = sp.lambdify((system.q, system.dq, system.t, system.p), system.gamma, "numpy")
         mech = system.mechanism
-        ctx = constraints.Context(mech, model.make_symbols(mech))
+        ctx = constraints.Context(mech, symbols_module.make_symbols(mech))
         self.points = tuple((b, n) for b, body in mech.bodies.items() for n in body.points)
         vectors = [ctx.vector(mech.bodies[b].points[n]) for b, n in self.points]
         self._points = sp.lambdify((system.p,), sp.Matrix([[v[0], v[1]] for v in vectors])
@@ -70,11 +71,11 @@ class LambdifyKernel:
 def kernel_for(system, backend: str):
     """symkin.compile(system, backend); the lambdify stand-in while codegen is not there."""
     try:
-        import symkin.build
+        import symkin.build.compile
     except ImportError:
         if backend == "numpy":
             return LambdifyKernel(system)
-        pytest.skip("symkin.build (the C backend) is not available yet")
+        pytest.skip("symkin.build.compile (the C backend) is not available yet")
     return symkin.compile(system, backend=backend)
 
 

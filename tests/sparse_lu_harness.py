@@ -17,7 +17,7 @@ from pathlib import Path
 import jinja2
 import numpy as np
 
-from symkin import sparse_lu
+from symkin.codegen import lu_plan as sparse_lu
 from symkin.resources import template_root
 
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-O2", "-fPIC", "-shared"]

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from symkin import derivation, model
+from symkin.spec import validate as model
+from symkin.symbolic import derivation
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))

@@ -16,7 +16,7 @@ import pytest
 from codegen_support import GENERATED, ROOT, compilers, system
 
 import symkin
-from symkin import build
+from symkin.build import compile as build
 from symkin.errors import BuildError
 
 needs_cc = pytest.mark.skipif(not compilers(), reason="no C compiler")
@@ -154,7 +154,7 @@ def test_kernel_metadata_and_nominal_parameters(backend: str, shared_cache: Path
 
 _RUNTIME_ONLY = """
 import sys
-from symkin import kernel
+from symkin.runtime import kernel
 for folder in sys.argv[1:]:
     k = kernel.load(folder)
     k.gamma(k.q0 + 0.1, k.q0 + 0.2, 0.3)

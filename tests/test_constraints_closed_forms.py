@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import pytest
 import sympy as sp
 
-from symkin.derivation import System, derive
-from symkin.model import from_dict
+from symkin.spec.validate import from_dict
+from symkin.symbolic.derivation import System, derive
 
 OMEGA = sp.Matrix([[0, -1], [1, 0]])
 I2 = sp.eye(2)

@@ -20,8 +20,8 @@ import mpmath
 import pytest
 import sympy as sp
 
-from symkin.derivation import System, derive
-from symkin.model import from_dict
+from symkin.spec.validate import from_dict
+from symkin.symbolic.derivation import System, derive
 
 DIGITS = 40
 STEP = mpmath.mpf("1e-12")

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from driver_support import BACKENDS, derive, kernel_for
 
-from symkin import driver
 from symkin.errors import SolveError
+from symkin.runtime import driver, newton
 
 DEAD_CENTRE_ROWS = (
     "joints[0] revolute ground-crank (x)",
@@ -76,7 +76,7 @@ def test_links_too_short_cannot_assemble_at_t0(backend: str) -> None:
 def test_newton_failure_reports_t_residual_iterations() -> None:
     kernel = kernel_for(derive("offset_crank_slider"), "numpy")
     # one huge step: the crank turns 3 rad between grid points, Newton is capped at 2 iterations
-    failure = _failure(kernel, t=[0.0, 1.0], options=driver.Options(max_iterations=2))
+    failure = _failure(kernel, t=[0.0, 1.0], options=newton.Options(max_iterations=2))
     assert failure.t == 1.0 and failure.iterations == 2
     assert failure.trajectory.t.size == 1
     assert math.isfinite(failure.residual) and failure.residual > 1e-10
@@ -87,8 +87,8 @@ def test_assembly_from_zero_uses_levenberg_marquardt() -> None:
     """Phi_q is singular at q = 0 for the four-bar, so plain Newton cannot start there."""
     kernel = kernel_for(derive("four_bar_test"), "numpy")
     zero = np.zeros(len(kernel.coordinates))
-    options = driver.Options()
-    assert driver.newton(kernel, zero, 0.0, kernel.p_values, options).status != driver.OK
+    options = newton.Options()
+    assert newton.newton(kernel, zero, 0.0, kernel.p_values, options).status != newton.OK
     trajectory = driver.solve(kernel, q0=zero)
     for k, t in enumerate(trajectory.t[::10]):
         assert np.abs(kernel.phi(trajectory.q[10 * k], t)).max() < 1e-10

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from driver_support import derive, kernel_for
 
-from symkin import driver
 from symkin.errors import SolveError, SymkinError
+from symkin.runtime import driver
 
 
 def test_grid_is_t0_plus_k_dt_with_the_end_point() -> None:
@@ -59,7 +59,7 @@ def test_runtime_imports_no_sympy() -> None:
     import sys
     from pathlib import Path
 
-    code = ("import sys, symkin.driver, symkin.results; "
+    code = ("import sys, symkin.runtime.driver, symkin.runtime.results; "
             "assert 'sympy' not in sys.modules and 'jinja2' not in sys.modules")
     root = Path(__file__).resolve().parent.parent
     subprocess.run([sys.executable, "-c", code], cwd=root, check=True)

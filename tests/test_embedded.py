@@ -20,8 +20,8 @@ from codegen_support import (
     undefined_symbols,
 )
 
-from symkin import render
-from symkin.names import LIBM_NAMES
+from symkin.codegen import render
+from symkin.spec.names import LIBM_NAMES
 
 ARM_GCC, ARM_NM = shutil.which("arm-none-eabi-gcc"), shutil.which("arm-none-eabi-nm")
 pytestmark = pytest.mark.skipif(not (ARM_GCC and ARM_NM),

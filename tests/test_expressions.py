@@ -18,9 +18,9 @@ import sympy as sp
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from symkin import expressions
 from symkin.errors import ExpressionError
-from symkin.expressions import parse, parse_time_function
+from symkin.spec import expressions
+from symkin.spec.expressions import parse, parse_time_function
 
 t = sp.Symbol("t", real=True)
 a = sp.Symbol("a", real=True)

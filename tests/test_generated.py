@@ -27,7 +27,7 @@ from codegen_support import (
     system,
 )
 
-from symkin import render
+from symkin.codegen import render
 
 UPDATE = os.environ.get("SYMKIN_UPDATE_GOLDENS") == "1"
 

@@ -15,7 +15,7 @@ import pytest
 
 from symkin import cli
 from symkin.errors import MechanismError
-from symkin.model import load
+from symkin.spec.validate import load
 
 CORPUS = Path(__file__).resolve().parent / "bad_mechanisms"
 

@@ -17,8 +17,9 @@ import pytest
 import sympy as sp
 
 import symkin
-from symkin.derivation import System
-from symkin.model import degrees_of_freedom, equation_count
+from symkin.spec.schema import equation_count
+from symkin.spec.validate import degrees_of_freedom
+from symkin.symbolic.derivation import System
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 MINE = ["crank_slider.yaml", "four_bar.yaml", "quick_return.yaml", "all_drivers.yaml",

@@ -11,9 +11,10 @@ import pytest
 import sympy as sp
 
 import symkin
-from symkin import cli, loader
+from symkin import cli
 from symkin.errors import MechanismError
-from symkin.model import from_dict, json_schema, load
+from symkin.spec import loader
+from symkin.spec.validate import from_dict, json_schema, load
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))

@@ -13,9 +13,9 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from symkin.derivation import derive
 from symkin.errors import MechanismError
-from symkin.model import load
+from symkin.spec.validate import load
+from symkin.symbolic.derivation import derive
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 SOURCES = [(EXAMPLES / name).read_text() for name in ("crank_slider.yaml", "quick_return.yaml")]

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from driver_support import MECHANISMS
 
-from symkin.runner import ProgressBar
+from symkin.cli.run import ProgressBar
 
 ROOT = Path(__file__).resolve().parent.parent
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"

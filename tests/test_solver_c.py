@@ -17,7 +17,7 @@ import pytest
 from driver_support import derive, kernel_for
 
 import symkin
-from symkin import driver
+from symkin.runtime import driver, newton
 
 MECHANISMS = ("four_bar_test", "offset_crank_slider", "slide_driven", "point_trajectory")
 WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
@@ -176,12 +176,12 @@ def test_fallbacks_are_counted_and_reach_the_trajectory() -> None:
     guess = assembled.copy()
     guess[8] = 1e-3  # rocker.phi: sin ~ 1e-3, cos ~ 1
     p = np.array(kernel.p_values)
-    reference = driver.newton(kernel_for(system, "numpy"), guess, 0.0, p, driver.Options())
-    assert reference.status == driver.OK
+    reference = newton.newton(kernel_for(system, "numpy"), guess, 0.0, p, newton.Options())
+    assert reference.status == newton.OK
     times = np.array([0.0, 0.01, 0.02])
     run = driver._Run(times, *(np.empty((3, 9)) for _ in range(3)))
-    result = driver._c_loop(kernel, run, guess, p, driver.Options(), None)
-    assert result.status == driver.OK and run.done == 3 and run.fallbacks >= 1
+    result = driver._c_loop(kernel, run, guess, p, newton.Options(), None)
+    assert result.status == newton.OK and run.done == 3 and run.fallbacks >= 1
     assert np.abs(run.q[0] - reference.q).max() <= 1e-10
     assert np.abs(kernel.phi(run.q[0], 0.0)).max() <= 1e-10
     assert driver._trajectory(kernel, run, p).lu_fallbacks == run.fallbacks

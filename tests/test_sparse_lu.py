@@ -16,8 +16,10 @@ import pytest
 import sympy as sp
 from sparse_lu_harness import build, render
 
-from symkin import derivation, model, sparse_lu
+from symkin.codegen import lu_plan as sparse_lu
 from symkin.errors import SolveError
+from symkin.spec import validate as model
+from symkin.symbolic import derivation
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is not installed")
 ROOT = Path(__file__).resolve().parent.parent

@@ -17,7 +17,11 @@ import yaml
 from driver_support import kernel_for
 
 import symkin
-from symkin import codegen, driver, model, runner
+from symkin.cli import run as runner
+from symkin.codegen import lower as codegen
+from symkin.codegen import sample as codegen_sample
+from symkin.runtime import driver, linalg
+from symkin.spec import validate as model
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
@@ -33,7 +37,7 @@ def crank_slider_q(t: float, a: float = 1.0, b: float = 5.0, c: float = 4.0) -> 
 def test_sample_configuration_is_the_assembled_position(crank_slider_system) -> None:
     # the file's q0 is the chapter's q = 0, far from the assembled position
     assert not np.allclose(crank_slider_system.q0, crank_slider_q(0.0), atol=0.1)
-    sample = np.array(codegen.sample_configuration(crank_slider_system))
+    sample = np.array(codegen_sample.sample_configuration(crank_slider_system))
     np.testing.assert_allclose(sample, crank_slider_q(0.0), atol=1e-9)
 
 
@@ -41,7 +45,7 @@ def test_sample_configuration_falls_back_to_q0_when_assembly_fails() -> None:
     data = yaml.safe_load((EXAMPLES / "crank_slider.yaml").read_text())
     data["parameters"]["c"] = 10.0  # the slider's guide beyond the reach of crank + rod (6)
     system = symkin.derive(model.from_dict(data))
-    assert codegen.sample_configuration(system) == tuple(system.q0)
+    assert codegen_sample.sample_configuration(system) == tuple(system.q0)
     code = codegen.lower(system, "c")  # the plan is still made (at q0), generation goes on
     assert code.linalg == "sparse" and code.extra["lu"]["n_lu"] >= code.nnz
 
@@ -56,9 +60,9 @@ def test_python_driver_sparse_path_matches_dense(crank_slider_system, monkeypatc
     kernel = kernel_for(crank_slider_system, "numpy")
     times = driver.grid(0.0, 1.5, 0.01)
     dense = driver.solve(kernel, t=times)
-    monkeypatch.setattr(driver, "SPARSE_FROM", 1)
-    assert isinstance(driver.factor_at(kernel, dense.q[5], times[5], kernel.p_values),
-                      driver.SparseFactors)
+    monkeypatch.setattr(linalg, "SPARSE_FROM", 1)
+    assert isinstance(linalg.factor_at(kernel, dense.q[5], times[5], kernel.p_values),
+                      linalg.SparseFactors)
     sparse = driver.solve(kernel, t=times)
     for name in ("q", "dq", "d2q"):
         assert np.abs(getattr(sparse, name) - getattr(dense, name)).max() <= 1e-12, name
@@ -77,14 +81,14 @@ def test_factor_sparse_solves_and_judges_singularity() -> None:
     a = np.zeros((n, n))
     a[rows, cols] = values
     b = rng.normal(size=n)
-    factors = driver.factor_sparse(n, rows, cols, values)
+    factors = linalg.factor_sparse(n, rows, cols, values)
     np.testing.assert_allclose(factors.solve(b), np.linalg.solve(a, b), rtol=1e-10, atol=1e-12)
     # SuperLU orders rows and columns its own way, so its pivots differ from LAPACK's
     assert 0.0 < factors.pivot_ratio <= 1.0
     singular = values.copy()
     singular[(rows == 3)] = 0.0  # an empty row
-    assert driver.factor_sparse(n, rows, cols, singular).pivot_ratio == 0.0
-    assert driver.factor_sparse(n, rows, cols, np.full(values.size, np.nan)).pivot_ratio == 0.0
+    assert linalg.factor_sparse(n, rows, cols, singular).pivot_ratio == 0.0
+    assert linalg.factor_sparse(n, rows, cols, np.full(values.size, np.nan)).pivot_ratio == 0.0
 
 
 def test_run_mentions_fallbacks() -> None:

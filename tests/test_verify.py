@@ -1,4 +1,4 @@
-"""symkin.verify, numeric route: hand derivations with planted slips are found and located.
+"""symkin.verify.numeric, numeric route: hand derivations with planted slips are found and located.
 
 The correct hand derivations (examples/textbook_hand_corrected.py and tests/verify_cases/*_hand.py)
 are written from the chapter's closed-form formulas, not from symkin's output, so their passing
@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 import symkin
-from symkin import verify
+from symkin.verify import hand as verify_hand
+from symkin.verify import numeric, sampling
 
 ROOT = Path(__file__).resolve().parent.parent
 CASES = Path(__file__).resolve().parent / "verify_cases"
@@ -89,8 +90,8 @@ SLIPS = [
 
 
 @pytest.fixture(scope="module")
-def derived() -> dict[str, verify.Derived]:
-    return {name: verify.derived_functions(symkin.derive(path))
+def derived() -> dict[str, numeric.Derived]:
+    return {name: numeric.derived_functions(symkin.derive(path))
             for name, (path, _) in MECHANISMS.items()}
 
 
@@ -107,7 +108,7 @@ def _planted(tmp_path: Path, base: Path, old: str, new: str) -> Path:
 def test_a_planted_slip_is_found_and_located(derived, tmp_path, mechanism, kind, old, new,
                                              expected) -> None:
     hand = _planted(tmp_path, MECHANISMS[mechanism][1], old, new)
-    report = verify.verify(derived[mechanism], hand)
+    report = numeric.verify(derived[mechanism], hand)
     found = {(m.function, m.row, m.column): m.owner.rsplit(" (", 1)[0]
              for m in report.mismatches}
     assert found == expected
@@ -122,15 +123,15 @@ def test_a_planted_slip_is_found_and_located(derived, tmp_path, mechanism, kind,
 
 @pytest.mark.parametrize("mechanism", sorted(MECHANISMS))
 def test_correct_derivations_pass_over_many_seeds(derived, mechanism) -> None:
-    hand = verify.load_hand_module(MECHANISMS[mechanism][1])
+    hand = verify_hand.load_hand_module(MECHANISMS[mechanism][1])
     for seed in range(40):
-        report = verify.verify(derived[mechanism], hand, seed=seed)
+        report = numeric.verify(derived[mechanism], hand, seed=seed)
         assert report.ok, report.text()
         assert [r.name for r in report.results] == ["phi", "phi_q", "phi_t", "gamma"]
 
 
 def test_the_printed_slip_is_flagged_at_gamma_rows_5_and_6(derived) -> None:
-    report = verify.verify(derived["textbook"], FAITHFUL)
+    report = numeric.verify(derived["textbook"], FAITHFUL)
     assert [(m.function, m.row, m.owner) for m in report.mismatches] == [
         ("gamma", 4, f"{REV23} (x)"), ("gamma", 5, f"{REV23} (y)")]
     # gam(5:6) carries the derived term of sB3 and the rate of the slider
@@ -140,13 +141,13 @@ def test_the_printed_slip_is_flagged_at_gamma_rows_5_and_6(derived) -> None:
 
 def test_the_printed_slip_hides_at_the_nominal_design(derived) -> None:
     """sB2 = sB3 = 0 in Dane.m: only varying the parameters exposes the slip."""
-    assert verify.verify(derived["textbook"], FAITHFUL, spread=0).ok
-    assert verify.verify(derived["textbook"], CORRECTED).ok
+    assert numeric.verify(derived["textbook"], FAITHFUL, spread=0).ok
+    assert numeric.verify(derived["textbook"], CORRECTED).ok
 
 
 def test_transcription_gives_the_books_example_2_5_values() -> None:
     """Independent check of the transcription: Example 2.5 (j), (k), (l) at its q*, dq*, t*."""
-    hand = verify.load_hand_module(FAITHFUL)
+    hand = verify_hand.load_hand_module(FAITHFUL)
     root = math.sqrt(2 * math.pi)
     q = np.array([0, 0, math.pi, -1, 0, math.atan(4 / 3), 2, 4, 0])
     dq = np.array([0, 0, root, 0, -root, root / 3, -4 * root / 3, 0, 0])
@@ -164,7 +165,7 @@ def test_derived_values_are_the_books_at_example_2_5(derived) -> None:
     """The derived side of the comparison, checked against Example 2.5 (l)."""
     root = math.sqrt(2 * math.pi)
     system = derived["textbook"].system
-    state = verify.State(np.array([0, 0, math.pi, -1, 0, math.atan(4 / 3), 2, 4, 0]),
+    state = sampling.State(np.array([0, 0, math.pi, -1, 0, math.atan(4 / 3), 2, 4, 0]),
                          np.array([0, 0, root, 0, -root, root / 3, -4 * root / 3, 0, 0]),
                          math.sqrt(math.pi / 2), np.array(system.p_values))
     np.testing.assert_allclose(derived["textbook"].evaluate("gamma", state),
@@ -177,16 +178,16 @@ def test_derived_values_are_the_books_at_example_2_5(derived) -> None:
 
 def test_parameters_vary_around_the_nominal_design() -> None:
     system = symkin.derive(TEXTBOOK)
-    states = verify.sample_states(system, 200, seed=1, spread=0.3)
+    states = sampling.sample_states(system, 200, seed=1, spread=0.3)
     p = np.array([s.p for s in states])
     nominal = np.array(system.p_values)
     nonzero = nominal != 0
     assert np.all(np.abs(p[:, nonzero] / nominal[nonzero] - 1) <= 0.3)
-    assert np.all(np.abs(p[:, ~nonzero]) <= 0.3 * verify.length_scale(system))
+    assert np.all(np.abs(p[:, ~nonzero]) <= 0.3 * sampling.length_scale(system))
     assert np.all(np.std(p, axis=0) > 0)  # every parameter, zeros included, is varied
     t0, t1, _ = system.time_grid
     assert all(t0 <= s.t <= t1 for s in states)
-    kept = verify.sample_states(system, 5, seed=1, spread=0)
+    kept = sampling.sample_states(system, 5, seed=1, spread=0)
     assert all(np.array_equal(s.p, nominal) for s in kept)
 
 
@@ -196,7 +197,7 @@ def test_only_the_defined_functions_are_compared(derived, tmp_path) -> None:
     text = source.read_text()
     partial.write_text(text.replace("def phi(", "def _phi(").replace("def phi_q(", "def _phi_q(")
                        .replace("def phi_t(", "def _phi_t("))
-    report = verify.verify(derived["four_bar"], partial)
+    report = numeric.verify(derived["four_bar"], partial)
     assert [r.name for r in report.results] == ["gamma"]
     assert report.skipped == ("phi", "phi_q", "phi_t") and report.ok
     assert "phi_q  not defined, skipped" in report.text()
@@ -205,21 +206,21 @@ def test_only_the_defined_functions_are_compared(derived, tmp_path) -> None:
 def test_a_non_finite_hand_value_is_a_mismatch(derived) -> None:
     import types
 
-    hand = verify.load_hand_module(CASES / "four_bar_hand.py")
+    hand = verify_hand.load_hand_module(CASES / "four_bar_hand.py")
 
     def gamma(q, dq, t, p):
         value = hand.gamma(q, dq, t, p)
         value[8] = np.nan
         return value
 
-    report = verify.verify(derived["four_bar"], types.SimpleNamespace(gamma=gamma))
+    report = numeric.verify(derived["four_bar"], types.SimpleNamespace(gamma=gamma))
     assert [(m.function, m.row) for m in report.mismatches] == [("gamma", 8)]
     assert report.mismatches[0].error == math.inf
 
 
 def test_loading_by_path_leaves_sys_path_and_modules_alone() -> None:
     path_before, modules_before = list(sys.path), set(sys.modules)
-    module = verify.load_hand_module(CASES / "four_bar_hand.py")
+    module = verify_hand.load_hand_module(CASES / "four_bar_hand.py")
     assert callable(module.gamma)
     assert sys.path == path_before
     assert set(sys.modules) - modules_before == set()
@@ -232,8 +233,8 @@ def test_slips_behind_zero_dimensions_need_random_parameters(derived, tmp_path, 
     design, found once the parameters vary."""
     mechanism, _, old, new, expected = slip
     hand = _planted(tmp_path, MECHANISMS[mechanism][1], old, new)
-    assert verify.verify(derived[mechanism], hand, spread=0).ok
-    assert {(m.function, m.row, m.column) for m in verify.verify(derived[mechanism],
+    assert numeric.verify(derived[mechanism], hand, spread=0).ok
+    assert {(m.function, m.row, m.column) for m in numeric.verify(derived[mechanism],
                                                                   hand).mismatches} == set(expected)
 
 
@@ -256,7 +257,7 @@ def test_a_mechanism_without_parameters() -> None:
     def phi_t(q, t, p):
         return [0, 0, np.cos(t)]  # slip: the sign of -theta'
 
-    report = verify.verify(mech, types.SimpleNamespace(phi=phi, phi_t=phi_t))
+    report = numeric.verify(mech, types.SimpleNamespace(phi=phi, phi_t=phi_t))
     assert [(m.function, m.row, m.owner) for m in report.mismatches] == [
         ("phi_t", 2, "drivers[0] angle bob-ground (angle)")]
 
@@ -264,10 +265,10 @@ def test_a_mechanism_without_parameters() -> None:
 def test_rounding_noise_against_an_exact_zero_is_no_mismatch() -> None:
     derived = np.zeros((4, 3))
     noise = np.full((4, 3), 3e-17)
-    assert np.all(verify.relative_errors(derived, noise, least=1e-6) < 1e-10)
+    assert np.all(numeric.relative_errors(derived, noise, least=1e-6) < 1e-10)
     # a real difference on the same floor is one
-    assert verify.relative_errors(derived, noise + 0.1, least=1e-6).min() > 0.9
+    assert numeric.relative_errors(derived, noise + 0.1, least=1e-6).min() > 0.9
     # relative to the entry when it is large; the floor keeps tiny entries absolute
-    errors = verify.relative_errors(np.array([[100.0, 1e-9]]), np.array([[100.0 + 1e-6, 2e-9]]))
+    errors = numeric.relative_errors(np.array([[100.0, 1e-9]]), np.array([[100.0 + 1e-6, 2e-9]]))
     assert errors[0, 0] == pytest.approx(1e-8)
     assert errors[0, 1] == pytest.approx(1e-8)  # 1e-9 / (1e-3 * 100), not 0.5

@@ -1,4 +1,4 @@
-"""symkin.verify.compare (symbolic route) and symkin.testing.assert_kinematics_match."""
+"""symkin.verify.symbolic.compare (symbolic route) and symkin.testing.assert_kinematics_match."""
 
 from __future__ import annotations
 
@@ -10,9 +10,10 @@ import pytest
 import sympy as sp
 
 import symkin
-from symkin import verify
 from symkin.errors import SymkinError
 from symkin.testing import assert_kinematics_match
+from symkin.verify import hand as verify_hand
+from symkin.verify import numeric, symbolic
 
 ROOT = Path(__file__).resolve().parent.parent
 CASES = Path(__file__).resolve().parent / "verify_cases"
@@ -36,7 +37,7 @@ def _book_jacobian() -> sp.Matrix:
 
 
 def test_a_correct_hand_jacobian_is_equal(crank_slider_system) -> None:
-    result = verify.compare(crank_slider_system.phi_q, _book_jacobian())
+    result = symbolic.compare(crank_slider_system.phi_q, _book_jacobian())
     assert result.equal and bool(result) and len(result.entries) == 81
     assert result.text() == "all 81 entries are equal\n"
 
@@ -44,7 +45,7 @@ def test_a_correct_hand_jacobian_is_equal(crank_slider_system) -> None:
 def test_a_wrong_entry_is_located_with_a_counterexample(crank_slider_system) -> None:
     hand = _book_jacobian()
     hand[5, 5] = b * sp.sin(f2)  # a slip: sin for cos
-    result = verify.compare(crank_slider_system.phi_q, hand, system=crank_slider_system)
+    result = symbolic.compare(crank_slider_system.phi_q, hand, system=crank_slider_system)
     [entry] = result.differences
     assert (entry.row, entry.column, entry.method) == (5, 5, "counterexample")
     values = {sp.Symbol(str(s)): v for s, v in entry.point.items()}
@@ -56,7 +57,7 @@ def test_a_wrong_entry_is_located_with_a_counterexample(crank_slider_system) -> 
 def test_equal_after_simplification(crank_slider_system) -> None:
     hand = _book_jacobian()
     hand[5, 5] = b * (sp.cos(f2 / 2) ** 2 - sp.sin(f2 / 2) ** 2)
-    result = verify.compare(crank_slider_system.phi_q, hand)
+    result = symbolic.compare(crank_slider_system.phi_q, hand)
     entry = next(e for e in result.entries if (e.row, e.column) == (5, 5))
     assert result.equal and entry.method in ("simplification", "numeric")
 
@@ -65,36 +66,36 @@ def test_gamma_and_single_entries(crank_slider_system) -> None:
     dphi1, dphi2 = sp.symbols("crank.phi_t rod.phi_t")
     hand = sp.Matrix([0, 0, a * sp.cos(f1) * dphi1**2, a * sp.sin(f1) * dphi1**2,
                       b * sp.cos(f2) * dphi2**2, b * sp.sin(f2) * dphi2**2, 0, 0, 2])
-    assert verify.compare(crank_slider_system.gamma, hand).equal
+    assert symbolic.compare(crank_slider_system.gamma, hand).equal
     # a missing term, one entry alone: the chapter's gam(3:4) without Rot1*sA1*dfi1^2
-    lone = verify.compare(crank_slider_system.gamma[2], sp.Integer(0))
+    lone = symbolic.compare(crank_slider_system.gamma[2], sp.Integer(0))
     assert not lone.equal and lone.differences[0].method == "counterexample"
-    assert verify.compare(sp.sin(a) ** 2 + sp.cos(a) ** 2, 1).equal
+    assert symbolic.compare(sp.sin(a) ** 2 + sp.cos(a) ** 2, 1).equal
 
 
 def test_numeric_fallback_when_simplification_gives_up(monkeypatch) -> None:
     monkeypatch.setattr(sp, "simplify", lambda expr: expr)  # a simplifier that proves nothing
-    result = verify.compare(sp.Matrix([sp.sin(2 * a)]), sp.Matrix([2 * sp.sin(a) * sp.cos(a)]))
+    result = symbolic.compare(sp.Matrix([sp.sin(2 * a)]), sp.Matrix([2 * sp.sin(a) * sp.cos(a)]))
     assert result.equal and result.entries[0].method == "numeric"
 
 
 def test_shape_mismatch_and_bad_arguments(crank_slider_system) -> None:
     with pytest.raises(SymkinError, match="9 x 9 but the hand one is 9 x 8"):
-        verify.compare(crank_slider_system.phi_q, sp.zeros(9, 8))
+        symbolic.compare(crank_slider_system.phi_q, sp.zeros(9, 8))
     with pytest.raises(SymkinError, match="give a SymPy expression or matrix"):
-        verify.compare(crank_slider_system.phi_q, "J")
+        symbolic.compare(crank_slider_system.phi_q, "J")
 
 
 # ----- the pytest helper ---------------------------------------------------------------------
 
 def test_helper_passes_for_a_correct_derivation() -> None:
     report = assert_kinematics_match(CASES / "four_bar.yaml", CASES / "four_bar_hand.py")
-    assert report.ok and report.samples == verify.DEFAULT_SAMPLES
+    assert report.ok and report.samples == numeric.DEFAULT_SAMPLES
 
 
 def test_helper_accepts_a_module_or_an_object() -> None:
     system = symkin.derive(CASES / "luffing.yaml")
-    module = verify.load_hand_module(CASES / "luffing_hand.py")
+    module = verify_hand.load_hand_module(CASES / "luffing_hand.py")
     assert_kinematics_match(system, module, samples=10)
     assert_kinematics_match(system, types.SimpleNamespace(phi_t=module.phi_t), samples=10)
 
@@ -112,7 +113,7 @@ def test_helper_keeps_the_users_exception_as_the_cause() -> None:
     def phi(q, t, p):
         return np.zeros(9)[q.size + 1]  # IndexError inside the user's code
 
-    with pytest.raises(verify.HandModuleError, match=r"phi\(q, t, p\) raised IndexError") as err:
+    with pytest.raises(verify_hand.HandModuleError, match=r"phi\(q, t, p\) raised IndexError") as err:
         assert_kinematics_match(ROOT / "examples" / "crank_slider.yaml",
                                 types.SimpleNamespace(phi=phi))
     assert isinstance(err.value.__cause__, IndexError)

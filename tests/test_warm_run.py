@@ -22,7 +22,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
-HEAVY = ("sympy", "jinja2", "pydantic", "symkin.derivation", "symkin.model", "symkin.build",
+HEAVY = ("sympy", "jinja2", "pydantic", "symkin.symbolic.derivation", "symkin.spec.validate", "symkin.build.compile",
          "scipy")
 # The Python driver loop factors Phi_q with LAPACK through SciPy; the C solver needs none of it.
 WARM_HEAVY = {"c": [], "numpy": ["scipy"]}
@@ -148,7 +148,7 @@ def test_editing_a_template_misses(tmp_path: Path, snapshot: Path) -> None:
 
 
 def test_corrupt_index_entry_is_rebuilt(snapshot: Path, tmp_path: Path) -> None:
-    from symkin import cache
+    from symkin.build import index as cache
 
     folder = tmp_path / "cache"
     symkin_run(snapshot, folder, TEXTBOOK, "-o", "a.npz", cwd=tmp_path)
@@ -194,7 +194,7 @@ def test_damaged_kernel_is_never_loaded(snapshot: Path, tmp_path: Path, backend:
 
 
 def test_entry_naming_a_folder_outside_the_cache_is_refused(tmp_path: Path) -> None:
-    from symkin import cache
+    from symkin.build import index as cache
 
     outside = tmp_path / "outside"
     outside.mkdir()
@@ -211,7 +211,7 @@ def test_entry_naming_a_folder_outside_the_cache_is_refused(tmp_path: Path) -> N
 
 
 def test_key_changes_with_every_input(tmp_path: Path) -> None:
-    from symkin import cache
+    from symkin.build import index as cache
 
     mechanism = tmp_path / "m.yaml"
     mechanism.write_bytes(TEXTBOOK.read_bytes())
@@ -230,11 +230,12 @@ def test_key_changes_with_every_input(tmp_path: Path) -> None:
 
 
 def test_default_options_are_the_compilers() -> None:
-    """The index's defaults must be the ones symkin.build.compile uses, or a warm run would
+    """The index's defaults must be the ones symkin.build.compile.compile uses, or a warm run would
     look up another kernel than a cold run builds."""
     import inspect
 
-    from symkin import build, cache
+    from symkin.build import compile as build
+    from symkin.build import index as cache
 
     defaults = inspect.signature(build.compile).parameters
     assert cache.Options().real == defaults["real"].default

@@ -71,12 +71,14 @@ def build_sparse(folder: Path, optimisation: str = "-O2") -> Solver:
 
     from sparse_lu_harness import write_sources
 
-    from symkin import codegen, derivation, sparse_lu
+    from symkin.codegen import lu_plan as sparse_lu
+    from symkin.codegen import sample as codegen_sample
+    from symkin.symbolic import derivation
 
     system = derivation.derive(ROOT / "examples" / "crank_slider.yaml")
     pattern = system.pattern()
     rows, cols = [r for r, _ in pattern], [c for _, c in pattern]
-    assembled = codegen.sample_configuration(system)
+    assembled = codegen_sample.sample_configuration(system)
     values = {**dict(zip(system.q, assembled)), **dict(zip(system.p, system.p_values))}
     sample = [float(system.phi_q[r, c].subs(values)) for r, c in pattern]
     plan = sparse_lu.analyse(len(system.q), rows, cols, sample)

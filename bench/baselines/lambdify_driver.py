@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from symkin import derivation
+from symkin.symbolic import derivation
 
 TOLERANCE = 1e-10
 MAX_ITERATIONS = 25

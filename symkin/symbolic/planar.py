@@ -3,7 +3,7 @@
 Every unit takes the constraint's spec and a :class:`Context` (the symbols of the two bodies
 and the resolved local vectors) and returns its equations in the chapter's vector form. Only
 Phi is written here; Phi_q, Phi_t and Gamma are derived from it symbolically in
-:mod:`symkin.derivation`, and the tests check them against the chapter's closed forms.
+:mod:`symkin.symbolic.derivation`, and the tests check them against the chapter's closed forms.
 """
 
 from __future__ import annotations
@@ -14,8 +14,11 @@ from typing import Any
 
 import sympy as sp
 
-from symkin import expressions, model
-from symkin.model import GROUND, Mechanism, Symbols
+from symkin.spec import expressions
+from symkin.spec import schema as model
+from symkin.spec.schema import GROUND
+from symkin.spec.schema import MechanismSpec as Mechanism
+from symkin.symbolic.symbols import Symbols
 
 OMEGA = sp.Matrix([[0, -1], [1, 0]])  # (2.41)
 

@@ -19,14 +19,16 @@ from typing import Any
 
 import jinja2
 
-from symkin import codegen, resources
-from symkin.codegen import Code, Routine
-from symkin.derivation import System
+from symkin import resources
+from symkin.codegen import backends
+from symkin.codegen import lower as codegen
+from symkin.codegen.lower import Code, Routine
 from symkin.errors import BuildError
+from symkin.symbolic.derivation import System
 
 CDEF_TEMPLATE = "cdef.j2"
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
-MANIFEST = "manifest.json"
+MANIFEST = resources.MANIFEST
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out"}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points"}
@@ -61,10 +63,9 @@ def template_names(backend: str, linalg: str = codegen.DEFAULT_LINALG) -> list[s
                   and p.name.split(".")[0] != left_out)
 
 
-def output_name(template: str, prefix: str) -> str:
+def output_name(template: str, prefix: str, backend: str = "c") -> str:
     """``kernel.h.j2 -> crank_slider.h``; ``solver.c.j2 -> crank_slider_solver.c``."""
-    stem, suffix = template.removesuffix(".j2").rsplit(".", 1)
-    return f"{prefix}.{suffix}" if stem == "kernel" else f"{prefix}_{stem}.{suffix}"
+    return backends.get(backend).output_name(template, prefix)
 
 
 def render_sources(code: Code) -> dict[str, str]:
@@ -72,7 +73,7 @@ def render_sources(code: Code) -> dict[str, str]:
     context = template_context(code)
     files = {}
     for template in template_names(code.backend, code.linalg):
-        name = output_name(template, code.name)
+        name = output_name(template, code.name, code.backend)
         files[name] = _render(f"{code.backend}/{template}",
                               {**context, "template": template, "file_name": name})
     return dict(sorted(files.items()))
@@ -171,7 +172,7 @@ def metadata(code: Code) -> dict[str, Any]:
 
 def template_context(code: Code) -> dict[str, Any]:
     """The plain data every template of ``code.backend`` receives."""
-    literal = _c_literal(code.real) if code.backend == "c" else repr
+    literal = backends.get(code.backend).literal(code.real)
     return {
         "prefix": code.name, "PREFIX": code.name.upper(), "name_comment": codegen.comment(code.name),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
@@ -227,14 +228,3 @@ def _labels(code: Code, routine: str) -> list[str]:
         return [codegen.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in "xy"]
     return [codegen.comment(row) for row in code.rows]
-
-
-def _c_literal(real: str):
-    """A C literal of the real type: full precision for double, ``F`` suffix for float."""
-    suffix = "F" if real == "float" else ""
-
-    def literal(value: float) -> str:
-        text = repr(float(value))
-        return text + suffix if any(ch in text for ch in ".en") else text + ".0" + suffix
-
-    return literal

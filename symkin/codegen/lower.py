@@ -10,24 +10,21 @@ user's name can never collide with a temporary (``w0``...) or reach the generate
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
 import sympy as sp
-from sympy.codegen.ast import float32, float64
-from sympy.codegen.ast import real as real_type
-from sympy.printing.c import C99CodePrinter
-from sympy.printing.numpy import NumPyPrinter
-from sympy.printing.precedence import PRECEDENCE
+from sympy.printing.codeprinter import CodePrinter
 
-from symkin.derivation import System
+from symkin.codegen import backends, sample, symbols
+from symkin.codegen.symbols import symbol_text
 from symkin.errors import BuildError
+from symkin.symbolic import planar as constraints
+from symkin.symbolic import symbols as symbols_module
+from symkin.symbolic.derivation import System
 
-BACKENDS = ("c", "numpy")
 REAL_TYPES = ("double", "float")
 # The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
 # pivoting) or templates/c/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
@@ -111,75 +108,8 @@ class Code:
         return next(routine for routine in self.routines if routine.name == name)
 
 
-# ----- printers ------------------------------------------------------------------------------
-
-_INTERNAL = re.compile(r"_(q|dq|p)(\d+)\Z")
-_TEMPORARY = re.compile(r"w\d+\Z")
-
-
-def symbol_text(name: str) -> str:
-    """The code for a symbol: ``_q3`` -> ``q[3]``, ``_t`` -> ``t``, temporaries as they are.
-
-    Anything else would be a name from the mechanism file reaching the code, so it is refused.
-    """
-    if name == "_t":
-        return "t"
-    match = _INTERNAL.match(name)
-    if match:
-        return f"{match.group(1)}[{match.group(2)}]"
-    if _TEMPORARY.match(name):
-        return name
-    raise BuildError(f"internal error: the symbol {name!r} is not an argument of the generated "
-                     "function")
-
-
-class CPrinter(C99CodePrinter):
-    """C99 printer for generated kernels: array arguments, literal constants, no ``pow(x, 2)``.
-
-    ``M_PI`` is not part of C99 (it is POSIX), so pi and e are printed as literals; in float mode
-    the base class already prints ``sinf``/``0.5F``, so nothing is promoted to double.
-    """
-
-    def __init__(self, real: str = "double") -> None:
-        alias = float32 if real == "float" else float64
-        super().__init__({"type_aliases": {real_type: alias}, "strict": True})
-        self._suffix = "F" if real == "float" else ""
-
-    def _print_Symbol(self, expr: sp.Symbol) -> str:
-        return symbol_text(expr.name)
-
-    def _print_Pi(self, expr: Any) -> str:
-        return repr(math.pi) + self._suffix
-
-    def _print_Exp1(self, expr: Any) -> str:
-        return repr(math.e) + self._suffix
-
-    def _print_Pow(self, expr: sp.Pow) -> str:
-        # A square is the most common power in kinematics; a product is exact and cheaper.
-        if expr.exp == 2:
-            base = self.parenthesize(expr.base, PRECEDENCE["Mul"])
-            return f"({base}*{base})"
-        return super()._print_Pow(expr)
-
-
-class PythonPrinter(NumPyPrinter):
-    """NumPy printer for the generated module: array arguments, ``numpy.`` functions."""
-
-    def __init__(self) -> None:
-        super().__init__({"strict": True})
-
-    def _print_Symbol(self, expr: sp.Symbol) -> str:
-        return symbol_text(expr.name)
-
-    def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
-        if expr.exp == 2:
-            base = self.parenthesize(expr.base, PRECEDENCE["Mul"])
-            return f"({base}*{base})"
-        return super()._print_Pow(expr, rational)
-
-
-def _printer(backend: str, real: str) -> C99CodePrinter | NumPyPrinter:
-    return CPrinter(real) if backend == "c" else PythonPrinter()
+def _printer(backend: str, real: str) -> CodePrinter:
+    return backends.get(backend).printer(real)
 
 
 # ----- lowering ------------------------------------------------------------------------------
@@ -199,12 +129,12 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         BuildError: an unknown backend or real type, or an expression the printer cannot print.
     """
     _check_options(backend, real, linalg)
-    internal = _internal_symbols(system)
+    internal = symbols.internal_symbols(system)
     pattern = system.pattern()
     expressions = _routine_expressions(system, pattern)
     printer = _printer(backend, real)
     routines = tuple(
-        _routine(name, [_prepare(e, internal) for e in exprs], printer, cse)
+        _routine(name, [symbols.prepare(e, internal) for e in exprs], printer, cse)
         for name, exprs in expressions.items())
     return Code(
         backend=backend, real=real, cse=cse, name=system.name,
@@ -216,7 +146,7 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         points=point_names(system), routines=routines,
         ops_before_cse={name: _count_ops(exprs) for name, exprs in expressions.items()},
         linalg=linalg,
-        extra=({"lu": _sparse_lu_plan(system, pattern)}
+        extra=({"lu": sample.sparse_lu_plan(system, pattern)}
                if backend == "c" and linalg == "sparse" else {}),
     )
 
@@ -224,94 +154,13 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
 def _check_options(backend: str, real: str, linalg: str) -> None:
     if linalg not in LINALG:
         raise BuildError(f"unknown linear algebra {linalg!r}; choose 'dense' or 'sparse'")
-    if backend not in BACKENDS:
-        raise BuildError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    if backend not in backends.NAMES:
+        raise BuildError(f"unknown backend {backend!r}; choose one of {', '.join(backends.NAMES)}")
     if real not in REAL_TYPES:
         raise BuildError(f"unknown real type {real!r}; choose 'double' or 'float'")
     if backend == "numpy" and real != "double":
         raise BuildError("the NumPy backend computes in double precision; use real='double' "
                          "(real='float' is for the C backend)")
-
-
-def _sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> dict[str, Any]:
-    """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration."""
-    from symkin import sparse_lu
-    from symkin.errors import SolveError
-
-    kernel = _SampleKernel(system, pattern)
-    sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
-    try:
-        plan = sparse_lu.analyse(len(system.q), [r for r, _ in pattern],
-                                 [c for _, c in pattern], [float(v) for v in sample])
-    except SolveError as error:
-        raise BuildError(f"cannot plan the sparse LU of Phi_q: {error}") from None
-    return sparse_lu.template_context(plan)
-
-
-def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...]:
-    """Where the pivot order of the sparse LU is chosen: the mechanism assembled at t0.
-
-    The file's q0 is only a first guess (the chapter starts from q = 0), and a pivot order
-    that is numerically good there may be poor on the motion itself; the assembled position
-    is the first point the solver factors. It is found numerically here with the driver's
-    own assembly (Newton, then Levenberg-Marquardt); when that fails, q0 is used and the
-    run-time pivot checks still guard every factorization.
-
-    Args:
-        system: the derived kinematics.
-        kernel: Phi and Phi_q as NumPy functions; built here when not given.
-    """
-    from symkin import driver
-    from symkin.errors import SolveError
-
-    q0 = np.array(system.q0, dtype=float)
-    kernel = kernel or _SampleKernel(system, system.pattern())
-    p = np.array(system.p_values, dtype=float)
-    try:
-        with np.errstate(all="ignore"):
-            start = driver.assemble(kernel, q0, float(system.time_grid[0]), p, driver.Options())
-    except (SolveError, ArithmeticError, ValueError, np.linalg.LinAlgError):
-        return tuple(q0)
-    if start.status != driver.OK or not np.all(np.isfinite(start.q)):
-        return tuple(q0)
-    return tuple(float(v) for v in start.q)
-
-
-class _SampleKernel:
-    """Phi and the non-zeros of Phi_q as NumPy functions (sympy.lambdify over the internal
-    symbols), with the few Kernel attributes the driver's assembly reads."""
-
-    def __init__(self, system: System, pattern: Sequence[tuple[int, int]]) -> None:
-        internal = _internal_symbols(system)
-        arguments = ([internal[s] for s in system.q], internal[system.t],
-                     [internal[s] for s in system.p])
-        self.coordinates = system.coordinates
-        self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
-        self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
-        self._phi = sp.lambdify(arguments, [_prepare(e, internal) for e in system.phi],
-                                modules="numpy")
-        self._nz = sp.lambdify(arguments, [_prepare(system.phi_q[r, c], internal)
-                                           for r, c in pattern], modules="numpy")
-        self._p = np.array(system.p_values, dtype=float)
-
-    def phi(self, q: Any, t: float, p: Any = None) -> np.ndarray:
-        return np.array(self._phi(q, t, self._p if p is None else p), dtype=float)
-
-    def phi_q_nz(self, q: Any, t: float, p: Any = None) -> np.ndarray:
-        return np.array(self._nz(q, t, self._p if p is None else p), dtype=float)
-
-    def phi_q(self, q: Any, t: float, p: Any = None) -> np.ndarray:
-        dense = np.zeros((len(self.coordinates),) * 2)
-        dense[self.pattern_rows, self.pattern_cols] = self.phi_q_nz(q, t, p)
-        return dense
-
-
-def _internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:
-    """User symbols -> internal symbols whose names the printers turn into array accesses."""
-    mapping = {system.t: sp.Symbol("_t", real=True)}
-    for prefix, symbols in (("q", system.q), ("dq", system.dq), ("p", system.p)):
-        mapping.update({s: sp.Symbol(f"_{prefix}{k}", real=True) for k, s in enumerate(symbols)})
-    return mapping
 
 
 def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]]
@@ -333,19 +182,9 @@ def point_names(system: System) -> tuple[tuple[str, str], ...]:
 
 def point_vectors(system: System) -> list[tuple[sp.Expr, sp.Expr]]:
     """The local vector s of every named point, as expressions of the parameters."""
-    from symkin import constraints, model
-
-    ctx = constraints.Context(system.mechanism, model.make_symbols(system.mechanism))
+    ctx = constraints.Context(system.mechanism, symbols_module.make_symbols(system.mechanism))
     # make_symbols creates equal symbols (same names and assumptions) to the System's.
     return [tuple(ctx.local(body, point)) for body, point in point_names(system)]
-
-
-def _prepare(expr: sp.Expr, internal: dict[sp.Symbol, sp.Symbol]) -> sp.Expr:
-    """Internal symbols, and the step functions in a form every printer knows."""
-    expr = sp.sympify(expr).xreplace(internal)
-    # d/dx Heaviside is DiracDelta, which is zero wherever it can be evaluated in floats.
-    expr = expr.replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: sp.Integer(0))
-    return expr.rewrite(sp.Piecewise) if expr.has(sp.Heaviside, sp.sign) else expr
 
 
 def _routine(name: str, exprs: list[sp.Expr], printer: Any, cse: bool) -> Routine:

@@ -11,13 +11,13 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 from symkin.errors import MechanismError, SymkinError
-
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
 
 def _show(args: argparse.Namespace) -> int:
-    from symkin import derivation, report
+    from symkin.symbolic import derivation
+    from symkin.symbolic import show as report
 
     system = derivation.derive(args.mechanism)
     print(report.latex(system) if args.latex else report.text(system), end="")
@@ -27,7 +27,7 @@ def _show(args: argparse.Namespace) -> int:
 def _schema(args: argparse.Namespace) -> int:
     import json
 
-    from symkin import model
+    from symkin.spec import validate as model
 
     print(json.dumps(model.json_schema(), indent=2))
     return EXIT_OK
@@ -43,7 +43,7 @@ def _add_show(commands: argparse._SubParsersAction) -> None:
 
 
 def _verify(args: argparse.Namespace) -> int:
-    from symkin import verify
+    from symkin.cli import verify
 
     return verify.command(args.mechanism, args.against, samples=args.samples, seed=args.seed,
                           spread=args.spread, tolerance=args.tolerance)
@@ -68,7 +68,8 @@ def _add_verify(commands: argparse._SubParsersAction) -> None:
 
 # Each entry adds one subcommand; its handler returns the exit status.
 def _generate(args: argparse.Namespace) -> int:
-    from symkin import derivation, render
+    from symkin.codegen import render
+    from symkin.symbolic import derivation
 
     if args.backend == "numpy" and args.real == "float":
         print("symkin: error: --real float is for the C backend; the NumPy backend computes in "
@@ -97,7 +98,7 @@ def _add_generate(commands: argparse._SubParsersAction) -> None:
 
 
 def _add_run(commands: argparse._SubParsersAction) -> None:
-    from symkin import runner  # the `run` subcommand lives in its own module
+    from symkin.cli import run as runner  # the `run` subcommand lives in its own module
 
     runner.add_parser(commands)
 

@@ -13,8 +13,10 @@ from pathlib import Path
 
 import sympy as sp
 
-from symkin import constraints, model
-from symkin.model import Mechanism
+from symkin.spec import validate as model
+from symkin.spec.validate import Mechanism
+from symkin.symbolic import planar as constraints
+from symkin.symbolic import symbols as symbols_module
 
 
 @dataclass(frozen=True)
@@ -72,7 +74,7 @@ class System:
     def time_grid(self) -> tuple[float, float, float]:
         """(t0, t1, dt) at the nominal parameter values."""
         values = dict(zip(self.p, self.p_values))
-        parse = constraints.Context(self.mechanism, model.make_symbols(self.mechanism)).expr
+        parse = constraints.Context(self.mechanism, symbols_module.make_symbols(self.mechanism)).expr
         grid = self.mechanism.time
         t0, t1, dt = (float(parse(raw).subs(values)) for raw in (grid.t0, grid.t1, grid.dt))
         return t0, t1, dt
@@ -86,7 +88,7 @@ def derive(mech: Mechanism | str | Path) -> System:
     """Derive Phi, Phi_q, Phi_t and Gamma of a mechanism (a Mechanism or a file path)."""
     if not isinstance(mech, Mechanism):
         mech = model.load(mech)
-    symbols = model.make_symbols(mech)
+    symbols = symbols_module.make_symbols(mech)
     ctx = constraints.Context(mech, symbols)
     phi, rows = _constraint_rows(mech, ctx)
     column = {q: k for k, q in enumerate(symbols.q)}
@@ -141,7 +143,7 @@ def _row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
     return {k: value for k, value in derivatives.items() if value != 0}
 
 
-def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr, symbols: model.Symbols) -> sp.Expr:
+def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr, symbols: symbols_module.Symbols) -> sp.Expr:
     """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt, from this row's columns."""
     q, dq, t = symbols.q, symbols.dq, symbols.t
     velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))

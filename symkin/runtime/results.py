@@ -1,6 +1,6 @@
 """Stage 7 — results: point kinematics (2.14-2.16), the Trajectory and the files a run writes.
 
-Imports only NumPy: it is part of the runtime. Plots and animation live in symkin.plots.
+Imports only NumPy: it is part of the runtime. Plots and animation live in symkin.present.plots.
 """
 
 from __future__ import annotations

@@ -12,7 +12,6 @@ import importlib.machinery
 import importlib.util
 import json
 import sys
-import sysconfig
 from collections.abc import Mapping
 from pathlib import Path
 from types import ModuleType
@@ -20,6 +19,8 @@ from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from symkin import resources
 
 Array = NDArray[np.float64]
 
@@ -192,14 +193,14 @@ def load(folder: str | Path) -> Kernel:
     the compiled extension. Needs only NumPy (and cffi for C), never SymPy.
     """
     folder = Path(folder)
-    meta = json.loads((folder / "manifest.json").read_text(encoding="utf-8"))
+    meta = json.loads((folder / resources.MANIFEST).read_text(encoding="utf-8"))
     if meta["backend"] == "numpy":
         source = folder / f"{meta['name']}.py"
         digest = hashlib.sha256(source.read_bytes()).hexdigest()
         module = import_file(f"_symkin_{meta['name']}_py_{digest[:20]}", source, None)
         return from_module(module, folder)
     library = extension_file(folder, meta["name"])
-    name = library.name[: -len(_EXTENSION_SUFFIX)]
+    name = library.name[: -len(resources.extension_suffix())]
     loader = importlib.machinery.ExtensionFileLoader(name, str(library))
     module = import_file(name, library, loader)
     return from_cffi(module.ffi, module.lib, meta, folder)
@@ -211,10 +212,10 @@ def extension_file(folder: Path, name: str | None = None) -> Path:
     A build-cache folder is named after its module, so that file is the one; any other folder
     must hold exactly one ``_symkin_<name>_*`` extension.
     """
-    own = folder / (folder.name + _EXTENSION_SUFFIX)
+    own = folder / (folder.name + resources.extension_suffix())
     if own.is_file():
         return own
-    pattern = f"_symkin_{name or ''}{'_' if name else ''}*{_EXTENSION_SUFFIX}"
+    pattern = f"_symkin_{name or ''}{'_' if name else ''}*{resources.extension_suffix()}"
     libraries = sorted(folder.glob(pattern))
     if len(libraries) != 1:
         found = "no" if not libraries else "more than one"
@@ -234,5 +235,3 @@ def import_file(name: str, path: Path, loader: Any) -> ModuleType:
         sys.modules[name] = module
     return sys.modules[name]
 
-
-_EXTENSION_SUFFIX = sysconfig.get_config_var("EXT_SUFFIX") or ".so"

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import SymkinError
-from symkin.results import Trajectory, rotation
+from symkin.runtime.results import Trajectory, rotation
 
 MAX_FRAMES = 200
 
@@ -136,30 +136,3 @@ def animate(trajectory: Trajectory, path: str | Path,
 def _closed(vertices: NDArray[np.float64]) -> NDArray[np.float64]:
     """A polygon through the vertices, closed when it has more than two."""
     return np.vstack([vertices, vertices[:1]]) if len(vertices) > 2 else vertices
-
-
-def outlines(system) -> dict[str, NDArray[np.float64]]:
-    """Per body, the local vectors of its joint and driver attachments and its named points,
-    at the nominal parameter values: what ``animate`` draws each body through.
-
-    Args:
-        system: the derived System (SymPy is imported here, at the CLI's side of the runtime).
-    """
-    from symkin import constraints, model
-
-    mech = system.mechanism
-    ctx = constraints.Context(mech, model.make_symbols(mech))
-    values = dict(zip(system.p, system.p_values))
-    found: dict[str, list[tuple[float, float]]] = {body: [] for body in mech.bodies}
-    attachments = [(getattr(c, "i", None), getattr(c, "sA", None)) for c in
-                   [*mech.joints, *mech.drivers]]
-    attachments += [(getattr(c, "j", None), getattr(c, "sB", None)) for c in
-                    [*mech.joints, *mech.drivers]]
-    attachments += [(body, name) for body, spec in mech.bodies.items() for name in spec.points]
-    for body, ref in attachments:
-        if body in found and ref is not None:
-            x, y = (float(v.subs(values)) for v in ctx.local(body, ref))
-            vector = (x, y)
-            if vector not in found[body]:
-                found[body].append(vector)
-    return {body: np.array(v or [(0.0, 0.0)], dtype=float) for body, v in found.items()}

@@ -28,9 +28,13 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from symkin import codegen, kernel, render
-from symkin.cache import cache_root  # one cache folder for the build cache and the index
-from symkin.derivation import System
+from symkin.codegen import lower as codegen
+from symkin import resources
+from symkin.runtime import kernel
+from symkin.codegen import render
+from symkin.build import toolchain
+from symkin.build.cache import cache_root, content_key, publish
+from symkin.symbolic.derivation import System
 from symkin.errors import BuildError
 
 # Plain -O2: -ffast-math would break the NaN checks of the solver and reorder sums, and
@@ -58,7 +62,7 @@ def compile(system: System, backend: str = "c", *, real: str = "double", cse: bo
     """
     cache = Path(cache_dir) if cache_dir is not None else cache_root()
     if backend == "c":
-        compiler = c_compiler()
+        compiler = toolchain.c_compiler()
         if compiler is None:
             warnings.warn(
                 f"no C compiler found (looked for {os.environ.get('CC') or 'cc'}); using the "
@@ -70,30 +74,22 @@ def compile(system: System, backend: str = "c", *, real: str = "double", cse: bo
     return _load_numpy(codegen.lower(system, backend, real, cse), cache)
 
 
-def c_compiler() -> list[str] | None:
-    """The C compiler command (``$CC``, else Python's, else ``cc``), or None when missing."""
-    if os.name != "posix":
-        return None
-    command = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
-    return command if command and shutil.which(command[0]) else None
-
-
 # ----- C backend -----------------------------------------------------------------------------
 
 def _compile_c(code: codegen.Code, cache: Path, compiler: list[str]) -> kernel.Kernel:
     files = render.render_sources(code)
-    files[render.MANIFEST] = render.manifest(code, files)
+    files[resources.MANIFEST] = render.manifest(code, files)
     cdef = render.render_cdef(code)
-    key = _key({"files": files, "cdef": cdef, "compiler": compiler, "flags": C_FLAGS,
-                "wrapper_flags": WRAPPER_FLAGS, **_toolchain()})
+    key = content_key({"files": files, "cdef": cdef, "compiler": compiler, "flags": C_FLAGS,
+                "wrapper_flags": WRAPPER_FLAGS, **toolchain.fingerprint(compiler)})
     module_name = f"_symkin_{code.name}_{key[:20]}"
     folder = cache / module_name
-    library = folder / (module_name + _extension_suffix())
+    library = folder / (module_name + resources.extension_suffix())
     if not library.exists():
-        _publish(cache, folder, lambda build: _build_c(build, files, cdef, module_name,
+        publish(cache, folder, lambda build: _build_c(build, files, cdef, module_name,
                                                         compiler, code.name))
     module = _import_extension(module_name, library)
-    meta = json.loads(files[render.MANIFEST])
+    meta = json.loads(files[resources.MANIFEST])
     return kernel.from_cffi(module.ffi, module.lib, meta, folder)
 
 
@@ -115,7 +111,7 @@ def _build_c(build: Path, files: dict[str, str], cdef: str, module_name: str,
     for source in sorted(n for n in files if n.endswith(".c")):
         objects.append(_object(compiler, [*C_FLAGS, *include], build / source))
     objects.append(_object(compiler, [*WRAPPER_FLAGS, *include], wrapper))
-    library = build / (module_name + _extension_suffix())
+    library = build / (module_name + resources.extension_suffix())
     run([*compiler, *_link_flags(), "-o", str(library), *map(str, objects), "-lm"], build)
 
 
@@ -161,48 +157,12 @@ def _import_extension(module_name: str, library: Path) -> ModuleType:
 
 def _load_numpy(code: codegen.Code, cache: Path) -> kernel.Kernel:
     files = render.render_sources(code)
-    key = _key({"files": files})
+    key = content_key({"files": files})
     module_name = f"_symkin_{code.name}_py_{key[:20]}"
     folder = cache / module_name
     source = folder / f"{code.name}.py"
     if not source.exists():
-        _publish(cache, folder, lambda build: render.write(code, build))
+        publish(cache, folder, lambda build: render.write(code, build))
     return kernel.from_module(kernel.import_file(module_name, source, None), folder)
 
 
-# ----- cache ---------------------------------------------------------------------------------
-
-def _publish(cache: Path, folder: Path, fill: Any) -> None:
-    """Fill a private temporary folder and rename it to ``folder`` in one atomic step.
-
-    When another process published the same folder first, the rename fails; its result is
-    the same (same key, same inputs), so this build is discarded.
-    """
-    cache.mkdir(parents=True, exist_ok=True)
-    build = Path(tempfile.mkdtemp(dir=cache, prefix=f".{folder.name}."))
-    try:
-        fill(build)
-        try:
-            os.replace(build, folder)
-        except OSError:
-            if not folder.is_dir():
-                raise
-    finally:
-        if build.exists():
-            shutil.rmtree(build, ignore_errors=True)
-
-
-def _key(inputs: dict[str, Any]) -> str:
-    return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()
-
-
-def _toolchain() -> dict[str, str]:
-    import cffi
-
-    return {"cffi": cffi.__version__, "python": sys.version, "implementation":
-            sys.implementation.cache_tag or "", "platform": sysconfig.get_platform(),
-            "machine": platform.machine(), "suffix": _extension_suffix()}
-
-
-def _extension_suffix() -> str:
-    return sysconfig.get_config_var("EXT_SUFFIX") or ".so"

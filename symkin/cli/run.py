@@ -15,7 +15,8 @@ import time
 from pathlib import Path
 from typing import Any, TextIO
 
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
+
 SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png",), "animate": (".gif",)}
 
 
@@ -47,7 +48,7 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
 
 
 def _times(kernel: Any, args: argparse.Namespace):
-    from symkin import driver
+    from symkin.runtime import driver
 
     t0, t1, dt = kernel.time_grid
     t0 = t0 if args.t0 is None else args.t0
@@ -70,7 +71,8 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def _solve_and_write(args: argparse.Namespace) -> int:
-    from symkin import cache, driver
+    from symkin.build import index as cache
+    from symkin.runtime import driver
 
     prepared = cache.prepare(args.mechanism, cache.Options(backend=args.backend),
                              outlines=args.animate is not None)
@@ -116,7 +118,7 @@ def _write(trajectory: Any, args: argparse.Namespace, outlines: Any) -> list[Pat
 
 
 def _write_files(trajectory: Any, args: argparse.Namespace, outlines: Any) -> list[Path]:
-    from symkin import plots
+    from symkin.present import plots
 
     written = []
     if args.output:

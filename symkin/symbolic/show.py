@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from symkin.derivation import System
-from symkin.model import degrees_of_freedom
+from symkin.spec.validate import degrees_of_freedom
+from symkin.symbolic.derivation import System
 
 
 def _names(system: System) -> dict[sp.Symbol, sp.Symbol]:

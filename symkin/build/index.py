@@ -36,22 +36,24 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin import kernel as kernel_module
 from symkin import resources
-from symkin.kernel import Kernel
+from symkin.build import toolchain
+from symkin.build.cache import cache_root
+from symkin.runtime import kernel as kernel_module
+from symkin.runtime.kernel import Kernel
 
 # Bump when the entry layout or the meaning of a key changes.
 FORMAT = 1
 INDEX_FOLDER = "index"
-MANIFEST = "manifest.json"
-_PACKAGE = Path(__file__).resolve().parent
+MANIFEST = resources.MANIFEST
+_PACKAGE = Path(__file__).resolve().parents[1]
 
 Outlines = dict[str, NDArray[np.float64]]
 
 
 @dataclass(frozen=True)
 class Options:
-    """What, besides the file, decides the kernel: see ``symkin.build.compile``."""
+    """What, besides the file, decides the kernel: see ``symkin.build.compile.compile``."""
 
     backend: str = "numpy"
     real: str = "double"
@@ -66,7 +68,7 @@ class Prepared:
     Attributes:
         kernel: the loaded kernel.
         hit: True when it came from the index (no validation, no derivation).
-        outlines: per body, the local vectors ``plots.animate`` draws, when asked for.
+        outlines: per body, the local vectors ``present.plots.animate`` draws, when asked for.
         system: the derived System on a miss, None on a hit.
     """
 
@@ -107,23 +109,15 @@ def prepare(mechanism: str | Path, options: Options = Options(), *, outlines: bo
     return prepared
 
 
-def cache_root() -> Path:
-    """``$SYMKIN_CACHE_DIR``, else the user cache folder (the same as symkin.build's)."""
-    explicit = os.environ.get("SYMKIN_CACHE_DIR")
-    if explicit:
-        return Path(explicit)
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "symkin"
-
-
 def _full_pipeline(mechanism: Path, options: Options, cache: Path,
                    want_outlines: bool) -> Prepared:
-    from symkin import build, derivation, plots
+    from symkin.build import compile as build
+    from symkin.symbolic import derivation, drawing
 
     system = derivation.derive(mechanism)
     kernel = build.compile(system, backend=options.backend, real=options.real,
                            cse=options.cse, linalg=options.linalg, cache_dir=cache)
-    drawn = plots.outlines(system) if want_outlines else None
+    drawn = drawing.outlines(system) if want_outlines else None
     return Prepared(kernel, hit=False, outlines=drawn, system=system)
 
 
@@ -163,17 +157,9 @@ def code_version() -> str:
 
 
 def environment(backend: str) -> dict[str, Any]:
-    """The interpreter and, for C, the compiler a kernel was built for.
-
-    The build cache keys its folders on these too; here they make sure a warm run never
-    reaches for a folder built for another interpreter or compiler.
-    """
-    found: dict[str, Any] = {"python": sys.version, "platform": sysconfig.get_platform(),
-                             "suffix": sysconfig.get_config_var("EXT_SUFFIX") or ".so"}
-    if backend == "c":
-        command = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
-        found["compiler"] = [shutil.which(command[0]) if command else None, *command]
-    return found
+    """The interpreter and, for C, the compiler (path and version) a kernel was built for,
+    so a warm run never reaches for a folder built for another interpreter or compiler."""
+    return toolchain.fingerprint(toolchain.c_compiler() if backend == "c" else None)
 
 
 # ----- entries -------------------------------------------------------------------------------

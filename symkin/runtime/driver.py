@@ -27,34 +27,24 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.errors import SolveError
-from symkin.results import Trajectory
+from symkin.runtime.linalg import dependent_rows, factor_at
+from symkin.runtime.newton import (
+    NO_CONVERGENCE,
+    OK,
+    SINGULAR,
+    Newton,
+    Options,
+    assemble,
+    newton,
+)
+from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
 
-# Status codes shared with the generated C solver (templates/c/solver.h.j2).
-OK, NO_CONVERGENCE, SINGULAR = 0, 1, 2
 # Diagnosis only (never a stopping test): condition numbers of Phi_q taken as singular at a
 # failed iterate, and as "nearly singular" at the last point solved before a failure.
 ILL_CONDITIONED, NEARLY_SINGULAR = 1e8, 1e5
-
-
-@dataclass(frozen=True)
-class Options:
-    """Newton tolerances and the singularity test.
-
-    Args:
-        tol_phi: converged when max |Phi| of the current iterate is at most this...
-        tol_dq: ...and the last Newton step max |dq| is at most this.
-        max_iterations: Newton iterations allowed per time point.
-        min_pivot_ratio: Phi_q counts as singular when min |u_kk| / max |u_kk| of its LU
-            factors falls below this (a cheap estimate of the reciprocal condition number).
-    """
-
-    tol_phi: float = 1e-10
-    tol_dq: float = 1e-9
-    max_iterations: int = 25
-    min_pivot_ratio: float = 1e-10
 
 
 class SolveFailure(SolveError):
@@ -125,183 +115,6 @@ def _params(kernel: Any, params: Mapping[str, float] | ArrayLike | None) -> Arra
     if given.shape != values.shape:
         raise SolveError(f"params has {given.size} values; the mechanism has {values.size}")
     return given
-
-
-# ----- linear algebra ------------------------------------------------------------------------
-
-SPARSE_FROM = 100
-"""Phi_q with this many coordinates or more is factored as a sparse matrix (SuperLU through
-scipy.sparse.linalg.splu): a dense factorization costs O(N^3) and its N x N array O(N^2)
-memory, while Phi_q has at most about six non-zeros a row (chapter section 2.7). Below it,
-LAPACK on the dense matrix is faster than building a sparse one."""
-
-
-@dataclass(frozen=True)
-class Factors:
-    """LU factors of Phi_q with partial pivoting, and the pivot-ratio singularity estimate."""
-
-    lu: Array
-    pivots: NDArray[np.int32]
-    pivot_ratio: float
-    getrs: Callable[..., Any]  # LAPACK's solve with these factors
-
-    def solve(self, b: Array) -> Array:
-        x, _ = self.getrs(self.lu, self.pivots, b)
-        return x
-
-
-@dataclass(frozen=True)
-class SparseFactors:
-    """Sparse LU factors of Phi_q (SuperLU, partial pivoting by rows, fill-reducing column
-    order) with the same pivot-ratio estimate; ``lu`` is None when a pivot vanished."""
-
-    lu: Any
-    pivot_ratio: float
-
-    def solve(self, b: Array) -> Array:
-        return self.lu.solve(np.asarray(b, dtype=float))
-
-
-def factor(jacobian: Array) -> Factors:
-    """Factor P Phi_q = L U (LAPACK getrf, as the C runtime does it: largest pivot in the column).
-
-    A zero pivot is not an error here: it gives ratio 0, which the caller judges.
-    """
-    from scipy.linalg import lapack  # imported on use: a warm C run never needs SciPy
-
-    lu, pivots, _ = lapack.dgetrf(jacobian)
-    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs)
-
-
-def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values: Array
-                  ) -> SparseFactors:
-    """Factor Phi_q given as its structural non-zeros (pattern order), in O(non-zeros + fill)."""
-    from scipy.sparse import csc_matrix
-    from scipy.sparse.linalg import splu
-
-    if not np.all(np.isfinite(values)):
-        return SparseFactors(None, 0.0)
-    matrix = csc_matrix((values, (rows, cols)), shape=(n, n))
-    try:
-        lu = splu(matrix)
-    except RuntimeError:  # SuperLU: "Factor is exactly singular"
-        return SparseFactors(None, 0.0)
-    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())))
-
-
-def factor_at(kernel: Any, q: Array, t: float, p: Array) -> Factors | SparseFactors:
-    """Factor Phi_q(q, t): dense below SPARSE_FROM coordinates, sparse from there on."""
-    n = len(kernel.coordinates)
-    if n < SPARSE_FROM:
-        return factor(kernel.phi_q(q, t, p))
-    return factor_sparse(n, kernel.pattern_rows, kernel.pattern_cols,
-                         np.asarray(kernel.phi_q_nz(q, t, p), dtype=float))
-
-
-def _ratio(magnitudes: Array) -> float:
-    """min |u_kk| / max |u_kk|; 0 when a pivot vanished or is not finite."""
-    largest = magnitudes.max(initial=0.0)
-    ratio = float(magnitudes.min() / largest) if largest > 0 else 0.0
-    return ratio if math.isfinite(ratio) else 0.0
-
-
-def dependent_rows(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8) -> list[str]:
-    """The equations whose rows of Phi_q are linearly dependent.
-
-    The left null space of Phi_q (left singular vectors with sigma <= rcond sigma_max) holds the
-    combinations y with y^T Phi_q = 0; a row takes part in a dependency when some y weighs it.
-    """
-    if not np.all(np.isfinite(jacobian)):
-        return list(labels)
-    u, sigma, _ = np.linalg.svd(jacobian)
-    null = u[:, sigma <= rcond * max(sigma[0], 1e-300)]
-    if null.shape[1] == 0:
-        null = u[:, -1:]  # ill-conditioned but above rcond: name the weakest direction
-    weight = np.abs(null).max(axis=1)
-    return [label for label, w in zip(labels, weight) if w > 1e-6]
-
-
-# ----- Newton-Raphson and assembly -----------------------------------------------------------
-
-@dataclass
-class Newton:
-    """The outcome of Newton-Raphson at one time point."""
-
-    q: Array
-    status: int
-    iterations: int
-    residual: float
-    factors: Factors | SparseFactors | None
-
-
-def newton(kernel: Any, q: Array, t: float, p: Array, options: Options) -> Newton:
-    """Newton-Raphson that tests the residual of the current iterate (2.72).
-
-    Converged when max |Phi(q_k)| <= tol_phi and the step that led to q_k was at most tol_dq
-    (or no step was needed). The factors returned are those of Phi_q at the converged q, ready
-    for the velocity and acceleration solves.
-    """
-    q = np.array(q, dtype=float)
-    step = math.inf
-    for iteration in range(options.max_iterations + 1):
-        phi = kernel.phi(q, t, p)
-        residual = float(np.abs(phi).max(initial=0.0))
-        if not math.isfinite(residual):
-            return Newton(q, NO_CONVERGENCE, iteration, residual, None)
-        factors = factor_at(kernel, q, t, p)
-        if factors.pivot_ratio < options.min_pivot_ratio:
-            return Newton(q, SINGULAR, iteration, residual, factors)
-        if residual <= options.tol_phi and (iteration == 0 or step <= options.tol_dq):
-            return Newton(q, OK, iteration, residual, factors)
-        if iteration == options.max_iterations:
-            break
-        delta = factors.solve(-phi)
-        q += delta
-        step = float(np.abs(delta).max(initial=0.0))
-    return Newton(q, NO_CONVERGENCE, options.max_iterations, residual, None)
-
-
-def levenberg_marquardt(kernel: Any, q: Array, t: float, p: Array, options: Options,
-                        max_iterations: int = 200) -> tuple[Array, float]:
-    """Minimise |Phi(q, t)|^2 from a poor guess; returns the best q and its max |Phi|.
-
-    Each step solves (J^T J + mu I) dq = -J^T Phi; mu shrinks after a step that lowers the
-    residual and grows otherwise, so the method moves like Newton near a solution and like
-    gradient descent far from one. It works where Phi_q is singular (e.g. q = 0).
-    """
-    q = np.array(q, dtype=float)
-    phi = kernel.phi(q, t, p)
-    cost = float(phi @ phi)
-    mu = 1e-3
-    for _ in range(max_iterations):
-        if math.sqrt(cost) <= options.tol_phi:
-            break
-        jacobian = kernel.phi_q(q, t, p)
-        normal = jacobian.T @ jacobian
-        gradient = jacobian.T @ phi
-        scale = mu * max(float(np.max(np.diag(normal))), 1.0)
-        delta = np.linalg.solve(normal + scale * np.eye(q.size), -gradient)
-        trial = q + delta
-        trial_phi = kernel.phi(trial, t, p)
-        trial_cost = float(trial_phi @ trial_phi)
-        if math.isfinite(trial_cost) and trial_cost < cost:
-            q, phi, cost, mu = trial, trial_phi, trial_cost, max(mu / 10, 1e-12)
-        else:
-            mu *= 10
-            if mu > 1e12:
-                break
-    return q, float(np.abs(phi).max(initial=0.0))
-
-
-def assemble(kernel: Any, q0: Array, t0: float, p: Array, options: Options) -> Newton:
-    """Assemble the mechanism at t0 from q0: Newton, else Levenberg-Marquardt then Newton."""
-    result = newton(kernel, q0, t0, p, options)
-    if result.status == OK:
-        return result
-    q, _ = levenberg_marquardt(kernel, q0, t0, p, options)
-    polished = newton(kernel, q, t0, p, options)
-    polished.iterations += result.iterations
-    return polished
 
 
 # ----- the time loop -------------------------------------------------------------------------

@@ -9,7 +9,7 @@ from __future__ import annotations
 import keyword
 import re
 
-from symkin.expressions import FUNCTIONS
+from symkin.spec.expressions import FUNCTIONS
 
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 MAX_NAME_LENGTH = 48

@@ -1,0 +1,147 @@
+"""A sample configuration of a mechanism, for choices made at generation time.
+
+The pivot order of the generated sparse LU is checked on Phi_q at the mechanism assembled at
+t0. That configuration is found here with plain NumPy (SymPy's lambdify of Phi and Phi_q) and a
+small assembly of its own, so code generation never depends on the runtime driver.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from symkin.codegen import lu_plan as sparse_lu
+from symkin.codegen import symbols
+from symkin.errors import BuildError, SolveError
+from symkin.symbolic.derivation import System
+
+# Assembly tolerances: the runtime's Newton defaults (a tighter sample changes nothing).
+TOL_PHI, TOL_DQ, MAX_NEWTON, MIN_PIVOT_RATIO = 1e-10, 1e-9, 25, 1e-10
+
+
+def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> dict[str, Any]:
+    """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration."""
+    kernel = _SampleKernel(system, pattern)
+    sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
+    try:
+        plan = sparse_lu.analyse(len(system.q), [r for r, _ in pattern],
+                                 [c for _, c in pattern], [float(v) for v in sample])
+    except SolveError as error:
+        raise BuildError(f"cannot plan the sparse LU of Phi_q: {error}") from None
+    return sparse_lu.template_context(plan)
+
+
+def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...]:
+    """Where the pivot order of the sparse LU is chosen: the mechanism assembled at t0.
+
+    The file's q0 is only a first guess (the chapter starts from q = 0), and a pivot order
+    that is numerically good there may be poor on the motion itself; the assembled position
+    is the first point the solver factors. It is found numerically here with the driver's
+    own assembly (Newton, then Levenberg-Marquardt); when that fails, q0 is used and the
+    run-time pivot checks still guard every factorization.
+
+    Args:
+        system: the derived kinematics.
+        kernel: Phi and Phi_q as NumPy functions; built here when not given.
+    """
+
+    q0 = np.array(system.q0, dtype=float)
+    kernel = kernel or _SampleKernel(system, system.pattern())
+    p = np.array(system.p_values, dtype=float)
+    try:
+        with np.errstate(all="ignore"):
+            q = _assemble(kernel, q0, float(system.time_grid[0]), p)
+    except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+        return tuple(q0)
+    if q is None or not np.all(np.isfinite(q)):
+        return tuple(q0)
+    return tuple(float(v) for v in q)
+
+
+class _SampleKernel:
+    """Phi and the non-zeros of Phi_q as NumPy functions (sympy.lambdify over the internal
+    symbols), with the few Kernel attributes the driver's assembly reads."""
+
+    def __init__(self, system: System, pattern: Sequence[tuple[int, int]]) -> None:
+        internal = symbols.internal_symbols(system)
+        arguments = ([internal[s] for s in system.q], internal[system.t],
+                     [internal[s] for s in system.p])
+        self.coordinates = system.coordinates
+        self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
+        self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
+        self._phi = sp.lambdify(arguments, [symbols.prepare(e, internal) for e in system.phi],
+                                modules="numpy")
+        self._nz = sp.lambdify(arguments, [symbols.prepare(system.phi_q[r, c], internal)
+                                           for r, c in pattern], modules="numpy")
+        self._p = np.array(system.p_values, dtype=float)
+
+    def phi(self, q: Any, t: float, p: Any = None) -> np.ndarray:
+        return np.array(self._phi(q, t, self._p if p is None else p), dtype=float)
+
+    def phi_q_nz(self, q: Any, t: float, p: Any = None) -> np.ndarray:
+        return np.array(self._nz(q, t, self._p if p is None else p), dtype=float)
+
+    def phi_q(self, q: Any, t: float, p: Any = None) -> np.ndarray:
+        dense = np.zeros((len(self.coordinates),) * 2)
+        dense[self.pattern_rows, self.pattern_cols] = self.phi_q_nz(q, t, p)
+        return dense
+
+
+def _assemble(kernel: Any, q0: np.ndarray, t0: float, p: np.ndarray) -> np.ndarray | None:
+    """Newton from q0, else Levenberg-Marquardt then Newton: the assembled q, or None."""
+    q = _newton(kernel, q0, t0, p)
+    if q is not None:
+        return q
+    return _newton(kernel, _levenberg_marquardt(kernel, q0, t0, p), t0, p)
+
+
+def _newton(kernel: Any, q: np.ndarray, t: float, p: np.ndarray) -> np.ndarray | None:
+    """Newton-Raphson testing the residual of the iterate; None when it fails or Phi_q is
+    singular (pivot ratio of the LU factors below MIN_PIVOT_RATIO)."""
+    import scipy.linalg
+
+    q = np.array(q, dtype=float)
+    step = math.inf
+    for iteration in range(MAX_NEWTON + 1):
+        phi = kernel.phi(q, t, p)
+        residual = float(np.abs(phi).max(initial=0.0))
+        if not math.isfinite(residual):
+            return None
+        lu, pivots = scipy.linalg.lu_factor(kernel.phi_q(q, t, p), check_finite=False)
+        diagonal = np.abs(np.diag(lu))
+        if diagonal.max(initial=0.0) == 0.0 or diagonal.min() / diagonal.max() < MIN_PIVOT_RATIO:
+            return None
+        if residual <= TOL_PHI and (iteration == 0 or step <= TOL_DQ):
+            return q
+        delta = scipy.linalg.lu_solve((lu, pivots), -phi, check_finite=False)
+        q = q + delta
+        step = float(np.abs(delta).max(initial=0.0))
+    return None
+
+
+def _levenberg_marquardt(kernel: Any, q: np.ndarray, t: float, p: np.ndarray,
+                         max_iterations: int = 200) -> np.ndarray:
+    """Minimise |Phi|^2 from a poor guess with (J^T J + mu I) dq = -J^T Phi."""
+    q = np.array(q, dtype=float)
+    phi = kernel.phi(q, t, p)
+    cost, mu = float(phi @ phi), 1e-3
+    for _ in range(max_iterations):
+        if math.sqrt(cost) <= TOL_PHI:
+            break
+        jacobian = kernel.phi_q(q, t, p)
+        normal = jacobian.T @ jacobian
+        scale = mu * max(float(np.max(np.diag(normal))), 1.0)
+        trial = q + np.linalg.solve(normal + scale * np.eye(q.size), -(jacobian.T @ phi))
+        trial_phi = kernel.phi(trial, t, p)
+        trial_cost = float(trial_phi @ trial_phi)
+        if math.isfinite(trial_cost) and trial_cost < cost:
+            q, phi, cost, mu = trial, trial_phi, trial_cost, max(mu / 10, 1e-12)
+        else:
+            mu *= 10
+            if mu > 1e12:
+                break
+    return q

@@ -1,0 +1,49 @@
+"""How a symbol of the derivation appears in generated code: an array element or a temporary.
+
+The printers of every backend map symbols through :func:`symbol_text`; a name from the
+mechanism file can never reach generated code, because only internal names are mapped.
+"""
+
+from __future__ import annotations
+
+import re
+
+import sympy as sp
+
+from symkin.errors import BuildError
+from symkin.symbolic.derivation import System
+
+_INTERNAL = re.compile(r"_(q|dq|p)(\d+)\Z")
+_TEMPORARY = re.compile(r"w\d+\Z")
+
+
+def symbol_text(name: str) -> str:
+    """The code for a symbol: ``_q3`` -> ``q[3]``, ``_t`` -> ``t``, temporaries as they are.
+
+    Anything else would be a name from the mechanism file reaching the code, so it is refused.
+    """
+    if name == "_t":
+        return "t"
+    match = _INTERNAL.match(name)
+    if match:
+        return f"{match.group(1)}[{match.group(2)}]"
+    if _TEMPORARY.match(name):
+        return name
+    raise BuildError(f"internal error: the symbol {name!r} is not an argument of the generated "
+                     "function")
+
+
+def internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:
+    """User symbols -> internal symbols whose names the printers turn into array accesses."""
+    mapping = {system.t: sp.Symbol("_t", real=True)}
+    for prefix, symbols in (("q", system.q), ("dq", system.dq), ("p", system.p)):
+        mapping.update({s: sp.Symbol(f"_{prefix}{k}", real=True) for k, s in enumerate(symbols)})
+    return mapping
+
+
+def prepare(expr: sp.Expr, internal: dict[sp.Symbol, sp.Symbol]) -> sp.Expr:
+    """Internal symbols, and the step functions in a form every printer knows."""
+    expr = sp.sympify(expr).xreplace(internal)
+    # d/dx Heaviside is DiracDelta, which is zero wherever it can be evaluated in floats.
+    expr = expr.replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: sp.Integer(0))
+    return expr.rewrite(sp.Piecewise) if expr.has(sp.Heaviside, sp.sign) else expr

@@ -1,0 +1,109 @@
+"""Linear algebra of the runtime: LU factors of Phi_q (dense LAPACK or sparse SuperLU), the
+pivot ratio that tells a singular Phi_q, and the dependent rows behind a singularity."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+SPARSE_FROM = 100
+"""Phi_q with this many coordinates or more is factored as a sparse matrix (SuperLU through
+scipy.sparse.linalg.splu): a dense factorization costs O(N^3) and its N x N array O(N^2)
+memory, while Phi_q has at most about six non-zeros a row (chapter section 2.7). Below it,
+LAPACK on the dense matrix is faster than building a sparse one."""
+
+
+@dataclass(frozen=True)
+class Factors:
+    """LU factors of Phi_q with partial pivoting, and the pivot-ratio singularity estimate."""
+
+    lu: Array
+    pivots: NDArray[np.int32]
+    pivot_ratio: float
+    getrs: Callable[..., Any]  # LAPACK's solve with these factors
+
+    def solve(self, b: Array) -> Array:
+        x, _ = self.getrs(self.lu, self.pivots, b)
+        return x
+
+
+@dataclass(frozen=True)
+class SparseFactors:
+    """Sparse LU factors of Phi_q (SuperLU, partial pivoting by rows, fill-reducing column
+    order) with the same pivot-ratio estimate; ``lu`` is None when a pivot vanished."""
+
+    lu: Any
+    pivot_ratio: float
+
+    def solve(self, b: Array) -> Array:
+        return self.lu.solve(np.asarray(b, dtype=float))
+
+
+def factor(jacobian: Array) -> Factors:
+    """Factor P Phi_q = L U (LAPACK getrf, as the C runtime does it: largest pivot in the column).
+
+    A zero pivot is not an error here: it gives ratio 0, which the caller judges.
+    """
+    from scipy.linalg import lapack  # imported on use: a warm C run never needs SciPy
+
+    lu, pivots, _ = lapack.dgetrf(jacobian)
+    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs)
+
+
+def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values: Array
+                  ) -> SparseFactors:
+    """Factor Phi_q given as its structural non-zeros (pattern order), in O(non-zeros + fill)."""
+    from scipy.sparse import csc_matrix
+    from scipy.sparse.linalg import splu
+
+    if not np.all(np.isfinite(values)):
+        return SparseFactors(None, 0.0)
+    matrix = csc_matrix((values, (rows, cols)), shape=(n, n))
+    try:
+        lu = splu(matrix)
+    except RuntimeError:  # SuperLU: "Factor is exactly singular"
+        return SparseFactors(None, 0.0)
+    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())))
+
+
+def factor_at(kernel: Any, q: Array, t: float, p: Array) -> Factors | SparseFactors:
+    """Factor Phi_q(q, t): dense below SPARSE_FROM coordinates, sparse from there on."""
+    n = len(kernel.coordinates)
+    if n < SPARSE_FROM:
+        return factor(kernel.phi_q(q, t, p))
+    return factor_sparse(n, kernel.pattern_rows, kernel.pattern_cols,
+                         np.asarray(kernel.phi_q_nz(q, t, p), dtype=float))
+
+
+def _ratio(magnitudes: Array) -> float:
+    """min |u_kk| / max |u_kk|; 0 when a pivot vanished or is not finite."""
+    largest = magnitudes.max(initial=0.0)
+    ratio = float(magnitudes.min() / largest) if largest > 0 else 0.0
+    return ratio if math.isfinite(ratio) else 0.0
+
+
+def dependent_rows(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8) -> list[str]:
+    """The equations whose rows of Phi_q are linearly dependent.
+
+    The left null space of Phi_q (left singular vectors with sigma <= rcond sigma_max) holds the
+    combinations y with y^T Phi_q = 0; a row takes part in a dependency when some y weighs it.
+    """
+    if not np.all(np.isfinite(jacobian)):
+        return list(labels)
+    u, sigma, _ = np.linalg.svd(jacobian)
+    null = u[:, sigma <= rcond * max(sigma[0], 1e-300)]
+    if null.shape[1] == 0:
+        null = u[:, -1:]  # ill-conditioned but above rcond: name the weakest direction
+    weight = np.abs(null).max(axis=1)
+    return [label for label, w in zip(labels, weight) if w > 1e-6]
+
+
+# ----- Newton-Raphson and assembly -----------------------------------------------------------

@@ -1,0 +1,298 @@
+"""Validation of a mechanism: shapes (pydantic, :mod:`symkin.spec.schema`), then what needs
+the whole file — names, references between fields, expressions, the time grid and the
+degree-of-freedom count. Every mistake is a :class:`MechanismError` with the field path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import sympy as sp
+from pydantic import ValidationError, model_validator
+
+from symkin.errors import ExpressionError, MechanismError, format_path
+from symkin.spec import expressions, loader
+from symkin.spec.messages import translate
+from symkin.spec.names import name_problem
+from symkin.spec.schema import (
+    GROUND,
+    MAX_GRID_POINTS,
+    Custom,
+    MechanismSpec,
+    equation_count,
+)
+
+
+class Mechanism(MechanismSpec):
+    """A validated planar mechanism. Build it with :func:`load` or :func:`from_dict`."""
+
+    @model_validator(mode="after")
+    def _semantics(self) -> Mechanism:
+        _check_semantics(self)
+        return self
+
+
+@dataclass(frozen=True)
+class _Names:
+    """What expressions of a file may name: parameters, t and (custom rows) coordinates.
+
+    The symbols equal those of :mod:`symkin.symbolic.symbols` (same names, same assumptions),
+    but validation does not depend on the symbolic stage.
+    """
+
+    parameters: dict[str, sp.Symbol]
+    t: sp.Symbol
+    by_coordinate: dict[tuple[str, str], sp.Symbol]
+
+    @property
+    def q(self) -> tuple[sp.Symbol, ...]:
+        return tuple(self.by_coordinate.values())
+
+
+def _names(mech: MechanismSpec) -> _Names:
+    return _Names(
+        parameters={name: sp.Symbol(name, real=True) for name in mech.parameters},
+        t=sp.Symbol("t", real=True),
+        by_coordinate={(body, part): sp.Symbol(f"{body}.{part}", real=True)
+                       for body in mech.bodies for part in ("x", "y", "phi")})
+
+def load(path: str | Path) -> Mechanism:
+    """Read and validate a mechanism file (YAML, or TOML by suffix)."""
+    document = loader.read(path)
+    return _validate(document)
+
+
+def from_dict(data: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
+    """Validate a mechanism given as plain Python data (the file's structure)."""
+    return _validate(loader.Document(dict(data) if isinstance(data, Mapping) else data, source))
+
+
+def json_schema() -> dict[str, Any]:
+    """The JSON Schema of the mechanism file format."""
+    return Mechanism.model_json_schema()
+
+
+def _validate(document: loader.Document) -> Mechanism:
+    if not isinstance(document.data, dict):
+        raise MechanismError("the file must be a mapping with keys name, parameters, bodies, "
+                             "joints, drivers, time", source=document.source, line=1)
+    try:
+        return Mechanism.model_validate(document.data)
+    except MechanismError as error:
+        raise error.located(document.source, document.line_of(error.path)) from None
+    except ValidationError as error:
+        raise translate(error, document) from None
+
+
+def _check_semantics(mech: Mechanism) -> None:
+    _check_names(mech)
+    symbols = _names(mech)
+    values = _check_parameters(mech)
+    nominal = {symbols.parameters[name]: value for name, value in values.items()}
+    for name, body in mech.bodies.items():
+        for k, raw in enumerate(body.q0):
+            _expression(raw, symbols, ("bodies", name, "q0", k), values=nominal)
+        for point, vector in body.points.items():
+            for k, raw in enumerate(vector):
+                _expression(raw, symbols, ("bodies", name, "points", point, k), values=nominal)
+    named: dict[str, tuple[str | int, ...]] = {}
+    for section in ("joints", "drivers"):
+        for index, constraint in enumerate(getattr(mech, section)):
+            path = (section, index)
+            _check_constraint(mech, constraint, symbols, nominal, path)
+            if constraint.name in named:
+                raise MechanismError(f"the name {constraint.name!r} is already used by "
+                                     f"{format_path(named[constraint.name])}", path + ("name",),
+                                     "Joints and drivers need different names: each labels "
+                                     "rows of Phi.")
+            if constraint.name is not None:
+                named[constraint.name] = path
+    _check_time(mech, symbols, nominal)
+    check_degrees_of_freedom(mech)
+
+
+def _check_names(mech: Mechanism) -> None:
+    problem = name_problem(mech.name)
+    if problem:
+        raise MechanismError(problem, ("name",), "Use a plain identifier such as crank_slider; "
+                             "it becomes the C prefix.")
+    seen: dict[str, tuple[str | int, ...]] = {}
+    for section in ("parameters", "bodies"):
+        for name in getattr(mech, section):
+            path = (section, name)
+            problem = name_problem(name)
+            if problem:
+                raise MechanismError(problem, path, "Rename it.")
+            if name.lower() in seen:
+                raise MechanismError(f"the name {name!r} is already used at "
+                                     f"{'.'.join(map(str, seen[name.lower()]))}", path,
+                                     "Names of parameters and bodies must differ (ignoring "
+                                     "case).")
+            seen[name.lower()] = path
+    for body, spec in mech.bodies.items():
+        for point in spec.points:
+            problem = name_problem(point)
+            if problem:
+                raise MechanismError(problem, ("bodies", body, "points", point), "Rename it.")
+
+
+def _check_parameters(mech: Mechanism) -> dict[str, float]:
+    values = {}
+    for name, raw in mech.parameters.items():
+        try:
+            expr = expressions.parse(raw, {})
+        except ExpressionError as error:
+            raise MechanismError(str(error), ("parameters", name),
+                                 "A parameter's value is a number or an expression of numbers, "
+                                 "pi and E; it cannot use t or other parameters.") from None
+        values[name] = _numeric(expr, {}, ("parameters", name))
+    return values
+
+
+def _numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float],
+             path: tuple[str | int, ...]) -> float:
+    """The value of ``expr`` at the nominal parameters: a finite real number, or an error."""
+    try:
+        number = float(expr.subs(values))
+    except (TypeError, ValueError, OverflowError, ZeroDivisionError):
+        number = math.nan  # complex (sqrt(-1), asin(2)) or too large for a float
+    if not math.isfinite(number):
+        raise MechanismError(f"{sp.sstr(expr)} is not a finite real number at the nominal "
+                             f"parameter values", path,
+                             "Check the arguments of sqrt, log, asin, acos and the magnitudes.")
+    return number
+
+
+def _expression(raw: Any, symbols: _Names | None, path: tuple[str | int, ...],
+                time: bool = False, coordinates: bool = False,
+                values: Mapping[sp.Symbol, float] | None = None) -> sp.Expr:
+    """Parse a field; with ``values`` (a constant field) also check its nominal value."""
+    if values is not None:
+        expr = _expression(raw, symbols, path, time, coordinates)
+        _numeric(expr, values, path)
+        return expr
+    names = dict(symbols.parameters) if symbols else {}
+    if time and symbols:
+        names["t"] = symbols.t
+    try:
+        if time and isinstance(raw, Mapping):
+            return expressions.parse_time_function(raw, names, symbols.t)  # type: ignore[union-attr]
+        return expressions.parse(raw, names, symbols.by_coordinate if coordinates and symbols
+                                 else None)
+    except ExpressionError as error:
+        hint = "Use numbers, parameter names, pi, E, + - * / ** and the listed functions"
+        hint += ", and t." if time else "."
+        raise MechanismError(str(error), path, hint) from None
+
+
+def _body_ref(mech: Mechanism, name: str, path: tuple[str | int, ...]) -> None:
+    if name != GROUND and name not in mech.bodies:
+        known = ", ".join([GROUND, *mech.bodies])
+        raise MechanismError(f"unknown body {name!r}", path, f"Use one of: {known}.")
+
+
+def _point(mech: Mechanism, body: str, ref: Any, symbols: _Names,
+           nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
+    if isinstance(ref, str):
+        points = mech.bodies[body].points if body != GROUND else {}
+        if ref not in points:
+            known = ", ".join(points) or "none"
+            raise MechanismError(f"body {body!r} has no point named {ref!r}", path,
+                                 f"Its points are: {known}; or give a vector [x, y].")
+        return
+    for k, raw in enumerate(ref):
+        _expression(raw, symbols, path + (k,), values=nominal)
+
+
+def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
+                      nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
+    if constraint.name is not None and name_problem(constraint.name):
+        raise MechanismError(str(name_problem(constraint.name)), path + ("name",), "Rename it.")
+    if isinstance(constraint, Custom):
+        for k, text in enumerate(constraint.equations):
+            expr = _expression(text, symbols, path + ("equations", k), time=True,
+                               coordinates=True)
+            if not expr.free_symbols & set(symbols.q):
+                raise MechanismError("this equation uses no coordinate, so it cannot "
+                                     "constrain the mechanism", path + ("equations", k),
+                                     "Use coordinates such as crank.phi or rod.x in it.")
+        return
+    bodies = [key for key in ("i", "j") if hasattr(constraint, key)]
+    for key in bodies:
+        _body_ref(mech, getattr(constraint, key), path + (key,))
+    if constraint.type == "trajectory" and constraint.j == GROUND:
+        raise MechanismError("a trajectory needs a moving body j, not the ground",
+                             path + ("j",), "Name the body whose point should follow f(t).")
+    if len(bodies) == 2 and constraint.i == constraint.j:
+        raise MechanismError(f"a {constraint.type} joins body {constraint.i!r} to itself",
+                             path + ("j",), "A constraint needs two different bodies.")
+    for key, body_key in (("sA", "i"), ("sB", "j")):
+        if hasattr(constraint, key):
+            _point(mech, getattr(constraint, body_key), getattr(constraint, key), symbols,
+                   nominal, path + (key,))
+    for key in ("v", "u"):
+        if hasattr(constraint, key):
+            vector = [_expression(raw, symbols, path + (key, k), values=nominal)
+                      for k, raw in enumerate(getattr(constraint, key))]
+            _nonzero_vector(vector, nominal, path + (key,))
+    if hasattr(constraint, "phi0"):
+        _expression(constraint.phi0, symbols, path + ("phi0",), values=nominal)
+    for key in ("f", "theta"):
+        if hasattr(constraint, key):
+            value = getattr(constraint, key)
+            items = value if isinstance(value, list) else [value]
+            for k, raw in enumerate(items):
+                _expression(raw, symbols, path + ((key, k) if key == "f" and
+                                                  isinstance(value, list) else (key,)), time=True)
+
+
+def _nonzero_vector(vector: list[sp.Expr], nominal: Mapping[sp.Symbol, float],
+                    path: tuple[str | int, ...]) -> None:
+    if all(_numeric(component, nominal, path) == 0.0 for component in vector):
+        raise MechanismError("the direction vector is zero", path,
+                             "Give a non-zero vector, e.g. [0, 1].")
+
+
+def _check_time(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, float]) -> None:
+    grid = {}
+    for key in ("t0", "t1", "dt"):
+        expr = _expression(getattr(mech.time, key), symbols, ("time", key))
+        grid[key] = _numeric(expr, nominal, ("time", key))
+    if not grid["dt"] > 0:
+        raise MechanismError(f"the time step dt = {grid['dt']} is not positive",
+                             ("time", "dt"), "Use dt > 0.")
+    if not grid["t1"] > grid["t0"]:
+        raise MechanismError(f"the end time t1 = {grid['t1']} is not after t0 = {grid['t0']}",
+                             ("time", "t1"), "Use t1 > t0.")
+    if (grid["t1"] - grid["t0"]) / grid["dt"] > MAX_GRID_POINTS:
+        raise MechanismError(f"the grid has more than {MAX_GRID_POINTS} points", ("time", "dt"),
+                             "Use a larger dt or a shorter interval.")
+
+
+def degrees_of_freedom(mech: Mechanism) -> int:
+    """Grübler's count w = 3n - 2 p5 - p4, less the equations of custom joints."""
+    return 3 * len(mech.bodies) - sum(equation_count(joint) for joint in mech.joints)
+
+
+def check_degrees_of_freedom(mech: Mechanism) -> None:
+    """Check that the drivers supply exactly as many equations as there are DOF."""
+    dof = degrees_of_freedom(mech)
+    driving = sum(equation_count(driver) for driver in mech.drivers)
+    if dof == driving:
+        return
+    p5 = sum(joint.type in ("revolute", "prismatic") for joint in mech.joints)
+    p4 = sum(joint.type == "pin_slot" for joint in mech.joints)
+    formula = f"w = 3·{len(mech.bodies)} − 2·{p5} − {p4}"
+    custom = dof - (3 * len(mech.bodies) - 2 * p5 - p4)
+    if custom:
+        formula += f" − {-custom} (custom joint equations)"
+    if driving < dof:
+        fix = f"Add drivers for {dof - driving} more equation(s), or add joints."
+    else:
+        fix = f"Remove {driving - dof} driving equation(s), or check for a missing joint."
+    raise MechanismError(f"the mechanism has {formula} = {dof} degree(s) of freedom but its "
+                         f"drivers give {driving} equation(s)", ("drivers",), fix)

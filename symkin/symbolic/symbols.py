@@ -1,0 +1,54 @@
+"""The SymPy symbols of a mechanism: coordinates, velocities, time and parameters."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import sympy as sp
+
+from symkin.spec.schema import GROUND, MechanismSpec
+
+
+@dataclass(frozen=True)
+class Symbols:
+    """The SymPy symbols of a mechanism: coordinates, velocities, time and parameters."""
+
+    q: tuple[sp.Symbol, ...]
+    dq: tuple[sp.Symbol, ...]
+    t: sp.Symbol
+    p: tuple[sp.Symbol, ...]
+    coordinates: tuple[str, ...]
+
+    # Built once per Symbols: derivation asks for them for every constraint and expression.
+    @cached_property
+    def parameters(self) -> dict[str, sp.Symbol]:
+        return {symbol.name: symbol for symbol in self.p}
+
+    @cached_property
+    def by_coordinate(self) -> dict[tuple[str, str], sp.Symbol]:
+        """``(body, "x"|"y"|"phi") -> q symbol``, for custom constraints."""
+        pairs = (name.partition(".") for name in self.coordinates)
+        return {(body, part): q for (body, _, part), q in zip(pairs, self.q)}
+
+    @cached_property
+    def _first_coordinate(self) -> dict[str, int]:
+        """Body name -> index of its x coordinate."""
+        return {name[:-2]: k for k, name in enumerate(self.coordinates) if name.endswith(".x")}
+
+    def body(self, name: str, velocities: bool = False) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+        """(x, y, phi) of a body (or their rates); the ground is fixed at zero."""
+        if name == GROUND:
+            return (sp.Integer(0),) * 3
+        start = self._first_coordinate[name]
+        source = self.dq if velocities else self.q
+        return source[start], source[start + 1], source[start + 2]
+
+
+def make_symbols(mech: MechanismSpec) -> Symbols:
+    """Create the symbols of ``mech``; coordinate names are ``body.x``, ``body.y``, ``body.phi``."""
+    coordinates = tuple(f"{b}.{c}" for b in mech.bodies for c in ("x", "y", "phi"))
+    q = tuple(sp.Symbol(name, real=True) for name in coordinates)
+    dq = tuple(sp.Symbol(name + "_t", real=True) for name in coordinates)
+    p = tuple(sp.Symbol(name, real=True) for name in mech.parameters)
+    return Symbols(q, dq, sp.Symbol("t", real=True), p, coordinates)
