@@ -5,6 +5,7 @@ Run with SYMKIN_UPDATE_GOLDENS=1 to rewrite generated/ from the current template
 
 from __future__ import annotations
 
+import difflib
 import os
 import re
 import shutil
@@ -47,11 +48,30 @@ def test_golden_matches_regeneration(name: str, backend: str, tmp_path: Path) ->
         shutil.copytree(fresh, golden)
     assert golden.is_dir(), f"no golden for {name}; run with SYMKIN_UPDATE_GOLDENS=1"
     expected, actual = _files(golden), _files(fresh)
-    assert sorted(actual) == sorted(expected), "file list differs"
+    assert sorted(actual) == sorted(expected), (
+        f"file list differs: only golden {sorted(set(expected) - set(actual))}, "
+        f"only fresh {sorted(set(actual) - set(expected))}")
     for file_name in expected:
         assert actual[file_name] == expected[file_name], (
             f"generated/{name}/{backend}/{file_name} is stale; rerun with "
-            "SYMKIN_UPDATE_GOLDENS=1 and review the diff")
+            "SYMKIN_UPDATE_GOLDENS=1 and review this diff:\n"
+            + unified_diff(expected[file_name], actual[file_name], file_name))
+
+
+def unified_diff(golden: bytes, fresh: bytes, file_name: str, limit: int = 80) -> str:
+    """The first ``limit`` lines of a unified diff from the golden file to the fresh one."""
+    lines = list(difflib.unified_diff(
+        golden.decode("utf-8", "replace").splitlines(keepends=True),
+        fresh.decode("utf-8", "replace").splitlines(keepends=True),
+        fromfile=f"golden/{file_name}", tofile=f"fresh/{file_name}"))
+    more = f"... {len(lines) - limit} more diff lines\n" if len(lines) > limit else ""
+    return "".join(lines[:limit]) + more
+
+
+def test_golden_mismatch_message_is_a_unified_diff() -> None:
+    text = unified_diff(b"a\nb\nc\n", b"a\nB\nc\n", "x.c")
+    assert "--- golden/x.c" in text and "+++ fresh/x.c" in text
+    assert "-b\n" in text and "+B\n" in text
 
 
 def test_every_golden_has_an_example() -> None:

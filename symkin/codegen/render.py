@@ -21,6 +21,7 @@ import jinja2
 
 from symkin import resources
 from symkin.codegen import backends
+from symkin.runtime import newton
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
 from symkin.errors import BuildError
@@ -198,6 +199,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg, **code.extra,
+        "newton_defaults": _newton_defaults(code, literal),
     }
 
 
@@ -228,3 +230,11 @@ def _labels(code: Code, routine: str) -> list[str]:
         return [codegen.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in "xy"]
     return [codegen.comment(row) for row in code.rows]
+
+
+def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
+    """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
+    options = newton.defaults(code.real)
+    return {"tol_phi": literal(options.tol_phi), "tol_dq": literal(options.tol_dq),
+            "max_iterations": str(options.max_iterations),
+            "min_pivot_ratio": literal(options.min_pivot_ratio)}

@@ -35,6 +35,7 @@ from symkin.runtime.newton import (
     Newton,
     Options,
     assemble,
+    defaults as newton_defaults,
     newton,
 )
 from symkin.runtime.results import Trajectory
@@ -157,10 +158,7 @@ def _python_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
 
 def default_options(kernel: Any) -> Options:
     """Options() for double precision; looser ones for a C kernel computing in float."""
-    ffi = getattr(kernel, "ffi", None)
-    if ffi is not None and ffi.sizeof(f"{kernel.name}_real") == 4:
-        return Options(tol_phi=1e-5, tol_dq=1e-4, min_pivot_ratio=1e-6)
-    return Options()
+    return newton_defaults(getattr(kernel, "real", "double"))
 
 
 def _has_c_solver(kernel: Any) -> bool:
@@ -183,7 +181,7 @@ def _c_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
     # with the sparse LU it holds an N x N dense fall-back buffer that is rarely touched.
     work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
     report = ffi.new(f"{name}_report *")
-    dtype = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
+    dtype = np.float32 if kernel.real == "float" else np.float64
     direct = dtype == np.float64  # the C solver writes straight into the result arrays
     pbuf = ffi.new(f"{name}_real[]", max(p.size, 1))
     pbuf[0:p.size] = p.tolist()

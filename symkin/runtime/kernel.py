@@ -44,6 +44,8 @@ class Kernel:
     def __init__(self, backend: str, meta: Mapping[str, Any], functions: _Functions,
                  ffi: Any = None, lib: Any = None, folder: Path | None = None) -> None:
         self.backend = backend
+        # The real type the kernel computes in: "float" only for C kernels built so.
+        self.real: str = meta.get("real", "double")
         # The cache folder the kernel was loaded from (None for one built elsewhere).
         self.folder = folder
         self.name: str = meta["name"]

@@ -36,6 +36,19 @@ class Options:
     min_pivot_ratio: float = 1e-10
 
 
+# The defaults per real type, defined once: the generated C's <prefix>_default_options is
+# rendered from this table (codegen.render), so Python and C can never disagree.
+DEFAULTS = {
+    "double": Options(),
+    "float": Options(tol_phi=1e-5, tol_dq=1e-4, min_pivot_ratio=1e-6),
+}
+
+
+def defaults(real: str) -> Options:
+    """The Newton options for a kernel computing in ``real`` ("double" or "float")."""
+    return DEFAULTS[real]
+
+
 @dataclass
 class Newton:
     """The outcome of Newton-Raphson at one time point."""

@@ -7,37 +7,32 @@
 
 #include "all_drivers_solver.h"
 
-#define N ALL_DRIVERS_NQ
-
-typedef all_drivers_real real;
-
 void all_drivers_default_options(all_drivers_options *options)
 {
-    int single = sizeof(real) < sizeof(double);
-    options->tol_phi = single ? (real)1e-5 : (real)1e-10;
-    options->tol_dq = single ? (real)1e-4 : (real)1e-9;
+    options->tol_phi = 1e-10;
+    options->tol_dq = 1e-09;
     options->max_iterations = 25;
-    options->min_pivot_ratio = single ? (real)1e-6 : (real)1e-10;
+    options->min_pivot_ratio = 1e-10;
 }
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
-static real max_abs(const real v[])
+static all_drivers_real all_drivers_max_abs(const all_drivers_real v[])
 {
-    real largest = 0;
+    all_drivers_real largest = 0;
     int i, nan = 0;
-    for (i = 0; i < N; ++i) {
-        real a = fabs(v[i]);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+        all_drivers_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
         nan |= a != a;
     }
-    return nan ? (real)NAN : largest;
+    return nan ? (all_drivers_real)NAN : largest;
 }
 
 /* Factor Phi_q(q, t) into work->lu; SINGULAR when a pivot vanishes or the pivots spread too far. */
-static int factor_jacobian(const all_drivers_options *options, const real p[], real t,
-                           const real q[], all_drivers_workspace *work, all_drivers_report *report)
+static int all_drivers_factor_jacobian(const all_drivers_options *options, const all_drivers_real p[], all_drivers_real t,
+                           const all_drivers_real q[], all_drivers_workspace *work, all_drivers_report *report)
 {
-    real ratio;
+    all_drivers_real ratio;
     int failed;
     all_drivers_phi_q(q, t, p, work->nz);
     failed = all_drivers_lu_factor(work->nz, &work->lu);
@@ -51,23 +46,23 @@ static int factor_jacobian(const all_drivers_options *options, const real p[], r
 
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
-static int newton(const all_drivers_options *options, const real p[], real t, real q[],
+static int all_drivers_newton(const all_drivers_options *options, const all_drivers_real p[], all_drivers_real t, all_drivers_real q[],
                   all_drivers_workspace *work, all_drivers_report *report)
 {
-    real step = 0;
+    all_drivers_real step = 0;
     int i, iteration;
     report->t = t;
     report->pivot = -1;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        real residual;
+        all_drivers_real residual;
         all_drivers_phi(q, t, p, work->phi);
-        residual = max_abs(work->phi);
+        residual = all_drivers_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN */
             return ALL_DRIVERS_NO_CONVERGENCE;
         }
-        if (factor_jacobian(options, p, t, q, work, report) != ALL_DRIVERS_OK) {
+        if (all_drivers_factor_jacobian(options, p, t, q, work, report) != ALL_DRIVERS_OK) {
             return ALL_DRIVERS_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
@@ -76,45 +71,45 @@ static int newton(const all_drivers_options *options, const real p[], real t, re
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         all_drivers_lu_solve(&work->lu, work->phi);
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = max_abs(work->phi);
+        step = all_drivers_max_abs(work->phi);
     }
     return ALL_DRIVERS_NO_CONVERGENCE;
 }
 
-static void predict(real t, all_drivers_state *state)
+static void all_drivers_predict(all_drivers_real t, all_drivers_state *state)
 {
-    real h = t - state->t;
+    all_drivers_real h = t - state->t;
     int i;
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
         state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
     }
 }
 
-int all_drivers_solve_step(const all_drivers_options *options, const real p[], real t,
+int all_drivers_solve_step(const all_drivers_options *options, const all_drivers_real p[], all_drivers_real t,
                             all_drivers_state *state, all_drivers_workspace *work,
                             all_drivers_report *report)
 {
     int i;
     if (state->started) {
-        predict(t, state);
+        all_drivers_predict(t, state);
     } else {
         all_drivers_lu_init(&work->lu); /* the caller's workspace may hold anything */
     }
-    report->status = newton(options, p, t, state->q, work, report);
+    report->status = all_drivers_newton(options, p, t, state->q, work, report);
     report->fallbacks = all_drivers_lu_fallbacks(&work->lu);
     if (report->status != ALL_DRIVERS_OK) {
         return report->status;
     }
     /* Both right-hand sides are formed and solved in place in the state: no copies. */
     all_drivers_phi_t(state->q, t, p, state->dq);
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
     all_drivers_lu_solve(&work->lu, state->dq); /* (2.73) */
@@ -126,16 +121,16 @@ int all_drivers_solve_step(const all_drivers_options *options, const real p[], r
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
-static void store(real out[], int k, const real v[])
+static void all_drivers_store(all_drivers_real out[], int k, const all_drivers_real v[])
 {
     if (out) {
-        memcpy(out + (size_t)k * N, v, N * sizeof v[0]);
+        memcpy(out + (size_t)k * ALL_DRIVERS_NQ, v, ALL_DRIVERS_NQ * sizeof v[0]);
     }
 }
 
-int all_drivers_solve_grid(const all_drivers_options *options, const real p[], int n,
-                            const real t[], all_drivers_state *state, real q_out[],
-                            real dq_out[], real ddq_out[], all_drivers_workspace *work,
+int all_drivers_solve_grid(const all_drivers_options *options, const all_drivers_real p[], int n,
+                            const all_drivers_real t[], all_drivers_state *state, all_drivers_real q_out[],
+                            all_drivers_real dq_out[], all_drivers_real ddq_out[], all_drivers_workspace *work,
                             all_drivers_report *report)
 {
     int k;
@@ -144,9 +139,9 @@ int all_drivers_solve_grid(const all_drivers_options *options, const real p[], i
         if (all_drivers_solve_step(options, p, t[k], state, work, report) != ALL_DRIVERS_OK) {
             return k;
         }
-        store(q_out, k, state->q);
-        store(dq_out, k, state->dq);
-        store(ddq_out, k, state->ddq);
+        all_drivers_store(q_out, k, state->q);
+        all_drivers_store(dq_out, k, state->dq);
+        all_drivers_store(ddq_out, k, state->ddq);
     }
     return n;
 }

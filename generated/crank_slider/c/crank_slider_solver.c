@@ -7,37 +7,32 @@
 
 #include "crank_slider_solver.h"
 
-#define N CRANK_SLIDER_NQ
-
-typedef crank_slider_real real;
-
 void crank_slider_default_options(crank_slider_options *options)
 {
-    int single = sizeof(real) < sizeof(double);
-    options->tol_phi = single ? (real)1e-5 : (real)1e-10;
-    options->tol_dq = single ? (real)1e-4 : (real)1e-9;
+    options->tol_phi = 1e-10;
+    options->tol_dq = 1e-09;
     options->max_iterations = 25;
-    options->min_pivot_ratio = single ? (real)1e-6 : (real)1e-10;
+    options->min_pivot_ratio = 1e-10;
 }
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
-static real max_abs(const real v[])
+static crank_slider_real crank_slider_max_abs(const crank_slider_real v[])
 {
-    real largest = 0;
+    crank_slider_real largest = 0;
     int i, nan = 0;
-    for (i = 0; i < N; ++i) {
-        real a = fabs(v[i]);
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
+        crank_slider_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
         nan |= a != a;
     }
-    return nan ? (real)NAN : largest;
+    return nan ? (crank_slider_real)NAN : largest;
 }
 
 /* Factor Phi_q(q, t) into work->lu; SINGULAR when a pivot vanishes or the pivots spread too far. */
-static int factor_jacobian(const crank_slider_options *options, const real p[], real t,
-                           const real q[], crank_slider_workspace *work, crank_slider_report *report)
+static int crank_slider_factor_jacobian(const crank_slider_options *options, const crank_slider_real p[], crank_slider_real t,
+                           const crank_slider_real q[], crank_slider_workspace *work, crank_slider_report *report)
 {
-    real ratio;
+    crank_slider_real ratio;
     int failed;
     crank_slider_phi_q(q, t, p, work->nz);
     failed = crank_slider_lu_factor(work->nz, &work->lu);
@@ -51,23 +46,23 @@ static int factor_jacobian(const crank_slider_options *options, const real p[], 
 
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
-static int newton(const crank_slider_options *options, const real p[], real t, real q[],
+static int crank_slider_newton(const crank_slider_options *options, const crank_slider_real p[], crank_slider_real t, crank_slider_real q[],
                   crank_slider_workspace *work, crank_slider_report *report)
 {
-    real step = 0;
+    crank_slider_real step = 0;
     int i, iteration;
     report->t = t;
     report->pivot = -1;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        real residual;
+        crank_slider_real residual;
         crank_slider_phi(q, t, p, work->phi);
-        residual = max_abs(work->phi);
+        residual = crank_slider_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN */
             return CRANK_SLIDER_NO_CONVERGENCE;
         }
-        if (factor_jacobian(options, p, t, q, work, report) != CRANK_SLIDER_OK) {
+        if (crank_slider_factor_jacobian(options, p, t, q, work, report) != CRANK_SLIDER_OK) {
             return CRANK_SLIDER_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
@@ -76,45 +71,45 @@ static int newton(const crank_slider_options *options, const real p[], real t, r
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         crank_slider_lu_solve(&work->lu, work->phi);
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = max_abs(work->phi);
+        step = crank_slider_max_abs(work->phi);
     }
     return CRANK_SLIDER_NO_CONVERGENCE;
 }
 
-static void predict(real t, crank_slider_state *state)
+static void crank_slider_predict(crank_slider_real t, crank_slider_state *state)
 {
-    real h = t - state->t;
+    crank_slider_real h = t - state->t;
     int i;
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
         state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
     }
 }
 
-int crank_slider_solve_step(const crank_slider_options *options, const real p[], real t,
+int crank_slider_solve_step(const crank_slider_options *options, const crank_slider_real p[], crank_slider_real t,
                             crank_slider_state *state, crank_slider_workspace *work,
                             crank_slider_report *report)
 {
     int i;
     if (state->started) {
-        predict(t, state);
+        crank_slider_predict(t, state);
     } else {
         crank_slider_lu_init(&work->lu); /* the caller's workspace may hold anything */
     }
-    report->status = newton(options, p, t, state->q, work, report);
+    report->status = crank_slider_newton(options, p, t, state->q, work, report);
     report->fallbacks = crank_slider_lu_fallbacks(&work->lu);
     if (report->status != CRANK_SLIDER_OK) {
         return report->status;
     }
     /* Both right-hand sides are formed and solved in place in the state: no copies. */
     crank_slider_phi_t(state->q, t, p, state->dq);
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
     crank_slider_lu_solve(&work->lu, state->dq); /* (2.73) */
@@ -126,16 +121,16 @@ int crank_slider_solve_step(const crank_slider_options *options, const real p[],
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
-static void store(real out[], int k, const real v[])
+static void crank_slider_store(crank_slider_real out[], int k, const crank_slider_real v[])
 {
     if (out) {
-        memcpy(out + (size_t)k * N, v, N * sizeof v[0]);
+        memcpy(out + (size_t)k * CRANK_SLIDER_NQ, v, CRANK_SLIDER_NQ * sizeof v[0]);
     }
 }
 
-int crank_slider_solve_grid(const crank_slider_options *options, const real p[], int n,
-                            const real t[], crank_slider_state *state, real q_out[],
-                            real dq_out[], real ddq_out[], crank_slider_workspace *work,
+int crank_slider_solve_grid(const crank_slider_options *options, const crank_slider_real p[], int n,
+                            const crank_slider_real t[], crank_slider_state *state, crank_slider_real q_out[],
+                            crank_slider_real dq_out[], crank_slider_real ddq_out[], crank_slider_workspace *work,
                             crank_slider_report *report)
 {
     int k;
@@ -144,9 +139,9 @@ int crank_slider_solve_grid(const crank_slider_options *options, const real p[],
         if (crank_slider_solve_step(options, p, t[k], state, work, report) != CRANK_SLIDER_OK) {
             return k;
         }
-        store(q_out, k, state->q);
-        store(dq_out, k, state->dq);
-        store(ddq_out, k, state->ddq);
+        crank_slider_store(q_out, k, state->q);
+        crank_slider_store(dq_out, k, state->dq);
+        crank_slider_store(ddq_out, k, state->ddq);
     }
     return n;
 }

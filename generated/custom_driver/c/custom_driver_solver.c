@@ -7,37 +7,32 @@
 
 #include "custom_driver_solver.h"
 
-#define N CUSTOM_DRIVER_NQ
-
-typedef custom_driver_real real;
-
 void custom_driver_default_options(custom_driver_options *options)
 {
-    int single = sizeof(real) < sizeof(double);
-    options->tol_phi = single ? (real)1e-5 : (real)1e-10;
-    options->tol_dq = single ? (real)1e-4 : (real)1e-9;
+    options->tol_phi = 1e-10;
+    options->tol_dq = 1e-09;
     options->max_iterations = 25;
-    options->min_pivot_ratio = single ? (real)1e-6 : (real)1e-10;
+    options->min_pivot_ratio = 1e-10;
 }
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
-static real max_abs(const real v[])
+static custom_driver_real custom_driver_max_abs(const custom_driver_real v[])
 {
-    real largest = 0;
+    custom_driver_real largest = 0;
     int i, nan = 0;
-    for (i = 0; i < N; ++i) {
-        real a = fabs(v[i]);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+        custom_driver_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
         nan |= a != a;
     }
-    return nan ? (real)NAN : largest;
+    return nan ? (custom_driver_real)NAN : largest;
 }
 
 /* Factor Phi_q(q, t) into work->lu; SINGULAR when a pivot vanishes or the pivots spread too far. */
-static int factor_jacobian(const custom_driver_options *options, const real p[], real t,
-                           const real q[], custom_driver_workspace *work, custom_driver_report *report)
+static int custom_driver_factor_jacobian(const custom_driver_options *options, const custom_driver_real p[], custom_driver_real t,
+                           const custom_driver_real q[], custom_driver_workspace *work, custom_driver_report *report)
 {
-    real ratio;
+    custom_driver_real ratio;
     int failed;
     custom_driver_phi_q(q, t, p, work->nz);
     failed = custom_driver_lu_factor(work->nz, &work->lu);
@@ -51,23 +46,23 @@ static int factor_jacobian(const custom_driver_options *options, const real p[],
 
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
-static int newton(const custom_driver_options *options, const real p[], real t, real q[],
+static int custom_driver_newton(const custom_driver_options *options, const custom_driver_real p[], custom_driver_real t, custom_driver_real q[],
                   custom_driver_workspace *work, custom_driver_report *report)
 {
-    real step = 0;
+    custom_driver_real step = 0;
     int i, iteration;
     report->t = t;
     report->pivot = -1;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        real residual;
+        custom_driver_real residual;
         custom_driver_phi(q, t, p, work->phi);
-        residual = max_abs(work->phi);
+        residual = custom_driver_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN */
             return CUSTOM_DRIVER_NO_CONVERGENCE;
         }
-        if (factor_jacobian(options, p, t, q, work, report) != CUSTOM_DRIVER_OK) {
+        if (custom_driver_factor_jacobian(options, p, t, q, work, report) != CUSTOM_DRIVER_OK) {
             return CUSTOM_DRIVER_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
@@ -76,45 +71,45 @@ static int newton(const custom_driver_options *options, const real p[], real t, 
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         custom_driver_lu_solve(&work->lu, work->phi);
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = max_abs(work->phi);
+        step = custom_driver_max_abs(work->phi);
     }
     return CUSTOM_DRIVER_NO_CONVERGENCE;
 }
 
-static void predict(real t, custom_driver_state *state)
+static void custom_driver_predict(custom_driver_real t, custom_driver_state *state)
 {
-    real h = t - state->t;
+    custom_driver_real h = t - state->t;
     int i;
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
         state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
     }
 }
 
-int custom_driver_solve_step(const custom_driver_options *options, const real p[], real t,
+int custom_driver_solve_step(const custom_driver_options *options, const custom_driver_real p[], custom_driver_real t,
                             custom_driver_state *state, custom_driver_workspace *work,
                             custom_driver_report *report)
 {
     int i;
     if (state->started) {
-        predict(t, state);
+        custom_driver_predict(t, state);
     } else {
         custom_driver_lu_init(&work->lu); /* the caller's workspace may hold anything */
     }
-    report->status = newton(options, p, t, state->q, work, report);
+    report->status = custom_driver_newton(options, p, t, state->q, work, report);
     report->fallbacks = custom_driver_lu_fallbacks(&work->lu);
     if (report->status != CUSTOM_DRIVER_OK) {
         return report->status;
     }
     /* Both right-hand sides are formed and solved in place in the state: no copies. */
     custom_driver_phi_t(state->q, t, p, state->dq);
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
     custom_driver_lu_solve(&work->lu, state->dq); /* (2.73) */
@@ -126,16 +121,16 @@ int custom_driver_solve_step(const custom_driver_options *options, const real p[
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
-static void store(real out[], int k, const real v[])
+static void custom_driver_store(custom_driver_real out[], int k, const custom_driver_real v[])
 {
     if (out) {
-        memcpy(out + (size_t)k * N, v, N * sizeof v[0]);
+        memcpy(out + (size_t)k * CUSTOM_DRIVER_NQ, v, CUSTOM_DRIVER_NQ * sizeof v[0]);
     }
 }
 
-int custom_driver_solve_grid(const custom_driver_options *options, const real p[], int n,
-                            const real t[], custom_driver_state *state, real q_out[],
-                            real dq_out[], real ddq_out[], custom_driver_workspace *work,
+int custom_driver_solve_grid(const custom_driver_options *options, const custom_driver_real p[], int n,
+                            const custom_driver_real t[], custom_driver_state *state, custom_driver_real q_out[],
+                            custom_driver_real dq_out[], custom_driver_real ddq_out[], custom_driver_workspace *work,
                             custom_driver_report *report)
 {
     int k;
@@ -144,9 +139,9 @@ int custom_driver_solve_grid(const custom_driver_options *options, const real p[
         if (custom_driver_solve_step(options, p, t[k], state, work, report) != CUSTOM_DRIVER_OK) {
             return k;
         }
-        store(q_out, k, state->q);
-        store(dq_out, k, state->dq);
-        store(ddq_out, k, state->ddq);
+        custom_driver_store(q_out, k, state->q);
+        custom_driver_store(dq_out, k, state->dq);
+        custom_driver_store(ddq_out, k, state->ddq);
     }
     return n;
 }

@@ -7,37 +7,32 @@
 
 #include "four_bar_solver.h"
 
-#define N FOUR_BAR_NQ
-
-typedef four_bar_real real;
-
 void four_bar_default_options(four_bar_options *options)
 {
-    int single = sizeof(real) < sizeof(double);
-    options->tol_phi = single ? (real)1e-5 : (real)1e-10;
-    options->tol_dq = single ? (real)1e-4 : (real)1e-9;
+    options->tol_phi = 1e-10;
+    options->tol_dq = 1e-09;
     options->max_iterations = 25;
-    options->min_pivot_ratio = single ? (real)1e-6 : (real)1e-10;
+    options->min_pivot_ratio = 1e-10;
 }
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
-static real max_abs(const real v[])
+static four_bar_real four_bar_max_abs(const four_bar_real v[])
 {
-    real largest = 0;
+    four_bar_real largest = 0;
     int i, nan = 0;
-    for (i = 0; i < N; ++i) {
-        real a = fabs(v[i]);
+    for (i = 0; i < FOUR_BAR_NQ; ++i) {
+        four_bar_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
         nan |= a != a;
     }
-    return nan ? (real)NAN : largest;
+    return nan ? (four_bar_real)NAN : largest;
 }
 
 /* Factor Phi_q(q, t) into work->lu; SINGULAR when a pivot vanishes or the pivots spread too far. */
-static int factor_jacobian(const four_bar_options *options, const real p[], real t,
-                           const real q[], four_bar_workspace *work, four_bar_report *report)
+static int four_bar_factor_jacobian(const four_bar_options *options, const four_bar_real p[], four_bar_real t,
+                           const four_bar_real q[], four_bar_workspace *work, four_bar_report *report)
 {
-    real ratio;
+    four_bar_real ratio;
     int failed;
     four_bar_phi_q(q, t, p, work->nz);
     failed = four_bar_lu_factor(work->nz, &work->lu);
@@ -51,23 +46,23 @@ static int factor_jacobian(const four_bar_options *options, const real p[], real
 
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
-static int newton(const four_bar_options *options, const real p[], real t, real q[],
+static int four_bar_newton(const four_bar_options *options, const four_bar_real p[], four_bar_real t, four_bar_real q[],
                   four_bar_workspace *work, four_bar_report *report)
 {
-    real step = 0;
+    four_bar_real step = 0;
     int i, iteration;
     report->t = t;
     report->pivot = -1;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        real residual;
+        four_bar_real residual;
         four_bar_phi(q, t, p, work->phi);
-        residual = max_abs(work->phi);
+        residual = four_bar_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN */
             return FOUR_BAR_NO_CONVERGENCE;
         }
-        if (factor_jacobian(options, p, t, q, work, report) != FOUR_BAR_OK) {
+        if (four_bar_factor_jacobian(options, p, t, q, work, report) != FOUR_BAR_OK) {
             return FOUR_BAR_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
@@ -76,45 +71,45 @@ static int newton(const four_bar_options *options, const real p[], real t, real 
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < FOUR_BAR_NQ; ++i) {
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         four_bar_lu_solve(&work->lu, work->phi);
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < FOUR_BAR_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = max_abs(work->phi);
+        step = four_bar_max_abs(work->phi);
     }
     return FOUR_BAR_NO_CONVERGENCE;
 }
 
-static void predict(real t, four_bar_state *state)
+static void four_bar_predict(four_bar_real t, four_bar_state *state)
 {
-    real h = t - state->t;
+    four_bar_real h = t - state->t;
     int i;
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < FOUR_BAR_NQ; ++i) {
         state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
     }
 }
 
-int four_bar_solve_step(const four_bar_options *options, const real p[], real t,
+int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[], four_bar_real t,
                             four_bar_state *state, four_bar_workspace *work,
                             four_bar_report *report)
 {
     int i;
     if (state->started) {
-        predict(t, state);
+        four_bar_predict(t, state);
     } else {
         four_bar_lu_init(&work->lu); /* the caller's workspace may hold anything */
     }
-    report->status = newton(options, p, t, state->q, work, report);
+    report->status = four_bar_newton(options, p, t, state->q, work, report);
     report->fallbacks = four_bar_lu_fallbacks(&work->lu);
     if (report->status != FOUR_BAR_OK) {
         return report->status;
     }
     /* Both right-hand sides are formed and solved in place in the state: no copies. */
     four_bar_phi_t(state->q, t, p, state->dq);
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < FOUR_BAR_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
     four_bar_lu_solve(&work->lu, state->dq); /* (2.73) */
@@ -126,16 +121,16 @@ int four_bar_solve_step(const four_bar_options *options, const real p[], real t,
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
-static void store(real out[], int k, const real v[])
+static void four_bar_store(four_bar_real out[], int k, const four_bar_real v[])
 {
     if (out) {
-        memcpy(out + (size_t)k * N, v, N * sizeof v[0]);
+        memcpy(out + (size_t)k * FOUR_BAR_NQ, v, FOUR_BAR_NQ * sizeof v[0]);
     }
 }
 
-int four_bar_solve_grid(const four_bar_options *options, const real p[], int n,
-                            const real t[], four_bar_state *state, real q_out[],
-                            real dq_out[], real ddq_out[], four_bar_workspace *work,
+int four_bar_solve_grid(const four_bar_options *options, const four_bar_real p[], int n,
+                            const four_bar_real t[], four_bar_state *state, four_bar_real q_out[],
+                            four_bar_real dq_out[], four_bar_real ddq_out[], four_bar_workspace *work,
                             four_bar_report *report)
 {
     int k;
@@ -144,9 +139,9 @@ int four_bar_solve_grid(const four_bar_options *options, const real p[], int n,
         if (four_bar_solve_step(options, p, t[k], state, work, report) != FOUR_BAR_OK) {
             return k;
         }
-        store(q_out, k, state->q);
-        store(dq_out, k, state->dq);
-        store(ddq_out, k, state->ddq);
+        four_bar_store(q_out, k, state->q);
+        four_bar_store(dq_out, k, state->dq);
+        four_bar_store(ddq_out, k, state->ddq);
     }
     return n;
 }

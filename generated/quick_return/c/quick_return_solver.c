@@ -7,37 +7,32 @@
 
 #include "quick_return_solver.h"
 
-#define N QUICK_RETURN_NQ
-
-typedef quick_return_real real;
-
 void quick_return_default_options(quick_return_options *options)
 {
-    int single = sizeof(real) < sizeof(double);
-    options->tol_phi = single ? (real)1e-5 : (real)1e-10;
-    options->tol_dq = single ? (real)1e-4 : (real)1e-9;
+    options->tol_phi = 1e-10;
+    options->tol_dq = 1e-09;
     options->max_iterations = 25;
-    options->min_pivot_ratio = single ? (real)1e-6 : (real)1e-10;
+    options->min_pivot_ratio = 1e-10;
 }
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
-static real max_abs(const real v[])
+static quick_return_real quick_return_max_abs(const quick_return_real v[])
 {
-    real largest = 0;
+    quick_return_real largest = 0;
     int i, nan = 0;
-    for (i = 0; i < N; ++i) {
-        real a = fabs(v[i]);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+        quick_return_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
         nan |= a != a;
     }
-    return nan ? (real)NAN : largest;
+    return nan ? (quick_return_real)NAN : largest;
 }
 
 /* Factor Phi_q(q, t) into work->lu; SINGULAR when a pivot vanishes or the pivots spread too far. */
-static int factor_jacobian(const quick_return_options *options, const real p[], real t,
-                           const real q[], quick_return_workspace *work, quick_return_report *report)
+static int quick_return_factor_jacobian(const quick_return_options *options, const quick_return_real p[], quick_return_real t,
+                           const quick_return_real q[], quick_return_workspace *work, quick_return_report *report)
 {
-    real ratio;
+    quick_return_real ratio;
     int failed;
     quick_return_phi_q(q, t, p, work->nz);
     failed = quick_return_lu_factor(work->nz, &work->lu);
@@ -51,23 +46,23 @@ static int factor_jacobian(const quick_return_options *options, const real p[], 
 
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
-static int newton(const quick_return_options *options, const real p[], real t, real q[],
+static int quick_return_newton(const quick_return_options *options, const quick_return_real p[], quick_return_real t, quick_return_real q[],
                   quick_return_workspace *work, quick_return_report *report)
 {
-    real step = 0;
+    quick_return_real step = 0;
     int i, iteration;
     report->t = t;
     report->pivot = -1;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        real residual;
+        quick_return_real residual;
         quick_return_phi(q, t, p, work->phi);
-        residual = max_abs(work->phi);
+        residual = quick_return_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN */
             return QUICK_RETURN_NO_CONVERGENCE;
         }
-        if (factor_jacobian(options, p, t, q, work, report) != QUICK_RETURN_OK) {
+        if (quick_return_factor_jacobian(options, p, t, q, work, report) != QUICK_RETURN_OK) {
             return QUICK_RETURN_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
@@ -76,45 +71,45 @@ static int newton(const quick_return_options *options, const real p[], real t, r
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) {
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         quick_return_lu_solve(&work->lu, work->phi);
-        for (i = 0; i < N; ++i) {
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = max_abs(work->phi);
+        step = quick_return_max_abs(work->phi);
     }
     return QUICK_RETURN_NO_CONVERGENCE;
 }
 
-static void predict(real t, quick_return_state *state)
+static void quick_return_predict(quick_return_real t, quick_return_state *state)
 {
-    real h = t - state->t;
+    quick_return_real h = t - state->t;
     int i;
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
         state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
     }
 }
 
-int quick_return_solve_step(const quick_return_options *options, const real p[], real t,
+int quick_return_solve_step(const quick_return_options *options, const quick_return_real p[], quick_return_real t,
                             quick_return_state *state, quick_return_workspace *work,
                             quick_return_report *report)
 {
     int i;
     if (state->started) {
-        predict(t, state);
+        quick_return_predict(t, state);
     } else {
         quick_return_lu_init(&work->lu); /* the caller's workspace may hold anything */
     }
-    report->status = newton(options, p, t, state->q, work, report);
+    report->status = quick_return_newton(options, p, t, state->q, work, report);
     report->fallbacks = quick_return_lu_fallbacks(&work->lu);
     if (report->status != QUICK_RETURN_OK) {
         return report->status;
     }
     /* Both right-hand sides are formed and solved in place in the state: no copies. */
     quick_return_phi_t(state->q, t, p, state->dq);
-    for (i = 0; i < N; ++i) {
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
     quick_return_lu_solve(&work->lu, state->dq); /* (2.73) */
@@ -126,16 +121,16 @@ int quick_return_solve_step(const quick_return_options *options, const real p[],
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
-static void store(real out[], int k, const real v[])
+static void quick_return_store(quick_return_real out[], int k, const quick_return_real v[])
 {
     if (out) {
-        memcpy(out + (size_t)k * N, v, N * sizeof v[0]);
+        memcpy(out + (size_t)k * QUICK_RETURN_NQ, v, QUICK_RETURN_NQ * sizeof v[0]);
     }
 }
 
-int quick_return_solve_grid(const quick_return_options *options, const real p[], int n,
-                            const real t[], quick_return_state *state, real q_out[],
-                            real dq_out[], real ddq_out[], quick_return_workspace *work,
+int quick_return_solve_grid(const quick_return_options *options, const quick_return_real p[], int n,
+                            const quick_return_real t[], quick_return_state *state, quick_return_real q_out[],
+                            quick_return_real dq_out[], quick_return_real ddq_out[], quick_return_workspace *work,
                             quick_return_report *report)
 {
     int k;
@@ -144,9 +139,9 @@ int quick_return_solve_grid(const quick_return_options *options, const real p[],
         if (quick_return_solve_step(options, p, t[k], state, work, report) != QUICK_RETURN_OK) {
             return k;
         }
-        store(q_out, k, state->q);
-        store(dq_out, k, state->dq);
-        store(ddq_out, k, state->ddq);
+        quick_return_store(q_out, k, state->q);
+        quick_return_store(dq_out, k, state->dq);
+        quick_return_store(ddq_out, k, state->ddq);
     }
     return n;
 }
