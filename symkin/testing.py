@@ -17,16 +17,18 @@ from typing import Any
 from symkin.spec.validate import Mechanism
 from symkin.symbolic.derivation import System
 from symkin.verify import numeric as _verify
+from symkin.verify.report import Report
 
 
 def assert_kinematics_match(mechanism: Mechanism | System | _verify.Derived | str | Path,
                             hand_module: Any, *, samples: int = _verify.DEFAULT_SAMPLES,
                             seed: int = 0, spread: float = _verify.DEFAULT_SPREAD,
-                            tolerance: float = _verify.DEFAULT_TOLERANCE) -> _verify.Report:
+                            tolerance: float = _verify.DEFAULT_TOLERANCE) -> Report:
     """Fail (AssertionError) unless the hand functions match the derived ones.
 
     Args:
-        mechanism: a mechanism file, Mechanism, System or :func:`symkin.verify.numeric.derived_functions`.
+        mechanism: a mechanism file, Mechanism, System or
+            :func:`symkin.verify.numeric.derived_functions`.
         hand_module: a module (or any object) with some of ``phi``, ``phi_q``, ``phi_t``,
             ``gamma``, or the path of a Python file defining them.
         samples, seed, spread, tolerance: as for :func:`symkin.verify.numeric.verify`.
@@ -36,7 +38,7 @@ def assert_kinematics_match(mechanism: Mechanism | System | _verify.Derived | st
 
     Raises:
         AssertionError: some entries differ; the message is the full report.
-        symkin.verify.numeric.HandModuleError: the hand module cannot be loaded, raises or returns the
+        symkin.verify.hand.HandModuleError: the hand module cannot be loaded, raises or returns the
             wrong shape (the original exception is its ``__cause__``).
     """
     __tracebackhide__ = True  # pytest shows the caller's line, not this helper's

@@ -25,6 +25,8 @@ class LambdifyKernel:
     """The Kernel interface evaluated with sympy.lambdify."""
 
     backend = "lambdify"
+    real = "double"
+    has_grid_solver = False
 
     def __init__(self, system) -> None:
         args = (system.q, system.t, system.p)

@@ -1,5 +1,6 @@
-"""The package's layering holds: the import-linter contracts of pyproject.toml are kept, and
-no module grows past the size one reader can hold at once."""
+"""The package's layering holds: the import-linter contracts of pyproject.toml are kept, the
+package is ruff-clean and mypy --strict clean (settings in pyproject.toml), and no module grows
+past the size one reader can hold at once."""
 
 from __future__ import annotations
 
@@ -25,3 +26,19 @@ def test_no_module_is_too_long() -> None:
     long = {str(path.relative_to(ROOT)): n for path in (ROOT / "symkin").rglob("*.py")
             if (n := len(path.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES}
     assert not long, f"split these modules: {long}"
+
+
+def _tool(module: str, *arguments: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", module, *arguments], cwd=ROOT,
+                          capture_output=True, text=True, check=False)
+
+
+def test_package_is_ruff_clean() -> None:
+    result = _tool("ruff", "check", "--no-cache", "symkin")
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_package_is_mypy_strict_clean() -> None:
+    result = _tool("mypy", "--no-incremental")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "Success" in result.stdout

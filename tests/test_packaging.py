@@ -57,4 +57,4 @@ def test_templates_ship_inside_the_package(installed: Path, tmp_path: Path) -> N
     expected = sorted(str(p.relative_to(ROOT / "templates")) for p in
                       (ROOT / "templates").rglob("*.j2"))
     assert listing == repr(expected)
-    assert sys.version_info >= (3, 10)
+    assert sys.version_info >= (3, 11)

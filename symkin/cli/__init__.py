@@ -33,7 +33,7 @@ def _schema(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _add_show(commands: argparse._SubParsersAction) -> None:
+def _add_show(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     show = commands.add_parser("show", help="print Phi, Phi_q, Phi_t, Gamma and the DOF count")
     show.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
     show.add_argument("--latex", action="store_true", help="print LaTeX instead of text")
@@ -49,7 +49,7 @@ def _verify(args: argparse.Namespace) -> int:
                           spread=args.spread, tolerance=args.tolerance)
 
 
-def _add_verify(commands: argparse._SubParsersAction) -> None:
+def _add_verify(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     check = commands.add_parser(
         "verify", help="check hand-written phi, phi_q, phi_t, gamma against the derived ones")
     check.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
@@ -82,7 +82,7 @@ def _generate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _add_generate(commands: argparse._SubParsersAction) -> None:
+def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     generate = commands.add_parser("generate", help="write the C or NumPy source of a mechanism")
     generate.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
     generate.add_argument("--backend", choices=("c", "numpy"), default="c")
@@ -97,13 +97,13 @@ def _add_generate(commands: argparse._SubParsersAction) -> None:
     generate.set_defaults(handler=_generate)
 
 
-def _add_run(commands: argparse._SubParsersAction) -> None:
+def _add_run(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     from symkin.cli import run as runner  # the `run` subcommand lives in its own module
 
     runner.add_parser(commands)
 
 
-SUBCOMMANDS: list[Callable[[argparse._SubParsersAction], None]] = [
+SUBCOMMANDS: list[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]], None]] = [
     _add_show, _add_verify, _add_generate, _add_run]
 
 
@@ -119,7 +119,8 @@ def parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     args = parser().parse_args(argv)
     try:
-        return args.handler(args)
+        status: int = args.handler(args)
+        return status
     except MechanismError as error:
         print(f"symkin: error: {error}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -20,7 +20,7 @@ from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png",), "animate": (".gif",)}
 
 
-def add_parser(commands: argparse._SubParsersAction) -> None:
+def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``run`` subcommand."""
     run = commands.add_parser(
         "run", help="solve positions, velocities and accelerations over the time grid")
@@ -47,7 +47,7 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
     return None
 
 
-def _times(kernel: Any, args: argparse.Namespace):
+def _times(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
     from symkin.runtime import driver
 
     t0, t1, dt = kernel.time_grid

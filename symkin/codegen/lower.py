@@ -220,7 +220,7 @@ def _inline_trivial(temporaries: list[tuple[sp.Symbol, sp.Expr]], exprs: list[sp
 
 def _print(printer: Any, expr: sp.Expr) -> str:
     try:
-        return printer.doprint(expr)
+        return str(printer.doprint(expr))
     except (TypeError, ValueError, NotImplementedError) as error:
         raise BuildError(f"cannot generate code for the expression {expr}: {error}") from None
 

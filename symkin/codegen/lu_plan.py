@@ -22,6 +22,7 @@ from __future__ import annotations
 import bisect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -356,7 +357,7 @@ def _tables(plan: LUPlan) -> dict[str, list[int]]:
     """The plan as compressed index arrays (offsets per pivot), each ending in one zero record
     so that no C array is empty (C99 forbids it) even when a plan has no such entry."""
     tables: dict[str, list[int]] = {"pivot": [s.pivot for s in plan.steps]}
-    records: tuple[tuple[str, int, Callable[[Step], tuple]], ...] = (
+    records: tuple[tuple[str, int, Callable[[Step], Any]], ...] = (
         ("lower", 2, lambda s: s.lower), ("upper", 2, lambda s: s.upper),
         ("update", 3, lambda s: s.updates))
     for name, width, pick in records:
@@ -370,10 +371,11 @@ def _tables(plan: LUPlan) -> dict[str, list[int]]:
     return tables
 
 
-def _parts(steps: list[dict], size: Callable[[dict], int], limit: int) -> list[dict]:
+def _parts(steps: list[dict[str, Any]], size: Callable[[dict[str, Any]], int],
+           limit: int) -> list[dict[str, Any]]:
     """Consecutive runs of steps of at most ``limit`` operations each (at least one step);
     ``checks`` says whether a run has a ratio test (and so needs its column maximum)."""
-    runs: list[list[dict]] = []
+    runs: list[list[dict[str, Any]]] = []
     total = 0
     for step in steps:
         ops = size(step)

@@ -21,10 +21,10 @@ import jinja2
 
 from symkin import resources
 from symkin.codegen import backends
-from symkin.runtime import newton
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
 from symkin.errors import BuildError
+from symkin.runtime import options as runtime_options
 from symkin.symbolic.derivation import System
 
 CDEF_TEMPLATE = "cdef.j2"
@@ -175,7 +175,8 @@ def template_context(code: Code) -> dict[str, Any]:
     """The plain data every template of ``code.backend`` receives."""
     literal = backends.get(code.backend).literal(code.real)
     return {
-        "prefix": code.name, "PREFIX": code.name.upper(), "name_comment": codegen.comment(code.name),
+        "prefix": code.name, "PREFIX": code.name.upper(),
+        "name_comment": codegen.comment(code.name),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "real": code.real, "cse": code.cse, "spec_sha256": code.spec_sha256,
         # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
@@ -234,7 +235,7 @@ def _labels(code: Code, routine: str) -> list[str]:
 
 def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
     """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
-    options = newton.defaults(code.real)
+    options = runtime_options.defaults(code.real)
     return {"tol_phi": literal(options.tol_phi), "tol_dq": literal(options.tol_dq),
             "max_iterations": str(options.max_iterations),
             "min_pivot_ratio": literal(options.min_pivot_ratio)}

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,7 +20,7 @@ from symkin.runtime.results import Trajectory, rotation
 MAX_FRAMES = 200
 
 
-def _pyplot():
+def _pyplot() -> Any:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -64,7 +65,7 @@ def plot(trajectory: Trajectory, path: str | Path,
     return _save(figure, plt, Path(path))
 
 
-def _save(figure, plt, path: Path) -> Path:
+def _save(figure: Any, plt: Any, path: Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(path, dpi=100)
     plt.close(figure)

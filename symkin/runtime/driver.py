@@ -21,23 +21,16 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.errors import SolveError
 from symkin.runtime.linalg import dependent_rows, factor_at
-from symkin.runtime.newton import (
-    NO_CONVERGENCE,
-    OK,
-    SINGULAR,
-    Newton,
-    Options,
-    assemble,
-    defaults as newton_defaults,
-    newton,
-)
+from symkin.runtime.newton import Newton, assemble, newton
+from symkin.runtime.options import NO_CONVERGENCE, OK, SINGULAR, Options
+from symkin.runtime.options import defaults as newton_defaults
+from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
@@ -88,7 +81,7 @@ def grid(t0: float, t1: float, dt: float) -> Array:
     return times
 
 
-def _times(kernel: Any, t: ArrayLike | None) -> Array:
+def _times(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
     if t is None:
         return grid(*kernel.time_grid)
     times = np.atleast_1d(np.asarray(t, dtype=float))
@@ -99,7 +92,7 @@ def _times(kernel: Any, t: ArrayLike | None) -> Array:
     return times
 
 
-def _params(kernel: Any, params: Mapping[str, float] | ArrayLike | None) -> Array:
+def _params(kernel: KinematicsKernel, params: Mapping[str, float] | ArrayLike | None) -> Array:
     """Nominal parameter values, overridden by name (a mapping) or replaced (a sequence)."""
     values = np.array(kernel.p_values, dtype=float)
     if params is None:
@@ -132,7 +125,7 @@ class _Run:
     fallbacks: int = 0  # the generated sparse LU's fall-backs to dense LU (C solver)
 
 
-def _python_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
+def _python_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
                  progress: Progress | None) -> Newton:
     """The grid loop in Python; returns the Newton outcome at the last point attempted."""
     dq = np.zeros_like(q)
@@ -156,64 +149,37 @@ def _python_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
     return result
 
 
-def default_options(kernel: Any) -> Options:
+def default_options(kernel: KinematicsKernel) -> Options:
     """Options() for double precision; looser ones for a C kernel computing in float."""
     return newton_defaults(getattr(kernel, "real", "double"))
 
 
-def _has_c_solver(kernel: Any) -> bool:
-    lib = getattr(kernel, "lib", None)
-    return lib is not None and hasattr(lib, f"{kernel.name}_solve_grid")
-
-
-def _c_loop(kernel: Any, run: _Run, q: Array, p: Array, options: Options,
+def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
             progress: Progress | None) -> Newton:
     """The grid loop in the generated C solver: one call per chunk (one chunk unless a
     progress callback wants to hear in between)."""
-    ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
-    c_options = ffi.new(f"{name}_options *")
-    getattr(lib, f"{name}_default_options")(c_options)
-    c_options.tol_phi, c_options.tol_dq = options.tol_phi, options.tol_dq
-    c_options.max_iterations, c_options.min_pivot_ratio = options.max_iterations, \
-        options.min_pivot_ratio
-    state = ffi.new(f"{name}_state *")
-    # The solver initialises its workspace on the first step, so it is not zero-filled here:
-    # with the sparse LU it holds an N x N dense fall-back buffer that is rarely touched.
-    work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
-    report = ffi.new(f"{name}_report *")
-    dtype = np.float32 if kernel.real == "float" else np.float64
-    direct = dtype == np.float64  # the C solver writes straight into the result arrays
-    pbuf = ffi.new(f"{name}_real[]", max(p.size, 1))
-    pbuf[0:p.size] = p.tolist()
-    state.q[0:q.size] = q.tolist()
+    solver = kernel.grid_solver(options, q, p)
+    assert solver is not None  # only called for kernels that have one
     chunk = run.t.size if progress is None else max(1, run.t.size // 100)
-    solve_grid = getattr(lib, f"{name}_solve_grid")
-    n = q.size
+    result = None
     for start in range(0, run.t.size, chunk):
         stop = min(start + chunk, run.t.size)
-        times = np.ascontiguousarray(run.t[start:stop], dtype=dtype)
-        out = [a[start:stop] if direct else np.zeros((stop - start, n), dtype=dtype)
-               for a in (run.q, run.dq, run.d2q)]
-        ptrs = [ffi.cast(f"{name}_real *", ffi.from_buffer(a)) for a in (times, *out)]
-        solved = solve_grid(c_options, pbuf, stop - start, ptrs[0], state, ptrs[1], ptrs[2],
-                            ptrs[3], work, report)
-        if not direct:
-            for target, source in zip((run.q, run.dq, run.d2q), out):
-                target[start:start + solved] = source[:solved]
-        run.done = start + solved
-        run.fallbacks = int(report.fallbacks)
-        if report.status != OK:
-            last = np.array(ffi.unpack(state.q, n), dtype=float)
-            factors = factor_at(kernel, last, report.t, p) if report.status == SINGULAR \
+        result = solver.solve(run.t[start:stop], run.q[start:stop], run.dq[start:stop],
+                              run.d2q[start:stop])
+        run.done = start + result.solved
+        run.fallbacks = result.fallbacks
+        if result.status != OK:
+            last = solver.last_q()
+            factors = factor_at(kernel, last, result.t, p) if result.status == SINGULAR \
                 else None
-            return Newton(last, report.status, report.iterations, report.residual, factors)
+            return Newton(last, result.status, result.iterations, result.residual, factors)
         if progress is not None:
             progress(run.done, run.t.size)
-    return Newton(np.array(ffi.unpack(state.q, n)), OK, report.iterations, report.residual,
-                  None)
+    assert result is not None  # the grid has at least one point
+    return Newton(solver.last_q(), OK, result.iterations, result.residual, None)
 
 
-def solve(kernel: Any, t: ArrayLike | None = None, q0: ArrayLike | None = None,
+def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
           params: Mapping[str, float] | ArrayLike | None = None, *,
           options: Options | None = None, progress: Progress | None = None,
           use_c_solver: bool = True) -> Trajectory:
@@ -246,7 +212,7 @@ def solve(kernel: Any, t: ArrayLike | None = None, q0: ArrayLike | None = None,
     shape = (times.size, q.size)
     # Rows past run.done are never exposed, so the arrays need no zero-filling.
     run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape))
-    in_c = use_c_solver and _has_c_solver(kernel)
+    in_c = use_c_solver and kernel.has_grid_solver
     # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
     # the damped assembly in Python take over (and the grid is run again from its result).
     result = _c_loop(kernel, run, q, p, options, progress) if in_c else None
@@ -261,7 +227,7 @@ def solve(kernel: Any, t: ArrayLike | None = None, q0: ArrayLike | None = None,
     return _trajectory(kernel, run, p)
 
 
-def _trajectory(kernel: Any, run: _Run, p: Array) -> Trajectory:
+def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
     done = run.done
 
     def solved(a: Array) -> Array:  # the run's own arrays (never the caller's): no copy
@@ -269,12 +235,13 @@ def _trajectory(kernel: Any, run: _Run, p: Array) -> Trajectory:
 
     return Trajectory(t=run.t[:done].copy(), q=solved(run.q), dq=solved(run.dq),
                       d2q=solved(run.d2q), coordinates=tuple(kernel.coordinates),
-                      points=tuple(tuple(point) for point in kernel.points),
+                      points=tuple((body, point) for body, point in kernel.points),
                       point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
                       params=p.copy(), lu_fallbacks=run.fallbacks)
 
 
-def _fail(kernel: Any, run: _Run, p: Array, result: Newton, t: float, assembling: bool) -> None:
+def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
+          assembling: bool) -> None:
     """Raise SolveFailure with a message that says where, why and what to try."""
     labels = list(kernel.rows)
     rows, near = _singular_rows(kernel, run, p, result, t)
@@ -303,7 +270,7 @@ def _fail(kernel: Any, run: _Run, p: Array, result: Newton, t: float, assembling
                        result.iterations, rows, reason)
 
 
-def _singular_rows(kernel: Any, run: _Run, p: Array, result: Newton, t: float
+def _singular_rows(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float
                    ) -> tuple[list[str], float | None]:
     """Dependent equations at the failure, or at the last point solved when Newton failed just
     past it (a mechanism driven through a dead centre has no solution beyond it).

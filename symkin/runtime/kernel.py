@@ -21,6 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin import resources
+from symkin.runtime.csolver import GridSolver
+from symkin.runtime.options import Options
 
 Array = NDArray[np.float64]
 
@@ -53,7 +55,7 @@ class Kernel:
         self.parameter_names: tuple[str, ...] = tuple(meta["parameter_names"])
         self.p_values: Array = np.array(meta["p_values"], dtype=float)
         self.q0: Array = np.array(meta["q0"], dtype=float)
-        self.time_grid: tuple[float, float, float] = tuple(meta["time_grid"])  # type: ignore
+        self.time_grid: tuple[float, float, float] = tuple(meta["time_grid"])
         self.rows: tuple[str, ...] = tuple(meta["rows"])
         self.pattern_rows = np.array(meta["pattern_rows"], dtype=np.intp)
         self.pattern_cols = np.array(meta["pattern_cols"], dtype=np.intp)
@@ -61,6 +63,17 @@ class Kernel:
         self.ffi = ffi
         self.lib = lib
         self._functions = functions
+
+    @property
+    def has_grid_solver(self) -> bool:
+        """True for a C kernel whose generated solver runs whole grids (``solve_grid``)."""
+        return self.lib is not None and hasattr(self.lib, f"{self.name}_solve_grid")
+
+    def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
+        """A fresh run of the generated C grid loop from q, or None without a C solver."""
+        if not self.has_grid_solver:
+            return None
+        return GridSolver(self.ffi, self.lib, self.name, self.real, options, q, p)
 
     @property
     def nq(self) -> int:

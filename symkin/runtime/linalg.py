@@ -11,6 +11,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.runtime.protocol import KinematicsKernel
+
 Array = NDArray[np.float64]
 
 
@@ -32,7 +34,7 @@ class Factors:
 
     def solve(self, b: Array) -> Array:
         x, _ = self.getrs(self.lu, self.pivots, b)
-        return x
+        return np.asarray(x, dtype=float)
 
 
 @dataclass(frozen=True)
@@ -44,7 +46,7 @@ class SparseFactors:
     pivot_ratio: float
 
     def solve(self, b: Array) -> Array:
-        return self.lu.solve(np.asarray(b, dtype=float))
+        return np.asarray(self.lu.solve(np.asarray(b, dtype=float)), dtype=float)
 
 
 def factor(jacobian: Array) -> Factors:
@@ -74,13 +76,13 @@ def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values
     return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())))
 
 
-def factor_at(kernel: Any, q: Array, t: float, p: Array) -> Factors | SparseFactors:
+def factor_at(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> Factors | SparseFactors:
     """Factor Phi_q(q, t): dense below SPARSE_FROM coordinates, sparse from there on."""
     n = len(kernel.coordinates)
     if n < SPARSE_FROM:
         return factor(kernel.phi_q(q, t, p))
     return factor_sparse(n, kernel.pattern_rows, kernel.pattern_cols,
-                         np.asarray(kernel.phi_q_nz(q, t, p), dtype=float))
+                         np.asarray(kernel.phi_q_nz(q, t, p), dtype=np.float64))
 
 
 def _ratio(magnitudes: Array) -> float:

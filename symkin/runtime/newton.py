@@ -5,49 +5,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from symkin.runtime.linalg import Factors, SparseFactors, factor_at
+from symkin.runtime.options import NO_CONVERGENCE, OK, SINGULAR, Options
+from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
-
-# Status codes shared with the generated C solver (templates/c/solver.h.j2).
-OK, NO_CONVERGENCE, SINGULAR = 0, 1, 2
-
-
-@dataclass(frozen=True)
-class Options:
-    """Newton tolerances and the singularity test.
-
-    Args:
-        tol_phi: converged when max |Phi| of the current iterate is at most this...
-        tol_dq: ...and the last Newton step max |dq| is at most this.
-        max_iterations: Newton iterations allowed per time point.
-        min_pivot_ratio: Phi_q counts as singular when min |u_kk| / max |u_kk| of its LU
-            factors falls below this (a cheap estimate of the reciprocal condition number).
-    """
-
-    tol_phi: float = 1e-10
-    tol_dq: float = 1e-9
-    max_iterations: int = 25
-    min_pivot_ratio: float = 1e-10
-
-
-# The defaults per real type, defined once: the generated C's <prefix>_default_options is
-# rendered from this table (codegen.render), so Python and C can never disagree.
-DEFAULTS = {
-    "double": Options(),
-    "float": Options(tol_phi=1e-5, tol_dq=1e-4, min_pivot_ratio=1e-6),
-}
-
-
-def defaults(real: str) -> Options:
-    """The Newton options for a kernel computing in ``real`` ("double" or "float")."""
-    return DEFAULTS[real]
-
 
 @dataclass
 class Newton:
@@ -60,7 +26,7 @@ class Newton:
     factors: Factors | SparseFactors | None
 
 
-def newton(kernel: Any, q: Array, t: float, p: Array, options: Options) -> Newton:
+def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options) -> Newton:
     """Newton-Raphson that tests the residual of the current iterate (2.72).
 
     Converged when max |Phi(q_k)| <= tol_phi and the step that led to q_k was at most tol_dq
@@ -87,7 +53,7 @@ def newton(kernel: Any, q: Array, t: float, p: Array, options: Options) -> Newto
     return Newton(q, NO_CONVERGENCE, options.max_iterations, residual, None)
 
 
-def levenberg_marquardt(kernel: Any, q: Array, t: float, p: Array, options: Options,
+def levenberg_marquardt(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options,
                         max_iterations: int = 200) -> tuple[Array, float]:
     """Minimise |Phi(q, t)|^2 from a poor guess; returns the best q and its max |Phi|.
 
@@ -119,7 +85,7 @@ def levenberg_marquardt(kernel: Any, q: Array, t: float, p: Array, options: Opti
     return q, float(np.abs(phi).max(initial=0.0))
 
 
-def assemble(kernel: Any, q0: Array, t0: float, p: Array, options: Options) -> Newton:
+def assemble(kernel: KinematicsKernel, q0: Array, t0: float, p: Array, options: Options) -> Newton:
     """Assemble the mechanism at t0 from q0: Newton, else Levenberg-Marquardt then Newton."""
     result = newton(kernel, q0, t0, p, options)
     if result.status == OK:

@@ -9,11 +9,11 @@ object, and remembers the line of each field so that errors can point at it.
 from __future__ import annotations
 
 import re
+import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, cast
 
-import tomllib
 import yaml
 
 from symkin.errors import MechanismError
@@ -150,7 +150,7 @@ class _Loader(yaml.SafeLoader):
 
     # Replace PyYAML's YAML 1.1 resolution: every plain scalar gets one tag, so an explicit
     # ``!!str`` can still be told apart, and ``_scalar`` applies the YAML 1.2 rules.
-    yaml_implicit_resolvers: ClassVar[dict] = {}
+    yaml_implicit_resolvers: ClassVar[dict[str, Any]] = {}
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         if self.check_event(yaml.AliasEvent):

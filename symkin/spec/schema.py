@@ -11,7 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PlainValidator, WithJsonSchema
@@ -38,7 +38,7 @@ def _expr(value: Any) -> Any:
     return value
 
 
-def _vector(size: int):
+def _vector(size: int) -> Callable[[Any], list[Any]]:
     def check(value: Any) -> list[Any]:
         if not isinstance(value, (list, tuple)) or len(value) != size:
             got = f"{len(value)} items" if isinstance(value, (list, tuple)) else _kind(value)

@@ -74,7 +74,8 @@ class System:
     def time_grid(self) -> tuple[float, float, float]:
         """(t0, t1, dt) at the nominal parameter values."""
         values = dict(zip(self.p, self.p_values))
-        parse = constraints.Context(self.mechanism, symbols_module.make_symbols(self.mechanism)).expr
+        symbols = symbols_module.make_symbols(self.mechanism)
+        parse = constraints.Context(self.mechanism, symbols).expr
         grid = self.mechanism.time
         t0, t1, dt = (float(parse(raw).subs(values)) for raw in (grid.t0, grid.t1, grid.dt))
         return t0, t1, dt
@@ -143,7 +144,8 @@ def _row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
     return {k: value for k, value in derivatives.items() if value != 0}
 
 
-def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr, symbols: symbols_module.Symbols) -> sp.Expr:
+def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr,
+               symbols: symbols_module.Symbols) -> sp.Expr:
     """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt, from this row's columns."""
     q, dq, t = symbols.q, symbols.dq, symbols.t
     velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))

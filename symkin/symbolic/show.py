@@ -18,7 +18,7 @@ def text(system: System) -> str:
     rename = _names(system)
 
     def show(expr: sp.Expr) -> str:
-        return sp.sstr(expr.xreplace(rename))
+        return str(sp.sstr(expr.xreplace(rename)))
 
     width = max(len(str(row)) for row in system.rows)
     summary = (f"mechanism {system.name}: {len(system.q)} coordinates, {len(system.rows)} "

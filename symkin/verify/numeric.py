@@ -103,7 +103,8 @@ def derived_functions(system: System) -> Derived:
 
     def make(values: Iterable[sp.Expr]) -> Callable[..., Any]:
         column = [sp.sympify(value).xreplace(rename) for value in values]
-        return sp.lambdify([q, dq, t, p], column, modules="numpy")
+        function: Callable[..., Any] = sp.lambdify([q, dq, t, p], column, modules="numpy")
+        return function
 
     pattern = tuple(system.pattern())
     return Derived(system=system, phi=make(system.phi), phi_t=make(system.phi_t),
@@ -196,6 +197,6 @@ def relative_errors(derived: np.ndarray, hand: np.ndarray, least: float = 0.0) -
 def show_expression(system: System, expr: sp.Expr) -> str:
     """An expression as ``symkin show`` prints it: rates of coordinates as ``crank.phi'``."""
     rates = {dq: sp.Symbol(f"{name}'") for dq, name in zip(system.dq, system.coordinates)}
-    return sp.sstr(sp.sympify(expr).xreplace(rates))
+    return str(sp.sstr(sp.sympify(expr).xreplace(rates)))
 
 

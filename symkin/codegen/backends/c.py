@@ -41,7 +41,7 @@ class CPrinter(C99CodePrinter):
         if expr.exp == 2:
             base = self.parenthesize(expr.base, PRECEDENCE["Mul"])
             return f"({base}*{base})"
-        return super()._print_Pow(expr)
+        return str(super()._print_Pow(expr))
 
 
 def literal(real: str) -> Any:

@@ -25,7 +25,7 @@ class PythonPrinter(NumPyPrinter):
         if expr.exp == 2:
             base = self.parenthesize(expr.base, PRECEDENCE["Mul"])
             return f"({base}*{base})"
-        return super()._print_Pow(expr, rational)
+        return str(super()._print_Pow(expr, rational))
 
 
 def _printer(real: str) -> PythonPrinter:

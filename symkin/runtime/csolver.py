@@ -1,0 +1,90 @@
+"""The generated C solver's grid loop, called through cffi: every C call of the runtime's
+time loop lives here, so the driver sees plain NumPy arrays and a :class:`ChunkResult`.
+
+The C solver keeps its state (the last q, dq, ddq and t) between calls, so a grid can be run
+in chunks (for progress reports, interrupts) and continues exactly as one call would.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.runtime.options import Options
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """What one call of ``<prefix>_solve_grid`` reports.
+
+    Attributes:
+        solved: how many time points of the chunk were solved.
+        status: newton.OK, NO_CONVERGENCE or SINGULAR at the last point attempted.
+        t: the time of that point.
+        iterations, residual: Newton's count and max |Phi| there.
+        fallbacks: the sparse LU's fall-backs to dense LU so far (0 for the dense LU).
+    """
+
+    solved: int
+    status: int
+    t: float
+    iterations: int
+    residual: float
+    fallbacks: int
+
+
+class GridSolver:
+    """One run of the generated C grid loop: options, state, workspace and report structs."""
+
+    def __init__(self, ffi: Any, lib: Any, name: str, real: str, options: Options,
+                 q: Array, p: Array) -> None:
+        self._ffi, self._name = ffi, name
+        self._options = ffi.new(f"{name}_options *")
+        getattr(lib, f"{name}_default_options")(self._options)
+        self._options.tol_phi, self._options.tol_dq = options.tol_phi, options.tol_dq
+        self._options.max_iterations = options.max_iterations
+        self._options.min_pivot_ratio = options.min_pivot_ratio
+        self._state = ffi.new(f"{name}_state *")
+        # The solver initialises its workspace on the first step, so it is not zero-filled
+        # here: with the sparse LU it holds an N x N dense fall-back buffer rarely touched.
+        self._work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
+        self._report = ffi.new(f"{name}_report *")
+        self._p = ffi.new(f"{name}_real[]", max(p.size, 1))
+        self._p[0:p.size] = p.tolist()
+        self._state.q[0:q.size] = q.tolist()
+        self._n = q.size
+        self._solve_grid = getattr(lib, f"{name}_solve_grid")
+        self.dtype = np.float32 if real == "float" else np.float64
+
+    def solve(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array) -> ChunkResult:
+        """Solve the grid points ``times`` after those already solved, writing their rows.
+
+        The output arrays are written in place when they are C-contiguous arrays of the
+        kernel's real type; otherwise the rows are copied in after the call.
+        """
+        chunk = np.ascontiguousarray(times, dtype=self.dtype)
+        outputs = (q_out, dq_out, d2q_out)
+        direct = all(a.dtype == self.dtype and a.flags.c_contiguous for a in outputs)
+        buffers = outputs if direct else tuple(np.zeros((chunk.size, self._n), dtype=self.dtype)
+                                               for _ in outputs)
+        real = f"{self._name}_real *"
+        pointers = [self._ffi.cast(real, self._ffi.from_buffer(a)) for a in (chunk, *buffers)]
+        solved = self._solve_grid(self._options, self._p, chunk.size, pointers[0], self._state,
+                                  pointers[1], pointers[2], pointers[3], self._work,
+                                  self._report)
+        if not direct:
+            for target, source in zip(outputs, buffers):
+                target[:solved] = source[:solved]
+        report = self._report
+        return ChunkResult(int(solved), int(report.status), float(report.t),
+                           int(report.iterations), float(report.residual),
+                           int(report.fallbacks))
+
+    def last_q(self) -> Array:
+        """The solver's current q: the last converged point, or the failed iterate."""
+        return np.array(self._ffi.unpack(self._state.q, self._n), dtype=float)
