@@ -206,3 +206,21 @@ def test_lu_behind_the_solver_solves_phi_q(linalg: str, shared_cache: Path) -> N
         expected = np.linalg.solve(k.phi_q(q, 0.1), b)
         assert np.allclose(np.frombuffer(ffi.buffer(x), dtype=float), expected, rtol=1e-9,
                            atol=1e-9)
+
+
+def test_cdef_is_the_generated_headers(tmp_path: Path) -> None:
+    """cffi reads the headers a C user compiles against: every prototype of every header is
+    in the cdef, headers come after those they include, and no comment or include is left."""
+    from symkin.codegen.cdef import from_headers
+
+    folder = GENERATED / "crank_slider" / "c"
+    files = {p.name: p.read_text(encoding="utf-8") for p in folder.iterdir() if p.is_file()}
+    cdef = from_headers(files)
+    assert "/*" not in cdef and "#include" not in cdef and "#ifndef" not in cdef
+    assert cdef.index("typedef double crank_slider_real;") < cdef.index("crank_slider_lu;")
+    assert cdef.index("crank_slider_lu;") < cdef.index("crank_slider_solve_grid(")
+    for name in ("crank_slider_phi(", "crank_slider_lu_factor(", "crank_slider_solve_step("):
+        assert name in cdef
+    import cffi
+
+    cffi.FFI().cdef(cdef)  # parses as C declarations

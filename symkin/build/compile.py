@@ -32,6 +32,7 @@ from symkin.codegen import lower as codegen
 from symkin import resources
 from symkin.runtime import kernel
 from symkin.codegen import render
+from symkin.codegen.cdef import from_headers as cdef_from_headers
 from symkin.build import toolchain
 from symkin.build.cache import cache_root, content_key, publish
 from symkin.symbolic.derivation import System
@@ -79,7 +80,7 @@ def compile(system: System, backend: str = "c", *, real: str = "double", cse: bo
 def _compile_c(code: codegen.Code, cache: Path, compiler: list[str]) -> kernel.Kernel:
     files = render.render_sources(code)
     files[resources.MANIFEST] = render.manifest(code, files)
-    cdef = render.render_cdef(code)
+    cdef = cdef_from_headers(files)
     key = content_key({"files": files, "cdef": cdef, "compiler": compiler, "flags": C_FLAGS,
                 "wrapper_flags": WRAPPER_FLAGS, **toolchain.fingerprint(compiler)})
     module_name = f"_symkin_{code.name}_{key[:20]}"

@@ -3,10 +3,11 @@
 Every ``X.Y.j2`` in ``templates/<backend>/`` becomes one file of the generated folder:
 ``kernel.h.j2 -> <prefix>.h``, ``kernel.c.j2 -> <prefix>.c``, ``kernel.py.j2 -> <prefix>.py``
 and any other ``X.Y.j2 -> <prefix>_X.Y`` (the solver runtime of the C backend). Templates
-whose name starts with ``_`` are partials and ``cdef.j2`` renders the cffi declarations, so
-neither is written out. The folder also gets ``manifest.json``: the files with their sha256,
-the op counts and the metadata a runtime needs. The output depends only on the input, so the
-same mechanism gives the same bytes on every run and machine.
+whose name starts with ``_`` are partials and are not written out (the cffi declarations come
+from the rendered headers themselves, :mod:`symkin.codegen.cdef`). The folder also gets
+``manifest.json``: the files with their sha256, the op counts and the metadata a runtime
+needs. The output depends only on the input: the same mechanism gives the same bytes on every
+run and machine.
 """
 
 from __future__ import annotations
@@ -27,7 +28,6 @@ from symkin.errors import BuildError
 from symkin.runtime import options as runtime_options
 from symkin.symbolic.derivation import System
 
-CDEF_TEMPLATE = "cdef.j2"
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
 MANIFEST = resources.MANIFEST
 
@@ -60,7 +60,7 @@ def template_names(backend: str, linalg: str = codegen.DEFAULT_LINALG) -> list[s
     folder = resources.template_root() / backend
     left_out = _LINALG_TEMPLATES["sparse" if linalg == "dense" else "dense"]
     return sorted(p.name for p in folder.glob("*.j2")
-                  if not p.name.startswith("_") and p.name != CDEF_TEMPLATE
+                  if not p.name.startswith("_")
                   and p.name.split(".")[0] != left_out)
 
 
@@ -78,13 +78,6 @@ def render_sources(code: Code) -> dict[str, str]:
         files[name] = _render(f"{code.backend}/{template}",
                               {**context, "template": template, "file_name": name})
     return dict(sorted(files.items()))
-
-
-def render_cdef(code: Code) -> str:
-    """The cffi declarations of the C backend (plain C, concrete types, no macros)."""
-    context = template_context(code)
-    return _render(f"c/{CDEF_TEMPLATE}", {**context, "template": CDEF_TEMPLATE,
-                                          "file_name": "cdef"})
 
 
 def _render(template: str, context: dict[str, Any]) -> str:

@@ -55,4 +55,4 @@ def literal(real: str) -> Any:
 
 
 BACKEND = Backend(name="c", template_folder="c", printer=CPrinter, literal=literal,
-                  module_template="kernel", cdef_template="cdef.j2")
+                  module_template="kernel")

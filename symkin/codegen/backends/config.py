@@ -22,7 +22,6 @@ class Backend:
         literal: ``literal(real)`` -> a function printing a float as a literal of the language.
         module_template: the stem of the template rendered to ``<prefix>.<suffix>``; every
             other ``X.Y.j2`` renders to ``<prefix>_X.Y``.
-        cdef_template: the template of the cffi declarations (C only), never written out.
     """
 
     name: str
@@ -30,7 +29,6 @@ class Backend:
     printer: Callable[[str], Any]
     literal: Callable[[str], Callable[[float], str]]
     module_template: str
-    cdef_template: str | None
 
     def output_name(self, template: str, prefix: str) -> str:
         """``kernel.h.j2 -> crank_slider.h``; ``solver.c.j2 -> crank_slider_solver.c``."""

@@ -40,4 +40,4 @@ def _literal(real: str) -> Any:
 
 
 BACKEND = Backend(name="numpy", template_folder="numpy", printer=_printer, literal=_literal,
-                  module_template="kernel", cdef_template=None)
+                  module_template="kernel")
