@@ -86,7 +86,8 @@ void harness_repeat(long reps, const double *nz, double *b)
 def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
            plan: sparse_lu.LUPlan, real: str = "double", style: str | None = None
            ) -> dict[str, str]:
-    """Render the two sparse LU templates with a context shaped like the codegen stream's."""
+    """Render the sparse LU templates and the dense LU they fall back to, with a context
+    shaped like the codegen stream's."""
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(template_root() / "c"),
                              undefined=jinja2.StrictUndefined, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True)
@@ -95,7 +96,7 @@ def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
                "pattern_cols": list(cols), "spec_sha256": "0" * 64,
                "lu": sparse_lu.template_context(plan, style=style)}
     return {f"{prefix}_{name[:-3]}": env.get_template(name).render(template=name, **context)
-            for name in ("sparse_lu.h.j2", "sparse_lu.c.j2")}
+            for name in ("sparse_lu.h.j2", "sparse_lu.c.j2", "dense_lu.h.j2", "dense_lu.c.j2")}
 
 
 @dataclass
@@ -138,7 +139,7 @@ def write_sources(folder: Path, prefix: str, nq: int, rows: Sequence[int], cols:
     files[f"{prefix}.c"] = _STUB_C.format(**names)
     for name, text in files.items():
         (folder / name).write_text(text)
-    return [folder / f"{prefix}.c", folder / f"{prefix}_sparse_lu.c"]
+    return [folder / f"{prefix}{suffix}.c" for suffix in ("", "_sparse_lu", "_dense_lu")]
 
 
 def compile_library(sources: Sequence[Path], library: Path, flags: Sequence[str] = ()) -> None:

@@ -111,7 +111,7 @@ def test_solver_objects_have_no_mutable_data_and_call_no_allocator(linalg, tmp_p
         pytest.skip("gcc and nm are needed")
     symkin.generate(crank_slider_system, backend="c", out_dir=tmp_path, linalg=linalg)
     lu = "crank_slider_linalg" if linalg == "dense" else "crank_slider_sparse_lu"
-    for name in ("crank_slider_solver", lu):
+    for name in ("crank_slider_solver", lu, "crank_slider_dense_lu"):
         obj = tmp_path / f"{name}.o"
         subprocess.run(["gcc", *WARNINGS, "-O2", "-c", str(tmp_path / f"{name}.c"), "-o",
                         str(obj)], check=True)
@@ -187,3 +187,23 @@ def test_fallbacks_are_counted_and_reach_the_trajectory() -> None:
     assert driver._trajectory(kernel, run, p).lu_fallbacks == run.fallbacks
     # the ordinary path, assembled first in Python, never needs the fall-back
     assert driver.solve(kernel).lu_fallbacks == 0
+
+
+@pytest.mark.parametrize("scale", [0.0, 1e-300, 1e-17])
+def test_dense_and_sparse_lu_agree_on_a_vanished_pivot(scale: float, crank_slider_system) -> None:
+    """One dense LU serves the dense linear algebra and the sparse LU's fall-back, so both call
+    the same pivot vanished: a Phi_q whose crank.x column is (numerically) zero is singular
+    (status k + 1, pivot ratio 0) for both, whether the column is 0, denormal or 1e-17."""
+    verdicts = []
+    for linalg in ("dense", "sparse"):
+        kernel = symkin.compile(crank_slider_system, backend="c", linalg=linalg)
+        assert kernel.backend == "c"
+        ffi, lib = kernel.ffi, kernel.lib
+        q = driver.solve(kernel, t=[0.3]).q[0]
+        nz = kernel.phi_q_nz(q, 0.3)
+        nz[kernel.pattern_cols == 0] *= scale  # the column of crank.x
+        lu = ffi.new("crank_slider_lu *")
+        lib.crank_slider_lu_init(lu)
+        status = lib.crank_slider_lu_factor(ffi.new("crank_slider_real[]", nz.tolist()), lu)
+        verdicts.append((status != 0, lib.crank_slider_lu_pivot_ratio(lu) < 1e-10))
+    assert verdicts == [(True, True), (True, True)]

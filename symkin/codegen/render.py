@@ -54,8 +54,8 @@ def environment(root: str | None = None) -> jinja2.Environment:
 def template_names(backend: str, linalg: str = codegen.DEFAULT_LINALG) -> list[str]:
     """The templates of ``backend`` that each render to one file, sorted.
 
-    ``linalg.*.j2`` (dense LU) and ``sparse_lu.*.j2`` define the same functions, so only the
-    chosen one is rendered.
+    ``linalg.*.j2`` (on the dense LU) and ``sparse_lu.*.j2`` define the same functions, so only
+    the chosen one is rendered; ``dense_lu.*.j2``, which both use, always is.
     """
     folder = resources.template_root() / backend
     left_out = _LINALG_TEMPLATES["sparse" if linalg == "dense" else "dense"]

@@ -10,23 +10,12 @@
 /* A pivot at or below NQ * epsilon * max |Phi_q| means a numerically singular Jacobian. */
 #define ALL_DRIVERS_LU_TINY (ALL_DRIVERS_NQ * DBL_EPSILON)
 
-/* The tiny-pivot bound: NQ * epsilon * the largest entry (NaN when an entry is NaN). */
-static all_drivers_real all_drivers_lu_tiny(const all_drivers_real nz[])
-{
-    all_drivers_real amax = 0;
-    int e;
-    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) {
-        if (!(fabs(nz[e]) <= amax)) amax = fabs(nz[e]);
-    }
-    return ALL_DRIVERS_LU_TINY * amax;
-}
-
 
 void all_drivers_lu_init(all_drivers_lu *lu)
 {
     int e;
     for (e = 0; e < ALL_DRIVERS_LU_NLU; ++e) lu->v[e] = 0;
-    for (e = 0; e < ALL_DRIVERS_NQ; ++e) { lu->inv[e] = 0; lu->perm[e] = e; }
+    for (e = 0; e < ALL_DRIVERS_NQ; ++e) { lu->inv[e] = 0; lu->dense_lu.perm[e] = e; }
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
@@ -56,7 +45,7 @@ static all_drivers_real all_drivers_lu_load(const all_drivers_real nz[], all_dri
         finite += a - a;             /* stays 0 unless an entry is inf or NaN */
     }
     for (e = ALL_DRIVERS_NNZ; e < ALL_DRIVERS_LU_NLU; ++e) v[e] = 0;  /* fill-in */
-    /* NaN when an entry is not finite, so that every pivot test fails, as in _lu_tiny. */
+    /* NaN when an entry is not finite, so that every pivot test fails, as in all_drivers_dense_lu_tiny. */
     return ALL_DRIVERS_LU_TINY * amax + finite;
 }
 
@@ -190,44 +179,6 @@ int all_drivers_lu_factor_sparse(const all_drivers_real nz[], all_drivers_lu *lu
     return 0;
 }
 
-int all_drivers_lu_factor_dense(const all_drivers_real nz[], all_drivers_lu *lu)
-{
-    const int n = ALL_DRIVERS_NQ;
-    all_drivers_real *a = lu->lu;
-    const all_drivers_real tiny = all_drivers_lu_tiny(nz);
-    int i, j, k, e;
-    for (e = 0; e < n * n; ++e) a[e] = 0;
-    for (e = 0; e < ALL_DRIVERS_NNZ; ++e)
-        a[all_drivers_phi_q_row[e] * n + all_drivers_phi_q_col[e]] = nz[e];
-    for (i = 0; i < n; ++i) lu->perm[i] = i;
-    for (k = 0; k < n; ++k) {
-        int p = k;
-        all_drivers_real best = fabs(a[k * n + k]);
-        for (i = k + 1; i < n; ++i) {
-            if (fabs(a[i * n + k]) > best) { best = fabs(a[i * n + k]); p = i; }
-        }
-        if (!(best > tiny)) return k + 1;
-        if (p != k) {
-            int swap = lu->perm[k];
-            lu->perm[k] = lu->perm[p];
-            lu->perm[p] = swap;
-            for (j = 0; j < n; ++j) {
-                all_drivers_real tmp = a[k * n + j];
-                a[k * n + j] = a[p * n + j];
-                a[p * n + j] = tmp;
-            }
-        }
-        for (i = k + 1; i < n; ++i) {
-            all_drivers_real m = a[i * n + k] / a[k * n + k];
-            a[i * n + k] = m;
-            if (m != 0) {
-                for (j = k + 1; j < n; ++j) a[i * n + j] -= m * a[k * n + j];
-            }
-        }
-    }
-    return 0;
-}
-
 int all_drivers_lu_factor(const all_drivers_real nz[], all_drivers_lu *lu)
 {
     int status = all_drivers_lu_factor_sparse(nz, lu);
@@ -239,7 +190,7 @@ int all_drivers_lu_factor(const all_drivers_real nz[], all_drivers_lu *lu)
     /* The fixed pivot order is unsafe at this state: pivot instead, and count it. */
     lu->fallbacks += 1;
     lu->dense = 1;
-    return all_drivers_lu_factor_dense(nz, lu);
+    return all_drivers_dense_lu_factor(nz, &lu->dense_lu);
 }
 
 unsigned long all_drivers_lu_fallbacks(const all_drivers_lu *lu)
@@ -254,40 +205,15 @@ all_drivers_real all_drivers_lu_pivot_ratio(const all_drivers_lu *lu)
     all_drivers_real low, high;
     int k;
     if (lu->dense) {
-        low = high = fabs(lu->lu[0]);
-        for (k = 1; k < ALL_DRIVERS_NQ; ++k) {
-            const all_drivers_real u = fabs(lu->lu[k * ALL_DRIVERS_NQ + k]);
-            low = u < low ? u : low;
-            high = u > high ? u : high;
-        }
-    } else {
-        low = high = fabs(lu->inv[0]);
-        for (k = 1; k < ALL_DRIVERS_NQ; ++k) {  /* branch-free min and max */
-            const all_drivers_real w = fabs(lu->inv[k]);
-            low = w < low ? w : low;
-            high = w > high ? w : high;
-        }
+        return all_drivers_dense_lu_pivot_ratio(&lu->dense_lu);
+    }
+    low = high = fabs(lu->inv[0]);
+    for (k = 1; k < ALL_DRIVERS_NQ; ++k) {  /* branch-free min and max */
+        const all_drivers_real w = fabs(lu->inv[k]);
+        low = w < low ? w : low;
+        high = w > high ? w : high;
     }
     return high > 0 ? low / high : 0;
-}
-
-static void all_drivers_lu_solve_dense(const all_drivers_lu *lu, all_drivers_real b[])
-{
-    const int n = ALL_DRIVERS_NQ;
-    const all_drivers_real *a = lu->lu;
-    all_drivers_real x[ALL_DRIVERS_NQ];
-    int i, j;
-    for (i = 0; i < n; ++i) {
-        all_drivers_real sum = b[lu->perm[i]];
-        for (j = 0; j < i; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum;
-    }
-    for (i = n - 1; i >= 0; --i) {
-        all_drivers_real sum = x[i];
-        for (j = i + 1; j < n; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum / a[i * n + i];
-    }
-    for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
 /* L y = P b, columns 4..13 */
@@ -352,7 +278,7 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
 {
     all_drivers_real x[ALL_DRIVERS_NQ];
     if (lu->dense) {
-        all_drivers_lu_solve_dense(lu, b);
+        all_drivers_dense_lu_solve(&lu->dense_lu, b);
         return;
     }
     /* the row permutation, baked in: no index table to load */

@@ -10,7 +10,7 @@
 #ifndef ALL_DRIVERS_SPARSE_LU_H
 #define ALL_DRIVERS_SPARSE_LU_H
 
-#include "all_drivers.h"
+#include "all_drivers_dense_lu.h"
 
 #define ALL_DRIVERS_LU_NLU 46
 
@@ -18,8 +18,7 @@
 typedef struct {
     all_drivers_real v[ALL_DRIVERS_LU_NLU];       /* L and U on the filled pattern (sparse path) */
     all_drivers_real inv[ALL_DRIVERS_NQ];          /* reciprocals of the pivots (sparse path) */
-    all_drivers_real lu[ALL_DRIVERS_NQ * ALL_DRIVERS_NQ];  /* row-major dense LU (fall-back path) */
-    int perm[ALL_DRIVERS_NQ];                       /* row permutation of the fall-back path */
+    all_drivers_dense_lu dense_lu;                  /* the fall-back path (all_drivers_dense_lu.h) */
     int dense;                 /* 1 when the last factorization used the fall-back path */
     int failed_pivot;          /* k + 1 when pivot k failed the run-time test last time, else 0 */
     unsigned long fallbacks;   /* factorizations that fell back since all_drivers_lu_init */
@@ -30,9 +29,6 @@ void all_drivers_lu_init(all_drivers_lu *lu);
 
 /* Sparse path only: 0 on success, k + 1 when pivot k fails the relative test. */
 int all_drivers_lu_factor_sparse(const all_drivers_real nz[], all_drivers_lu *lu);
-
-/* Dense LU with partial pivoting: 0 on success, k + 1 when column k has no non-zero pivot. */
-int all_drivers_lu_factor_dense(const all_drivers_real nz[], all_drivers_lu *lu);
 
 /* Factor the non-zeros of Phi_q (pattern order): sparse path, else the counted fall-back.
  * 0 on success, k + 1 when the matrix is singular at pivot k of the fall-back. */

@@ -10,7 +10,7 @@
 #ifndef CRANK_SLIDER_SPARSE_LU_H
 #define CRANK_SLIDER_SPARSE_LU_H
 
-#include "crank_slider.h"
+#include "crank_slider_dense_lu.h"
 
 #define CRANK_SLIDER_LU_NLU 17
 
@@ -18,8 +18,7 @@
 typedef struct {
     crank_slider_real v[CRANK_SLIDER_LU_NLU];       /* L and U on the filled pattern (sparse path) */
     crank_slider_real inv[CRANK_SLIDER_NQ];          /* reciprocals of the pivots (sparse path) */
-    crank_slider_real lu[CRANK_SLIDER_NQ * CRANK_SLIDER_NQ];  /* row-major dense LU (fall-back path) */
-    int perm[CRANK_SLIDER_NQ];                       /* row permutation of the fall-back path */
+    crank_slider_dense_lu dense_lu;                  /* the fall-back path (crank_slider_dense_lu.h) */
     int dense;                 /* 1 when the last factorization used the fall-back path */
     int failed_pivot;          /* k + 1 when pivot k failed the run-time test last time, else 0 */
     unsigned long fallbacks;   /* factorizations that fell back since crank_slider_lu_init */
@@ -30,9 +29,6 @@ void crank_slider_lu_init(crank_slider_lu *lu);
 
 /* Sparse path only: 0 on success, k + 1 when pivot k fails the relative test. */
 int crank_slider_lu_factor_sparse(const crank_slider_real nz[], crank_slider_lu *lu);
-
-/* Dense LU with partial pivoting: 0 on success, k + 1 when column k has no non-zero pivot. */
-int crank_slider_lu_factor_dense(const crank_slider_real nz[], crank_slider_lu *lu);
 
 /* Factor the non-zeros of Phi_q (pattern order): sparse path, else the counted fall-back.
  * 0 on success, k + 1 when the matrix is singular at pivot k of the fall-back. */

@@ -10,23 +10,12 @@
 /* A pivot at or below NQ * epsilon * max |Phi_q| means a numerically singular Jacobian. */
 #define CRANK_SLIDER_GENERAL_LU_TINY (CRANK_SLIDER_GENERAL_NQ * DBL_EPSILON)
 
-/* The tiny-pivot bound: NQ * epsilon * the largest entry (NaN when an entry is NaN). */
-static crank_slider_general_real crank_slider_general_lu_tiny(const crank_slider_general_real nz[])
-{
-    crank_slider_general_real amax = 0;
-    int e;
-    for (e = 0; e < CRANK_SLIDER_GENERAL_NNZ; ++e) {
-        if (!(fabs(nz[e]) <= amax)) amax = fabs(nz[e]);
-    }
-    return CRANK_SLIDER_GENERAL_LU_TINY * amax;
-}
-
 
 void crank_slider_general_lu_init(crank_slider_general_lu *lu)
 {
     int e;
     for (e = 0; e < CRANK_SLIDER_GENERAL_LU_NLU; ++e) lu->v[e] = 0;
-    for (e = 0; e < CRANK_SLIDER_GENERAL_NQ; ++e) { lu->inv[e] = 0; lu->perm[e] = e; }
+    for (e = 0; e < CRANK_SLIDER_GENERAL_NQ; ++e) { lu->inv[e] = 0; lu->dense_lu.perm[e] = e; }
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
@@ -56,7 +45,7 @@ static crank_slider_general_real crank_slider_general_lu_load(const crank_slider
         finite += a - a;             /* stays 0 unless an entry is inf or NaN */
     }
     for (e = CRANK_SLIDER_GENERAL_NNZ; e < CRANK_SLIDER_GENERAL_LU_NLU; ++e) v[e] = 0;  /* fill-in */
-    /* NaN when an entry is not finite, so that every pivot test fails, as in _lu_tiny. */
+    /* NaN when an entry is not finite, so that every pivot test fails, as in crank_slider_general_dense_lu_tiny. */
     return CRANK_SLIDER_GENERAL_LU_TINY * amax + finite;
 }
 
@@ -142,44 +131,6 @@ int crank_slider_general_lu_factor_sparse(const crank_slider_general_real nz[], 
     return 0;
 }
 
-int crank_slider_general_lu_factor_dense(const crank_slider_general_real nz[], crank_slider_general_lu *lu)
-{
-    const int n = CRANK_SLIDER_GENERAL_NQ;
-    crank_slider_general_real *a = lu->lu;
-    const crank_slider_general_real tiny = crank_slider_general_lu_tiny(nz);
-    int i, j, k, e;
-    for (e = 0; e < n * n; ++e) a[e] = 0;
-    for (e = 0; e < CRANK_SLIDER_GENERAL_NNZ; ++e)
-        a[crank_slider_general_phi_q_row[e] * n + crank_slider_general_phi_q_col[e]] = nz[e];
-    for (i = 0; i < n; ++i) lu->perm[i] = i;
-    for (k = 0; k < n; ++k) {
-        int p = k;
-        crank_slider_general_real best = fabs(a[k * n + k]);
-        for (i = k + 1; i < n; ++i) {
-            if (fabs(a[i * n + k]) > best) { best = fabs(a[i * n + k]); p = i; }
-        }
-        if (!(best > tiny)) return k + 1;
-        if (p != k) {
-            int swap = lu->perm[k];
-            lu->perm[k] = lu->perm[p];
-            lu->perm[p] = swap;
-            for (j = 0; j < n; ++j) {
-                crank_slider_general_real tmp = a[k * n + j];
-                a[k * n + j] = a[p * n + j];
-                a[p * n + j] = tmp;
-            }
-        }
-        for (i = k + 1; i < n; ++i) {
-            crank_slider_general_real m = a[i * n + k] / a[k * n + k];
-            a[i * n + k] = m;
-            if (m != 0) {
-                for (j = k + 1; j < n; ++j) a[i * n + j] -= m * a[k * n + j];
-            }
-        }
-    }
-    return 0;
-}
-
 int crank_slider_general_lu_factor(const crank_slider_general_real nz[], crank_slider_general_lu *lu)
 {
     int status = crank_slider_general_lu_factor_sparse(nz, lu);
@@ -191,7 +142,7 @@ int crank_slider_general_lu_factor(const crank_slider_general_real nz[], crank_s
     /* The fixed pivot order is unsafe at this state: pivot instead, and count it. */
     lu->fallbacks += 1;
     lu->dense = 1;
-    return crank_slider_general_lu_factor_dense(nz, lu);
+    return crank_slider_general_dense_lu_factor(nz, &lu->dense_lu);
 }
 
 unsigned long crank_slider_general_lu_fallbacks(const crank_slider_general_lu *lu)
@@ -206,40 +157,15 @@ crank_slider_general_real crank_slider_general_lu_pivot_ratio(const crank_slider
     crank_slider_general_real low, high;
     int k;
     if (lu->dense) {
-        low = high = fabs(lu->lu[0]);
-        for (k = 1; k < CRANK_SLIDER_GENERAL_NQ; ++k) {
-            const crank_slider_general_real u = fabs(lu->lu[k * CRANK_SLIDER_GENERAL_NQ + k]);
-            low = u < low ? u : low;
-            high = u > high ? u : high;
-        }
-    } else {
-        low = high = fabs(lu->inv[0]);
-        for (k = 1; k < CRANK_SLIDER_GENERAL_NQ; ++k) {  /* branch-free min and max */
-            const crank_slider_general_real w = fabs(lu->inv[k]);
-            low = w < low ? w : low;
-            high = w > high ? w : high;
-        }
+        return crank_slider_general_dense_lu_pivot_ratio(&lu->dense_lu);
+    }
+    low = high = fabs(lu->inv[0]);
+    for (k = 1; k < CRANK_SLIDER_GENERAL_NQ; ++k) {  /* branch-free min and max */
+        const crank_slider_general_real w = fabs(lu->inv[k]);
+        low = w < low ? w : low;
+        high = w > high ? w : high;
     }
     return high > 0 ? low / high : 0;
-}
-
-static void crank_slider_general_lu_solve_dense(const crank_slider_general_lu *lu, crank_slider_general_real b[])
-{
-    const int n = CRANK_SLIDER_GENERAL_NQ;
-    const crank_slider_general_real *a = lu->lu;
-    crank_slider_general_real x[CRANK_SLIDER_GENERAL_NQ];
-    int i, j;
-    for (i = 0; i < n; ++i) {
-        crank_slider_general_real sum = b[lu->perm[i]];
-        for (j = 0; j < i; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum;
-    }
-    for (i = n - 1; i >= 0; --i) {
-        crank_slider_general_real sum = x[i];
-        for (j = i + 1; j < n; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum / a[i * n + i];
-    }
-    for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
 /* L y = P b, columns 0..7 */
@@ -284,7 +210,7 @@ void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slid
 {
     crank_slider_general_real x[CRANK_SLIDER_GENERAL_NQ];
     if (lu->dense) {
-        crank_slider_general_lu_solve_dense(lu, b);
+        crank_slider_general_dense_lu_solve(&lu->dense_lu, b);
         return;
     }
     /* the row permutation, baked in: no index table to load */

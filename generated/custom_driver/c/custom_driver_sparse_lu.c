@@ -10,23 +10,12 @@
 /* A pivot at or below NQ * epsilon * max |Phi_q| means a numerically singular Jacobian. */
 #define CUSTOM_DRIVER_LU_TINY (CUSTOM_DRIVER_NQ * DBL_EPSILON)
 
-/* The tiny-pivot bound: NQ * epsilon * the largest entry (NaN when an entry is NaN). */
-static custom_driver_real custom_driver_lu_tiny(const custom_driver_real nz[])
-{
-    custom_driver_real amax = 0;
-    int e;
-    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e) {
-        if (!(fabs(nz[e]) <= amax)) amax = fabs(nz[e]);
-    }
-    return CUSTOM_DRIVER_LU_TINY * amax;
-}
-
 
 void custom_driver_lu_init(custom_driver_lu *lu)
 {
     int e;
     for (e = 0; e < CUSTOM_DRIVER_LU_NLU; ++e) lu->v[e] = 0;
-    for (e = 0; e < CUSTOM_DRIVER_NQ; ++e) { lu->inv[e] = 0; lu->perm[e] = e; }
+    for (e = 0; e < CUSTOM_DRIVER_NQ; ++e) { lu->inv[e] = 0; lu->dense_lu.perm[e] = e; }
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
@@ -45,7 +34,7 @@ static custom_driver_real custom_driver_lu_load(const custom_driver_real nz[], c
         finite += a - a;             /* stays 0 unless an entry is inf or NaN */
     }
     for (e = CUSTOM_DRIVER_NNZ; e < CUSTOM_DRIVER_LU_NLU; ++e) v[e] = 0;  /* fill-in */
-    /* NaN when an entry is not finite, so that every pivot test fails, as in _lu_tiny. */
+    /* NaN when an entry is not finite, so that every pivot test fails, as in custom_driver_dense_lu_tiny. */
     return CUSTOM_DRIVER_LU_TINY * amax + finite;
 }
 
@@ -92,44 +81,6 @@ int custom_driver_lu_factor_sparse(const custom_driver_real nz[], custom_driver_
     return 0;
 }
 
-int custom_driver_lu_factor_dense(const custom_driver_real nz[], custom_driver_lu *lu)
-{
-    const int n = CUSTOM_DRIVER_NQ;
-    custom_driver_real *a = lu->lu;
-    const custom_driver_real tiny = custom_driver_lu_tiny(nz);
-    int i, j, k, e;
-    for (e = 0; e < n * n; ++e) a[e] = 0;
-    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e)
-        a[custom_driver_phi_q_row[e] * n + custom_driver_phi_q_col[e]] = nz[e];
-    for (i = 0; i < n; ++i) lu->perm[i] = i;
-    for (k = 0; k < n; ++k) {
-        int p = k;
-        custom_driver_real best = fabs(a[k * n + k]);
-        for (i = k + 1; i < n; ++i) {
-            if (fabs(a[i * n + k]) > best) { best = fabs(a[i * n + k]); p = i; }
-        }
-        if (!(best > tiny)) return k + 1;
-        if (p != k) {
-            int swap = lu->perm[k];
-            lu->perm[k] = lu->perm[p];
-            lu->perm[p] = swap;
-            for (j = 0; j < n; ++j) {
-                custom_driver_real tmp = a[k * n + j];
-                a[k * n + j] = a[p * n + j];
-                a[p * n + j] = tmp;
-            }
-        }
-        for (i = k + 1; i < n; ++i) {
-            custom_driver_real m = a[i * n + k] / a[k * n + k];
-            a[i * n + k] = m;
-            if (m != 0) {
-                for (j = k + 1; j < n; ++j) a[i * n + j] -= m * a[k * n + j];
-            }
-        }
-    }
-    return 0;
-}
-
 int custom_driver_lu_factor(const custom_driver_real nz[], custom_driver_lu *lu)
 {
     int status = custom_driver_lu_factor_sparse(nz, lu);
@@ -141,7 +92,7 @@ int custom_driver_lu_factor(const custom_driver_real nz[], custom_driver_lu *lu)
     /* The fixed pivot order is unsafe at this state: pivot instead, and count it. */
     lu->fallbacks += 1;
     lu->dense = 1;
-    return custom_driver_lu_factor_dense(nz, lu);
+    return custom_driver_dense_lu_factor(nz, &lu->dense_lu);
 }
 
 unsigned long custom_driver_lu_fallbacks(const custom_driver_lu *lu)
@@ -156,40 +107,15 @@ custom_driver_real custom_driver_lu_pivot_ratio(const custom_driver_lu *lu)
     custom_driver_real low, high;
     int k;
     if (lu->dense) {
-        low = high = fabs(lu->lu[0]);
-        for (k = 1; k < CUSTOM_DRIVER_NQ; ++k) {
-            const custom_driver_real u = fabs(lu->lu[k * CUSTOM_DRIVER_NQ + k]);
-            low = u < low ? u : low;
-            high = u > high ? u : high;
-        }
-    } else {
-        low = high = fabs(lu->inv[0]);
-        for (k = 1; k < CUSTOM_DRIVER_NQ; ++k) {  /* branch-free min and max */
-            const custom_driver_real w = fabs(lu->inv[k]);
-            low = w < low ? w : low;
-            high = w > high ? w : high;
-        }
+        return custom_driver_dense_lu_pivot_ratio(&lu->dense_lu);
+    }
+    low = high = fabs(lu->inv[0]);
+    for (k = 1; k < CUSTOM_DRIVER_NQ; ++k) {  /* branch-free min and max */
+        const custom_driver_real w = fabs(lu->inv[k]);
+        low = w < low ? w : low;
+        high = w > high ? w : high;
     }
     return high > 0 ? low / high : 0;
-}
-
-static void custom_driver_lu_solve_dense(const custom_driver_lu *lu, custom_driver_real b[])
-{
-    const int n = CUSTOM_DRIVER_NQ;
-    const custom_driver_real *a = lu->lu;
-    custom_driver_real x[CUSTOM_DRIVER_NQ];
-    int i, j;
-    for (i = 0; i < n; ++i) {
-        custom_driver_real sum = b[lu->perm[i]];
-        for (j = 0; j < i; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum;
-    }
-    for (i = n - 1; i >= 0; --i) {
-        custom_driver_real sum = x[i];
-        for (j = i + 1; j < n; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum / a[i * n + i];
-    }
-    for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
 /* U z = y, rows 8..0 */
@@ -222,7 +148,7 @@ void custom_driver_lu_solve(const custom_driver_lu *lu, custom_driver_real b[])
 {
     custom_driver_real x[CUSTOM_DRIVER_NQ];
     if (lu->dense) {
-        custom_driver_lu_solve_dense(lu, b);
+        custom_driver_dense_lu_solve(&lu->dense_lu, b);
         return;
     }
     /* the row permutation, baked in: no index table to load */

@@ -10,7 +10,7 @@
 #ifndef CUSTOM_DRIVER_SPARSE_LU_H
 #define CUSTOM_DRIVER_SPARSE_LU_H
 
-#include "custom_driver.h"
+#include "custom_driver_dense_lu.h"
 
 #define CUSTOM_DRIVER_LU_NLU 19
 
@@ -18,8 +18,7 @@
 typedef struct {
     custom_driver_real v[CUSTOM_DRIVER_LU_NLU];       /* L and U on the filled pattern (sparse path) */
     custom_driver_real inv[CUSTOM_DRIVER_NQ];          /* reciprocals of the pivots (sparse path) */
-    custom_driver_real lu[CUSTOM_DRIVER_NQ * CUSTOM_DRIVER_NQ];  /* row-major dense LU (fall-back path) */
-    int perm[CUSTOM_DRIVER_NQ];                       /* row permutation of the fall-back path */
+    custom_driver_dense_lu dense_lu;                  /* the fall-back path (custom_driver_dense_lu.h) */
     int dense;                 /* 1 when the last factorization used the fall-back path */
     int failed_pivot;          /* k + 1 when pivot k failed the run-time test last time, else 0 */
     unsigned long fallbacks;   /* factorizations that fell back since custom_driver_lu_init */
@@ -30,9 +29,6 @@ void custom_driver_lu_init(custom_driver_lu *lu);
 
 /* Sparse path only: 0 on success, k + 1 when pivot k fails the relative test. */
 int custom_driver_lu_factor_sparse(const custom_driver_real nz[], custom_driver_lu *lu);
-
-/* Dense LU with partial pivoting: 0 on success, k + 1 when column k has no non-zero pivot. */
-int custom_driver_lu_factor_dense(const custom_driver_real nz[], custom_driver_lu *lu);
 
 /* Factor the non-zeros of Phi_q (pattern order): sparse path, else the counted fall-back.
  * 0 on success, k + 1 when the matrix is singular at pivot k of the fall-back. */

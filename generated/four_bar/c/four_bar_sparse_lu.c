@@ -10,23 +10,12 @@
 /* A pivot at or below NQ * epsilon * max |Phi_q| means a numerically singular Jacobian. */
 #define FOUR_BAR_LU_TINY (FOUR_BAR_NQ * DBL_EPSILON)
 
-/* The tiny-pivot bound: NQ * epsilon * the largest entry (NaN when an entry is NaN). */
-static four_bar_real four_bar_lu_tiny(const four_bar_real nz[])
-{
-    four_bar_real amax = 0;
-    int e;
-    for (e = 0; e < FOUR_BAR_NNZ; ++e) {
-        if (!(fabs(nz[e]) <= amax)) amax = fabs(nz[e]);
-    }
-    return FOUR_BAR_LU_TINY * amax;
-}
-
 
 void four_bar_lu_init(four_bar_lu *lu)
 {
     int e;
     for (e = 0; e < FOUR_BAR_LU_NLU; ++e) lu->v[e] = 0;
-    for (e = 0; e < FOUR_BAR_NQ; ++e) { lu->inv[e] = 0; lu->perm[e] = e; }
+    for (e = 0; e < FOUR_BAR_NQ; ++e) { lu->inv[e] = 0; lu->dense_lu.perm[e] = e; }
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
@@ -56,7 +45,7 @@ static four_bar_real four_bar_lu_load(const four_bar_real nz[], four_bar_real v[
         finite += a - a;             /* stays 0 unless an entry is inf or NaN */
     }
     for (e = FOUR_BAR_NNZ; e < FOUR_BAR_LU_NLU; ++e) v[e] = 0;  /* fill-in */
-    /* NaN when an entry is not finite, so that every pivot test fails, as in _lu_tiny. */
+    /* NaN when an entry is not finite, so that every pivot test fails, as in four_bar_dense_lu_tiny. */
     return FOUR_BAR_LU_TINY * amax + finite;
 }
 
@@ -131,44 +120,6 @@ int four_bar_lu_factor_sparse(const four_bar_real nz[], four_bar_lu *lu)
     return 0;
 }
 
-int four_bar_lu_factor_dense(const four_bar_real nz[], four_bar_lu *lu)
-{
-    const int n = FOUR_BAR_NQ;
-    four_bar_real *a = lu->lu;
-    const four_bar_real tiny = four_bar_lu_tiny(nz);
-    int i, j, k, e;
-    for (e = 0; e < n * n; ++e) a[e] = 0;
-    for (e = 0; e < FOUR_BAR_NNZ; ++e)
-        a[four_bar_phi_q_row[e] * n + four_bar_phi_q_col[e]] = nz[e];
-    for (i = 0; i < n; ++i) lu->perm[i] = i;
-    for (k = 0; k < n; ++k) {
-        int p = k;
-        four_bar_real best = fabs(a[k * n + k]);
-        for (i = k + 1; i < n; ++i) {
-            if (fabs(a[i * n + k]) > best) { best = fabs(a[i * n + k]); p = i; }
-        }
-        if (!(best > tiny)) return k + 1;
-        if (p != k) {
-            int swap = lu->perm[k];
-            lu->perm[k] = lu->perm[p];
-            lu->perm[p] = swap;
-            for (j = 0; j < n; ++j) {
-                four_bar_real tmp = a[k * n + j];
-                a[k * n + j] = a[p * n + j];
-                a[p * n + j] = tmp;
-            }
-        }
-        for (i = k + 1; i < n; ++i) {
-            four_bar_real m = a[i * n + k] / a[k * n + k];
-            a[i * n + k] = m;
-            if (m != 0) {
-                for (j = k + 1; j < n; ++j) a[i * n + j] -= m * a[k * n + j];
-            }
-        }
-    }
-    return 0;
-}
-
 int four_bar_lu_factor(const four_bar_real nz[], four_bar_lu *lu)
 {
     int status = four_bar_lu_factor_sparse(nz, lu);
@@ -180,7 +131,7 @@ int four_bar_lu_factor(const four_bar_real nz[], four_bar_lu *lu)
     /* The fixed pivot order is unsafe at this state: pivot instead, and count it. */
     lu->fallbacks += 1;
     lu->dense = 1;
-    return four_bar_lu_factor_dense(nz, lu);
+    return four_bar_dense_lu_factor(nz, &lu->dense_lu);
 }
 
 unsigned long four_bar_lu_fallbacks(const four_bar_lu *lu)
@@ -195,40 +146,15 @@ four_bar_real four_bar_lu_pivot_ratio(const four_bar_lu *lu)
     four_bar_real low, high;
     int k;
     if (lu->dense) {
-        low = high = fabs(lu->lu[0]);
-        for (k = 1; k < FOUR_BAR_NQ; ++k) {
-            const four_bar_real u = fabs(lu->lu[k * FOUR_BAR_NQ + k]);
-            low = u < low ? u : low;
-            high = u > high ? u : high;
-        }
-    } else {
-        low = high = fabs(lu->inv[0]);
-        for (k = 1; k < FOUR_BAR_NQ; ++k) {  /* branch-free min and max */
-            const four_bar_real w = fabs(lu->inv[k]);
-            low = w < low ? w : low;
-            high = w > high ? w : high;
-        }
+        return four_bar_dense_lu_pivot_ratio(&lu->dense_lu);
+    }
+    low = high = fabs(lu->inv[0]);
+    for (k = 1; k < FOUR_BAR_NQ; ++k) {  /* branch-free min and max */
+        const four_bar_real w = fabs(lu->inv[k]);
+        low = w < low ? w : low;
+        high = w > high ? w : high;
     }
     return high > 0 ? low / high : 0;
-}
-
-static void four_bar_lu_solve_dense(const four_bar_lu *lu, four_bar_real b[])
-{
-    const int n = FOUR_BAR_NQ;
-    const four_bar_real *a = lu->lu;
-    four_bar_real x[FOUR_BAR_NQ];
-    int i, j;
-    for (i = 0; i < n; ++i) {
-        four_bar_real sum = b[lu->perm[i]];
-        for (j = 0; j < i; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum;
-    }
-    for (i = n - 1; i >= 0; --i) {
-        four_bar_real sum = x[i];
-        for (j = i + 1; j < n; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum / a[i * n + i];
-    }
-    for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
 /* L y = P b, columns 0..7 */
@@ -266,7 +192,7 @@ void four_bar_lu_solve(const four_bar_lu *lu, four_bar_real b[])
 {
     four_bar_real x[FOUR_BAR_NQ];
     if (lu->dense) {
-        four_bar_lu_solve_dense(lu, b);
+        four_bar_dense_lu_solve(&lu->dense_lu, b);
         return;
     }
     /* the row permutation, baked in: no index table to load */

@@ -10,7 +10,7 @@
 #ifndef FOUR_BAR_SPARSE_LU_H
 #define FOUR_BAR_SPARSE_LU_H
 
-#include "four_bar.h"
+#include "four_bar_dense_lu.h"
 
 #define FOUR_BAR_LU_NLU 19
 
@@ -18,8 +18,7 @@
 typedef struct {
     four_bar_real v[FOUR_BAR_LU_NLU];       /* L and U on the filled pattern (sparse path) */
     four_bar_real inv[FOUR_BAR_NQ];          /* reciprocals of the pivots (sparse path) */
-    four_bar_real lu[FOUR_BAR_NQ * FOUR_BAR_NQ];  /* row-major dense LU (fall-back path) */
-    int perm[FOUR_BAR_NQ];                       /* row permutation of the fall-back path */
+    four_bar_dense_lu dense_lu;                  /* the fall-back path (four_bar_dense_lu.h) */
     int dense;                 /* 1 when the last factorization used the fall-back path */
     int failed_pivot;          /* k + 1 when pivot k failed the run-time test last time, else 0 */
     unsigned long fallbacks;   /* factorizations that fell back since four_bar_lu_init */
@@ -30,9 +29,6 @@ void four_bar_lu_init(four_bar_lu *lu);
 
 /* Sparse path only: 0 on success, k + 1 when pivot k fails the relative test. */
 int four_bar_lu_factor_sparse(const four_bar_real nz[], four_bar_lu *lu);
-
-/* Dense LU with partial pivoting: 0 on success, k + 1 when column k has no non-zero pivot. */
-int four_bar_lu_factor_dense(const four_bar_real nz[], four_bar_lu *lu);
 
 /* Factor the non-zeros of Phi_q (pattern order): sparse path, else the counted fall-back.
  * 0 on success, k + 1 when the matrix is singular at pivot k of the fall-back. */

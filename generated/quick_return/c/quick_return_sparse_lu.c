@@ -10,23 +10,12 @@
 /* A pivot at or below NQ * epsilon * max |Phi_q| means a numerically singular Jacobian. */
 #define QUICK_RETURN_LU_TINY (QUICK_RETURN_NQ * DBL_EPSILON)
 
-/* The tiny-pivot bound: NQ * epsilon * the largest entry (NaN when an entry is NaN). */
-static quick_return_real quick_return_lu_tiny(const quick_return_real nz[])
-{
-    quick_return_real amax = 0;
-    int e;
-    for (e = 0; e < QUICK_RETURN_NNZ; ++e) {
-        if (!(fabs(nz[e]) <= amax)) amax = fabs(nz[e]);
-    }
-    return QUICK_RETURN_LU_TINY * amax;
-}
-
 
 void quick_return_lu_init(quick_return_lu *lu)
 {
     int e;
     for (e = 0; e < QUICK_RETURN_LU_NLU; ++e) lu->v[e] = 0;
-    for (e = 0; e < QUICK_RETURN_NQ; ++e) { lu->inv[e] = 0; lu->perm[e] = e; }
+    for (e = 0; e < QUICK_RETURN_NQ; ++e) { lu->inv[e] = 0; lu->dense_lu.perm[e] = e; }
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
@@ -45,7 +34,7 @@ static quick_return_real quick_return_lu_load(const quick_return_real nz[], quic
         finite += a - a;             /* stays 0 unless an entry is inf or NaN */
     }
     for (e = QUICK_RETURN_NNZ; e < QUICK_RETURN_LU_NLU; ++e) v[e] = 0;  /* fill-in */
-    /* NaN when an entry is not finite, so that every pivot test fails, as in _lu_tiny. */
+    /* NaN when an entry is not finite, so that every pivot test fails, as in quick_return_dense_lu_tiny. */
     return QUICK_RETURN_LU_TINY * amax + finite;
 }
 
@@ -101,44 +90,6 @@ int quick_return_lu_factor_sparse(const quick_return_real nz[], quick_return_lu 
     return 0;
 }
 
-int quick_return_lu_factor_dense(const quick_return_real nz[], quick_return_lu *lu)
-{
-    const int n = QUICK_RETURN_NQ;
-    quick_return_real *a = lu->lu;
-    const quick_return_real tiny = quick_return_lu_tiny(nz);
-    int i, j, k, e;
-    for (e = 0; e < n * n; ++e) a[e] = 0;
-    for (e = 0; e < QUICK_RETURN_NNZ; ++e)
-        a[quick_return_phi_q_row[e] * n + quick_return_phi_q_col[e]] = nz[e];
-    for (i = 0; i < n; ++i) lu->perm[i] = i;
-    for (k = 0; k < n; ++k) {
-        int p = k;
-        quick_return_real best = fabs(a[k * n + k]);
-        for (i = k + 1; i < n; ++i) {
-            if (fabs(a[i * n + k]) > best) { best = fabs(a[i * n + k]); p = i; }
-        }
-        if (!(best > tiny)) return k + 1;
-        if (p != k) {
-            int swap = lu->perm[k];
-            lu->perm[k] = lu->perm[p];
-            lu->perm[p] = swap;
-            for (j = 0; j < n; ++j) {
-                quick_return_real tmp = a[k * n + j];
-                a[k * n + j] = a[p * n + j];
-                a[p * n + j] = tmp;
-            }
-        }
-        for (i = k + 1; i < n; ++i) {
-            quick_return_real m = a[i * n + k] / a[k * n + k];
-            a[i * n + k] = m;
-            if (m != 0) {
-                for (j = k + 1; j < n; ++j) a[i * n + j] -= m * a[k * n + j];
-            }
-        }
-    }
-    return 0;
-}
-
 int quick_return_lu_factor(const quick_return_real nz[], quick_return_lu *lu)
 {
     int status = quick_return_lu_factor_sparse(nz, lu);
@@ -150,7 +101,7 @@ int quick_return_lu_factor(const quick_return_real nz[], quick_return_lu *lu)
     /* The fixed pivot order is unsafe at this state: pivot instead, and count it. */
     lu->fallbacks += 1;
     lu->dense = 1;
-    return quick_return_lu_factor_dense(nz, lu);
+    return quick_return_dense_lu_factor(nz, &lu->dense_lu);
 }
 
 unsigned long quick_return_lu_fallbacks(const quick_return_lu *lu)
@@ -165,40 +116,15 @@ quick_return_real quick_return_lu_pivot_ratio(const quick_return_lu *lu)
     quick_return_real low, high;
     int k;
     if (lu->dense) {
-        low = high = fabs(lu->lu[0]);
-        for (k = 1; k < QUICK_RETURN_NQ; ++k) {
-            const quick_return_real u = fabs(lu->lu[k * QUICK_RETURN_NQ + k]);
-            low = u < low ? u : low;
-            high = u > high ? u : high;
-        }
-    } else {
-        low = high = fabs(lu->inv[0]);
-        for (k = 1; k < QUICK_RETURN_NQ; ++k) {  /* branch-free min and max */
-            const quick_return_real w = fabs(lu->inv[k]);
-            low = w < low ? w : low;
-            high = w > high ? w : high;
-        }
+        return quick_return_dense_lu_pivot_ratio(&lu->dense_lu);
+    }
+    low = high = fabs(lu->inv[0]);
+    for (k = 1; k < QUICK_RETURN_NQ; ++k) {  /* branch-free min and max */
+        const quick_return_real w = fabs(lu->inv[k]);
+        low = w < low ? w : low;
+        high = w > high ? w : high;
     }
     return high > 0 ? low / high : 0;
-}
-
-static void quick_return_lu_solve_dense(const quick_return_lu *lu, quick_return_real b[])
-{
-    const int n = QUICK_RETURN_NQ;
-    const quick_return_real *a = lu->lu;
-    quick_return_real x[QUICK_RETURN_NQ];
-    int i, j;
-    for (i = 0; i < n; ++i) {
-        quick_return_real sum = b[lu->perm[i]];
-        for (j = 0; j < i; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum;
-    }
-    for (i = n - 1; i >= 0; --i) {
-        quick_return_real sum = x[i];
-        for (j = i + 1; j < n; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum / a[i * n + i];
-    }
-    for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
 /* U z = y, rows 11..0 */
@@ -237,7 +163,7 @@ void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[])
 {
     quick_return_real x[QUICK_RETURN_NQ];
     if (lu->dense) {
-        quick_return_lu_solve_dense(lu, b);
+        quick_return_dense_lu_solve(&lu->dense_lu, b);
         return;
     }
     /* the row permutation, baked in: no index table to load */

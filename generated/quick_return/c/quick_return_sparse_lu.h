@@ -10,7 +10,7 @@
 #ifndef QUICK_RETURN_SPARSE_LU_H
 #define QUICK_RETURN_SPARSE_LU_H
 
-#include "quick_return.h"
+#include "quick_return_dense_lu.h"
 
 #define QUICK_RETURN_LU_NLU 25
 
@@ -18,8 +18,7 @@
 typedef struct {
     quick_return_real v[QUICK_RETURN_LU_NLU];       /* L and U on the filled pattern (sparse path) */
     quick_return_real inv[QUICK_RETURN_NQ];          /* reciprocals of the pivots (sparse path) */
-    quick_return_real lu[QUICK_RETURN_NQ * QUICK_RETURN_NQ];  /* row-major dense LU (fall-back path) */
-    int perm[QUICK_RETURN_NQ];                       /* row permutation of the fall-back path */
+    quick_return_dense_lu dense_lu;                  /* the fall-back path (quick_return_dense_lu.h) */
     int dense;                 /* 1 when the last factorization used the fall-back path */
     int failed_pivot;          /* k + 1 when pivot k failed the run-time test last time, else 0 */
     unsigned long fallbacks;   /* factorizations that fell back since quick_return_lu_init */
@@ -30,9 +29,6 @@ void quick_return_lu_init(quick_return_lu *lu);
 
 /* Sparse path only: 0 on success, k + 1 when pivot k fails the relative test. */
 int quick_return_lu_factor_sparse(const quick_return_real nz[], quick_return_lu *lu);
-
-/* Dense LU with partial pivoting: 0 on success, k + 1 when column k has no non-zero pivot. */
-int quick_return_lu_factor_dense(const quick_return_real nz[], quick_return_lu *lu);
 
 /* Factor the non-zeros of Phi_q (pattern order): sparse path, else the counted fall-back.
  * 0 on success, k + 1 when the matrix is singular at pivot k of the fall-back. */
