@@ -88,14 +88,15 @@ def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
            ) -> dict[str, str]:
     """Render the sparse LU templates and the dense LU they fall back to, with a context
     shaped like the codegen stream's."""
-    env = jinja2.Environment(loader=jinja2.FileSystemLoader(template_root() / "c"),
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(template_root()),
                              undefined=jinja2.StrictUndefined, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True)
     context = {"prefix": prefix, "PREFIX": prefix.upper(), "nq": nq, "nnz": len(rows),
                "n_params": 0, "real": real, "pattern_rows": list(rows),
                "pattern_cols": list(cols), "spec_sha256": "0" * 64,
                "lu": sparse_lu.template_context(plan, style=style)}
-    return {f"{prefix}_{name[:-3]}": env.get_template(name).render(template=name, **context)
+    return {f"{prefix}_{name[:-3]}": env.get_template(f"c/{name}").render(
+                template=name, header=[f"{prefix}_{name[:-3]}: sparse LU test harness"], **context)
             for name in ("sparse_lu.h.j2", "sparse_lu.c.j2", "dense_lu.h.j2", "dense_lu.c.j2")}
 
 

@@ -54,5 +54,13 @@ def literal(real: str) -> Any:
     return text
 
 
+PURPOSES = {
+    "kernel": "kinematic kernel of the mechanism {name}: Phi, Phi_q, Phi_t, Gamma, points",
+    "solver": "position, velocity and acceleration analysis of {name} (Example 2.6)",
+    "linalg": "the solver's linear algebra on the dense LU",
+    "sparse_lu": "sparse LU of Phi_q with its pivot order fixed at generation time",
+    "dense_lu": "dense LU with partial pivoting (also the sparse LU's fall-back)",
+}
+
 BACKEND = Backend(name="c", template_folder="c", printer=CPrinter, literal=literal,
-                  module_template="kernel")
+                  module_template="kernel", purposes=PURPOSES)

@@ -6,7 +6,7 @@ a folder ``templates/<template_folder>/`` and an entry in :data:`symkin.codegen.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,6 +22,8 @@ class Backend:
         literal: ``literal(real)`` -> a function printing a float as a literal of the language.
         module_template: the stem of the template rendered to ``<prefix>.<suffix>``; every
             other ``X.Y.j2`` renders to ``<prefix>_X.Y``.
+        purposes: per template stem, what its file is (``{name}`` is the mechanism), for the
+            header of the generated file.
     """
 
     name: str
@@ -29,6 +31,11 @@ class Backend:
     printer: Callable[[str], Any]
     literal: Callable[[str], Callable[[float], str]]
     module_template: str
+    purposes: Mapping[str, str]
+
+    def purpose(self, template: str) -> str:
+        """What the file rendered from ``template`` is, for its header."""
+        return self.purposes[template.split(".")[0]]
 
     def output_name(self, template: str, prefix: str) -> str:
         """``kernel.h.j2 -> crank_slider.h``; ``solver.c.j2 -> crank_slider_solver.c``."""

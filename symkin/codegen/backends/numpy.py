@@ -40,4 +40,5 @@ def _literal(real: str) -> Any:
 
 
 BACKEND = Backend(name="numpy", template_folder="numpy", printer=_printer, literal=_literal,
-                  module_template="kernel")
+                  module_template="kernel",
+                  purposes={"kernel": "kinematic kernel of the mechanism {name}"})
