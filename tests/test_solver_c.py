@@ -166,15 +166,16 @@ def test_solver_initialises_its_own_workspace(linalg, crank_slider_system) -> No
 
 
 def test_fallbacks_are_counted_and_reach_the_trajectory() -> None:
-    """The four-bar's plan pivots on c sin(rocker.phi) with -c cos(rocker.phi) below it. A first
-    guess with rocker.phi near 0 makes that pivot fail the run-time ratio test: the first
+    """The four-bar's plan (chosen from structure) pivots on b sin(coupler.phi) with
+    b cos(coupler.phi) below it. A first guess with coupler.phi near 0 makes that pivot fail
+    the run-time ratio test: the first
     factorization falls back to dense LU, Newton still converges to the assembly that LAPACK's
     Newton reaches from the same guess, and the count reaches report and Trajectory."""
     system = symkin.derive(EXAMPLES / "four_bar.yaml")
     kernel = symkin.compile(system, backend="c", linalg="sparse")
     assembled = driver.solve(kernel, t=[0.0]).q[0]
     guess = assembled.copy()
-    guess[8] = 1e-3  # rocker.phi: sin ~ 1e-3, cos ~ 1
+    guess[5] = 1e-3  # coupler.phi: sin ~ 1e-3, cos ~ 1
     p = np.array(kernel.p_values)
     reference = newton.newton(kernel_for(system, "numpy"), guess, 0.0, p, newton.Options())
     assert reference.status == newton.OK

@@ -6,6 +6,7 @@ pivoting, on the permuted matrix) for which pivot must fail the run-time ratio t
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import math
 import shutil
@@ -299,3 +300,27 @@ def test_singular_sample_still_gives_a_guarded_order(crank: Case) -> None:
     b = np.arange(1.0, crank.n + 1)
     np.testing.assert_allclose(sparse_lu.solve_with_plan(plan, nz, b),
                                np.linalg.solve(crank.dense(nz), b), rtol=1e-12)
+
+
+def test_pivot_order_does_not_follow_the_last_bits_of_the_sample() -> None:
+    """Two entries of one column that both pass the threshold test: which is larger by one
+    rounding error must not decide the order (it did when magnitudes broke ties)."""
+    rows, cols = [0, 0, 1, 1], [0, 1, 0, 1]
+    tie = 1.0 + 2.0**-52
+    first = sparse_lu.analyse(2, rows, cols, [1.0, 2.0, tie, 3.0])
+    second = sparse_lu.analyse(2, rows, cols, [tie, 2.0, 1.0, 3.0])
+    assert first.row_perm == second.row_perm and first.col_perm == second.col_perm
+    assert first.steps == tuple(dataclasses.replace(s, sample_ratio=f.sample_ratio)
+                                for s, f in zip(second.steps, first.steps))
+
+
+def test_numeric_check_only_rejects_the_structural_order() -> None:
+    """The structural order pivots on (0, 0) first; a zero there in the sample rejects it and
+    the threshold-restricted alternative pivots on (0, 1), the first entry by position that
+    passes (|1| >= 0.1 * 3), with every pivot checked."""
+    rows, cols = [0, 0, 1, 1], [0, 1, 0, 1]
+    accepted = sparse_lu.analyse(2, rows, cols, [1.0, 1.0, 1.0, 3.0])
+    rejected = sparse_lu.analyse(2, rows, cols, [0.0, 1.0, 1.0, 3.0])
+    assert (accepted.row_perm, accepted.col_perm, accepted.unchecked) == ((0, 1), (0, 1), ())
+    assert (rejected.row_perm, rejected.col_perm, rejected.unchecked) == ((0, 1), (1, 0), ())
+    assert rejected.steps[0].sample_ratio == pytest.approx(1 / 3)

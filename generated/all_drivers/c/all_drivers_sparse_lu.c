@@ -82,64 +82,64 @@ static int all_drivers_lu_factor_0(all_drivers_real *v, all_drivers_real *inv,
     if (!all_drivers_lu_pivot_ok(v[1], cmax, tiny)) return 6;
     inv[5] = 1 / v[1];
     v[5] *= inv[5];
-    /* pivot 6: row 3, column 2 */
-    cmax = fabs(v[6]);
-    cmax = all_drivers_lu_amax(cmax, v[3]);
-    if (!all_drivers_lu_pivot_ok(v[6], cmax, tiny)) return 7;
-    inv[6] = 1 / v[6];
-    v[3] *= inv[6];
-    v[41] -= v[3] * v[7];
-    /* pivot 7: row 2, column 3 */
-    cmax = fabs(v[4]);
+    /* pivot 6: row 2, column 2 */
+    cmax = fabs(v[3]);
+    cmax = all_drivers_lu_amax(cmax, v[6]);
+    if (!all_drivers_lu_pivot_ok(v[3], cmax, tiny)) return 7;
+    inv[6] = 1 / v[3];
+    v[6] *= inv[6];
+    v[41] -= v[6] * v[4];
+    /* pivot 7: row 3, column 3 */
+    cmax = fabs(v[41]);
     cmax = all_drivers_lu_amax(cmax, v[15]);
     cmax = all_drivers_lu_amax(cmax, v[10]);
     cmax = all_drivers_lu_amax(cmax, v[19]);
-    if (!all_drivers_lu_pivot_ok(v[4], cmax, tiny)) return 8;
-    inv[7] = 1 / v[4];
+    if (!all_drivers_lu_pivot_ok(v[41], cmax, tiny)) return 8;
+    inv[7] = 1 / v[41];
     v[15] *= inv[7];
     v[10] *= inv[7];
     v[19] *= inv[7];
-    v[11] -= v[10] * v[41];
-    v[42] -= v[15] * v[41];
-    v[20] -= v[19] * v[41];
-    /* pivot 8: row 4, column 8 */
-    cmax = fabs(v[9]);
+    v[11] -= v[10] * v[7];
+    v[42] -= v[15] * v[7];
+    v[20] -= v[19] * v[7];
+    /* pivot 8: row 4, column 5 */
+    cmax = fabs(v[8]);
+    cmax = all_drivers_lu_amax(cmax, v[16]);
+    cmax = all_drivers_lu_amax(cmax, v[18]);
+    cmax = all_drivers_lu_amax(cmax, v[12]);
+    if (!all_drivers_lu_pivot_ok(v[8], cmax, tiny)) return 9;
+    inv[8] = 1 / v[8];
+    v[16] *= inv[8];
+    v[18] *= inv[8];
+    v[12] *= inv[8];
+    v[43] -= v[12] * v[9];
+    v[44] -= v[16] * v[9];
+    v[45] -= v[18] * v[9];
+    /* pivot 9: row 6, column 4 */
+    cmax = fabs(v[42]);
+    cmax = all_drivers_lu_amax(cmax, v[17]);
+    cmax = all_drivers_lu_amax(cmax, v[11]);
+    cmax = all_drivers_lu_amax(cmax, v[20]);
+    if (!all_drivers_lu_pivot_ok(v[42], cmax, tiny)) return 10;
+    inv[9] = 1 / v[42];
+    v[17] *= inv[9];
+    v[11] *= inv[9];
+    v[20] *= inv[9];
+    v[43] -= v[11] * v[44];
+    v[45] -= v[17] * v[44];
+    v[23] -= v[20] * v[44];
+    /* pivot 10: row 7, column 8 */
+    cmax = fabs(v[45]);
+    cmax = all_drivers_lu_amax(cmax, v[43]);
     cmax = all_drivers_lu_amax(cmax, v[23]);
     cmax = all_drivers_lu_amax(cmax, v[26]);
     cmax = all_drivers_lu_amax(cmax, v[31]);
-    if (!all_drivers_lu_pivot_ok(v[9], cmax, tiny)) return 9;
-    inv[8] = 1 / v[9];
-    v[23] *= inv[8];
-    v[26] *= inv[8];
-    v[31] *= inv[8];
-    v[43] -= v[23] * v[8];
-    v[44] -= v[26] * v[8];
-    v[45] -= v[31] * v[8];
-    /* pivot 9: row 7, column 4 */
-    cmax = fabs(v[17]);
-    cmax = all_drivers_lu_amax(cmax, v[42]);
-    cmax = all_drivers_lu_amax(cmax, v[11]);
-    cmax = all_drivers_lu_amax(cmax, v[20]);
-    if (!all_drivers_lu_pivot_ok(v[17], cmax, tiny)) return 10;
-    inv[9] = 1 / v[17];
-    v[42] *= inv[9];
-    v[11] *= inv[9];
-    v[20] *= inv[9];
-    v[12] -= v[11] * v[18];
-    v[16] -= v[42] * v[18];
-    v[43] -= v[20] * v[18];
-    /* pivot 10: row 6, column 5 */
-    cmax = fabs(v[16]);
-    cmax = all_drivers_lu_amax(cmax, v[12]);
-    cmax = all_drivers_lu_amax(cmax, v[43]);
-    cmax = all_drivers_lu_amax(cmax, v[44]);
-    cmax = all_drivers_lu_amax(cmax, v[45]);
-    if (!all_drivers_lu_pivot_ok(v[16], cmax, tiny)) return 11;
-    inv[10] = 1 / v[16];
-    v[12] *= inv[10];
+    if (!all_drivers_lu_pivot_ok(v[45], cmax, tiny)) return 11;
+    inv[10] = 1 / v[45];
     v[43] *= inv[10];
-    v[44] *= inv[10];
-    v[45] *= inv[10];
+    v[23] *= inv[10];
+    v[26] *= inv[10];
+    v[31] *= inv[10];
     /* pivot 11: row 5, column 6 */
     cmax = fabs(v[13]);
     cmax = all_drivers_lu_amax(cmax, v[21]);
@@ -161,16 +161,16 @@ static int all_drivers_lu_factor_0(all_drivers_real *v, all_drivers_real *inv,
     inv[12] = 1 / v[22];
     v[25] *= inv[12];
     v[30] *= inv[12];
-    /* pivot 13: row 9, column 10 */
-    cmax = fabs(v[28]);
-    cmax = all_drivers_lu_amax(cmax, v[33]);
-    if (!all_drivers_lu_pivot_ok(v[28], cmax, tiny)) return 14;
-    inv[13] = 1 / v[28];
-    v[33] *= inv[13];
-    v[32] -= v[33] * v[27];
-    /* pivot 14: row 10, column 9 */
-    if (!(fabs(v[32]) > tiny)) return 15;
-    inv[14] = 1 / v[32];
+    /* pivot 13: row 9, column 9 */
+    cmax = fabs(v[27]);
+    cmax = all_drivers_lu_amax(cmax, v[32]);
+    if (!all_drivers_lu_pivot_ok(v[27], cmax, tiny)) return 14;
+    inv[13] = 1 / v[27];
+    v[32] *= inv[13];
+    v[33] -= v[32] * v[28];
+    /* pivot 14: row 10, column 10 */
+    if (!(fabs(v[33]) > tiny)) return 15;
+    inv[14] = 1 / v[33];
     return 0;
 }
 
@@ -223,28 +223,28 @@ all_drivers_real all_drivers_lu_pivot_ratio(const all_drivers_lu *lu)
 /* L y = P b, columns 4..13 */
 static void all_drivers_lu_forward_0(const all_drivers_real *v, all_drivers_real *x)
 {
-    x[7] -= v[2] * x[4];
-    x[6] -= v[5] * x[5];
-    x[7] -= v[3] * x[6];
-    x[10] -= v[15] * x[7];
+    x[6] -= v[2] * x[4];
+    x[7] -= v[5] * x[5];
+    x[7] -= v[6] * x[6];
+    x[9] -= v[15] * x[7];
     x[11] -= v[10] * x[7];
     x[12] -= v[19] * x[7];
-    x[12] -= v[23] * x[8];
-    x[13] -= v[26] * x[8];
-    x[14] -= v[31] * x[8];
-    x[10] -= v[42] * x[9];
+    x[9] -= v[16] * x[8];
+    x[10] -= v[18] * x[8];
+    x[11] -= v[12] * x[8];
+    x[10] -= v[17] * x[9];
     x[11] -= v[11] * x[9];
     x[12] -= v[20] * x[9];
-    x[11] -= v[12] * x[10];
-    x[12] -= v[43] * x[10];
-    x[13] -= v[44] * x[10];
-    x[14] -= v[45] * x[10];
+    x[11] -= v[43] * x[10];
+    x[12] -= v[23] * x[10];
+    x[13] -= v[26] * x[10];
+    x[14] -= v[31] * x[10];
     x[12] -= v[21] * x[11];
     x[13] -= v[24] * x[11];
     x[14] -= v[29] * x[11];
     x[13] -= v[25] * x[12];
     x[14] -= v[30] * x[12];
-    x[14] -= v[33] * x[13];
+    x[14] -= v[32] * x[13];
 }
 
 /* U z = y, rows 14..0 */
@@ -253,28 +253,28 @@ static void all_drivers_lu_backward_0(const all_drivers_real *v,
 {
     (void)v;
     x[14] *= inv[14];
-    x[13] -= v[27] * x[14];
+    x[13] -= v[28] * x[14];
     x[13] *= inv[13];
     x[12] *= inv[12];
     x[11] -= v[14] * x[12];
     x[11] *= inv[11];
     x[10] *= inv[10];
-    x[9] -= v[18] * x[10];
+    x[9] -= v[44] * x[10];
     x[9] *= inv[9];
-    x[8] -= v[8] * x[10];
+    x[8] -= v[9] * x[10];
     x[8] *= inv[8];
-    x[7] -= v[41] * x[9];
+    x[7] -= v[7] * x[9];
     x[7] *= inv[7];
-    x[6] -= v[7] * x[9];
+    x[6] -= v[4] * x[7];
     x[6] *= inv[6];
     x[5] *= inv[5];
     x[4] *= inv[4];
     x[3] *= inv[3];
-    x[2] -= v[38] * x[13];
+    x[2] -= v[38] * x[14];
     x[2] *= inv[2];
-    x[1] -= v[36] * x[14];
+    x[1] -= v[36] * x[13];
     x[1] *= inv[1];
-    x[0] -= v[34] * x[8];
+    x[0] -= v[34] * x[10];
     x[0] *= inv[0];
 }
 
@@ -292,11 +292,11 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
     x[3] = b[14];
     x[4] = b[0];
     x[5] = b[1];
-    x[6] = b[3];
-    x[7] = b[2];
+    x[6] = b[2];
+    x[7] = b[3];
     x[8] = b[4];
-    x[9] = b[7];
-    x[10] = b[6];
+    x[9] = b[6];
+    x[10] = b[7];
     x[11] = b[5];
     x[12] = b[8];
     x[13] = b[9];
@@ -311,11 +311,11 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
     b[1] = x[5];
     b[2] = x[6];
     b[3] = x[7];
-    b[8] = x[8];
+    b[5] = x[8];
     b[4] = x[9];
-    b[5] = x[10];
+    b[8] = x[10];
     b[6] = x[11];
     b[7] = x[12];
-    b[10] = x[13];
-    b[9] = x[14];
+    b[9] = x[13];
+    b[10] = x[14];
 }

@@ -106,20 +106,20 @@ static int crank_slider_general_lu_factor_0(crank_slider_general_real *v, crank_
     inv[5] = 1 / v[10];
     v[16] *= inv[5];
     v[17] -= v[16] * v[11];
-    /* pivot 6: row 4, column 6 */
-    cmax = fabs(v[14]);
+    /* pivot 6: row 4, column 5 */
+    cmax = fabs(v[13]);
+    cmax = crank_slider_general_lu_amax(cmax, v[17]);
+    if (!crank_slider_general_lu_pivot_ok(v[13], cmax, tiny)) return 7;
+    inv[6] = 1 / v[13];
+    v[17] *= inv[6];
+    v[25] -= v[17] * v[14];
+    /* pivot 7: row 5, column 6 */
+    cmax = fabs(v[25]);
     cmax = crank_slider_general_lu_amax(cmax, v[21]);
-    if (!crank_slider_general_lu_pivot_ok(v[14], cmax, tiny)) return 7;
-    inv[6] = 1 / v[14];
-    v[21] *= inv[6];
-    v[25] -= v[21] * v[13];
-    /* pivot 7: row 5, column 5 */
-    cmax = fabs(v[17]);
-    cmax = crank_slider_general_lu_amax(cmax, v[25]);
-    if (!crank_slider_general_lu_pivot_ok(v[17], cmax, tiny)) return 8;
-    inv[7] = 1 / v[17];
-    v[25] *= inv[7];
-    v[22] -= v[25] * v[18];
+    if (!crank_slider_general_lu_pivot_ok(v[25], cmax, tiny)) return 8;
+    inv[7] = 1 / v[25];
+    v[21] *= inv[7];
+    v[22] -= v[21] * v[18];
     /* pivot 8: row 7, column 7 */
     if (!(fabs(v[22]) > tiny)) return 9;
     inv[8] = 1 / v[22];
@@ -186,8 +186,8 @@ static void crank_slider_general_lu_forward_0(const crank_slider_general_real *v
     x[5] -= v[8] * x[3];
     x[6] -= v[12] * x[4];
     x[7] -= v[16] * x[5];
-    x[8] -= v[21] * x[6];
-    x[8] -= v[25] * x[7];
+    x[7] -= v[17] * x[6];
+    x[8] -= v[21] * x[7];
 }
 
 /* U z = y, rows 8..0 */
@@ -198,11 +198,11 @@ static void crank_slider_general_lu_backward_0(const crank_slider_general_real *
     x[8] *= inv[8];
     x[7] -= v[18] * x[8];
     x[7] *= inv[7];
-    x[6] -= v[13] * x[7];
+    x[6] -= v[14] * x[7];
     x[6] *= inv[6];
-    x[5] -= v[11] * x[7];
+    x[5] -= v[11] * x[6];
     x[5] *= inv[5];
-    x[4] -= v[7] * x[7];
+    x[4] -= v[7] * x[6];
     x[4] *= inv[4];
     x[3] *= inv[3];
     x[2] *= inv[2];
@@ -235,7 +235,7 @@ void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slid
     b[1] = x[3];
     b[3] = x[4];
     b[4] = x[5];
-    b[6] = x[6];
-    b[5] = x[7];
+    b[5] = x[6];
+    b[6] = x[7];
     b[7] = x[8];
 }

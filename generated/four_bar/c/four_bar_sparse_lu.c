@@ -102,16 +102,16 @@ static int four_bar_lu_factor_0(four_bar_real *v, four_bar_real *inv,
     if (!four_bar_lu_pivot_ok(v[7], cmax, tiny)) return 7;
     inv[6] = 1 / v[7];
     v[12] *= inv[6];
-    /* pivot 7: row 4, column 8 */
-    cmax = fabs(v[11]);
-    cmax = four_bar_lu_amax(cmax, v[15]);
-    if (!four_bar_lu_pivot_ok(v[11], cmax, tiny)) return 8;
-    inv[7] = 1 / v[11];
-    v[15] *= inv[7];
-    v[13] -= v[15] * v[9];
-    /* pivot 8: row 5, column 5 */
-    if (!(fabs(v[13]) > tiny)) return 9;
-    inv[8] = 1 / v[13];
+    /* pivot 7: row 4, column 5 */
+    cmax = fabs(v[9]);
+    cmax = four_bar_lu_amax(cmax, v[13]);
+    if (!four_bar_lu_pivot_ok(v[9], cmax, tiny)) return 8;
+    inv[7] = 1 / v[9];
+    v[13] *= inv[7];
+    v[15] -= v[13] * v[11];
+    /* pivot 8: row 5, column 8 */
+    if (!(fabs(v[15]) > tiny)) return 9;
+    inv[8] = 1 / v[15];
     return 0;
 }
 
@@ -172,7 +172,7 @@ static void four_bar_lu_forward_0(const four_bar_real *v, four_bar_real *x)
     x[6] -= v[6] * x[4];
     x[7] -= v[8] * x[5];
     x[8] -= v[12] * x[6];
-    x[8] -= v[15] * x[7];
+    x[8] -= v[13] * x[7];
 }
 
 /* U z = y, rows 8..0 */
@@ -181,7 +181,7 @@ static void four_bar_lu_backward_0(const four_bar_real *v,
 {
     (void)v;
     x[8] *= inv[8];
-    x[7] -= v[9] * x[8];
+    x[7] -= v[11] * x[8];
     x[7] *= inv[7];
     x[6] *= inv[6];
     x[5] *= inv[5];
@@ -218,6 +218,6 @@ void four_bar_lu_solve(const four_bar_lu *lu, four_bar_real b[])
     b[2] = x[4];
     b[3] = x[5];
     b[4] = x[6];
-    b[8] = x[7];
-    b[5] = x[8];
+    b[5] = x[7];
+    b[8] = x[8];
 }
