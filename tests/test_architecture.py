@@ -42,3 +42,15 @@ def test_package_is_mypy_strict_clean() -> None:
     result = _tool("mypy", "--no-incremental")
     assert result.returncode == 0, result.stdout + result.stderr
     assert "Success" in result.stdout
+
+
+def test_every_subpackage_ships_in_the_wheel() -> None:
+    """pyproject lists the packages explicitly (templates are mapped in as symkin.templates):
+    a new stage folder that is not listed would be missing from an installed symkin."""
+    import tomllib
+
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+                 ["packages"])
+    found = {".".join(init.parent.relative_to(ROOT).parts)
+             for init in (ROOT / "symkin").rglob("__init__.py")}
+    assert found <= listed, f"add to [tool.setuptools] packages: {sorted(found - listed)}"

@@ -1,7 +1,8 @@
 """The package installs with a plain (non-editable) `pip install .` and works from any folder.
 
-The install goes into a fresh virtual environment that sees the machine's site-packages (so no
-download is needed) and the package is installed without its dependencies: what is checked is
+The install goes into a fresh virtual environment that sees the running interpreter's
+site-packages through a .pth file (so no download is needed, also when the tests themselves run
+in a virtualenv) and the package is installed without its dependencies: what is checked is
 the wheel's own content — modules, templates and the console script.
 """
 
@@ -11,6 +12,7 @@ import os
 import shutil
 import subprocess
 import sys
+import sysconfig
 import venv
 from pathlib import Path
 
@@ -19,16 +21,36 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 
 
+_NEVER_COPIED = shutil.ignore_patterns(".git", "__pycache__", "*.egg-info", ".pytest_cache",
+                                       ".hypothesis", ".mypy_cache", ".ruff_cache")
+
+
+def _not_sources(folder: str, names: list[str]) -> set[str]:
+    """Caches and a top-level setuptools ``build/`` are left out; ``symkin/build`` (the build
+    stage of the package) is not."""
+    skipped = set(_NEVER_COPIED(folder, names))
+    if Path(folder) == ROOT and "build" in names:
+        skipped.add("build")
+    return skipped
+
+
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A venv with symkin installed from a copy of the source tree; returns its bin folder."""
     work = tmp_path_factory.mktemp("packaging")
     source = work / "source"
-    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(
-        ".git", "__pycache__", "*.egg-info", "build", ".pytest_cache", ".hypothesis"))
+    shutil.copytree(ROOT, source, ignore=_not_sources)
     env_dir = work / "venv"
-    venv.create(env_dir, system_site_packages=True, with_pip=True)
+    venv.create(env_dir, system_site_packages=False, with_pip=True)
     bin_dir = env_dir / "bin"
+    # The running interpreter's packages (itself maybe a virtualenv, whose base interpreter
+    # lacks them), seen through a .pth file: dependencies and build tools without a download.
+    inner = subprocess.run([str(bin_dir / "python"), "-c",
+                            "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                           capture_output=True, text=True, check=True).stdout.strip()
+    outer = {sysconfig.get_paths()[key] for key in ("purelib", "platlib")}
+    Path(inner, "outer-site-packages.pth").write_text(
+        "".join(f"{path}\n" for path in sorted(outer)), encoding="utf-8")
     subprocess.run([str(bin_dir / "python"), "-m", "pip", "install", "-q", "--no-deps",
                     "--no-build-isolation", str(source)], check=True, cwd=work)
     return bin_dir
