@@ -82,3 +82,12 @@ def format_path(path: Sequence[str | int]) -> str:
         else:
             text += ("." if text else "") + str(part)
     return text
+
+
+class SymkinWarning(UserWarning):
+    """Something a user should know that does not stop the work (the CLI prints it as a note)."""
+
+
+class UsageError(SymkinError):
+    """A request that cannot be carried out as given (a bad path, an option that does not
+    fit); the command line exits with status 2."""

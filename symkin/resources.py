@@ -16,9 +16,15 @@ def template_root() -> Path:
     return _PACKAGE.parent / "templates"
 
 
-# The file every generated folder carries: its files with their sha256 and the metadata a
-# runtime needs. Written by codegen.render, read by runtime.kernel and build.index.
-MANIFEST = "manifest.json"
+# The file every generated folder carries, one per mechanism (so that several mechanisms can
+# share a folder): its files with their sha256 and the metadata a runtime needs. Written by
+# codegen.render, read by runtime.kernel and build.index.
+MANIFEST_SUFFIX = "_manifest.json"
+
+
+def manifest_name(prefix: str) -> str:
+    """``crank_slider`` -> ``crank_slider_manifest.json``."""
+    return prefix + MANIFEST_SUFFIX
 
 
 def extension_suffix() -> str:

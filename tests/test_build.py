@@ -17,6 +17,7 @@ from codegen_support import GENERATED, ROOT, compilers, system
 
 import symkin
 from symkin.build import compile as build
+from symkin.build import cache as build_cache
 from symkin.errors import BuildError
 
 needs_cc = pytest.mark.skipif(not compilers(), reason="no C compiler")
@@ -36,11 +37,11 @@ def _entries(cache: Path) -> list[Path]:
 def test_cache_root_follows_the_environment(monkeypatch: pytest.MonkeyPatch,
                                             tmp_path: Path) -> None:
     monkeypatch.setenv("SYMKIN_CACHE_DIR", str(tmp_path / "x"))
-    assert build.cache_root() == tmp_path / "x"
+    assert build_cache.cache_root() == tmp_path / "x"
     monkeypatch.delenv("SYMKIN_CACHE_DIR")
     monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
     monkeypatch.setenv("HOME", str(tmp_path))
-    assert build.cache_root() == tmp_path / ".cache" / "symkin"
+    assert build_cache.cache_root() == tmp_path / ".cache" / "symkin"
 
 
 @needs_cc

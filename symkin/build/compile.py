@@ -11,32 +11,29 @@ and platform.
 
 from __future__ import annotations
 
-import hashlib
 import importlib.machinery
 import importlib.util
 import json
 import os
-import platform
 import shlex
-import shutil
 import subprocess
 import sys
 import sysconfig
-import tempfile
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from symkin.codegen import lower as codegen
 from symkin import resources
-from symkin.runtime import kernel
+from symkin.build import toolchain
+from symkin.build.cache import content_key, open_cache, publish, verified
+from symkin.codegen import lower as codegen
 from symkin.codegen import render
 from symkin.codegen.cdef import from_headers as cdef_from_headers
-from symkin.build import toolchain
-from symkin.build.cache import cache_root, content_key, publish
-from symkin.symbolic.derivation import System
 from symkin.errors import BuildError
+from symkin.runtime import kernel
+from symkin.symbolic.derivation import System
 
 # Plain -O2: -ffast-math would break the NaN checks of the solver and reorder sums, and
 # -march=native would make a cached binary non-portable.
@@ -61,7 +58,7 @@ def compile(system: System, backend: str = "c", *, real: str = "double", cse: bo
     Raises:
         BuildError: the compiler failed (the message has the command and its output).
     """
-    cache = Path(cache_dir) if cache_dir is not None else cache_root()
+    cache = open_cache(cache_dir)
     if backend == "c":
         compiler = toolchain.c_compiler()
         if compiler is None:
@@ -79,18 +76,17 @@ def compile(system: System, backend: str = "c", *, real: str = "double", cse: bo
 
 def _compile_c(code: codegen.Code, cache: Path, compiler: list[str]) -> kernel.Kernel:
     files = render.render_sources(code)
-    files[resources.MANIFEST] = render.manifest(code, files)
+    files[resources.manifest_name(code.name)] = render.manifest(code, files)
     cdef = cdef_from_headers(files)
     key = content_key({"files": files, "cdef": cdef, "compiler": compiler, "flags": C_FLAGS,
                 "wrapper_flags": WRAPPER_FLAGS, **toolchain.fingerprint(compiler)})
     module_name = f"_symkin_{code.name}_{key[:20]}"
     folder = cache / module_name
     library = folder / (module_name + resources.extension_suffix())
-    if not library.exists():
-        publish(cache, folder, lambda build: _build_c(build, files, cdef, module_name,
-                                                        compiler, code.name))
+    _build_unless_verified(cache, folder, files, lambda build: _build_c(
+        build, files, cdef, module_name, compiler, code.name))
     module = _import_extension(module_name, library)
-    meta = json.loads(files[resources.MANIFEST])
+    meta = json.loads(files[resources.manifest_name(code.name)])
     return kernel.from_cffi(module.ffi, module.lib, meta, folder)
 
 
@@ -162,8 +158,20 @@ def _load_numpy(code: codegen.Code, cache: Path) -> kernel.Kernel:
     module_name = f"_symkin_{code.name}_py_{key[:20]}"
     folder = cache / module_name
     source = folder / f"{code.name}.py"
-    if not source.exists():
-        publish(cache, folder, lambda build: render.write(code, build))
+    expected = {**files, resources.manifest_name(code.name): render.manifest(code, files)}
+    _build_unless_verified(cache, folder, expected, lambda build: render.write(code, build))
     return kernel.from_module(kernel.import_file(module_name, source, None), folder)
+
+
+def _build_unless_verified(cache: Path, folder: Path, expected: dict[str, str],
+                           build: Callable[[Path], Any]) -> None:
+    """Publish a fresh build unless ``folder`` holds a verified one (see build.cache); a
+    folder that fails verification, whoever put it there, is never loaded."""
+    if verified(folder, expected):
+        return
+    publish(cache, folder, build)
+    if not verified(folder, expected):
+        raise BuildError(f"the kernel folder {folder} changed while it was being built; "
+                         "run again, and make sure no other user can write to the cache")
 
 

@@ -20,14 +20,11 @@ Entries are written to a temporary file and renamed, so concurrent runs see whol
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
 import os
-import shlex
-import shutil
-import sys
-import sysconfig
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,14 +35,13 @@ from numpy.typing import NDArray
 
 from symkin import resources
 from symkin.build import toolchain
-from symkin.build.cache import cache_root
+from symkin.build.cache import discard, open_cache, sha256_of
 from symkin.runtime import kernel as kernel_module
 from symkin.runtime.kernel import Kernel
 
 # Bump when the entry layout or the meaning of a key changes.
 FORMAT = 1
 INDEX_FOLDER = "index"
-MANIFEST = resources.MANIFEST
 _PACKAGE = Path(__file__).resolve().parents[1]
 
 Outlines = dict[str, NDArray[np.float64]]
@@ -93,7 +89,7 @@ def prepare(mechanism: str | Path, options: Options = Options(), *, outlines: bo
         MechanismError: the file is invalid (only ever on a miss: a hit was valid before).
         BuildError: generating or compiling failed.
     """
-    cache = Path(cache_dir) if cache_dir is not None else cache_root()
+    cache = open_cache(cache_dir)
     key = index_key(Path(mechanism), options)
     if key is not None:
         found = lookup(cache, key, options, need_outlines=outlines)
@@ -191,7 +187,7 @@ def lookup(cache: Path, key: str, options: Options, need_outlines: bool = False
         return None  # a valid entry without outlines: the full pipeline adds them
     try:
         loaded = kernel_module.load(folder)
-    except Exception:  # noqa: BLE001 — any failure to load a cached kernel means: rebuild it
+    except Exception:
         _discard(path, folder)
         return None
     return Prepared(loaded, hit=True, outlines=drawn)
@@ -201,22 +197,24 @@ def _matches(entry: Any, key: str, options: Options) -> bool:
     """A well-formed entry of this format, key and backend."""
     return (isinstance(entry, dict) and entry.get("format") == FORMAT
             and entry.get("key") == key and entry.get("backend") == options.backend
-            and isinstance(entry.get("files"), dict) and MANIFEST in entry["files"])
+            and isinstance(entry.get("files"), dict)
+            and any(str(name).endswith(resources.MANIFEST_SUFFIX) for name in entry["files"]))
 
 
 def _intact(folder: Path, files: dict[Any, Any], options: Options) -> bool:
     """Every recorded file is still there with the recorded hash, and the manifest agrees."""
     for name, expected in files.items():
         if not (_plain_name(name) and isinstance(expected, str)
-                and _sha256(folder / name) == expected):
+                and sha256_of(folder / name) == expected):
             return False
     return _manifest_matches(folder, options)
 
 
 def _manifest_matches(folder: Path, options: Options) -> bool:
     try:
-        meta = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        manifest = next(folder.glob("*" + resources.MANIFEST_SUFFIX))
+        meta = json.loads(manifest.read_text(encoding="utf-8"))
+    except (OSError, ValueError, StopIteration):
         return False
     wanted = {"backend": options.backend, "cse": options.cse}
     if options.backend == "c":
@@ -255,7 +253,7 @@ def record(cache: Path, key: str, built: Kernel, outlines: Outlines | None = Non
     folder = built.folder
     if folder is None:
         return
-    files = {name: _sha256(folder / name) for name in _loaded_files(built, folder)}
+    files = {name: sha256_of(folder / name) for name in _loaded_files(built, folder)}
     if any(digest is None for digest in files.values()):
         return
     entry = {"format": FORMAT, "key": key, "backend": built.backend, "folder": folder.name,
@@ -263,17 +261,16 @@ def record(cache: Path, key: str, built: Kernel, outlines: Outlines | None = Non
     if outlines is not None:
         entry["outlines"] = {body: np.asarray(v, dtype=float).tolist()
                              for body, v in outlines.items()}
-    try:
+    with contextlib.suppress(OSError):  # no entry: the next run derives again, that is all
         _write_atomic(entry_path(cache, key), json.dumps(entry, indent=1, sort_keys=True))
-    except OSError:
-        pass
 
 
 def _loaded_files(built: Kernel, folder: Path) -> list[str]:
     """The files ``kernel.load`` reads: the manifest and the module or extension."""
+    manifest = resources.manifest_name(built.name)
     if built.backend == "numpy":
-        return [MANIFEST, f"{built.name}.py"]
-    return [MANIFEST, kernel_module.extension_file(folder).name]
+        return [manifest, f"{built.name}.py"]
+    return [manifest, kernel_module.extension_file(folder).name]
 
 
 def _write_atomic(path: Path, text: str) -> None:
@@ -289,25 +286,8 @@ def _write_atomic(path: Path, text: str) -> None:
 
 
 def _discard(entry: Path, folder: Path | None) -> None:
-    """Remove a damaged entry and the kernel folder it vouched for.
-
-    The folder is renamed away first (one atomic step), so a concurrent build republishes a
-    whole folder instead of finding a half-deleted one.
-    """
+    """Remove a damaged entry and the kernel folder it vouched for (moved aside first, so a
+    concurrent build republishes a whole folder instead of finding a half-deleted one)."""
     entry.unlink(missing_ok=True)
-    if folder is None or not folder.is_dir():
-        return
-    trash = Path(tempfile.mkdtemp(dir=folder.parent, prefix=".discarded."))
-    try:
-        os.replace(folder, trash / folder.name)
-    except OSError:
-        pass
-    shutil.rmtree(trash, ignore_errors=True)
-
-
-def _sha256(path: Path) -> str | None:
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return None
-
+    if folder is not None:
+        discard(folder)

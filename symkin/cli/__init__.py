@@ -7,12 +7,16 @@ message naming the file and the place in it, never a traceback).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TextIO
 
-from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
-from symkin.errors import MechanismError, SymkinError
+from symkin.cli import messages
+from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
+from symkin.errors import MechanismError, SymkinError, UsageError
 
 
 def _show(args: argparse.Namespace) -> int:
@@ -72,12 +76,11 @@ def _generate(args: argparse.Namespace) -> int:
     from symkin.symbolic import derivation
 
     if args.backend == "numpy" and args.real == "float":
-        print("symkin: error: --real float is for the C backend; the NumPy backend computes in "
-              "double precision", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return messages.error("--real float is for the C backend; the NumPy backend computes in "
+                              "double precision", EXIT_BAD_INPUT)
     system = derivation.derive(args.mechanism)
     paths = render.generate(system, backend=args.backend, out_dir=args.output, real=args.real,
-                            cse=not args.no_cse, linalg=args.linalg)
+                            cse=not args.no_cse, linalg=args.linalg, force=args.force)
     print("\n".join(str(path) for path in paths))
     return EXIT_OK
 
@@ -89,6 +92,9 @@ def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser])
     generate.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     generate.add_argument("--real", choices=("double", "float"), default="double",
                           help="C real type (default double)")
+    generate.add_argument("--force", action="store_true",
+                          help="write into a folder that also holds files symkin did not "
+                               "write (they are left alone)")
     generate.add_argument("--no-cse", action="store_true",
                           help="do not eliminate common subexpressions")
     generate.add_argument("--linalg", choices=("sparse", "dense"), default="sparse",
@@ -103,8 +109,14 @@ def _add_run(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> N
     runner.add_parser(commands)
 
 
+def _add_cache(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    from symkin.cli import cache
+
+    cache.add_parser(commands)
+
+
 SUBCOMMANDS: list[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]], None]] = [
-    _add_show, _add_verify, _add_generate, _add_run]
+    _add_show, _add_verify, _add_generate, _add_run, _add_cache]
 
 
 def parser() -> argparse.ArgumentParser:
@@ -116,19 +128,31 @@ def parser() -> argparse.ArgumentParser:
     return main_parser
 
 
+def _note_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: TextIO | None = None, line: str | None = None) -> None:
+    """Warnings reach a command-line user as one plain line, not as a source location."""
+    messages.note(str(message))
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = parser().parse_args(argv)
+    warnings.showwarning = _note_warning
     try:
         status: int = args.handler(args)
+        sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
         return status
-    except MechanismError as error:
-        print(f"symkin: error: {error}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except (MechanismError, UsageError) as error:
+        return messages.error(str(error), EXIT_BAD_INPUT)
     except SymkinError as error:
-        print(f"symkin: error: {error}", file=sys.stderr)
-        return EXIT_FAILED
+        return messages.error(str(error), EXIT_FAILED)
     except KeyboardInterrupt:
-        return 130
+        messages.note("interrupted")
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # The reader went away (`symkin schema | head`): stop quietly, and keep Python from
+        # failing again when it flushes stdout at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_FAILED
 
 
 if __name__ == "__main__":

@@ -10,12 +10,15 @@ Exit status 0 on success; 1 when the solve fails (the rows solved so far are sti
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
 from typing import Any, TextIO
 
-from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
+from symkin import limits
+from symkin.cli import messages
+from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 
 SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png",), "animate": (".gif",)}
 
@@ -42,12 +45,18 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
         path = getattr(args, option)
         if path is not None and path.suffix.lower() not in suffixes:
             return (f"--{option} {path}: the file must end in {' or '.join(suffixes)}")
+    for option in ("t0", "t1", "dt"):
+        value = getattr(args, option)
+        if value is not None and not math.isfinite(value):
+            return f"--{option} {value}: give a finite number"
     if args.dt is not None and not args.dt > 0:
         return f"--dt {args.dt}: the time step must be positive"
     return None
 
 
 def _times(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
+    """The grid of the file, with the command line's overrides, or what is wrong with it: the
+    same checks as the file's own grid, and the memory its results would need."""
     from symkin.runtime import driver
 
     t0, t1, dt = kernel.time_grid
@@ -55,8 +64,23 @@ def _times(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
     t1 = t1 if args.t1 is None else args.t1
     dt = dt if args.dt is None else args.dt
     if t1 < t0:
-        return None, f"the time grid ends (t1 = {t1:g}) before it starts (t0 = {t0:g})"
+        return None, (f"the time grid ends (t1 = {t1:g}) before it starts (t0 = {t0:g}); "
+                      "change --t0/--t1")
+    points = limits.grid_points(t0, t1, dt)
+    if points > limits.MAX_GRID_POINTS:
+        need = limits.result_bytes(points, len(kernel.coordinates))
+        return None, (f"the grid t0 = {t0:g} to t1 = {t1:g} by dt = {dt:g} has {points:.3g} "
+                      f"points, more than the {limits.MAX_GRID_POINTS:,} allowed (its results "
+                      f"would need {_size(need)}); use a larger --dt or a shorter interval")
     return driver.grid(t0, t1, dt), None
+
+
+def _size(count: float) -> str:
+    """Bytes in the unit a person reads: 21.6 GB, 350 MB."""
+    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
+        if count >= scale:
+            return f"{count / scale:.3g} {unit}" if count < 1e15 else f"{count:.3g} bytes"
+    return f"{count / 1e3:.3g} kB"
 
 
 def handle(args: argparse.Namespace) -> int:
@@ -68,6 +92,8 @@ def handle(args: argparse.Namespace) -> int:
         return _solve_and_write(args)
     except CannotWrite as error:
         return _error(str(error), EXIT_BAD_INPUT)
+    except OSError as error:  # e.g. a cache folder that cannot be used at all
+        return _error(f"{error.strerror or error}: {error.filename or ''}", EXIT_FAILED)
 
 
 def _solve_and_write(args: argparse.Namespace) -> int:
@@ -79,16 +105,19 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     kernel = prepared.kernel
     times, problem = _times(kernel, args)
     if problem:
-        return _error(f"{args.mechanism}: {problem}; change --t0/--t1", EXIT_BAD_INPUT)
+        return _error(f"{args.mechanism}: {problem}", EXIT_BAD_INPUT)
     progress = ProgressBar(sys.stderr) if sys.stderr.isatty() else None
     try:
         trajectory = driver.solve(kernel, t=times, progress=progress)
+    except driver.SolveInterrupted as interrupted:
+        if progress:
+            progress.finish()
+        return _stopped(args, prepared, interrupted, times.size, "interrupted",
+                        EXIT_INTERRUPTED)
     except driver.SolveFailure as failure:
         if progress:
             progress.finish()
-        _write(failure.trajectory, args, prepared.outlines)
-        return _error(f"{args.mechanism}: {failure} Solved {failure.trajectory.t.size} of "
-                      f"{times.size} time points; those are written.", EXIT_FAILED)
+        return _stopped(args, prepared, failure, times.size, str(failure), EXIT_FAILED)
     if progress:
         progress.finish()
     written = _write(trajectory, args, prepared.outlines)
@@ -98,6 +127,25 @@ def _solve_and_write(args: argparse.Namespace) -> int:
           + _fallback_note(trajectory.lu_fallbacks)
           + "".join(f"; wrote {path}" for path in written))
     return EXIT_OK
+
+
+def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why: str,
+             status: int) -> int:
+    """A run that ended early: say why first (even if writing then fails), then write the
+    rows solved so far and say where they went."""
+    solved = stop.trajectory.t.size
+    message = f"{args.mechanism}: {why}"
+    if status == EXIT_INTERRUPTED:
+        message += f" at t = {stop.t:g}."
+    _error(f"{message} Solved {solved} of {total} time points.", status)
+    try:
+        written = _write(stop.trajectory, args, prepared.outlines)
+    except CannotWrite as error:
+        _error(str(error), EXIT_BAD_INPUT)
+        return status
+    if written:
+        messages.note("the solved rows are written to " + ", ".join(map(str, written)))
+    return status
 
 
 def _fallback_note(count: int) -> str:
@@ -133,8 +181,7 @@ def _write_files(trajectory: Any, args: argparse.Namespace, outlines: Any) -> li
 
 
 def _error(message: str, status: int) -> int:
-    print(f"symkin: error: {message}", file=sys.stderr)
-    return status
+    return messages.error(message, status)
 
 
 class CannotWrite(Exception):

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
+from symkin.cli.messages import printable
 from symkin.symbolic.derivation import derive
 from symkin.verify.hand import HandModuleError
 from symkin.verify.numeric import DEFAULT_SAMPLES, DEFAULT_SPREAD, DEFAULT_TOLERANCE, verify
@@ -23,14 +24,14 @@ def command(mechanism: str | Path, against: str | Path, *, samples: int = DEFAUL
     """
     problem = _option_problem(samples, spread, tolerance)
     if problem:
-        print(f"symkin verify: error: {problem}", file=sys.stderr)
+        print(f"symkin verify: error: {printable(problem)}", file=sys.stderr)
         return EXIT_BAD_INPUT
     system = derive(mechanism)
     try:
         report = verify(system, against, samples=samples, seed=seed, spread=spread,
                         tolerance=tolerance)
     except HandModuleError as error:
-        print(f"symkin verify: error: {error}", file=sys.stderr)
+        print(f"symkin verify: error: {printable(str(error))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     print(report.text(), end="")
     return EXIT_OK if report.ok else EXIT_FAILED

@@ -24,12 +24,11 @@ from symkin import resources
 from symkin.codegen import backends
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
-from symkin.errors import BuildError
+from symkin.errors import BuildError, UsageError
 from symkin.runtime import options as runtime_options
 from symkin.symbolic.derivation import System
 
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
-MANIFEST = resources.MANIFEST
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out"}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points"}
@@ -92,53 +91,102 @@ def _render(template: str, context: dict[str, Any]) -> str:
 
 def generate(system: System, backend: str = "c", out_dir: str | Path = "generated",
              real: str = "double", cse: bool = True,
-             linalg: str = codegen.DEFAULT_LINALG) -> list[Path]:
+             linalg: str = codegen.DEFAULT_LINALG, force: bool = False) -> list[Path]:
     """Generate the source files of one backend into ``out_dir``.
 
     Args:
         system: the derived kinematics.
         backend: ``"c"`` (a self-contained C99 folder) or ``"numpy"`` (one Python module).
-        out_dir: the folder to write; created when missing. Existing files of the same names
-            are replaced, other files are left alone.
+        out_dir: the folder to write; created when missing. It may hold earlier output of
+            symkin (this mechanism's is replaced, other mechanisms' is left alone); any other
+            file makes it refuse, unless ``force``.
         real: the C real type, ``"double"`` or ``"float"``.
         cse: eliminate common subexpressions.
         linalg: the LU behind the C solver, ``"sparse"`` (default: the generated sparse LU
             with run-time pivot checks and a dense fall-back) or ``"dense"``.
+        force: write even where files symkin did not write are present (they are never
+            deleted; one with the name of a generated file is replaced).
 
     Returns:
         The paths written, sorted, the manifest last.
+
+    Raises:
+        UsageError: the folder holds files symkin did not write (and not ``force``), or it
+            cannot be written.
     """
     code = codegen.lower(system, backend, real, cse, linalg)
-    return write(code, Path(out_dir))
+    return write(code, Path(out_dir), force=force)
 
 
-def write(code: Code, out_dir: Path) -> list[Path]:
-    """Write the rendered files of ``code`` and its manifest into ``out_dir``."""
+def write(code: Code, out_dir: Path, force: bool = False) -> list[Path]:
+    """Write the rendered files of ``code`` and its manifest into ``out_dir``: symkin's own
+    earlier output of this mechanism is replaced (files it no longer has are removed), and a
+    file symkin did not write (or that was edited since) is never deleted."""
     files = render_sources(code)
-    files[MANIFEST] = manifest(code, files)
+    manifest_file = resources.manifest_name(code.name)
+    files[manifest_file] = manifest(code, files)
     paths = [out_dir / name for name in files]
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
-        _remove_stale(out_dir, set(files))
+        ours, theirs = _generated_here(out_dir, code.name)
+        foreign = sorted(_files_in(out_dir) - ours - theirs)
+        if foreign and not force:
+            shown = ", ".join(foreign[:5]) + (", ..." if len(foreign) > 5 else "")
+            raise UsageError(f"{out_dir} holds files symkin did not write ({shown}); generate "
+                             "into an empty folder, or pass --force (force=True) to write "
+                             "beside them")
+        for name in sorted(ours - set(files)):  # e.g. the dense LU after switching to sparse
+            (out_dir / name).unlink(missing_ok=True)
         for path, text in zip(paths, files.values()):
             path.write_text(text, encoding="utf-8", newline="\n")
     except OSError as error:
-        raise BuildError(f"cannot write the generated files into {out_dir}: {error.strerror}. "
-                         "Choose a folder you can write to.") from None
+        raise UsageError(f"cannot write the generated files into {out_dir}: "
+                         f"{error.strerror or error}. Choose a folder you can write to.") from None
     return paths
 
 
-def _remove_stale(out_dir: Path, keep: set[str]) -> None:
-    """Delete the files an earlier generation listed in its manifest and this one does not
-    write (e.g. the sparse LU after switching to dense), so the folder compiles on its own."""
+def _files_in(folder: Path) -> set[str]:
+    return {path.name for path in folder.iterdir() if path.is_file() or path.is_symlink()}
+
+
+def _generated_here(folder: Path, prefix: str) -> tuple[set[str], set[str]]:
+    """The files symkin generated in ``folder`` and nobody changed since: (this mechanism's,
+    other mechanisms'), each with its manifest. A manifest symkin did not write, or a listed
+    file whose bytes differ from the recorded sha256, counts as not symkin's."""
+    ours: set[str] = set()
+    theirs: set[str] = set()
+    for path in sorted(folder.glob("*" + resources.MANIFEST_SUFFIX)):
+        listed = _intact_files(folder, path)
+        if listed is None:
+            continue
+        owner = ours if path.name == resources.manifest_name(prefix) else theirs
+        owner.update(listed | {path.name})
+    return ours, theirs
+
+
+def _intact_files(folder: Path, manifest_path: Path) -> set[str] | None:
+    """The files a symkin manifest lists that still have their recorded hash; None when the
+    manifest is not one symkin wrote."""
     try:
-        previous = json.loads((out_dir / MANIFEST).read_text(encoding="utf-8"))
-        listed = [name for name in previous.get("files", {}) if isinstance(name, str)]
-    except (OSError, ValueError, AttributeError):
-        return
-    for name in listed:
-        if name not in keep and Path(name).name == name:  # a plain name, never a path
-            (out_dir / name).unlink(missing_ok=True)
+        data = json.loads(manifest_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("generator") != "symkin":
+        return None
+    listed = data.get("files")
+    if not isinstance(listed, dict) or \
+            manifest_path.name != resources.manifest_name(str(data.get("name"))):
+        return None
+    return {name for name, digest in listed.items()
+            if isinstance(name, str) and Path(name).name == name
+            and _sha256_file(folder / name) == digest}
+
+
+def _sha256_file(path: Path) -> str | None:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
 
 
 def manifest(code: Code, files: dict[str, str]) -> str:

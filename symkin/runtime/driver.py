@@ -19,12 +19,14 @@ trajectory. Imports NumPy and SciPy only: it is part of the runtime.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin import limits
 from symkin.errors import SolveError
 from symkin.runtime.linalg import dependent_rows, factor_at
 from symkin.runtime.newton import Newton, assemble, newton
@@ -39,6 +41,20 @@ Progress = Callable[[int, int], None]
 # Diagnosis only (never a stopping test): condition numbers of Phi_q taken as singular at a
 # failed iterate, and as "nearly singular" at the last point solved before a failure.
 ILL_CONDITIONED, NEARLY_SINGULAR = 1e8, 1e5
+
+
+class SolveInterrupted(SolveError):
+    """The solve was interrupted (SIGINT, Ctrl-C); carries the rows solved before it.
+
+    Attributes:
+        trajectory: the time points solved before the interrupt.
+        t: the first time point not solved.
+    """
+
+    def __init__(self, trajectory: Trajectory, t: float) -> None:
+        super().__init__(f"interrupted at t = {t:g} after {trajectory.t.size} time points")
+        self.trajectory = trajectory
+        self.t = t
 
 
 class SolveFailure(SolveError):
@@ -74,6 +90,9 @@ def grid(t0: float, t1: float, dt: float) -> Array:
     """
     if not (dt > 0 and t1 >= t0 and math.isfinite(t1 - t0)):
         raise SolveError(f"bad time grid t0={t0}, t1={t1}, dt={dt}: need dt > 0 and t1 >= t0")
+    if limits.grid_points(t0, t1, dt) > limits.MAX_GRID_POINTS:
+        raise SolveError(f"the grid t0={t0}, t1={t1}, dt={dt} has more than "
+                         f"{limits.MAX_GRID_POINTS} points; use a larger dt")
     steps = math.floor((t1 - t0) / dt + 1e-9)
     times = t0 + dt * np.arange(steps + 1, dtype=float)
     if abs(times[-1] - t1) <= 1e-9 * dt:
@@ -154,18 +173,38 @@ def default_options(kernel: KinematicsKernel) -> Options:
     return newton_defaults(getattr(kernel, "real", "double"))
 
 
+class _Chunks:
+    """How many grid points one call of the C grid loop solves: about CHUNK_SECONDS of work,
+    so that Ctrl-C (handled between calls) and progress reports answer quickly, while the
+    Python between calls stays negligible."""
+
+    CHUNK_SECONDS = 0.05
+
+    def __init__(self, total: int, reporting: bool) -> None:
+        self.limit = max(1, total // 100) if reporting else total
+        self.size = min(256, self.limit)
+
+    def took(self, seconds: float) -> None:
+        """Scale the next chunk to the time this one took (at most 4x larger at once)."""
+        grow = 4.0 if seconds <= 0 else min(4.0, self.CHUNK_SECONDS / seconds)
+        self.size = int(min(self.limit, max(1, self.size * grow)))
+
+
 def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
             progress: Progress | None) -> Newton:
     """The grid loop in the generated C solver: one call per chunk (one chunk unless a
     progress callback wants to hear in between)."""
     solver = kernel.grid_solver(options, q, p)
     assert solver is not None  # only called for kernels that have one
-    chunk = run.t.size if progress is None else max(1, run.t.size // 100)
+    chunks = _Chunks(run.t.size, progress is not None)
     result = None
-    for start in range(0, run.t.size, chunk):
-        stop = min(start + chunk, run.t.size)
+    start = 0
+    while start < run.t.size:
+        stop = min(start + chunks.size, run.t.size)
+        began = time.perf_counter()
         result = solver.solve(run.t[start:stop], run.q[start:stop], run.dq[start:stop],
                               run.d2q[start:stop])
+        chunks.took(time.perf_counter() - began)
         run.done = start + result.solved
         run.fallbacks = result.fallbacks
         if result.status != OK:
@@ -175,6 +214,7 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Op
             return Newton(last, result.status, result.iterations, result.residual, factors)
         if progress is not None:
             progress(run.done, run.t.size)
+        start = stop
     assert result is not None  # the grid has at least one point
     return Newton(solver.last_q(), OK, result.iterations, result.residual, None)
 
@@ -215,13 +255,18 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     in_c = use_c_solver and kernel.has_grid_solver
     # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
     # the damped assembly in Python take over (and the grid is run again from its result).
-    result = _c_loop(kernel, run, q, p, options, progress) if in_c else None
-    if result is None or (result.status != OK and run.done == 0):
-        start = assemble(kernel, q, float(times[0]), p, options)
-        if start.status != OK:
-            _fail(kernel, run, p, start, float(times[0]), assembling=True)
-        loop = _c_loop if in_c else _python_loop
-        result = loop(kernel, run, start.q, p, options, progress)
+    try:
+        result = _c_loop(kernel, run, q, p, options, progress) if in_c else None
+        if result is None or (result.status != OK and run.done == 0):
+            start = assemble(kernel, q, float(times[0]), p, options)
+            if start.status != OK:
+                _fail(kernel, run, p, start, float(times[0]), assembling=True)
+            loop = _c_loop if in_c else _python_loop
+            result = loop(kernel, run, start.q, p, options, progress)
+    except KeyboardInterrupt:
+        # The rows done so far are whole (run.done counts only finished rows): hand them on.
+        stop = float(times[min(run.done, times.size - 1)])
+        raise SolveInterrupted(_trajectory(kernel, run, p), stop) from None
     if result.status != OK:
         _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
     return _trajectory(kernel, run, p)

@@ -201,14 +201,15 @@ def from_cffi(ffi: Any, lib: Any, meta: Mapping[str, Any], folder: Path | None =
     return Kernel("c", meta, functions, ffi=ffi, lib=lib, folder=folder)
 
 
-def load(folder: str | Path) -> Kernel:
+def load(folder: str | Path, name: str | None = None) -> Kernel:
     """Load a built kernel from its folder (a cache entry, or a generated NumPy folder).
 
-    The folder's ``manifest.json`` says the backend and the mechanism; a C folder must also hold
-    the compiled extension. Needs only NumPy (and cffi for C), never SymPy.
+    The folder's ``<name>_manifest.json`` says the backend and the mechanism (a folder holding
+    several mechanisms needs ``name``); a C folder must also hold the compiled extension.
+    Needs only NumPy (and cffi for C), never SymPy.
     """
     folder = Path(folder)
-    meta = json.loads((folder / resources.MANIFEST).read_text(encoding="utf-8"))
+    meta = json.loads(_manifest(folder, name).read_text(encoding="utf-8"))
     if meta["backend"] == "numpy":
         source = folder / f"{meta['name']}.py"
         digest = hashlib.sha256(source.read_bytes()).hexdigest()
@@ -219,6 +220,16 @@ def load(folder: str | Path) -> Kernel:
     loader = importlib.machinery.ExtensionFileLoader(name, str(library))
     module = import_file(name, library, loader)
     return from_cffi(module.ffi, module.lib, meta, folder)
+
+
+def _manifest(folder: Path, name: str | None) -> Path:
+    if name is not None:
+        return folder / resources.manifest_name(name)
+    found = sorted(folder.glob("*" + resources.MANIFEST_SUFFIX))
+    if len(found) != 1:
+        raise FileNotFoundError(f"{folder} holds {len(found)} symkin manifests; name the "
+                                "mechanism to load")
+    return found[0]
 
 
 def extension_file(folder: Path, name: str | None = None) -> Path:

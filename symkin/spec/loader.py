@@ -17,6 +17,7 @@ from typing import Any, ClassVar, cast
 import yaml
 
 from symkin.errors import MechanismError
+from symkin.limits import MAX_FILE_BYTES, MAX_NESTING
 
 Path_ = tuple[str | int, ...]
 
@@ -31,7 +32,6 @@ _ALLOWED_TAGS = {
     "tag:yaml.org,2002:bool", "tag:yaml.org,2002:null", "tag:yaml.org,2002:map",
     "tag:yaml.org,2002:seq",
 }
-MAX_FILE_BYTES = 1_000_000
 
 
 @dataclass
@@ -55,12 +55,15 @@ def read(path: str | Path) -> Document:
     path = Path(path)
     source = str(path)
     try:
-        raw = path.read_bytes()
+        with path.open("rb") as stream:  # never more than the limit, even from /dev/zero
+            raw = stream.read(MAX_FILE_BYTES + 1)
     except OSError as error:
         raise MechanismError(f"cannot read the file ({error.strerror})",
                              hint="Check the path.", source=source) from None
     if len(raw) > MAX_FILE_BYTES:
-        raise MechanismError(f"the file is larger than {MAX_FILE_BYTES} bytes", source=source)
+        raise MechanismError(f"the file is larger than {MAX_FILE_BYTES} bytes",
+                             hint="A mechanism file is a few kilobytes; check the path.",
+                             source=source)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -76,13 +79,30 @@ def read_toml(text: str, source: str) -> Document:
     """Parse TOML text; field lines are found by a light scan of keys and table headers."""
     try:
         data = tomllib.loads(text)
+    except RecursionError:
+        raise _too_deep(source) from None
     except tomllib.TOMLDecodeError as error:
         # tomllib puts the place into its message: "... (at line 2, column 23)".
         found = _TOML_PLACE.search(str(error))
         message = _TOML_PLACE.sub("", str(error)).strip()
         raise MechanismError(f"this is not valid TOML: {message}", source=source,
                              line=int(found.group(1)) if found else None) from None
+    if _depth(data) > MAX_NESTING:
+        raise _too_deep(source)
     return Document(data, source, _toml_lines(text))
+
+
+def _depth(data: Any) -> int:
+    """How deeply lists and mappings nest in plain data (iterative: no recursion limit)."""
+    deepest, stack = 0, [(data, 0)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        if isinstance(node, dict):
+            stack.extend((value, depth + 1) for value in node.values())
+        elif isinstance(node, list):
+            stack.extend((value, depth + 1) for value in node)
+    return deepest
 
 
 _TOML_PLACE = re.compile(r"\(at line (\d+), column \d+\)")
@@ -131,6 +151,8 @@ def read_yaml(text: str, source: str) -> Document:
     """Parse YAML text into plain data with line numbers, refusing unsafe constructs."""
     try:
         node = yaml.compose(text, Loader=_Loader)
+    except RecursionError:
+        raise _too_deep(source) from None
     except yaml.MarkedYAMLError as error:
         # A problem at the end of the stream is reported on the last line, not past it.
         last = max(1, len(text.splitlines()))
@@ -166,8 +188,16 @@ def _fail(document: Document, node: yaml.Node, path: Path_, message: str,
     return MechanismError(message, path, hint, document.source, node.start_mark.line + 1)
 
 
+def _too_deep(source: str, line: int | None = None) -> MechanismError:
+    return MechanismError(f"lists and mappings are nested more than {MAX_NESTING} deep",
+                          hint="A mechanism file nests a few levels; check the brackets.",
+                          source=source, line=line)
+
+
 def _convert(node: yaml.Node, path: Path_, document: Document) -> Any:
     document.lines[path] = node.start_mark.line + 1
+    if len(path) > MAX_NESTING:
+        raise _too_deep(document.source, node.start_mark.line + 1)
     if node.tag not in _ALLOWED_TAGS:
         raise _fail(document, node, path, f"the YAML tag {node.tag!r} is not allowed",
                     "Remove the tag; mechanism files hold only plain values.")

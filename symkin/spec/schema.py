@@ -20,7 +20,6 @@ from pydantic_core import PydanticCustomError
 from symkin.spec import expressions
 
 GROUND = "ground"
-MAX_GRID_POINTS = 10_000_000
 
 # ----- field types ---------------------------------------------------------------------------
 

@@ -15,12 +15,12 @@ import sympy as sp
 from pydantic import ValidationError, model_validator
 
 from symkin.errors import ExpressionError, MechanismError, format_path
+from symkin.limits import MAX_GRID_POINTS, grid_points
 from symkin.spec import expressions, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
 from symkin.spec.schema import (
     GROUND,
-    MAX_GRID_POINTS,
     Custom,
     MechanismSpec,
     equation_count,
@@ -268,7 +268,7 @@ def _check_time(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, fl
     if not grid["t1"] > grid["t0"]:
         raise MechanismError(f"the end time t1 = {grid['t1']} is not after t0 = {grid['t0']}",
                              ("time", "t1"), "Use t1 > t0.")
-    if (grid["t1"] - grid["t0"]) / grid["dt"] > MAX_GRID_POINTS:
+    if grid_points(grid["t0"], grid["t1"], grid["dt"]) > MAX_GRID_POINTS:
         raise MechanismError(f"the grid has more than {MAX_GRID_POINTS} points", ("time", "dt"),
                              "Use a larger dt or a shorter interval.")
 

@@ -1,0 +1,23 @@
+"""Limits that hold at every entry point (the mechanism file, the command line, the API), in
+one place so that none of them can be looser than another."""
+
+MAX_GRID_POINTS = 10_000_000
+"""Time points of one grid. Its results take (3 N + 1) * 8 bytes a point: 2.2 GB for the
+nine-coordinate crank-slider at this limit."""
+
+MAX_FILE_BYTES = 1_000_000
+"""Size of a mechanism file; read no further than this."""
+
+MAX_NESTING = 32
+"""Depth of nested mappings and lists in a mechanism file (real files use four or five)."""
+
+
+def grid_points(t0: float, t1: float, dt: float) -> float:
+    """How many points the grid t0, t0 + dt, ..., t1 has (a float: it may be astronomically
+    large, and is only compared with the limit)."""
+    return (t1 - t0) / dt + 1
+
+
+def result_bytes(points: float, nq: int) -> float:
+    """Memory for q, dq, d2q and t over ``points`` time points of ``nq`` coordinates."""
+    return points * (3 * nq + 1) * 8
