@@ -21,6 +21,12 @@ from symkin.errors import MechanismError, SymkinError, UsageError
 
 def _show(args: argparse.Namespace) -> int:
     from symkin.symbolic import derivation
+
+    if args.local:
+        from symkin.spec import drawn, validate
+
+        print(drawn.dump(validate.load(args.mechanism)), end="")
+        return EXIT_OK
     from symkin.symbolic import show as report
 
     system = derivation.derive(args.mechanism)
@@ -41,6 +47,9 @@ def _add_show(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
     show = commands.add_parser("show", help="print Phi, Phi_q, Phi_t, Gamma and the DOF count")
     show.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
     show.add_argument("--latex", action="store_true", help="print LaTeX instead of text")
+    show.add_argument("--local", action="store_true",
+                      help="print the mechanism in the local layout (local vectors, v, phi0, "
+                           "q0), as derived from a drawn file")
     show.set_defaults(handler=_show)
     schema = commands.add_parser("schema", help="print the JSON Schema of mechanism files")
     schema.set_defaults(handler=_schema)

@@ -16,7 +16,7 @@ from pydantic import ValidationError, model_validator
 
 from symkin.errors import ExpressionError, MechanismError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
-from symkin.spec import expressions, loader
+from symkin.spec import drawn, expressions, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
 from symkin.spec.schema import (
@@ -81,7 +81,8 @@ def _validate(document: loader.Document) -> Mechanism:
         raise MechanismError("the file must be a mapping with keys name, parameters, bodies, "
                              "joints, drivers, time", source=document.source, line=1)
     try:
-        return Mechanism.model_validate(document.data)
+        # A drawn document (layout: drawn) is first turned into the local form.
+        return Mechanism.model_validate(drawn.to_local(document.data))
     except MechanismError as error:
         raise error.located(document.source, document.line_of(error.path)) from None
     except ValidationError as error:

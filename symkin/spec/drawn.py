@@ -1,0 +1,412 @@
+"""The drawn layout: a mechanism written as it is drawn, turned into the local form.
+
+With ``layout: drawn`` every point coordinate is global, in one assembled configuration. Each
+body's frame is its first listed point with axes parallel to the global axes, or
+``frame: {origin: POINT | [x, y], angle: EXPR}``; joints take ``at: POINT | [x, y]`` (or a
+global ``sA``/``sB`` pair), prismatic and pin-slot joints ``axis: [dx, dy]``, the sliding
+direction. From the drawing this module derives what the local form needs: every local vector
+``s' = A(angle)^T (r - origin)``, the slide normal ``v`` (the axis turned by +90°, in body j),
+``phi0`` (the frames' angle difference) and each body's ``q0`` = [origin, angle].
+
+It works on the file's plain data, before the schema sees it, and builds expression *text*:
+each piece of user text is first parsed alone by the whitelist parser (so that wrapping it in
+parentheses cannot change its meaning) and is never evaluated by anything else. A piece that is
+a plain number stays a number, so a numeric drawing gives a numeric local form.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import sympy as sp
+import yaml
+
+from symkin.errors import ExpressionError, MechanismError
+from symkin.spec import expressions
+from symkin.spec.schema import MechanismSpec
+
+GROUND = "ground"
+LAYOUTS = ("local", "drawn")
+# Joint points that should coincide may differ by this much, relative to the drawing's size.
+CLOSURE_TOLERANCE = 1e-6
+
+Path_ = tuple[str | int, ...]
+
+
+@dataclass(frozen=True)
+class Q:
+    """One drawn quantity: its text (a number or an expression) and its nominal value."""
+
+    text: Any
+    value: float
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A body's frame in the drawing: origin and angle."""
+
+    x: Q
+    y: Q
+    angle: Q
+
+
+class _Context:
+    """The parameters' nominal values, to check and evaluate each piece of the drawing."""
+
+    def __init__(self, parameters: Mapping[str, Any]) -> None:
+        self.symbols = {name: sp.Symbol(name, real=True) for name in parameters}
+        self.values: dict[sp.Symbol, float] = {}
+        for name, raw in parameters.items():
+            try:
+                self.values[self.symbols[name]] = float(expressions.parse(raw, {}))
+            except (ExpressionError, TypeError, ValueError):
+                continue  # validation of the local form names it
+
+    def quantity(self, raw: Any, path: Path_) -> Q:
+        if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+            raise MechanismError("expected a number or an expression", path)
+        if not isinstance(raw, str):
+            return Q(raw, float(raw))
+        try:
+            value = float(expressions.parse(raw, self.symbols).subs(self.values))
+        except ExpressionError as error:
+            raise MechanismError(str(error), path, "Use numbers, parameter names, pi, E and "
+                                 "the listed functions.") from None
+        except (TypeError, ValueError, OverflowError, ZeroDivisionError):
+            value = math.nan
+        if not math.isfinite(value):
+            raise MechanismError(f"{raw!r} is not a finite real number at the nominal "
+                                 "parameter values", path)
+        return Q(raw, value)
+
+    def tidy(self, q: Q) -> Any:
+        """The text of a derived quantity in its simplest form: the parser's own expression
+        printed back (cos(pi/2)*(a) -> 0), kept only if it parses back to the same thing."""
+        if not isinstance(q.text, str):
+            return q.text
+        expr = expressions.parse(q.text, self.symbols)
+        if expr.is_Number:
+            return _clean(float(expr)) if expr.is_Float else int(expr) if expr.is_Integer \
+                else q.text
+        text = sp.sstr(expr)
+        try:
+            same = expressions.parse(text, self.symbols) == expr
+        except ExpressionError:
+            same = False
+        return text if same else q.text
+
+    def vector(self, raw: Any, path: Path_) -> tuple[Q, Q]:
+        if not isinstance(raw, (list, tuple)) or len(raw) != 2:
+            raise MechanismError("expected a vector [x, y]", path)
+        return self.quantity(raw[0], path + (0,)), self.quantity(raw[1], path + (1,))
+
+
+# ----- arithmetic on drawn quantities (numbers stay numbers) ---------------------------------
+
+def _clean(value: float) -> float | int:
+    """A float without the last-bit noise of a subtraction (0.3 - 0.1 -> 0.2)."""
+    cleaned = float(f"{value:.15g}")
+    return int(cleaned) if cleaned.is_integer() and abs(cleaned) < 2**53 else cleaned
+
+
+def _numeric(q: Q) -> bool:
+    return not isinstance(q.text, str)
+
+
+def _sub(a: Q, b: Q) -> Q:
+    if a.text == b.text:
+        return Q(0, 0.0)
+    if _numeric(a) and _numeric(b):
+        return Q(_clean(a.value - b.value), a.value - b.value)
+    if _numeric(b) and b.value == 0:
+        return a
+    return Q(f"({a.text}) - ({b.text})", a.value - b.value)
+
+
+def _neg(a: Q) -> Q:
+    return Q(_clean(-a.value), -a.value) if _numeric(a) else Q(f"-({a.text})", -a.value)
+
+
+def _to_frame(dx: Q, dy: Q, angle: Q) -> tuple[Q, Q]:
+    """A^T(angle) [dx, dy]: a global difference vector in a frame turned by ``angle``."""
+    if _numeric(angle) and angle.value == 0:
+        return dx, dy
+    c, s = math.cos(angle.value), math.sin(angle.value)
+    x, y = c * dx.value + s * dy.value, -s * dx.value + c * dy.value
+    if _numeric(angle) and _numeric(dx) and _numeric(dy):
+        return Q(_clean(x), x), Q(_clean(y), y)
+    a = angle.text
+    return (Q(f"cos({a})*({dx.text}) + sin({a})*({dy.text})", x),
+            Q(f"-sin({a})*({dx.text}) + cos({a})*({dy.text})", y))
+
+
+# ----- the drawing ---------------------------------------------------------------------------
+
+class Drawing:
+    """The global points and frames of a drawn document."""
+
+    def __init__(self, data: Mapping[str, Any]) -> None:
+        self.context = _Context(data.get("parameters") or {})
+        bodies = data.get("bodies")
+        if not isinstance(bodies, Mapping) or not bodies:
+            raise MechanismError("expected a mapping of bodies", ("bodies",))
+        self.points: dict[str, dict[str, tuple[Q, Q]]] = {}
+        self.frames: dict[str, Frame] = {GROUND: Frame(Q(0, 0.0), Q(0, 0.0), Q(0, 0.0))}
+        for body, spec in bodies.items():
+            self._body(str(body), spec)
+
+    def _body(self, body: str, spec: Any) -> None:
+        path: Path_ = ("bodies", body)
+        if not isinstance(spec, Mapping):
+            raise MechanismError("expected a mapping with points (and frame)", path)
+        allowed = {"points"} if body == GROUND else {"points", "frame"}
+        for key in spec:
+            if key not in allowed:
+                hint = ("In the drawn layout q0 follows from the drawing: give the body's "
+                        "frame with frame: {origin: POINT, angle: EXPR} instead."
+                        if key == "q0" else f"Allowed keys here: {', '.join(sorted(allowed))}.")
+                raise MechanismError(f"unknown key {key!r} in the drawn layout", path + (key,),
+                                     hint)
+        points = spec.get("points") or {}
+        if not isinstance(points, Mapping):
+            raise MechanismError("expected a mapping of point names to [x, y]",
+                                 path + ("points",))
+        self.points[body] = {str(name): self.context.vector(raw, path + ("points", name))
+                             for name, raw in points.items()}
+        if body != GROUND:
+            self.frames[body] = self._frame(body, spec.get("frame"), path)
+
+    def _frame(self, body: str, raw: Any, path: Path_) -> Frame:
+        origin: Any = None
+        angle = Q(0, 0.0)
+        if raw is not None:
+            if not isinstance(raw, Mapping) or set(raw) - {"origin", "angle"}:
+                raise MechanismError("expected frame: {origin: POINT | [x, y], angle: EXPR}",
+                                     path + ("frame",))
+            origin = raw.get("origin")
+            if "angle" in raw:
+                angle = self.context.quantity(raw["angle"], path + ("frame", "angle"))
+        if origin is None:
+            if not self.points[body]:
+                raise MechanismError(f"body {body!r} has no point to place its frame at",
+                                     path, "List its points, or give frame: {origin: [x, y]}.")
+            x, y = next(iter(self.points[body].values()))
+        elif isinstance(origin, str):
+            if origin not in self.points[body]:
+                raise MechanismError(f"body {body!r} has no point named {origin!r}",
+                                     path + ("frame", "origin"), "Name one of its points, or "
+                                     "give global coordinates [x, y].")
+            x, y = self.points[body][origin]
+        else:
+            x, y = self.context.vector(origin, path + ("frame", "origin"))
+        return Frame(x, y, angle)
+
+    def local(self, body: str, point: tuple[Q, Q]) -> tuple[Q, Q]:
+        """A global point as a vector in the frame of ``body``."""
+        frame = self.frames[body]
+        return _to_frame(_sub(point[0], frame.x), _sub(point[1], frame.y), frame.angle)
+
+    def q0(self, body: str) -> list[Any]:
+        frame = self.frames[body]
+        return [self.context.tidy(q) for q in (frame.x, frame.y, frame.angle)]
+
+    def texts(self, vector: tuple[Q, Q]) -> list[Any]:
+        return [self.context.tidy(vector[0]), self.context.tidy(vector[1])]
+
+    def size(self) -> float:
+        """The drawing's largest coordinate magnitude (at least 1): the closure scale."""
+        values = [abs(c.value) for pts in self.points.values() for p in pts.values() for c in p]
+        return max([1.0, *values])
+
+
+# ----- the local form ------------------------------------------------------------------------
+
+_PAIR_KEYS = {"revolute": set(), "prismatic": {"axis"}, "pin_slot": {"axis"}}
+_DRIVER_POINTS = {"displacement": ("sA", "sB"), "displacement_local": ("sA", "sB"),
+                  "slide": ("sA", "sB"), "trajectory": ("sB",)}
+
+
+def layout_of(data: Any) -> str:
+    """The document's layout ('local' when the key is absent); an error for another value."""
+    if not isinstance(data, Mapping) or "layout" not in data:
+        return "local"
+    layout = data["layout"]
+    if layout not in LAYOUTS:
+        raise MechanismError(f"unknown layout {layout!r}", ("layout",),
+                             "Use layout: drawn (global coordinates as drawn) or leave the key "
+                             "out (local vectors, the chapter's form).")
+    return str(layout)
+
+
+def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
+    """The local form of a document; a document without ``layout: drawn`` is returned as is."""
+    local = {key: value for key, value in data.items() if key != "layout"}
+    if layout_of(data) != "drawn":
+        return local
+    drawing = Drawing(data)
+    local["bodies"] = {body: {"q0": drawing.q0(body),
+                              "points": {name: drawing.texts(drawing.local(body, point))
+                                         for name, point in drawing.points[body].items()}}
+                       for body in drawing.frames if body != GROUND}
+    joints, residuals = [], []
+    for index, joint in enumerate(_items(data, "joints")):
+        converted, residual = _joint(drawing, joint, ("joints", index))
+        joints.append(converted)
+        if residual is not None:
+            residuals.append((index, joint, residual))
+    local["joints"] = joints
+    local["drivers"] = [_driver(drawing, driver, ("drivers", index))
+                        for index, driver in enumerate(_items(data, "drivers"))]
+    _check_closure(drawing, residuals)
+    return local
+
+
+def _items(data: Mapping[str, Any], section: str) -> list[Any]:
+    items = data.get(section) or []
+    if not isinstance(items, list):
+        raise MechanismError(f"expected a list of {section}", (section,))
+    return items
+
+
+def _body(drawing: Drawing, constraint: Mapping[str, Any], key: str, path: Path_) -> str:
+    body = constraint.get(key)
+    if body not in drawing.frames:
+        known = ", ".join(drawing.frames)
+        raise MechanismError(f"unknown body {body!r}", path + (key,), f"Use one of: {known}.")
+    return str(body)
+
+
+def _point(drawing: Drawing, body: str, raw: Any, path: Path_) -> tuple[Any, tuple[Q, Q]]:
+    """A point given by name (on ``body``) or by global coordinates: (local ref, global)."""
+    if isinstance(raw, str):
+        if raw not in drawing.points.get(body, {}):
+            known = ", ".join(drawing.points.get(body, {})) or "none"
+            raise MechanismError(f"body {body!r} has no point named {raw!r}", path,
+                                 f"Its points are: {known}; or give global coordinates [x, y].")
+        point = drawing.points[body][raw]
+    else:
+        point = drawing.context.vector(raw, path)
+    if isinstance(raw, str) and body != GROUND:
+        return raw, point
+    return drawing.texts(drawing.local(body, point)), point
+
+
+def _pair_points(drawing: Drawing, pair: Mapping[str, Any], i: str, j: str,
+                 path: Path_) -> tuple[Any, Any, tuple[Q, Q], tuple[Q, Q]]:
+    """sA, sB (local refs) and A, B (global) of a joint written with at: or with sA and sB."""
+    if "at" in pair:
+        if "sA" in pair or "sB" in pair:
+            raise MechanismError("give either at: or sA and sB, not both", path + ("at",))
+        at = pair["at"]
+        if isinstance(at, str):
+            owners = [body for body in (i, j) if at in drawing.points.get(body, {})]
+            if not owners:
+                raise MechanismError(f"neither {i!r} nor {j!r} has a point named {at!r}",
+                                     path + ("at",), "Name a point of one of the two bodies, "
+                                     "or give global coordinates [x, y].")
+            a_raw = at if i in owners else drawing.points[owners[0]][at]
+            b_raw = at if j in owners else drawing.points[owners[0]][at]
+            sA, A = _point(drawing, i, _raw(a_raw), path + ("at",))
+            sB, B = _point(drawing, j, _raw(b_raw), path + ("at",))
+            return sA, sB, A, B
+        sA, A = _point(drawing, i, at, path + ("at",))
+        sB, B = _point(drawing, j, at, path + ("at",))
+        return sA, sB, A, B
+    for key in ("sA", "sB"):
+        if key not in pair:
+            raise MechanismError("the joint's point is missing", path + ("at",),
+                                 "Give at: POINT | [x, y] (or a global sA and sB).")
+    sA, A = _point(drawing, i, pair["sA"], path + ("sA",))
+    sB, B = _point(drawing, j, pair["sB"], path + ("sB",))
+    return sA, sB, A, B
+
+
+def _raw(value: Any) -> Any:
+    """A point name stays a name; a drawn point (Q, Q) becomes its raw coordinates."""
+    return value if isinstance(value, str) else [value[0].text, value[1].text]
+
+
+def _joint(drawing: Drawing, joint: Any,
+           path: Path_) -> tuple[Any, tuple[str, float] | None]:
+    if not isinstance(joint, Mapping) or joint.get("type") not in _PAIR_KEYS:
+        return joint, None  # custom joints and shape errors go to the schema as they are
+    kind = joint["type"]
+    for key in ("v", "phi0"):
+        if key in joint:
+            raise MechanismError(f"{key} is not used in the drawn layout", path + (key,),
+                                 "Give axis: [dx, dy], the sliding direction as drawn; v (the "
+                                 "normal to the slide) and phi0 follow from the drawing.")
+    extra = set(joint) - {"type", "name", "i", "j", "at", "sA", "sB"} - _PAIR_KEYS[kind]
+    if extra:
+        raise MechanismError(f"unknown key {sorted(extra)[0]!r}", path + (sorted(extra)[0],),
+                             "A drawn joint has type, name, i, j, at (or sA, sB) and, for "
+                             "prismatic and pin_slot, axis.")
+    i, j = _body(drawing, joint, "i", path), _body(drawing, joint, "j", path)
+    sA, sB, A, B = _pair_points(drawing, joint, i, j, path)
+    local = {key: joint[key] for key in ("type", "name", "i", "j") if key in joint}
+    local.update(sA=sA, sB=sB)
+    gap = math.hypot(B[0].value - A[0].value, B[1].value - A[1].value)
+    if kind != "revolute":
+        if "axis" not in joint:
+            raise MechanismError(f"a {kind} joint needs axis: [dx, dy]", path + ("axis",),
+                                 "Give the sliding direction as drawn, e.g. axis: [1, 0].")
+        dx, dy = drawing.context.vector(joint["axis"], path + ("axis",))
+        length = math.hypot(dx.value, dy.value)
+        if length == 0:
+            raise MechanismError("the axis is zero", path + ("axis",), "Give a non-zero "
+                                 "direction, e.g. [1, 0].")
+        # The slide's normal v = axis turned by +90 degrees, expressed in body j's frame.
+        local["v"] = drawing.texts(_to_frame(_neg(dy), dx, drawing.frames[j].angle))
+        gap = abs((B[0].value - A[0].value) * -dy.value
+                  + (B[1].value - A[1].value) * dx.value) / length
+        if kind == "prismatic":
+            local["phi0"] = drawing.context.tidy(
+                _sub(drawing.frames[i].angle, drawing.frames[j].angle))
+    return local, (f"{kind} {i}–{j}", gap)
+
+
+def _driver(drawing: Drawing, driver: Any, path: Path_) -> Any:
+    if not isinstance(driver, Mapping) or driver.get("type") not in _DRIVER_POINTS:
+        return driver  # angle and custom drivers keep their meaning; shapes go to the schema
+    local = dict(driver)
+    for key in _DRIVER_POINTS[driver["type"]]:
+        body = _body(drawing, driver, "i" if key == "sA" else "j", path)
+        if key not in driver:
+            raise MechanismError(f"the required key {key!r} is missing", path + (key,))
+        local[key], _ = _point(drawing, body, driver[key], path + (key,))
+    if "u" in driver:
+        j = _body(drawing, driver, "j", path)
+        dx, dy = drawing.context.vector(driver["u"], path + ("u",))
+        local["u"] = drawing.texts(_to_frame(dx, dy, drawing.frames[j].angle))
+    return local
+
+
+def _check_closure(drawing: Drawing, residuals: list[tuple[int, Any, tuple[str, float]]]) -> None:
+    """Joint points that should coincide (or lie on the slide) must do so in the drawing."""
+    tolerance = CLOSURE_TOLERANCE * drawing.size()
+    open_joints = [(index, joint, label, gap) for index, joint, (label, gap) in residuals
+                   if not gap <= tolerance]
+    if not open_joints:
+        return
+    said = "; ".join(f"joints[{index}]{' ' + repr(joint['name']) if joint.get('name') else ''}"
+                     f" ({label}) is off by {gap:.6g}" for index, joint, label, gap in open_joints)
+    raise MechanismError(f"the drawing does not close: {said}", ("joints", open_joints[0][0]),
+                         f"The two points of each joint must coincide (revolute) or lie on the "
+                         f"slide (prismatic, pin_slot) within {tolerance:.3g}; correct their "
+                         "coordinates, or give the joint one point with at:.")
+
+
+_KEY_ORDER = ("type", "name", "i", "j", "sA", "sB", "v", "phi0", "u", "f", "theta", "equations")
+
+
+def dump(mech: MechanismSpec) -> str:
+    """A mechanism in the local layout as YAML text: a file ``symkin`` reads back unchanged."""
+    data = mech.model_dump(mode="json", exclude_none=True)
+    for section in ("joints", "drivers"):
+        data[section] = [{key: item[key] for key in _KEY_ORDER if key in item}
+                         for item in data[section]]
+    return str(yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100,
+                              allow_unicode=True))
