@@ -16,7 +16,7 @@ from pydantic import ValidationError, model_validator
 
 from symkin.errors import ExpressionError, MechanismError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
-from symkin.spec import drawn, expressions, loader
+from symkin.spec import drawn, drawn_schema, expressions, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
 from symkin.spec.schema import (
@@ -73,7 +73,7 @@ def from_dict(data: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism
 
 def json_schema() -> dict[str, Any]:
     """The JSON Schema of the mechanism file format."""
-    return Mechanism.model_json_schema()
+    return drawn_schema.json_schema_of(Mechanism)
 
 
 def _validate(document: loader.Document) -> Mechanism:
