@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
 from symkin.codegen import backends, sample, symbols
+from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbols import symbol_text
 from symkin.errors import BuildError
 from symkin.symbolic import planar as constraints
@@ -89,7 +90,8 @@ class Code:
     routines: tuple[Routine, ...]
     ops_before_cse: dict[str, int]
     linalg: str = DEFAULT_LINALG
-    extra: dict[str, Any] = field(default_factory=dict)
+    lu_plan: LUPlan | None = None
+    """The sparse LU's pivot order and steps (C with sparse linear algebra only)."""
 
     @property
     def nnz(self) -> int:
@@ -146,8 +148,8 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         points=point_names(system), routines=routines,
         ops_before_cse={name: _count_ops(exprs) for name, exprs in expressions.items()},
         linalg=linalg,
-        extra=({"lu": sample.sparse_lu_plan(system, pattern)}
-               if backend == "c" and linalg == "sparse" else {}),
+        lu_plan=(sample.sparse_lu_plan(system, pattern)
+                 if backend == "c" and linalg == "sparse" else None),
     )
 
 

@@ -21,7 +21,7 @@ from typing import Any
 import jinja2
 
 from symkin import resources
-from symkin.codegen import backends
+from symkin.codegen import backends, lu_plan
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
 from symkin.errors import BuildError, UsageError
@@ -241,7 +241,8 @@ def template_context(code: Code) -> dict[str, Any]:
         "parameter_literals": [repr(n) for n in code.parameter_names],
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
-        "linalg": code.linalg, **code.extra,
+        "linalg": code.linalg,
+        **({"lu": lu_plan.template_context(code.lu_plan)} if code.lu_plan else {}),
         "newton_defaults": _newton_defaults(code, literal),
     }
 

@@ -17,13 +17,14 @@ import sympy as sp
 from symkin.codegen import lu_plan as sparse_lu
 from symkin.codegen import symbols
 from symkin.errors import BuildError, SolveError
+from symkin.runtime import options as runtime_options
 from symkin.symbolic.derivation import System
 
-# Assembly tolerances: the runtime's Newton defaults (a tighter sample changes nothing).
-TOL_PHI, TOL_DQ, MAX_NEWTON, MIN_PIVOT_RATIO = 1e-10, 1e-9, 25, 1e-10
+# Assembly tolerances: the runtime's own Newton defaults (a tighter sample changes nothing).
+NEWTON = runtime_options.defaults("double")
 
 
-def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> dict[str, Any]:
+def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> sparse_lu.LUPlan:
     """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration."""
     kernel = _SampleKernel(system, pattern)
     sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
@@ -32,7 +33,7 @@ def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> dict[s
                                  [c for _, c in pattern], [float(v) for v in sample])
     except SolveError as error:
         raise BuildError(f"cannot plan the sparse LU of Phi_q: {error}") from None
-    return sparse_lu.template_context(plan)
+    return plan
 
 
 def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...]:
@@ -101,21 +102,22 @@ def _assemble(kernel: Any, q0: np.ndarray, t0: float, p: np.ndarray) -> np.ndarr
 
 def _newton(kernel: Any, q: np.ndarray, t: float, p: np.ndarray) -> np.ndarray | None:
     """Newton-Raphson testing the residual of the iterate; None when it fails or Phi_q is
-    singular (pivot ratio of the LU factors below MIN_PIVOT_RATIO)."""
+    singular (pivot ratio of the LU factors below NEWTON.min_pivot_ratio)."""
     import scipy.linalg
 
     q = np.array(q, dtype=float)
     step = math.inf
-    for iteration in range(MAX_NEWTON + 1):
+    for iteration in range(NEWTON.max_iterations + 1):
         phi = kernel.phi(q, t, p)
         residual = float(np.abs(phi).max(initial=0.0))
         if not math.isfinite(residual):
             return None
         lu, pivots = scipy.linalg.lu_factor(kernel.phi_q(q, t, p), check_finite=False)
         diagonal = np.abs(np.diag(lu))
-        if diagonal.max(initial=0.0) == 0.0 or diagonal.min() / diagonal.max() < MIN_PIVOT_RATIO:
+        largest = diagonal.max(initial=0.0)
+        if largest == 0.0 or diagonal.min() / largest < NEWTON.min_pivot_ratio:
             return None
-        if residual <= TOL_PHI and (iteration == 0 or step <= TOL_DQ):
+        if residual <= NEWTON.tol_phi and (iteration == 0 or step <= NEWTON.tol_dq):
             return q
         delta = scipy.linalg.lu_solve((lu, pivots), -phi, check_finite=False)
         q = q + delta
@@ -130,7 +132,7 @@ def _levenberg_marquardt(kernel: Any, q: np.ndarray, t: float, p: np.ndarray,
     phi = kernel.phi(q, t, p)
     cost, mu = float(phi @ phi), 1e-3
     for _ in range(max_iterations):
-        if math.sqrt(cost) <= TOL_PHI:
+        if math.sqrt(cost) <= NEWTON.tol_phi:
             break
         jacobian = kernel.phi_q(q, t, p)
         normal = jacobian.T @ jacobian
