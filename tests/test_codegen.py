@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import mpmath
 import numpy as np
 import pytest
 import sympy as sp
@@ -134,13 +135,36 @@ def test_printers_refuse_what_they_cannot_print() -> None:
         codegen._print(c_backend.CPrinter(), sp.besselj(0, q0))
 
 
-def test_step_functions_become_piecewise() -> None:
+def test_step_functions_print_their_closed_forms() -> None:
+    """H(x) (H(0) = 1/2) + delta(x) + sign(x): delta is dropped, H and sign print directly
+    (no Piecewise rewrite, which hangs on nested Abs); the NumPy text gives H + sign."""
     x = sp.Symbol("x", real=True)
     expr = codegen_symbols.prepare(sp.Heaviside(x, sp.Rational(1, 2)) + sp.DiracDelta(x) + sp.sign(x),
                             {x: _internal("_q0")})
-    assert not expr.has(sp.Heaviside, sp.DiracDelta, sp.sign)
+    assert not expr.has(sp.DiracDelta, sp.Piecewise)
+    c_text = c_backend.CPrinter().doprint(expr)
+    assert "? 1.0 :" in c_text and "q[0]" in c_text
+    numpy_text = numpy_backend.PythonPrinter().doprint(expr)
+    for value, expected in ((-2.0, -1.0), (0.0, 0.5), (3.0, 2.0)):
+        q = np.array([value])
+        assert eval(numpy_text, {"numpy": np, "q": q}) == expected  # generated text, not user text
+
+
+def test_constants_become_correctly_rounded_literals() -> None:
+    """sqrt(2), log(2), pi/2 and an integer wider than 64 bits: plain C99 literals (no POSIX
+    M_ macros, no truncated integer constant), the nearest doubles of the exact values."""
+    q0 = _internal("_q0")
+    big = sp.Integer(18446744073709551617)
+    expr = codegen_symbols.prepare(sp.sqrt(2) * q0 + sp.log(2) + sp.pi / 2 + sp.Min(q0, big), {})
+    for real in ("double", "float"):
+        text = c_backend.CPrinter(real).doprint(expr)
+        assert "M_" not in text and "18446744073709551617" not in text, text
     text = c_backend.CPrinter().doprint(expr)
-    assert "?" in text and "q[0]" in text
+    assert "1.4142135623730951" in text and "1.8446744073709552e+19" in text, text
+    # log(2) + pi/2 is one constant part, folded as a whole to the nearest double.
+    with mpmath.workdps(50):
+        exact = float(mpmath.log(2) + mpmath.pi / 2)
+    assert repr(exact) in text, text
 
 
 def test_bad_options_are_refused() -> None:

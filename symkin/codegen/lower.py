@@ -213,7 +213,8 @@ def _inline_trivial(temporaries: list[tuple[sp.Symbol, sp.Expr]], exprs: list[sp
     trivial: dict[sp.Symbol, sp.Expr] = {}
     for symbol, value in temporaries:
         value = value.xreplace(trivial)
-        if value.is_Atom or (-value).is_Atom:
+        # (a relational temporary, e.g. from Max(t, 1 - t), has no negative)
+        if value.is_Atom or (isinstance(value, sp.Expr) and (-value).is_Atom):
             trivial[symbol] = value
         else:
             kept.append((symbol, value))

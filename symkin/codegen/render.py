@@ -253,7 +253,8 @@ def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
     arguments = [f"{real} t" if a == "t" else f"const {real} {a}[]" for a in routine.arguments]
     python_arguments = [a for a in routine.arguments if a != "p"] + ["p=None"]
     return {
-        "name": routine.name, "unused": list(routine.unused), "output": output,
+        "name": routine.name, "arguments": list(routine.arguments),
+        "unused": list(routine.unused), "output": output,
         "temporaries": list(routine.temporaries), "outputs": list(routine.outputs),
         # C99 restrict on the output (definitions only; the header keeps plain []): it never
         # overlaps the inputs, and knowing so lets the compiler keep q[i] in a register across

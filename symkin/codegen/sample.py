@@ -8,6 +8,7 @@ small assembly of its own, so code generation never depends on the runtime drive
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -27,7 +28,10 @@ NEWTON = runtime_options.defaults("double")
 def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> sparse_lu.LUPlan:
     """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration."""
     kernel = _SampleKernel(system, pattern)
-    sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        # A singular first guess (SciPy's LinAlgWarning) is expected here and handled.
+        warnings.simplefilter("ignore")
+        sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
     try:
         plan = sparse_lu.analyse(len(system.q), [r for r, _ in pattern],
                                  [c for _, c in pattern], [float(v) for v in sample])
@@ -80,11 +84,13 @@ class _SampleKernel:
                                            for r, c in pattern], modules="numpy")
         self._p = np.array(system.p_values, dtype=float)
 
+    # t as a NumPy float: IEEE semantics as in the generated code (inf, NaN), never a Python
+    # ZeroDivisionError or a complex power.
     def phi(self, q: Any, t: float, p: Any = None) -> np.ndarray:
-        return np.array(self._phi(q, t, self._p if p is None else p), dtype=float)
+        return np.array(self._phi(q, np.float64(t), self._p if p is None else p), dtype=float)
 
     def phi_q_nz(self, q: Any, t: float, p: Any = None) -> np.ndarray:
-        return np.array(self._nz(q, t, self._p if p is None else p), dtype=float)
+        return np.array(self._nz(q, np.float64(t), self._p if p is None else p), dtype=float)
 
     def phi_q(self, q: Any, t: float, p: Any = None) -> np.ndarray:
         dense = np.zeros((len(self.coordinates),) * 2)

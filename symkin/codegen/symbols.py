@@ -10,7 +10,8 @@ import re
 
 import sympy as sp
 
-from symkin.errors import BuildError
+from symkin.errors import BuildError, ExpressionError
+from symkin.spec import constants
 from symkin.symbolic.derivation import System
 
 _INTERNAL = re.compile(r"_(q|dq|p)(\d+)\Z")
@@ -42,8 +43,21 @@ def internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:
 
 
 def prepare(expr: sp.Expr, internal: dict[sp.Symbol, sp.Symbol]) -> sp.Expr:
-    """Internal symbols, and the step functions in a form every printer knows."""
+    """Internal symbols, no DiracDelta, and every constant part a plain number.
+
+    Constants are folded to correctly rounded doubles (:func:`constants.fold`), so no printer
+    ever meets ``sqrt(2)`` (C99 would print the POSIX macro ``M_SQRT2``) or an integer wider
+    than a C integer constant.
+
+    Raises:
+        BuildError: a constant part has no finite real value.
+    """
     expr = sp.sympify(expr).xreplace(internal)
     # d/dx Heaviside is DiracDelta, which is zero wherever it can be evaluated in floats.
-    expr = expr.replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: sp.Integer(0))
-    return expr.rewrite(sp.Piecewise) if expr.has(sp.Heaviside, sp.sign) else expr
+    if expr.has(sp.DiracDelta):
+        expr = expr.replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: sp.Integer(0))
+    try:
+        return constants.fold(expr)
+    except ExpressionError as error:
+        raise BuildError(f"cannot generate code for {sp.sstr(expr)[:200]}: "
+                         f"{error.message}") from None

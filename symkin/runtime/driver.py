@@ -30,7 +30,7 @@ from symkin import limits
 from symkin.errors import SolveError
 from symkin.runtime.linalg import dependent_rows, factor_at
 from symkin.runtime.newton import Newton, assemble, newton
-from symkin.runtime.options import NO_CONVERGENCE, OK, SINGULAR, Options
+from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.options import defaults as newton_defaults
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.results import Trajectory
@@ -66,7 +66,7 @@ class SolveFailure(SolveError):
         residual: max |Phi| of the last iterate.
         iterations: Newton iterations spent at t.
         rows: labels of the dependent equations when Phi_q was singular, else ().
-        reason: "singular", "no convergence" or "no assembly".
+        reason: "singular", "no convergence", "no assembly" or "not finite".
     """
 
     def __init__(self, message: str, trajectory: Trajectory, t: float, residual: float,
@@ -161,6 +161,8 @@ def _python_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, option
         assert factors is not None  # newton returns the factors whenever it converges
         dq = factors.solve(-kernel.phi_t(q, t, p))  # (2.73)
         d2q = factors.solve(kernel.gamma(q, dq, t, p))  # (2.74)
+        if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(d2q))):
+            return Newton(q, NOT_FINITE, result.iterations, result.residual, None)
         run.q[k], run.dq[k], run.d2q[k] = q, dq, d2q
         run.done = k + 1
         if progress is not None:
@@ -242,6 +244,15 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         SolveFailure (a SolveError) with the partial trajectory when the mechanism cannot be
         assembled at t[0], Newton does not converge, or Phi_q is singular.
     """
+    # An expression singular at some t gives inf/NaN there; that is reported as a failure
+    # (status NOT_FINITE), so NumPy's floating-point warnings would only repeat it.
+    with np.errstate(all="ignore"):
+        return _solve(kernel, t, q0, params, options, progress, use_c_solver)
+
+
+def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
+           params: Mapping[str, float] | ArrayLike | None, options: Options | None,
+           progress: Progress | None, use_c_solver: bool) -> Trajectory:
     times = _times(kernel, t)
     p = _params(kernel, params)
     options = options or default_options(kernel)
@@ -289,10 +300,17 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
           assembling: bool) -> None:
     """Raise SolveFailure with a message that says where, why and what to try."""
     labels = list(kernel.rows)
-    rows, near = _singular_rows(kernel, run, p, result, t)
     where = f"at t = {t:.10g}"
+    not_finite = _not_finite(kernel, result.q, t, p) if result.status in (NOT_FINITE, SINGULAR) \
+        else None
+    rows, near = ([], None) if not_finite else _singular_rows(kernel, run, p, result, t)
     facts = f"(residual max|Phi| = {result.residual:.3g} after {result.iterations} iterations)"
-    if assembling and not rows:
+    if not_finite:
+        reason = "not finite"
+        message = (f"{not_finite} is not finite {where}: an expression in it is singular there "
+                   "(a division by zero, the root or logarithm of a negative number, or a "
+                   "derivative of such). End the time grid before it, or change the expression.")
+    elif assembling and not rows:
         reason = "no assembly"
         worst = _worst_rows(kernel.phi(result.q, t, p), labels)
         message = (f"the mechanism cannot be assembled {where} {facts}: no position satisfies "
@@ -313,6 +331,27 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
                    "dt, or check that the drivers are smooth and reachable.")
     raise SolveFailure(message, _trajectory(kernel, run, p), t, result.residual,
                        result.iterations, rows, reason)
+
+
+def _not_finite(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> str | None:
+    """The first of Phi, Phi_q, Phi_t, Gamma that is inf or NaN at (q, t), as the row of the
+    mechanism it comes from, or None when all four are finite."""
+    labels = list(kernel.rows)
+    phi = kernel.phi(q, t, p)
+    jacobian = kernel.phi_q(q, t, p)
+    phi_t = kernel.phi_t(q, t, p)
+    for name, values in (("Phi", phi), ("Phi_t", phi_t)):
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            return f"{name} in row {bad[0]} ({labels[bad[0]]})"
+    bad_entries = np.argwhere(~np.isfinite(jacobian))
+    if bad_entries.size:
+        return f"Phi_q in row {bad_entries[0][0]} ({labels[bad_entries[0][0]]})"
+    dq = np.linalg.lstsq(jacobian, -phi_t, rcond=None)[0]
+    bad = np.flatnonzero(~np.isfinite(kernel.gamma(q, dq, t, p)))
+    if bad.size:
+        return f"Gamma in row {bad[0]} ({labels[bad[0]]})"
+    return None
 
 
 def _singular_rows(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.runtime.linalg import Factors, SparseFactors, factor_at
-from symkin.runtime.options import NO_CONVERGENCE, OK, SINGULAR, Options
+from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
@@ -38,8 +38,9 @@ def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Opti
     for iteration in range(options.max_iterations + 1):
         phi = kernel.phi(q, t, p)
         residual = float(np.abs(phi).max(initial=0.0))
-        if not math.isfinite(residual):
-            return Newton(q, NO_CONVERGENCE, iteration, residual, None)
+        if not math.isfinite(residual):  # singular at t (first iterate), or diverged
+            return Newton(q, NOT_FINITE if iteration == 0 else NO_CONVERGENCE, iteration,
+                          residual, None)
         factors = factor_at(kernel, q, t, p)
         if factors.pivot_ratio < options.min_pivot_ratio:
             return Newton(q, SINGULAR, iteration, residual, factors)

@@ -7,7 +7,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 # Status codes shared with the generated C solver (templates/c/solver.h.j2).
-OK, NO_CONVERGENCE, SINGULAR = 0, 1, 2
+# NOT_FINITE: Phi at the predicted q, or the velocity or acceleration, is inf or NaN, i.e. an
+# expression of the mechanism is singular at that time (a time function such as 1/(t - 0.5)).
+OK, NO_CONVERGENCE, SINGULAR, NOT_FINITE = 0, 1, 2, 3
 
 
 @dataclass(frozen=True)

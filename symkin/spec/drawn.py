@@ -25,7 +25,7 @@ import sympy as sp
 import yaml
 
 from symkin.errors import ExpressionError, MechanismError
-from symkin.spec import expressions
+from symkin.spec import constants, expressions
 from symkin.spec.schema import MechanismSpec
 
 GROUND = "ground"
@@ -61,7 +61,7 @@ class _Context:
         self.values: dict[sp.Symbol, float] = {}
         for name, raw in parameters.items():
             try:
-                self.values[self.symbols[name]] = float(expressions.parse(raw, {}))
+                self.values[self.symbols[name]] = constants.value(expressions.parse(raw, {}))
             except (ExpressionError, TypeError, ValueError):
                 continue  # validation of the local form names it
 
@@ -71,11 +71,13 @@ class _Context:
         if not isinstance(raw, str):
             return Q(raw, float(raw))
         try:
-            value = float(expressions.parse(raw, self.symbols).subs(self.values))
+            expr = expressions.parse(raw, self.symbols)
         except ExpressionError as error:
             raise MechanismError(str(error), path, "Use numbers, parameter names, pi, E and "
                                  "the listed functions.") from None
-        except (TypeError, ValueError, OverflowError, ZeroDivisionError):
+        try:
+            value = constants.value(expr, self.values)
+        except ExpressionError:
             value = math.nan
         if not math.isfinite(value):
             raise MechanismError(f"{raw!r} is not a finite real number at the nominal "

@@ -15,11 +15,13 @@ from collections.abc import Callable, Mapping, Sequence
 import sympy as sp
 
 from symkin.errors import ExpressionError
+from symkin.spec import constants
 
 MAX_LENGTH = 1000
 MAX_DEPTH = 60
 MAX_EXPONENT = 64
 MAX_DIGITS = 300
+MAX_DERIVATIVE_OPS = 20000
 
 # What a number-or-expression field may hold in a mechanism file.
 RawExpr = int | float | str
@@ -259,7 +261,43 @@ def parse(
     if expr.has(sp.I):
         raise ExpressionError("the expression is not real (the root or logarithm of a "
                               "negative number?)", text)
+    try:
+        constants.check_constants(expr)
+    except ExpressionError as error:
+        raise ExpressionError(error.message, text) from None
     return expr
+
+
+# What the code printers of every backend can print: the nodes the parser builds, and those
+# SymPy's derivatives of them introduce (sign from Abs, DiracDelta from Heaviside).
+_PRINTABLE: tuple[type, ...] = (
+    sp.Symbol, sp.Number, sp.NumberSymbol, sp.Add, sp.Mul, sp.Pow, sp.Piecewise,
+    sp.sign, sp.DiracDelta, sp.Heaviside, sp.Min, sp.Max, sp.Abs, sp.exp, sp.log,
+    sp.sin, sp.cos, sp.tan, sp.asin, sp.acos, sp.atan, sp.atan2, sp.sinh, sp.cosh, sp.tanh,
+    sp.core.relational.Relational, sp.logic.boolalg.BooleanAtom, sp.functions.elementary.
+    piecewise.ExprCondPair,
+)
+
+
+def check_derivatives(expr: sp.Expr, variables: Sequence[sp.Symbol], text: str) -> None:
+    """Refuse an expression whose first or second derivatives need functions no backend
+    prints (``Abs(t**t)`` differentiates into ``re`` and ``im``), or grow past the size limit.
+
+    Raises:
+        ExpressionError: naming the function that appeared, or the size.
+    """
+    first = [sp.diff(expr, v) for v in variables]
+    second = [sp.diff(d, v) for d in first for v in variables]
+    for derivative in [expr, *first, *second]:
+        if sp.count_ops(derivative) > MAX_DERIVATIVE_OPS:
+            raise ExpressionError(f"its derivatives grow past {MAX_DERIVATIVE_OPS} operations; "
+                                  f"simplify it", text)
+        for node in sp.preorder_traversal(derivative):
+            if not isinstance(node, _PRINTABLE):
+                raise ExpressionError(
+                    f"its derivative needs {type(node).__name__}(), which symkin cannot "
+                    f"generate code for (is every argument of Abs, log and powers real "
+                    f"for every t?)", text)
 
 
 def parse_time_function(raw: RawExpr | Mapping[str, Sequence[RawExpr]],

@@ -5,7 +5,6 @@ degree-of-freedom count. Every mistake is a :class:`MechanismError` with the fie
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,7 +15,7 @@ from pydantic import ValidationError, model_validator
 
 from symkin.errors import ExpressionError, MechanismError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
-from symkin.spec import drawn, drawn_schema, expressions, loader
+from symkin.spec import constants, drawn, drawn_schema, expressions, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
 from symkin.spec.schema import (
@@ -158,14 +157,12 @@ def _numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float],
              path: tuple[str | int, ...]) -> float:
     """The value of ``expr`` at the nominal parameters: a finite real number, or an error."""
     try:
-        number = float(expr.subs(values))
-    except (TypeError, ValueError, OverflowError, ZeroDivisionError):
-        number = math.nan  # complex (sqrt(-1), asin(2)) or too large for a float
-    if not math.isfinite(number):
-        raise MechanismError(f"{sp.sstr(expr)} is not a finite real number at the nominal "
-                             f"parameter values", path,
-                             "Check the arguments of sqrt, log, asin, acos and the magnitudes.")
-    return number
+        return constants.value(expr, values)
+    except ExpressionError as error:
+        raise MechanismError(f"{sp.sstr(expr)[:120]} has no finite real value at the nominal "
+                             f"parameter values: {error.message}", path,
+                             "Check the arguments of sqrt, log, asin, acos and the "
+                             "magnitudes.") from None
 
 
 def _expression(raw: Any, symbols: _Names | None, path: tuple[str | int, ...],
@@ -182,8 +179,13 @@ def _expression(raw: Any, symbols: _Names | None, path: tuple[str | int, ...],
     try:
         if time and isinstance(raw, Mapping):
             return expressions.parse_time_function(raw, names, symbols.t)  # type: ignore[union-attr]
-        return expressions.parse(raw, names, symbols.by_coordinate if coordinates and symbols
+        expr = expressions.parse(raw, names, symbols.by_coordinate if coordinates and symbols
                                  else None)
+        if time and symbols:
+            # Phi_t and Gamma differentiate it: their derivatives must be printable too.
+            variables = [symbols.t, *sorted(expr.free_symbols & set(symbols.q), key=str)]
+            expressions.check_derivatives(expr, variables, str(raw))
+        return expr
     except ExpressionError as error:
         hint = "Use numbers, parameter names, pi, E, + - * / ** and the listed functions"
         hint += ", and t." if time else "."

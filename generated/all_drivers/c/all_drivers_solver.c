@@ -61,8 +61,8 @@ static int all_drivers_newton(const all_drivers_options *options, const all_driv
         residual = all_drivers_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
-        if (residual - residual != 0) { /* inf or NaN */
-            return ALL_DRIVERS_NO_CONVERGENCE;
+        if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
+            return iteration == 0 ? ALL_DRIVERS_NOT_FINITE : ALL_DRIVERS_NO_CONVERGENCE;
         }
         if (all_drivers_factor_jacobian(options, p, t, q, work, report) != ALL_DRIVERS_OK) {
             return ALL_DRIVERS_SINGULAR;
@@ -117,6 +117,12 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
     all_drivers_lu_solve(&work->lu, state->dq); /* (2.73) */
     all_drivers_gamma(state->q, state->dq, t, p, state->ddq);
     all_drivers_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
+            report->status = ALL_DRIVERS_NOT_FINITE; /* Phi_t or Gamma singular at t */
+            return report->status;
+        }
+    }
     state->t = t;
     state->started = 1;
     return ALL_DRIVERS_OK;

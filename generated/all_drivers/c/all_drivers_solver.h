@@ -16,8 +16,9 @@
 #include "all_drivers_sparse_lu.h"
 
 #define ALL_DRIVERS_OK 0             /* converged */
-#define ALL_DRIVERS_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
+#define ALL_DRIVERS_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define ALL_DRIVERS_SINGULAR 2       /* Phi_q singular or ill-conditioned */
+#define ALL_DRIVERS_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
 
 typedef struct {
     all_drivers_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -27,7 +28,7 @@ typedef struct {
 } all_drivers_options;
 
 typedef struct {
-    int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE or _SINGULAR */
+    int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     all_drivers_real t;         /* the time of the last step attempted           */
     all_drivers_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */

@@ -79,6 +79,7 @@ def phi(q, t, p=None):
     """Phi(q, t), shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w0 = numpy.sin(q[5])
     w1 = q[3] - q[6]
     w2 = numpy.cos(q[5])
@@ -166,6 +167,7 @@ def phi_t(q, t, p=None):
     """Phi_t(q, t), shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w0 = p[7]*t
     w1 = numpy.sin(w0)
     w2 = p[4]*p[7]
@@ -187,6 +189,7 @@ def gamma(q, dq, t, p=None):
     """Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w0 = (dq[2]*dq[2])*p[0]
     w1 = numpy.cos(q[5])
     w2 = dq[6]*w1

@@ -61,8 +61,8 @@ static int custom_driver_newton(const custom_driver_options *options, const cust
         residual = custom_driver_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
-        if (residual - residual != 0) { /* inf or NaN */
-            return CUSTOM_DRIVER_NO_CONVERGENCE;
+        if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
+            return iteration == 0 ? CUSTOM_DRIVER_NOT_FINITE : CUSTOM_DRIVER_NO_CONVERGENCE;
         }
         if (custom_driver_factor_jacobian(options, p, t, q, work, report) != CUSTOM_DRIVER_OK) {
             return CUSTOM_DRIVER_SINGULAR;
@@ -117,6 +117,12 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
     custom_driver_lu_solve(&work->lu, state->dq); /* (2.73) */
     custom_driver_gamma(state->q, state->dq, t, p, state->ddq);
     custom_driver_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
+            report->status = CUSTOM_DRIVER_NOT_FINITE; /* Phi_t or Gamma singular at t */
+            return report->status;
+        }
+    }
     state->t = t;
     state->started = 1;
     return CUSTOM_DRIVER_OK;

@@ -16,8 +16,9 @@
 #include "custom_driver_sparse_lu.h"
 
 #define CUSTOM_DRIVER_OK 0             /* converged */
-#define CUSTOM_DRIVER_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
+#define CUSTOM_DRIVER_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define CUSTOM_DRIVER_SINGULAR 2       /* Phi_q singular or ill-conditioned */
+#define CUSTOM_DRIVER_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
 
 typedef struct {
     custom_driver_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -27,7 +28,7 @@ typedef struct {
 } custom_driver_options;
 
 typedef struct {
-    int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE or _SINGULAR */
+    int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     custom_driver_real t;         /* the time of the last step attempted           */
     custom_driver_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */

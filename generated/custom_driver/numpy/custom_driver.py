@@ -62,6 +62,7 @@ def phi(q, t, p=None):
     """Phi(q, t), shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w0 = p[0]*numpy.cos(q[2]) + q[0]
     w1 = p[0]*numpy.sin(q[2]) + q[1]
     w3 = p[2]*t
@@ -83,6 +84,7 @@ def phi_q_nz(q, t, p=None):
     """The non-zeros of Phi_q in pattern order, shape (NNZ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w0 = p[0]*numpy.sin(q[2])
     w1 = p[0]*numpy.cos(q[2])
     w2 = p[2]*t
@@ -116,6 +118,7 @@ def phi_t(q, t, p=None):
     """Phi_t(q, t), shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w0 = p[2]*t
     w1 = p[2]*p[3]*numpy.cos(w0) + p[2]
     w2 = p[3]*numpy.sin(w0) + p[4] + w0
@@ -128,6 +131,7 @@ def gamma(q, dq, t, p=None):
     """Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w0 = (dq[2]*dq[2])
     w1 = numpy.cos(q[2])
     w2 = p[0]*w1

@@ -61,8 +61,8 @@ static int four_bar_newton(const four_bar_options *options, const four_bar_real 
         residual = four_bar_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
-        if (residual - residual != 0) { /* inf or NaN */
-            return FOUR_BAR_NO_CONVERGENCE;
+        if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
+            return iteration == 0 ? FOUR_BAR_NOT_FINITE : FOUR_BAR_NO_CONVERGENCE;
         }
         if (four_bar_factor_jacobian(options, p, t, q, work, report) != FOUR_BAR_OK) {
             return FOUR_BAR_SINGULAR;
@@ -117,6 +117,12 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
     four_bar_lu_solve(&work->lu, state->dq); /* (2.73) */
     four_bar_gamma(state->q, state->dq, t, p, state->ddq);
     four_bar_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    for (i = 0; i < FOUR_BAR_NQ; ++i) {
+        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
+            report->status = FOUR_BAR_NOT_FINITE; /* Phi_t or Gamma singular at t */
+            return report->status;
+        }
+    }
     state->t = t;
     state->started = 1;
     return FOUR_BAR_OK;

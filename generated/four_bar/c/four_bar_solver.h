@@ -16,8 +16,9 @@
 #include "four_bar_sparse_lu.h"
 
 #define FOUR_BAR_OK 0             /* converged */
-#define FOUR_BAR_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
+#define FOUR_BAR_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define FOUR_BAR_SINGULAR 2       /* Phi_q singular or ill-conditioned */
+#define FOUR_BAR_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
 
 typedef struct {
     four_bar_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -27,7 +28,7 @@ typedef struct {
 } four_bar_options;
 
 typedef struct {
-    int status;                  /* FOUR_BAR_OK, _NO_CONVERGENCE or _SINGULAR */
+    int status;                  /* FOUR_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     four_bar_real t;         /* the time of the last step attempted           */
     four_bar_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */

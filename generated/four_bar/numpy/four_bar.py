@@ -64,6 +64,7 @@ def phi(q, t, p=None):
     """Phi(q, t), shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     out = numpy.zeros(9)
     out[0] = -q[0]  # joints[0] O2 revolute ground-crank (x)
     out[1] = -q[1]  # joints[0] O2 revolute ground-crank (y)

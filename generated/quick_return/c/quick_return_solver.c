@@ -61,8 +61,8 @@ static int quick_return_newton(const quick_return_options *options, const quick_
         residual = quick_return_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
-        if (residual - residual != 0) { /* inf or NaN */
-            return QUICK_RETURN_NO_CONVERGENCE;
+        if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
+            return iteration == 0 ? QUICK_RETURN_NOT_FINITE : QUICK_RETURN_NO_CONVERGENCE;
         }
         if (quick_return_factor_jacobian(options, p, t, q, work, report) != QUICK_RETURN_OK) {
             return QUICK_RETURN_SINGULAR;
@@ -117,6 +117,12 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
     quick_return_lu_solve(&work->lu, state->dq); /* (2.73) */
     quick_return_gamma(state->q, state->dq, t, p, state->ddq);
     quick_return_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
+            report->status = QUICK_RETURN_NOT_FINITE; /* Phi_t or Gamma singular at t */
+            return report->status;
+        }
+    }
     state->t = t;
     state->started = 1;
     return QUICK_RETURN_OK;

@@ -16,8 +16,9 @@
 #include "quick_return_sparse_lu.h"
 
 #define QUICK_RETURN_OK 0             /* converged */
-#define QUICK_RETURN_NO_CONVERGENCE 1 /* iteration cap reached, or Phi not finite */
+#define QUICK_RETURN_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define QUICK_RETURN_SINGULAR 2       /* Phi_q singular or ill-conditioned */
+#define QUICK_RETURN_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
 
 typedef struct {
     quick_return_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -27,7 +28,7 @@ typedef struct {
 } quick_return_options;
 
 typedef struct {
-    int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE or _SINGULAR */
+    int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     quick_return_real t;         /* the time of the last step attempted           */
     quick_return_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */

@@ -70,6 +70,7 @@ def phi(q, t, p=None):
     """Phi(q, t), shape (NQ,)."""
     if p is None:
         p = P_VALUES
+    t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
     w2 = numpy.cos(q[5])
     w3 = numpy.sin(q[5])
     out = numpy.zeros(12)

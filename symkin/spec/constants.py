@@ -1,0 +1,264 @@
+"""Bounded numeric evaluation of expressions: a value, or a refusal that says why.
+
+SymPy's own evaluation (``float(expr)``, ``evalf``) raises the working precision until it is
+sure of the digits it returns, so ``sin(exp(100000000))`` takes many minutes. Here an
+expression tree is evaluated with mpmath at a fixed ladder of precisions (120 bits, doubled up
+to 1920): two successive precisions must agree to double precision, or the value is refused.
+Arguments no double-precision code could evaluate meaningfully are refused before any work is
+done: trigonometric arguments beyond 1e15, magnitudes beyond 1e300.
+
+The same evaluator serves validation (a parameter, a point, the time grid at the nominal
+parameter values) and code generation (constant parts of an expression become correctly
+rounded literals, :func:`fold`), so what is accepted is what is generated.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+import mpmath
+import sympy as sp
+
+from symkin.errors import ExpressionError
+
+START_BITS = 120
+MAX_BITS = 1920
+MAX_MAGNITUDE = 1e300
+MAX_TRIG_ARGUMENT = 1e15
+# Integers and rationals are printed exactly up to here; beyond, as correctly rounded reals
+# (a C integer constant wider than long long is truncated, and no double holds more digits).
+MAX_EXACT_INTEGER = 2**53
+
+_Number = mpmath.mpf
+
+
+class _Refused(Exception):
+    """Inside the evaluator: the expression has no finite real value symkin will compute."""
+
+
+def _check(x: _Number, what: str) -> _Number:
+    if not mpmath.isfinite(x):
+        raise _Refused(f"{what} is not finite")
+    if abs(x) > MAX_MAGNITUDE:
+        raise _Refused(f"{what} is larger than {MAX_MAGNITUDE:g} in magnitude")
+    return x
+
+
+def _trig(function: Callable[[_Number], _Number], name: str) -> Callable[[_Number], _Number]:
+    def evaluate(x: _Number) -> _Number:
+        if abs(x) > MAX_TRIG_ARGUMENT:
+            raise _Refused(f"the argument of {name} is larger than {MAX_TRIG_ARGUMENT:g}: no "
+                           f"double-precision code can evaluate it meaningfully")
+        return function(x)
+    return evaluate
+
+
+def _domain(function: Callable[[_Number], _Number], name: str,
+            inside: Callable[[_Number], bool], where: str) -> Callable[[_Number], _Number]:
+    def evaluate(x: _Number) -> _Number:
+        if not inside(x):
+            raise _Refused(f"{name} of {mpmath.nstr(x, 6)} is not real ({where})")
+        return function(x)
+    return evaluate
+
+
+def _exponential(function: Callable[[_Number], _Number], name: str
+                 ) -> Callable[[_Number], _Number]:
+    def evaluate(x: _Number) -> _Number:
+        if abs(x) > 709:
+            if name == "exp" and x < 0:
+                return mpmath.mpf(0)
+            raise _Refused(f"{name} of {mpmath.nstr(x, 6)} is larger than the largest double")
+        return function(x)
+    return evaluate
+
+
+def _atan2(y: _Number, x: _Number) -> _Number:
+    if x == 0 and y == 0:
+        raise _Refused("atan2(0, 0) is undefined")
+    return mpmath.atan2(y, x)
+
+
+def _heaviside(x: _Number, at_zero: _Number = mpmath.mpf(0.5)) -> _Number:
+    return mpmath.mpf(1) if x > 0 else mpmath.mpf(0) if x < 0 else at_zero
+
+
+def _sign(x: _Number) -> _Number:
+    return mpmath.mpf(mpmath.sign(x))
+
+
+_FUNCTIONS: Mapping[type, Callable[..., _Number]] = {
+    sp.sin: _trig(mpmath.sin, "sin"),
+    sp.cos: _trig(mpmath.cos, "cos"),
+    sp.tan: _trig(mpmath.tan, "tan"),
+    sp.exp: _exponential(mpmath.exp, "exp"),
+    sp.sinh: _exponential(mpmath.sinh, "sinh"),
+    sp.cosh: _exponential(mpmath.cosh, "cosh"),
+    sp.tanh: mpmath.tanh,
+    sp.log: _domain(mpmath.log, "log", lambda x: x > 0, "log needs a positive argument"),
+    sp.asin: _domain(mpmath.asin, "asin", lambda x: -1 <= x <= 1, "asin needs -1 <= x <= 1"),
+    sp.acos: _domain(mpmath.acos, "acos", lambda x: -1 <= x <= 1, "acos needs -1 <= x <= 1"),
+    sp.atan: mpmath.atan,
+    sp.atan2: _atan2,
+    sp.Abs: abs,
+    sp.sign: _sign,
+    sp.Heaviside: _heaviside,
+    sp.Min: lambda *xs: min(xs),
+    sp.Max: lambda *xs: max(xs),
+}
+
+_RELATIONS: Mapping[type, Callable[[_Number, _Number], bool]] = {
+    sp.StrictLessThan: lambda a, b: bool(a < b),
+    sp.LessThan: lambda a, b: bool(a <= b),
+    sp.StrictGreaterThan: lambda a, b: bool(a > b),
+    sp.GreaterThan: lambda a, b: bool(a >= b),
+    sp.Equality: lambda a, b: bool(a == b),
+    sp.Unequality: lambda a, b: bool(a != b),
+}
+
+
+class _Evaluator:
+    """One evaluation of a tree at the current mpmath precision."""
+
+    def __init__(self, values: Mapping[sp.Symbol, float]) -> None:
+        self.values = values
+        self.scale = mpmath.mpf(0)  # the largest magnitude met on the way
+
+    def __call__(self, node: sp.Basic) -> _Number:
+        result = _check(self._node(node), sp.sstr(node)[:80])
+        self.scale = max(self.scale, abs(result))
+        return result
+
+    def _node(self, node: sp.Basic) -> _Number:
+        if isinstance(node, sp.Rational):
+            return mpmath.mpf(node.p) / node.q
+        if isinstance(node, sp.Float):
+            return mpmath.mpf(node._mpf_)
+        if node is sp.pi:
+            return +mpmath.pi
+        if node is sp.E:
+            return +mpmath.e
+        if isinstance(node, sp.Symbol):
+            if node not in self.values:
+                raise _Refused(f"{node} has no value here")
+            return mpmath.mpf(self.values[node])
+        if isinstance(node, sp.Add):
+            return mpmath.fsum(self(arg) for arg in node.args)
+        if isinstance(node, sp.Mul):
+            return mpmath.fprod(self(arg) for arg in node.args)
+        if isinstance(node, sp.Pow):
+            return self._power(node)
+        if isinstance(node, sp.Piecewise):
+            return self._piecewise(node)
+        if isinstance(node, sp.DiracDelta):
+            return mpmath.mpf(0)  # zero wherever it can be evaluated in floats
+        function = _FUNCTIONS.get(type(node)) or _FUNCTIONS.get(getattr(node, "func", None))
+        if function is None:
+            raise _Refused(f"symkin cannot evaluate {type(node).__name__}")
+        return function(*(self(arg) for arg in node.args))
+
+    def _power(self, node: sp.Pow) -> _Number:
+        base = self(node.base)
+        exponent = node.exp
+        if isinstance(exponent, sp.Integer):
+            if base == 0 and exponent < 0:
+                raise _Refused(f"{sp.sstr(node)[:80]} divides by zero")
+            return base ** int(exponent)
+        power = self(exponent)
+        if base < 0:
+            raise _Refused(f"{sp.sstr(node)[:80]} is a fractional power of a negative number, "
+                           f"which is not real")
+        if base == 0 and power <= 0:
+            raise _Refused(f"{sp.sstr(node)[:80]} divides by zero")
+        if base > 0 and power * mpmath.log(base) > 709:
+            raise _Refused(f"{sp.sstr(node)[:80]} is larger than the largest double")
+        return base**power
+
+    def _piecewise(self, node: sp.Piecewise) -> _Number:
+        for value, condition in node.args:
+            if self._holds(condition):
+                return self(value)
+        raise _Refused("no condition of a Piecewise holds")
+
+    def _holds(self, condition: sp.Basic) -> bool:
+        if condition is sp.true:
+            return True
+        if condition is sp.false:
+            return False
+        relation = _RELATIONS.get(type(condition))
+        if relation is None:
+            raise _Refused(f"symkin cannot evaluate the condition {condition}")
+        return relation(self(condition.lhs), self(condition.rhs))
+
+
+def value(expr: sp.Basic, values: Mapping[sp.Symbol, float] | None = None) -> float:
+    """The value of ``expr`` as a double, with its symbols set to ``values``.
+
+    Raises:
+        ExpressionError: the value is not a finite real number, needs more than the bounded
+            precision to be known to double precision, or is beyond what a double holds.
+    """
+    values = values or {}
+    previous: tuple[float, bool] | None = None
+    bits = START_BITS
+    while bits <= MAX_BITS:
+        evaluator = _Evaluator(values)
+        try:
+            with mpmath.workprec(bits):
+                result = evaluator(expr)
+        except _Refused as why:
+            raise ExpressionError(str(why)) from None
+        number = float(result)
+        # Below the rounding noise of the largest intermediate: zero at this precision.
+        noise = abs(result) <= evaluator.scale * mpmath.mpf(2) ** (8 - bits)
+        if previous is not None:
+            if _agree(previous[0], number):
+                return number
+            if previous[1] and noise:
+                return 0.0
+        previous = (number, noise)
+        bits *= 2
+    raise ExpressionError(f"its value is not known to double precision at {MAX_BITS} bits of "
+                          f"working precision (it cancels too much)")
+
+
+def _agree(a: float, b: float) -> bool:
+    return a == b or abs(a - b) <= 4 * 2.0**-53 * max(abs(a), abs(b))
+
+
+def is_plain_number(expr: sp.Basic) -> bool:
+    """A number every backend prints exactly: a float, or a not too large integer/rational."""
+    if isinstance(expr, sp.Float):
+        return True
+    if isinstance(expr, sp.Rational):
+        return abs(expr.p) <= MAX_EXACT_INTEGER and expr.q <= MAX_EXACT_INTEGER
+    return False
+
+
+def fold(expr: sp.Expr) -> sp.Expr:
+    """Replace each largest constant part of ``expr`` that is not a plain number by its value.
+
+    ``sqrt(2)*t`` -> ``1.4142135623730951*t``; ``Min(c, 18446744073709551617)`` keeps c and
+    folds the integer to the nearest double. The printers then only ever see plain numbers.
+
+    Raises:
+        ExpressionError: a constant part has no value (see :func:`value`).
+    """
+    replacements: dict[sp.Basic, sp.Basic] = {}
+
+    def visit(node: sp.Basic) -> None:
+        if isinstance(node, sp.Expr) and not node.free_symbols:
+            if not is_plain_number(node):
+                replacements[node] = sp.Float(value(node), 17)
+            return
+        for arg in node.args:
+            visit(arg)
+
+    visit(expr)
+    return expr.xreplace(replacements) if replacements else expr
+
+
+def check_constants(expr: sp.Expr) -> None:
+    """Evaluate every largest constant part of ``expr`` once, so a constant with no value (or
+    one the bounded evaluator refuses) is reported where the expression is written."""
+    fold(expr)
