@@ -91,3 +91,7 @@ class SymkinWarning(UserWarning):
 class UsageError(SymkinError):
     """A request that cannot be carried out as given (a bad path, an option that does not
     fit); the command line exits with status 2."""
+
+
+class NoCompilerError(UsageError, BuildError):
+    """The C backend was asked for by name and there is no C compiler (exit status 2)."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -22,6 +23,16 @@ def crank_slider_system(crank_slider_path: Path):
     import symkin
 
     return symkin.derive(crank_slider_path)
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Under CI, a tool it installed (SYMKIN_REQUIRE_TOOLS) must be found: the tests that need
+    it would otherwise skip, and a C test that skips proves nothing."""
+    required = os.environ.get("SYMKIN_REQUIRE_TOOLS", "").split()
+    missing = [tool for tool in required if shutil.which(tool) is None]
+    if missing:
+        pytest.exit(f"required tools not found on PATH: {', '.join(missing)} (CI installed "
+                    "them; their tests must run, not skip)", returncode=1)
 
 
 @pytest.fixture(scope="session", autouse=True)

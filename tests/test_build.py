@@ -116,16 +116,32 @@ def test_a_real_compile_error_is_reported(tmp_path: Path) -> None:
         build.run([compilers()[0], "-c", str(source)], tmp_path)
 
 
-def test_no_compiler_warns_once_and_falls_back(cache: Path,
-                                               monkeypatch: pytest.MonkeyPatch) -> None:
+def test_auto_without_a_compiler_notes_once_and_uses_numpy(
+        cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CC", "/nonexistent/cc")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        k = symkin.compile(system("crank_slider"), "c")
+        k = symkin.compile(system("crank_slider"))  # backend="auto"
     messages = [str(w.message) for w in caught]
     assert len(messages) == 1 and "no C compiler" in messages[0] and "CC" in messages[0]
     assert k.backend == "numpy"
     assert k.phi(np.zeros(9), 0.0)[8] == pytest.approx(-np.pi / 2)
+
+
+def test_explicit_c_without_a_compiler_is_an_error_not_numpy(
+        cache: Path, monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    from symkin import cli
+    from symkin.errors import NoCompilerError
+
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    with pytest.raises(NoCompilerError, match="apt install gcc"):
+        symkin.compile(system("crank_slider"), "c")
+    example = Path(__file__).resolve().parent.parent / "examples" / "crank_slider.yaml"
+    status = cli.main(["run", str(example), "--backend", "c", "-o", str(tmp_path / "r.npz")])
+    assert status == cli.EXIT_BAD_INPUT
+    assert "needs a C compiler" in capsys.readouterr().err
+    assert not (tmp_path / "r.npz").exists()
 
 
 def test_kernel_checks_argument_shapes(cache: Path) -> None:

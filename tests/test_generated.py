@@ -157,6 +157,44 @@ def test_c_compiles_without_warnings(name: str, real: str, tmp_path: Path) -> No
     _assert_no_mutable_data(sorted(tmp_path.glob("*.o")))
 
 
+NO_POINTS_NO_PARAMETERS = {
+    "name": "bare_pendulum", "parameters": {},
+    "bodies": {"arm": {"q0": [0, 0, 0]}},
+    "joints": [{"type": "revolute", "i": "ground", "j": "arm", "sA": [0, 0], "sB": [0, 0]}],
+    "drivers": [{"type": "angle", "i": "arm", "j": "ground", "theta": "sqrt(2)*t + pi/3"}],
+    "time": {"t0": 0, "t1": 1, "dt": 0.5},
+}
+
+
+def _test_mechanisms() -> list[str]:
+    return sorted(path.stem for path in (ROOT / "tests" / "mechanisms").glob("*.yaml")) + [
+        "andrews_squeezer", "bare_pendulum"]
+
+
+@pytest.mark.skipif(not compilers(), reason="neither gcc nor clang is installed")
+@pytest.mark.parametrize("real", ["double", "float"])
+@pytest.mark.parametrize("name", _test_mechanisms())
+def test_every_test_mechanism_compiles_with_the_advertised_flags(name: str, real: str,
+                                                                 tmp_path: Path) -> None:
+    """-std=c99 -Wall -Wextra -pedantic -Werror, double and float, with every compiler found:
+    also a mechanism with no named points and no parameters (nothing unused may warn)."""
+    import symkin
+
+    if name == "bare_pendulum":
+        mechanism = symkin.from_dict(NO_POINTS_NO_PARAMETERS)
+    elif name == "andrews_squeezer":
+        mechanism = symkin.load(ROOT / "examples" / "andrews_squeezer.yaml")
+    else:
+        mechanism = symkin.load(ROOT / "tests" / "mechanisms" / f"{name}.yaml")
+    folder = tmp_path / "src"
+    render.generate(symkin.derive(mechanism), backend="c", out_dir=folder, real=real)
+    for compiler in compilers():
+        for source in sorted(folder.glob("*.c")):
+            result = compile_object(compiler, source, [*STRICT_FLAGS, "-Wdouble-promotion", "-O2"],
+                                    tmp_path / f"{compiler}_{source.stem}.o")
+            assert result.returncode == 0, f"{compiler} {source.name}:\n{result.stderr}"
+
+
 def _assert_no_mutable_data(objects: list[Path]) -> None:
     """No writable globals or statics: no symbol in .data or .bss (nm types D, d, B, b)."""
     nm = shutil.which("nm")

@@ -73,15 +73,18 @@ EXPECTED: dict[str, tuple[int, str]] = {
     # names
     "name_not_ascii.yaml": (4, "'żuraw' is not a plain ASCII identifier"),
     "name_with_dash.yaml": (1, "'my-pendulum' is not a plain ASCII identifier"),
-    "name_c_keyword.yaml": (4, "'int' is a C or Python keyword"),
-    "name_python_keyword.yaml": (2, "'lambda' is a C or Python keyword"),
-    "name_libm.yaml": (2, "'hypot' is the name of a C math library function"),
-    "name_t.yaml": (2, "'t' is reserved by symkin"),
-    "name_pi.yaml": (4, "'pi' is reserved by symkin"),
-    "name_ground.yaml": (5, "'ground' is reserved by symkin"),
-    "point_name_reserved.yaml": (4, "'sqrt' is reserved by symkin"),
-    "names_clash.yaml": (4, "the name 'crank' is already used at parameters.crank"),
-    "names_clash_case.yaml": (2, "the name 'A' is already used at parameters.a"),
+    "name_c_keyword.yaml": (1, "at name: 'int' is a C or Python keyword"),
+    "name_python_keyword.yaml": (2, "'lambda' is a Python keyword, which no expression can"),
+    "name_libm.yaml": (1, "at name: 'hypot' is the name of a C math library function"),
+    "name_t.yaml": (2, "at parameters.t: 't' is the time in expressions"),
+    "name_pi.yaml": (4, "at bodies.pi: 'pi' is a constant in expressions"),
+    "name_ground.yaml": (5, "'ground' is the fixed frame, present in every mechanism"),
+    "name_system_header.yaml": (1, "'string' would generate string.h, the name of a system"),
+    "names_clash.yaml": (4, "at bodies.crank: 'crank' is already used at parameters.crank"),
+    # every clash in one message, not one per run
+    "names_clash_all.yaml": (2, "4 names cannot be used: parameters.t: 't' is the time in "
+                                "expressions; parameters.pi: 'pi' is a constant in expressions; "
+                                "parameters.sin: 'sin' is a function in expressions"),
     # time grid
     "time_step_zero.yaml": (9, "the time step dt = 0.0 is not positive"),
     "time_backwards.yaml": (9, "the end time t1 = -1.0 is not after t0 = 0.0"),

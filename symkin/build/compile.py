@@ -31,7 +31,7 @@ from symkin.build.cache import content_key, open_cache, publish, verified
 from symkin.codegen import lower as codegen
 from symkin.codegen import render
 from symkin.codegen.cdef import from_headers as cdef_from_headers
-from symkin.errors import BuildError
+from symkin.errors import BuildError, NoCompilerError, SymkinWarning
 from symkin.runtime import kernel
 from symkin.symbolic.derivation import System
 
@@ -41,15 +41,42 @@ C_FLAGS = ("-std=c99", "-O2", "-fPIC")
 WRAPPER_FLAGS = ("-O2", "-fPIC")
 
 
-def compile(system: System, backend: str = "c", *, real: str = "double", cse: bool = True,
+BACKENDS = ("auto", "c", "numpy")
+
+
+def resolve_backend(backend: str) -> str:
+    """The backend to build: ``"auto"`` is C when a compiler is found, else NumPy with a
+    one-line note; an explicit ``"c"`` without a compiler is an error, never a silent NumPy.
+
+    Raises:
+        NoCompilerError: ``"c"`` was asked for and no C compiler is found.
+    """
+    if backend not in ("auto", "c"):
+        return backend
+    if toolchain.c_compiler() is not None:
+        return "c"
+    looked_for = os.environ.get("CC") or "cc"
+    if backend == "c":
+        raise NoCompilerError(
+            f"the C backend needs a C compiler and none was found (looked for {looked_for}). "
+            "Install one (Debian/Ubuntu: apt install gcc; macOS: xcode-select --install; "
+            "or conda install c-compiler), set CC to it, or use backend 'numpy' or 'auto'.")
+    warnings.warn(f"no C compiler found (looked for {looked_for}): using the NumPy backend. "
+                  "Install gcc or clang, or set CC, for the C backend.", SymkinWarning,
+                  stacklevel=3)
+    return "numpy"
+
+
+def compile(system: System, backend: str = "auto", *, real: str = "double", cse: bool = True,
             linalg: str = codegen.DEFAULT_LINALG, cache_dir: str | Path | None = None
             ) -> kernel.Kernel:
     """Generate, compile (or find in the cache) and load the kernel of ``system``.
 
     Args:
         system: the derived kinematics.
-        backend: ``"c"`` (cffi extension) or ``"numpy"`` (generated Python module). With no C
-            compiler, ``"c"`` warns once and falls back to ``"numpy"``.
+        backend: ``"auto"`` (default: C when a compiler is found, else NumPy with a note),
+            ``"c"`` (cffi extension; an error without a compiler) or ``"numpy"`` (generated
+            Python module).
         real: the C real type, ``"double"`` or ``"float"``.
         cse: eliminate common subexpressions.
         linalg: the LU behind the C solver, ``"sparse"`` (default) or ``"dense"``.
@@ -57,18 +84,16 @@ def compile(system: System, backend: str = "c", *, real: str = "double", cse: bo
 
     Raises:
         BuildError: the compiler failed (the message has the command and its output).
+        NoCompilerError: ``backend="c"`` and no C compiler is found.
     """
+    if backend not in BACKENDS:
+        raise BuildError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    backend = resolve_backend(backend)
     cache = open_cache(cache_dir)
     if backend == "c":
         compiler = toolchain.c_compiler()
-        if compiler is None:
-            warnings.warn(
-                f"no C compiler found (looked for {os.environ.get('CC') or 'cc'}); using the "
-                "NumPy backend instead. Install gcc or clang, or set CC to a C compiler.",
-                RuntimeWarning, stacklevel=2)
-            backend, real = "numpy", "double"
-        else:
-            return _compile_c(codegen.lower(system, "c", real, cse, linalg), cache, compiler)
+        assert compiler is not None  # resolve_backend chose C because there is one
+        return _compile_c(codegen.lower(system, "c", real, cse, linalg), cache, compiler)
     return _load_numpy(codegen.lower(system, backend, real, cse), cache)
 
 
@@ -103,7 +128,10 @@ def _build_c(build: Path, files: dict[str, str], cdef: str, module_name: str,
     wrapper = build / f"{module_name}.c"
     preamble = "".join(f'#include "{h}"\n' for h in headers)
     make_c_source(ffi, module_name, preamble, str(wrapper), verbose=False)
-    include = [f"-I{build}"] + [f"-I{sysconfig.get_paths()[k]}" for k in ("include", "platinclude")]
+    # -iquote: the generated headers are found by #include "..." only, so a generated file can
+    # never stand in for a system header included with <...>.
+    include = [f"-iquote{build}"] + [f"-I{sysconfig.get_paths()[k]}"
+                                     for k in ("include", "platinclude")]
     objects = []
     for source in sorted(n for n in files if n.endswith(".c")):
         objects.append(_object(compiler, [*C_FLAGS, *include], build / source))

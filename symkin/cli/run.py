@@ -28,8 +28,9 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     run = commands.add_parser(
         "run", help="solve positions, velocities and accelerations over the time grid")
     run.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    run.add_argument("--backend", choices=("c", "numpy"), default="numpy",
-                     help="kernel to run (default numpy; c compiles the generated C)")
+    run.add_argument("--backend", choices=("auto", "c", "numpy"), default="auto",
+                     help="kernel to run (default auto: the generated C when a C compiler is "
+                          "found, else NumPy; c without a compiler is an error)")
     run.add_argument("--t0", type=float, help="first time (default: the file's)")
     run.add_argument("--t1", type=float, help="last time, included (default: the file's)")
     run.add_argument("--dt", type=float, help="time step (default: the file's)")
@@ -98,9 +99,10 @@ def handle(args: argparse.Namespace) -> int:
 
 def _solve_and_write(args: argparse.Namespace) -> int:
     from symkin.build import index as cache
+    from symkin.build.compile import resolve_backend
     from symkin.runtime import driver
 
-    prepared = cache.prepare(args.mechanism, cache.Options(backend=args.backend),
+    prepared = cache.prepare(args.mechanism, cache.Options(backend=resolve_backend(args.backend)),
                              outlines=args.animate is not None)
     kernel = prepared.kernel
     times, problem = _times(kernel, args)

@@ -15,6 +15,7 @@ rounded literals, :func:`fold`), so what is accepted is what is generated.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from typing import Any, TypeAlias
 
 import mpmath
 import sympy as sp
@@ -29,7 +30,8 @@ MAX_TRIG_ARGUMENT = 1e15
 # (a C integer constant wider than long long is truncated, and no double holds more digits).
 MAX_EXACT_INTEGER = 2**53
 
-_Number = mpmath.mpf
+# An mpmath real (mpmath ships no type information).
+_Number: TypeAlias = Any
 
 
 class _Refused(Exception):
@@ -79,8 +81,11 @@ def _atan2(y: _Number, x: _Number) -> _Number:
     return mpmath.atan2(y, x)
 
 
-def _heaviside(x: _Number, at_zero: _Number = mpmath.mpf(0.5)) -> _Number:
-    return mpmath.mpf(1) if x > 0 else mpmath.mpf(0) if x < 0 else at_zero
+def _heaviside(x: _Number, at_zero: _Number | None = None) -> _Number:
+    # SymPy's Heaviside(x) is 1/2 at 0, the value the parser also gives explicitly.
+    if x == 0:
+        return mpmath.mpf(0.5) if at_zero is None else at_zero
+    return mpmath.mpf(1) if x > 0 else mpmath.mpf(0)
 
 
 def _sign(x: _Number) -> _Number:
@@ -152,7 +157,7 @@ class _Evaluator:
             return self._piecewise(node)
         if isinstance(node, sp.DiracDelta):
             return mpmath.mpf(0)  # zero wherever it can be evaluated in floats
-        function = _FUNCTIONS.get(type(node)) or _FUNCTIONS.get(getattr(node, "func", None))
+        function = _FUNCTIONS.get(type(node))
         if function is None:
             raise _Refused(f"symkin cannot evaluate {type(node).__name__}")
         return function(*(self(arg) for arg in node.args))
@@ -231,7 +236,7 @@ def is_plain_number(expr: sp.Basic) -> bool:
     if isinstance(expr, sp.Float):
         return True
     if isinstance(expr, sp.Rational):
-        return abs(expr.p) <= MAX_EXACT_INTEGER and expr.q <= MAX_EXACT_INTEGER
+        return bool(abs(expr.p) <= MAX_EXACT_INTEGER and expr.q <= MAX_EXACT_INTEGER)
     return False
 
 

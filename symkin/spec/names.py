@@ -18,15 +18,25 @@ C_KEYWORDS = frozenset(["auto", "break", "case", "char", "const", "continue", "d
 
 LIBM_NAMES = frozenset(["acos", "acosh", "asin", "asinh", "atan", "atan2", "atanh", "cbrt", "ceil", "copysign", "cos", "cosh", "erf", "erfc", "exp", "exp2", "expm1", "fabs", "fdim", "floor", "fma", "fmax", "fmin", "fmod", "frexp", "hypot", "ilogb", "ldexp", "lgamma", "llrint", "llround", "log", "log10", "log1p", "log2", "logb", "lrint", "lround", "modf", "nan", "nearbyint", "nextafter", "nexttoward", "pow", "remainder", "remquo", "rint", "round", "scalbln", "scalbn", "sin", "sinh", "sqrt", "tan", "tanh", "tgamma", "trunc", "abs"])
 
-# Names the generated code and the expression language use for themselves.
-SYMKIN_NAMES = frozenset(
-    {"t", "pi", "E", "ground", "q", "dq", "ddq", "p", "x", "y", "phi", "Piecewise", "True",
-     "False", "None", "np", "numpy", "math"} | set(FUNCTIONS)
-)
+# What an expression could mean instead of a parameter or a body: the time, the constants, the
+# functions of the expression language and the literals Python's parser treats specially.
+EXPRESSION_NAMES = frozenset({"t", "pi", "E", "Piecewise", "True", "False", "None"}
+                             | set(FUNCTIONS))
+
+# Standard C and POSIX header names: a mechanism named "string" would generate string.h,
+# found by #include <string.h> before the system's own in some include orders.
+SYSTEM_HEADERS = frozenset(["assert", "complex", "ctype", "errno", "fenv", "float", "inttypes", "iso646", "limits", "locale", "math", "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbool", "stddef", "stdint", "stdio", "stdlib", "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype", "unistd", "fcntl", "pthread", "dirent", "sched", "strings", "syslog", "termios", "Python", "numpy", "cffi", "symkin", "ground"])
+
+# Each kind of name has its own namespace (README, "Names"):
+#   mechanism   -> the C prefix, file names and a Python module: identifiers of both languages,
+#                  no libm function, no system header;
+#   parameter, body -> names in expressions: anything but what an expression means otherwise;
+#   point, joint, driver -> labels only (rows, columns, comments): any identifier, E and p too.
+KINDS = ("mechanism", "parameter", "body", "point", "joint", "driver")
 
 
-def name_problem(name: object) -> str | None:
-    """Say what is wrong with ``name`` as a mechanism, body, point or parameter name, or None."""
+def name_problem(name: object, kind: str = "mechanism") -> str | None:
+    """Say what is wrong with ``name`` as a name of ``kind`` (one of :data:`KINDS`), or None."""
     if not isinstance(name, str):
         return f"{name!r} is not a name"
     if not _IDENTIFIER.match(name):
@@ -34,12 +44,33 @@ def name_problem(name: object) -> str | None:
                 f"or '_')")
     if len(name) > MAX_NAME_LENGTH:
         return f"{name!r} is longer than {MAX_NAME_LENGTH} characters"
-    if name in SYMKIN_NAMES:
-        return f"{name!r} is reserved by symkin"
+    if "__" in name:
+        return f"{name!r} contains a double underscore"
+    if kind in ("parameter", "body"):
+        return _expression_clash(name, kind)
+    if kind == "mechanism":
+        return _identifier_clash(name)
+    return None
+
+
+def _expression_clash(name: str, kind: str) -> str | None:
+    if name in EXPRESSION_NAMES:
+        meaning = ("the time" if name == "t" else "a constant" if name in ("pi", "E") else
+                   "a function" if name in FUNCTIONS or
+                   name == "Piecewise" else "a Python literal")
+        return f"{name!r} is {meaning} in expressions"
+    if keyword.iskeyword(name):
+        return f"{name!r} is a Python keyword, which no expression can use as a name"
+    if kind == "body" and name == "ground":
+        return "'ground' is the fixed frame, present in every mechanism"
+    return None
+
+
+def _identifier_clash(name: str) -> str | None:
     if name in C_KEYWORDS or keyword.iskeyword(name) or keyword.issoftkeyword(name):
         return f"{name!r} is a C or Python keyword"
     if name in LIBM_NAMES:
         return f"{name!r} is the name of a C math library function"
-    if name.startswith("_") or "__" in name:
-        return f"{name!r} contains a double underscore"
+    if name in SYSTEM_HEADERS:
+        return f"{name!r} would generate {name}.h, the name of a system header"
     return None

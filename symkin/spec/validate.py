@@ -116,28 +116,34 @@ def _check_semantics(mech: Mechanism) -> None:
 
 
 def _check_names(mech: Mechanism) -> None:
-    problem = name_problem(mech.name)
+    """Every name by the rules of its kind (spec.names); all clashes reported at once."""
+    problem = name_problem(mech.name, "mechanism")
     if problem:
         raise MechanismError(problem, ("name",), "Use a plain identifier such as crank_slider; "
-                             "it becomes the C prefix.")
+                             "it becomes the C prefix and the file names.")
+    problems: list[tuple[tuple[str | int, ...], str]] = []
     seen: dict[str, tuple[str | int, ...]] = {}
-    for section in ("parameters", "bodies"):
+    for section, kind in (("parameters", "parameter"), ("bodies", "body")):
         for name in getattr(mech, section):
             path = (section, name)
-            problem = name_problem(name)
+            problem = name_problem(name, kind)
+            if problem is None and name in seen:
+                problem = f"{name!r} is already used at {format_path(seen[name])}"
             if problem:
-                raise MechanismError(problem, path, "Rename it.")
-            if name.lower() in seen:
-                raise MechanismError(f"the name {name!r} is already used at "
-                                     f"{'.'.join(map(str, seen[name.lower()]))}", path,
-                                     "Names of parameters and bodies must differ (ignoring "
-                                     "case).")
-            seen[name.lower()] = path
+                problems.append((path, problem))
+            seen.setdefault(name, path)
     for body, spec in mech.bodies.items():
         for point in spec.points:
-            problem = name_problem(point)
+            problem = name_problem(point, "point")
             if problem:
-                raise MechanismError(problem, ("bodies", body, "points", point), "Rename it.")
+                problems.append((("bodies", body, "points", point), problem))
+    if problems:
+        listed = problems[0][1] if len(problems) == 1 else f"{len(problems)} names cannot be " \
+            "used: " + "; ".join(f"{format_path(path)}: {problem}" for path, problem in problems)
+        raise MechanismError(listed, problems[0][0],
+                             "Rename them. Parameters and bodies may not be t, pi, E, a function "
+                             "name, True/False/None or a Python keyword, and must differ from "
+                             "each other; point, joint and driver names are free identifiers.")
 
 
 def _check_parameters(mech: Mechanism) -> dict[str, float]:
@@ -213,8 +219,10 @@ def _point(mech: Mechanism, body: str, ref: Any, symbols: _Names,
 
 def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
                       nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
-    if constraint.name is not None and name_problem(constraint.name):
-        raise MechanismError(str(name_problem(constraint.name)), path + ("name",), "Rename it.")
+    kind = "joint" if path[0] == "joints" else "driver"
+    if constraint.name is not None and name_problem(constraint.name, kind):
+        raise MechanismError(str(name_problem(constraint.name, kind)), path + ("name",),
+                             "Rename it.")
     if isinstance(constraint, Custom):
         for k, text in enumerate(constraint.equations):
             expr = _expression(text, symbols, path + ("equations", k), time=True,

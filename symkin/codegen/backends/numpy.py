@@ -36,7 +36,7 @@ class PythonPrinter(NumPyPrinter):
 
     def _nested(self, function: str, args: tuple[sp.Expr, ...]) -> str:
         # fmin/fmax, as in C: the generated code of both backends treats NaN alike.
-        text = self._print(args[-1])
+        text = str(self._print(args[-1]))
         for arg in reversed(args[:-1]):
             text = f"{function}({self._print(arg)}, {text})"
         return text
