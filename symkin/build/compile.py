@@ -14,12 +14,10 @@ from __future__ import annotations
 import importlib.machinery
 import importlib.util
 import json
-import os
 import shlex
 import subprocess
 import sys
 import sysconfig
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
@@ -28,10 +26,11 @@ from typing import Any
 from symkin import resources
 from symkin.build import toolchain
 from symkin.build.cache import content_key, open_cache, publish, verified
+from symkin.build.toolchain import BACKENDS, resolve_backend
 from symkin.codegen import lower as codegen
 from symkin.codegen import render
 from symkin.codegen.cdef import from_headers as cdef_from_headers
-from symkin.errors import BuildError, NoCompilerError, SymkinWarning
+from symkin.errors import BuildError
 from symkin.runtime import kernel
 from symkin.symbolic.derivation import System
 
@@ -39,32 +38,6 @@ from symkin.symbolic.derivation import System
 # -march=native would make a cached binary non-portable.
 C_FLAGS = ("-std=c99", "-O2", "-fPIC")
 WRAPPER_FLAGS = ("-O2", "-fPIC")
-
-
-BACKENDS = ("auto", "c", "numpy")
-
-
-def resolve_backend(backend: str) -> str:
-    """The backend to build: ``"auto"`` is C when a compiler is found, else NumPy with a
-    one-line note; an explicit ``"c"`` without a compiler is an error, never a silent NumPy.
-
-    Raises:
-        NoCompilerError: ``"c"`` was asked for and no C compiler is found.
-    """
-    if backend not in ("auto", "c"):
-        return backend
-    if toolchain.c_compiler() is not None:
-        return "c"
-    looked_for = os.environ.get("CC") or "cc"
-    if backend == "c":
-        raise NoCompilerError(
-            f"the C backend needs a C compiler and none was found (looked for {looked_for}). "
-            "Install one (Debian/Ubuntu: apt install gcc; macOS: xcode-select --install; "
-            "or conda install c-compiler), set CC to it, or use backend 'numpy' or 'auto'.")
-    warnings.warn(f"no C compiler found (looked for {looked_for}): using the NumPy backend. "
-                  "Install gcc or clang, or set CC, for the C backend.", SymkinWarning,
-                  stacklevel=3)
-    return "numpy"
 
 
 def compile(system: System, backend: str = "auto", *, real: str = "double", cse: bool = True,

@@ -14,9 +14,11 @@ import shutil
 import subprocess
 import sys
 import sysconfig
+import warnings
 from typing import Any
 
 from symkin import resources
+from symkin.errors import NoCompilerError, SymkinWarning
 
 
 def c_compiler() -> list[str] | None:
@@ -53,3 +55,29 @@ def fingerprint(compiler: list[str] | None) -> dict[str, Any]:
         found["compiler"] = [shutil.which(compiler[0]), *compiler]
         found["compiler_version"] = compiler_version(tuple(compiler))
     return found
+
+
+BACKENDS = ("auto", "c", "numpy")
+
+
+def resolve_backend(backend: str) -> str:
+    """The backend to build: ``"auto"`` is C when a compiler is found, else NumPy with a
+    one-line note; an explicit ``"c"`` without a compiler is an error, never a silent NumPy.
+
+    Raises:
+        NoCompilerError: ``"c"`` was asked for and no C compiler is found.
+    """
+    if backend not in ("auto", "c"):
+        return backend
+    if c_compiler() is not None:
+        return "c"
+    looked_for = os.environ.get("CC") or "cc"
+    if backend == "c":
+        raise NoCompilerError(
+            f"the C backend needs a C compiler and none was found (looked for {looked_for}). "
+            "Install one (Debian/Ubuntu: apt install gcc; macOS: xcode-select --install; "
+            "or conda install c-compiler), set CC to it, or use backend 'numpy' or 'auto'.")
+    warnings.warn(f"no C compiler found (looked for {looked_for}): using the NumPy backend. "
+                  "Install gcc or clang, or set CC, for the C backend.", SymkinWarning,
+                  stacklevel=3)
+    return "numpy"

@@ -99,7 +99,7 @@ def handle(args: argparse.Namespace) -> int:
 
 def _solve_and_write(args: argparse.Namespace) -> int:
     from symkin.build import index as cache
-    from symkin.build.compile import resolve_backend
+    from symkin.build.toolchain import resolve_backend
     from symkin.runtime import driver
 
     prepared = cache.prepare(args.mechanism, cache.Options(backend=resolve_backend(args.backend)),
