@@ -186,7 +186,11 @@ class _Builder:
         if not fewest <= len(node.args) <= most:
             count = str(fewest) if fewest == most else f"{fewest} to {most}"
             raise self.fail(node, f"{name}() takes {count} arguments, got {len(node.args)}")
-        return function(*(self.build(arg, depth) for arg in node.args))
+        args = [self.build(arg, depth) for arg in node.args]
+        try:
+            return function(*args)
+        except (TypeError, ValueError):  # e.g. Max(asin(7), 1): SymPy cannot order a non-real
+            raise self.fail(node, f"the arguments of {name}() must be real") from None
 
     def _piecewise(self, node: ast.Call, depth: int) -> sp.Expr:
         pieces = []
