@@ -19,7 +19,7 @@ import numpy as np
 import sympy as sp
 
 import symkin
-from symkin.codegen import lower as codegen
+from symkin.spec import expressions
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
@@ -59,7 +59,11 @@ class Reference:
         q, dq, t, p = system.q, system.dq, system.t, system.p
         self.nq = len(q)
         dense = sp.Matrix(system.phi_q)
-        vectors = [component for vector in codegen.point_vectors(system) for component in vector]
+        # The point vectors straight from the file's text (the parser, not codegen's own
+        # point_vectors, which is under test), in file order: bodies, then their points.
+        by_name = {symbol.name: symbol for symbol in p}
+        vectors = [expressions.parse(raw, by_name) for body in system.mechanism.bodies.values()
+                   for vector in body.points.values() for raw in vector]
         self._phi = sp.lambdify((q, t, p), list(system.phi), MPMATH)
         self._phi_q = sp.lambdify((q, t, p), list(dense), MPMATH)
         self._phi_t = sp.lambdify((q, t, p), list(system.phi_t), MPMATH)
