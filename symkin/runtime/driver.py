@@ -334,7 +334,7 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
 
 
 def _not_finite(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> str | None:
-    """The first of Phi, Phi_q, Phi_t, Gamma that is inf or NaN at (q, t), as the row of the
+    """The first of Phi, Phi_t, Phi_q, Gamma that is inf or NaN at (q, t), as the row of the
     mechanism it comes from, or None when all four are finite."""
     labels = list(kernel.rows)
     phi = kernel.phi(q, t, p)

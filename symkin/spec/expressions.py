@@ -291,7 +291,9 @@ def check_derivatives(expr: sp.Expr, variables: Sequence[sp.Symbol], text: str) 
         ExpressionError: naming the function that appeared, or the size.
     """
     first = [sp.diff(expr, v) for v in variables]
-    second = [sp.diff(d, v) for d in first for v in variables]
+    # The second derivatives are symmetric: each pair once.
+    second = [sp.diff(first[i], variables[j]) for i in range(len(variables))
+              for j in range(i, len(variables))]
     for derivative in [expr, *first, *second]:
         if sp.count_ops(derivative) > MAX_DERIVATIVE_OPS:
             raise ExpressionError(f"its derivatives grow past {MAX_DERIVATIVE_OPS} operations; "

@@ -25,7 +25,11 @@ EXPRESSION_NAMES = frozenset({"t", "pi", "E", "Piecewise", "True", "False", "Non
 
 # Standard C and POSIX header names: a mechanism named "string" would generate string.h,
 # found by #include <string.h> before the system's own in some include orders.
-SYSTEM_HEADERS = frozenset(["assert", "complex", "ctype", "errno", "fenv", "float", "inttypes", "iso646", "limits", "locale", "math", "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbool", "stddef", "stdint", "stdio", "stdlib", "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype", "unistd", "fcntl", "pthread", "dirent", "sched", "strings", "syslog", "termios", "Python", "numpy", "cffi", "symkin", "ground"])
+SYSTEM_HEADERS = frozenset(["assert", "complex", "ctype", "errno", "fenv", "float", "inttypes", "iso646", "limits", "locale", "math", "setjmp", "signal", "stdalign", "stdarg", "stdatomic", "stdbool", "stddef", "stdint", "stdio", "stdlib", "stdnoreturn", "string", "tgmath", "threads", "time", "uchar", "wchar", "wctype", "unistd", "fcntl", "pthread", "dirent", "sched", "strings", "syslog", "termios", "Python"])
+
+# The generated NumPy kernel is a Python module named after the mechanism: it must not shadow a
+# module the kernel or symkin imports.
+PYTHON_MODULES = frozenset(["numpy", "scipy", "cffi", "symkin", "math", "sys", "os"])
 
 # Each kind of name has its own namespace (README, "Names"):
 #   mechanism   -> the C prefix, file names and a Python module: identifiers of both languages,
@@ -73,4 +77,6 @@ def _identifier_clash(name: str) -> str | None:
         return f"{name!r} is the name of a C math library function"
     if name in SYSTEM_HEADERS:
         return f"{name!r} would generate {name}.h, the name of a system header"
+    if name in PYTHON_MODULES:
+        return f"{name!r} would generate {name}.py, shadowing the Python module {name}"
     return None

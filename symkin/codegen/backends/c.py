@@ -42,8 +42,7 @@ class CPrinter(C99CodePrinter):
     def _print_Pi(self, expr: sp.Expr) -> str:
         return self._literal(float(expr))
 
-    def _print_Exp1(self, expr: sp.Expr) -> str:
-        return self._literal(float(expr))
+    _print_Exp1 = _print_Pi
 
     def _print_Integer(self, expr: sp.Integer) -> str:
         if abs(int(expr)) > _INT_MAX:
