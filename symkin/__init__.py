@@ -7,6 +7,7 @@ does not pay for importing SymPy.
 from __future__ import annotations
 
 import importlib
+from pathlib import Path
 from typing import Any
 
 __all__ = [
@@ -14,6 +15,7 @@ __all__ = [
     "MechanismError",
     "SolveError",
     "SymkinError",
+    "__version__",
     "compile",
     "derive",
     "from_dict",
@@ -38,7 +40,33 @@ _EXPORTS = {
 }
 
 
+def _version() -> str:
+    """The installed distribution's version when this very file belongs to it; else the
+    version in the source tree's pyproject.toml (a checkout on the path); else "unknown"."""
+    from importlib import metadata
+
+    here = Path(__file__).resolve()
+    try:
+        found = metadata.distribution("symkin")
+        if Path(str(found.locate_file("symkin/__init__.py"))).resolve() == here:
+            return found.version
+    except metadata.PackageNotFoundError:
+        pass
+    pyproject = here.parent.parent / "pyproject.toml"
+    try:
+        import tomllib
+
+        project = tomllib.loads(pyproject.read_text(encoding="utf-8")).get("project", {})
+        if project.get("name") == "symkin" and isinstance(project.get("version"), str):
+            return str(project["version"])
+    except (OSError, ValueError):
+        pass
+    return "unknown"
+
+
 def __getattr__(name: str) -> Any:
+    if name == "__version__":
+        return _version()
     if name not in _EXPORTS:
         raise AttributeError(f"module 'symkin' has no attribute {name!r}")
     module, attribute = _EXPORTS[name]

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from driver_support import MECHANISMS
 
-from symkin.cli.run import ProgressBar
+from symkin.cli.outputs import ProgressBar
 
 ROOT = Path(__file__).resolve().parent.parent
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
@@ -47,8 +47,10 @@ def test_npz_csv_plot_and_animation(tmp_path: Path) -> None:
     result = run(str(TEXTBOOK), "--backend", "c", "-o", "out.csv", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     header = (tmp_path / "out.csv").read_text().splitlines()[0].split(",")
+    point_columns = [f"{p}_{s}" for p in ("crank.tip", "rod.P")
+                     for s in ("x", "y", "vx", "vy", "ax", "ay")]
     assert header == ["t", *COORDINATES, *(c + "_t" for c in COORDINATES),
-                      *(c + "_tt" for c in COORDINATES)]
+                      *(c + "_tt" for c in COORDINATES), *point_columns]
     table = np.loadtxt(tmp_path / "out.csv", delimiter=",", skiprows=1)
     assert np.abs(table[:, 1:10] - data["q"]).max() < 1e-12
     assert np.abs(table[:, 19:28] - data["d2q"]).max() < 1e-11
@@ -103,8 +105,8 @@ def test_bad_mechanism_file_exits_2(tmp_path: Path) -> None:
 
 def test_progress_bar_draws_and_ends_the_line() -> None:
     stream = io.StringIO()
-    bar = ProgressBar(stream, width=10)
+    bar = ProgressBar(stream)
     bar(5, 10)
     bar(10, 10)
     bar.finish()
-    assert stream.getvalue().endswith("[##########] 10/10\n")
+    assert "10/10" in stream.getvalue() and stream.getvalue().endswith("\n")

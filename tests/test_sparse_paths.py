@@ -17,7 +17,7 @@ import yaml
 from driver_support import kernel_for
 
 import symkin
-from symkin.cli import run as runner
+from symkin.cli import outputs
 from symkin.codegen import lower as codegen
 from symkin.codegen import sample as codegen_sample
 from symkin.runtime import driver, linalg
@@ -91,7 +91,7 @@ def test_factor_sparse_solves_and_judges_singularity() -> None:
     assert linalg.factor_sparse(n, rows, cols, np.full(values.size, np.nan)).pivot_ratio == 0.0
 
 
-def test_run_mentions_fallbacks() -> None:
-    assert runner._fallback_note(0) == ""
-    assert runner._fallback_note(1) == "; 1 pivot fall-back to dense LU"
-    assert runner._fallback_note(3) == "; 3 pivot fall-backs to dense LU"
+def test_run_mentions_fallbacks_and_that_they_cost_no_accuracy() -> None:
+    assert outputs.fallback_note(1, 31).startswith("1 pivot fall-back to dense LU over 31")
+    note = outputs.fallback_note(3, 31)
+    assert note.startswith("3 pivot fall-backs to dense LU") and "not accuracy" in note

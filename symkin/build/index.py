@@ -55,6 +55,9 @@ class Options:
     real: str = "double"
     cse: bool = True
     linalg: str = "sparse"  # codegen.DEFAULT_LINALG (not imported: it would load SymPy)
+    # Parameter values replacing the file's (``--set``), as (name, text) pairs: they change
+    # the nominal values (and the first guess q0) recorded with the kernel.
+    parameters: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass
@@ -108,9 +111,10 @@ def prepare(mechanism: str | Path, options: Options = Options(), *, outlines: bo
 def _full_pipeline(mechanism: Path, options: Options, cache: Path,
                    want_outlines: bool) -> Prepared:
     from symkin.build import compile as build
+    from symkin.spec import validate
     from symkin.symbolic import derivation, drawing
 
-    system = derivation.derive(mechanism)
+    system = derivation.derive(validate.load(mechanism, dict(options.parameters)))
     kernel = build.compile(system, backend=options.backend, real=options.real,
                            cse=options.cse, linalg=options.linalg, cache_dir=cache)
     drawn = drawing.outlines(system) if want_outlines else None
@@ -130,7 +134,8 @@ def index_key(mechanism: Path, options: Options) -> str | None:
         "format": FORMAT, "file_sha256": hashlib.sha256(raw).hexdigest(),
         # The loader picks TOML or YAML by suffix: the same bytes may mean different things.
         "file_format": "toml" if mechanism.suffix.lower() == ".toml" else "yaml",
-        "options": [options.backend, options.real, options.cse, options.linalg],
+        "options": [options.backend, options.real, options.cse, options.linalg,
+                    [list(pair) for pair in options.parameters]],
         "code": code_version(), **environment(options.backend),
     }
     return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()

@@ -12,24 +12,31 @@ import sys
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
-from symkin.cli import messages
+from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 from symkin.errors import MechanismError, SymkinError, UsageError
+
+
+def _load(args: argparse.Namespace) -> Any:
+    """The validated mechanism of ``args.mechanism`` with the ``--set`` values."""
+    from symkin.spec import validate
+
+    return validate.load(args.mechanism, overrides.parse(args.overrides))
 
 
 def _show(args: argparse.Namespace) -> int:
     from symkin.symbolic import derivation
 
     if args.local:
-        from symkin.spec import drawn, validate
+        from symkin.spec import drawn
 
-        print(drawn.dump(validate.load(args.mechanism)), end="")
+        print(drawn.dump(_load(args)), end="")
         return EXIT_OK
     from symkin.symbolic import show as report
 
-    system = derivation.derive(args.mechanism)
+    system = derivation.derive(_load(args))
     print(report.latex(system) if args.latex else report.text(system), end="")
     return EXIT_OK
 
@@ -50,6 +57,7 @@ def _add_show(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
     show.add_argument("--local", action="store_true",
                       help="print the mechanism in the local layout (local vectors, v, phi0, "
                            "q0), as derived from a drawn file")
+    overrides.add_argument(show)
     show.set_defaults(handler=_show)
     schema = commands.add_parser("schema", help="print the JSON Schema of mechanism files")
     schema.set_defaults(handler=_schema)
@@ -81,14 +89,17 @@ def _add_verify(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -
 
 # Each entry adds one subcommand; its handler returns the exit status.
 def _generate(args: argparse.Namespace) -> int:
+    from symkin.build.toolchain import resolve_backend
     from symkin.codegen import render
     from symkin.symbolic import derivation
 
-    if args.backend == "numpy" and args.real == "float":
+    # Writing C source needs no compiler: only "auto" asks whether one is there.
+    backend = resolve_backend("auto") if args.backend == "auto" else args.backend
+    if backend == "numpy" and args.real == "float":
         return messages.error("--real float is for the C backend; the NumPy backend computes in "
                               "double precision", EXIT_BAD_INPUT)
-    system = derivation.derive(args.mechanism)
-    paths = render.generate(system, backend=args.backend, out_dir=args.output, real=args.real,
+    system = derivation.derive(_load(args))
+    paths = render.generate(system, backend=backend, out_dir=args.output, real=args.real,
                             cse=not args.no_cse, linalg=args.linalg, force=args.force)
     print("\n".join(str(path) for path in paths))
     return EXIT_OK
@@ -97,7 +108,9 @@ def _generate(args: argparse.Namespace) -> int:
 def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     generate = commands.add_parser("generate", help="write the C or NumPy source of a mechanism")
     generate.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    generate.add_argument("--backend", choices=("c", "numpy"), default="c")
+    generate.add_argument("--backend", choices=("auto", "c", "numpy"), default="auto",
+                          help="source to write (default auto, as for run: C when a C compiler "
+                               "is found, else NumPy with a note)")
     generate.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     generate.add_argument("--real", choices=("double", "float"), default="double",
                           help="C real type (default double)")
@@ -109,6 +122,7 @@ def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser])
     generate.add_argument("--linalg", choices=("sparse", "dense"), default="sparse",
                           help="LU behind the C solver: generated sparse LU with run-time pivot "
                           "checks and a dense fall-back (default), or dense partial pivoting")
+    overrides.add_argument(generate)
     generate.set_defaults(handler=_generate)
 
 
@@ -131,6 +145,10 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]]
 def parser() -> argparse.ArgumentParser:
     main_parser = argparse.ArgumentParser(
         prog="symkin", description="Symbolic kinematics code generator for planar mechanisms.")
+    import symkin
+
+    main_parser.add_argument("--version", action="version",
+                             version=f"%(prog)s {symkin.__version__}")
     commands = main_parser.add_subparsers(dest="command", required=True)
     for add in SUBCOMMANDS:
         add(commands)

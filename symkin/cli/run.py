@@ -4,7 +4,9 @@ A thin layer over symkin.derive -> symkin.compile -> symkin.solve -> Trajectory.
 The kernel comes through the index of symkin/cache.py: a second run of an unchanged file loads
 the cached kernel and its metadata directly, and never imports SymPy, pydantic or jinja2.
 Exit status 0 on success; 1 when the solve fails (the rows solved so far are still written);
-2 for bad input (a message, never a traceback).
+2 for bad input (a message, never a traceback). ``--at T`` solves one configuration (the
+chapter's single-instant problem) and prints it; the files a run writes are in
+:mod:`symkin.cli.outputs`.
 """
 
 from __future__ import annotations
@@ -12,15 +14,17 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any
 
 from symkin import limits
-from symkin.cli import messages
+from symkin.cli import messages, outputs, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
+from symkin.cli.outputs import CannotWrite, ProgressBar
 
-SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png",), "animate": (".gif",)}
+SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png", ".svg", ".pdf"), "animate": (".gif",),
+            "html": (".html", ".htm")}
+GRID_ONLY = ("t0", "t1", "dt", "plot", "animate", "html")
 
 
 def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -34,9 +38,26 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     run.add_argument("--t0", type=float, help="first time (default: the file's)")
     run.add_argument("--t1", type=float, help="last time, included (default: the file's)")
     run.add_argument("--dt", type=float, help="time step (default: the file's)")
+    run.add_argument("--at", type=float, metavar="T",
+                     help="solve the single configuration at time T and print q, dq, d2q and "
+                          "the named points (no grid)")
     run.add_argument("-o", "--output", type=Path, help="results file, .npz or .csv")
-    run.add_argument("--plot", type=Path, help="PNG of coordinates and point paths against t")
+    run.add_argument("--plot", type=Path,
+                     help="figure of position, velocity and acceleration against t: .png, "
+                          ".svg or .pdf")
+    run.add_argument("--select", metavar="NAMES",
+                     help="what --plot and --html show: coordinates and named points, e.g. "
+                          "crank.phi,coupler.P (default: the angles and the moving points)")
+    run.add_argument("--html", type=Path,
+                     help="interactive report: the mechanism moving under a time slider, with "
+                          "paths, velocity and acceleration vectors, and the selected plots "
+                          "(one self-contained file)")
     run.add_argument("--animate", type=Path, help="GIF of the mechanism moving")
+    run.add_argument("--size", default="900x600", metavar="WxH",
+                     help="--animate picture size in pixels (default 900x600)")
+    run.add_argument("--fps", type=int, default=20,
+                     help="--animate frames per second (default 20)")
+    overrides.add_argument(run)
     run.set_defaults(handler=handle)
 
 
@@ -52,6 +73,15 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
             return f"--{option} {value}: give a finite number"
     if args.dt is not None and not args.dt > 0:
         return f"--dt {args.dt}: the time step must be positive"
+    if args.at is not None:
+        if not math.isfinite(args.at):
+            return f"--at {args.at}: give a finite time"
+        clash = [f"--{option}" for option in GRID_ONLY if getattr(args, option) is not None]
+        if clash:
+            return (f"--at solves one configuration; {', '.join(clash)} need a time grid. "
+                    "Leave out --at, or those options")
+    if not 1 <= args.fps <= 100:
+        return f"--fps {args.fps}: give 1 to 100 frames per second"
     return None
 
 
@@ -102,13 +132,19 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     from symkin.build.toolchain import resolve_backend
     from symkin.runtime import driver
 
-    prepared = cache.prepare(args.mechanism, cache.Options(backend=resolve_backend(args.backend)),
-                             outlines=args.animate is not None)
+    options = cache.Options(backend=resolve_backend(args.backend),
+                            parameters=overrides.pairs(args.overrides))
+    prepared = cache.prepare(args.mechanism, options,
+                             outlines=args.animate is not None or args.html is not None)
     kernel = prepared.kernel
-    times, problem = _times(kernel, args)
+    picture = outputs.Pictures.of(args, kernel)  # --select checked before any solving
+    if args.at is not None:
+        times, problem = driver.grid(args.at, args.at, 1.0), None
+    else:
+        times, problem = _times(kernel, args)
     if problem:
         return _error(f"{args.mechanism}: {problem}", EXIT_BAD_INPUT)
-    progress = ProgressBar(sys.stderr) if sys.stderr.isatty() else None
+    progress = ProgressBar(sys.stderr) if sys.stderr.isatty() and args.at is None else None
     try:
         trajectory = driver.solve(kernel, t=times, progress=progress)
     except driver.SolveInterrupted as interrupted:
@@ -122,12 +158,17 @@ def _solve_and_write(args: argparse.Namespace) -> int:
         return _stopped(args, prepared, failure, times.size, str(failure), EXIT_FAILED)
     if progress:
         progress.finish()
-    written = _write(trajectory, args, prepared.outlines)
+    written = _write(trajectory, args, prepared.outlines, picture)
     origin = ", cached kernel" if prepared.hit else ""
-    print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
-          f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
-          + _fallback_note(trajectory.lu_fallbacks)
-          + "".join(f"; wrote {path}" for path in written))
+    if args.at is not None:
+        print(outputs.configuration(trajectory, kernel.name, f"{kernel.backend} backend{origin}"),
+              end="")
+    else:
+        print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
+              f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
+              + "".join(f"; wrote {path}" for path in written))
+    if trajectory.lu_fallbacks:
+        messages.note(outputs.fallback_note(trajectory.lu_fallbacks, trajectory.t.size))
     return EXIT_OK
 
 
@@ -141,7 +182,8 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
         message += f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     try:
-        written = _write(stop.trajectory, args, prepared.outlines)
+        written = _write(stop.trajectory, args, prepared.outlines, outputs.Pictures.of(
+            args, prepared.kernel))
     except CannotWrite as error:
         _error(str(error), EXIT_BAD_INPUT)
         return status
@@ -150,66 +192,16 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     return status
 
 
-def _fallback_note(count: int) -> str:
-    """How often the generated sparse LU left its fixed pivot order (results stay exact)."""
-    if not count:
-        return ""
-    return f"; {count} pivot fall-back{'s' if count != 1 else ''} to dense LU"
-
-
-def _write(trajectory: Any, args: argparse.Namespace, outlines: Any) -> list[Path]:
-    """Save the results, plot and animation asked for (a partial trajectory too)."""
+def _write(trajectory: Any, args: argparse.Namespace, outlines: Any,
+           picture: outputs.Pictures) -> list[Path]:
+    """Save the results and pictures asked for (a partial trajectory too)."""
     try:
-        return _write_files(trajectory, args, outlines)
+        return outputs.write(trajectory, args, outlines, picture)
     except OSError as error:
         raise CannotWrite(f"cannot write {error.filename or 'the output'}: "
                           f"{error.strerror or error}; check the path and its permissions"
                           ) from None
 
 
-def _write_files(trajectory: Any, args: argparse.Namespace, outlines: Any) -> list[Path]:
-    from symkin.present import plots
-
-    written = []
-    if args.output:
-        written.append(trajectory.save(args.output))
-    if trajectory.t.size == 0:
-        return written
-    if args.plot:
-        written.append(plots.plot(trajectory, args.plot))
-    if args.animate:
-        written.append(plots.animate(trajectory, args.animate, outlines))
-    return written
-
-
 def _error(message: str, status: int) -> int:
     return messages.error(message, status)
-
-
-class CannotWrite(Exception):
-    """An output file could not be written (a bad path, not a failed solve)."""
-
-
-class ProgressBar:
-    """A one-line progress bar on a terminal, redrawn at most ten times a second."""
-
-    def __init__(self, stream: TextIO, width: int = 40) -> None:
-        self.stream = stream
-        self.width = width
-        self.last = 0.0
-        self.drawn = False
-
-    def __call__(self, done: int, total: int) -> None:
-        now = time.monotonic()
-        if done < total and now - self.last < 0.1:
-            return
-        self.last = now
-        filled = self.width * done // max(total, 1)
-        self.stream.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total}")
-        self.stream.flush()
-        self.drawn = True
-
-    def finish(self) -> None:
-        if self.drawn:
-            self.stream.write("\n")
-            self.stream.flush()

@@ -104,7 +104,8 @@ class Trajectory:
         return r, dr, ddr
 
     def save(self, path: str | Path) -> Path:
-        """Write .npz (all arrays, see DESIGN.md) or .csv (t, q, q_t, q_tt columns)."""
+        """Write .npz (all arrays, see DESIGN.md) or .csv (t, q, q_t, q_tt columns, then each
+        named point's x, y, vx, vy, ax, ay)."""
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix not in SAVE_FORMATS:
@@ -112,6 +113,11 @@ class Trajectory:
         path.parent.mkdir(parents=True, exist_ok=True)
         (self._save_npz if suffix == ".npz" else self._save_csv)(path)
         return path
+
+    def _point_columns(self) -> list[str]:
+        """``<body>.<point>_x, _y, _vx, _vy, _ax, _ay`` for every named point."""
+        return [f"{body}.{point}_{suffix}" for body, point in self.points
+                for suffix in ("x", "y", "vx", "vy", "ax", "ay")]
 
     def _save_npz(self, path: Path) -> None:
         r, dr, ddr = self.point_arrays()
@@ -122,8 +128,11 @@ class Trajectory:
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
-                  *(c + "_tt" for c in self.coordinates)]
-        table = np.column_stack([self.t, self.q, self.dq, self.d2q]) if self.t.size else \
-            np.zeros((0, len(header)))
+                  *(c + "_tt" for c in self.coordinates), *self._point_columns()]
+        r, dr, ddr = self.point_arrays()
+        # Per point: x, y, vx, vy, ax, ay (2.14-2.16).
+        points = np.concatenate([r, dr, ddr], axis=2).reshape(self.t.size, -1)
+        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points]) if self.t.size \
+            else np.zeros((0, len(header)))
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")

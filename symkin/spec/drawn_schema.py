@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field
 
-from symkin.spec.schema import Driver, Expr, PointRef, TimeGrid, Vec2, _Strict
+from symkin.spec.schema import Driver, Expr, PointRef, TimeGrid, Units, Vec2, _Strict
 
 
 class Frame(_Strict):
@@ -75,6 +75,7 @@ class DrawnMechanism(_Strict):
     joints: list[DrawnJoint] = Field(default_factory=list)
     drivers: list[Driver] = Field(default_factory=list)
     time: TimeGrid
+    units: Units | None = None
 
 
 def json_schema_of(local: type[Any]) -> dict[str, Any]:

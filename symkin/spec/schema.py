@@ -197,6 +197,24 @@ class TimeGrid(_Strict):
     dt: Expr
 
 
+# A unit is a label printed on plots and reports (lengths are not converted; angles may be
+# shown in degrees): short, and made of characters that are safe in any output format.
+UNIT_PATTERN = r"^[A-Za-z0-9µμ°/^.*· -]{1,16}$"
+Unit = Annotated[str, Field(pattern=UNIT_PATTERN)]
+
+
+class Units(_Strict):
+    """Units of the file's numbers, for plots and reports: ``{length: m, angle: rad}``.
+
+    symkin computes in the file's own numbers (angles always in radians); ``angle: deg`` only
+    shows angles in degrees.
+    """
+
+    length: Unit | None = None
+    angle: Literal["rad", "deg"] = "rad"
+    time: Unit = "s"
+
+
 class MechanismSpec(_Strict):
     """The fields of a mechanism file, shape-checked; :class:`symkin.spec.validate.Mechanism`
     adds the semantic checks."""
@@ -207,7 +225,7 @@ class MechanismSpec(_Strict):
     joints: list[Joint] = []
     drivers: list[Driver] = []
     time: TimeGrid
-
+    units: Units | None = None
 
     # -- derived views ------------------------------------------------------------------------
     @property
@@ -219,8 +237,10 @@ class MechanismSpec(_Strict):
         return {name: float(expressions.parse(raw, {})) for name, raw in self.parameters.items()}
 
     def canonical_json(self) -> str:
-        """The spec in a canonical text form: the input of its sha256."""
-        return json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+        """The spec in a canonical text form: the input of its sha256. Units only label
+        pictures, so they are left out: the generated code does not depend on them."""
+        return json.dumps(self.model_dump(mode="json", exclude={"units"}), sort_keys=True,
+                          separators=(",", ":"))
 
     def spec_hash(self) -> str:
         return hashlib.sha256(self.canonical_json().encode()).hexdigest()

@@ -13,7 +13,7 @@ from typing import Any
 import sympy as sp
 from pydantic import ValidationError, model_validator
 
-from symkin.errors import ExpressionError, MechanismError, format_path
+from symkin.errors import ExpressionError, MechanismError, UsageError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
 from symkin.spec import constants, drawn, drawn_schema, expressions, loader
 from symkin.spec.messages import translate
@@ -59,10 +59,41 @@ def _names(mech: MechanismSpec) -> _Names:
         by_coordinate={(body, part): sp.Symbol(f"{body}.{part}", real=True)
                        for body in mech.bodies for part in ("x", "y", "phi")})
 
-def load(path: str | Path) -> Mechanism:
-    """Read and validate a mechanism file (YAML, or TOML by suffix)."""
+def load(path: str | Path, overrides: Mapping[str, str] | None = None) -> Mechanism:
+    """Read and validate a mechanism file (YAML, or TOML by suffix).
+
+    Args:
+        path: the file.
+        overrides: parameter values replacing the file's (``--set b=2*pi``): each a number or
+            an expression of numbers, read by the whitelist parser.
+
+    Raises:
+        MechanismError: the file is invalid.
+        UsageError: an override names no parameter of the file or is not a finite number.
+    """
     document = loader.read(path)
+    if overrides:
+        document.data = override_parameters(document.data, overrides, document.source)
     return _validate(document)
+
+
+def override_parameters(data: Any, overrides: Mapping[str, str], source: str) -> Any:
+    """The file's data with parameter values replaced; each new value is checked here."""
+    if not isinstance(data, Mapping):
+        return data
+    parameters = data.get("parameters")
+    parameters = parameters if isinstance(parameters, Mapping) else {}
+    known = list(parameters)
+    for name, text in overrides.items():
+        if name not in known:
+            raise UsageError(f"--set {name}: {source} has no parameter {name!r}; its "
+                             f"parameters are: {', '.join(map(str, known)) or 'none'}")
+        try:
+            constants.value(expressions.parse(text, {}))
+        except ExpressionError as error:
+            raise UsageError(f"--set {name}={text}: {error}. Give a number or an expression "
+                             "of numbers, such as 2.5 or 2*pi/3") from None
+    return {**data, "parameters": {**parameters, **overrides}}
 
 
 def from_dict(data: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:

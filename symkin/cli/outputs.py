@@ -1,0 +1,138 @@
+"""What ``symkin run`` writes and prints: results files, figures, the report, the animation,
+one configuration (``--at``), progress bars, and notes that say whether an event matters.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TextIO
+
+import numpy as np
+
+from symkin.present import series
+from symkin.present.series import Units
+
+
+class CannotWrite(Exception):
+    """An output file could not be written (a bad path, not a failed solve)."""
+
+
+@dataclass(frozen=True)
+class Pictures:
+    """What the figures show: the selection (None: the default), units and title."""
+
+    select: list[str] | None
+    units: Units
+    title: str
+
+    @classmethod
+    def of(cls, args: argparse.Namespace, kernel: Any) -> Pictures:
+        """From the command line and the kernel; an unknown ``--select`` name is a UsageError
+        listing the valid ones (raised before anything is solved)."""
+        select = None
+        if args.select is not None:
+            select = series.check_selection(series.parse_selection(args.select),
+                                            kernel.coordinates, kernel.points)
+        return cls(select, units_of(args.mechanism), kernel.name)
+
+
+def units_of(mechanism: Path) -> Units:
+    """The file's ``units`` (validated with the file: on a warm run it was valid before)."""
+    from symkin.errors import SymkinError
+    from symkin.spec import loader
+
+    try:
+        data = loader.read(mechanism).data
+    except (SymkinError, OSError):  # validated by the run; a file changed since loses labels
+        return Units()
+    return Units.of(data.get("units") if isinstance(data, dict) else None)
+
+
+def write(trajectory: Any, args: argparse.Namespace, outlines: Any,
+          picture: Pictures) -> list[Path]:
+    """Write every file asked for; returns their paths. OSError goes to the caller."""
+    written = []
+    if args.output:
+        written.append(trajectory.save(args.output))
+    if trajectory.t.size == 0:
+        return written
+    if args.plot:
+        from symkin.present import plots
+
+        written.append(plots.plot(trajectory, args.plot, picture.select, picture.units,
+                                  picture.title))
+    if args.html:
+        from symkin.present import html
+
+        written.append(html.report(trajectory, args.html, outlines or {}, picture.select,
+                                   picture.units, picture.title))
+    if args.animate:
+        from symkin.present import animation
+
+        bar = ProgressBar(sys.stderr, "drawing", "frame") if sys.stderr.isatty() else None
+        try:
+            written.append(animation.animate(trajectory, args.animate, outlines or {},
+                                             fps=args.fps, size=animation.parse_size(args.size),
+                                             progress=bar))
+        finally:
+            if bar:
+                bar.finish()
+    return written
+
+
+def configuration(trajectory: Any, name: str, origin: str) -> str:
+    """One solved instant as text: every coordinate with its first and second derivative, then
+    every named point's position, velocity and acceleration (2.14-2.16)."""
+    t = float(trajectory.t[0])
+    lines = [f"{name} at t = {t:.10g} ({origin})", "",
+             f"{'coordinate':<24}{'q':>20}{'dq/dt':>20}{'d2q/dt2':>20}"]
+    # "+ 0.0" below prints a negative zero as 0.
+    for k, coordinate in enumerate(trajectory.coordinates):
+        lines.append(f"{coordinate:<24}" + "".join(
+            f"{float(values[0, k]) + 0.0:>20.12g}" for values in (trajectory.q, trajectory.dq,
+                                                            trajectory.d2q)))
+    if trajectory.points:
+        lines += ["", f"{'point':<24}" + "".join(f"{h:>16}" for h in
+                                                  ("x", "y", "vx", "vy", "ax", "ay"))]
+        for body, point in trajectory.points:
+            r, dr, ddr = trajectory.point(body, point)
+            numbers = np.concatenate([r[0], dr[0], ddr[0]])
+            lines.append(f"{body + '.' + point:<24}"
+                         + "".join(f"{float(v) + 0.0:>16.10g}" for v in numbers))
+    return "\n".join(lines) + "\n"
+
+
+def fallback_note(count: int, points: int) -> str:
+    """Why sparse-LU fall-backs do not matter for the numbers (they cost only time)."""
+    which = "factorization" if count == 1 else "factorizations"
+    return (f"{count} pivot fall-back{'s' if count != 1 else ''} to dense LU over {points} time "
+            f"points: {count} {which} of the generated sparse LU met a pivot below its "
+            "threshold and were redone with dense LU and partial pivoting. This costs time, "
+            "not accuracy: every pivot is checked, and no result comes from a rejected one")
+
+
+class ProgressBar:
+    """A progress bar on a terminal (tqdm: count, rate and time left), for any loop that
+    reports ``(done, total)``: the solver's grid, in C or in Python, or animation frames."""
+
+    def __init__(self, stream: TextIO, label: str = "solving", unit: str = "point") -> None:
+        self.stream = stream
+        self.label = label
+        self.unit = unit
+        self._bar: Any = None
+
+    def __call__(self, done: int, total: int) -> None:
+        if self._bar is None:
+            from tqdm import tqdm
+
+            self._bar = tqdm(total=total, file=self.stream, desc=self.label, unit=self.unit,
+                             mininterval=0.1, dynamic_ncols=True, leave=True)
+        self._bar.update(done - self._bar.n)
+
+    def finish(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None

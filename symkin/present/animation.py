@@ -1,0 +1,196 @@
+"""Stage 7 — the mechanism moving: a GIF with every body, ground pivot and slide axis.
+
+Bodies are drawn as polygons through the local vectors of their joints and points
+(``outlines``, from :func:`symkin.symbolic.drawing.outlines`), so what moves on screen is what
+the constraints hold together. Ground pivots are drawn as hatched triangles, slide axes as
+dash-dotted lines through the whole picture; the legend stands to the right of the mechanism.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.errors import SymkinError, UsageError
+from symkin.present import series
+from symkin.runtime.results import Trajectory, rotation
+
+Array = NDArray[np.float64]
+Outlines = Mapping[str, Array]
+Progress = Callable[[int, int], None]
+
+MAX_FRAMES = 200
+DEFAULT_SIZE = (900, 600)  # pixels
+DPI = 100
+GROUND = "ground"
+
+
+def body_shapes(trajectory: Trajectory, outlines: Outlines) -> dict[str, Array]:
+    """Global positions of each body's outline vertices, each shape (T, K, 2) (2.14)."""
+    shapes = {}
+    for body in trajectory.bodies:
+        local = np.asarray(outlines.get(body, np.zeros((1, 2))), dtype=float).reshape(-1, 2)
+        shapes[body] = _global(trajectory, body, local)
+    return shapes
+
+
+def _global(trajectory: Trajectory, body: str, local: Array) -> Array:
+    """Local vectors of ``body`` (K, 2) in the global frame at every time: (T, K, 2)."""
+    if body == GROUND:
+        return np.broadcast_to(local, (trajectory.t.size, *local.shape))
+    q, _, _ = trajectory.body(body)
+    turned: Array = np.einsum("tij,kj->tki", rotation(q[:, 2]), local)
+    return q[:, None, :2] + turned
+
+
+def slide_axes(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]]:
+    """Every slide axis as (point, unit direction), each (T, 2), in the global frame."""
+    axes = []
+    for key, rows in outlines.items():
+        if not key.startswith("slide:"):
+            continue
+        body = key.split(":", 1)[1]
+        rows = np.asarray(rows, dtype=float).reshape(-1, 2)
+        if body != GROUND and body not in trajectory.bodies:
+            continue
+        for point, direction in zip(rows[0::2], rows[1::2]):
+            norm = float(np.hypot(*direction))
+            if norm == 0:
+                continue
+            at = _global(trajectory, body, point[None])[:, 0]
+            turned = _global(trajectory, body, np.array([point + direction / norm]))[:, 0]
+            axes.append((at, turned - at))
+    return axes
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``"900x600"`` -> (900, 600), pixels; UsageError for anything else."""
+    width, _, height = text.lower().partition("x")
+    try:
+        size = (int(width), int(height))
+    except ValueError:
+        size = (0, 0)
+    if not (100 <= size[0] <= 4000 and 100 <= size[1] <= 4000):
+        raise UsageError(f"--size {text}: give WIDTHxHEIGHT in pixels, each 100 to 4000, "
+                         "e.g. 900x600")
+    return size
+
+
+def animate(trajectory: Trajectory, path: str | Path, outlines: Outlines, fps: int = 20,
+            size: tuple[int, int] = DEFAULT_SIZE, progress: Progress | None = None) -> Path:
+    """Write a GIF of the mechanism moving, with the traces of its moving named points.
+
+    Args:
+        trajectory: the solved run.
+        path: the .gif to write.
+        outlines: per body, the local vectors to draw it through; ``ground`` pivots and
+            ``slide:<body>`` axes (see :func:`symkin.symbolic.drawing.outlines`).
+        fps: frames per second; at most MAX_FRAMES frames are drawn, evenly spaced.
+        size: width and height in pixels.
+        progress: called as progress(frames done, frames) while frames are drawn.
+    """
+    if trajectory.t.size == 0:
+        raise SymkinError("nothing to animate: no time point was solved")
+    if not 1 <= fps <= 100:
+        raise UsageError(f"--fps {fps}: give 1 to 100 frames per second")
+    from matplotlib.animation import PillowWriter
+
+    from symkin.present.plots import _pyplot
+
+    plt = _pyplot()
+    scene = _Scene(plt, trajectory, outlines, size)
+    frames = np.unique(np.linspace(0, trajectory.t.size - 1, MAX_FRAMES).astype(int))
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    writer = PillowWriter(fps=fps)
+    try:
+        with writer.saving(scene.figure, str(path), dpi=DPI):
+            for done, k in enumerate(frames, start=1):
+                scene.show(int(k))
+                writer.grab_frame()
+                if progress is not None:
+                    progress(done, frames.size)
+    finally:
+        plt.close(scene.figure)
+    return path
+
+
+class _Scene:
+    """The figure of an animation and the artists that move."""
+
+    def __init__(self, plt: Any, trajectory: Trajectory, outlines: Outlines,
+                 size: tuple[int, int]) -> None:
+        self.trajectory = trajectory
+        self.figure, ax = plt.subplots(figsize=(size[0] / DPI, size[1] / DPI), dpi=DPI,
+                                       layout="constrained")
+        self.ax = ax
+        self.shapes = body_shapes(trajectory, outlines)
+        self.slides = slide_axes(trajectory, outlines)
+        x0, x1, y0, y1 = _limits([*self.shapes.values(), _ground(outlines)[None]])
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
+        ax.set_aspect("equal", adjustable="box")
+        ax.grid(True, linewidth=0.3, alpha=0.4)
+        span = max(x1 - x0, y1 - y0)
+        self.reach = 2 * span
+        self.slide_lines = [ax.plot([], [], "-.", color="0.45", linewidth=0.9,
+                                    label="slide axis" if k == 0 else None)[0]
+                            for k in range(len(self.slides))]
+        _pivots(ax, _ground(outlines), span)
+        colours = series.palette(len(self.shapes))
+        self.lines = {body: ax.plot([], [], "o-", linewidth=3, markersize=4, color=colour,
+                                    alpha=0.85, label=body)[0]
+                      for body, colour in zip(self.shapes, colours)}
+        self.traces = [(trajectory.point(b, p)[0], ax.plot([], [], ":", linewidth=1,
+                                                             color="0.3")[0])
+                       for b, p in trajectory.points if _moving_point(trajectory, b, p)]
+        self.title = ax.set_title("")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small",
+                  borderaxespad=0.0)
+
+    def show(self, k: int) -> None:
+        for body, line in self.lines.items():
+            line.set_data(*_closed(self.shapes[body][k]).T)
+        for trace, line in self.traces:
+            line.set_data(trace[:k + 1, 0], trace[:k + 1, 1])
+        for (at, direction), line in zip(self.slides, self.slide_lines):
+            ends = at[k] + np.outer([-self.reach, self.reach], direction[k])
+            line.set_data(ends[:, 0], ends[:, 1])
+        self.title.set_text(f"t = {self.trajectory.t[k]:.4g}")
+
+
+def _moving_point(trajectory: Trajectory, body: str, point: str) -> bool:
+    r, _, _ = trajectory.point(body, point)
+    return bool(np.ptp(r, axis=0).max() > 1e-12 * max(1.0, float(np.abs(r).max())))
+
+
+def _ground(outlines: Outlines) -> Array:
+    return np.asarray(outlines.get(GROUND, np.zeros((0, 2))), dtype=float).reshape(-1, 2)
+
+
+def _pivots(ax: Any, points: Array, span: float) -> None:
+    """A hatched triangle under every ground pivot (the usual sign for a fixed support)."""
+    from matplotlib.patches import Polygon
+
+    size = 0.04 * span
+    for k, (x, y) in enumerate(points):
+        triangle = np.array([[x, y], [x - size, y - 1.6 * size], [x + size, y - 1.6 * size]])
+        ax.add_patch(Polygon(triangle, closed=True, facecolor="none", edgecolor="black",
+                             hatch="////", linewidth=1.0, zorder=1,
+                             label="ground pivot" if k == 0 else None))
+
+
+def _limits(shapes: list[Array]) -> tuple[float, float, float, float]:
+    every = np.concatenate([s.reshape(-1, 2) for s in shapes] + [np.zeros((1, 2))])
+    low, high = every.min(axis=0), every.max(axis=0)
+    margin = 0.1 * max(float(np.max(high - low)), 1e-9)
+    return low[0] - margin, high[0] + margin, low[1] - 2 * margin, high[1] + margin
+
+
+def _closed(vertices: Array) -> Array:
+    """A polygon through the vertices, closed when it has more than two."""
+    return np.vstack([vertices, vertices[:1]]) if len(vertices) > 2 else vertices
