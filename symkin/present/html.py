@@ -128,7 +128,7 @@ class _Scene:
         for (body, _), colour in zip(self.shapes.items(), colours):
             moving.append(self._add(figure, go.Scatter(
                 mode="lines+markers", name=body, line={"width": 4, "color": colour},
-                marker={"size": 6}, fill="toself", opacity=0.85)))
+                marker={"size": 6}, fill="toself", fillcolor=_translucent(colour))))
         for k in range(len(self.slides)):
             moving.append(self._add(figure, go.Scatter(
                 mode="lines", name="slide axis", showlegend=k == 0, legendgroup="slide",
@@ -259,6 +259,12 @@ def _layout(figure: Any, trajectory: Trajectory, frames: Array, scene: _Scene,
                           {"label": "❚❚", "method": "animate",
                            "args": [[None], {"mode": "immediate",
                                              "frame": {"duration": 0, "redraw": False}}]}]}])
+
+
+def _translucent(colour: str) -> str:
+    """``#rrggbb`` as a light fill: rgba with alpha 0.25."""
+    red, green, blue = (int(colour[k:k + 2], 16) for k in (1, 3, 5))
+    return f"rgba({red},{green},{blue},0.25)"
 
 
 def _closed(vertices: Array) -> Array:

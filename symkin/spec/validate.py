@@ -93,7 +93,16 @@ def override_parameters(data: Any, overrides: Mapping[str, str], source: str) ->
         except ExpressionError as error:
             raise UsageError(f"--set {name}={text}: {error}. Give a number or an expression "
                              "of numbers, such as 2.5 or 2*pi/3") from None
-    return {**data, "parameters": {**parameters, **overrides}}
+    return {**data, "parameters": {**parameters, **{name: _number_or_text(text)
+                                                    for name, text in overrides.items()}}}
+
+
+def _number_or_text(text: str) -> float | str:
+    """A plain number stays a number (shown as one by ``show --local``); else the text."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
 
 
 def from_dict(data: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
