@@ -181,3 +181,16 @@ def test_generate_defaults_to_the_backend_run_uses(tmp_path: Path) -> None:
     made = symkin_cli("generate", str(TEXTBOOK), "--backend", "c", "-o", "c2", cwd=tmp_path,
                       env={"CC": "no-such-compiler-here"})
     assert made.returncode == 0 and (tmp_path / "c2" / "crank_slider.c").exists()
+
+
+def test_readme_walkthrough_is_the_drawn_example() -> None:
+    """The README's 'Describe your mechanism' file is valid and is the example file."""
+    import yaml
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text[text.index("## Describe your mechanism"):]
+    block = section[section.index("```yaml") + len("```yaml"):section.index("```\n", 10)]
+    from_readme = symkin.from_dict(yaml.safe_load(block))
+    example = symkin.load(ROOT / "examples" / "crank_slider_drawn.yaml")
+    assert from_readme.canonical_json() == example.canonical_json()
+    assert from_readme.units == example.units

@@ -1,9 +1,11 @@
 """The package installs with a plain (non-editable) `pip install .` and works from any folder.
 
-The install goes into a fresh virtual environment that sees the running interpreter's
-site-packages through a .pth file (so no download is needed, also when the tests themselves run
-in a virtualenv) and the package is installed without its dependencies: what is checked is
-the wheel's own content — modules, templates and the console script.
+The install goes into a fresh virtual environment built from the running interpreter: it sees
+the running interpreter's site-packages (pip, setuptools, wheel and symkin's dependencies)
+through a .pth file, so no download is needed and nothing comes from the base interpreter,
+also when the tests themselves run in a virtualenv. The package is installed without its
+dependencies: what is checked is the wheel's own content — modules, templates and the console
+script.
 """
 
 from __future__ import annotations
@@ -41,7 +43,8 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     source = work / "source"
     shutil.copytree(ROOT, source, ignore=_not_sources)
     env_dir = work / "venv"
-    venv.create(env_dir, system_site_packages=False, with_pip=True)
+    # No ensurepip: the running interpreter's pip is used through the .pth file below.
+    venv.create(env_dir, system_site_packages=False, with_pip=False)
     bin_dir = env_dir / "bin"
     # The running interpreter's packages (itself maybe a virtualenv, whose base interpreter
     # lacks them), seen through a .pth file: dependencies and build tools without a download.
@@ -80,3 +83,21 @@ def test_templates_ship_inside_the_package(installed: Path, tmp_path: Path) -> N
                       (ROOT / "templates").rglob("*.j2"))
     assert listing == repr(expected)
     assert sys.version_info >= (3, 11)
+
+
+@pytest.mark.slow
+def test_installed_version_comes_from_the_package_metadata(installed: Path,
+                                                           tmp_path: Path) -> None:
+    import tomllib
+
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    shown = subprocess.run([str(installed / "symkin"), "--version"], cwd=tmp_path, env=env,
+                           capture_output=True, text=True, check=True).stdout.strip()
+    assert shown == f"symkin {declared}"
+    code = ("import symkin, importlib.metadata as m; "
+            "print(symkin.__version__, m.version('symkin'), symkin.__file__)")
+    version, metadata, where = subprocess.run(
+        [str(installed / "python"), "-c", code], cwd=tmp_path, env=env, capture_output=True,
+        text=True, check=True).stdout.split()
+    assert version == metadata == declared and "site-packages" in where
