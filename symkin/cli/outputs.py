@@ -5,6 +5,8 @@ one configuration (``--at``), progress bars, and notes that say whether an event
 from __future__ import annotations
 
 import argparse
+import io
+import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -128,8 +130,16 @@ class ProgressBar:
         if self._bar is None:
             from tqdm import tqdm
 
+            # A terminal that reports its size as 0 x 0 (some pseudo-terminals) would get no
+            # bar at all from tqdm: give it the usual 80 x 24 then.
+            try:
+                size = os.get_terminal_size(self.stream.fileno())
+            except (OSError, ValueError, io.UnsupportedOperation):
+                size = os.terminal_size((0, 0))
+            known = size.columns > 0 and size.lines > 0
             self._bar = tqdm(total=total, file=self.stream, desc=self.label, unit=self.unit,
-                             mininterval=0.1, dynamic_ncols=True, leave=True)
+                             mininterval=0.1, dynamic_ncols=known, leave=True,
+                             ncols=None if known else 80, nrows=None if known else 24)
         self._bar.update(done - self._bar.n)
 
     def finish(self) -> None:
