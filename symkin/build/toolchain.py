@@ -77,7 +77,8 @@ def resolve_backend(backend: str) -> str:
             f"the C backend needs a C compiler and none was found (looked for {looked_for}). "
             "Install one (Debian/Ubuntu: apt install gcc; macOS: xcode-select --install; "
             "or conda install c-compiler), set CC to it, or use backend 'numpy' or 'auto'.")
-    warnings.warn(f"no C compiler found (looked for {looked_for}): using the NumPy backend. "
-                  "Install gcc or clang, or set CC, for the C backend.", SymkinWarning,
+    warnings.warn(f"no C compiler found (looked for {looked_for}): using the NumPy backend, "
+                  "which gives the same results, more slowly. Install gcc or clang, or set "
+                  "CC, for the C backend.", SymkinWarning,
                   stacklevel=3)
     return "numpy"

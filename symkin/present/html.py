@@ -179,7 +179,7 @@ def _plots(go: Any, figure: Any, trajectory: Trajectory, curves: Sequence[series
                 for k, part in enumerate(curve.components):
                     figure.add_trace(go.Scatter(
                         x=trajectory.t, y=curve.values[order][:, k], mode="lines",
-                        name=curve.name + (f" {part}" if part else ""),
+                        name=curve.name if k == 0 else f"{curve.name} {part}",
                         legendgroup=curve.name, showlegend=order == 0 and k == 0,
                         line={"color": curve.colour, "dash": "dash" if part == "y" else "solid",
                               "width": 1.5}), row=order + 1, col=column)
@@ -240,7 +240,8 @@ def _layout(figure: Any, trajectory: Trajectory, frames: Array, scene: _Scene,
             "transition": {"duration": 0}}
     figure.update_layout(
         title={"text": f"{title}: {trajectory.t.size} time points, t = "
-                       f"{trajectory.t[0]:.4g} to {trajectory.t[-1]:.4g}"},
+                       f"{trajectory.t[0]:.4g} to {trajectory.t[-1]:.4g}"
+                       + (" (points: x solid, y dashed)" if scene.points else "")},
         height=760, template="plotly_white", hovermode="closest",
         legend={"x": 1.02, "y": 1.0, "xanchor": "left", "yanchor": "top",
                 "font": {"size": 11}, "groupclick": "togglegroup"},
