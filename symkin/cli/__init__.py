@@ -142,13 +142,23 @@ SUBCOMMANDS: list[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]]
     _add_show, _add_verify, _add_generate, _add_run, _add_cache]
 
 
+class _Version(argparse.Action):
+    """``--version``, looked up only when asked for: reading the package metadata costs a
+    tenth of a second that every other command would otherwise pay at start."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: Any, option_string: str | None = None) -> None:
+        import symkin
+
+        print(f"symkin {symkin.__version__}")
+        parser.exit()
+
+
 def parser() -> argparse.ArgumentParser:
     main_parser = argparse.ArgumentParser(
         prog="symkin", description="Symbolic kinematics code generator for planar mechanisms.")
-    import symkin
-
-    main_parser.add_argument("--version", action="version",
-                             version=f"%(prog)s {symkin.__version__}")
+    main_parser.add_argument("--version", action=_Version, nargs=0,
+                             help="print symkin's version and exit")
     commands = main_parser.add_subparsers(dest="command", required=True)
     for add in SUBCOMMANDS:
         add(commands)

@@ -38,7 +38,9 @@ class Pictures:
         if args.select is not None:
             select = series.check_selection(series.parse_selection(args.select),
                                             kernel.coordinates, kernel.points)
-        return cls(select, units_of(args.mechanism), kernel.name)
+        # The file is read again only for pictures: a plain warm run stays free of YAML.
+        wanted = args.plot is not None or args.html is not None
+        return cls(select, units_of(args.mechanism) if wanted else Units(), kernel.name)
 
 
 def units_of(mechanism: Path) -> Units:
