@@ -243,3 +243,17 @@ def test_report_in_headless_chromium(six_bar, tmp_path: Path) -> None:
         rgb = np.array([int(colour[k:k + 2], 16) for k in (1, 3, 5)])
         close = np.abs(mechanism - rgb).sum(axis=2) < 40
         assert close.sum() > 50, f"no {colour} body drawn in the mechanism's view"
+
+
+def test_run_without_plotly_stops_before_solving(tmp_path: Path) -> None:
+    """--html without plotly: exit 2 at once with the install hint, nothing written."""
+    blocker = tmp_path / "blocker"
+    blocker.mkdir()
+    (blocker / "sitecustomize.py").write_text("import sys\nsys.modules['plotly'] = None\n")
+    env = {**os.environ, "PYTHONPATH": f"{blocker}{os.pathsep}{ROOT}"}
+    result = subprocess.run([sys.executable, "-m", "symkin", "run", str(TEXTBOOK), "-o", "a.csv",
+                             "--html", "r.html"], cwd=tmp_path, env=env, capture_output=True,
+                            text=True, timeout=300, check=False)
+    assert result.returncode == 2 and "pip install 'symkin[html]'" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not (tmp_path / "a.csv").exists() and not (tmp_path / "r.html").exists()

@@ -82,6 +82,12 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
                     "Leave out --at, or those options")
     if not 1 <= args.fps <= 100:
         return f"--fps {args.fps}: give 1 to 100 frames per second"
+    if args.html is not None:
+        from symkin.present import html
+
+        if not html.available():
+            return ("--html needs the plotly package, which draws the report: "
+                    "pip install 'symkin[html]' (or pip install plotly)")
     return None
 
 

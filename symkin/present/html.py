@@ -30,6 +30,16 @@ VECTOR_SHARE = 0.15  # the longest vector of the run drawn this long, relative t
 VELOCITY, ACCELERATION = "#d62728", "#1f77b4"
 
 
+def available() -> bool:
+    """Whether the report can be drawn (plotly is installed), without importing it."""
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("plotly") is not None
+    except ValueError:  # a module entry without a spec (blocked or half-imported)
+        return False
+
+
 def _plotly() -> Any:
     try:
         import plotly.graph_objects as go
@@ -54,6 +64,9 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
         units: labels from the file's ``units`` key.
         title: the page's title, e.g. the mechanism's name.
     """
+    path = Path(path)
+    if path.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"cannot write a report to {path.name}: use a file ending in .html")
     if trajectory.t.size == 0:
         raise UsageError("nothing to report: no time point was solved")
     go = _plotly()
@@ -77,9 +90,6 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
     cursors = _plots(go, figure, trajectory, curves, columns, units)
     _animate(go, figure, trajectory, frames, scene, moving, cursors)
     _layout(figure, trajectory, frames, scene, columns, units, title)
-    path = Path(path)
-    if path.suffix.lower() not in (".html", ".htm"):
-        raise UsageError(f"cannot write a report to {path.name}: use a file ending in .html")
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
                       config={"displaylogo": False, "responsive": True},
