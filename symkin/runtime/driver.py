@@ -224,7 +224,7 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Op
 def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
           params: Mapping[str, float] | ArrayLike | None = None, *,
           options: Options | None = None, progress: Progress | None = None,
-          use_c_solver: bool = True) -> Trajectory:
+          use_c_solver: bool = True, sensitivities: bool = False) -> Trajectory:
     """Positions, velocities and accelerations of a mechanism over a time grid.
 
     Args:
@@ -236,6 +236,7 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
             kernel's real type (looser for a C kernel generated with float).
         progress: called as progress(done, total) while the grid is solved.
         use_c_solver: run the grid loop in the generated C solver when the kernel has one.
+        sensitivities: also compute ``q_p`` = dq/dp (T, N, NP) from Phi_q q_p = -Phi_p.
 
     Returns:
         The Trajectory.
@@ -247,7 +248,12 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     # An expression singular at some t gives inf/NaN there; that is reported as a failure
     # (status NOT_FINITE), so NumPy's floating-point warnings would only repeat it.
     with np.errstate(all="ignore"):
-        return _solve(kernel, t, q0, params, options, progress, use_c_solver)
+        trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver)
+    if sensitivities:
+        from symkin.runtime.sensitivity import with_sensitivities
+
+        return with_sensitivities(kernel, trajectory)
+    return trajectory
 
 
 def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,

@@ -35,6 +35,7 @@ class _Functions(Protocol):
     def phi_t(self, q: Array, t: float, p: Array) -> Array: ...
     def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array: ...
     def points(self, p: Array) -> Array: ...
+    def phi_p_nz(self, q: Array, t: float, p: Array) -> Array: ...
 
 
 class Kernel:
@@ -60,6 +61,10 @@ class Kernel:
         self.pattern_rows = np.array(meta["pattern_rows"], dtype=np.intp)
         self.pattern_cols = np.array(meta["pattern_cols"], dtype=np.intp)
         self.points: tuple[tuple[str, str], ...] = tuple(tuple(p) for p in meta["points"])
+        # The non-zeros of Phi_p (row, parameter); absent from kernels built before Phi_p.
+        self.phi_p_rows = np.array(meta.get("phi_p_rows", ()), dtype=np.intp)
+        self.phi_p_cols = np.array(meta.get("phi_p_cols", ()), dtype=np.intp)
+        self.has_phi_p = "phi_p_rows" in meta
         self.ffi = ffi
         self.lib = lib
         self._functions = functions
@@ -109,6 +114,16 @@ class Kernel:
         """Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (N,)."""
         return self._functions.gamma(self._q(q), self._q(dq, "dq"), float(t), self._p(p))
 
+    def phi_p(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """Phi_p = d Phi / d p as a dense N x NP array (the design sensitivities' right side)."""
+        if not self.has_phi_p:
+            raise ValueError(f"the kernel of {self.name} was built without Phi_p; rebuild it "
+                             "with symkin.compile")
+        dense = np.zeros((self.nq, self.p_values.size))
+        dense[self.phi_p_rows, self.phi_p_cols] = self._functions.phi_p_nz(
+            self._q(q), float(t), self._p(p))
+        return dense
+
     def point_vectors(self, p: ArrayLike | None = None) -> Array:
         """Local vectors of the named points, shape (NPOINTS, 2), in ``points`` order."""
         return self._functions.points(self._p(p)).reshape(len(self.points), 2)
@@ -142,18 +157,20 @@ class _ModuleFunctions:
         self.phi_t = module.phi_t
         self.gamma = module.gamma
         self.points = module._points
+        self.phi_p_nz = getattr(module, "phi_p_nz", None)
 
 
 class _CFunctions:
     """Adapter over a cffi extension: converts arrays to the generated real type and back."""
 
     def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
-                 npoints: int) -> None:
+                 npoints: int, nnz_p: int = 0) -> None:
         self._ffi = ffi
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
-        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints}
-        self._c = {name: getattr(lib, f"{prefix}_{name}") for name in self._sizes}
+        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
+                       "phi_p": nnz_p}
+        self._c = {name: getattr(lib, f"{prefix}_{name}", None) for name in self._sizes}
 
     def _in(self, array: Array) -> Any:
         if array.size == 0:
@@ -181,6 +198,9 @@ class _CFunctions:
     def points(self, p: Array) -> Array:
         return self._call("points", self._in(p))
 
+    def phi_p_nz(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi_p", self._in(q), t, self._in(p))
+
 
 def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
     """A Kernel over a generated NumPy module (its metadata comes from the module)."""
@@ -190,6 +210,8 @@ def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
         "q0": module.Q0, "time_grid": module.TIME_GRID, "rows": module.ROWS,
         "pattern_rows": module.PATTERN_ROWS, "pattern_cols": module.PATTERN_COLS,
         "points": module.POINTS,
+        **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
+           if hasattr(module, "PHI_P_ROWS") else {}),
     }
     return Kernel("numpy", meta, _ModuleFunctions(module), folder=folder)
 
@@ -197,7 +219,8 @@ def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
 def from_cffi(ffi: Any, lib: Any, meta: Mapping[str, Any], folder: Path | None = None) -> Kernel:
     """A Kernel over a cffi extension built from the generated C; ``meta`` is the manifest."""
     functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
-                            len(meta["pattern_rows"]), len(meta["points"]))
+                            len(meta["pattern_rows"]), len(meta["points"]),
+                            len(meta.get("phi_p_rows", ())))
     return Kernel("c", meta, functions, ffi=ffi, lib=lib, folder=folder)
 
 

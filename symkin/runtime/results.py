@@ -60,6 +60,8 @@ class Trajectory:
         params: the parameter values solved with.
         lu_fallbacks: factorizations of the generated C solver whose sparse LU left its fixed
             pivot order for the dense partial-pivoting path (always 0 elsewhere).
+        q_p: design sensitivities dq/dp, shape (T, N, NP), when solved with
+            ``sensitivities=True`` (from Phi_q q_p = -Phi_p); else None.
     """
 
     t: NDArray[np.float64]
@@ -71,6 +73,7 @@ class Trajectory:
     point_vectors: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
     params: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     lu_fallbacks: int = 0
+    q_p: NDArray[np.float64] | None = None
 
     @property
     def bodies(self) -> tuple[str, ...]:
