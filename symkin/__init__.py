@@ -20,6 +20,7 @@ __all__ = [
     "generate",
     "load",
     "solve",
+    "sweep",
 ]
 
 _EXPORTS = {
@@ -31,6 +32,7 @@ _EXPORTS = {
     "generate": ("symkin.codegen.render", "generate"),
     "compile": ("symkin.build.compile", "compile"),
     "solve": ("symkin.runtime.driver", "solve"),
+    "sweep": ("symkin.sweep.api", "sweep"),
     "SymkinError": ("symkin.errors", "SymkinError"),
     "MechanismError": ("symkin.errors", "MechanismError"),
     "SolveError": ("symkin.errors", "SolveError"),
