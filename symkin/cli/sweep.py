@@ -2,10 +2,10 @@
 draws within tolerances — solved in this process, local processes or on a Dask cluster.
 
 Prints how many sets were solved, the failed ones with their reason, and for every named point
-the envelope of its position (min/max and mean ± 3σ over the solved sets, at the time of the
-widest spread); with --monte-carlo also the first-order ±3σ from the sensitivities q_p beside
-the Monte-Carlo one. Exit status 0 when at least one set was solved, 1 when none was, 2 for bad
-input (a one-paragraph message), 130 when interrupted.
+the envelope of its position (min/max and mean ± 3 sigma over the solved sets, at the time of the
+widest spread); with --monte-carlo also the first-order ±3 sigma from the sensitivities q_p
+beside the Monte-Carlo one. Exit status 0 when at least one set was solved, 1 when none was,
+2 for bad input (a one-paragraph message), 130 when interrupted.
 """
 
 from __future__ import annotations
@@ -172,7 +172,7 @@ def _client(address: str) -> Any:
     except ImportError:
         raise UsageError("--scheduler needs Dask: pip install 'symkin[distributed]'") from None
     try:
-        return Client(address, timeout="10s")
+        return Client(address, timeout="10s")  # type: ignore[no-untyped-call,unused-ignore]
     except (OSError, TimeoutError, ValueError) as error:
         raise UsageError(f"--scheduler {address}: cannot connect ({error}); check the "
                          "address of the Dask scheduler and that it is running") from None

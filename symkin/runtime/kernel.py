@@ -12,7 +12,7 @@ import importlib.machinery
 import importlib.util
 import json
 import sys
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Protocol
@@ -157,7 +157,12 @@ class _ModuleFunctions:
         self.phi_t = module.phi_t
         self.gamma = module.gamma
         self.points = module._points
-        self.phi_p_nz = getattr(module, "phi_p_nz", None)
+        self.phi_p_nz: Callable[[Array, float, Array], Array] = getattr(
+            module, "phi_p_nz", _no_phi_p)
+
+
+def _no_phi_p(q: Array, t: float, p: Array) -> Array:
+    raise ValueError("this kernel was generated without Phi_p; rebuild it with symkin.compile")
 
 
 class _CFunctions:
@@ -170,7 +175,9 @@ class _CFunctions:
         self._ctype = f"{real}[]"
         self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
                        "phi_p": nnz_p}
-        self._c = {name: getattr(lib, f"{prefix}_{name}", None) for name in self._sizes}
+        # getattr with a default: a kernel folder built before phi_p existed has none.
+        self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
+                                   for name in self._sizes}
 
     def _in(self, array: Array) -> Any:
         if array.size == 0:

@@ -132,7 +132,7 @@ def _workers(workers: int | None, points: int) -> int:
 
 def _cluster_size(client: Any) -> int:
     try:
-        return max(1, sum(client.nthreads().values()))
+        return max(1, int(sum(client.nthreads().values())))
     except Exception:  # a client that cannot say: a few chunks still balance the load
         return 4
 

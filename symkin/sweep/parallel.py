@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import hashlib
+import itertools
 import json
 import multiprocessing
 from collections.abc import Callable, Iterator, Sequence
@@ -76,7 +77,7 @@ def run_chunk(source: Payload, params: Array, t: Array, q0: Array,
 def split(m: int, pieces: int) -> list[slice]:
     """[0, m) in ``pieces`` contiguous slices of nearly equal size (none empty)."""
     bounds = np.linspace(0, m, min(max(pieces, 1), max(m, 1)) + 1).round().astype(int)
-    return [slice(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds) if b > a]
 
 
 def _q0_part(q0: Array, part: slice) -> Array:
@@ -102,14 +103,15 @@ def on_dask(client: Any, source: Payload, params: Array, t: Array, q0: Array,
             ) -> list[Chunk]:
     """The chunks solved on a Dask cluster through ``client`` (a distributed.Client)."""
     try:
-        from distributed import as_completed
+        from distributed import as_completed  # type: ignore[import-untyped,unused-ignore]
     except ImportError:  # pragma: no cover - a client cannot exist without distributed
         raise SolveError("client= needs dask.distributed: pip install 'symkin[distributed]'"
                          ) from None
     remote = client.scatter(source, broadcast=True)
     futures = {client.submit(run_chunk, remote, params[part], t, _q0_part(q0, part), options,
                              pure=False): k for k, part in enumerate(parts)}
-    return _collect(futures, as_completed(list(futures)), parts, progress, params.shape[0])
+    completed = as_completed(list(futures))  # type: ignore[no-untyped-call,unused-ignore]
+    return _collect(futures, completed, parts, progress, params.shape[0])
 
 
 def _collect(futures: dict[Any, int], completed: Iterator[Any], parts: Sequence[slice],

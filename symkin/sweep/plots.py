@@ -1,4 +1,5 @@
-"""The envelope plot of a sweep: each named point's x and y over t, min/max shaded, mean ± 3σ."""
+"""The envelope plot of a sweep: each named point's x and y over t, min/max shaded, and the
+mean ± 3 sigma."""
 
 from __future__ import annotations
 

@@ -157,7 +157,8 @@ def point_sensitivities(kernel: Kernel, t: Array, params: Array | None = None
 def first_order_std(r_p: Array, spread: Array) -> Array:
     """The standard deviation of r from independent parameters of standard deviation
     ``spread`` (covariance propagation, first order): sqrt(sum_k r_p[..., k]^2 sigma_k^2)."""
-    return np.sqrt(np.einsum("...k,k->...", r_p**2, spread**2))
+    variance: Array = np.einsum("...k,k->...", r_p**2, spread**2)
+    return np.sqrt(variance)
 
 
 def _point_vector_derivatives(kernel: Kernel, p: Array) -> Array:
@@ -171,7 +172,8 @@ def _point_vector_derivatives(kernel: Kernel, p: Array) -> Array:
         columns.append((kernel.point_vectors(p + step) - kernel.point_vectors(p - step)) / (2 * h))
     if not columns:
         return np.zeros((len(kernel.points), 2, 0))
-    return np.stack(columns, -1)
+    derivatives: Array = np.stack(columns, -1)
+    return derivatives
 
 
 def _known(kernel: Kernel, names: Sequence[str], where: str = "") -> None:
