@@ -3,8 +3,10 @@
 What travels to a worker is the kernel's generated source, its manifest included (a few tens
 of kB), never a compiled binary: each worker builds it into its own machine's cache, or finds
 it there by the same content hash ``symkin.compile`` uses, and loads it once per process
-(:func:`worker_kernel`). Chunks of parameter sets then go out, and come back as
-:class:`batch.Chunk`. Dask is imported only when a client is given.
+(:func:`worker_kernel`). A worker on the machine that compiled it (local processes, a
+LocalCluster) first tries the sender's cache folder, verified against the same sources, and so
+needs neither a build nor the SymPy import a build would bring. Chunks of parameter sets then
+go out, and come back as :class:`batch.Chunk`. Dask is imported only when a client is given.
 """
 
 from __future__ import annotations
@@ -16,14 +18,17 @@ import json
 import multiprocessing
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from symkin import resources
+from symkin.build.cache import verified
 from symkin.errors import SolveError
 from symkin.runtime.kernel import Kernel
+from symkin.runtime.kernel import load as load_kernel
 from symkin.runtime.options import Options
 from symkin.sweep.batch import Chunk, solve_chunk
 
@@ -36,6 +41,7 @@ class Payload:
     """A kernel as its generated files: what a worker needs to build or find it."""
 
     files: dict[str, str]
+    folder: str | None = None  # where the sender's build lives (useful on the same machine)
 
     @property
     def key(self) -> str:
@@ -51,7 +57,8 @@ def payload(kernel: Kernel) -> Payload:
     manifest = resources.manifest_name(kernel.name)
     listed = json.loads((folder / manifest).read_text(encoding="utf-8"))["files"]
     names = [*sorted(listed), manifest]
-    return Payload({name: (folder / name).read_text(encoding="utf-8") for name in names})
+    return Payload({name: (folder / name).read_text(encoding="utf-8") for name in names},
+                   str(folder))
 
 
 # One kernel per payload and process: loading verifies the files, so it is done once.
@@ -62,10 +69,29 @@ def worker_kernel(source: Payload) -> Kernel:
     """The kernel of ``source`` in this process: built or found in this machine's cache."""
     key = source.key
     if key not in _LOADED:
-        from symkin.build.compile import from_sources
-
-        _LOADED[key] = from_sources(source.files)
+        _LOADED[key] = _same_machine(source) or _built(source)
     return _LOADED[key]
+
+
+def _same_machine(source: Payload) -> Kernel | None:
+    """The sender's own build, when this machine has it and it verifies against the sources."""
+    if source.folder is None:
+        return None
+    folder = Path(source.folder)
+    try:
+        if not verified(folder, source.files):
+            return None
+        name = json.loads(source.files[next(n for n in source.files
+                                            if n.endswith(resources.MANIFEST_SUFFIX))])["name"]
+        return load_kernel(folder, name)
+    except (OSError, ImportError, ValueError, KeyError, StopIteration):
+        return None
+
+
+def _built(source: Payload) -> Kernel:
+    from symkin.build.compile import from_sources  # loads SymPy: only when building
+
+    return from_sources(source.files)
 
 
 def run_chunk(source: Payload, params: Array, t: Array, q0: Array,
