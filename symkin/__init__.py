@@ -44,4 +44,6 @@ def __getattr__(name: str) -> Any:
     if name not in _EXPORTS:
         raise AttributeError(f"module 'symkin' has no attribute {name!r}")
     module, attribute = _EXPORTS[name]
-    return getattr(importlib.import_module(module), attribute)
+    value = getattr(importlib.import_module(module), attribute)
+    globals()[name] = value  # found once: later lookups (symkin.solve in a loop) cost nothing
+    return value

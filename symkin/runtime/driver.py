@@ -32,6 +32,7 @@ from symkin.runtime.linalg import dependent_rows, factor_at
 from symkin.runtime.newton import Newton, assemble, newton
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.options import defaults as newton_defaults
+from symkin.runtime.csolver import GridSolver
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.results import Trajectory
 
@@ -104,9 +105,13 @@ def _times(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
     if t is None:
         return grid(*kernel.time_grid)
     times = np.atleast_1d(np.asarray(t, dtype=float))
-    if times.ndim != 1 or times.size == 0 or not np.all(np.isfinite(times)):
+    if times.ndim != 1 or times.size == 0 or not math.isfinite(times[0] + times[-1]):
         raise SolveError("t must be a non-empty 1-D sequence of finite times")
-    if np.any(np.diff(times) <= 0):
+    # Strictly increasing steps between finite ends: then every time is finite (a NaN fails
+    # the comparison). One pass, where diff and isfinite would take three.
+    if times.size > 1 and not bool((times[1:] > times[:-1]).all()):
+        if not np.all(np.isfinite(times)):
+            raise SolveError("t must be a non-empty 1-D sequence of finite times")
         raise SolveError("t must be strictly increasing")
     return times
 
@@ -198,6 +203,14 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Op
     progress callback wants to hear in between)."""
     solver = kernel.grid_solver(options, q, p)
     assert solver is not None  # only called for kernels that have one
+    try:
+        return _c_chunks(kernel, run, p, solver, progress)
+    finally:
+        getattr(solver, "release", lambda: None)()  # back to the kernel's pool for reuse
+
+
+def _c_chunks(kernel: KinematicsKernel, run: _Run, p: Array, solver: GridSolver,
+              progress: Progress | None) -> Newton:
     chunks = _Chunks(run.t.size, progress is not None)
     result = None
     start = 0
@@ -218,7 +231,8 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Op
             progress(run.done, run.t.size)
         start = stop
     assert result is not None  # the grid has at least one point
-    return Newton(solver.last_q(), OK, result.iterations, result.residual, None)
+    # The last row written is the solver's q: no need to read it back from C.
+    return Newton(run.q[run.done - 1], OK, result.iterations, result.residual, None)
 
 
 def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
@@ -297,7 +311,7 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
 
     return Trajectory(t=run.t[:done].copy(), q=solved(run.q), dq=solved(run.dq),
                       d2q=solved(run.d2q), coordinates=tuple(kernel.coordinates),
-                      points=tuple((body, point) for body, point in kernel.points),
+                      points=tuple(kernel.points),
                       point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
                       params=p.copy(), lu_fallbacks=run.fallbacks)
 

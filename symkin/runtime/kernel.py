@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin import resources
-from symkin.runtime.csolver import GridSolver
+from symkin.runtime.csolver import GridSolver, SolverPool
 from symkin.runtime.options import Options
 
 Array = NDArray[np.float64]
@@ -68,6 +68,7 @@ class Kernel:
         self.ffi = ffi
         self.lib = lib
         self._functions = functions
+        self._solvers: SolverPool | None = None  # GridSolvers reused from run to run
 
     @property
     def has_grid_solver(self) -> bool:
@@ -76,9 +77,11 @@ class Kernel:
 
     def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
         """A fresh run of the generated C grid loop from q, or None without a C solver."""
-        if not self.has_grid_solver:
-            return None
-        return GridSolver(self.ffi, self.lib, self.name, self.real, options, q, p)
+        if self._solvers is None:
+            if not self.has_grid_solver:
+                return None
+            self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
+        return self._solvers.take(options, q, p)
 
     @property
     def nq(self) -> int:
