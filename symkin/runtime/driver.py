@@ -28,11 +28,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin import limits
 from symkin.errors import SolveError
+from symkin.runtime.csolver import GridSolver
 from symkin.runtime.linalg import dependent_rows, factor_at
 from symkin.runtime.newton import Newton, assemble, newton
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.options import defaults as newton_defaults
-from symkin.runtime.csolver import GridSolver
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.results import Trajectory
 

@@ -9,8 +9,8 @@ that cannot be solved is marked with its reason and never stops the others.
 
 from __future__ import annotations
 
-import math
 import os
+import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -22,7 +22,7 @@ from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
 from symkin.runtime.options import Options
 from symkin.sweep import parallel
-from symkin.sweep.batch import Chunk, solve_chunk
+from symkin.sweep.batch import Chunk, empty_chunk, solve_chunk
 from symkin.sweep.result import SweepResult
 
 Array = NDArray[np.float64]
@@ -32,6 +32,7 @@ Progress = Callable[[int, int], None]
 # cost more to start than they save: workers=None then solves in this process.
 MIN_PARALLEL_POINTS = 200_000
 CHUNKS_PER_WORKER = 4
+CHUNK_SECONDS = 0.05
 
 
 def sweep(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike,
@@ -64,7 +65,9 @@ def sweep(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike,
     starts = _starts(kernel, q0, values.shape[0])
     m = values.shape[0]
     count = _workers(workers, m * times.size) if client is None else 0
-    if client is not None:
+    if m == 0:
+        chunks = [empty_chunk(0, times, len(kernel.coordinates))]
+    elif client is not None:
         parts = parallel.split(m, _cluster_size(client) * CHUNKS_PER_WORKER)
         chunks = parallel.on_dask(client, parallel.payload(kernel), values, times, starts,
                                   options, parts, progress)
@@ -139,16 +142,23 @@ def _cluster_size(client: Any) -> int:
 
 def _here(kernel: Kernel, values: Array, times: Array, starts: Array, options: Options | None,
           progress: Progress | None) -> list[Chunk]:
-    """This process; in ~100 chunks when someone wants to hear about progress."""
+    """This process, in calls of about CHUNK_SECONDS each written straight into one result:
+    Ctrl-C (seen between calls) and progress reports answer quickly, and no copying."""
     m = values.shape[0]
-    if progress is None:
-        return [solve_chunk(kernel, values, times, starts, options)]
-    chunks = []
-    for part in parallel.split(m, min(100, math.ceil(m / 8))):
-        chunks.append(solve_chunk(kernel, values[part], times,
-                                  starts[part] if starts.ndim == 2 else starts, options))
-        progress(part.stop, m)
-    return chunks
+    full = empty_chunk(m, times, len(kernel.coordinates))
+    # The first call: about 20000 time points (a few ms); then scaled to the time it took.
+    size, start = max(1, min(m, 20_000 // times.size)), 0
+    while start < m:
+        part = slice(start, min(m, start + size))
+        began = time.perf_counter()
+        solve_chunk(kernel, values[part], times, starts[part] if starts.ndim == 2 else starts,
+                    options, into=full.rows(part))
+        took = time.perf_counter() - began
+        size = int(max(1, size * min(4.0, CHUNK_SECONDS / took if took > 0 else 4.0)))
+        start = part.stop
+        if progress is not None:
+            progress(start, m)
+    return [full]
 
 
 def _join(chunks: list[Chunk]) -> Chunk:
@@ -156,8 +166,8 @@ def _join(chunks: list[Chunk]) -> Chunk:
         return chunks[0]
     arrays = {name: np.concatenate([getattr(c, name) for c in chunks])
               for name in ("q", "dq", "d2q", "status", "solved", "t_reached", "iterations")}
-    return Chunk(**arrays, reasons=[r for c in chunks for r in c.reasons],
-                 messages=[s for c in chunks for s in c.messages])
+    return Chunk(**arrays, reasons=np.concatenate([c.reasons for c in chunks]),
+                 messages=np.concatenate([c.messages for c in chunks]))
 
 
 def _result(kernel: Kernel, times: Array, values: Array, chunk: Chunk) -> SweepResult:

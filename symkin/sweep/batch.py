@@ -10,6 +10,7 @@ own re-run.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -46,19 +47,30 @@ class Chunk:
     solved: NDArray[np.int64]
     t_reached: Array
     iterations: NDArray[np.int64]
-    reasons: list[str]
-    messages: list[str]
+    reasons: NDArray[np.object_]
+    messages: NDArray[np.object_]
+
+    def rows(self, part: slice) -> Chunk:
+        """The sets ``part`` of this chunk as views: solving into them fills this chunk."""
+        return Chunk(*(getattr(self, f.name)[part] for f in dataclasses.fields(self)))
+
+
+def empty_chunk(m: int, t: Array, size: int) -> Chunk:
+    """Room for m sets (q, dq, d2q not initialised: every row is written or set to NaN)."""
+    shape = (m, t.size, size)
+    return Chunk(np.empty(shape), np.empty(shape), np.empty(shape),
+                 np.zeros(m, dtype=np.int64), np.full(m, t.size, dtype=np.int64),
+                 np.full(m, t[-1]), np.zeros(m, dtype=np.int64),
+                 np.full(m, "", dtype=object), np.full(m, "", dtype=object))
 
 
 def solve_chunk(kernel: Kernel, params: Array, t: Array, q0: Array,
-                options: Options | None = None) -> Chunk:
-    """Solve every row of ``params`` (m, NP) over ``t`` from ``q0`` ((N,) or (m, N))."""
+                options: Options | None = None, into: Chunk | None = None) -> Chunk:
+    """Solve every row of ``params`` (m, NP) over ``t`` from ``q0`` ((N,) or (m, N)), into
+    ``into`` (m rows, e.g. ``rows`` of a larger chunk) or a new chunk."""
     options = options or driver.default_options(kernel)
     m, size = params.shape[0], len(kernel.coordinates)
-    shape = (m, t.size, size)
-    chunk = Chunk(np.empty(shape), np.empty(shape), np.empty(shape),
-                  np.zeros(m, dtype=np.int64), np.full(m, t.size, dtype=np.int64),
-                  np.full(m, t[-1]), np.zeros(m, dtype=np.int64), [""] * m, [""] * m)
+    chunk = empty_chunk(m, t, size) if into is None else into
     starts = np.broadcast_to(q0, (m, size))
     if hasattr(kernel.lib, f"{kernel.name}_solve_batch"):
         pending = _c_batch(kernel, params, t, q0, options, chunk)
