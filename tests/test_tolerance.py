@@ -127,3 +127,29 @@ def test_cli_bad_input_exits_2_with_one_message(tmp_path: Path, args, message) -
     assert result.returncode == 2, result.stdout + result.stderr
     assert message in result.stderr and result.stderr.startswith("symkin: error:")
     assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_cli_too_many_sets_is_refused_before_any_work(tmp_path: Path) -> None:
+    result = sweep_cli(str(TEXTBOOK), "--vary", "a=0.9:1.1:1000", "--vary", "b=5:6:1000",
+                       cwd=tmp_path)
+    assert result.returncode == 2 and "points in all, more than the" in result.stderr
+
+
+def test_cli_interrupt_exits_130_without_a_traceback(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    squeezer = str(ROOT / "examples" / "andrews_squeezer.yaml")
+    warm = sweep_cli(squeezer, "--monte-carlo", "1", "--tolerance", "xa=±1e-5", cwd=tmp_path)
+    assert warm.returncode == 0, warm.stderr  # the kernel is built: the wait below is solving
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    process = subprocess.Popen(
+        # Andrews' squeezer, 160000 sets x 61 points: far longer than the wait below
+        [sys.executable, "-m", "symkin", "sweep", squeezer, "--monte-carlo", "160000", "--tolerance", "xa=±1e-5", "--workers", "1"], cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(4)
+    process.send_signal(signal.SIGINT)
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 130, out + err
+    assert "Traceback" not in err and "interrupted" in err

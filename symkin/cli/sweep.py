@@ -70,6 +70,12 @@ def handle(args: argparse.Namespace) -> int:
         design, spread = _design(kernel, args)
     except UsageError as error:
         return messages.error(f"{args.mechanism}: {error}", EXIT_BAD_INPUT)
+    from symkin.runtime.driver import grid
+    from symkin.sweep.api import too_large
+
+    problem = too_large(design.shape[0], grid(*kernel.time_grid).size, len(kernel.coordinates))
+    if problem:
+        return messages.error(f"{args.mechanism}: {problem}", EXIT_BAD_INPUT)
     return _run(kernel, args, design, spread)
 
 

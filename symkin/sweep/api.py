@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin import limits
 from symkin.errors import SolveError
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
@@ -62,6 +63,9 @@ def sweep(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike,
     """
     values = parameter_table(kernel, params)
     times = _times(kernel, t)
+    problem = too_large(values.shape[0], times.size, len(kernel.coordinates))
+    if problem:
+        raise SolveError(problem)
     starts = _starts(kernel, q0, values.shape[0])
     m = values.shape[0]
     count = _workers(workers, m * times.size) if client is None else 0
@@ -103,6 +107,17 @@ def parameter_table(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike)
         raise SolveError(f"params must have shape (M, {len(names)}) in the order "
                          f"{', '.join(names) or '(none)'}, got {table.shape}")
     return np.ascontiguousarray(table)
+
+
+def too_large(m: int, steps: int, size: int) -> str | None:
+    """Why a sweep of m sets over ``steps`` time points is refused, or None: its results are
+    bounded like one run's grid (limits.MAX_GRID_POINTS time points in all)."""
+    if m * steps <= limits.MAX_GRID_POINTS:
+        return None
+    need = limits.result_bytes(m * steps, size) / 1e9
+    return (f"the sweep has {m} sets x {steps} time points = {m * steps:.3g} points in all, "
+            f"more than the {limits.MAX_GRID_POINTS:,} allowed (its results would need "
+            f"{need:.3g} GB); sweep fewer sets at a time, or use a coarser time grid")
 
 
 def _times(kernel: Kernel, t: ArrayLike | None) -> Array:

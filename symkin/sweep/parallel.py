@@ -115,13 +115,18 @@ def in_processes(source: Payload, params: Array, t: Array, q0: Array, options: O
                  ) -> list[Chunk]:
     """The chunks solved by ``workers`` local processes (spawned: safe beside threads)."""
     context = multiprocessing.get_context("spawn")
-    with concurrent.futures.ProcessPoolExecutor(
-            max_workers=workers, mp_context=context, initializer=worker_kernel,
-            initargs=(source,)) as pool:
+    pool = concurrent.futures.ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=worker_kernel, initargs=(source,))
+    try:
         futures = {pool.submit(run_chunk, source, params[part], t, _q0_part(q0, part),
                                options): k for k, part in enumerate(parts)}
-        return _collect(futures, concurrent.futures.as_completed(futures), parts, progress,
-                        params.shape[0])
+        chunks = _collect(futures, concurrent.futures.as_completed(futures), parts, progress,
+                          params.shape[0])
+    except BaseException:  # Ctrl-C above all: drop the queued chunks, do not wait for them
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+    return chunks
 
 
 def on_dask(client: Any, source: Payload, params: Array, t: Array, q0: Array,
@@ -137,7 +142,11 @@ def on_dask(client: Any, source: Payload, params: Array, t: Array, q0: Array,
     futures = {client.submit(run_chunk, remote, params[part], t, _q0_part(q0, part), options,
                              pure=False): k for k, part in enumerate(parts)}
     completed = as_completed(list(futures))  # type: ignore[no-untyped-call,unused-ignore]
-    return _collect(futures, completed, parts, progress, params.shape[0])
+    try:
+        return _collect(futures, completed, parts, progress, params.shape[0])
+    except BaseException:  # Ctrl-C above all: the cluster need not finish the sweep
+        client.cancel(list(futures))
+        raise
 
 
 def _collect(futures: dict[Any, int], completed: Iterator[Any], parts: Sequence[slice],
