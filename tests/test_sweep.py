@@ -155,3 +155,24 @@ def test_dask_local_cluster_equals_this_process(c_kernel) -> None:
     for name in ("q", "dq", "d2q"):
         assert np.array_equal(getattr(here, name), getattr(remote, name), equal_nan=True)
     assert here.reasons == remote.reasons and np.array_equal(here.t_reached, remote.t_reached)
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_a_worker_without_the_build_builds_it_from_the_source(crank_slider_system, backend,
+                                                              tmp_path: Path) -> None:
+    from symkin.build.compile import from_sources
+    from symkin.sweep import parallel
+
+    kernel = symkin.compile(crank_slider_system, backend=backend)
+    files = parallel.payload(kernel).files
+    rebuilt = from_sources(files, cache_dir=tmp_path / "elsewhere")
+    assert rebuilt.backend == backend and rebuilt.folder != kernel.folder
+    assert rebuilt.folder.parent == tmp_path / "elsewhere"
+    designs = _designs(kernel, 5, spread=0.02)
+    assert np.array_equal(symkin.sweep(rebuilt, designs, T).q, symkin.sweep(kernel, designs, T).q)
+    for bad in ({**files, "../escape.c": "int x;"}, {k: v for k, v in files.items()
+                                                    if not k.endswith(".h")} or files):
+        if bad == files:
+            continue
+        with pytest.raises(symkin.BuildError, match="not one generated symkin folder"):
+            from_sources(bad, cache_dir=tmp_path / "elsewhere")
