@@ -1,4 +1,5 @@
-"""Design sensitivities q_p = dq/dp from Phi_q q_p = -Phi_p (Phi_p derived symbolically).
+"""Design sensitivities q_p = dq/dp from Phi_q q_p = -Phi_p (Phi_p derived symbolically), and
+the velocity sensitivities dq_p from its time derivative.
 
 References: central finite differences of solve() over the parameters; for the textbook
 crank-slider, the derivative of Example 2.7's closed form with respect to a, b, c, written out
@@ -49,9 +50,15 @@ def test_crank_slider_q_p_matches_example_2_7(crank_slider_system, backend) -> N
     assert np.abs(trajectory.q_p - expected).max() < 1e-9
     varied = symkin.solve(kernel, params={"a": 0.9, "b": 5.4, "c": 3.7}, sensitivities=True)
     assert np.abs(varied.q_p - _closed_form_q_p(varied.t, 0.9, 5.4, 3.7)).max() < 1e-9
+    # dq_p = d/dt of q_p: the closed form differentiated in t by central differences
+    h = 1e-6
+    rate = (_closed_form_q_p(trajectory.t + h, 1.0, 5.0, 4.0)
+            - _closed_form_q_p(trajectory.t - h, 1.0, 5.0, 4.0)) / (2 * h)
+    assert np.abs(trajectory.dq_p - rate).max() < 1e-6
 
 
-@pytest.mark.parametrize("example", ["four_bar", "crank_slider_general", "quick_return"])
+@pytest.mark.parametrize("example", ["four_bar", "crank_slider_general", "quick_return",
+                                     "custom_driver"])
 def test_q_p_equals_central_differences(example) -> None:
     system = symkin.derive(EXAMPLES / f"{example}.yaml")
     kernel = symkin.compile(system, backend="c")
@@ -67,6 +74,14 @@ def test_q_p_equals_central_differences(example) -> None:
             shifted.append(symkin.solve(kernel, t=t, q0=base.q[0], params=p, options=TIGHT).q)
         central = (shifted[0] - shifted[1]) / (2 * h)
         assert np.abs(base.q_p[:, :, k] - central).max() < 1e-6, system.parameter_names[k]
+        velocities = []
+        for sign in (1, -1):
+            p = kernel.p_values.copy()
+            p[k] += sign * h
+            velocities.append(symkin.solve(kernel, t=t, q0=base.q[0], params=p,
+                                           options=TIGHT).dq)
+        central = (velocities[0] - velocities[1]) / (2 * h)
+        assert np.abs(base.dq_p[:, :, k] - central).max() < 1e-6, system.parameter_names[k]
 
 
 def test_phi_p_is_the_derivative_of_phi(crank_slider_system) -> None:
@@ -87,4 +102,5 @@ def test_phi_p_is_the_derivative_of_phi(crank_slider_system) -> None:
 
 def test_without_sensitivities_there_is_no_q_p(crank_slider_system) -> None:
     kernel = symkin.compile(crank_slider_system, backend="c")
-    assert symkin.solve(kernel).q_p is None
+    plain = symkin.solve(kernel)
+    assert plain.q_p is None and plain.dq_p is None

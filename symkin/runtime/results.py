@@ -62,6 +62,7 @@ class Trajectory:
             pivot order for the dense partial-pivoting path (always 0 elsewhere).
         q_p: design sensitivities dq/dp, shape (T, N, NP), when solved with
             ``sensitivities=True`` (from Phi_q q_p = -Phi_p); else None.
+        dq_p: velocity sensitivities d dq/dp, (T, N, NP), with ``q_p``.
     """
 
     t: NDArray[np.float64]
@@ -74,6 +75,7 @@ class Trajectory:
     params: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     lu_fallbacks: int = 0
     q_p: NDArray[np.float64] | None = None
+    dq_p: NDArray[np.float64] | None = None
 
     @property
     def bodies(self) -> tuple[str, ...]:
