@@ -40,8 +40,6 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "gamma": ("q", "dq", "t", "p"),
     "points": ("p",),
     "phi_p": ("q", "t", "p"),
-    "phi_q_dot": ("q", "dq", "t", "p"),
-    "phi_p_dot": ("q", "dq", "t", "p"),
 }
 
 # Characters allowed in a comment of generated code; anything else becomes '?'.
@@ -191,19 +189,7 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
         "gamma": list(system.gamma),
         "points": [component for vector in point_vectors(system) for component in vector],
         "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
-        # d/dt of Phi_q and Phi_p along the motion, for the velocity sensitivities:
-        # Phi_q dq_p = -(d Phi_q/dt) q_p - d Phi_p/dt (the time derivative of Phi_q q_p = -Phi_p)
-        "phi_q_dot": [_along_motion(system.phi_q[r, c], system) for r, c in pattern],
-        "phi_p_dot": [] if system.phi_p is None else
-        [_along_motion(system.phi_p[r, k], system) for r, k in p_pattern],
     }
-
-
-def _along_motion(expr: sp.Expr, system: System) -> sp.Expr:
-    """d expr / dt = sum_j (d expr / d q_j) dq_j + d expr / d t."""
-    used = expr.free_symbols
-    return sp.Add(*(sp.diff(expr, q) * dq for q, dq in zip(system.q, system.dq) if q in used),
-                  sp.diff(expr, system.t))
 
 
 def point_names(system: System) -> tuple[tuple[str, str], ...]:

@@ -31,9 +31,8 @@ from symkin.symbolic.derivation import System
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
-             "phi_p": "nz", "phi_q_dot": "nz", "phi_p_dot": "nz"}
-_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
-                "phi_q_dot": "phi_q_dot_nz", "phi_p_dot": "phi_p_dot_nz"}
+             "phi_p": "nz"}
+_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz"}
 _PYTHON_DOC = {
     "phi": "Phi(q, t), shape (NQ,).",
     "phi_q": "The non-zeros of Phi_q in pattern order, shape (NNZ,).",
@@ -41,8 +40,6 @@ _PYTHON_DOC = {
     "gamma": "Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,).",
     "points": "Local vectors of the named points, flat (x, y) pairs in POINTS order.",
     "phi_p": "The non-zeros of Phi_p (d Phi / d p) in PHI_P_ROWS/COLS order, shape (NNZ_P,).",
-    "phi_q_dot": "d Phi_q / dt along the motion (q, dq), non-zeros in pattern order, (NNZ,).",
-    "phi_p_dot": "d Phi_p / dt along the motion (q, dq), in PHI_P_ROWS/COLS order, (NNZ_P,).",
 }
 
 
@@ -277,9 +274,9 @@ def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
 
 def _labels(code: Code, routine: str) -> list[str]:
     """A short comment per output slot: the row of Phi, or the (row, column) of Phi_q."""
-    if routine in ("phi_q", "phi_q_dot"):
+    if routine == "phi_q":
         return [f"({r}, {c})" for r, c in zip(code.pattern_rows, code.pattern_cols)]
-    if routine in ("phi_p", "phi_p_dot"):
+    if routine == "phi_p":
         return [codegen.comment(f"({r}, {code.parameter_names[k]})")
                 for r, k in zip(code.phi_p_rows, code.phi_p_cols)]
     if routine == "points":

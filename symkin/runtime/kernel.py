@@ -36,8 +36,6 @@ class _Functions(Protocol):
     def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array: ...
     def points(self, p: Array) -> Array: ...
     def phi_p_nz(self, q: Array, t: float, p: Array) -> Array: ...
-    def phi_q_dot_nz(self, q: Array, dq: Array, t: float, p: Array) -> Array: ...
-    def phi_p_dot_nz(self, q: Array, dq: Array, t: float, p: Array) -> Array: ...
 
 
 class Kernel:
@@ -129,19 +127,6 @@ class Kernel:
             self._q(q), float(t), self._p(p))
         return dense
 
-    def phi_dots(self, q: ArrayLike, dq: ArrayLike, t: float, p: ArrayLike | None = None
-                 ) -> tuple[Array, Array]:
-        """d Phi_q/dt (N x N) and d Phi_p/dt (N x NP) along the motion (q, dq), dense."""
-        if not self.has_phi_p:
-            raise ValueError(f"the kernel of {self.name} was built without Phi_p; rebuild it "
-                             "with symkin.compile")
-        q, dq, p, t = self._q(q), self._q(dq, "dq"), self._p(p), float(t)
-        jacobian = np.zeros((self.nq, self.nq))
-        jacobian[self.pattern_rows, self.pattern_cols] = self._functions.phi_q_dot_nz(q, dq, t, p)
-        parameters = np.zeros((self.nq, self.p_values.size))
-        parameters[self.phi_p_rows, self.phi_p_cols] = self._functions.phi_p_dot_nz(q, dq, t, p)
-        return jacobian, parameters
-
     def point_vectors(self, p: ArrayLike | None = None) -> Array:
         """Local vectors of the named points, shape (NPOINTS, 2), in ``points`` order."""
         return self._functions.points(self._p(p)).reshape(len(self.points), 2)
@@ -177,13 +162,9 @@ class _ModuleFunctions:
         self.points = module._points
         self.phi_p_nz: Callable[[Array, float, Array], Array] = getattr(
             module, "phi_p_nz", _no_phi_p)
-        self.phi_q_dot_nz: Callable[[Array, Array, float, Array], Array] = getattr(
-            module, "phi_q_dot_nz", _no_phi_p)
-        self.phi_p_dot_nz: Callable[[Array, Array, float, Array], Array] = getattr(
-            module, "phi_p_dot_nz", _no_phi_p)
 
 
-def _no_phi_p(*arguments: Any) -> Array:
+def _no_phi_p(q: Array, t: float, p: Array) -> Array:
     raise ValueError("this kernel was generated without Phi_p; rebuild it with symkin.compile")
 
 
@@ -196,7 +177,7 @@ class _CFunctions:
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
         self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
-                       "phi_p": nnz_p, "phi_q_dot": nnz, "phi_p_dot": nnz_p}
+                       "phi_p": nnz_p}
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}
@@ -229,12 +210,6 @@ class _CFunctions:
 
     def phi_p_nz(self, q: Array, t: float, p: Array) -> Array:
         return self._call("phi_p", self._in(q), t, self._in(p))
-
-    def phi_q_dot_nz(self, q: Array, dq: Array, t: float, p: Array) -> Array:
-        return self._call("phi_q_dot", self._in(q), self._in(dq), t, self._in(p))
-
-    def phi_p_dot_nz(self, q: Array, dq: Array, t: float, p: Array) -> Array:
-        return self._call("phi_p_dot", self._in(q), self._in(dq), t, self._in(p))
 
 
 def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
