@@ -57,12 +57,14 @@ class SweepResult:
     @functools.cached_property
     def point_vectors(self) -> Array:
         """(M, P, 2): the named points' local vectors for each set's parameters."""
-        if self.local_vectors is None or not self.points_named:
-            return np.zeros((self.params.shape[0], len(self.points_named), 2))
+        count = len(self.points_named)
+        if not count or not self.params.shape[0]:
+            return np.zeros((self.params.shape[0], count, 2))
+        if self.local_vectors is None:  # never a silent zero vector
+            raise SymkinError("this result carries no point vectors; sweep with symkin.sweep")
         vectors = self.local_vectors
-        return np.stack([np.asarray(vectors(p), dtype=float).reshape(-1, 2)
-                         for p in self.params]) if self.params.shape[0] else \
-            np.zeros((0, len(self.points_named), 2))
+        return np.stack([np.asarray(vectors(p), dtype=float).reshape(count, 2)
+                         for p in self.params])
 
     @property
     def ok(self) -> NDArray[np.bool_]:
