@@ -176,3 +176,32 @@ def test_a_worker_without_the_build_builds_it_from_the_source(crank_slider_syste
             continue
         with pytest.raises(symkin.BuildError, match="not one generated symkin folder"):
             from_sources(bad, cache_dir=tmp_path / "elsewhere")
+
+
+def test_c_batch_reports_without_outputs_and_counts_newton(c_kernel) -> None:
+    """<prefix>_solve_batch called directly: NULL outputs are allowed, each report says how its
+    set ended, and a set's Newton count is the sum over its steps of one solve_grid run."""
+    ffi, lib = c_kernel.ffi, c_kernel.lib
+    designs = np.array([[1.0, 5.0, 4.0], [1.0, 2.0, 4.0], [1.05, 5.1, 4.1]])
+    times = np.ascontiguousarray(T)
+    options = ffi.new("crank_slider_options *")
+    lib.crank_slider_default_options(options)
+    reports = ffi.new("crank_slider_batch_report[]", 3)
+    solved = lib.crank_slider_solve_batch(
+        options, 3, ffi.from_buffer("double[]", designs), ffi.from_buffer("double[]", c_kernel.q0),
+        0, T.size, ffi.from_buffer("double[]", times), ffi.NULL, ffi.NULL, ffi.NULL,
+        ffi.new("crank_slider_state *"), ffi.new("crank_slider_workspace *"), reports)
+    assert solved == 2
+    assert [reports[j].status for j in range(3)] == [0, 1, 0]  # plain Newton: no convergence
+    assert reports[1].solved == 0 and reports[1].t == 0.0 and reports[1].residual > 1e-3
+    assert reports[0].solved == T.size and reports[0].t == T[-1]
+    for j in (0, 2):  # the same count, step by step through solve_step
+        state, work = ffi.new("crank_slider_state *"), ffi.new("crank_slider_workspace *")
+        report = ffi.new("crank_slider_report *")
+        state.q[0:9] = c_kernel.q0.tolist()
+        p = ffi.new("double[]", designs[j].tolist())
+        total = 0
+        for time_point in T:
+            assert lib.crank_slider_solve_step(options, p, time_point, state, work, report) == 0
+            total += report.iterations
+        assert reports[j].iterations == total
