@@ -21,7 +21,7 @@ import numpy as np
 
 from symkin.cli import messages
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
-from symkin.errors import UsageError
+from symkin.errors import SymkinError, UsageError
 
 _VARY = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*([^:]+):([^:]+):\s*(\d+)\s*$")
 _TOLERANCE = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(?:±|\+-|\+/-)?\s*([^%\s]+)\s*(%?)\s*$")
@@ -203,7 +203,11 @@ def _report(kernel: Any, result: Any, spread: Any) -> None:
         return
     estimate = None
     if spread is not None:
-        estimate = tolerance.point_sensitivities(kernel, result.t)
+        try:
+            estimate = tolerance.point_sensitivities(kernel, result.t)
+        except SymkinError as error:  # the nominal design itself fails: no linearisation
+            messages.note(f"no first-order estimate: the nominal design cannot be solved "
+                          f"({error})")
     print("named points, position over the solved sets at the time of widest spread:")
     for body, name in result.points_named:
         band = tolerance.envelope(result, body, name)
