@@ -22,6 +22,7 @@ __all__ = [
     "generate",
     "load",
     "solve",
+    "sweep",
 ]
 
 _EXPORTS = {
@@ -33,6 +34,7 @@ _EXPORTS = {
     "generate": ("symkin.codegen.render", "generate"),
     "compile": ("symkin.build.compile", "compile"),
     "solve": ("symkin.runtime.driver", "solve"),
+    "sweep": ("symkin.sweep.api", "sweep"),
     "SymkinError": ("symkin.errors", "SymkinError"),
     "MechanismError": ("symkin.errors", "MechanismError"),
     "SolveError": ("symkin.errors", "SolveError"),
@@ -70,4 +72,6 @@ def __getattr__(name: str) -> Any:
     if name not in _EXPORTS:
         raise AttributeError(f"module 'symkin' has no attribute {name!r}")
     module, attribute = _EXPORTS[name]
-    return getattr(importlib.import_module(module), attribute)
+    value = getattr(importlib.import_module(module), attribute)
+    globals()[name] = value  # found once: later lookups (symkin.solve in a loop) cost nothing
+    return value

@@ -75,16 +75,65 @@ def compile(system: System, backend: str = "auto", *, real: str = "double", cse:
 def _compile_c(code: codegen.Code, cache: Path, compiler: list[str]) -> kernel.Kernel:
     files = render.render_sources(code)
     files[resources.manifest_name(code.name)] = render.manifest(code, files)
+    return _compile_files(files, code.name, cache, compiler)
+
+
+def from_sources(files: dict[str, str], cache_dir: str | Path | None = None) -> kernel.Kernel:
+    """Build (or find in this machine's cache) and load a kernel from its generated files.
+
+    ``files`` is a generated folder as text, its manifest included (what a sweep sends to the
+    processes and cluster workers that solve it); no derivation, so no SymPy. The files are
+    keyed and verified exactly as ``compile`` keys and verifies its own.
+
+    Raises:
+        BuildError: the files hold no symkin manifest, or the compiler failed.
+        NoCompilerError: they are C and this machine has no C compiler.
+    """
+    manifests = [name for name in files if name.endswith(resources.MANIFEST_SUFFIX)]
+    if len(manifests) != 1:
+        raise BuildError(f"expected one symkin manifest among the files, found {len(manifests)}")
+    meta = json.loads(files[manifests[0]])
+    name = meta.get("name")
+    plain = all(isinstance(n, str) and Path(n).name == n and not n.startswith(".")
+                for n in files)
+    if not (isinstance(name, str) and name.isidentifier() and plain
+            and manifests[0] == resources.manifest_name(name)
+            and set(files) == {*meta.get("files", {}), manifests[0]}):
+        raise BuildError("the files are not one generated symkin folder (names, manifest and "
+                         "file list must agree); send the folder symkin.compile built")
+    cache = open_cache(cache_dir)
+    if meta["backend"] == "numpy":
+        sources = {name: text for name, text in files.items() if name != manifests[0]}
+        key = content_key({"files": sources})
+        folder = cache / f"_symkin_{meta['name']}_py_{key[:20]}"
+        _build_unless_verified(cache, folder, files, lambda build: _write_files(build, files))
+        source = folder / f"{meta['name']}.py"
+        return kernel.from_module(kernel.import_file(folder.name, source, None), folder)
+    compiler = toolchain.c_compiler()
+    if compiler is None:
+        resolve_backend("c")  # raises NoCompilerError with the how-to-install message
+    assert compiler is not None
+    return _compile_files(files, meta["name"], cache, compiler)
+
+
+def _write_files(folder: Path, files: dict[str, str]) -> None:
+    for name, text in files.items():
+        (folder / name).write_text(text, encoding="utf-8", newline="\n")
+
+
+def _compile_files(files: dict[str, str], name: str, cache: Path, compiler: list[str]
+                   ) -> kernel.Kernel:
+    """Build the C files of one kernel into the cache (unless a verified build is there)."""
     cdef = cdef_from_headers(files)
     key = content_key({"files": files, "cdef": cdef, "compiler": compiler, "flags": C_FLAGS,
                 "wrapper_flags": WRAPPER_FLAGS, **toolchain.fingerprint(compiler)})
-    module_name = f"_symkin_{code.name}_{key[:20]}"
+    module_name = f"_symkin_{name}_{key[:20]}"
     folder = cache / module_name
     library = folder / (module_name + resources.extension_suffix())
     _build_unless_verified(cache, folder, files, lambda build: _build_c(
-        build, files, cdef, module_name, compiler, code.name))
+        build, files, cdef, module_name, compiler, name))
     module = _import_extension(module_name, library)
-    meta = json.loads(files[resources.manifest_name(code.name)])
+    meta = json.loads(files[resources.manifest_name(name)])
     return kernel.from_cffi(module.ffi, module.lib, meta, folder)
 
 

@@ -132,6 +132,12 @@ def _add_run(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> N
     runner.add_parser(commands)
 
 
+def _add_sweep(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    from symkin.cli import sweep
+
+    sweep.add_parser(commands)
+
+
 def _add_cache(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     from symkin.cli import cache
 
@@ -139,7 +145,7 @@ def _add_cache(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 
 SUBCOMMANDS: list[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]], None]] = [
-    _add_show, _add_verify, _add_generate, _add_run, _add_cache]
+    _add_show, _add_verify, _add_generate, _add_run, _add_cache, _add_sweep]
 
 
 class _Version(argparse.Action):

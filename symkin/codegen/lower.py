@@ -39,6 +39,7 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "phi_t": ("q", "t", "p"),
     "gamma": ("q", "dq", "t", "p"),
     "points": ("p",),
+    "phi_p": ("q", "t", "p"),
 }
 
 # Characters allowed in a comment of generated code; anything else becomes '?'.
@@ -92,10 +93,17 @@ class Code:
     linalg: str = DEFAULT_LINALG
     lu_plan: LUPlan | None = None
     """The sparse LU's pivot order and steps (C with sparse linear algebra only)."""
+    phi_p_rows: tuple[int, ...] = ()
+    phi_p_cols: tuple[int, ...] = ()
+    """The structural non-zeros of Phi_p (row, parameter), row-major."""
 
     @property
     def nnz(self) -> int:
         return len(self.pattern_rows)
+
+    @property
+    def nnz_p(self) -> int:
+        return len(self.phi_p_rows)
 
     @property
     def npoints(self) -> int:
@@ -133,7 +141,8 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
     _check_options(backend, real, linalg)
     internal = symbols.internal_symbols(system)
     pattern = system.pattern()
-    expressions = _routine_expressions(system, pattern)
+    p_pattern = parameter_pattern(system)
+    expressions = _routine_expressions(system, pattern, p_pattern)
     printer = _printer(backend, real)
     routines = tuple(
         _routine(name, [symbols.prepare(e, internal) for e in exprs], printer, cse)
@@ -148,6 +157,7 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         points=point_names(system), routines=routines,
         ops_before_cse={name: _count_ops(exprs) for name, exprs in expressions.items()},
         linalg=linalg,
+        phi_p_rows=tuple(r for r, _ in p_pattern), phi_p_cols=tuple(c for _, c in p_pattern),
         lu_plan=(sample.sparse_lu_plan(system, pattern)
                  if backend == "c" and linalg == "sparse" else None),
     )
@@ -165,14 +175,20 @@ def _check_options(backend: str, real: str, linalg: str) -> None:
                          "(real='float' is for the C backend)")
 
 
-def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]]
-                         ) -> dict[str, list[sp.Expr]]:
+def parameter_pattern(system: System) -> list[tuple[int, int]]:
+    """Structural non-zeros of Phi_p as (row, parameter), row-major."""
+    return [] if system.phi_p is None else sorted(system.phi_p.todok())
+
+
+def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
+                         p_pattern: Sequence[tuple[int, int]]) -> dict[str, list[sp.Expr]]:
     return {
         "phi": list(system.phi),
         "phi_q": [system.phi_q[r, c] for r, c in pattern],
         "phi_t": list(system.phi_t),
         "gamma": list(system.gamma),
         "points": [component for vector in point_vectors(system) for component in vector],
+        "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
     }
 
 

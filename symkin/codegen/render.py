@@ -30,14 +30,16 @@ from symkin.symbolic.derivation import System
 
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
 
-_C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out"}
-_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points"}
+_C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
+             "phi_p": "nz"}
+_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz"}
 _PYTHON_DOC = {
     "phi": "Phi(q, t), shape (NQ,).",
     "phi_q": "The non-zeros of Phi_q in pattern order, shape (NNZ,).",
     "phi_t": "Phi_t(q, t), shape (NQ,).",
     "gamma": "Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,).",
     "points": "Local vectors of the named points, flat (x, y) pairs in POINTS order.",
+    "phi_p": "The non-zeros of Phi_p (d Phi / d p) in PHI_P_ROWS/COLS order, shape (NNZ_P,).",
 }
 
 
@@ -207,6 +209,7 @@ def metadata(code: Code) -> dict[str, Any]:
         "p_values": list(code.p_values), "q0": list(code.q0), "time_grid": list(code.time_grid),
         "rows": list(code.rows), "pattern_rows": list(code.pattern_rows),
         "pattern_cols": list(code.pattern_cols), "points": [list(p) for p in code.points],
+        "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
     }
 
@@ -225,6 +228,8 @@ def template_context(code: Code) -> dict[str, Any]:
         "libm_suffix": "f" if code.real == "float" else "",
         "literal_suffix": "F" if code.real == "float" else "",
         "pattern_rows": list(code.pattern_rows), "pattern_cols": list(code.pattern_cols),
+        "nnz_p": code.nnz_p,
+        "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "ops": sorted(code.ops.items()),
         "p_literals": [literal(v) for v in code.p_values],
         "q0_literals": [literal(v) for v in code.q0],
@@ -271,6 +276,9 @@ def _labels(code: Code, routine: str) -> list[str]:
     """A short comment per output slot: the row of Phi, or the (row, column) of Phi_q."""
     if routine == "phi_q":
         return [f"({r}, {c})" for r, c in zip(code.pattern_rows, code.pattern_cols)]
+    if routine == "phi_p":
+        return [codegen.comment(f"({r}, {code.parameter_names[k]})")
+                for r, k in zip(code.phi_p_rows, code.phi_p_cols)]
     if routine == "points":
         return [codegen.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in "xy"]

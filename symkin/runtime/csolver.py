@@ -39,27 +39,47 @@ class ChunkResult:
 
 
 class GridSolver:
-    """One run of the generated C grid loop: options, state, workspace and report structs."""
+    """One run of the generated C grid loop: options, state, workspace and report structs.
+
+    The structs are allocated once and a solver is reused run after run (:meth:`start`), so
+    a short solve pays for no allocation; :class:`SolverPool` hands one to each run.
+    """
 
     def __init__(self, ffi: Any, lib: Any, name: str, real: str, options: Options,
                  q: Array, p: Array) -> None:
-        self._ffi, self._name = ffi, name
+        self._ffi, self._lib, self._name = ffi, lib, name
         self._options = ffi.new(f"{name}_options *")
-        getattr(lib, f"{name}_default_options")(self._options)
-        self._options.tol_phi, self._options.tol_dq = options.tol_phi, options.tol_dq
-        self._options.max_iterations = options.max_iterations
-        self._options.min_pivot_ratio = options.min_pivot_ratio
         self._state = ffi.new(f"{name}_state *")
         # The solver initialises its workspace on the first step, so it is not zero-filled
         # here: with the sparse LU it holds an N x N dense fall-back buffer rarely touched.
         self._work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
         self._report = ffi.new(f"{name}_report *")
         self._p = ffi.new(f"{name}_real[]", max(p.size, 1))
-        self._p[0:p.size] = p.tolist()
-        self._state.q[0:q.size] = q.tolist()
         self._n = q.size
         self._solve_grid = getattr(lib, f"{name}_solve_grid")
+        self._real_pointer = f"{name}_real[]"
         self.dtype = np.float32 if real == "float" else np.float64
+        self._set_options: Options | None = None
+        self.pool: SolverPool | None = None
+        self.start(options, q, p)
+
+    def start(self, options: Options, q: Array, p: Array) -> GridSolver:
+        """Begin a new run from q with parameters p (the state is reset, not reallocated)."""
+        if options is not self._set_options:
+            getattr(self._lib, f"{self._name}_default_options")(self._options)
+            self._options.tol_phi, self._options.tol_dq = options.tol_phi, options.tol_dq
+            self._options.max_iterations = options.max_iterations
+            self._options.min_pivot_ratio = options.min_pivot_ratio
+            self._set_options = options
+        self._p[0:p.size] = p.tolist()
+        self._state.q[0:q.size] = q.tolist()
+        self._state.started = 0
+        return self
+
+    def release(self) -> None:
+        """Hand the solver back to its pool for the next run (no-op outside a pool)."""
+        if self.pool is not None:
+            self.pool.put(self)
 
     def solve(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array) -> ChunkResult:
         """Solve the grid points ``times`` after those already solved, writing their rows.
@@ -72,8 +92,7 @@ class GridSolver:
         direct = all(a.dtype == self.dtype and a.flags.c_contiguous for a in outputs)
         buffers = outputs if direct else tuple(np.zeros((chunk.size, self._n), dtype=self.dtype)
                                                for _ in outputs)
-        real = f"{self._name}_real *"
-        pointers = [self._ffi.cast(real, self._ffi.from_buffer(a)) for a in (chunk, *buffers)]
+        pointers = [self._ffi.from_buffer(self._real_pointer, a) for a in (chunk, *buffers)]
         solved = self._solve_grid(self._options, self._p, chunk.size, pointers[0], self._state,
                                   pointers[1], pointers[2], pointers[3], self._work,
                                   self._report)
@@ -88,3 +107,28 @@ class GridSolver:
     def last_q(self) -> Array:
         """The solver's current q: the last converged point, or the failed iterate."""
         return np.array(self._ffi.unpack(self._state.q, self._n), dtype=float)
+
+
+class SolverPool:
+    """Idle GridSolvers of one kernel, so that the per-run structs are allocated once.
+
+    A solver is taken for one run and put back after it; concurrent runs (threads, or a solve
+    inside a progress callback) each take their own, so sharing a kernel stays safe.
+    """
+
+    def __init__(self, ffi: Any, lib: Any, name: str, real: str) -> None:
+        self._arguments = (ffi, lib, name, real)
+        self._idle: list[GridSolver] = []
+
+    def take(self, options: Options, q: Array, p: Array) -> GridSolver:
+        try:
+            solver = self._idle.pop()  # atomic under the GIL
+        except IndexError:
+            solver = GridSolver(*self._arguments, options, q, p)
+            solver.pool = self
+            return solver
+        return solver.start(options, q, p)
+
+    def put(self, solver: GridSolver) -> None:
+        if len(self._idle) < 8:
+            self._idle.append(solver)

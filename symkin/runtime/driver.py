@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin import limits
 from symkin.errors import SolveError
+from symkin.runtime.csolver import GridSolver
 from symkin.runtime.linalg import dependent_rows, factor_at
 from symkin.runtime.newton import Newton, assemble, newton
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
@@ -104,9 +105,13 @@ def _times(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
     if t is None:
         return grid(*kernel.time_grid)
     times = np.atleast_1d(np.asarray(t, dtype=float))
-    if times.ndim != 1 or times.size == 0 or not np.all(np.isfinite(times)):
+    if times.ndim != 1 or times.size == 0 or not math.isfinite(times[0] + times[-1]):
         raise SolveError("t must be a non-empty 1-D sequence of finite times")
-    if np.any(np.diff(times) <= 0):
+    # Strictly increasing steps between finite ends: then every time is finite (a NaN fails
+    # the comparison). One pass, where diff and isfinite would take three.
+    if times.size > 1 and not bool((times[1:] > times[:-1]).all()):
+        if not np.all(np.isfinite(times)):
+            raise SolveError("t must be a non-empty 1-D sequence of finite times")
         raise SolveError("t must be strictly increasing")
     return times
 
@@ -198,6 +203,14 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Op
     progress callback wants to hear in between)."""
     solver = kernel.grid_solver(options, q, p)
     assert solver is not None  # only called for kernels that have one
+    try:
+        return _c_chunks(kernel, run, p, solver, progress)
+    finally:
+        getattr(solver, "release", lambda: None)()  # back to the kernel's pool for reuse
+
+
+def _c_chunks(kernel: KinematicsKernel, run: _Run, p: Array, solver: GridSolver,
+              progress: Progress | None) -> Newton:
     chunks = _Chunks(run.t.size, progress is not None)
     result = None
     start = 0
@@ -218,13 +231,14 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Op
             progress(run.done, run.t.size)
         start = stop
     assert result is not None  # the grid has at least one point
-    return Newton(solver.last_q(), OK, result.iterations, result.residual, None)
+    # The last row written is the solver's q: no need to read it back from C.
+    return Newton(run.q[run.done - 1], OK, result.iterations, result.residual, None)
 
 
 def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
           params: Mapping[str, float] | ArrayLike | None = None, *,
           options: Options | None = None, progress: Progress | None = None,
-          use_c_solver: bool = True) -> Trajectory:
+          use_c_solver: bool = True, sensitivities: bool = False) -> Trajectory:
     """Positions, velocities and accelerations of a mechanism over a time grid.
 
     Args:
@@ -236,6 +250,7 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
             kernel's real type (looser for a C kernel generated with float).
         progress: called as progress(done, total) while the grid is solved.
         use_c_solver: run the grid loop in the generated C solver when the kernel has one.
+        sensitivities: also compute ``q_p`` = dq/dp (T, N, NP) from Phi_q q_p = -Phi_p.
 
     Returns:
         The Trajectory.
@@ -247,7 +262,12 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     # An expression singular at some t gives inf/NaN there; that is reported as a failure
     # (status NOT_FINITE), so NumPy's floating-point warnings would only repeat it.
     with np.errstate(all="ignore"):
-        return _solve(kernel, t, q0, params, options, progress, use_c_solver)
+        trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver)
+    if sensitivities:
+        from symkin.runtime.sensitivity import with_sensitivities
+
+        return with_sensitivities(kernel, trajectory)
+    return trajectory
 
 
 def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
@@ -291,7 +311,7 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
 
     return Trajectory(t=run.t[:done].copy(), q=solved(run.q), dq=solved(run.dq),
                       d2q=solved(run.d2q), coordinates=tuple(kernel.coordinates),
-                      points=tuple((body, point) for body, point in kernel.points),
+                      points=tuple(kernel.points),
                       point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
                       params=p.copy(), lu_fallbacks=run.fallbacks)
 

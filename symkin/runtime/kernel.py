@@ -12,7 +12,7 @@ import importlib.machinery
 import importlib.util
 import json
 import sys
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Protocol
@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin import resources
-from symkin.runtime.csolver import GridSolver
+from symkin.runtime.csolver import GridSolver, SolverPool
 from symkin.runtime.options import Options
 
 Array = NDArray[np.float64]
@@ -35,6 +35,7 @@ class _Functions(Protocol):
     def phi_t(self, q: Array, t: float, p: Array) -> Array: ...
     def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array: ...
     def points(self, p: Array) -> Array: ...
+    def phi_p_nz(self, q: Array, t: float, p: Array) -> Array: ...
 
 
 class Kernel:
@@ -60,9 +61,14 @@ class Kernel:
         self.pattern_rows = np.array(meta["pattern_rows"], dtype=np.intp)
         self.pattern_cols = np.array(meta["pattern_cols"], dtype=np.intp)
         self.points: tuple[tuple[str, str], ...] = tuple(tuple(p) for p in meta["points"])
+        # The non-zeros of Phi_p (row, parameter); absent from kernels built before Phi_p.
+        self.phi_p_rows = np.array(meta.get("phi_p_rows", ()), dtype=np.intp)
+        self.phi_p_cols = np.array(meta.get("phi_p_cols", ()), dtype=np.intp)
+        self.has_phi_p = "phi_p_rows" in meta
         self.ffi = ffi
         self.lib = lib
         self._functions = functions
+        self._solvers: SolverPool | None = None  # GridSolvers reused from run to run
 
     @property
     def has_grid_solver(self) -> bool:
@@ -71,9 +77,11 @@ class Kernel:
 
     def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
         """A fresh run of the generated C grid loop from q, or None without a C solver."""
-        if not self.has_grid_solver:
-            return None
-        return GridSolver(self.ffi, self.lib, self.name, self.real, options, q, p)
+        if self._solvers is None:
+            if not self.has_grid_solver:
+                return None
+            self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
+        return self._solvers.take(options, q, p)
 
     @property
     def nq(self) -> int:
@@ -109,6 +117,16 @@ class Kernel:
         """Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (N,)."""
         return self._functions.gamma(self._q(q), self._q(dq, "dq"), float(t), self._p(p))
 
+    def phi_p(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """Phi_p = d Phi / d p as a dense N x NP array (the design sensitivities' right side)."""
+        if not self.has_phi_p:
+            raise ValueError(f"the kernel of {self.name} was built without Phi_p; rebuild it "
+                             "with symkin.compile")
+        dense = np.zeros((self.nq, self.p_values.size))
+        dense[self.phi_p_rows, self.phi_p_cols] = self._functions.phi_p_nz(
+            self._q(q), float(t), self._p(p))
+        return dense
+
     def point_vectors(self, p: ArrayLike | None = None) -> Array:
         """Local vectors of the named points, shape (NPOINTS, 2), in ``points`` order."""
         return self._functions.points(self._p(p)).reshape(len(self.points), 2)
@@ -142,18 +160,27 @@ class _ModuleFunctions:
         self.phi_t = module.phi_t
         self.gamma = module.gamma
         self.points = module._points
+        self.phi_p_nz: Callable[[Array, float, Array], Array] = getattr(
+            module, "phi_p_nz", _no_phi_p)
+
+
+def _no_phi_p(q: Array, t: float, p: Array) -> Array:
+    raise ValueError("this kernel was generated without Phi_p; rebuild it with symkin.compile")
 
 
 class _CFunctions:
     """Adapter over a cffi extension: converts arrays to the generated real type and back."""
 
     def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
-                 npoints: int) -> None:
+                 npoints: int, nnz_p: int = 0) -> None:
         self._ffi = ffi
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
-        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints}
-        self._c = {name: getattr(lib, f"{prefix}_{name}") for name in self._sizes}
+        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
+                       "phi_p": nnz_p}
+        # getattr with a default: a kernel folder built before phi_p existed has none.
+        self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
+                                   for name in self._sizes}
 
     def _in(self, array: Array) -> Any:
         if array.size == 0:
@@ -181,6 +208,9 @@ class _CFunctions:
     def points(self, p: Array) -> Array:
         return self._call("points", self._in(p))
 
+    def phi_p_nz(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi_p", self._in(q), t, self._in(p))
+
 
 def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
     """A Kernel over a generated NumPy module (its metadata comes from the module)."""
@@ -190,6 +220,8 @@ def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
         "q0": module.Q0, "time_grid": module.TIME_GRID, "rows": module.ROWS,
         "pattern_rows": module.PATTERN_ROWS, "pattern_cols": module.PATTERN_COLS,
         "points": module.POINTS,
+        **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
+           if hasattr(module, "PHI_P_ROWS") else {}),
     }
     return Kernel("numpy", meta, _ModuleFunctions(module), folder=folder)
 
@@ -197,7 +229,8 @@ def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
 def from_cffi(ffi: Any, lib: Any, meta: Mapping[str, Any], folder: Path | None = None) -> Kernel:
     """A Kernel over a cffi extension built from the generated C; ``meta`` is the manifest."""
     functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
-                            len(meta["pattern_rows"]), len(meta["points"]))
+                            len(meta["pattern_rows"]), len(meta["points"]),
+                            len(meta.get("phi_p_rows", ())))
     return Kernel("c", meta, functions, ffi=ffi, lib=lib, folder=folder)
 
 

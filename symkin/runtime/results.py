@@ -60,6 +60,9 @@ class Trajectory:
         params: the parameter values solved with.
         lu_fallbacks: factorizations of the generated C solver whose sparse LU left its fixed
             pivot order for the dense partial-pivoting path (always 0 elsewhere).
+        q_p: design sensitivities dq/dp, shape (T, N, NP), when solved with
+            ``sensitivities=True`` (from Phi_q q_p = -Phi_p); else None.
+        dq_p: velocity sensitivities d dq/dp, (T, N, NP), with ``q_p``.
     """
 
     t: NDArray[np.float64]
@@ -71,6 +74,8 @@ class Trajectory:
     point_vectors: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
     params: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     lu_fallbacks: int = 0
+    q_p: NDArray[np.float64] | None = None
+    dq_p: NDArray[np.float64] | None = None
 
     @property
     def bodies(self) -> tuple[str, ...]:

@@ -4,6 +4,9 @@ Each row is derived from the few coordinates it touches (at most six for the cha
 so the cost grows linearly with the number of joints:
 
     Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt                       (2.74)
+
+and Phi_p, the derivative with respect to the parameters, for design sensitivities: along a
+solution Phi(q(p), t, p) = 0, so Phi_q q_p = -Phi_p.
 """
 
 from __future__ import annotations
@@ -57,6 +60,8 @@ class System:
     gamma: sp.ImmutableMatrix
     rows: tuple[Row, ...]
     q0: tuple[float, ...]
+    phi_p: sp.ImmutableSparseMatrix | None = None
+    """dPhi/dp, N x NP (sparse): Phi_q q_p = -Phi_p gives the sensitivities q_p."""
 
     @property
     def name(self) -> str:
@@ -110,6 +115,7 @@ def derive(mech: Mechanism | str | Path) -> System:
         phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
         phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
         q0=_initial_guess(mech, ctx, dict(zip(symbols.p, p_values))),
+        phi_p=_parameter_jacobian(phi, symbols.p),
     )
 
 
@@ -142,6 +148,17 @@ def _row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
     touched = sorted(column[s] for s in row.free_symbols if s in column)
     derivatives = {k: sp.diff(row, q[k]) for k in touched}
     return {k: value for k, value in derivatives.items() if value != 0}
+
+
+def _parameter_jacobian(phi: list[sp.Expr], p: tuple[sp.Symbol, ...]
+                        ) -> sp.ImmutableSparseMatrix:
+    """Phi_p: per row, the derivatives with respect to the parameters the row contains."""
+    column = {symbol: k for k, symbol in enumerate(p)}
+    entries: dict[tuple[int, int], sp.Expr] = {}
+    for r, row in enumerate(phi):
+        entries.update({(r, k): value for k, value in
+                        _row_jacobian(row, column, p).items()})
+    return sp.ImmutableSparseMatrix(len(phi), len(p), entries)
 
 
 def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr,

@@ -1,0 +1,152 @@
+"""One chunk of a sweep solved in this process: the generated ``<prefix>_solve_batch`` in C,
+or the driver set by set for a kernel without it (NumPy).
+
+The C batch runs plain Newton from q0 at t[0], like the first attempt of ``symkin.solve``. A set
+it cannot solve is then handed to ``symkin.solve`` itself, which adds the damped assembly and
+names the reason (no assembly, singular, no convergence, not finite) — so every set of a sweep
+is exactly what a per-set ``solve`` gives, failures included, and a failed set costs only its
+own re-run.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.runtime import driver
+from symkin.runtime.kernel import Kernel
+from symkin.runtime.options import OK, Options
+
+Array = NDArray[np.float64]
+
+# Status of a failed set, by the reason symkin.solve gives (0 = solved).
+REASON_CODES = {"no convergence": 1, "singular": 2, "not finite": 3, "no assembly": 4}
+
+
+@dataclass
+class Chunk:
+    """The results of sets [start, start + m) of a sweep.
+
+    Attributes:
+        q, dq, d2q: (m, T, N); rows a set did not reach are NaN.
+        status: (m,) 0 = solved, else REASON_CODES[reason].
+        solved: (m,) time points solved per set.
+        t_reached: (m,) the time of the last point attempted (t[-1] for a solved set).
+        iterations: (m,) Newton iterations of the C batch (0 where it did not run).
+        reasons, messages: per set, "" when solved.
+    """
+
+    q: Array
+    dq: Array
+    d2q: Array
+    status: NDArray[np.int64]
+    solved: NDArray[np.int64]
+    t_reached: Array
+    iterations: NDArray[np.int64]
+    reasons: NDArray[np.object_]
+    messages: NDArray[np.object_]
+
+    def rows(self, part: slice) -> Chunk:
+        """The sets ``part`` of this chunk as views: solving into them fills this chunk."""
+        return Chunk(*(getattr(self, f.name)[part] for f in dataclasses.fields(self)))
+
+
+def empty_chunk(m: int, t: Array, size: int) -> Chunk:
+    """Room for m sets (q, dq, d2q not initialised: every row is written or set to NaN)."""
+    shape = (m, t.size, size)
+    return Chunk(np.empty(shape), np.empty(shape), np.empty(shape),
+                 np.zeros(m, dtype=np.int64), np.full(m, t.size, dtype=np.int64),
+                 np.full(m, t[-1]), np.zeros(m, dtype=np.int64),
+                 np.full(m, "", dtype=object), np.full(m, "", dtype=object))
+
+
+def solve_chunk(kernel: Kernel, params: Array, t: Array, q0: Array,
+                options: Options | None = None, into: Chunk | None = None) -> Chunk:
+    """Solve every row of ``params`` (m, NP) over ``t`` from ``q0`` ((N,) or (m, N)), into
+    ``into`` (m rows, e.g. ``rows`` of a larger chunk) or a new chunk."""
+    options = options or driver.default_options(kernel)
+    m, size = params.shape[0], len(kernel.coordinates)
+    chunk = empty_chunk(m, t, size) if into is None else into
+    starts = np.broadcast_to(q0, (m, size))
+    if hasattr(kernel.lib, f"{kernel.name}_solve_batch"):
+        pending = _c_batch(kernel, params, t, q0, options, chunk)
+    else:
+        pending = np.arange(m)
+    for j in pending:
+        _solve_one(kernel, params[j], t, starts[j], options, chunk, int(j))
+    return chunk
+
+
+def _c_batch(kernel: Kernel, params: Array, t: Array, q0: Array, options: Options,
+             chunk: Chunk) -> NDArray[np.intp]:
+    """Run ``<prefix>_solve_batch`` over all sets; returns the indices of failed sets."""
+    ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
+    dtype = np.float32 if kernel.real == "float" else np.float64
+    m = params.shape[0]
+    direct = dtype == np.float64
+    outputs = (chunk.q, chunk.dq, chunk.d2q) if direct else tuple(
+        np.empty(chunk.q.shape, dtype=dtype) for _ in range(3))
+    inputs = [np.ascontiguousarray(a, dtype=dtype) for a in (params, q0, t)]
+    real = f"{name}_real *"
+    pointers = [ffi.cast(real, ffi.from_buffer(a)) if a.size else ffi.NULL
+                for a in (*inputs, *outputs)]
+    c_options = _options(ffi, lib, name, options)
+    state = ffi.new(f"{name}_state *")
+    work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
+    reports = ffi.new(f"{name}_batch_report[]", max(m, 1))
+    stride = len(kernel.coordinates) if q0.ndim == 2 else 0
+    getattr(lib, f"{name}_solve_batch")(
+        c_options, m, pointers[0], pointers[1], stride, t.size, pointers[2], pointers[3],
+        pointers[4], pointers[5], state, work, reports)
+    if not direct:
+        for target, source in zip((chunk.q, chunk.dq, chunk.d2q), outputs):
+            target[...] = source
+    status = np.frombuffer(ffi.buffer(reports, m * ffi.sizeof(f"{name}_batch_report")),
+                           dtype=_report_dtype(ffi, name))
+    chunk.iterations[:] = status["iterations"]
+    return np.flatnonzero(status["status"] != OK)
+
+
+def _report_dtype(ffi: Any, name: str) -> np.dtype[Any]:
+    """The NumPy view of ``<prefix>_batch_report`` (offsets from cffi, not assumed)."""
+    struct = f"{name}_batch_report"
+    real = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
+    fields = {"status": np.int32, "solved": np.int32, "t": real, "iterations": np.int32,
+              "residual": real}
+    return np.dtype({"names": list(fields), "formats": list(fields.values()),
+                     "offsets": [ffi.offsetof(struct, f) for f in fields],
+                     "itemsize": ffi.sizeof(struct)})
+
+
+def _options(ffi: Any, lib: Any, name: str, options: Options) -> Any:
+    c_options = ffi.new(f"{name}_options *")
+    getattr(lib, f"{name}_default_options")(c_options)
+    c_options.tol_phi, c_options.tol_dq = options.tol_phi, options.tol_dq
+    c_options.max_iterations = options.max_iterations
+    c_options.min_pivot_ratio = options.min_pivot_ratio
+    return c_options
+
+
+def _solve_one(kernel: Kernel, p: Array, t: Array, q0: Array, options: Options, chunk: Chunk,
+               j: int) -> None:
+    """Set j through symkin.solve: its rows, or its partial rows and the reason it failed."""
+    try:
+        trajectory = driver.solve(kernel, t=t, q0=q0, params=p, options=options)
+    except driver.SolveFailure as failure:
+        trajectory = failure.trajectory
+        chunk.status[j] = REASON_CODES.get(failure.reason, max(REASON_CODES.values()) + 1)
+        chunk.reasons[j] = failure.reason or "failed"
+        chunk.messages[j] = str(failure)
+        chunk.t_reached[j] = failure.t
+    done = trajectory.t.size
+    chunk.solved[j] = done
+    for target, rows in zip((chunk.q, chunk.dq, chunk.d2q),
+                            (trajectory.q, trajectory.dq, trajectory.d2q)):
+        target[j, :done] = rows
+        target[j, done:] = np.nan
+    if chunk.status[j] == OK:
+        chunk.t_reached[j] = t[-1]
