@@ -110,6 +110,19 @@ def test_cli_monte_carlo_prints_the_first_order_estimate(tmp_path: Path) -> None
     assert "solved 300 of 300" in result.stdout and "first order ±3σ" in result.stdout
 
 
+def test_cli_set_fixes_the_parameters_not_varied(tmp_path: Path) -> None:
+    # --set c=4.2 moves the slider line (y = c) for every set; the slider's y equals c
+    # whatever a and b are (the prismatic joint holds it on that line).
+    result = sweep_cli(str(TEXTBOOK), "--vary", "a=0.9:1.1:3", "--set", "c=4.2", "-o", "s.npz",
+                       cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    data = np.load(tmp_path / "s.npz")
+    names = [str(n) for n in data["coordinates"]]
+    assert np.all(data["params"][:, 2] == 4.2)
+    np.testing.assert_allclose(data["q"][:, :, names.index("slider.y")], 4.2, atol=1e-12)
+    bad = sweep_cli(str(TEXTBOOK), "--vary", "a=0.9:1.1:3", "--set", "zz=1", cwd=tmp_path)
+    assert bad.returncode == 2 and "no parameter 'zz'" in bad.stderr
+
 @pytest.mark.parametrize("args, message", [
     (["--vary", "b=1:2"], "NAME=LO:HI:COUNT"),
     (["--vary", "zz=1:2:3"], "unknown parameter 'zz'"),

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from symkin.cli import messages
+from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 from symkin.errors import SymkinError, UsageError
 
@@ -53,6 +53,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                        help="a Dask scheduler (tcp://host:8786): run the sweep on its cluster")
     sweep.add_argument("-o", "--output", type=Path, help="results file, .npz")
     sweep.add_argument("--plot", type=Path, help="PNG of the named points' envelopes over t")
+    overrides.add_argument(sweep)
     sweep.set_defaults(handler=handle)
 
 
@@ -64,8 +65,9 @@ def handle(args: argparse.Namespace) -> int:
     from symkin.build import index as cache
     from symkin.build.toolchain import resolve_backend
 
-    kernel = cache.prepare(args.mechanism, cache.Options(backend=resolve_backend(args.backend))
-                           ).kernel
+    options = cache.Options(backend=resolve_backend(args.backend),
+                            parameters=overrides.pairs(args.overrides))
+    kernel = cache.prepare(args.mechanism, options).kernel
     try:
         design, spread = _design(kernel, args)
     except UsageError as error:
@@ -153,7 +155,7 @@ def _finite(text: str, where: str) -> float:
 
 
 def _run(kernel: Any, args: argparse.Namespace, design: Any, spread: Any) -> int:
-    from symkin.cli.run import ProgressBar
+    from symkin.cli.outputs import ProgressBar
     from symkin.sweep.api import sweep
 
     client = _client(args.scheduler) if args.scheduler else None
