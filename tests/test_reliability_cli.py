@@ -8,6 +8,8 @@ status, stdout and stderr are what a user sees.
 from __future__ import annotations
 
 import os
+import pty
+import select
 import signal
 import subprocess
 import sys
@@ -115,6 +117,23 @@ def test_no_claim_of_written_rows_without_an_output(tmp_path: Path, cache: Path)
     assert "are written" not in result.stderr and "those are" not in result.stderr
 
 
+def _read_until(fd: int, marker: bytes | None, deadline: float) -> bytes:
+    """What a pseudo-terminal shows until ``marker`` appears (None: until the child closes it)."""
+    seen = b""
+    while time.monotonic() < deadline and (marker is None or marker not in seen):
+        ready, _, _ = select.select([fd], [], [], 0.5)
+        if not ready:
+            continue
+        try:
+            chunk = os.read(fd, 4096)
+        except OSError:  # EIO: the child has closed its end
+            break
+        if not chunk:
+            break
+        seen += chunk
+    return seen
+
+
 @pytest.mark.parametrize("backend, dt", [("numpy", "1e-5"), ("c", "2e-7")])
 def test_ctrl_c_writes_the_rows_solved_and_exits_130(backend: str, dt: str, tmp_path: Path,
                                                      cache: Path) -> None:
@@ -123,15 +142,25 @@ def test_ctrl_c_writes_the_rows_solved_and_exits_130(backend: str, dt: str, tmp_
     symkin("run", str(TEXTBOOK), "--backend", backend, cwd=tmp_path, cache=cache)  # warm
     env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(cache)}
     out = tmp_path / "partial.npz"
+    # stderr on a pseudo-terminal: the progress bar then says when the solve has begun, so the
+    # interrupt lands in the solve however slowly the interpreter starts on a loaded machine.
+    terminal, child_end = pty.openpty()
     process = subprocess.Popen(
         [sys.executable, "-m", "symkin", "run", str(TEXTBOOK), "--backend", backend, "--dt", dt,
-         "-o", str(out)], cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+         "-o", str(out)], cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=child_end,
         text=True)
-    time.sleep(1.5)
-    assert process.poll() is None, "the run ended before it could be interrupted"
-    process.send_signal(signal.SIGINT)
-    began = time.monotonic()
-    _, stderr = process.communicate(timeout=120)
+    os.close(child_end)
+    try:
+        seen = _read_until(terminal, b"solving", deadline=time.monotonic() + 120)
+        assert process.poll() is None, "the run ended before it could be interrupted"
+        process.send_signal(signal.SIGINT)
+        began = time.monotonic()
+        process.wait(timeout=120)
+        stderr = (seen + _read_until(terminal, None, deadline=time.monotonic() + 30)).decode(errors="replace")
+    finally:
+        os.close(terminal)
+        if process.stdout:
+            process.stdout.close()
     assert process.returncode == 130, stderr
     assert "interrupted at t = " in stderr and "Traceback" not in stderr
     data = np.load(out)
