@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -29,9 +29,11 @@ from numpy.typing import ArrayLike, NDArray
 from symkin import limits
 from symkin.errors import SolveError
 from symkin.runtime.linalg import dependent_rows, factor_at
-from symkin.runtime.newton import Newton, assemble, newton
+from symkin.runtime.edges import Passage, Resolution, State, resolve
+from symkin.runtime.newton import Newton, Point, assemble, kinematics, newton
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.options import defaults as newton_defaults
+from symkin.runtime.csolver import GridSolver
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.results import Trajectory
 
@@ -140,31 +142,40 @@ class _Run:
     q: Array
     dq: Array
     d2q: Array
+    cond: Array
+    flagged: NDArray[np.bool_]
     done: int = 0
     fallbacks: int = 0  # the generated sparse LU's fall-backs to dense LU (C solver)
+    passages: list[Passage] = field(default_factory=list)
+
+    def store(self, k: int, point: Point) -> None:
+        self.q[k], self.dq[k], self.d2q[k] = point.q, point.dq, point.ddq
+        self.cond[k], self.flagged[k] = point.cond, point.flagged
+        self.done = k + 1
+
+    def state(self, k: int) -> State:
+        """Point k as the predictor's state."""
+        return State(float(self.t[k]), Point(self.q[k], self.dq[k], self.d2q[k],
+                                             float(self.cond[k]), bool(self.flagged[k])))
 
 
 def _python_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
                  progress: Progress | None) -> Newton:
-    """The grid loop in Python; returns the Newton outcome at the last point attempted."""
-    dq = np.zeros_like(q)
-    d2q = np.zeros_like(q)
+    """The grid loop in Python from point run.done (q: the first guess when it is the first
+    point); returns the Newton outcome at the last point attempted."""
     result = Newton(q, OK, 0, 0.0, None)
-    for k, t in enumerate(run.t):
+    for k in range(run.done, run.t.size):
+        t = float(run.t[k])
         if k > 0:
             h = t - run.t[k - 1]
-            q = q + dq * h + d2q * (h * h / 2)  # (2.76)
+            q = run.q[k - 1] + run.dq[k - 1] * h + run.d2q[k - 1] * (h * h / 2)  # (2.76)
         result = newton(kernel, q, t, p, options)
         if result.status != OK:
             return result
-        q, factors = result.q, result.factors
-        assert factors is not None  # newton returns the factors whenever it converges
-        dq = factors.solve(-kernel.phi_t(q, t, p))  # (2.73)
-        d2q = factors.solve(kernel.gamma(q, dq, t, p))  # (2.74)
-        if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(d2q))):
-            return Newton(q, NOT_FINITE, result.iterations, result.residual, None)
-        run.q[k], run.dq[k], run.d2q[k] = q, dq, d2q
-        run.done = k + 1
+        point = kinematics(kernel, result, t, p, options)
+        if point is None:
+            return Newton(result.q, NOT_FINITE, result.iterations, result.residual, None)
+        run.store(k, point)
         if progress is not None:
             progress(k + 1, run.t.size)
     return result
@@ -192,20 +203,19 @@ class _Chunks:
         self.size = int(min(self.limit, max(1, self.size * grow)))
 
 
-def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
+def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
             progress: Progress | None) -> Newton:
-    """The grid loop in the generated C solver: one call per chunk (one chunk unless a
-    progress callback wants to hear in between)."""
-    solver = kernel.grid_solver(options, q, p)
-    assert solver is not None  # only called for kernels that have one
+    """The grid loop in the generated C solver from point run.done: one call per chunk (one
+    chunk unless a progress callback wants to hear in between)."""
     chunks = _Chunks(run.t.size, progress is not None)
     result = None
-    start = 0
+    start = run.done
     while start < run.t.size:
         stop = min(start + chunks.size, run.t.size)
         began = time.perf_counter()
         result = solver.solve(run.t[start:stop], run.q[start:stop], run.dq[start:stop],
-                              run.d2q[start:stop])
+                              run.d2q[start:stop], run.cond[start:stop],
+                              run.flagged[start:stop])
         chunks.took(time.perf_counter() - began)
         run.done = start + result.solved
         run.fallbacks = result.fallbacks
@@ -217,8 +227,8 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Op
         if progress is not None:
             progress(run.done, run.t.size)
         start = stop
-    assert result is not None  # the grid has at least one point
-    return Newton(solver.last_q(), OK, result.iterations, result.residual, None)
+    return Newton(solver.last_q(), OK, 0 if result is None else result.iterations,
+                  0.0 if result is None else result.residual, None)
 
 
 def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
@@ -262,25 +272,59 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
                          f"{len(kernel.coordinates)} coordinates")
     shape = (times.size, q.size)
     # Rows past run.done are never exposed, so the arrays need no zero-filling.
-    run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape))
+    run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape),
+               np.full(times.size, math.nan), np.zeros(times.size, dtype=bool))
     in_c = use_c_solver and kernel.has_grid_solver
-    # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
-    # the damped assembly in Python take over (and the grid is run again from its result).
     try:
-        result = _c_loop(kernel, run, q, p, options, progress) if in_c else None
-        if result is None or (result.status != OK and run.done == 0):
-            start = assemble(kernel, q, float(times[0]), p, options)
-            if start.status != OK:
-                _fail(kernel, run, p, start, float(times[0]), assembling=True)
-            loop = _c_loop if in_c else _python_loop
-            result = loop(kernel, run, start.q, p, options, progress)
+        result = _run(kernel, run, q, p, options, progress, in_c)
     except KeyboardInterrupt:
         # The rows done so far are whole (run.done counts only finished rows): hand them on.
         stop = float(times[min(run.done, times.size - 1)])
         raise SolveInterrupted(_trajectory(kernel, run, p), stop) from None
+    if isinstance(result, Resolution):
+        _fail_edge(kernel, run, p, result, float(times[run.done]))
     if result.status != OK:
         _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
     return _trajectory(kernel, run, p)
+
+
+def _run(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
+         progress: Progress | None, in_c: bool) -> Newton | Resolution:
+    """Assemble at t[0], then solve the grid; a point the plain step cannot solve goes to
+    edges.resolve and the loop resumes after it. Returns the outcome that stopped the run
+    (status OK when the grid is done)."""
+    solver = kernel.grid_solver(options, q, p) if in_c else None
+    # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
+    # the damped assembly in Python take over (and the grid is run again from its result).
+    result = _c_loop(kernel, run, solver, p, progress) if solver is not None else None
+    if result is None or (result.status != OK and run.done == 0):
+        start = assemble(kernel, q, float(run.t[0]), p, options)
+        if start.status != OK:
+            _fail(kernel, run, p, start, float(run.t[0]), assembling=True)
+        solver = kernel.grid_solver(options, start.q, p) if in_c else None
+        result = _resume(kernel, run, solver, start.q, p, options, progress)
+    while result.status not in (OK, NOT_FINITE) and run.done > 0 \
+            and not options.stop_at_singular:
+        k = run.done
+        resolution = resolve(kernel, p, options, run.state(k - 1), float(run.t[k]))
+        if resolution.passage is not None:
+            run.passages.append(resolution.passage)
+        if resolution.point is None:
+            return resolution
+        run.store(k, resolution.point)
+        if solver is not None:
+            solver.set_state(run.state(k))
+        if progress is not None:
+            progress(run.done, run.t.size)
+        result = _resume(kernel, run, solver, resolution.point.q, p, options, progress)
+    return result
+
+
+def _resume(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: Array, p: Array,
+            options: Options, progress: Progress | None) -> Newton:
+    if solver is not None:
+        return _c_loop(kernel, run, solver, p, progress)
+    return _python_loop(kernel, run, q, p, options, progress)
 
 
 def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
@@ -293,7 +337,10 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
                       d2q=solved(run.d2q), coordinates=tuple(kernel.coordinates),
                       points=tuple((body, point) for body, point in kernel.points),
                       point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
-                      params=p.copy(), lu_fallbacks=run.fallbacks)
+                      params=p.copy(), lu_fallbacks=run.fallbacks,
+                      flagged=run.flagged[:done].copy(), cond=run.cond[:done].copy(),
+                      singular=tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
+                                     for s in run.passages))
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
@@ -331,6 +378,42 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
                    "dt, or check that the drivers are smooth and reachable.")
     raise SolveFailure(message, _trajectory(kernel, run, p), t, result.residual,
                        result.iterations, rows, reason)
+
+
+def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,
+               t: float) -> None:
+    """Raise SolveFailure for a grid point that could not be reached even by substeps."""
+    reached = stop.reached
+    assert reached is not None
+    last, failed = reached.t, stop.failed_at
+    joints = _joint_names([row for group in stop.groups for row in group])
+    if stop.limit:
+        reason = "limit position"
+        message = (f"the driven motion reaches a limit position near t = {last:.10g} (bisected "
+                   f"to {last:.10g} .. {failed:.10g}, grid point t = {t:.10g}): "
+                   f"{', '.join(joints)} become aligned (Phi_q loses rank there, condition "
+                   f"{reached.point.cond:.3g}; dependent: {_groups(stop.groups)}), and the "
+                   "driver cannot be followed beyond it. The motion can go on only by "
+                   "reversing the driver (the mechanism then moves back on its other branch), "
+                   "or by driving a joint that passes through this position; end the time grid "
+                   "before it.")
+    else:
+        reason = "no convergence"
+        message = (f"Newton-Raphson did not converge at t = {t:.10g}, not even with the step "
+                   f"reduced to {failed - last:.3g} after t = {last:.10g}; Phi_q is "
+                   f"well-conditioned there (condition {reached.point.cond:.3g}), so this is "
+                   "not a singular position: check that the drivers are smooth and reachable.")
+    raise SolveFailure(message, _trajectory(kernel, run, p), t, math.nan, 0,
+                       [row for group in stop.groups for row in group], reason)
+
+
+def _joint_names(rows: Sequence[str]) -> list[str]:
+    """The joints and drivers behind row labels, once each: 'joints[1] A revolute r0-c0'."""
+    return list(dict.fromkeys(row.rsplit(" (", 1)[0] for row in rows))
+
+
+def _groups(groups: Sequence[Sequence[str]]) -> str:
+    return "; ".join("{" + ", ".join(group) + "}" for group in groups)
 
 
 def _not_finite(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> str | None:

@@ -36,6 +36,11 @@ class Factors:
         x, _ = self.getrs(self.lu, self.pivots, b)
         return np.asarray(x, dtype=float)
 
+    def solve_transposed(self, b: Array) -> Array:
+        """Solve Phi_q^T x = b with the same factors (the condition estimate needs it)."""
+        x, _ = self.getrs(self.lu, self.pivots, b, trans=1)
+        return np.asarray(x, dtype=float)
+
 
 @dataclass(frozen=True)
 class SparseFactors:
@@ -47,6 +52,10 @@ class SparseFactors:
 
     def solve(self, b: Array) -> Array:
         return np.asarray(self.lu.solve(np.asarray(b, dtype=float)), dtype=float)
+
+    def solve_transposed(self, b: Array) -> Array:
+        """Solve Phi_q^T x = b with the same factors (the condition estimate needs it)."""
+        return np.asarray(self.lu.solve(np.asarray(b, dtype=float), trans="T"), dtype=float)
 
 
 def factor(jacobian: Array) -> Factors:
@@ -109,3 +118,36 @@ def dependent_rows(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8) 
 
 
 # ----- Newton-Raphson and assembly -----------------------------------------------------------
+
+
+def dependencies(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8
+                 ) -> tuple[int, list[list[str]]]:
+    """The rank loss of Phi_q and a minimal set of dependent rows for each lost rank.
+
+    The left null space (left singular vectors with sigma <= rcond sigma_max; at least the
+    weakest one) is brought to reduced row-echelon form, pivoting each time on the largest
+    remaining entry: each basis vector then vanishes on the other vectors' pivot rows, which
+    leaves it the few rows of one dependency (a closed loop of aligned links, a redundant
+    joint) rather than every row the null space touches.
+    """
+    if not np.all(np.isfinite(jacobian)):
+        return 0, [list(labels)]
+    u, sigma, _ = np.linalg.svd(jacobian)
+    null = u[:, sigma <= rcond * max(sigma[0], 1e-300)]
+    if null.shape[1] == 0:
+        null = u[:, -1:]
+    basis = null.T.copy()
+    pivots: list[int] = []
+    for row in range(basis.shape[0]):
+        free = np.abs(basis[row:]).copy()
+        free[:, pivots] = 0
+        r, c = np.unravel_index(int(np.argmax(free)), free.shape)
+        basis[[row, row + r]] = basis[[row + r, row]]
+        basis[row] /= basis[row, c]
+        for other in range(basis.shape[0]):
+            if other != row:
+                basis[other] -= basis[other, c] * basis[row]
+        pivots.append(int(c))
+    groups = [[labels[i] for i in np.flatnonzero(np.abs(vector) > 1e-6 * np.abs(vector).max())]
+              for vector in basis]
+    return int(null.shape[1]), groups

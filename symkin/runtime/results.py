@@ -60,6 +60,11 @@ class Trajectory:
         params: the parameter values solved with.
         lu_fallbacks: factorizations of the generated C solver whose sparse LU left its fixed
             pivot order for the dense partial-pivoting path (always 0 elsewhere).
+        flagged: (T,) True where q, dq or ddq may miss the accuracy targets (Phi_q is
+            ill-conditioned there, or a singular configuration was passed through).
+        cond: (T,) the estimated 1-norm condition number of Phi_q at each point.
+        singular: the singular configurations passed through, as (t, rank loss, groups of
+            dependent rows).
     """
 
     t: NDArray[np.float64]
@@ -71,6 +76,16 @@ class Trajectory:
     point_vectors: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)))
     params: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     lu_fallbacks: int = 0
+    flagged: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    cond: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
+
+    def __post_init__(self) -> None:
+        # A Trajectory built without them (by hand, or from older code) is unflagged.
+        if self.flagged.shape != self.t.shape:
+            object.__setattr__(self, "flagged", np.zeros(self.t.shape, dtype=bool))
+        if self.cond.shape != self.t.shape:
+            object.__setattr__(self, "cond", np.full(self.t.shape, np.nan))
 
     @property
     def bodies(self) -> tuple[str, ...]:
@@ -118,12 +133,13 @@ class Trajectory:
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
         np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
                  coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr)
+                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond)
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
-                  *(c + "_tt" for c in self.coordinates)]
-        table = np.column_stack([self.t, self.q, self.dq, self.d2q]) if self.t.size else \
+                  *(c + "_tt" for c in self.coordinates), "flagged"]
+        table = np.column_stack([self.t, self.q, self.dq, self.d2q, self.flagged]) \
+            if self.t.size else \
             np.zeros((0, len(header)))
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")
