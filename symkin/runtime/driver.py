@@ -313,7 +313,7 @@ def _run(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Optio
             return resolution
         run.store(k, resolution.point)
         if solver is not None:
-            solver.set_state(run.state(k))
+            solver.set_state(float(run.t[k]), run.q[k], run.dq[k], run.d2q[k])
         if progress is not None:
             progress(run.done, run.t.size)
         result = _resume(kernel, run, solver, resolution.point.q, p, options, progress)
