@@ -386,17 +386,17 @@ def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,
     reached = stop.reached
     assert reached is not None
     last, failed = reached.t, stop.failed_at
-    joints = _joint_names([row for group in stop.groups for row in group])
     if stop.limit:
         reason = "limit position"
         message = (f"the driven motion reaches a limit position near t = {last:.10g} (bisected "
-                   f"to {last:.10g} .. {failed:.10g}, grid point t = {t:.10g}): "
-                   f"{', '.join(joints)} become aligned (Phi_q loses rank there, condition "
-                   f"{reached.point.cond:.3g}; dependent: {_groups(stop.groups)}), and the "
-                   "driver cannot be followed beyond it. The motion can go on only by "
-                   "reversing the driver (the mechanism then moves back on its other branch), "
-                   "or by driving a joint that passes through this position; end the time grid "
-                   "before it.")
+                   f"to {last:.13g} .. {failed:.13g}; the grid point t = {t:.10g} is beyond "
+                   f"it): {', '.join(stop.aligned)} become aligned, and "
+                   f"{' and '.join(stop.drivers)} cannot be followed beyond it (Phi_q loses "
+                   f"rank 1 there, condition {reached.point.cond:.3g}). The motion can go on "
+                   "only by reversing the driver from this time (the mechanism then moves back "
+                   "on its other branch), or by driving one of the aligned joints instead, "
+                   "which passes through this position smoothly; or end the time grid before "
+                   "it.")
     else:
         reason = "no convergence"
         message = (f"Newton-Raphson did not converge at t = {t:.10g}, not even with the step "
@@ -405,15 +405,6 @@ def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,
                    "not a singular position: check that the drivers are smooth and reachable.")
     raise SolveFailure(message, _trajectory(kernel, run, p), t, math.nan, 0,
                        [row for group in stop.groups for row in group], reason)
-
-
-def _joint_names(rows: Sequence[str]) -> list[str]:
-    """The joints and drivers behind row labels, once each: 'joints[1] A revolute r0-c0'."""
-    return list(dict.fromkeys(row.rsplit(" (", 1)[0] for row in rows))
-
-
-def _groups(groups: Sequence[Sequence[str]]) -> str:
-    return "; ".join("{" + ", ".join(group) + "}" for group in groups)
 
 
 def _not_finite(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> str | None:

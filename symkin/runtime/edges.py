@@ -72,6 +72,8 @@ class Resolution:
     reached: State | None = None
     failed_at: float = math.nan
     groups: tuple[tuple[str, ...], ...] = ()
+    aligned: tuple[str, ...] = ()
+    drivers: tuple[str, ...] = ()
 
 
 def _step(kernel: KinematicsKernel, p: Array, options: Options, state: State, t: float
@@ -184,10 +186,29 @@ def _passage(kernel: KinematicsKernel, p: Array, before: State, after: State) ->
 def _stopped(kernel: KinematicsKernel, p: Array, state: State, failed: float) -> Resolution:
     """The motion cannot go on past state.t: a limit position, or no convergence."""
     limit = state.point.cond > LIMIT_COND
-    groups: tuple[tuple[str, ...], ...] = ()
+    stop = Resolution(None, limit=limit, reached=state, failed_at=state.t + failed)
     if limit:
-        _, found = dependencies(kernel.phi_q(state.point.q, state.t, p), list(kernel.rows),
-                                rcond=1.0 / LIMIT_COND)
-        groups = tuple(tuple(group) for group in found)
-    return Resolution(None, limit=limit, reached=state, failed_at=state.t + failed,
-                      groups=groups)
+        jacobian = kernel.phi_q(state.point.q, state.t, p)
+        _, found = dependencies(jacobian, list(kernel.rows), rcond=1.0 / LIMIT_COND)
+        stop.groups = tuple(tuple(group) for group in found)
+        stop.aligned, stop.drivers = _aligned(kernel, jacobian)
+    return stop
+
+
+def _aligned(kernel: KinematicsKernel, jacobian: Array) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The joints that become aligned at a limit position, and the drivers that hold.
+
+    The right null vector of Phi_q is the motion the constraints allow with every driver held:
+    the bodies it moves are the aligned links, and the joints on them are the aligned joints;
+    the drivers are the rows that the dependent set holds besides."""
+    _, _, vt = np.linalg.svd(jacobian)
+    motion = np.abs(vt[-1])
+    body = [name.rsplit(".", 1)[0] for name in kernel.coordinates]
+    bodies = {body[c] for c in np.flatnonzero(motion > 1e-3 * motion.max())}
+    rows = sorted({int(r) for r, c in zip(kernel.pattern_rows, kernel.pattern_cols)
+                   if body[int(c)] in bodies})
+    names = [kernel.rows[r].rsplit(" (", 1)[0] for r in rows]
+    joints = tuple(dict.fromkeys(n for n in names if n.startswith("joints")))
+    drivers = tuple(dict.fromkeys(label.rsplit(" (", 1)[0] for label in kernel.rows
+                                  if label.startswith("drivers")))
+    return joints, drivers

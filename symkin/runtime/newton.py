@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.runtime import accuracy
-from symkin.runtime.linalg import Factors, SparseFactors, factor_at
+from symkin.runtime.linalg import SPARSE_FROM, Factors, SparseFactors, factor_at
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.protocol import KinematicsKernel
 
@@ -85,8 +85,11 @@ def _estimate(kernel: KinematicsKernel, result: Newton, t: float, p: Array) -> N
     assert factors is not None
     n = result.q.size
     result.inv_norm = accuracy.inverse_norm1(factors.solve, factors.solve_transposed, n)
-    result.norm_a = accuracy.norm1(np.asarray(kernel.phi_q_nz(result.q, t, p), dtype=float),
-                                   kernel.pattern_cols, n)
+    if n < SPARSE_FROM:  # factored dense: the dense Phi_q is at hand for any kernel
+        result.norm_a = float(np.abs(kernel.phi_q(result.q, t, p)).sum(axis=0).max(initial=0))
+    else:
+        result.norm_a = accuracy.norm1(np.asarray(kernel.phi_q_nz(result.q, t, p), dtype=float),
+                                       kernel.pattern_cols, n)
     return result
 
 
