@@ -37,6 +37,9 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     run.add_argument("-o", "--output", type=Path, help="results file, .npz or .csv")
     run.add_argument("--plot", type=Path, help="PNG of coordinates and point paths against t")
     run.add_argument("--animate", type=Path, help="GIF of the mechanism moving")
+    run.add_argument("--stop-at-singular", action="store_true",
+                     help="stop at the first singular or ill-conditioned point instead of "
+                          "passing through it (and do not subdivide a failed step)")
     run.set_defaults(handler=handle)
 
 
@@ -110,7 +113,8 @@ def _solve_and_write(args: argparse.Namespace) -> int:
         return _error(f"{args.mechanism}: {problem}", EXIT_BAD_INPUT)
     progress = ProgressBar(sys.stderr) if sys.stderr.isatty() else None
     try:
-        trajectory = driver.solve(kernel, t=times, progress=progress)
+        trajectory = driver.solve(kernel, t=times, progress=progress,
+                                  stop_at_singular=args.stop_at_singular)
     except driver.SolveInterrupted as interrupted:
         if progress:
             progress.finish()
@@ -122,6 +126,7 @@ def _solve_and_write(args: argparse.Namespace) -> int:
         return _stopped(args, prepared, failure, times.size, str(failure), EXIT_FAILED)
     if progress:
         progress.finish()
+    _warn_flagged(trajectory)
     written = _write(trajectory, args, prepared.outlines)
     origin = ", cached kernel" if prepared.hit else ""
     print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
@@ -136,6 +141,7 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     """A run that ended early: say why first (even if writing then fails), then write the
     rows solved so far and say where they went."""
     solved = stop.trajectory.t.size
+    _warn_flagged(stop.trajectory)
     message = f"{args.mechanism}: {why}"
     if status == EXIT_INTERRUPTED:
         message += f" at t = {stop.t:g}."
@@ -148,6 +154,51 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     if written:
         messages.note("the solved rows are written to " + ", ".join(map(str, written)))
     return status
+
+
+def _warn_flagged(trajectory: Any) -> None:
+    """One warning line per stretch of consecutive flagged points (the run still succeeds)."""
+    for line in flag_warnings(trajectory):
+        messages.note(line)
+
+
+def flag_warnings(trajectory: Any) -> list[str]:
+    """``warning: ... at t = ...`` for each stretch of flagged points: where, how
+    ill-conditioned, and the singular configuration passed there with its dependent rows."""
+    from symkin.runtime.options import Options
+
+    targets = Options()
+    flagged = list(trajectory.flagged)
+    lines = []
+    k = 0
+    while k < len(flagged):
+        if not flagged[k]:
+            k += 1
+            continue
+        end = k
+        while end + 1 < len(flagged) and flagged[end + 1]:
+            end += 1
+        t0, t1 = float(trajectory.t[k]), float(trajectory.t[end])
+        where = f"t = {t0:.10g}" if k == end else f"t = {t0:.10g} .. {t1:.10g}"
+        count = end - k + 1
+        worst = max(float(c) for c in trajectory.cond[k:end + 1])
+        passed = [s for s in trajectory.singular
+                  if t0 - _step(trajectory, k) <= s[0] <= t1 + _step(trajectory, end + 1)]
+        detail = "".join(
+            f"; a singular configuration is passed at t = {t:.10g} (Phi_q loses rank {rank}; "
+            f"dependent rows: {'; '.join('{' + ', '.join(g) + '}' for g in groups)}), its "
+            "point(s) interpolated from both sides" for t, rank, groups in passed)
+        lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
+                     f"Phi_q is ill-conditioned there (condition up to {worst:.3g}), so q, dq, "
+                     f"ddq may miss {targets.target_q:g}, {targets.target_dq:g}, "
+                     f"{targets.target_ddq:g} (column 'flagged'){detail}")
+        k = end + 1
+    return lines
+
+
+def _step(trajectory: Any, k: int) -> float:
+    """The grid step before point k (0 at the ends)."""
+    return float(trajectory.t[k] - trajectory.t[k - 1]) if 0 < k < trajectory.t.size else 0.0
 
 
 def _fallback_note(count: int) -> str:

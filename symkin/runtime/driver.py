@@ -18,6 +18,7 @@ trajectory. Imports NumPy and SciPy only: it is part of the runtime.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -28,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin import limits
 from symkin.errors import SolveError
-from symkin.runtime.linalg import dependent_rows, factor_at
+from symkin.runtime.linalg import dependencies, factor_at
 from symkin.runtime.edges import Passage, Resolution, State, resolve
 from symkin.runtime.newton import Newton, Point, assemble, kinematics, newton
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
@@ -234,7 +235,7 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
 def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
           params: Mapping[str, float] | ArrayLike | None = None, *,
           options: Options | None = None, progress: Progress | None = None,
-          use_c_solver: bool = True) -> Trajectory:
+          use_c_solver: bool = True, stop_at_singular: bool = False) -> Trajectory:
     """Positions, velocities and accelerations of a mechanism over a time grid.
 
     Args:
@@ -246,6 +247,8 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
             kernel's real type (looser for a C kernel generated with float).
         progress: called as progress(done, total) while the grid is solved.
         use_c_solver: run the grid loop in the generated C solver when the kernel has one.
+        stop_at_singular: stop at the first singular point (SolveFailure) instead of passing
+            through it, and do not subdivide a step that fails (the behaviour of old).
 
     Returns:
         The Trajectory.
@@ -256,16 +259,18 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     """
     # An expression singular at some t gives inf/NaN there; that is reported as a failure
     # (status NOT_FINITE), so NumPy's floating-point warnings would only repeat it.
+    options = options or default_options(kernel)
+    if stop_at_singular:
+        options = dataclasses.replace(options, stop_at_singular=True)
     with np.errstate(all="ignore"):
         return _solve(kernel, t, q0, params, options, progress, use_c_solver)
 
 
 def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
-           params: Mapping[str, float] | ArrayLike | None, options: Options | None,
+           params: Mapping[str, float] | ArrayLike | None, options: Options,
            progress: Progress | None, use_c_solver: bool) -> Trajectory:
     times = _times(kernel, t)
     p = _params(kernel, params)
-    options = options or default_options(kernel)
     q = np.array(kernel.q0 if q0 is None else q0, dtype=float)
     if q.shape != (len(kernel.coordinates),):
         raise SolveError(f"q0 has {q.size} values; the mechanism has "
@@ -368,8 +373,7 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
         reason = "singular"
         when = where if near is None else (f"near t = {near:.10g}, the last point solved; "
                                            f"Newton-Raphson then failed {where}")
-        message = (f"Phi_q is singular {when} {facts}: the equations of {'; '.join(rows)} are "
-                   "dependent. This is a dead-centre or toggle position, a redundant joint, or "
+        message = (f"Phi_q is singular {when} {facts}: {rows[0]}. This is a dead-centre or toggle position, a redundant joint, or "
                    "a driver that cannot move the mechanism here; end the time grid before it, "
                    "or change the drivers.")
     else:
@@ -377,7 +381,7 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
         message = (f"Newton-Raphson did not converge {where} {facts}. Try a smaller time step "
                    "dt, or check that the drivers are smooth and reachable.")
     raise SolveFailure(message, _trajectory(kernel, run, p), t, result.residual,
-                       result.iterations, rows, reason)
+                       result.iterations, rows[1:], reason)
 
 
 def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,
@@ -439,13 +443,22 @@ def _singular_rows(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton
     jacobian = kernel.phi_q(result.q, t, p)
     finite = bool(np.all(np.isfinite(jacobian)))
     if result.status == SINGULAR or (finite and np.linalg.cond(jacobian) > ILL_CONDITIONED):
-        return dependent_rows(jacobian, labels), None
+        return _dependent(jacobian, labels), None
     if result.status == NO_CONVERGENCE and run.done > 0:
         last_t = float(run.t[run.done - 1])
         jacobian = kernel.phi_q(run.q[run.done - 1], last_t, p)
         if np.linalg.cond(jacobian) > NEARLY_SINGULAR:
-            return dependent_rows(jacobian, labels), last_t
+            return _dependent(jacobian, labels), last_t
     return [], None
+
+
+def _dependent(jacobian: Array, labels: Sequence[str]) -> list[str]:
+    """What is singular, said first, then the dependent rows (a minimal set per lost rank)."""
+    rank_loss, groups = dependencies(jacobian, labels)
+    said = "; ".join("{" + ", ".join(group) + "}" for group in groups)
+    summary = (f"it loses rank {rank_loss}; the equations of {said} are dependent"
+               if len(groups) > 1 else f"the equations of {'; '.join(groups[0])} are dependent")
+    return [summary, *dict.fromkeys(row for group in groups for row in group)]
 
 
 def _worst_rows(phi: Array, labels: Sequence[str], count: int = 3) -> str:

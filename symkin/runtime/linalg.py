@@ -101,23 +101,6 @@ def _ratio(magnitudes: Array) -> float:
     return ratio if math.isfinite(ratio) else 0.0
 
 
-def dependent_rows(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8) -> list[str]:
-    """The equations whose rows of Phi_q are linearly dependent.
-
-    The left null space of Phi_q (left singular vectors with sigma <= rcond sigma_max) holds the
-    combinations y with y^T Phi_q = 0; a row takes part in a dependency when some y weighs it.
-    """
-    if not np.all(np.isfinite(jacobian)):
-        return list(labels)
-    u, sigma, _ = np.linalg.svd(jacobian)
-    null = u[:, sigma <= rcond * max(sigma[0], 1e-300)]
-    if null.shape[1] == 0:
-        null = u[:, -1:]  # ill-conditioned but above rcond: name the weakest direction
-    weight = np.abs(null).max(axis=1)
-    return [label for label, w in zip(labels, weight) if w > 1e-6]
-
-
-# ----- Newton-Raphson and assembly -----------------------------------------------------------
 
 
 def dependencies(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8
@@ -125,10 +108,10 @@ def dependencies(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8
     """The rank loss of Phi_q and a minimal set of dependent rows for each lost rank.
 
     The left null space (left singular vectors with sigma <= rcond sigma_max; at least the
-    weakest one) is brought to reduced row-echelon form, pivoting each time on the largest
-    remaining entry: each basis vector then vanishes on the other vectors' pivot rows, which
-    leaves it the few rows of one dependency (a closed loop of aligned links, a redundant
-    joint) rather than every row the null space touches.
+    weakest one) is brought to reduced row-echelon form, then each basis vector is made
+    sparser by subtracting multiples of the others while that removes rows: each ends as the
+    few rows of one dependency (a closed loop of aligned links, a redundant joint) rather
+    than every row the null space touches.
     """
     if not np.all(np.isfinite(jacobian)):
         return 0, [list(labels)]
@@ -148,6 +131,28 @@ def dependencies(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8
             if other != row:
                 basis[other] -= basis[other, c] * basis[row]
         pivots.append(int(c))
-    groups = [[labels[i] for i in np.flatnonzero(np.abs(vector) > 1e-6 * np.abs(vector).max())]
-              for vector in basis]
+    basis = _sparsest(basis)
+    groups = sorted([[labels[i] for i in np.flatnonzero(_support(vector))] for vector in basis],
+                    key=lambda group: [labels.index(row) for row in group])
     return int(null.shape[1]), groups
+
+
+def _support(vector: Array) -> NDArray[np.bool_]:
+    return np.asarray(np.abs(vector) > 1e-6 * np.abs(vector).max(initial=0.0))
+
+
+def _sparsest(basis: Array) -> Array:
+    """Replace basis vectors by combinations with fewer non-zeros while any pair allows it."""
+    improved = True
+    while improved:
+        improved = False
+        for i in range(basis.shape[0]):
+            for j in range(basis.shape[0]):
+                if i == j:
+                    continue
+                for m in np.flatnonzero(_support(basis[i]) & _support(basis[j])):
+                    trial = basis[i] - basis[i, m] / basis[j, m] * basis[j]
+                    if _support(trial).sum() < _support(basis[i]).sum():
+                        basis[i], improved = trial / np.abs(trial).max(), True
+                        break
+    return basis
