@@ -31,7 +31,8 @@ from symkin import limits
 from symkin.errors import SolveError
 from symkin.runtime.linalg import dependencies, factor_at
 from symkin.runtime.edges import Passage, Resolution, State, resolve
-from symkin.runtime.newton import Newton, Point, assemble, kinematics, newton
+from symkin.runtime.assembly import Assembly, assemble
+from symkin.runtime.newton import Newton, Point, kinematics, newton
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.options import defaults as newton_defaults
 from symkin.runtime.csolver import GridSolver
@@ -303,9 +304,10 @@ def _run(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Optio
     # the damped assembly in Python take over (and the grid is run again from its result).
     result = _c_loop(kernel, run, solver, p, progress) if solver is not None else None
     if result is None or (result.status != OK and run.done == 0):
-        start = assemble(kernel, q, float(run.t[0]), p, options)
+        assembly = assemble(kernel, q, float(run.t[0]), p, options)
+        start = assembly.result
         if start.status != OK:
-            _fail(kernel, run, p, start, float(run.t[0]), assembling=True)
+            _fail(kernel, run, p, start, float(run.t[0]), assembling=True, assembly=assembly)
         solver = kernel.grid_solver(options, start.q, p) if in_c else None
         result = _resume(kernel, run, solver, start.q, p, options, progress)
     while result.status not in (OK, NOT_FINITE) and run.done > 0 \
@@ -349,13 +351,16 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
-          assembling: bool) -> None:
+          assembling: bool, assembly: Assembly | None = None) -> None:
     """Raise SolveFailure with a message that says where, why and what to try."""
     labels = list(kernel.rows)
     where = f"at t = {t:.10g}"
     not_finite = _not_finite(kernel, result.q, t, p) if result.status in (NOT_FINITE, SINGULAR) \
         else None
-    rows, near = ([], None) if not_finite else _singular_rows(kernel, run, p, result, t)
+    # Not assembled (the residual is not small): Phi_q singular at the guess is no dead centre.
+    unassembled = assembly is not None and not result.residual <= max(options_tol(kernel), 1e-6)
+    rows, near = ([], None) if not_finite or unassembled else \
+        _singular_rows(kernel, run, p, result, t)
     facts = f"(residual max|Phi| = {result.residual:.3g} after {result.iterations} iterations)"
     if not_finite:
         reason = "not finite"
@@ -364,11 +369,7 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
                    "derivative of such). End the time grid before it, or change the expression.")
     elif assembling and not rows:
         reason = "no assembly"
-        worst = _worst_rows(kernel.phi(result.q, t, p), labels)
-        message = (f"the mechanism cannot be assembled {where} {facts}: no position satisfies "
-                   f"all constraints near q0; the largest violations are in {worst}. Check the "
-                   "link lengths (a chain too short to close cannot assemble), or give a better "
-                   "q0 in the mechanism file.")
+        message = _no_assembly(kernel, result, t, p, assembly)
     elif rows:
         reason = "singular"
         when = where if near is None else (f"near t = {near:.10g}, the last point solved; "
@@ -382,6 +383,37 @@ def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: floa
                    "dt, or check that the drivers are smooth and reachable.")
     raise SolveFailure(message, _trajectory(kernel, run, p), t, result.residual,
                        result.iterations, rows[1:], reason)
+
+
+def options_tol(kernel: KinematicsKernel) -> float:
+    return default_options(kernel).tol_phi
+
+
+def _no_assembly(kernel: KinematicsKernel, result: Newton, t: float, p: Array,
+                 assembly: Assembly | None) -> str:
+    """Cannot be assembled: how close the best start came, the joints that cannot close, and
+    whether the evidence points at the link lengths or at a better q0."""
+    worst = _worst_rows(kernel.phi(result.q, t, p), list(kernel.rows))
+    if assembly is None or not assembly.residuals:
+        return (f"the mechanism cannot be assembled at t = {t:.10g} (residual max|Phi| = "
+                f"{result.residual:.3g}): the largest violations are in {worst}. Check the link "
+                "lengths, or give a better q0 in the mechanism file.")
+    residuals = assembly.residuals
+    least = min(residuals)
+    if assembly.evidence == "link lengths":
+        alike = sum(1 for r in residuals if r <= 1.05 * least + 1e-9)
+        why = (f"the evidence points at the link lengths: {alike} of {len(residuals)} starts end "
+               "at this same least residual, as when a chain is too short or too long to "
+               "close. Check the dimensions")
+    else:
+        why = (f"the evidence points at a better q0: the starts end at different residuals "
+               f"({least:.3g} to {max(residuals):.3g}), local minima of a mechanism that may "
+               "well assemble. Give a q0 close to an assembled configuration (a rough sketch "
+               "is enough)")
+    return (f"the mechanism cannot be assembled at t = {t:.10g}: from q0 and "
+            f"{len(residuals)} further starts (damped Newton from q0, bodies placed along their "
+            f"joints, q0 perturbed, random angles) the least residual max|Phi| is {least:.3g}, "
+            f"and the joints that cannot close are {worst}; {why}.")
 
 
 def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,

@@ -168,14 +168,3 @@ def levenberg_marquardt(kernel: KinematicsKernel, q: Array, t: float, p: Array, 
             if mu > 1e12:
                 break
     return q, float(np.abs(phi).max(initial=0.0))
-
-
-def assemble(kernel: KinematicsKernel, q0: Array, t0: float, p: Array, options: Options) -> Newton:
-    """Assemble the mechanism at t0 from q0: Newton, else Levenberg-Marquardt then Newton."""
-    result = newton(kernel, q0, t0, p, options)
-    if result.status == OK:
-        return result
-    q, _ = levenberg_marquardt(kernel, q0, t0, p, options)
-    polished = newton(kernel, q, t0, p, options)
-    polished.iterations += result.iterations
-    return polished
