@@ -123,8 +123,8 @@ def dependencies(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8
     pivots: list[int] = []
     for row in range(basis.shape[0]):
         free = np.abs(basis[row:]).copy()
-        free[:, pivots] = 0
-        r, c = np.unravel_index(int(np.argmax(free)), free.shape)
+        free[:, np.array(pivots, dtype=np.intp)] = 0
+        r, c = (int(i) for i in np.unravel_index(int(np.argmax(free)), free.shape))
         basis[[row, row + r]] = basis[[row + r, row]]
         basis[row] /= basis[row, c]
         for other in range(basis.shape[0]):
@@ -132,7 +132,8 @@ def dependencies(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8
                 basis[other] -= basis[other, c] * basis[row]
         pivots.append(int(c))
     basis = _sparsest(basis)
-    groups = sorted([[labels[i] for i in np.flatnonzero(_support(vector))] for vector in basis],
+    groups = sorted([[labels[int(i)] for i in np.flatnonzero(_support(vector))]
+                     for vector in basis],
                     key=lambda group: [labels.index(row) for row in group])
     return int(null.shape[1]), groups
 
