@@ -66,11 +66,15 @@ class SolveFailure(SolveError):
         residual: max |Phi| of the last iterate.
         iterations: Newton iterations spent at t.
         rows: labels of the dependent equations when Phi_q was singular, else ().
-        reason: "singular", "no convergence", "no assembly" or "not finite".
+        reason: "singular", "no convergence", "no assembly", "not finite" or
+            "limit position".
+        reached: where the step subdivision stopped (the limit time of a limit position: the
+            last time solved, bisected to within about 1e-9 of the grid step), else NaN.
     """
 
     def __init__(self, message: str, trajectory: Trajectory, t: float, residual: float,
-                 iterations: int, rows: Sequence[str] = (), reason: str = "") -> None:
+                 iterations: int, rows: Sequence[str] = (), reason: str = "",
+                 reached: float = math.nan) -> None:
         super().__init__(message)
         self.trajectory = trajectory
         self.t = t
@@ -78,6 +82,7 @@ class SolveFailure(SolveError):
         self.iterations = iterations
         self.rows = tuple(rows)
         self.reason = reason
+        self.reached = reached
 
 
 # ----- the time grid -------------------------------------------------------------------------
@@ -359,5 +364,6 @@ def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,
                t: float) -> None:
     """Raise SolveFailure for a grid point that could not be reached even by substeps."""
     message, reason = failures.explain_stop(stop, t)
+    reached = math.nan if stop.reached is None else stop.reached.t
     raise SolveFailure(message, _trajectory(kernel, run, p), t, math.nan, 0,
-                       [row for group in stop.groups for row in group], reason)
+                       [row for group in stop.groups for row in group], reason, reached)
