@@ -36,8 +36,9 @@ DELTA_FRACTION = 1.0 / 64
 """The step over a singular configuration spans 2 delta, delta = this times the grid step."""
 
 LIMIT_COND = 1e5
-"""A failure where Phi_q's condition at the last point reached exceeds this is a limit
-position (sigma_min -> 0 as t_b is approached), not a Newton failure."""
+"""A failure where Phi_q's condition at the last point reached exceeds this (or a tenth of
+options.max_cond, if lower) is a limit position (sigma_min -> 0 as t_b is approached), not a
+Newton failure."""
 
 
 @dataclass
@@ -151,18 +152,31 @@ def resolve(kernel: KinematicsKernel, p: Array, options: Options, previous: Stat
     delta = DELTA_FRACTION * h0
     before, early = march(kernel, p, options, previous, blocked - delta, h0, h_min) \
         if blocked - delta > previous.t else (previous, 0.0)
-    after = None if early else _step(kernel, p, options, before, blocked + delta)
+    after = None if early else _over(kernel, p, options, before, blocked, delta, h0)
     if after is None:
-        return _stopped(kernel, p, state, failed)
+        return _stopped(kernel, p, options, state, failed)
     passage = _passage(kernel, p, before, after)
     if t <= after.t:
         return Resolution(_through(kernel, p, options, before, after, t), passage)
     rest, failed = march(kernel, p, options, after, t, h0, h_min)
     if failed:
-        stop = _stopped(kernel, p, rest, failed)
+        stop = _stopped(kernel, p, options, rest, failed)
         stop.passage = passage
         return stop
     return Resolution(rest.point, passage)
+
+
+def _over(kernel: KinematicsKernel, p: Array, options: Options, before: State, blocked: float,
+          delta: float, h0: float) -> State | None:
+    """One step from before to past the blocked time: delta past it, or twice, four times ...
+    as far (up to a grid step) when Phi_q is still too ill-conditioned there."""
+    reach = delta
+    while reach <= h0:
+        after = _step(kernel, p, options, before, blocked + reach)
+        if after is not None:
+            return after
+        reach *= 2
+    return None
 
 
 def _passage(kernel: KinematicsKernel, p: Array, before: State, after: State) -> Passage:
@@ -183,13 +197,15 @@ def _passage(kernel: KinematicsKernel, p: Array, before: State, after: State) ->
     return Passage(t, rank_loss, groups)
 
 
-def _stopped(kernel: KinematicsKernel, p: Array, state: State, failed: float) -> Resolution:
+def _stopped(kernel: KinematicsKernel, p: Array, options: Options, state: State,
+             failed: float) -> Resolution:
     """The motion cannot go on past state.t: a limit position, or no convergence."""
-    limit = state.point.cond > LIMIT_COND
+    threshold = min(LIMIT_COND, options.max_cond / 10)
+    limit = state.point.cond > threshold
     stop = Resolution(None, limit=limit, reached=state, failed_at=state.t + failed)
     if limit:
         jacobian = kernel.phi_q(state.point.q, state.t, p)
-        _, found = dependencies(jacobian, list(kernel.rows), rcond=1.0 / LIMIT_COND)
+        _, found = dependencies(jacobian, list(kernel.rows), rcond=1.0 / threshold)
         stop.groups = tuple(tuple(group) for group in found)
         stop.aligned, stop.drivers = _aligned(kernel, jacobian)
     return stop
