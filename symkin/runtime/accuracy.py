@@ -75,11 +75,11 @@ def norm1(nz: Array, cols: NDArray[np.intp], n: int) -> float:
     return float(sums.max(initial=0.0))
 
 
-def errors(inv_norm: float, norm_a: float, residual: float, q: Array, dq: Array, ddq: Array,
+def errors(inv_norm: float, residual: float, n: int, nq: float, ndq: float, nddq: float,
            unit: float) -> tuple[float, float, float]:
-    """The estimated errors of q, dq and ddq at a solved point (the model of the docstring)."""
-    nq, ndq, nddq = (float(np.abs(v).max(initial=0.0)) for v in (q, dq, ddq))
-    s = inv_norm / math.sqrt(q.size)
+    """The estimated errors of q, dq and ddq at a solved point (the model of the docstring),
+    from the max norms nq, ndq, nddq of q, dq, ddq (N of them each)."""
+    s = inv_norm / math.sqrt(n)
     e_q = s * max(residual, unit * (1.0 + nq))
     e_dq = s * (unit * ndq + e_q * max(1.0, ndq))
     e_ddq = s * (unit * nddq + e_q * (nddq + ndq * ndq) + 2.0 * e_dq * max(1.0, ndq))
@@ -91,7 +91,7 @@ def flagged(inv_norm: float, norm_a: float, residual: float, q: Array, dq: Array
     """True when the estimated error of q, dq or ddq misses its target (options.target_*)."""
     if not math.isfinite(inv_norm * norm_a):
         return True
-    e_q, e_dq, e_ddq = errors(inv_norm, norm_a, residual, q, dq, ddq, unit)
-    scale = [max(1.0, float(np.abs(v).max(initial=0.0))) for v in (q, dq, ddq)]
-    return (e_q > options.target_q * scale[0] or e_dq > options.target_dq * scale[1]
-            or e_ddq > options.target_ddq * scale[2])
+    nq, ndq, nddq = (float(np.abs(v).max(initial=0.0)) for v in (q, dq, ddq))
+    e_q, e_dq, e_ddq = errors(inv_norm, residual, q.size, nq, ndq, nddq, unit)
+    return (e_q > options.target_q * max(1.0, nq) or e_dq > options.target_dq * max(1.0, ndq)
+            or e_ddq > options.target_ddq * max(1.0, nddq))

@@ -7,10 +7,13 @@ The chapter's algorithm (Example 2.6, section 2.7) on any compiled kernel:
     Phi_q dq  = -Phi_t                           velocity                         (2.73)
     Phi_q ddq = Gamma                            acceleration                     (2.74)
 
-One LU factorization (partial pivoting) of the converged Phi_q serves both linear solves. The
-first point is assembled from the file's q0, which may be poor (the chapter starts from q = 0):
-plain Newton first, then Levenberg-Marquardt when Newton does not converge. Where several
-assemblies exist, the one reached from q0 is taken.
+One LU factorization (partial pivoting) of the converged Phi_q serves both linear solves, and
+the condition estimate of each point (runtime.accuracy) that decides whether it is flagged.
+The first point is assembled from the file's q0, which may be poor (the chapter starts from
+q = 0): plain Newton first, then damped Newton from several starts (runtime.assembly). Where
+several assemblies exist, the one reached from q0 is taken. A grid point the plain step cannot
+solve goes to runtime.edges: a too-large step is subdivided, a singular configuration is
+passed on the predicted branch, a limit position is bisected and reported.
 
 With a C kernel that carries the generated solver, the grid loop runs in C: one call per
 trajectory. Imports NumPy and SciPy only: it is part of the runtime.

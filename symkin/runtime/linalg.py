@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.runtime import accuracy
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
@@ -31,6 +32,15 @@ class Factors:
     pivots: NDArray[np.int32]
     pivot_ratio: float
     getrs: Callable[..., Any]  # LAPACK's solve with these factors
+    norm1: float = math.nan  # ||Phi_q||_1 of the matrix factored
+    gecon: Callable[..., Any] | None = None  # LAPACK's condition estimate with these factors
+
+    def inverse_norm1(self) -> float:
+        """Estimate of ||Phi_q^-1||_1: LAPACK's xGECON, Hager-Higham as the C solver runs it."""
+        if self.gecon is None or not self.norm1 > 0:
+            return accuracy.inverse_norm1(self.solve, self.solve_transposed, self.lu.shape[0])
+        rcond, info = self.gecon(self.lu, self.norm1, norm="1")
+        return 1.0 / (rcond * self.norm1) if rcond > 0 and info == 0 else math.inf
 
     def solve(self, b: Array) -> Array:
         x, _ = self.getrs(self.lu, self.pivots, b)
@@ -49,6 +59,13 @@ class SparseFactors:
 
     lu: Any
     pivot_ratio: float
+    norm1: float = math.nan  # ||Phi_q||_1 of the matrix factored
+
+    def inverse_norm1(self) -> float:
+        """Estimate of ||Phi_q^-1||_1 (Hager-Higham, as the C solver runs it)."""
+        if self.lu is None:
+            return math.inf
+        return accuracy.inverse_norm1(self.solve, self.solve_transposed, self.lu.shape[0])
 
     def solve(self, b: Array) -> Array:
         return np.asarray(self.lu.solve(np.asarray(b, dtype=float)), dtype=float)
@@ -66,7 +83,8 @@ def factor(jacobian: Array) -> Factors:
     from scipy.linalg import lapack  # imported on use: a warm C run never needs SciPy
 
     lu, pivots, _ = lapack.dgetrf(jacobian)
-    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs)
+    norm = float(np.abs(jacobian).sum(axis=0).max(initial=0.0))
+    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs, norm, lapack.dgecon)
 
 
 def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values: Array
@@ -82,7 +100,7 @@ def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values
         lu = splu(matrix)
     except RuntimeError:  # SuperLU: "Factor is exactly singular"
         return SparseFactors(None, 0.0)
-    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())))
+    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())), accuracy.norm1(values, cols, n))
 
 
 def factor_at(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> Factors | SparseFactors:

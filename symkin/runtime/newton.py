@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.runtime import accuracy
-from symkin.runtime.linalg import SPARSE_FROM, Factors, SparseFactors, factor_at
+from symkin.runtime.linalg import Factors, SparseFactors, factor_at
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.protocol import KinematicsKernel
 
@@ -80,16 +80,10 @@ def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Opti
     return Newton(q, NO_CONVERGENCE, options.max_iterations, residual, None)
 
 
-def _estimate(kernel: KinematicsKernel, result: Newton, t: float, p: Array) -> Newton:
+def _estimate(result: Newton) -> Newton:
     factors = result.factors
     assert factors is not None
-    n = result.q.size
-    result.inv_norm = accuracy.inverse_norm1(factors.solve, factors.solve_transposed, n)
-    if n < SPARSE_FROM:  # factored dense: the dense Phi_q is at hand for any kernel
-        result.norm_a = float(np.abs(kernel.phi_q(result.q, t, p)).sum(axis=0).max(initial=0))
-    else:
-        result.norm_a = accuracy.norm1(np.asarray(kernel.phi_q_nz(result.q, t, p), dtype=float),
-                                       kernel.pattern_cols, n)
+    result.inv_norm, result.norm_a = factors.inverse_norm1(), factors.norm1
     return result
 
 
@@ -99,7 +93,7 @@ def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
     step still shrinks (each at most half the one before): once it stalls it is rounding noise,
     which a nearly singular Phi_q would only amplify along its null direction. Then estimate
     again. Above options.max_cond the point counts as singular."""
-    result = _estimate(kernel, result, t, p)
+    result = _estimate(result)
     if result.cond > options.tighten_cond:
         q, residual, factors, moved = result.q, result.residual, result.factors, False
         assert factors is not None
@@ -115,7 +109,7 @@ def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
             if factors.pivot_ratio < options.min_pivot_ratio:
                 return Newton(q, SINGULAR, result.iterations, residual, factors)
         if moved:
-            result = _estimate(kernel, Newton(q, OK, result.iterations, residual, factors), t, p)
+            result = _estimate(Newton(q, OK, result.iterations, residual, factors))
     if not result.cond <= options.max_cond:
         result.status = SINGULAR
     return result
