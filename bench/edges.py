@@ -42,10 +42,13 @@ def chain_reference(t: np.ndarray, n: int) -> tuple[np.ndarray, ...]:
 
 
 def unflagged(trajectory, reference) -> str:
-    keep = ~trajectory.flagged
-    errors = [np.abs(got[keep] - want[keep]).max() if keep.any() else 0.0
-              for got, want in zip((trajectory.q, trajectory.dq, trajectory.d2q), reference)]
-    return "q {:.1e}  dq {:.1e}  ddq {:.1e}".format(*errors)
+    """Max errors of q, dq, ddq at the unflagged points, then (in brackets) at the flagged."""
+    said = []
+    for keep in (~trajectory.flagged, trajectory.flagged):
+        errors = [np.abs(got[keep] - want[keep]).max() if keep.any() else 0.0
+                  for got, want in zip((trajectory.q, trajectory.dq, trajectory.d2q), reference)]
+        said.append("q {:.1e}  dq {:.1e}  ddq {:.1e}".format(*errors))
+    return f"{said[0]} (flagged points: {said[1]})"
 
 
 def kernel(name: str, backend: str):
