@@ -180,8 +180,10 @@ def test_fallbacks_are_counted_and_reach_the_trajectory() -> None:
     reference = newton.newton(kernel_for(system, "numpy"), guess, 0.0, p, newton.Options())
     assert reference.status == newton.OK
     times = np.array([0.0, 0.01, 0.02])
-    run = driver._Run(times, *(np.empty((3, 9)) for _ in range(3)))
-    result = driver._c_loop(kernel, run, guess, p, newton.Options(), None)
+    run = driver._Run(times, *(np.empty((3, 9)) for _ in range(3)), np.full(3, np.nan),
+                      np.zeros(3, dtype=bool))
+    solver = kernel.grid_solver(newton.Options(), guess, p)
+    result = driver._c_loop(kernel, run, solver, p, None)
     assert result.status == newton.OK and run.done == 3 and run.fallbacks >= 1
     assert np.abs(run.q[0] - reference.q).max() <= 1e-10
     assert np.abs(kernel.phi(run.q[0], 0.0)).max() <= 1e-10

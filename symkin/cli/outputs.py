@@ -148,3 +148,42 @@ class ProgressBar:
         if self._bar is not None:
             self._bar.close()
             self._bar = None
+
+
+def flag_warnings(trajectory: Any) -> list[str]:
+    """``warning: ... at t = ...`` for each stretch of flagged points: where, how
+    ill-conditioned, and the singular configuration passed there with its dependent rows."""
+    from symkin.runtime.options import Options
+
+    targets = Options()
+    flagged = list(trajectory.flagged)
+    lines = []
+    k = 0
+    while k < len(flagged):
+        if not flagged[k]:
+            k += 1
+            continue
+        end = k
+        while end + 1 < len(flagged) and flagged[end + 1]:
+            end += 1
+        t0, t1 = float(trajectory.t[k]), float(trajectory.t[end])
+        where = f"t = {t0:.10g}" if k == end else f"t = {t0:.10g} .. {t1:.10g}"
+        count = end - k + 1
+        worst = max(float(c) for c in trajectory.cond[k:end + 1])
+        passed = [s for s in trajectory.singular
+                  if t0 - _step(trajectory, k) <= s[0] <= t1 + _step(trajectory, end + 1)]
+        detail = "".join(
+            f"; a singular configuration is passed at t = {t:.10g} (Phi_q loses rank {rank}; "
+            f"dependent rows: {'; '.join('{' + ', '.join(g) + '}' for g in groups)}), its "
+            "point(s) interpolated from both sides" for t, rank, groups in passed)
+        lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
+                     f"Phi_q is ill-conditioned there (condition up to {worst:.3g}), so q, dq, "
+                     f"ddq may miss {targets.target_q:g}, {targets.target_dq:g}, "
+                     f"{targets.target_ddq:g} (column 'flagged'){detail}")
+        k = end + 1
+    return lines
+
+
+def _step(trajectory: Any, k: int) -> float:
+    """The grid step before point k (0 at the ends)."""
+    return float(trajectory.t[k] - trajectory.t[k - 1]) if 0 < k < trajectory.t.size else 0.0

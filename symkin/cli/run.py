@@ -58,6 +58,9 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     run.add_argument("--fps", type=int, default=20,
                      help="--animate frames per second (default 20)")
     overrides.add_argument(run)
+    run.add_argument("--stop-at-singular", action="store_true",
+                     help="stop at the first singular or ill-conditioned point instead of "
+                          "passing through it (and do not subdivide a failed step)")
     run.set_defaults(handler=handle)
 
 
@@ -152,7 +155,8 @@ def _solve_and_write(args: argparse.Namespace) -> int:
         return _error(f"{args.mechanism}: {problem}", EXIT_BAD_INPUT)
     progress = ProgressBar(sys.stderr) if sys.stderr.isatty() and args.at is None else None
     try:
-        trajectory = driver.solve(kernel, t=times, progress=progress)
+        trajectory = driver.solve(kernel, t=times, progress=progress,
+                                  stop_at_singular=args.stop_at_singular)
     except driver.SolveInterrupted as interrupted:
         if progress:
             progress.finish()
@@ -164,6 +168,7 @@ def _solve_and_write(args: argparse.Namespace) -> int:
         return _stopped(args, prepared, failure, times.size, str(failure), EXIT_FAILED)
     if progress:
         progress.finish()
+    _warn_flagged(trajectory)
     written = _write(trajectory, args, prepared.outlines, picture)
     origin = ", cached kernel" if prepared.hit else ""
     if args.at is not None:
@@ -183,6 +188,7 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     """A run that ended early: say why first (even if writing then fails), then write the
     rows solved so far and say where they went."""
     solved = stop.trajectory.t.size
+    _warn_flagged(stop.trajectory)
     message = f"{args.mechanism}: {why}"
     if status == EXIT_INTERRUPTED:
         message += f" at t = {stop.t:g}."
@@ -196,6 +202,12 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     if written:
         messages.note("the solved rows are written to " + ", ".join(map(str, written)))
     return status
+
+
+def _warn_flagged(trajectory: Any) -> None:
+    """One warning line per stretch of consecutive flagged points (the run still succeeds)."""
+    for line in outputs.flag_warnings(trajectory):
+        messages.note(line)
 
 
 def _write(trajectory: Any, args: argparse.Namespace, outlines: Any,

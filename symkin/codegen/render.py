@@ -288,9 +288,8 @@ def _labels(code: Code, routine: str) -> list[str]:
 def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
     """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
     options = runtime_options.defaults(code.real)
-    return {"tol_phi": literal(options.tol_phi), "tol_dq": literal(options.tol_dq),
-            "max_iterations": str(options.max_iterations),
-            "min_pivot_ratio": literal(options.min_pivot_ratio)}
+    return {name: str(value) if isinstance(value, (int, bool)) else literal(value)
+            for name, value in vars(options).items()}
 
 
 def header_lines(code: Code, template: str, file_name: str) -> list[str]:

@@ -56,7 +56,7 @@ class GridSolver:
         self._report = ffi.new(f"{name}_report *")
         self._p = ffi.new(f"{name}_real[]", max(p.size, 1))
         self._n = q.size
-        self._solve_grid = getattr(lib, f"{name}_solve_grid")
+        self._solve_grid = getattr(lib, f"{name}_solve_grid_checked")
         self._real_pointer = f"{name}_real[]"
         self.dtype = np.float32 if real == "float" else np.float64
         self._set_options: Options | None = None
@@ -70,6 +70,10 @@ class GridSolver:
             self._options.tol_phi, self._options.tol_dq = options.tol_phi, options.tol_dq
             self._options.max_iterations = options.max_iterations
             self._options.min_pivot_ratio = options.min_pivot_ratio
+            self._options.max_cond = options.max_cond
+            self._options.tighten_cond = options.tighten_cond
+            self._options.target_q, self._options.target_dq = options.target_q, options.target_dq
+            self._options.target_ddq = options.target_ddq
             self._set_options = options
         self._p[0:p.size] = p.tolist()
         self._state.q[0:q.size] = q.tolist()
@@ -81,28 +85,44 @@ class GridSolver:
         if self.pool is not None:
             self.pool.put(self)
 
-    def solve(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array) -> ChunkResult:
-        """Solve the grid points ``times`` after those already solved, writing their rows.
+    def solve(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
+              cond_out: Array, flagged_out: NDArray[np.bool_]) -> ChunkResult:
+        """Solve the grid points ``times`` after those already solved, writing their rows,
+        the condition estimate and the flag of each point.
 
         The output arrays are written in place when they are C-contiguous arrays of the
-        kernel's real type; otherwise the rows are copied in after the call.
+        kernel's real type (the flags: of bool); otherwise the rows are copied in after.
         """
         chunk = np.ascontiguousarray(times, dtype=self.dtype)
-        outputs = (q_out, dq_out, d2q_out)
+        outputs = (q_out, dq_out, d2q_out, cond_out)
         direct = all(a.dtype == self.dtype and a.flags.c_contiguous for a in outputs)
-        buffers = outputs if direct else tuple(np.zeros((chunk.size, self._n), dtype=self.dtype)
-                                               for _ in outputs)
+        buffers = outputs if direct else tuple(np.zeros((chunk.size, *a.shape[1:]),
+                                                        dtype=self.dtype) for a in outputs)
+        flags = flagged_out if flagged_out.dtype == np.bool_ and \
+            flagged_out.flags.c_contiguous else np.zeros(chunk.size, dtype=np.bool_)
         pointers = [self._ffi.from_buffer(self._real_pointer, a) for a in (chunk, *buffers)]
+        flag_pointer = self._ffi.from_buffer("unsigned char[]", flags)
         solved = self._solve_grid(self._options, self._p, chunk.size, pointers[0], self._state,
-                                  pointers[1], pointers[2], pointers[3], self._work,
-                                  self._report)
+                                  pointers[1], pointers[2], pointers[3], pointers[4],
+                                  flag_pointer, self._work, self._report)
         if not direct:
             for target, source in zip(outputs, buffers):
                 target[:solved] = source[:solved]
+        if flags is not flagged_out:
+            flagged_out[:solved] = flags[:solved]
         report = self._report
         return ChunkResult(int(solved), int(report.status), float(report.t),
                            int(report.iterations), float(report.residual),
                            int(report.fallbacks))
+
+    def set_state(self, t: float, q: Array, dq: Array, ddq: Array) -> None:
+        """Continue from a point solved elsewhere (the driver's treatment of a singular point):
+        the next step predicts from it. Only after a first step (the workspace is set up)."""
+        n = self._n
+        self._state.q[0:n], self._state.dq[0:n] = q.tolist(), dq.tolist()
+        self._state.ddq[0:n] = ddq.tolist()
+        self._state.t = t
+        self._state.started = 1
 
     def last_q(self) -> Array:
         """The solver's current q: the last converged point, or the failed iterate."""

@@ -7,10 +7,13 @@ The chapter's algorithm (Example 2.6, section 2.7) on any compiled kernel:
     Phi_q dq  = -Phi_t                           velocity                         (2.73)
     Phi_q ddq = Gamma                            acceleration                     (2.74)
 
-One LU factorization (partial pivoting) of the converged Phi_q serves both linear solves. The
-first point is assembled from the file's q0, which may be poor (the chapter starts from q = 0):
-plain Newton first, then Levenberg-Marquardt when Newton does not converge. Where several
-assemblies exist, the one reached from q0 is taken.
+One LU factorization (partial pivoting) of the converged Phi_q serves both linear solves, and
+the condition estimate of each point (runtime.accuracy) that decides whether it is flagged.
+The first point is assembled from the file's q0, which may be poor (the chapter starts from
+q = 0): plain Newton first, then damped Newton from several starts (runtime.assembly). Where
+several assemblies exist, the one reached from q0 is taken. A grid point the plain step cannot
+solve goes to runtime.edges: a too-large step is subdivided, a singular configuration is
+passed on the predicted branch, a limit position is bisected and reported.
 
 With a C kernel that carries the generated solver, the grid loop runs in C: one call per
 trajectory. Imports NumPy and SciPy only: it is part of the runtime.
@@ -18,31 +21,30 @@ trajectory. Imports NumPy and SciPy only: it is part of the runtime.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin import limits
 from symkin.errors import SolveError
+from symkin.runtime import failures
+from symkin.runtime.assembly import Assembly, assemble
 from symkin.runtime.csolver import GridSolver
-from symkin.runtime.linalg import dependent_rows, factor_at
-from symkin.runtime.newton import Newton, assemble, newton
-from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
+from symkin.runtime.edges import Passage, Resolution, State, resolve
+from symkin.runtime.linalg import factor_at
+from symkin.runtime.newton import Newton, Point, kinematics, newton
+from symkin.runtime.options import NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.options import defaults as newton_defaults
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
-
-# Diagnosis only (never a stopping test): condition numbers of Phi_q taken as singular at a
-# failed iterate, and as "nearly singular" at the last point solved before a failure.
-ILL_CONDITIONED, NEARLY_SINGULAR = 1e8, 1e5
-
 
 class SolveInterrupted(SolveError):
     """The solve was interrupted (SIGINT, Ctrl-C); carries the rows solved before it.
@@ -67,11 +69,15 @@ class SolveFailure(SolveError):
         residual: max |Phi| of the last iterate.
         iterations: Newton iterations spent at t.
         rows: labels of the dependent equations when Phi_q was singular, else ().
-        reason: "singular", "no convergence", "no assembly" or "not finite".
+        reason: "singular", "no convergence", "no assembly", "not finite" or
+            "limit position".
+        reached: where the step subdivision stopped (the limit time of a limit position: the
+            last time solved, bisected to within about 1e-9 of the grid step), else NaN.
     """
 
     def __init__(self, message: str, trajectory: Trajectory, t: float, residual: float,
-                 iterations: int, rows: Sequence[str] = (), reason: str = "") -> None:
+                 iterations: int, rows: Sequence[str] = (), reason: str = "",
+                 reached: float = math.nan) -> None:
         super().__init__(message)
         self.trajectory = trajectory
         self.t = t
@@ -79,6 +85,7 @@ class SolveFailure(SolveError):
         self.iterations = iterations
         self.rows = tuple(rows)
         self.reason = reason
+        self.reached = reached
 
 
 # ----- the time grid -------------------------------------------------------------------------
@@ -145,31 +152,40 @@ class _Run:
     q: Array
     dq: Array
     d2q: Array
+    cond: Array
+    flagged: NDArray[np.bool_]
     done: int = 0
     fallbacks: int = 0  # the generated sparse LU's fall-backs to dense LU (C solver)
+    passages: list[Passage] = field(default_factory=list)
+
+    def store(self, k: int, point: Point) -> None:
+        self.q[k], self.dq[k], self.d2q[k] = point.q, point.dq, point.ddq
+        self.cond[k], self.flagged[k] = point.cond, point.flagged
+        self.done = k + 1
+
+    def state(self, k: int) -> State:
+        """Point k as the predictor's state."""
+        return State(float(self.t[k]), Point(self.q[k], self.dq[k], self.d2q[k],
+                                             float(self.cond[k]), bool(self.flagged[k])))
 
 
 def _python_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
                  progress: Progress | None) -> Newton:
-    """The grid loop in Python; returns the Newton outcome at the last point attempted."""
-    dq = np.zeros_like(q)
-    d2q = np.zeros_like(q)
+    """The grid loop in Python from point run.done (q: the first guess when it is the first
+    point); returns the Newton outcome at the last point attempted."""
     result = Newton(q, OK, 0, 0.0, None)
-    for k, t in enumerate(run.t):
+    for k in range(run.done, run.t.size):
+        t = float(run.t[k])
         if k > 0:
             h = t - run.t[k - 1]
-            q = q + dq * h + d2q * (h * h / 2)  # (2.76)
+            q = run.q[k - 1] + run.dq[k - 1] * h + run.d2q[k - 1] * (h * h / 2)  # (2.76)
         result = newton(kernel, q, t, p, options)
         if result.status != OK:
             return result
-        q, factors = result.q, result.factors
-        assert factors is not None  # newton returns the factors whenever it converges
-        dq = factors.solve(-kernel.phi_t(q, t, p))  # (2.73)
-        d2q = factors.solve(kernel.gamma(q, dq, t, p))  # (2.74)
-        if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(d2q))):
-            return Newton(q, NOT_FINITE, result.iterations, result.residual, None)
-        run.q[k], run.dq[k], run.d2q[k] = q, dq, d2q
-        run.done = k + 1
+        point = kinematics(kernel, result, t, p, options)
+        if point is None:
+            return Newton(result.q, NOT_FINITE, result.iterations, result.residual, None)
+        run.store(k, point)
         if progress is not None:
             progress(k + 1, run.t.size)
     return result
@@ -197,28 +213,19 @@ class _Chunks:
         self.size = int(min(self.limit, max(1, self.size * grow)))
 
 
-def _c_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
+def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
             progress: Progress | None) -> Newton:
-    """The grid loop in the generated C solver: one call per chunk (one chunk unless a
-    progress callback wants to hear in between)."""
-    solver = kernel.grid_solver(options, q, p)
-    assert solver is not None  # only called for kernels that have one
-    try:
-        return _c_chunks(kernel, run, p, solver, progress)
-    finally:
-        getattr(solver, "release", lambda: None)()  # back to the kernel's pool for reuse
-
-
-def _c_chunks(kernel: KinematicsKernel, run: _Run, p: Array, solver: GridSolver,
-              progress: Progress | None) -> Newton:
+    """The grid loop in the generated C solver from point run.done: one call per chunk (one
+    chunk unless a progress callback wants to hear in between)."""
     chunks = _Chunks(run.t.size, progress is not None)
     result = None
-    start = 0
+    start = run.done
     while start < run.t.size:
         stop = min(start + chunks.size, run.t.size)
         began = time.perf_counter()
         result = solver.solve(run.t[start:stop], run.q[start:stop], run.dq[start:stop],
-                              run.d2q[start:stop])
+                              run.d2q[start:stop], run.cond[start:stop],
+                              run.flagged[start:stop])
         chunks.took(time.perf_counter() - began)
         run.done = start + result.solved
         run.fallbacks = result.fallbacks
@@ -230,15 +237,17 @@ def _c_chunks(kernel: KinematicsKernel, run: _Run, p: Array, solver: GridSolver,
         if progress is not None:
             progress(run.done, run.t.size)
         start = stop
-    assert result is not None  # the grid has at least one point
     # The last row written is the solver's q: no need to read it back from C.
-    return Newton(run.q[run.done - 1], OK, result.iterations, result.residual, None)
+    q = run.q[run.done - 1] if run.done else solver.last_q()
+    return Newton(q, OK, 0 if result is None else result.iterations,
+                  0.0 if result is None else result.residual, None)
 
 
 def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
           params: Mapping[str, float] | ArrayLike | None = None, *,
           options: Options | None = None, progress: Progress | None = None,
-          use_c_solver: bool = True, sensitivities: bool = False) -> Trajectory:
+          use_c_solver: bool = True, stop_at_singular: bool = False,
+          sensitivities: bool = False) -> Trajectory:
     """Positions, velocities and accelerations of a mechanism over a time grid.
 
     Args:
@@ -250,6 +259,8 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
             kernel's real type (looser for a C kernel generated with float).
         progress: called as progress(done, total) while the grid is solved.
         use_c_solver: run the grid loop in the generated C solver when the kernel has one.
+        stop_at_singular: stop at the first singular point (SolveFailure) instead of passing
+            through it, and do not subdivide a step that fails (the behaviour of old).
         sensitivities: also compute ``q_p`` = dq/dp (T, N, NP) from Phi_q q_p = -Phi_p.
 
     Returns:
@@ -261,6 +272,9 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     """
     # An expression singular at some t gives inf/NaN there; that is reported as a failure
     # (status NOT_FINITE), so NumPy's floating-point warnings would only repeat it.
+    options = options or default_options(kernel)
+    if stop_at_singular:
+        options = dataclasses.replace(options, stop_at_singular=True)
     with np.errstate(all="ignore"):
         trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver)
     if sensitivities:
@@ -271,36 +285,80 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
 
 
 def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
-           params: Mapping[str, float] | ArrayLike | None, options: Options | None,
+           params: Mapping[str, float] | ArrayLike | None, options: Options,
            progress: Progress | None, use_c_solver: bool) -> Trajectory:
     times = _times(kernel, t)
     p = _params(kernel, params)
-    options = options or default_options(kernel)
     q = np.array(kernel.q0 if q0 is None else q0, dtype=float)
     if q.shape != (len(kernel.coordinates),):
         raise SolveError(f"q0 has {q.size} values; the mechanism has "
                          f"{len(kernel.coordinates)} coordinates")
     shape = (times.size, q.size)
     # Rows past run.done are never exposed, so the arrays need no zero-filling.
-    run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape))
+    run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape),
+               np.full(times.size, math.nan), np.zeros(times.size, dtype=bool))
     in_c = use_c_solver and kernel.has_grid_solver
-    # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
-    # the damped assembly in Python take over (and the grid is run again from its result).
     try:
-        result = _c_loop(kernel, run, q, p, options, progress) if in_c else None
-        if result is None or (result.status != OK and run.done == 0):
-            start = assemble(kernel, q, float(times[0]), p, options)
-            if start.status != OK:
-                _fail(kernel, run, p, start, float(times[0]), assembling=True)
-            loop = _c_loop if in_c else _python_loop
-            result = loop(kernel, run, start.q, p, options, progress)
+        result = _run(kernel, run, q, p, options, progress, in_c)
     except KeyboardInterrupt:
         # The rows done so far are whole (run.done counts only finished rows): hand them on.
         stop = float(times[min(run.done, times.size - 1)])
         raise SolveInterrupted(_trajectory(kernel, run, p), stop) from None
-    if result.status != OK:
+    if isinstance(result, Resolution):
+        _fail_edge(kernel, run, p, result, float(times[run.done]))
+    elif result.status != OK:
         _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
     return _trajectory(kernel, run, p)
+
+
+def _run(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
+         progress: Progress | None, in_c: bool) -> Newton | Resolution:
+    """Assemble at t[0], then solve the grid; a point the plain step cannot solve goes to
+    edges.resolve and the loop resumes after it. Returns the outcome that stopped the run
+    (status OK when the grid is done)."""
+    solver = kernel.grid_solver(options, q, p) if in_c else None
+    try:
+        return _grid(kernel, run, solver, q, p, options, progress)
+    finally:
+        if solver is not None:
+            solver.release()  # back to the kernel's pool for the next run
+
+
+def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: Array, p: Array,
+          options: Options, progress: Progress | None) -> Newton | Resolution:
+    # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
+    # the damped assembly in Python take over (and the grid is run again from its result).
+    result = _c_loop(kernel, run, solver, p, progress) if solver is not None else None
+    if result is None or (result.status != OK and run.done == 0):
+        assembly = assemble(kernel, q, float(run.t[0]), p, options)
+        start = assembly.result
+        if start.status != OK:
+            _fail(kernel, run, p, start, float(run.t[0]), assembling=True, assembly=assembly)
+        if solver is not None:
+            solver.start(options, start.q, p)
+        result = _resume(kernel, run, solver, start.q, p, options, progress)
+    while result.status not in (OK, NOT_FINITE) and run.done > 0 \
+            and not options.stop_at_singular:
+        k = run.done
+        resolution = resolve(kernel, p, options, run.state(k - 1), float(run.t[k]))
+        if resolution.passage is not None:
+            run.passages.append(resolution.passage)
+        if resolution.point is None:
+            return resolution
+        run.store(k, resolution.point)
+        if solver is not None:
+            solver.set_state(float(run.t[k]), run.q[k], run.dq[k], run.d2q[k])
+        if progress is not None:
+            progress(run.done, run.t.size)
+        result = _resume(kernel, run, solver, resolution.point.q, p, options, progress)
+    return result
+
+
+def _resume(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: Array, p: Array,
+            options: Options, progress: Progress | None) -> Newton:
+    if solver is not None:
+        return _c_loop(kernel, run, solver, p, progress)
+    return _python_loop(kernel, run, q, p, options, progress)
 
 
 def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
@@ -313,88 +371,25 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
                       d2q=solved(run.d2q), coordinates=tuple(kernel.coordinates),
                       points=tuple(kernel.points),
                       point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
-                      params=p.copy(), lu_fallbacks=run.fallbacks)
+                      params=p.copy(), lu_fallbacks=run.fallbacks,
+                      flagged=run.flagged[:done].copy(), cond=run.cond[:done].copy(),
+                      singular=tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
+                                     for s in run.passages))
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
-          assembling: bool) -> None:
+          assembling: bool, assembly: Assembly | None = None) -> None:
     """Raise SolveFailure with a message that says where, why and what to try."""
-    labels = list(kernel.rows)
-    where = f"at t = {t:.10g}"
-    not_finite = _not_finite(kernel, result.q, t, p) if result.status in (NOT_FINITE, SINGULAR) \
-        else None
-    rows, near = ([], None) if not_finite else _singular_rows(kernel, run, p, result, t)
-    facts = f"(residual max|Phi| = {result.residual:.3g} after {result.iterations} iterations)"
-    if not_finite:
-        reason = "not finite"
-        message = (f"{not_finite} is not finite {where}: an expression in it is singular there "
-                   "(a division by zero, the root or logarithm of a negative number, or a "
-                   "derivative of such). End the time grid before it, or change the expression.")
-    elif assembling and not rows:
-        reason = "no assembly"
-        worst = _worst_rows(kernel.phi(result.q, t, p), labels)
-        message = (f"the mechanism cannot be assembled {where} {facts}: no position satisfies "
-                   f"all constraints near q0; the largest violations are in {worst}. Check the "
-                   "link lengths (a chain too short to close cannot assemble), or give a better "
-                   "q0 in the mechanism file.")
-    elif rows:
-        reason = "singular"
-        when = where if near is None else (f"near t = {near:.10g}, the last point solved; "
-                                           f"Newton-Raphson then failed {where}")
-        message = (f"Phi_q is singular {when} {facts}: the equations of {'; '.join(rows)} are "
-                   "dependent. This is a dead-centre or toggle position, a redundant joint, or "
-                   "a driver that cannot move the mechanism here; end the time grid before it, "
-                   "or change the drivers.")
-    else:
-        reason = "no convergence"
-        message = (f"Newton-Raphson did not converge {where} {facts}. Try a smaller time step "
-                   "dt, or check that the drivers are smooth and reachable.")
+    last = None if run.done == 0 else (float(run.t[run.done - 1]), run.q[run.done - 1])
+    message, reason, rows = failures.explain(kernel, p, result, t, assembling, assembly, last)
     raise SolveFailure(message, _trajectory(kernel, run, p), t, result.residual,
                        result.iterations, rows, reason)
 
 
-def _not_finite(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> str | None:
-    """The first of Phi, Phi_t, Phi_q, Gamma that is inf or NaN at (q, t), as the row of the
-    mechanism it comes from, or None when all four are finite."""
-    labels = list(kernel.rows)
-    phi = kernel.phi(q, t, p)
-    jacobian = kernel.phi_q(q, t, p)
-    phi_t = kernel.phi_t(q, t, p)
-    for name, values in (("Phi", phi), ("Phi_t", phi_t)):
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            return f"{name} in row {bad[0]} ({labels[bad[0]]})"
-    bad_entries = np.argwhere(~np.isfinite(jacobian))
-    if bad_entries.size:
-        return f"Phi_q in row {bad_entries[0][0]} ({labels[bad_entries[0][0]]})"
-    dq = np.linalg.lstsq(jacobian, -phi_t, rcond=None)[0]
-    bad = np.flatnonzero(~np.isfinite(kernel.gamma(q, dq, t, p)))
-    if bad.size:
-        return f"Gamma in row {bad[0]} ({labels[bad[0]]})"
-    return None
-
-
-def _singular_rows(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float
-                   ) -> tuple[list[str], float | None]:
-    """Dependent equations at the failure, or at the last point solved when Newton failed just
-    past it (a mechanism driven through a dead centre has no solution beyond it).
-
-    Returns the row labels and, when they come from the last point solved, its time.
-    """
-    labels = list(kernel.rows)
-    jacobian = kernel.phi_q(result.q, t, p)
-    finite = bool(np.all(np.isfinite(jacobian)))
-    if result.status == SINGULAR or (finite and np.linalg.cond(jacobian) > ILL_CONDITIONED):
-        return dependent_rows(jacobian, labels), None
-    if result.status == NO_CONVERGENCE and run.done > 0:
-        last_t = float(run.t[run.done - 1])
-        jacobian = kernel.phi_q(run.q[run.done - 1], last_t, p)
-        if np.linalg.cond(jacobian) > NEARLY_SINGULAR:
-            return dependent_rows(jacobian, labels), last_t
-    return [], None
-
-
-def _worst_rows(phi: Array, labels: Sequence[str], count: int = 3) -> str:
-    magnitude = np.where(np.isfinite(phi), np.abs(phi), np.inf)
-    order = np.argsort(-magnitude, kind="stable")[:count]
-    return "; ".join(f"{labels[k]} ({magnitude[k]:.3g})" for k in order if magnitude[k] > 0)
+def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,
+               t: float) -> None:
+    """Raise SolveFailure for a grid point that could not be reached even by substeps."""
+    message, reason = failures.explain_stop(stop, t)
+    reached = math.nan if stop.reached is None else stop.reached.t
+    raise SolveFailure(message, _trajectory(kernel, run, p), t, math.nan, 0,
+                       [row for group in stop.groups for row in group], reason, reached)

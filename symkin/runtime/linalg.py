@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.runtime import accuracy
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
@@ -31,9 +32,23 @@ class Factors:
     pivots: NDArray[np.int32]
     pivot_ratio: float
     getrs: Callable[..., Any]  # LAPACK's solve with these factors
+    norm1: float = math.nan  # ||Phi_q||_1 of the matrix factored
+    gecon: Callable[..., Any] | None = None  # LAPACK's condition estimate with these factors
+
+    def inverse_norm1(self) -> float:
+        """Estimate of ||Phi_q^-1||_1: LAPACK's xGECON, Hager-Higham as the C solver runs it."""
+        if self.gecon is None or not self.norm1 > 0:
+            return accuracy.inverse_norm1(self.solve, self.solve_transposed, self.lu.shape[0])
+        rcond, info = self.gecon(self.lu, self.norm1, norm="1")
+        return 1.0 / (rcond * self.norm1) if rcond > 0 and info == 0 else math.inf
 
     def solve(self, b: Array) -> Array:
         x, _ = self.getrs(self.lu, self.pivots, b)
+        return np.asarray(x, dtype=float)
+
+    def solve_transposed(self, b: Array) -> Array:
+        """Solve Phi_q^T x = b with the same factors (the condition estimate needs it)."""
+        x, _ = self.getrs(self.lu, self.pivots, b, trans=1)
         return np.asarray(x, dtype=float)
 
 
@@ -44,9 +59,20 @@ class SparseFactors:
 
     lu: Any
     pivot_ratio: float
+    norm1: float = math.nan  # ||Phi_q||_1 of the matrix factored
+
+    def inverse_norm1(self) -> float:
+        """Estimate of ||Phi_q^-1||_1 (Hager-Higham, as the C solver runs it)."""
+        if self.lu is None:
+            return math.inf
+        return accuracy.inverse_norm1(self.solve, self.solve_transposed, self.lu.shape[0])
 
     def solve(self, b: Array) -> Array:
         return np.asarray(self.lu.solve(np.asarray(b, dtype=float)), dtype=float)
+
+    def solve_transposed(self, b: Array) -> Array:
+        """Solve Phi_q^T x = b with the same factors (the condition estimate needs it)."""
+        return np.asarray(self.lu.solve(np.asarray(b, dtype=float), trans="T"), dtype=float)
 
 
 def factor(jacobian: Array) -> Factors:
@@ -57,7 +83,8 @@ def factor(jacobian: Array) -> Factors:
     from scipy.linalg import lapack  # imported on use: a warm C run never needs SciPy
 
     lu, pivots, _ = lapack.dgetrf(jacobian)
-    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs)
+    norm = float(np.abs(jacobian).sum(axis=0).max(initial=0.0))
+    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs, norm, lapack.dgecon)
 
 
 def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values: Array
@@ -73,7 +100,7 @@ def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values
         lu = splu(matrix)
     except RuntimeError:  # SuperLU: "Factor is exactly singular"
         return SparseFactors(None, 0.0)
-    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())))
+    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())), accuracy.norm1(values, cols, n))
 
 
 def factor_at(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> Factors | SparseFactors:
@@ -92,20 +119,59 @@ def _ratio(magnitudes: Array) -> float:
     return ratio if math.isfinite(ratio) else 0.0
 
 
-def dependent_rows(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8) -> list[str]:
-    """The equations whose rows of Phi_q are linearly dependent.
 
-    The left null space of Phi_q (left singular vectors with sigma <= rcond sigma_max) holds the
-    combinations y with y^T Phi_q = 0; a row takes part in a dependency when some y weighs it.
+
+def dependencies(jacobian: Array, labels: Sequence[str], rcond: float = 1e-8
+                 ) -> tuple[int, list[list[str]]]:
+    """The rank loss of Phi_q and a minimal set of dependent rows for each lost rank.
+
+    The left null space (left singular vectors with sigma <= rcond sigma_max; at least the
+    weakest one) is brought to reduced row-echelon form, then each basis vector is made
+    sparser by subtracting multiples of the others while that removes rows: each ends as the
+    few rows of one dependency (a closed loop of aligned links, a redundant joint) rather
+    than every row the null space touches.
     """
     if not np.all(np.isfinite(jacobian)):
-        return list(labels)
+        return 0, [list(labels)]
     u, sigma, _ = np.linalg.svd(jacobian)
     null = u[:, sigma <= rcond * max(sigma[0], 1e-300)]
     if null.shape[1] == 0:
-        null = u[:, -1:]  # ill-conditioned but above rcond: name the weakest direction
-    weight = np.abs(null).max(axis=1)
-    return [label for label, w in zip(labels, weight) if w > 1e-6]
+        null = u[:, -1:]
+    basis = null.T.copy()
+    pivots: list[int] = []
+    for row in range(basis.shape[0]):
+        free = np.abs(basis[row:]).copy()
+        free[:, np.array(pivots, dtype=np.intp)] = 0
+        r, c = (int(i) for i in np.unravel_index(int(np.argmax(free)), free.shape))
+        basis[[row, row + r]] = basis[[row + r, row]]
+        basis[row] /= basis[row, c]
+        for other in range(basis.shape[0]):
+            if other != row:
+                basis[other] -= basis[other, c] * basis[row]
+        pivots.append(int(c))
+    basis = _sparsest(basis)
+    groups = sorted([[labels[int(i)] for i in np.flatnonzero(_support(vector))]
+                     for vector in basis],
+                    key=lambda group: [labels.index(row) for row in group])
+    return int(null.shape[1]), groups
 
 
-# ----- Newton-Raphson and assembly -----------------------------------------------------------
+def _support(vector: Array) -> NDArray[np.bool_]:
+    return np.asarray(np.abs(vector) > 1e-6 * np.abs(vector).max(initial=0.0))
+
+
+def _sparsest(basis: Array) -> Array:
+    """Replace basis vectors by combinations with fewer non-zeros while any pair allows it."""
+    improved = True
+    while improved:
+        improved = False
+        for i in range(basis.shape[0]):
+            for j in range(basis.shape[0]):
+                if i == j:
+                    continue
+                for m in np.flatnonzero(_support(basis[i]) & _support(basis[j])):
+                    trial = basis[i] - basis[i, m] / basis[j, m] * basis[j]
+                    if _support(trial).sum() < _support(basis[i]).sum():
+                        basis[i], improved = trial / np.abs(trial).max(), True
+                        break
+    return basis

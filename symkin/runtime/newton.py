@@ -9,21 +9,46 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.runtime import accuracy
 from symkin.runtime.linalg import Factors, SparseFactors, factor_at
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
 
+TIGHTEN_STEPS = 3
+"""Newton iterations allowed after convergence at an ill-conditioned point (its step stalls at
+the rounding level within one or two)."""
+
+
 @dataclass
 class Newton:
-    """The outcome of Newton-Raphson at one time point."""
+    """The outcome of Newton-Raphson at one time point; at a converged point also the estimate
+    of ||Phi_q^-1||_1 and ||Phi_q||_1 (runtime.accuracy)."""
 
     q: Array
     status: int
     iterations: int
     residual: float
     factors: Factors | SparseFactors | None
+    inv_norm: float = math.nan
+    norm_a: float = math.nan
+
+    @property
+    def cond(self) -> float:
+        """The estimated 1-norm condition number of Phi_q at q."""
+        return self.inv_norm * self.norm_a
+
+
+@dataclass
+class Point:
+    """One solved time point: coordinates, velocities, accelerations and their trust."""
+
+    q: Array
+    dq: Array
+    ddq: Array
+    cond: float
+    flagged: bool
 
 
 def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options) -> Newton:
@@ -45,13 +70,66 @@ def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Opti
         if factors.pivot_ratio < options.min_pivot_ratio:
             return Newton(q, SINGULAR, iteration, residual, factors)
         if residual <= options.tol_phi and (iteration == 0 or step <= options.tol_dq):
-            return Newton(q, OK, iteration, residual, factors)
+            return _converged(kernel, Newton(q, OK, iteration, residual, factors), t, p,
+                              options, phi, step)
         if iteration == options.max_iterations:
             break
         delta = factors.solve(-phi)
         q += delta
         step = float(np.abs(delta).max(initial=0.0))
     return Newton(q, NO_CONVERGENCE, options.max_iterations, residual, None)
+
+
+def _estimate(result: Newton) -> Newton:
+    factors = result.factors
+    assert factors is not None
+    result.inv_norm, result.norm_a = factors.inverse_norm1(), factors.norm1
+    return result
+
+
+def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, options: Options,
+               phi: Array, step: float) -> Newton:
+    """Estimate the condition at a converged point; where it is high, iterate on while the
+    step still shrinks (each at most half the one before): once it stalls it is rounding noise,
+    which a nearly singular Phi_q would only amplify along its null direction. Then estimate
+    again. Above options.max_cond the point counts as singular."""
+    result = _estimate(result)
+    if result.cond > options.tighten_cond:
+        q, residual, factors, moved = result.q, result.residual, result.factors, False
+        assert factors is not None
+        for _ in range(TIGHTEN_STEPS):
+            delta = factors.solve(-phi)
+            size = float(np.abs(delta).max(initial=0.0))
+            if not 0 < size <= step / 2:
+                break
+            q = q + delta
+            phi = kernel.phi(q, t, p)
+            residual, step, moved = float(np.abs(phi).max(initial=0.0)), size, True
+            factors = factor_at(kernel, q, t, p)
+            if factors.pivot_ratio < options.min_pivot_ratio:
+                return Newton(q, SINGULAR, result.iterations, residual, factors)
+        if moved:
+            result = _estimate(Newton(q, OK, result.iterations, residual, factors))
+    if not result.cond <= options.max_cond:
+        result.status = SINGULAR
+    return result
+
+
+def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, options: Options
+               ) -> Point | None:
+    """Velocities (2.73) and accelerations (2.74) at a converged point, with its flag; None
+    when they are not finite (Phi_t or Gamma singular at t)."""
+    factors = result.factors
+    assert factors is not None  # newton returns the factors whenever it converges
+    q = result.q
+    dq = factors.solve(-kernel.phi_t(q, t, p))  # (2.73)
+    ddq = factors.solve(kernel.gamma(q, dq, t, p))  # (2.74)
+    if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(ddq))):
+        return None
+    unit = accuracy.UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
+    flag = accuracy.flagged(result.inv_norm, result.norm_a, result.residual, q, dq, ddq,
+                            options, unit)
+    return Point(q, dq, ddq, result.cond, flag)
 
 
 def levenberg_marquardt(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options,
@@ -84,14 +162,3 @@ def levenberg_marquardt(kernel: KinematicsKernel, q: Array, t: float, p: Array, 
             if mu > 1e12:
                 break
     return q, float(np.abs(phi).max(initial=0.0))
-
-
-def assemble(kernel: KinematicsKernel, q0: Array, t0: float, p: Array, options: Options) -> Newton:
-    """Assemble the mechanism at t0 from q0: Newton, else Levenberg-Marquardt then Newton."""
-    result = newton(kernel, q0, t0, p, options)
-    if result.status == OK:
-        return result
-    q, _ = levenberg_marquardt(kernel, q0, t0, p, options)
-    polished = newton(kernel, q, t0, p, options)
-    polished.iterations += result.iterations
-    return polished

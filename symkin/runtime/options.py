@@ -22,19 +22,34 @@ class Options:
         max_iterations: Newton iterations allowed per time point.
         min_pivot_ratio: Phi_q counts as singular when min |u_kk| / max |u_kk| of its LU
             factors falls below this (a cheap estimate of the reciprocal condition number).
+        max_cond: ...or when the estimated 1-norm condition number of Phi_q at the converged
+            point exceeds this: the point is then handed to the singular-point treatment.
+        tighten_cond: above this condition estimate Newton goes on iterating until its step
+            stalls near machine precision (the position error is amplified into dq and ddq).
+        target_q, target_dq, target_ddq: a point is flagged when the estimated error of q, dq
+            or ddq exceeds this times max(1, max |x|) (runtime.accuracy).
+        stop_at_singular: stop at the first singular point (the behaviour before singular
+            points were passed through); also no bisection of limit positions.
     """
 
     tol_phi: float = 1e-10
     tol_dq: float = 1e-9
     max_iterations: int = 25
     min_pivot_ratio: float = 1e-10
+    max_cond: float = 1e7
+    tighten_cond: float = 1e4
+    target_q: float = 1e-8
+    target_dq: float = 1e-7
+    target_ddq: float = 1e-6
+    stop_at_singular: bool = False
 
 
 # The defaults per real type, defined once: the generated C's <prefix>_default_options is
 # rendered from this table (codegen.render), so Python and C can never disagree.
 DEFAULTS = {
     "double": Options(),
-    "float": Options(tol_phi=1e-5, tol_dq=1e-4, min_pivot_ratio=1e-6),
+    "float": Options(tol_phi=1e-5, tol_dq=1e-4, min_pivot_ratio=1e-6, max_cond=1e3,
+                     tighten_cond=1e2, target_q=1e-3, target_dq=1e-2, target_ddq=1e-1),
 }
 
 

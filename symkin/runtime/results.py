@@ -63,6 +63,11 @@ class Trajectory:
         q_p: design sensitivities dq/dp, shape (T, N, NP), when solved with
             ``sensitivities=True`` (from Phi_q q_p = -Phi_p); else None.
         dq_p: velocity sensitivities d dq/dp, (T, N, NP), with ``q_p``.
+        flagged: (T,) True where q, dq or ddq may miss the accuracy targets (Phi_q is
+            ill-conditioned there, or a singular configuration was passed through).
+        cond: (T,) the estimated 1-norm condition number of Phi_q at each point.
+        singular: the singular configurations passed through, as (t, rank loss, groups of
+            dependent rows).
     """
 
     t: NDArray[np.float64]
@@ -76,6 +81,16 @@ class Trajectory:
     lu_fallbacks: int = 0
     q_p: NDArray[np.float64] | None = None
     dq_p: NDArray[np.float64] | None = None
+    flagged: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    cond: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
+
+    def __post_init__(self) -> None:
+        # A Trajectory built without them (by hand, or from older code) is unflagged.
+        if self.flagged.shape != self.t.shape:
+            object.__setattr__(self, "flagged", np.zeros(self.t.shape, dtype=bool))
+        if self.cond.shape != self.t.shape:
+            object.__setattr__(self, "cond", np.full(self.t.shape, np.nan))
 
     @property
     def bodies(self) -> tuple[str, ...]:
@@ -129,15 +144,15 @@ class Trajectory:
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
         np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
                  coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr)
+                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond)
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
-                  *(c + "_tt" for c in self.coordinates), *self._point_columns()]
+                  *(c + "_tt" for c in self.coordinates), *self._point_columns(), "flagged"]
         r, dr, ddr = self.point_arrays()
         # Per point: x, y, vx, vy, ax, ay (2.14-2.16).
         points = np.concatenate([r, dr, ddr], axis=2).reshape(self.t.size, -1)
-        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points]) if self.t.size \
-            else np.zeros((0, len(header)))
+        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, self.flagged]) \
+            if self.t.size else np.zeros((0, len(header)))
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")

@@ -87,3 +87,23 @@ void all_drivers_dense_lu_solve(const all_drivers_dense_lu *lu, all_drivers_real
     }
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
+
+void all_drivers_dense_lu_solve_transposed(const all_drivers_dense_lu *lu, all_drivers_real b[])
+{
+    /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */
+    const int n = ALL_DRIVERS_NQ;
+    const all_drivers_real *a = lu->a;
+    all_drivers_real x[ALL_DRIVERS_NQ];
+    int i, j;
+    for (i = 0; i < n; ++i) { /* U^T w = b, U^T lower triangular */
+        all_drivers_real sum = b[i];
+        for (j = 0; j < i; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum / a[i * n + i];
+    }
+    for (i = n - 1; i >= 0; --i) { /* L^T v = w, unit diagonal */
+        all_drivers_real sum = x[i];
+        for (j = i + 1; j < n; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum;
+    }
+    for (i = 0; i < n; ++i) b[lu->perm[i]] = x[i];
+}

@@ -33,4 +33,7 @@ all_drivers_real all_drivers_dense_lu_pivot_ratio(const all_drivers_dense_lu *lu
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void all_drivers_dense_lu_solve(const all_drivers_dense_lu *lu, all_drivers_real b[]);
 
+/* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
+void all_drivers_dense_lu_solve_transposed(const all_drivers_dense_lu *lu, all_drivers_real b[]);
+
 #endif /* ALL_DRIVERS_DENSE_LU_H */

@@ -4,7 +4,8 @@
  * Mechanism spec sha256: 7a058bf2c6431c4dea33e5cf378b1522c5e3c88dc472dc37365158a50013a246
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 137, phi 74, phi_p 33, phi_q 51, phi_t 23, points 1
  */
-#include <math.h> /* fabs */
+#include <float.h> /* the unit roundoff */
+#include <math.h> /* fabs, sqrt */
 #include <string.h> /* memcpy */
 
 #include "all_drivers_solver.h"
@@ -15,7 +16,17 @@ void all_drivers_default_options(all_drivers_options *options)
     options->tol_dq = 1e-09;
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
+    options->max_cond = 10000000.0;
+    options->tighten_cond = 10000.0;
+    options->target_q = 1e-08;
+    options->target_dq = 1e-07;
+    options->target_ddq = 1e-06;
 }
+
+#define ALL_DRIVERS_UNIT_ROUNDOFF DBL_EPSILON
+#define ALL_DRIVERS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
+#define ALL_DRIVERS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
+#define ALL_DRIVERS_SAFETY ((all_drivers_real)10) /* as runtime.accuracy.SAFETY */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static all_drivers_real all_drivers_max_abs(const all_drivers_real v[])
@@ -46,6 +57,118 @@ static int all_drivers_factor_jacobian(const all_drivers_options *options, const
     return ALL_DRIVERS_OK;
 }
 
+/* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
+{
+    all_drivers_real x[ALL_DRIVERS_NQ], y[ALL_DRIVERS_NQ], estimate = 0, norm, extra = 0;
+    int i, j, step;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) x[i] = (all_drivers_real)1 / ALL_DRIVERS_NQ;
+    for (step = 0; step < ALL_DRIVERS_ESTIMATOR_STEPS; ++step) {
+        all_drivers_real dot = 0, best;
+        memcpy(y, x, sizeof y);
+        all_drivers_lu_solve(lu, y);
+        norm = 0;
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) norm += fabs(y[i]);
+        if (norm - norm != 0) return (all_drivers_real)INFINITY;
+        if (step > 0 && norm <= estimate) break;
+        estimate = norm;
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
+        all_drivers_lu_solve_transposed(lu, y);
+        j = 0;
+        best = fabs(y[0]);
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+            dot += y[i] * x[i];
+            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        }
+        if (step > 0 && best <= dot) break;
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) x[i] = 0;
+        x[j] = 1;
+    }
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) { /* the alternating-sign test vector */
+        const all_drivers_real size = 1 + (all_drivers_real)i / (ALL_DRIVERS_NQ > 1 ? ALL_DRIVERS_NQ - 1 : 1);
+        y[i] = i % 2 == 0 ? size : -size;
+    }
+    all_drivers_lu_solve(lu, y);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) extra += fabs(y[i]);
+    extra = 2 * extra / (3 * ALL_DRIVERS_NQ);
+    if (extra - extra != 0) return (all_drivers_real)INFINITY;
+    return extra > estimate ? extra : estimate;
+}
+
+/* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
+static all_drivers_real all_drivers_norm1(const all_drivers_real nz[])
+{
+    all_drivers_real sums[ALL_DRIVERS_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < ALL_DRIVERS_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) sums[all_drivers_phi_q_col[e]] += fabs(nz[e]);
+    for (j = 0; j < ALL_DRIVERS_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+static void all_drivers_estimate(all_drivers_workspace *work, all_drivers_report *report)
+{
+    report->inv_norm = all_drivers_inverse_norm1(&work->lu);
+    report->cond = report->inv_norm * all_drivers_norm1(work->nz);
+}
+
+static all_drivers_real all_drivers_at_least_1(all_drivers_real x)
+{
+    return x > 1 ? x : 1;
+}
+
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+static int all_drivers_flagged(const all_drivers_options *options,
+                                const all_drivers_report *report, const all_drivers_state *state)
+{
+    const all_drivers_real u = ALL_DRIVERS_UNIT_ROUNDOFF;
+    const all_drivers_real nq = all_drivers_max_abs(state->q), ndq = all_drivers_max_abs(state->dq);
+    const all_drivers_real nddq = all_drivers_max_abs(state->ddq);
+    const all_drivers_real s = report->inv_norm / sqrt((all_drivers_real)ALL_DRIVERS_NQ);
+    const all_drivers_real floor = u * (1 + nq);
+    all_drivers_real e_q, e_dq, e_ddq;
+    if (report->cond - report->cond != 0) return 1;
+    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_dq = s * (u * ndq + e_q * all_drivers_at_least_1(ndq));
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * all_drivers_at_least_1(ndq));
+    return ALL_DRIVERS_SAFETY * e_q > options->target_q * all_drivers_at_least_1(nq)
+        || ALL_DRIVERS_SAFETY * e_dq > options->target_dq * all_drivers_at_least_1(ndq)
+        || ALL_DRIVERS_SAFETY * e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
+}
+
+/* At a converged point: estimate the condition; where it is high, go on while the Newton step
+ * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
+ * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+static int all_drivers_converged(const all_drivers_options *options, const all_drivers_real p[],
+                                  all_drivers_real t, all_drivers_real q[], all_drivers_real step,
+                                  all_drivers_workspace *work, all_drivers_report *report)
+{
+    int i, extra, moved = 0;
+    all_drivers_estimate(work, report);
+    if (report->cond > options->tighten_cond) {
+        for (extra = 0; extra < ALL_DRIVERS_TIGHTEN_STEPS; ++extra) {
+            all_drivers_real size;
+            for (i = 0; i < ALL_DRIVERS_NQ; ++i) work->phi[i] = -work->phi[i];
+            all_drivers_lu_solve(&work->lu, work->phi);
+            size = all_drivers_max_abs(work->phi);
+            if (!(size > 0 && size <= step / 2)) break;
+            for (i = 0; i < ALL_DRIVERS_NQ; ++i) q[i] += work->phi[i];
+            all_drivers_phi(q, t, p, work->phi);
+            report->residual = all_drivers_max_abs(work->phi);
+            step = size;
+            moved = 1;
+            if (all_drivers_factor_jacobian(options, p, t, q, work, report) != ALL_DRIVERS_OK) {
+                return ALL_DRIVERS_SINGULAR;
+            }
+        }
+        if (moved) {
+            all_drivers_estimate(work, report);
+        }
+    }
+    return report->cond <= options->max_cond ? ALL_DRIVERS_OK : ALL_DRIVERS_SINGULAR;
+}
+
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
 static int all_drivers_newton(const all_drivers_options *options, const all_drivers_real p[], all_drivers_real t, all_drivers_real q[],
@@ -68,7 +191,8 @@ static int all_drivers_newton(const all_drivers_options *options, const all_driv
             return ALL_DRIVERS_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
-            return ALL_DRIVERS_OK;
+            return all_drivers_converged(options, p, t, q, iteration == 0 ? (all_drivers_real)INFINITY : step,
+                                          work, report);
         }
         if (iteration == options->max_iterations) {
             break;
@@ -99,6 +223,8 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
                             all_drivers_report *report)
 {
     int i;
+    report->flagged = 0;
+    report->cond = (all_drivers_real)NAN;
     if (state->started) {
         all_drivers_predict(t, state);
     } else {
@@ -123,6 +249,7 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
             return report->status;
         }
     }
+    report->flagged = all_drivers_flagged(options, report, state);
     state->t = t;
     state->started = 1;
     return ALL_DRIVERS_OK;
@@ -136,10 +263,13 @@ static void all_drivers_store(all_drivers_real out[], int k, const all_drivers_r
     }
 }
 
-int all_drivers_solve_grid(const all_drivers_options *options, const all_drivers_real p[], int n,
-                            const all_drivers_real t[], all_drivers_state *state, all_drivers_real q_out[],
-                            all_drivers_real dq_out[], all_drivers_real ddq_out[], all_drivers_workspace *work,
-                            all_drivers_report *report)
+int all_drivers_solve_grid_checked(const all_drivers_options *options,
+                                    const all_drivers_real p[], int n,
+                                    const all_drivers_real t[], all_drivers_state *state,
+                                    all_drivers_real q_out[], all_drivers_real dq_out[],
+                                    all_drivers_real ddq_out[], all_drivers_real cond_out[],
+                                    unsigned char flagged_out[], all_drivers_workspace *work,
+                                    all_drivers_report *report)
 {
     int k;
     report->status = ALL_DRIVERS_OK;
@@ -150,8 +280,19 @@ int all_drivers_solve_grid(const all_drivers_options *options, const all_drivers
         all_drivers_store(q_out, k, state->q);
         all_drivers_store(dq_out, k, state->dq);
         all_drivers_store(ddq_out, k, state->ddq);
+        if (cond_out) cond_out[k] = report->cond;
+        if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
     return n;
+}
+
+int all_drivers_solve_grid(const all_drivers_options *options, const all_drivers_real p[], int n,
+                            const all_drivers_real t[], all_drivers_state *state, all_drivers_real q_out[],
+                            all_drivers_real dq_out[], all_drivers_real ddq_out[], all_drivers_workspace *work,
+                            all_drivers_report *report)
+{
+    return all_drivers_solve_grid_checked(options, p, n, t, state, q_out, dq_out, ddq_out, NULL,
+                                           NULL, work, report);
 }
 
 /* Row block `rows` of out, or NULL when out is NULL (no arithmetic on a null pointer). */

@@ -47,4 +47,8 @@ unsigned long all_drivers_lu_fallbacks(const all_drivers_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[]);
 
+/* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
+ * estimate of the solver). */
+void all_drivers_lu_solve_transposed(const all_drivers_lu *lu, all_drivers_real b[]);
+
 #endif /* ALL_DRIVERS_SPARSE_LU_H */

@@ -87,3 +87,23 @@ void andrews_squeezer_dense_lu_solve(const andrews_squeezer_dense_lu *lu, andrew
     }
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
+
+void andrews_squeezer_dense_lu_solve_transposed(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[])
+{
+    /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */
+    const int n = ANDREWS_SQUEEZER_NQ;
+    const andrews_squeezer_real *a = lu->a;
+    andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ];
+    int i, j;
+    for (i = 0; i < n; ++i) { /* U^T w = b, U^T lower triangular */
+        andrews_squeezer_real sum = b[i];
+        for (j = 0; j < i; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum / a[i * n + i];
+    }
+    for (i = n - 1; i >= 0; --i) { /* L^T v = w, unit diagonal */
+        andrews_squeezer_real sum = x[i];
+        for (j = i + 1; j < n; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum;
+    }
+    for (i = 0; i < n; ++i) b[lu->perm[i]] = x[i];
+}

@@ -33,4 +33,7 @@ andrews_squeezer_real andrews_squeezer_dense_lu_pivot_ratio(const andrews_squeez
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void andrews_squeezer_dense_lu_solve(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[]);
 
+/* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
+void andrews_squeezer_dense_lu_solve_transposed(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[]);
+
 #endif /* ANDREWS_SQUEEZER_DENSE_LU_H */

@@ -4,7 +4,8 @@
  * Mechanism spec sha256: ff79f9cb5c81e1a8052c580ce329e889fe712d3cc46c753968ced9b6d3661bd5
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 57, phi 70, phi_p 24, phi_q 58, phi_t 1, points 5
  */
-#include <math.h> /* fabs */
+#include <float.h> /* the unit roundoff */
+#include <math.h> /* fabs, sqrt */
 #include <string.h> /* memcpy */
 
 #include "andrews_squeezer_solver.h"
@@ -15,7 +16,17 @@ void andrews_squeezer_default_options(andrews_squeezer_options *options)
     options->tol_dq = 1e-09;
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
+    options->max_cond = 10000000.0;
+    options->tighten_cond = 10000.0;
+    options->target_q = 1e-08;
+    options->target_dq = 1e-07;
+    options->target_ddq = 1e-06;
 }
+
+#define ANDREWS_SQUEEZER_UNIT_ROUNDOFF DBL_EPSILON
+#define ANDREWS_SQUEEZER_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
+#define ANDREWS_SQUEEZER_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
+#define ANDREWS_SQUEEZER_SAFETY ((andrews_squeezer_real)10) /* as runtime.accuracy.SAFETY */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static andrews_squeezer_real andrews_squeezer_max_abs(const andrews_squeezer_real v[])
@@ -46,6 +57,118 @@ static int andrews_squeezer_factor_jacobian(const andrews_squeezer_options *opti
     return ANDREWS_SQUEEZER_OK;
 }
 
+/* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeezer_lu *lu)
+{
+    andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ], y[ANDREWS_SQUEEZER_NQ], estimate = 0, norm, extra = 0;
+    int i, j, step;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) x[i] = (andrews_squeezer_real)1 / ANDREWS_SQUEEZER_NQ;
+    for (step = 0; step < ANDREWS_SQUEEZER_ESTIMATOR_STEPS; ++step) {
+        andrews_squeezer_real dot = 0, best;
+        memcpy(y, x, sizeof y);
+        andrews_squeezer_lu_solve(lu, y);
+        norm = 0;
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) norm += fabs(y[i]);
+        if (norm - norm != 0) return (andrews_squeezer_real)INFINITY;
+        if (step > 0 && norm <= estimate) break;
+        estimate = norm;
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
+        andrews_squeezer_lu_solve_transposed(lu, y);
+        j = 0;
+        best = fabs(y[0]);
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+            dot += y[i] * x[i];
+            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        }
+        if (step > 0 && best <= dot) break;
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) x[i] = 0;
+        x[j] = 1;
+    }
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) { /* the alternating-sign test vector */
+        const andrews_squeezer_real size = 1 + (andrews_squeezer_real)i / (ANDREWS_SQUEEZER_NQ > 1 ? ANDREWS_SQUEEZER_NQ - 1 : 1);
+        y[i] = i % 2 == 0 ? size : -size;
+    }
+    andrews_squeezer_lu_solve(lu, y);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) extra += fabs(y[i]);
+    extra = 2 * extra / (3 * ANDREWS_SQUEEZER_NQ);
+    if (extra - extra != 0) return (andrews_squeezer_real)INFINITY;
+    return extra > estimate ? extra : estimate;
+}
+
+/* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
+static andrews_squeezer_real andrews_squeezer_norm1(const andrews_squeezer_real nz[])
+{
+    andrews_squeezer_real sums[ANDREWS_SQUEEZER_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < ANDREWS_SQUEEZER_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < ANDREWS_SQUEEZER_NNZ; ++e) sums[andrews_squeezer_phi_q_col[e]] += fabs(nz[e]);
+    for (j = 0; j < ANDREWS_SQUEEZER_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+static void andrews_squeezer_estimate(andrews_squeezer_workspace *work, andrews_squeezer_report *report)
+{
+    report->inv_norm = andrews_squeezer_inverse_norm1(&work->lu);
+    report->cond = report->inv_norm * andrews_squeezer_norm1(work->nz);
+}
+
+static andrews_squeezer_real andrews_squeezer_at_least_1(andrews_squeezer_real x)
+{
+    return x > 1 ? x : 1;
+}
+
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
+                                const andrews_squeezer_report *report, const andrews_squeezer_state *state)
+{
+    const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
+    const andrews_squeezer_real nq = andrews_squeezer_max_abs(state->q), ndq = andrews_squeezer_max_abs(state->dq);
+    const andrews_squeezer_real nddq = andrews_squeezer_max_abs(state->ddq);
+    const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
+    const andrews_squeezer_real floor = u * (1 + nq);
+    andrews_squeezer_real e_q, e_dq, e_ddq;
+    if (report->cond - report->cond != 0) return 1;
+    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_dq = s * (u * ndq + e_q * andrews_squeezer_at_least_1(ndq));
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * andrews_squeezer_at_least_1(ndq));
+    return ANDREWS_SQUEEZER_SAFETY * e_q > options->target_q * andrews_squeezer_at_least_1(nq)
+        || ANDREWS_SQUEEZER_SAFETY * e_dq > options->target_dq * andrews_squeezer_at_least_1(ndq)
+        || ANDREWS_SQUEEZER_SAFETY * e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
+}
+
+/* At a converged point: estimate the condition; where it is high, go on while the Newton step
+ * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
+ * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+static int andrews_squeezer_converged(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
+                                  andrews_squeezer_real t, andrews_squeezer_real q[], andrews_squeezer_real step,
+                                  andrews_squeezer_workspace *work, andrews_squeezer_report *report)
+{
+    int i, extra, moved = 0;
+    andrews_squeezer_estimate(work, report);
+    if (report->cond > options->tighten_cond) {
+        for (extra = 0; extra < ANDREWS_SQUEEZER_TIGHTEN_STEPS; ++extra) {
+            andrews_squeezer_real size;
+            for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) work->phi[i] = -work->phi[i];
+            andrews_squeezer_lu_solve(&work->lu, work->phi);
+            size = andrews_squeezer_max_abs(work->phi);
+            if (!(size > 0 && size <= step / 2)) break;
+            for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) q[i] += work->phi[i];
+            andrews_squeezer_phi(q, t, p, work->phi);
+            report->residual = andrews_squeezer_max_abs(work->phi);
+            step = size;
+            moved = 1;
+            if (andrews_squeezer_factor_jacobian(options, p, t, q, work, report) != ANDREWS_SQUEEZER_OK) {
+                return ANDREWS_SQUEEZER_SINGULAR;
+            }
+        }
+        if (moved) {
+            andrews_squeezer_estimate(work, report);
+        }
+    }
+    return report->cond <= options->max_cond ? ANDREWS_SQUEEZER_OK : ANDREWS_SQUEEZER_SINGULAR;
+}
+
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
 static int andrews_squeezer_newton(const andrews_squeezer_options *options, const andrews_squeezer_real p[], andrews_squeezer_real t, andrews_squeezer_real q[],
@@ -68,7 +191,8 @@ static int andrews_squeezer_newton(const andrews_squeezer_options *options, cons
             return ANDREWS_SQUEEZER_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
-            return ANDREWS_SQUEEZER_OK;
+            return andrews_squeezer_converged(options, p, t, q, iteration == 0 ? (andrews_squeezer_real)INFINITY : step,
+                                          work, report);
         }
         if (iteration == options->max_iterations) {
             break;
@@ -99,6 +223,8 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
                             andrews_squeezer_report *report)
 {
     int i;
+    report->flagged = 0;
+    report->cond = (andrews_squeezer_real)NAN;
     if (state->started) {
         andrews_squeezer_predict(t, state);
     } else {
@@ -123,6 +249,7 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
             return report->status;
         }
     }
+    report->flagged = andrews_squeezer_flagged(options, report, state);
     state->t = t;
     state->started = 1;
     return ANDREWS_SQUEEZER_OK;
@@ -136,10 +263,13 @@ static void andrews_squeezer_store(andrews_squeezer_real out[], int k, const and
     }
 }
 
-int andrews_squeezer_solve_grid(const andrews_squeezer_options *options, const andrews_squeezer_real p[], int n,
-                            const andrews_squeezer_real t[], andrews_squeezer_state *state, andrews_squeezer_real q_out[],
-                            andrews_squeezer_real dq_out[], andrews_squeezer_real ddq_out[], andrews_squeezer_workspace *work,
-                            andrews_squeezer_report *report)
+int andrews_squeezer_solve_grid_checked(const andrews_squeezer_options *options,
+                                    const andrews_squeezer_real p[], int n,
+                                    const andrews_squeezer_real t[], andrews_squeezer_state *state,
+                                    andrews_squeezer_real q_out[], andrews_squeezer_real dq_out[],
+                                    andrews_squeezer_real ddq_out[], andrews_squeezer_real cond_out[],
+                                    unsigned char flagged_out[], andrews_squeezer_workspace *work,
+                                    andrews_squeezer_report *report)
 {
     int k;
     report->status = ANDREWS_SQUEEZER_OK;
@@ -150,8 +280,19 @@ int andrews_squeezer_solve_grid(const andrews_squeezer_options *options, const a
         andrews_squeezer_store(q_out, k, state->q);
         andrews_squeezer_store(dq_out, k, state->dq);
         andrews_squeezer_store(ddq_out, k, state->ddq);
+        if (cond_out) cond_out[k] = report->cond;
+        if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
     return n;
+}
+
+int andrews_squeezer_solve_grid(const andrews_squeezer_options *options, const andrews_squeezer_real p[], int n,
+                            const andrews_squeezer_real t[], andrews_squeezer_state *state, andrews_squeezer_real q_out[],
+                            andrews_squeezer_real dq_out[], andrews_squeezer_real ddq_out[], andrews_squeezer_workspace *work,
+                            andrews_squeezer_report *report)
+{
+    return andrews_squeezer_solve_grid_checked(options, p, n, t, state, q_out, dq_out, ddq_out, NULL,
+                                           NULL, work, report);
 }
 
 /* Row block `rows` of out, or NULL when out is NULL (no arithmetic on a null pointer). */

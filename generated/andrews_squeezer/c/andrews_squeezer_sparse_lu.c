@@ -362,3 +362,54 @@ void andrews_squeezer_lu_solve(const andrews_squeezer_lu *lu, andrews_squeezer_r
     b[17] = x[19];
     b[20] = x[20];
 }
+
+/* The factors' structure as index tables, for the transposed solve only (the straight-line
+ * code above needs none): see the tables style for their layout. */
+static const int andrews_squeezer_lu_row_perm[ANDREWS_SQUEEZER_NQ] = {
+    0, 1, 10, 11, 14, 15, 18, 19, 20, 2, 3, 4, 5, 6, 7, 8, 9, 12, 13, 16, 17
+};
+static const int andrews_squeezer_lu_col_perm[ANDREWS_SQUEEZER_NQ] = {
+    0, 1, 6, 7, 12, 13, 18, 19, 2, 3, 4, 8, 5, 9, 10, 15, 16, 11, 14, 17, 20
+};
+static const int andrews_squeezer_lu_lower_start[22] = {
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 13, 16, 17, 21, 22, 23, 24, 25, 26, 26, 27, 27
+};
+
+static const int andrews_squeezer_lu_lower[56] = {
+    9, 2, 10, 5, 11, 10, 12, 14, 17, 32, 18, 36, 19, 42, 20, 46, 9, 3, 10, 6, 11, 8, 13, 16, 15,
+    22, 12, 12, 14, 19, 16, 25, 12, 15, 13, 17, 14, 20, 15, 23, 16, 26, 17, 30, 18, 34, 19, 40,
+    20, 44, 18, 35, 20, 45, 0, 0
+};
+
+static const int andrews_squeezer_lu_upper_start[22] = {
+    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 2, 2, 3, 3
+};
+
+static const int andrews_squeezer_lu_upper[8] = {
+    12, 9, 18, 33, 20, 43, 0, 0
+};
+
+void andrews_squeezer_lu_solve_transposed(const andrews_squeezer_lu *lu, andrews_squeezer_real b[])
+{
+    /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
+    andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ];
+    int k, e;
+    if (lu->dense) {
+        andrews_squeezer_dense_lu_solve_transposed(&lu->dense_lu, b);
+        return;
+    }
+    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) x[k] = b[andrews_squeezer_lu_col_perm[k]];
+    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
+        const andrews_squeezer_real zk = x[k] * lu->inv[k];
+        x[k] = zk;
+        for (e = andrews_squeezer_lu_upper_start[k]; e < andrews_squeezer_lu_upper_start[k + 1]; ++e)
+            x[andrews_squeezer_lu_upper[2 * e]] -= lu->v[andrews_squeezer_lu_upper[2 * e + 1]] * zk;
+    }
+    for (k = ANDREWS_SQUEEZER_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
+        andrews_squeezer_real sum = x[k];
+        for (e = andrews_squeezer_lu_lower_start[k]; e < andrews_squeezer_lu_lower_start[k + 1]; ++e)
+            sum -= lu->v[andrews_squeezer_lu_lower[2 * e + 1]] * x[andrews_squeezer_lu_lower[2 * e]];
+        x[k] = sum;
+    }
+    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) b[andrews_squeezer_lu_row_perm[k]] = x[k];
+}

@@ -47,4 +47,8 @@ unsigned long andrews_squeezer_lu_fallbacks(const andrews_squeezer_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void andrews_squeezer_lu_solve(const andrews_squeezer_lu *lu, andrews_squeezer_real b[]);
 
+/* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
+ * estimate of the solver). */
+void andrews_squeezer_lu_solve_transposed(const andrews_squeezer_lu *lu, andrews_squeezer_real b[]);
+
 #endif /* ANDREWS_SQUEEZER_SPARSE_LU_H */

@@ -87,3 +87,23 @@ void crank_slider_dense_lu_solve(const crank_slider_dense_lu *lu, crank_slider_r
     }
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
+
+void crank_slider_dense_lu_solve_transposed(const crank_slider_dense_lu *lu, crank_slider_real b[])
+{
+    /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */
+    const int n = CRANK_SLIDER_NQ;
+    const crank_slider_real *a = lu->a;
+    crank_slider_real x[CRANK_SLIDER_NQ];
+    int i, j;
+    for (i = 0; i < n; ++i) { /* U^T w = b, U^T lower triangular */
+        crank_slider_real sum = b[i];
+        for (j = 0; j < i; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum / a[i * n + i];
+    }
+    for (i = n - 1; i >= 0; --i) { /* L^T v = w, unit diagonal */
+        crank_slider_real sum = x[i];
+        for (j = i + 1; j < n; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum;
+    }
+    for (i = 0; i < n; ++i) b[lu->perm[i]] = x[i];
+}

@@ -47,4 +47,8 @@ unsigned long crank_slider_lu_fallbacks(const crank_slider_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void crank_slider_lu_solve(const crank_slider_lu *lu, crank_slider_real b[]);
 
+/* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
+ * estimate of the solver). */
+void crank_slider_lu_solve_transposed(const crank_slider_lu *lu, crank_slider_real b[]);
+
 #endif /* CRANK_SLIDER_SPARSE_LU_H */

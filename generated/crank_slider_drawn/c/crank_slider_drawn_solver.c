@@ -4,7 +4,8 @@
  * Mechanism spec sha256: 45c952b2768bfe05d819fa4a13e368e0b2e3d4867faa4597cc01e8e5356fea4e
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 26, phi 32, phi_p 24, phi_q 27, phi_t 2, points 6
  */
-#include <math.h> /* fabs */
+#include <float.h> /* the unit roundoff */
+#include <math.h> /* fabs, sqrt */
 #include <string.h> /* memcpy */
 
 #include "crank_slider_drawn_solver.h"
@@ -15,7 +16,17 @@ void crank_slider_drawn_default_options(crank_slider_drawn_options *options)
     options->tol_dq = 1e-09;
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
+    options->max_cond = 10000000.0;
+    options->tighten_cond = 10000.0;
+    options->target_q = 1e-08;
+    options->target_dq = 1e-07;
+    options->target_ddq = 1e-06;
 }
+
+#define CRANK_SLIDER_DRAWN_UNIT_ROUNDOFF DBL_EPSILON
+#define CRANK_SLIDER_DRAWN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
+#define CRANK_SLIDER_DRAWN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
+#define CRANK_SLIDER_DRAWN_SAFETY ((crank_slider_drawn_real)10) /* as runtime.accuracy.SAFETY */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static crank_slider_drawn_real crank_slider_drawn_max_abs(const crank_slider_drawn_real v[])
@@ -46,6 +57,118 @@ static int crank_slider_drawn_factor_jacobian(const crank_slider_drawn_options *
     return CRANK_SLIDER_DRAWN_OK;
 }
 
+/* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+static crank_slider_drawn_real crank_slider_drawn_inverse_norm1(const crank_slider_drawn_lu *lu)
+{
+    crank_slider_drawn_real x[CRANK_SLIDER_DRAWN_NQ], y[CRANK_SLIDER_DRAWN_NQ], estimate = 0, norm, extra = 0;
+    int i, j, step;
+    for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) x[i] = (crank_slider_drawn_real)1 / CRANK_SLIDER_DRAWN_NQ;
+    for (step = 0; step < CRANK_SLIDER_DRAWN_ESTIMATOR_STEPS; ++step) {
+        crank_slider_drawn_real dot = 0, best;
+        memcpy(y, x, sizeof y);
+        crank_slider_drawn_lu_solve(lu, y);
+        norm = 0;
+        for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) norm += fabs(y[i]);
+        if (norm - norm != 0) return (crank_slider_drawn_real)INFINITY;
+        if (step > 0 && norm <= estimate) break;
+        estimate = norm;
+        for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
+        crank_slider_drawn_lu_solve_transposed(lu, y);
+        j = 0;
+        best = fabs(y[0]);
+        for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) {
+            dot += y[i] * x[i];
+            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        }
+        if (step > 0 && best <= dot) break;
+        for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) x[i] = 0;
+        x[j] = 1;
+    }
+    for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) { /* the alternating-sign test vector */
+        const crank_slider_drawn_real size = 1 + (crank_slider_drawn_real)i / (CRANK_SLIDER_DRAWN_NQ > 1 ? CRANK_SLIDER_DRAWN_NQ - 1 : 1);
+        y[i] = i % 2 == 0 ? size : -size;
+    }
+    crank_slider_drawn_lu_solve(lu, y);
+    for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) extra += fabs(y[i]);
+    extra = 2 * extra / (3 * CRANK_SLIDER_DRAWN_NQ);
+    if (extra - extra != 0) return (crank_slider_drawn_real)INFINITY;
+    return extra > estimate ? extra : estimate;
+}
+
+/* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
+static crank_slider_drawn_real crank_slider_drawn_norm1(const crank_slider_drawn_real nz[])
+{
+    crank_slider_drawn_real sums[CRANK_SLIDER_DRAWN_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < CRANK_SLIDER_DRAWN_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < CRANK_SLIDER_DRAWN_NNZ; ++e) sums[crank_slider_drawn_phi_q_col[e]] += fabs(nz[e]);
+    for (j = 0; j < CRANK_SLIDER_DRAWN_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+static void crank_slider_drawn_estimate(crank_slider_drawn_workspace *work, crank_slider_drawn_report *report)
+{
+    report->inv_norm = crank_slider_drawn_inverse_norm1(&work->lu);
+    report->cond = report->inv_norm * crank_slider_drawn_norm1(work->nz);
+}
+
+static crank_slider_drawn_real crank_slider_drawn_at_least_1(crank_slider_drawn_real x)
+{
+    return x > 1 ? x : 1;
+}
+
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+static int crank_slider_drawn_flagged(const crank_slider_drawn_options *options,
+                                const crank_slider_drawn_report *report, const crank_slider_drawn_state *state)
+{
+    const crank_slider_drawn_real u = CRANK_SLIDER_DRAWN_UNIT_ROUNDOFF;
+    const crank_slider_drawn_real nq = crank_slider_drawn_max_abs(state->q), ndq = crank_slider_drawn_max_abs(state->dq);
+    const crank_slider_drawn_real nddq = crank_slider_drawn_max_abs(state->ddq);
+    const crank_slider_drawn_real s = report->inv_norm / sqrt((crank_slider_drawn_real)CRANK_SLIDER_DRAWN_NQ);
+    const crank_slider_drawn_real floor = u * (1 + nq);
+    crank_slider_drawn_real e_q, e_dq, e_ddq;
+    if (report->cond - report->cond != 0) return 1;
+    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_dq = s * (u * ndq + e_q * crank_slider_drawn_at_least_1(ndq));
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * crank_slider_drawn_at_least_1(ndq));
+    return CRANK_SLIDER_DRAWN_SAFETY * e_q > options->target_q * crank_slider_drawn_at_least_1(nq)
+        || CRANK_SLIDER_DRAWN_SAFETY * e_dq > options->target_dq * crank_slider_drawn_at_least_1(ndq)
+        || CRANK_SLIDER_DRAWN_SAFETY * e_ddq > options->target_ddq * crank_slider_drawn_at_least_1(nddq);
+}
+
+/* At a converged point: estimate the condition; where it is high, go on while the Newton step
+ * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
+ * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+static int crank_slider_drawn_converged(const crank_slider_drawn_options *options, const crank_slider_drawn_real p[],
+                                  crank_slider_drawn_real t, crank_slider_drawn_real q[], crank_slider_drawn_real step,
+                                  crank_slider_drawn_workspace *work, crank_slider_drawn_report *report)
+{
+    int i, extra, moved = 0;
+    crank_slider_drawn_estimate(work, report);
+    if (report->cond > options->tighten_cond) {
+        for (extra = 0; extra < CRANK_SLIDER_DRAWN_TIGHTEN_STEPS; ++extra) {
+            crank_slider_drawn_real size;
+            for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) work->phi[i] = -work->phi[i];
+            crank_slider_drawn_lu_solve(&work->lu, work->phi);
+            size = crank_slider_drawn_max_abs(work->phi);
+            if (!(size > 0 && size <= step / 2)) break;
+            for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) q[i] += work->phi[i];
+            crank_slider_drawn_phi(q, t, p, work->phi);
+            report->residual = crank_slider_drawn_max_abs(work->phi);
+            step = size;
+            moved = 1;
+            if (crank_slider_drawn_factor_jacobian(options, p, t, q, work, report) != CRANK_SLIDER_DRAWN_OK) {
+                return CRANK_SLIDER_DRAWN_SINGULAR;
+            }
+        }
+        if (moved) {
+            crank_slider_drawn_estimate(work, report);
+        }
+    }
+    return report->cond <= options->max_cond ? CRANK_SLIDER_DRAWN_OK : CRANK_SLIDER_DRAWN_SINGULAR;
+}
+
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
 static int crank_slider_drawn_newton(const crank_slider_drawn_options *options, const crank_slider_drawn_real p[], crank_slider_drawn_real t, crank_slider_drawn_real q[],
@@ -68,7 +191,8 @@ static int crank_slider_drawn_newton(const crank_slider_drawn_options *options, 
             return CRANK_SLIDER_DRAWN_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
-            return CRANK_SLIDER_DRAWN_OK;
+            return crank_slider_drawn_converged(options, p, t, q, iteration == 0 ? (crank_slider_drawn_real)INFINITY : step,
+                                          work, report);
         }
         if (iteration == options->max_iterations) {
             break;
@@ -99,6 +223,8 @@ int crank_slider_drawn_solve_step(const crank_slider_drawn_options *options, con
                             crank_slider_drawn_report *report)
 {
     int i;
+    report->flagged = 0;
+    report->cond = (crank_slider_drawn_real)NAN;
     if (state->started) {
         crank_slider_drawn_predict(t, state);
     } else {
@@ -123,6 +249,7 @@ int crank_slider_drawn_solve_step(const crank_slider_drawn_options *options, con
             return report->status;
         }
     }
+    report->flagged = crank_slider_drawn_flagged(options, report, state);
     state->t = t;
     state->started = 1;
     return CRANK_SLIDER_DRAWN_OK;
@@ -136,10 +263,13 @@ static void crank_slider_drawn_store(crank_slider_drawn_real out[], int k, const
     }
 }
 
-int crank_slider_drawn_solve_grid(const crank_slider_drawn_options *options, const crank_slider_drawn_real p[], int n,
-                            const crank_slider_drawn_real t[], crank_slider_drawn_state *state, crank_slider_drawn_real q_out[],
-                            crank_slider_drawn_real dq_out[], crank_slider_drawn_real ddq_out[], crank_slider_drawn_workspace *work,
-                            crank_slider_drawn_report *report)
+int crank_slider_drawn_solve_grid_checked(const crank_slider_drawn_options *options,
+                                    const crank_slider_drawn_real p[], int n,
+                                    const crank_slider_drawn_real t[], crank_slider_drawn_state *state,
+                                    crank_slider_drawn_real q_out[], crank_slider_drawn_real dq_out[],
+                                    crank_slider_drawn_real ddq_out[], crank_slider_drawn_real cond_out[],
+                                    unsigned char flagged_out[], crank_slider_drawn_workspace *work,
+                                    crank_slider_drawn_report *report)
 {
     int k;
     report->status = CRANK_SLIDER_DRAWN_OK;
@@ -150,8 +280,19 @@ int crank_slider_drawn_solve_grid(const crank_slider_drawn_options *options, con
         crank_slider_drawn_store(q_out, k, state->q);
         crank_slider_drawn_store(dq_out, k, state->dq);
         crank_slider_drawn_store(ddq_out, k, state->ddq);
+        if (cond_out) cond_out[k] = report->cond;
+        if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
     return n;
+}
+
+int crank_slider_drawn_solve_grid(const crank_slider_drawn_options *options, const crank_slider_drawn_real p[], int n,
+                            const crank_slider_drawn_real t[], crank_slider_drawn_state *state, crank_slider_drawn_real q_out[],
+                            crank_slider_drawn_real dq_out[], crank_slider_drawn_real ddq_out[], crank_slider_drawn_workspace *work,
+                            crank_slider_drawn_report *report)
+{
+    return crank_slider_drawn_solve_grid_checked(options, p, n, t, state, q_out, dq_out, ddq_out, NULL,
+                                           NULL, work, report);
 }
 
 /* Row block `rows` of out, or NULL when out is NULL (no arithmetic on a null pointer). */

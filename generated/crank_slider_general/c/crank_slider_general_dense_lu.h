@@ -33,4 +33,7 @@ crank_slider_general_real crank_slider_general_dense_lu_pivot_ratio(const crank_
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void crank_slider_general_dense_lu_solve(const crank_slider_general_dense_lu *lu, crank_slider_general_real b[]);
 
+/* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
+void crank_slider_general_dense_lu_solve_transposed(const crank_slider_general_dense_lu *lu, crank_slider_general_real b[]);
+
 #endif /* CRANK_SLIDER_GENERAL_DENSE_LU_H */

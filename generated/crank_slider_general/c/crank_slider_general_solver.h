@@ -8,6 +8,10 @@
  * Each step: Taylor predictor q += dq h + ddq h^2/2 (2.76); Newton-Raphson on Phi(q, t) = 0,
  * testing the residual of the current iterate; then Phi_q dq = -Phi_t (2.73) and
  * Phi_q ddq = Gamma (2.74) with the one LU factorization of the converged Phi_q.
+ * At each converged point the 1-norm condition of Phi_q is estimated from those factors
+ * (Hager-Higham: a few solves, one of them transposed); where it is high Newton goes on while
+ * its step still halves, and the point is flagged when an error model says q, dq or ddq may
+ * miss the targets of the options (the same model as the Python driver's runtime.accuracy).
  * No malloc, no stdio, no mutable statics: the caller owns every buffer.
  */
 #ifndef CRANK_SLIDER_GENERAL_SOLVER_H
@@ -25,6 +29,11 @@ typedef struct {
     crank_slider_general_real tol_dq;          /* ... and the last Newton step max|dq| <= tol_dq */
     int max_iterations;                /* Newton iterations per time step                */
     crank_slider_general_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
+    crank_slider_general_real max_cond;        /* ... or the condition estimate is above this     */
+    crank_slider_general_real tighten_cond;    /* above this, Newton goes on while its step halves */
+    crank_slider_general_real target_q;        /* flagged when the estimated error of q, dq or    */
+    crank_slider_general_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
+    crank_slider_general_real target_ddq;
 } crank_slider_general_options;
 
 typedef struct {
@@ -35,6 +44,9 @@ typedef struct {
     int pivot;                   /* singular: the zero pivot's column, else -1    */
     unsigned long fallbacks;     /* factorizations since the first step that left */
                                  /* the sparse LU's fixed pivot order (0 for dense) */
+    crank_slider_general_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
+    crank_slider_general_real cond;      /* estimate of the 1-norm condition of Phi_q there */
+    int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
 } crank_slider_general_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
@@ -71,6 +83,18 @@ int crank_slider_general_solve_grid(const crank_slider_general_options *options,
                             crank_slider_general_real ddq_out[], crank_slider_general_workspace *work,
                             crank_slider_general_report *report);
 
+/* crank_slider_general_solve_grid, and per step k also cond_out[k] (the condition estimate of Phi_q)
+ * and flagged_out[k] (1 when q, dq or ddq may miss the targets); either may be NULL. Stops,
+ * like crank_slider_general_solve_grid, at the first step that fails (also one whose condition
+ * estimate exceeds options->max_cond: status CRANK_SLIDER_GENERAL_SINGULAR), so that the caller can
+ * treat that point (pass a singular configuration, bisect to a limit position) and go on. */
+int crank_slider_general_solve_grid_checked(const crank_slider_general_options *options,
+                                    const crank_slider_general_real p[], int n,
+                                    const crank_slider_general_real t[], crank_slider_general_state *state,
+                                    crank_slider_general_real q_out[], crank_slider_general_real dq_out[],
+                                    crank_slider_general_real ddq_out[], crank_slider_general_real cond_out[],
+                                    unsigned char flagged_out[], crank_slider_general_workspace *work,
+                                    crank_slider_general_report *report);
 /* One set's outcome in crank_slider_general_solve_batch. */
 typedef struct {
     int status;                  /* CRANK_SLIDER_GENERAL_OK when every time point was solved        */

@@ -239,3 +239,52 @@ void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slid
     b[6] = x[7];
     b[7] = x[8];
 }
+
+/* The factors' structure as index tables, for the transposed solve only (the straight-line
+ * code above needs none): see the tables style for their layout. */
+static const int crank_slider_general_lu_row_perm[CRANK_SLIDER_GENERAL_NQ] = {
+    6, 8, 0, 1, 2, 3, 4, 5, 7
+};
+static const int crank_slider_general_lu_col_perm[CRANK_SLIDER_GENERAL_NQ] = {
+    8, 2, 0, 1, 3, 4, 5, 6, 7
+};
+static const int crank_slider_general_lu_lower_start[10] = {
+    0, 3, 7, 8, 9, 10, 11, 12, 13, 13
+};
+
+static const int crank_slider_general_lu_lower[28] = {
+    6, 15, 7, 19, 8, 23, 2, 1, 3, 3, 4, 5, 5, 9, 4, 4, 5, 8, 6, 12, 7, 16, 7, 17, 8, 21, 0, 0
+};
+
+static const int crank_slider_general_lu_upper_start[10] = {
+    0, 0, 0, 0, 0, 1, 2, 3, 4, 4
+};
+
+static const int crank_slider_general_lu_upper[10] = {
+    6, 7, 6, 11, 7, 14, 8, 18, 0, 0
+};
+
+void crank_slider_general_lu_solve_transposed(const crank_slider_general_lu *lu, crank_slider_general_real b[])
+{
+    /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
+    crank_slider_general_real x[CRANK_SLIDER_GENERAL_NQ];
+    int k, e;
+    if (lu->dense) {
+        crank_slider_general_dense_lu_solve_transposed(&lu->dense_lu, b);
+        return;
+    }
+    for (k = 0; k < CRANK_SLIDER_GENERAL_NQ; ++k) x[k] = b[crank_slider_general_lu_col_perm[k]];
+    for (k = 0; k < CRANK_SLIDER_GENERAL_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
+        const crank_slider_general_real zk = x[k] * lu->inv[k];
+        x[k] = zk;
+        for (e = crank_slider_general_lu_upper_start[k]; e < crank_slider_general_lu_upper_start[k + 1]; ++e)
+            x[crank_slider_general_lu_upper[2 * e]] -= lu->v[crank_slider_general_lu_upper[2 * e + 1]] * zk;
+    }
+    for (k = CRANK_SLIDER_GENERAL_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
+        crank_slider_general_real sum = x[k];
+        for (e = crank_slider_general_lu_lower_start[k]; e < crank_slider_general_lu_lower_start[k + 1]; ++e)
+            sum -= lu->v[crank_slider_general_lu_lower[2 * e + 1]] * x[crank_slider_general_lu_lower[2 * e]];
+        x[k] = sum;
+    }
+    for (k = 0; k < CRANK_SLIDER_GENERAL_NQ; ++k) b[crank_slider_general_lu_row_perm[k]] = x[k];
+}

@@ -47,4 +47,8 @@ unsigned long crank_slider_general_lu_fallbacks(const crank_slider_general_lu *l
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slider_general_real b[]);
 
+/* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
+ * estimate of the solver). */
+void crank_slider_general_lu_solve_transposed(const crank_slider_general_lu *lu, crank_slider_general_real b[]);
+
 #endif /* CRANK_SLIDER_GENERAL_SPARSE_LU_H */

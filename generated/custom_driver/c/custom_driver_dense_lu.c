@@ -87,3 +87,23 @@ void custom_driver_dense_lu_solve(const custom_driver_dense_lu *lu, custom_drive
     }
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
+
+void custom_driver_dense_lu_solve_transposed(const custom_driver_dense_lu *lu, custom_driver_real b[])
+{
+    /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */
+    const int n = CUSTOM_DRIVER_NQ;
+    const custom_driver_real *a = lu->a;
+    custom_driver_real x[CUSTOM_DRIVER_NQ];
+    int i, j;
+    for (i = 0; i < n; ++i) { /* U^T w = b, U^T lower triangular */
+        custom_driver_real sum = b[i];
+        for (j = 0; j < i; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum / a[i * n + i];
+    }
+    for (i = n - 1; i >= 0; --i) { /* L^T v = w, unit diagonal */
+        custom_driver_real sum = x[i];
+        for (j = i + 1; j < n; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum;
+    }
+    for (i = 0; i < n; ++i) b[lu->perm[i]] = x[i];
+}

@@ -33,4 +33,7 @@ custom_driver_real custom_driver_dense_lu_pivot_ratio(const custom_driver_dense_
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void custom_driver_dense_lu_solve(const custom_driver_dense_lu *lu, custom_driver_real b[]);
 
+/* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
+void custom_driver_dense_lu_solve_transposed(const custom_driver_dense_lu *lu, custom_driver_real b[]);
+
 #endif /* CUSTOM_DRIVER_DENSE_LU_H */

@@ -4,7 +4,8 @@
  * Mechanism spec sha256: 4fcf950995d6c44db2ddda1e8e0c491285c7cdf52e3ba1c359c9b05596567e52
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 63, phi 29, phi_p 31, phi_q 29, phi_t 22, points 1
  */
-#include <math.h> /* fabs */
+#include <float.h> /* the unit roundoff */
+#include <math.h> /* fabs, sqrt */
 #include <string.h> /* memcpy */
 
 #include "custom_driver_solver.h"
@@ -15,7 +16,17 @@ void custom_driver_default_options(custom_driver_options *options)
     options->tol_dq = 1e-09;
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
+    options->max_cond = 10000000.0;
+    options->tighten_cond = 10000.0;
+    options->target_q = 1e-08;
+    options->target_dq = 1e-07;
+    options->target_ddq = 1e-06;
 }
+
+#define CUSTOM_DRIVER_UNIT_ROUNDOFF DBL_EPSILON
+#define CUSTOM_DRIVER_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
+#define CUSTOM_DRIVER_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
+#define CUSTOM_DRIVER_SAFETY ((custom_driver_real)10) /* as runtime.accuracy.SAFETY */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static custom_driver_real custom_driver_max_abs(const custom_driver_real v[])
@@ -46,6 +57,118 @@ static int custom_driver_factor_jacobian(const custom_driver_options *options, c
     return CUSTOM_DRIVER_OK;
 }
 
+/* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu)
+{
+    custom_driver_real x[CUSTOM_DRIVER_NQ], y[CUSTOM_DRIVER_NQ], estimate = 0, norm, extra = 0;
+    int i, j, step;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) x[i] = (custom_driver_real)1 / CUSTOM_DRIVER_NQ;
+    for (step = 0; step < CUSTOM_DRIVER_ESTIMATOR_STEPS; ++step) {
+        custom_driver_real dot = 0, best;
+        memcpy(y, x, sizeof y);
+        custom_driver_lu_solve(lu, y);
+        norm = 0;
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) norm += fabs(y[i]);
+        if (norm - norm != 0) return (custom_driver_real)INFINITY;
+        if (step > 0 && norm <= estimate) break;
+        estimate = norm;
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
+        custom_driver_lu_solve_transposed(lu, y);
+        j = 0;
+        best = fabs(y[0]);
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+            dot += y[i] * x[i];
+            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        }
+        if (step > 0 && best <= dot) break;
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) x[i] = 0;
+        x[j] = 1;
+    }
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) { /* the alternating-sign test vector */
+        const custom_driver_real size = 1 + (custom_driver_real)i / (CUSTOM_DRIVER_NQ > 1 ? CUSTOM_DRIVER_NQ - 1 : 1);
+        y[i] = i % 2 == 0 ? size : -size;
+    }
+    custom_driver_lu_solve(lu, y);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) extra += fabs(y[i]);
+    extra = 2 * extra / (3 * CUSTOM_DRIVER_NQ);
+    if (extra - extra != 0) return (custom_driver_real)INFINITY;
+    return extra > estimate ? extra : estimate;
+}
+
+/* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
+static custom_driver_real custom_driver_norm1(const custom_driver_real nz[])
+{
+    custom_driver_real sums[CUSTOM_DRIVER_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < CUSTOM_DRIVER_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e) sums[custom_driver_phi_q_col[e]] += fabs(nz[e]);
+    for (j = 0; j < CUSTOM_DRIVER_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+static void custom_driver_estimate(custom_driver_workspace *work, custom_driver_report *report)
+{
+    report->inv_norm = custom_driver_inverse_norm1(&work->lu);
+    report->cond = report->inv_norm * custom_driver_norm1(work->nz);
+}
+
+static custom_driver_real custom_driver_at_least_1(custom_driver_real x)
+{
+    return x > 1 ? x : 1;
+}
+
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+static int custom_driver_flagged(const custom_driver_options *options,
+                                const custom_driver_report *report, const custom_driver_state *state)
+{
+    const custom_driver_real u = CUSTOM_DRIVER_UNIT_ROUNDOFF;
+    const custom_driver_real nq = custom_driver_max_abs(state->q), ndq = custom_driver_max_abs(state->dq);
+    const custom_driver_real nddq = custom_driver_max_abs(state->ddq);
+    const custom_driver_real s = report->inv_norm / sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
+    const custom_driver_real floor = u * (1 + nq);
+    custom_driver_real e_q, e_dq, e_ddq;
+    if (report->cond - report->cond != 0) return 1;
+    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_dq = s * (u * ndq + e_q * custom_driver_at_least_1(ndq));
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * custom_driver_at_least_1(ndq));
+    return CUSTOM_DRIVER_SAFETY * e_q > options->target_q * custom_driver_at_least_1(nq)
+        || CUSTOM_DRIVER_SAFETY * e_dq > options->target_dq * custom_driver_at_least_1(ndq)
+        || CUSTOM_DRIVER_SAFETY * e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
+}
+
+/* At a converged point: estimate the condition; where it is high, go on while the Newton step
+ * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
+ * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+static int custom_driver_converged(const custom_driver_options *options, const custom_driver_real p[],
+                                  custom_driver_real t, custom_driver_real q[], custom_driver_real step,
+                                  custom_driver_workspace *work, custom_driver_report *report)
+{
+    int i, extra, moved = 0;
+    custom_driver_estimate(work, report);
+    if (report->cond > options->tighten_cond) {
+        for (extra = 0; extra < CUSTOM_DRIVER_TIGHTEN_STEPS; ++extra) {
+            custom_driver_real size;
+            for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) work->phi[i] = -work->phi[i];
+            custom_driver_lu_solve(&work->lu, work->phi);
+            size = custom_driver_max_abs(work->phi);
+            if (!(size > 0 && size <= step / 2)) break;
+            for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) q[i] += work->phi[i];
+            custom_driver_phi(q, t, p, work->phi);
+            report->residual = custom_driver_max_abs(work->phi);
+            step = size;
+            moved = 1;
+            if (custom_driver_factor_jacobian(options, p, t, q, work, report) != CUSTOM_DRIVER_OK) {
+                return CUSTOM_DRIVER_SINGULAR;
+            }
+        }
+        if (moved) {
+            custom_driver_estimate(work, report);
+        }
+    }
+    return report->cond <= options->max_cond ? CUSTOM_DRIVER_OK : CUSTOM_DRIVER_SINGULAR;
+}
+
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
 static int custom_driver_newton(const custom_driver_options *options, const custom_driver_real p[], custom_driver_real t, custom_driver_real q[],
@@ -68,7 +191,8 @@ static int custom_driver_newton(const custom_driver_options *options, const cust
             return CUSTOM_DRIVER_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
-            return CUSTOM_DRIVER_OK;
+            return custom_driver_converged(options, p, t, q, iteration == 0 ? (custom_driver_real)INFINITY : step,
+                                          work, report);
         }
         if (iteration == options->max_iterations) {
             break;
@@ -99,6 +223,8 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
                             custom_driver_report *report)
 {
     int i;
+    report->flagged = 0;
+    report->cond = (custom_driver_real)NAN;
     if (state->started) {
         custom_driver_predict(t, state);
     } else {
@@ -123,6 +249,7 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
             return report->status;
         }
     }
+    report->flagged = custom_driver_flagged(options, report, state);
     state->t = t;
     state->started = 1;
     return CUSTOM_DRIVER_OK;
@@ -136,10 +263,13 @@ static void custom_driver_store(custom_driver_real out[], int k, const custom_dr
     }
 }
 
-int custom_driver_solve_grid(const custom_driver_options *options, const custom_driver_real p[], int n,
-                            const custom_driver_real t[], custom_driver_state *state, custom_driver_real q_out[],
-                            custom_driver_real dq_out[], custom_driver_real ddq_out[], custom_driver_workspace *work,
-                            custom_driver_report *report)
+int custom_driver_solve_grid_checked(const custom_driver_options *options,
+                                    const custom_driver_real p[], int n,
+                                    const custom_driver_real t[], custom_driver_state *state,
+                                    custom_driver_real q_out[], custom_driver_real dq_out[],
+                                    custom_driver_real ddq_out[], custom_driver_real cond_out[],
+                                    unsigned char flagged_out[], custom_driver_workspace *work,
+                                    custom_driver_report *report)
 {
     int k;
     report->status = CUSTOM_DRIVER_OK;
@@ -150,8 +280,19 @@ int custom_driver_solve_grid(const custom_driver_options *options, const custom_
         custom_driver_store(q_out, k, state->q);
         custom_driver_store(dq_out, k, state->dq);
         custom_driver_store(ddq_out, k, state->ddq);
+        if (cond_out) cond_out[k] = report->cond;
+        if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
     return n;
+}
+
+int custom_driver_solve_grid(const custom_driver_options *options, const custom_driver_real p[], int n,
+                            const custom_driver_real t[], custom_driver_state *state, custom_driver_real q_out[],
+                            custom_driver_real dq_out[], custom_driver_real ddq_out[], custom_driver_workspace *work,
+                            custom_driver_report *report)
+{
+    return custom_driver_solve_grid_checked(options, p, n, t, state, q_out, dq_out, ddq_out, NULL,
+                                           NULL, work, report);
 }
 
 /* Row block `rows` of out, or NULL when out is NULL (no arithmetic on a null pointer). */

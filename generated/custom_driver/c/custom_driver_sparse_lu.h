@@ -47,4 +47,8 @@ unsigned long custom_driver_lu_fallbacks(const custom_driver_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void custom_driver_lu_solve(const custom_driver_lu *lu, custom_driver_real b[]);
 
+/* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
+ * estimate of the solver). */
+void custom_driver_lu_solve_transposed(const custom_driver_lu *lu, custom_driver_real b[]);
+
 #endif /* CUSTOM_DRIVER_SPARSE_LU_H */

@@ -87,3 +87,23 @@ void four_bar_dense_lu_solve(const four_bar_dense_lu *lu, four_bar_real b[])
     }
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
+
+void four_bar_dense_lu_solve_transposed(const four_bar_dense_lu *lu, four_bar_real b[])
+{
+    /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */
+    const int n = FOUR_BAR_NQ;
+    const four_bar_real *a = lu->a;
+    four_bar_real x[FOUR_BAR_NQ];
+    int i, j;
+    for (i = 0; i < n; ++i) { /* U^T w = b, U^T lower triangular */
+        four_bar_real sum = b[i];
+        for (j = 0; j < i; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum / a[i * n + i];
+    }
+    for (i = n - 1; i >= 0; --i) { /* L^T v = w, unit diagonal */
+        four_bar_real sum = x[i];
+        for (j = i + 1; j < n; ++j) sum -= a[j * n + i] * x[j];
+        x[i] = sum;
+    }
+    for (i = 0; i < n; ++i) b[lu->perm[i]] = x[i];
+}

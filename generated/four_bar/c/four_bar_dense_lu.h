@@ -33,4 +33,7 @@ four_bar_real four_bar_dense_lu_pivot_ratio(const four_bar_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void four_bar_dense_lu_solve(const four_bar_dense_lu *lu, four_bar_real b[]);
 
+/* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
+void four_bar_dense_lu_solve_transposed(const four_bar_dense_lu *lu, four_bar_real b[]);
+
 #endif /* FOUR_BAR_DENSE_LU_H */

@@ -4,7 +4,8 @@
  * Mechanism spec sha256: 2eed1bb70210f583223f87cf3e0c229cbfbea589fbce03b925d45bd846ca8e2e
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 20, phi 28, phi_p 11, phi_q 21, phi_t 1, points 2
  */
-#include <math.h> /* fabs */
+#include <float.h> /* the unit roundoff */
+#include <math.h> /* fabs, sqrt */
 #include <string.h> /* memcpy */
 
 #include "four_bar_solver.h"
@@ -15,7 +16,17 @@ void four_bar_default_options(four_bar_options *options)
     options->tol_dq = 1e-09;
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
+    options->max_cond = 10000000.0;
+    options->tighten_cond = 10000.0;
+    options->target_q = 1e-08;
+    options->target_dq = 1e-07;
+    options->target_ddq = 1e-06;
 }
+
+#define FOUR_BAR_UNIT_ROUNDOFF DBL_EPSILON
+#define FOUR_BAR_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
+#define FOUR_BAR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
+#define FOUR_BAR_SAFETY ((four_bar_real)10) /* as runtime.accuracy.SAFETY */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static four_bar_real four_bar_max_abs(const four_bar_real v[])
@@ -46,6 +57,118 @@ static int four_bar_factor_jacobian(const four_bar_options *options, const four_
     return FOUR_BAR_OK;
 }
 
+/* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+static four_bar_real four_bar_inverse_norm1(const four_bar_lu *lu)
+{
+    four_bar_real x[FOUR_BAR_NQ], y[FOUR_BAR_NQ], estimate = 0, norm, extra = 0;
+    int i, j, step;
+    for (i = 0; i < FOUR_BAR_NQ; ++i) x[i] = (four_bar_real)1 / FOUR_BAR_NQ;
+    for (step = 0; step < FOUR_BAR_ESTIMATOR_STEPS; ++step) {
+        four_bar_real dot = 0, best;
+        memcpy(y, x, sizeof y);
+        four_bar_lu_solve(lu, y);
+        norm = 0;
+        for (i = 0; i < FOUR_BAR_NQ; ++i) norm += fabs(y[i]);
+        if (norm - norm != 0) return (four_bar_real)INFINITY;
+        if (step > 0 && norm <= estimate) break;
+        estimate = norm;
+        for (i = 0; i < FOUR_BAR_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
+        four_bar_lu_solve_transposed(lu, y);
+        j = 0;
+        best = fabs(y[0]);
+        for (i = 0; i < FOUR_BAR_NQ; ++i) {
+            dot += y[i] * x[i];
+            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        }
+        if (step > 0 && best <= dot) break;
+        for (i = 0; i < FOUR_BAR_NQ; ++i) x[i] = 0;
+        x[j] = 1;
+    }
+    for (i = 0; i < FOUR_BAR_NQ; ++i) { /* the alternating-sign test vector */
+        const four_bar_real size = 1 + (four_bar_real)i / (FOUR_BAR_NQ > 1 ? FOUR_BAR_NQ - 1 : 1);
+        y[i] = i % 2 == 0 ? size : -size;
+    }
+    four_bar_lu_solve(lu, y);
+    for (i = 0; i < FOUR_BAR_NQ; ++i) extra += fabs(y[i]);
+    extra = 2 * extra / (3 * FOUR_BAR_NQ);
+    if (extra - extra != 0) return (four_bar_real)INFINITY;
+    return extra > estimate ? extra : estimate;
+}
+
+/* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
+static four_bar_real four_bar_norm1(const four_bar_real nz[])
+{
+    four_bar_real sums[FOUR_BAR_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < FOUR_BAR_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < FOUR_BAR_NNZ; ++e) sums[four_bar_phi_q_col[e]] += fabs(nz[e]);
+    for (j = 0; j < FOUR_BAR_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+static void four_bar_estimate(four_bar_workspace *work, four_bar_report *report)
+{
+    report->inv_norm = four_bar_inverse_norm1(&work->lu);
+    report->cond = report->inv_norm * four_bar_norm1(work->nz);
+}
+
+static four_bar_real four_bar_at_least_1(four_bar_real x)
+{
+    return x > 1 ? x : 1;
+}
+
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+static int four_bar_flagged(const four_bar_options *options,
+                                const four_bar_report *report, const four_bar_state *state)
+{
+    const four_bar_real u = FOUR_BAR_UNIT_ROUNDOFF;
+    const four_bar_real nq = four_bar_max_abs(state->q), ndq = four_bar_max_abs(state->dq);
+    const four_bar_real nddq = four_bar_max_abs(state->ddq);
+    const four_bar_real s = report->inv_norm / sqrt((four_bar_real)FOUR_BAR_NQ);
+    const four_bar_real floor = u * (1 + nq);
+    four_bar_real e_q, e_dq, e_ddq;
+    if (report->cond - report->cond != 0) return 1;
+    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_dq = s * (u * ndq + e_q * four_bar_at_least_1(ndq));
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * four_bar_at_least_1(ndq));
+    return FOUR_BAR_SAFETY * e_q > options->target_q * four_bar_at_least_1(nq)
+        || FOUR_BAR_SAFETY * e_dq > options->target_dq * four_bar_at_least_1(ndq)
+        || FOUR_BAR_SAFETY * e_ddq > options->target_ddq * four_bar_at_least_1(nddq);
+}
+
+/* At a converged point: estimate the condition; where it is high, go on while the Newton step
+ * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
+ * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+static int four_bar_converged(const four_bar_options *options, const four_bar_real p[],
+                                  four_bar_real t, four_bar_real q[], four_bar_real step,
+                                  four_bar_workspace *work, four_bar_report *report)
+{
+    int i, extra, moved = 0;
+    four_bar_estimate(work, report);
+    if (report->cond > options->tighten_cond) {
+        for (extra = 0; extra < FOUR_BAR_TIGHTEN_STEPS; ++extra) {
+            four_bar_real size;
+            for (i = 0; i < FOUR_BAR_NQ; ++i) work->phi[i] = -work->phi[i];
+            four_bar_lu_solve(&work->lu, work->phi);
+            size = four_bar_max_abs(work->phi);
+            if (!(size > 0 && size <= step / 2)) break;
+            for (i = 0; i < FOUR_BAR_NQ; ++i) q[i] += work->phi[i];
+            four_bar_phi(q, t, p, work->phi);
+            report->residual = four_bar_max_abs(work->phi);
+            step = size;
+            moved = 1;
+            if (four_bar_factor_jacobian(options, p, t, q, work, report) != FOUR_BAR_OK) {
+                return FOUR_BAR_SINGULAR;
+            }
+        }
+        if (moved) {
+            four_bar_estimate(work, report);
+        }
+    }
+    return report->cond <= options->max_cond ? FOUR_BAR_OK : FOUR_BAR_SINGULAR;
+}
+
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
 static int four_bar_newton(const four_bar_options *options, const four_bar_real p[], four_bar_real t, four_bar_real q[],
@@ -68,7 +191,8 @@ static int four_bar_newton(const four_bar_options *options, const four_bar_real 
             return FOUR_BAR_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
-            return FOUR_BAR_OK;
+            return four_bar_converged(options, p, t, q, iteration == 0 ? (four_bar_real)INFINITY : step,
+                                          work, report);
         }
         if (iteration == options->max_iterations) {
             break;
@@ -99,6 +223,8 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
                             four_bar_report *report)
 {
     int i;
+    report->flagged = 0;
+    report->cond = (four_bar_real)NAN;
     if (state->started) {
         four_bar_predict(t, state);
     } else {
@@ -123,6 +249,7 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
             return report->status;
         }
     }
+    report->flagged = four_bar_flagged(options, report, state);
     state->t = t;
     state->started = 1;
     return FOUR_BAR_OK;
@@ -136,10 +263,13 @@ static void four_bar_store(four_bar_real out[], int k, const four_bar_real v[])
     }
 }
 
-int four_bar_solve_grid(const four_bar_options *options, const four_bar_real p[], int n,
-                            const four_bar_real t[], four_bar_state *state, four_bar_real q_out[],
-                            four_bar_real dq_out[], four_bar_real ddq_out[], four_bar_workspace *work,
-                            four_bar_report *report)
+int four_bar_solve_grid_checked(const four_bar_options *options,
+                                    const four_bar_real p[], int n,
+                                    const four_bar_real t[], four_bar_state *state,
+                                    four_bar_real q_out[], four_bar_real dq_out[],
+                                    four_bar_real ddq_out[], four_bar_real cond_out[],
+                                    unsigned char flagged_out[], four_bar_workspace *work,
+                                    four_bar_report *report)
 {
     int k;
     report->status = FOUR_BAR_OK;
@@ -150,8 +280,19 @@ int four_bar_solve_grid(const four_bar_options *options, const four_bar_real p[]
         four_bar_store(q_out, k, state->q);
         four_bar_store(dq_out, k, state->dq);
         four_bar_store(ddq_out, k, state->ddq);
+        if (cond_out) cond_out[k] = report->cond;
+        if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
     return n;
+}
+
+int four_bar_solve_grid(const four_bar_options *options, const four_bar_real p[], int n,
+                            const four_bar_real t[], four_bar_state *state, four_bar_real q_out[],
+                            four_bar_real dq_out[], four_bar_real ddq_out[], four_bar_workspace *work,
+                            four_bar_report *report)
+{
+    return four_bar_solve_grid_checked(options, p, n, t, state, q_out, dq_out, ddq_out, NULL,
+                                           NULL, work, report);
 }
 
 /* Row block `rows` of out, or NULL when out is NULL (no arithmetic on a null pointer). */

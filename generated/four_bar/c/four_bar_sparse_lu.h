@@ -47,4 +47,8 @@ unsigned long four_bar_lu_fallbacks(const four_bar_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void four_bar_lu_solve(const four_bar_lu *lu, four_bar_real b[]);
 
+/* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
+ * estimate of the solver). */
+void four_bar_lu_solve_transposed(const four_bar_lu *lu, four_bar_real b[]);
+
 #endif /* FOUR_BAR_SPARSE_LU_H */

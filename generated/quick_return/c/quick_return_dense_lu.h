@@ -33,4 +33,7 @@ quick_return_real quick_return_dense_lu_pivot_ratio(const quick_return_dense_lu 
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void quick_return_dense_lu_solve(const quick_return_dense_lu *lu, quick_return_real b[]);
 
+/* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
+void quick_return_dense_lu_solve_transposed(const quick_return_dense_lu *lu, quick_return_real b[]);
+
 #endif /* QUICK_RETURN_DENSE_LU_H */

@@ -4,7 +4,8 @@
  * Mechanism spec sha256: 4a2477ac80c60facac51b252e876ac049dc8ec9543ce809613e6036902ab4801
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 53, phi 34, phi_p 10, phi_q 37, phi_t 1, points 3
  */
-#include <math.h> /* fabs */
+#include <float.h> /* the unit roundoff */
+#include <math.h> /* fabs, sqrt */
 #include <string.h> /* memcpy */
 
 #include "quick_return_solver.h"
@@ -15,7 +16,17 @@ void quick_return_default_options(quick_return_options *options)
     options->tol_dq = 1e-09;
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
+    options->max_cond = 10000000.0;
+    options->tighten_cond = 10000.0;
+    options->target_q = 1e-08;
+    options->target_dq = 1e-07;
+    options->target_ddq = 1e-06;
 }
+
+#define QUICK_RETURN_UNIT_ROUNDOFF DBL_EPSILON
+#define QUICK_RETURN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
+#define QUICK_RETURN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
+#define QUICK_RETURN_SAFETY ((quick_return_real)10) /* as runtime.accuracy.SAFETY */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static quick_return_real quick_return_max_abs(const quick_return_real v[])
@@ -46,6 +57,118 @@ static int quick_return_factor_jacobian(const quick_return_options *options, con
     return QUICK_RETURN_OK;
 }
 
+/* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
+{
+    quick_return_real x[QUICK_RETURN_NQ], y[QUICK_RETURN_NQ], estimate = 0, norm, extra = 0;
+    int i, j, step;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) x[i] = (quick_return_real)1 / QUICK_RETURN_NQ;
+    for (step = 0; step < QUICK_RETURN_ESTIMATOR_STEPS; ++step) {
+        quick_return_real dot = 0, best;
+        memcpy(y, x, sizeof y);
+        quick_return_lu_solve(lu, y);
+        norm = 0;
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) norm += fabs(y[i]);
+        if (norm - norm != 0) return (quick_return_real)INFINITY;
+        if (step > 0 && norm <= estimate) break;
+        estimate = norm;
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
+        quick_return_lu_solve_transposed(lu, y);
+        j = 0;
+        best = fabs(y[0]);
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+            dot += y[i] * x[i];
+            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        }
+        if (step > 0 && best <= dot) break;
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) x[i] = 0;
+        x[j] = 1;
+    }
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) { /* the alternating-sign test vector */
+        const quick_return_real size = 1 + (quick_return_real)i / (QUICK_RETURN_NQ > 1 ? QUICK_RETURN_NQ - 1 : 1);
+        y[i] = i % 2 == 0 ? size : -size;
+    }
+    quick_return_lu_solve(lu, y);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) extra += fabs(y[i]);
+    extra = 2 * extra / (3 * QUICK_RETURN_NQ);
+    if (extra - extra != 0) return (quick_return_real)INFINITY;
+    return extra > estimate ? extra : estimate;
+}
+
+/* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
+static quick_return_real quick_return_norm1(const quick_return_real nz[])
+{
+    quick_return_real sums[QUICK_RETURN_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < QUICK_RETURN_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < QUICK_RETURN_NNZ; ++e) sums[quick_return_phi_q_col[e]] += fabs(nz[e]);
+    for (j = 0; j < QUICK_RETURN_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+static void quick_return_estimate(quick_return_workspace *work, quick_return_report *report)
+{
+    report->inv_norm = quick_return_inverse_norm1(&work->lu);
+    report->cond = report->inv_norm * quick_return_norm1(work->nz);
+}
+
+static quick_return_real quick_return_at_least_1(quick_return_real x)
+{
+    return x > 1 ? x : 1;
+}
+
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+static int quick_return_flagged(const quick_return_options *options,
+                                const quick_return_report *report, const quick_return_state *state)
+{
+    const quick_return_real u = QUICK_RETURN_UNIT_ROUNDOFF;
+    const quick_return_real nq = quick_return_max_abs(state->q), ndq = quick_return_max_abs(state->dq);
+    const quick_return_real nddq = quick_return_max_abs(state->ddq);
+    const quick_return_real s = report->inv_norm / sqrt((quick_return_real)QUICK_RETURN_NQ);
+    const quick_return_real floor = u * (1 + nq);
+    quick_return_real e_q, e_dq, e_ddq;
+    if (report->cond - report->cond != 0) return 1;
+    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_dq = s * (u * ndq + e_q * quick_return_at_least_1(ndq));
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * quick_return_at_least_1(ndq));
+    return QUICK_RETURN_SAFETY * e_q > options->target_q * quick_return_at_least_1(nq)
+        || QUICK_RETURN_SAFETY * e_dq > options->target_dq * quick_return_at_least_1(ndq)
+        || QUICK_RETURN_SAFETY * e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
+}
+
+/* At a converged point: estimate the condition; where it is high, go on while the Newton step
+ * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
+ * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+static int quick_return_converged(const quick_return_options *options, const quick_return_real p[],
+                                  quick_return_real t, quick_return_real q[], quick_return_real step,
+                                  quick_return_workspace *work, quick_return_report *report)
+{
+    int i, extra, moved = 0;
+    quick_return_estimate(work, report);
+    if (report->cond > options->tighten_cond) {
+        for (extra = 0; extra < QUICK_RETURN_TIGHTEN_STEPS; ++extra) {
+            quick_return_real size;
+            for (i = 0; i < QUICK_RETURN_NQ; ++i) work->phi[i] = -work->phi[i];
+            quick_return_lu_solve(&work->lu, work->phi);
+            size = quick_return_max_abs(work->phi);
+            if (!(size > 0 && size <= step / 2)) break;
+            for (i = 0; i < QUICK_RETURN_NQ; ++i) q[i] += work->phi[i];
+            quick_return_phi(q, t, p, work->phi);
+            report->residual = quick_return_max_abs(work->phi);
+            step = size;
+            moved = 1;
+            if (quick_return_factor_jacobian(options, p, t, q, work, report) != QUICK_RETURN_OK) {
+                return QUICK_RETURN_SINGULAR;
+            }
+        }
+        if (moved) {
+            quick_return_estimate(work, report);
+        }
+    }
+    return report->cond <= options->max_cond ? QUICK_RETURN_OK : QUICK_RETURN_SINGULAR;
+}
+
 /* Newton-Raphson that tests the residual of the current iterate; on success work->lu holds
  * the factors of Phi_q at the converged q. */
 static int quick_return_newton(const quick_return_options *options, const quick_return_real p[], quick_return_real t, quick_return_real q[],
@@ -68,7 +191,8 @@ static int quick_return_newton(const quick_return_options *options, const quick_
             return QUICK_RETURN_SINGULAR;
         }
         if (residual <= options->tol_phi && (iteration == 0 || step <= options->tol_dq)) {
-            return QUICK_RETURN_OK;
+            return quick_return_converged(options, p, t, q, iteration == 0 ? (quick_return_real)INFINITY : step,
+                                          work, report);
         }
         if (iteration == options->max_iterations) {
             break;
@@ -99,6 +223,8 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
                             quick_return_report *report)
 {
     int i;
+    report->flagged = 0;
+    report->cond = (quick_return_real)NAN;
     if (state->started) {
         quick_return_predict(t, state);
     } else {
@@ -123,6 +249,7 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
             return report->status;
         }
     }
+    report->flagged = quick_return_flagged(options, report, state);
     state->t = t;
     state->started = 1;
     return QUICK_RETURN_OK;
@@ -136,10 +263,13 @@ static void quick_return_store(quick_return_real out[], int k, const quick_retur
     }
 }
 
-int quick_return_solve_grid(const quick_return_options *options, const quick_return_real p[], int n,
-                            const quick_return_real t[], quick_return_state *state, quick_return_real q_out[],
-                            quick_return_real dq_out[], quick_return_real ddq_out[], quick_return_workspace *work,
-                            quick_return_report *report)
+int quick_return_solve_grid_checked(const quick_return_options *options,
+                                    const quick_return_real p[], int n,
+                                    const quick_return_real t[], quick_return_state *state,
+                                    quick_return_real q_out[], quick_return_real dq_out[],
+                                    quick_return_real ddq_out[], quick_return_real cond_out[],
+                                    unsigned char flagged_out[], quick_return_workspace *work,
+                                    quick_return_report *report)
 {
     int k;
     report->status = QUICK_RETURN_OK;
@@ -150,8 +280,19 @@ int quick_return_solve_grid(const quick_return_options *options, const quick_ret
         quick_return_store(q_out, k, state->q);
         quick_return_store(dq_out, k, state->dq);
         quick_return_store(ddq_out, k, state->ddq);
+        if (cond_out) cond_out[k] = report->cond;
+        if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
     return n;
+}
+
+int quick_return_solve_grid(const quick_return_options *options, const quick_return_real p[], int n,
+                            const quick_return_real t[], quick_return_state *state, quick_return_real q_out[],
+                            quick_return_real dq_out[], quick_return_real ddq_out[], quick_return_workspace *work,
+                            quick_return_report *report)
+{
+    return quick_return_solve_grid_checked(options, p, n, t, state, q_out, dq_out, ddq_out, NULL,
+                                           NULL, work, report);
 }
 
 /* Row block `rows` of out, or NULL when out is NULL (no arithmetic on a null pointer). */

@@ -197,3 +197,52 @@ void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[])
     b[10] = x[10];
     b[11] = x[11];
 }
+
+/* The factors' structure as index tables, for the transposed solve only (the straight-line
+ * code above needs none): see the tables style for their layout. */
+static const int quick_return_lu_row_perm[QUICK_RETURN_NQ] = {
+    7, 5, 8, 6, 4, 0, 1, 11, 2, 3, 10, 9
+};
+static const int quick_return_lu_col_perm[QUICK_RETURN_NQ] = {
+    9, 6, 8, 7, 5, 0, 1, 2, 3, 4, 10, 11
+};
+static const int quick_return_lu_lower_start[13] = {
+    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0
+};
+
+static const int quick_return_lu_lower[2] = {
+    0, 0
+};
+
+static const int quick_return_lu_upper_start[13] = {
+    0, 2, 4, 6, 8, 13, 13, 13, 13, 13, 13, 13, 13
+};
+
+static const int quick_return_lu_upper[28] = {
+    1, 16, 2, 17, 4, 11, 8, 10, 3, 19, 10, 21, 4, 14, 9, 13, 5, 4, 6, 5, 7, 6, 8, 7, 9, 8, 0, 0
+};
+
+void quick_return_lu_solve_transposed(const quick_return_lu *lu, quick_return_real b[])
+{
+    /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
+    quick_return_real x[QUICK_RETURN_NQ];
+    int k, e;
+    if (lu->dense) {
+        quick_return_dense_lu_solve_transposed(&lu->dense_lu, b);
+        return;
+    }
+    for (k = 0; k < QUICK_RETURN_NQ; ++k) x[k] = b[quick_return_lu_col_perm[k]];
+    for (k = 0; k < QUICK_RETURN_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
+        const quick_return_real zk = x[k] * lu->inv[k];
+        x[k] = zk;
+        for (e = quick_return_lu_upper_start[k]; e < quick_return_lu_upper_start[k + 1]; ++e)
+            x[quick_return_lu_upper[2 * e]] -= lu->v[quick_return_lu_upper[2 * e + 1]] * zk;
+    }
+    for (k = QUICK_RETURN_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
+        quick_return_real sum = x[k];
+        for (e = quick_return_lu_lower_start[k]; e < quick_return_lu_lower_start[k + 1]; ++e)
+            sum -= lu->v[quick_return_lu_lower[2 * e + 1]] * x[quick_return_lu_lower[2 * e]];
+        x[k] = sum;
+    }
+    for (k = 0; k < QUICK_RETURN_NQ; ++k) b[quick_return_lu_row_perm[k]] = x[k];
+}

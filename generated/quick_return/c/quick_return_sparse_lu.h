@@ -47,4 +47,8 @@ unsigned long quick_return_lu_fallbacks(const quick_return_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[]);
 
+/* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
+ * estimate of the solver). */
+void quick_return_lu_solve_transposed(const quick_return_lu *lu, quick_return_real b[]);
+
 #endif /* QUICK_RETURN_SPARSE_LU_H */

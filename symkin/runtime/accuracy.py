@@ -1,0 +1,97 @@
+"""Accuracy you can see: the condition of Phi_q at a solved point and whether q, dq, ddq there
+can be trusted to the accuracy targets.
+
+The estimate of ||Phi_q^-1||_1 is Hager's method with Higham's refinements (the algorithm of
+LAPACK's xLACN2): a few solves with the factors already made, never a new factorization. The
+generated C solver (templates/c/solver.c.j2) runs the same steps and the same error model, so
+both backends flag the same points.
+
+The error model, with u the unit roundoff and s = ||Phi_q^-1||_1 / sqrt(N) (max norms of
+vectors; near a singularity the 1-norm sums the null vector over about N entries, where one
+coordinate's error sees only its share):
+    e_q   = s max(r, u (1 + |q|))                  the residual r, or the rounding of Phi
+    e_dq  = s (u |dq| + e_q max(1, |dq|))          the solve's rounding, and Phi_q moved by e_q
+    e_ddq = s (u |ddq| + e_q (|ddq| + |dq|^2) + 2 e_dq max(1, |dq|))
+each times SAFETY; a point is flagged when one of them exceeds its target times max(1, |x|).
+The errors of a nearly singular Phi_q lie along its null direction and are amplified by s at
+each stage (position into velocity, velocity into acceleration), which is what the chain of
+parallelogram four-bars shows near its singular configuration (tests/test_edges_*.py).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.runtime.options import Options
+
+Array = NDArray[np.float64]
+Solve = Callable[[Array], Array]
+
+UNIT_ROUNDOFF = {"double": 2.0**-52, "float": 2.0**-23}
+SAFETY = 10.0
+"""The error model's estimates are multiplied by this before they are compared with the
+targets: the condition estimate may be low by a small factor, and the rounding of Phi is only
+known in size."""
+
+ESTIMATOR_STEPS = 5
+
+
+def inverse_norm1(solve: Solve, solve_transposed: Solve, n: int) -> float:
+    """An estimate (never above the true value, usually equal) of ||A^-1||_1 from solves.
+
+    Hager's method (1984) as refined by Higham (1988): ascend the convex function ||A^-1 x||_1
+    over the unit ball of the 1-norm, then compare with an alternating-sign test vector.
+    """
+    x = np.full(n, 1.0 / n)
+    estimate = 0.0
+    for step in range(ESTIMATOR_STEPS):
+        y = solve(x)
+        norm = float(np.abs(y).sum())
+        if not math.isfinite(norm):
+            return math.inf
+        if step > 0 and norm <= estimate:
+            break
+        estimate = norm
+        z = solve_transposed(np.where(y >= 0, 1.0, -1.0))
+        j = int(np.argmax(np.abs(z)))
+        if step > 0 and abs(z[j]) <= float(z @ x):
+            break
+        x = np.zeros(n)
+        x[j] = 1.0
+    signs = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    alternating = signs * (1.0 + np.arange(n) / max(n - 1, 1))
+    extra = 2.0 * float(np.abs(solve(alternating)).sum()) / (3.0 * n)
+    return max(estimate, extra) if math.isfinite(extra) else math.inf
+
+
+def norm1(nz: Array, cols: NDArray[np.intp], n: int) -> float:
+    """||Phi_q||_1, the largest column sum of |entries|, from the structural non-zeros."""
+    sums = np.zeros(n)
+    np.add.at(sums, cols, np.abs(nz))
+    return float(sums.max(initial=0.0))
+
+
+def errors(inv_norm: float, residual: float, n: int, nq: float, ndq: float, nddq: float,
+           unit: float) -> tuple[float, float, float]:
+    """The estimated errors of q, dq and ddq at a solved point (the model of the docstring),
+    from the max norms nq, ndq, nddq of q, dq, ddq (N of them each)."""
+    s = inv_norm / math.sqrt(n)
+    e_q = s * max(residual, unit * (1.0 + nq))
+    e_dq = s * (unit * ndq + e_q * max(1.0, ndq))
+    e_ddq = s * (unit * nddq + e_q * (nddq + ndq * ndq) + 2.0 * e_dq * max(1.0, ndq))
+    return SAFETY * e_q, SAFETY * e_dq, SAFETY * e_ddq
+
+
+def flagged(inv_norm: float, norm_a: float, residual: float, q: Array, dq: Array, ddq: Array,
+            options: Options, unit: float) -> bool:
+    """True when the estimated error of q, dq or ddq misses its target (options.target_*)."""
+    if not math.isfinite(inv_norm * norm_a):
+        return True
+    nq, ndq, nddq = (float(np.abs(v).max(initial=0.0)) for v in (q, dq, ddq))
+    e_q, e_dq, e_ddq = errors(inv_norm, residual, q.size, nq, ndq, nddq, unit)
+    return (e_q > options.target_q * max(1.0, nq) or e_dq > options.target_dq * max(1.0, ndq)
+            or e_ddq > options.target_ddq * max(1.0, nddq))

@@ -1,0 +1,107 @@
+"""Assembly at t0 from a rough first guess.
+
+Plain Newton from q0 first. When it fails (also when Phi_q is singular at the guess itself,
+e.g. every body of a slider chain placed on the slider's axis), Levenberg-Marquardt runs from
+several starts, in a fixed order, and the first start that Newton then finishes wins:
+
+1. q0 itself;
+2. the bodies placed along their joints: q0's angles kept, the positions solved for in the
+   least-squares sense (for fixed angles every pair of the chapter is linear in x and y);
+3. q0 perturbed (a fixed seed, so runs repeat);
+4. the bodies placed along their joints at random angles (fixed seed).
+
+When every start fails, the outcome says how close the best came and which evidence there is:
+the same least residual reached from many different starts points at the dimensions (the
+links cannot close); different residuals from different starts point at local minima (a
+better q0 will do).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.runtime.newton import Newton, levenberg_marquardt, newton
+from symkin.runtime.options import OK, SINGULAR, Options
+from symkin.runtime.protocol import KinematicsKernel
+
+Array = NDArray[np.float64]
+
+PERTURBED, RANDOM_ANGLES = 3, 8
+SEED = 20240
+
+
+@dataclass
+class Assembly:
+    """The outcome: ``result`` is Newton's at the assembled (or best) q. When it failed,
+    ``residuals`` are the least max |Phi| reached from each start and ``evidence`` is
+    "link lengths" or "a better q0"."""
+
+    result: Newton
+    starts: int
+    residuals: tuple[float, ...] = ()
+    evidence: str = ""
+
+
+def assemble(kernel: KinematicsKernel, q0: Array, t0: float, p: Array,
+             options: Options) -> Assembly:
+    """Assemble the mechanism at t0 from q0 (see the module docstring)."""
+    first = newton(kernel, q0, t0, p, options)
+    if first.status == OK:
+        return Assembly(first, 1)
+    best: Newton | None = None
+    singular: Newton | None = None  # assembled, but in a singular configuration
+    residuals = []
+    for count, start in enumerate(_starts(kernel, q0, t0, p), start=1):
+        q, residual = levenberg_marquardt(kernel, start, t0, p, options)
+        polished = newton(kernel, q, t0, p, options)
+        polished.iterations += first.iterations
+        if polished.status == OK:
+            return Assembly(polished, count + 1)
+        residuals.append(residual)
+        if polished.status == SINGULAR and polished.residual <= options.tol_phi:
+            singular = singular or polished
+        elif best is None or residual < best.residual:
+            best = Newton(q, polished.status, polished.iterations, residual, None)
+    if singular is not None:
+        return Assembly(singular, len(residuals) + 1, tuple(residuals))
+    assert best is not None
+    return Assembly(best, len(residuals) + 1, tuple(residuals), _evidence(residuals))
+
+
+def _evidence(residuals: list[float]) -> str:
+    """The same least residual from many starts: the dimensions; else local minima."""
+    least = min(residuals)
+    alike = sum(1 for r in residuals if r <= 1.05 * least + 1e-9)
+    return "link lengths" if alike >= max(2, len(residuals) // 3) else "a better q0"
+
+
+def _starts(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> Iterator[Array]:
+    rng = np.random.default_rng(SEED)
+    angles = np.array([name.endswith(".phi") for name in kernel.coordinates])
+    yield np.array(q0, dtype=float)
+    yield _placed(kernel, q0, angles, t0, p)
+    scale = np.where(angles, 0.5, 0.2 * max(1.0, float(np.abs(q0).max(initial=0.0))))
+    for _ in range(PERTURBED):
+        yield q0 + scale * rng.standard_normal(q0.size)
+    for _ in range(RANDOM_ANGLES):
+        q = np.array(q0, dtype=float)
+        q[angles] = rng.uniform(-math.pi, math.pi, int(angles.sum()))
+        yield _placed(kernel, q, angles, t0, p)
+
+
+def _placed(kernel: KinematicsKernel, q: Array, angles: NDArray[np.bool_], t0: float,
+            p: Array) -> Array:
+    """q with its angles kept and its positions solved in the least-squares sense."""
+    q = np.array(q, dtype=float)
+    q[~angles] = 0.0
+    phi = kernel.phi(q, t0, p)
+    jacobian = kernel.phi_q(q, t0, p)[:, ~angles]
+    if not (np.all(np.isfinite(phi)) and np.all(np.isfinite(jacobian))):
+        return q
+    q[~angles] = np.linalg.lstsq(jacobian, -phi, rcond=None)[0]
+    return q

@@ -1,0 +1,230 @@
+"""The grid points where the plain step fails: a step too large, a singular configuration the
+motion passes through, or a limit position the driven motion cannot pass.
+
+At such a point the step from the last solved point is subdivided (halved on failure, doubled
+on success; the chapter allows a variable step h_i) until it reaches the point or the failing
+step is below ``h_min``. Then:
+
+- reached: the step was only too large; the point is solved as any other.
+- blocked at t_b, but a step over t_b (from t_b - delta to t_b + delta) converges: the motion
+  passes through a singular configuration at t_b on the branch the predictor follows. A grid
+  point within that step gets q, dq, ddq from the quintic Hermite interpolant of the two
+  solved points on either side (accurate to O(delta^4) in ddq), its position then corrected
+  once in the minimum-norm least-squares sense, and it is flagged.
+- blocked and no step over it converges: a limit position when Phi_q becomes singular as
+  t_b is approached (its condition grows without bound), else a plain failure to converge.
+
+Imports NumPy only: part of the runtime.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.runtime.linalg import dependencies
+from symkin.runtime.newton import Point, kinematics, newton
+from symkin.runtime.options import OK, Options
+from symkin.runtime.protocol import KinematicsKernel
+
+Array = NDArray[np.float64]
+
+DELTA_FRACTION = 1.0 / 64
+"""The step over a singular configuration spans 2 delta, delta = this times the grid step."""
+
+LIMIT_COND = 1e5
+"""A failure where Phi_q's condition at the last point reached exceeds this (or a tenth of
+options.max_cond, if lower) is a limit position (sigma_min -> 0 as t_b is approached), not a
+Newton failure."""
+
+
+@dataclass
+class State:
+    """A solved point (the predictor's state)."""
+
+    t: float
+    point: Point
+
+
+@dataclass
+class Passage:
+    """A singular configuration passed through near t, and what was singular there."""
+
+    t: float
+    rank_loss: int
+    groups: list[list[str]]
+
+
+@dataclass
+class Resolution:
+    """What happened at a grid point the plain step could not solve.
+
+    point: the solved point (None when the motion stops); passage: a singular configuration
+    passed on the way; limit: True when the stop is a limit position; reached, failed_at:
+    the last time solved and the first that failed; groups: the dependent rows there.
+    """
+
+    point: Point | None
+    passage: Passage | None = None
+    limit: bool = False
+    reached: State | None = None
+    failed_at: float = math.nan
+    groups: tuple[tuple[str, ...], ...] = ()
+    aligned: tuple[str, ...] = ()
+    drivers: tuple[str, ...] = ()
+
+
+def _step(kernel: KinematicsKernel, p: Array, options: Options, state: State, t: float
+          ) -> State | None:
+    """Predict from state (2.76), Newton at t, velocities and accelerations; None on failure."""
+    h = t - state.t
+    point = state.point
+    guess = point.q + point.dq * h + point.ddq * (h * h / 2)
+    result = newton(kernel, guess, t, p, options)
+    if result.status != OK:
+        return None
+    solved = kinematics(kernel, result, t, p, options)
+    return None if solved is None else State(t, solved)
+
+
+def march(kernel: KinematicsKernel, p: Array, options: Options, state: State, target: float,
+          h0: float, h_min: float) -> tuple[State, float]:
+    """Advance from state to target by substeps; returns the last state reached and the step
+    that failed from it (0 when target was reached)."""
+    h = h0
+    while state.t < target:
+        step = min(h, target - state.t)
+        following = _step(kernel, p, options, state, target if step == target - state.t
+                          else state.t + step)
+        if following is None:
+            if step <= h_min:
+                return state, step
+            h = step / 2
+        else:
+            state, h = following, min(2 * step, h0)
+    return state, 0.0
+
+
+def hermite(a: State, b: State, t: float) -> tuple[Array, Array, Array]:
+    """q, dq, ddq at t from the quintic Hermite interpolant of q, dq, ddq at a.t and b.t."""
+    mid, half = (a.t + b.t) / 2, (b.t - a.t) / 2
+    s = (t - mid) / half
+
+    def rows(x: float) -> list[list[float]]:
+        value = [x**k for k in range(6)]
+        first = [k * x ** (k - 1) if k else 0.0 for k in range(6)]
+        second = [k * (k - 1) * x ** (k - 2) if k > 1 else 0.0 for k in range(6)]
+        return [value, first, second]
+
+    matrix = np.array(rows(-1.0) + rows(1.0))
+    scale = np.array([1.0, half, half * half])
+    data = np.vstack([np.vstack([a.point.q, a.point.dq, a.point.ddq]) * scale[:, None],
+                      np.vstack([b.point.q, b.point.dq, b.point.ddq]) * scale[:, None]])
+    coefficients = np.linalg.solve(matrix, data)
+    at = np.array(rows(s)) @ coefficients
+    return at[0], at[1] / half, at[2] / (half * half)
+
+
+def _through(kernel: KinematicsKernel, p: Array, options: Options, before: State,
+             after: State, t: float) -> Point:
+    """The flagged point at t between the two sides of a singular configuration."""
+    q, dq, ddq = hermite(before, after, t)
+    jacobian = kernel.phi_q(q, t, p)
+    # Minimum norm, the nearly singular directions cut off: it moves nothing along them.
+    correction = np.linalg.lstsq(jacobian, -kernel.phi(q, t, p), rcond=1e-6)[0]
+    q = q + correction
+    cond = float(np.linalg.cond(jacobian, 1)) if np.all(np.isfinite(jacobian)) else math.inf
+    return Point(q, dq, ddq, cond, True)
+
+
+def resolve(kernel: KinematicsKernel, p: Array, options: Options, previous: State,
+            t: float) -> Resolution:
+    """Solve the grid point t that the plain step from ``previous`` could not."""
+    h0 = t - previous.t
+    h_min = max(1e-9 * h0, 1e-13 * (1.0 + abs(t)))
+    state, failed = march(kernel, p, options, previous, t, h0, h_min)
+    if not failed:
+        return Resolution(state.point)
+    blocked = state.t + failed
+    delta = DELTA_FRACTION * h0
+    before, early = march(kernel, p, options, previous, blocked - delta, h0, h_min) \
+        if blocked - delta > previous.t else (previous, 0.0)
+    after = None if early else _over(kernel, p, options, before, blocked, delta, h0)
+    if after is None:
+        return _stopped(kernel, p, options, state, failed)
+    passage = _passage(kernel, p, before, after)
+    if t <= after.t:
+        return Resolution(_through(kernel, p, options, before, after, t), passage)
+    rest, failed = march(kernel, p, options, after, t, h0, h_min)
+    if failed:
+        stop = _stopped(kernel, p, options, rest, failed)
+        stop.passage = passage
+        return stop
+    return Resolution(rest.point, passage)
+
+
+def _over(kernel: KinematicsKernel, p: Array, options: Options, before: State, blocked: float,
+          delta: float, h0: float) -> State | None:
+    """One step from before to past the blocked time: delta past it, or twice, four times ...
+    as far (up to a grid step) when Phi_q is still too ill-conditioned there."""
+    reach = delta
+    while reach <= h0:
+        after = _step(kernel, p, options, before, blocked + reach)
+        if after is not None:
+            return after
+        reach *= 2
+    return None
+
+
+def _passage(kernel: KinematicsKernel, p: Array, before: State, after: State) -> Passage:
+    """Where between the two sides Phi_q is most nearly singular (sigma_min / sigma_max
+    minimised along the interpolated motion), and what is singular there."""
+    from scipy.optimize import minimize_scalar
+
+    def ratio(t: float) -> float:
+        sigma = np.linalg.svd(kernel.phi_q(hermite(before, after, t)[0], t, p),
+                              compute_uv=False)
+        return float(sigma[-1] / sigma[0])
+
+    found = minimize_scalar(ratio, bounds=(before.t, after.t), method="bounded",
+                            options={"xatol": 1e-13 * (1.0 + abs(after.t))})
+    t = float(found.x)
+    q, _, _ = hermite(before, after, t)
+    rank_loss, groups = dependencies(kernel.phi_q(q, t, p), list(kernel.rows), rcond=1e-7)
+    return Passage(t, rank_loss, groups)
+
+
+def _stopped(kernel: KinematicsKernel, p: Array, options: Options, state: State,
+             failed: float) -> Resolution:
+    """The motion cannot go on past state.t: a limit position, or no convergence."""
+    threshold = min(LIMIT_COND, options.max_cond / 10)
+    limit = state.point.cond > threshold
+    stop = Resolution(None, limit=limit, reached=state, failed_at=state.t + failed)
+    if limit:
+        jacobian = kernel.phi_q(state.point.q, state.t, p)
+        _, found = dependencies(jacobian, list(kernel.rows), rcond=1.0 / threshold)
+        stop.groups = tuple(tuple(group) for group in found)
+        stop.aligned, stop.drivers = _aligned(kernel, jacobian)
+    return stop
+
+
+def _aligned(kernel: KinematicsKernel, jacobian: Array) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The joints that become aligned at a limit position, and the drivers that hold.
+
+    The right null vector of Phi_q is the motion the constraints allow with every driver held:
+    the bodies it moves are the aligned links, and the joints on them are the aligned joints;
+    the drivers are the rows that the dependent set holds besides."""
+    _, _, vt = np.linalg.svd(jacobian)
+    motion = np.abs(vt[-1])
+    body = [name.rsplit(".", 1)[0] for name in kernel.coordinates]
+    bodies = {body[c] for c in np.flatnonzero(motion > 1e-3 * motion.max())}
+    rows = sorted({int(r) for r, c in zip(kernel.pattern_rows, kernel.pattern_cols)
+                   if body[int(c)] in bodies})
+    names = [kernel.rows[r].rsplit(" (", 1)[0] for r in rows]
+    joints = tuple(dict.fromkeys(n for n in names if n.startswith("joints")))
+    drivers = tuple(dict.fromkeys(label.rsplit(" (", 1)[0] for label in kernel.rows
+                                  if label.startswith("drivers")))
+    return joints, drivers
