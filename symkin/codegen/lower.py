@@ -39,10 +39,33 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "phi_t": ("q", "t", "p"),
     "gamma": ("q", "dq", "t", "p"),
     "points": ("p",),
+    # Fused evaluation (see _fused_expressions): one call per Newton iterate evaluates Phi, the
+    # non-zeros of Phi_q and the shared sines and cosines; Phi_t and Gamma at the converged q
+    # read those instead of calling libm again.
+    "phi_phi_q": ("q", "t", "p"),
+    "phi_t_shared": ("q", "t", "p", "shared"),
+    "gamma_shared": ("q", "dq", "t", "p", "shared"),
 }
+FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
 
 # Characters allowed in a comment of generated code; anything else becomes '?'.
 _COMMENT_UNSAFE = re.compile(r"[^A-Za-z0-9_.,:;()\[\] +=-]")
+
+
+PART_OUTPUTS = 200
+"""Outputs per generated function: a larger routine is split into parts of this many outputs,
+each with its own CSE, so that neither SymPy's CSE nor the C compiler (both superlinear in
+the size of one function) sees more than a bounded piece; the parts are consecutive outputs
+(rows of a chain stay together, so little sharing is lost between parts)."""
+
+
+@dataclass(frozen=True)
+class Part:
+    """A bounded piece of a routine: its temporaries and the output positions it writes."""
+
+    temporaries: tuple[tuple[str, str], ...]
+    slots: tuple[int, ...]
+    unused: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -57,6 +80,10 @@ class Routine:
         temporaries: ``(name, expression)`` pairs, in evaluation order.
         outputs: one expression per output slot.
         ops: operation count after CSE (SymPy's ``count_ops``).
+        sizes: how the outputs split among several output arrays, in order (the fused
+            ``phi_phi_q``: Phi, the non-zeros of Phi_q, the shared values); empty for one.
+        parts: the routine in pieces of at most PART_OUTPUTS outputs (one part when small);
+            ``temporaries`` is then the first part's.
     """
 
     name: str
@@ -65,6 +92,8 @@ class Routine:
     temporaries: tuple[tuple[str, str], ...]
     outputs: tuple[str, ...]
     ops: int
+    sizes: tuple[int, ...] = ()
+    parts: tuple[Part, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -92,6 +121,10 @@ class Code:
     linalg: str = DEFAULT_LINALG
     lu_plan: LUPlan | None = None
     """The sparse LU's pivot order and steps (C with sparse linear algebra only)."""
+    shared: tuple[str, ...] = ()
+    """The sines and cosines the fused routine passes to Phi_t and Gamma (printed, in order)."""
+    constant_nz: tuple[float | None, ...] = ()
+    """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
 
     @property
     def nnz(self) -> int:
@@ -135,9 +168,13 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
     pattern = system.pattern()
     expressions = _routine_expressions(system, pattern)
     printer = _printer(backend, real)
-    routines = tuple(
-        _routine(name, [symbols.prepare(e, internal) for e in exprs], printer, cse)
-        for name, exprs in expressions.items())
+    prepared = {name: [symbols.prepare(e, internal) for e in exprs]
+                for name, exprs in expressions.items()}
+    fused, shared = _fused_expressions(prepared)
+    sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}
+    orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
+    routines = tuple(_routine(name, exprs, printer, cse, sizes.get(name, ()), orders.get(name))
+                     for name, exprs in {**prepared, **fused}.items())
     return Code(
         backend=backend, real=real, cse=cse, name=system.name,
         spec_sha256=system.mechanism.spec_hash(), nq=len(system.q), n_params=len(system.p),
@@ -146,10 +183,13 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         time_grid=system.time_grid, rows=tuple(str(row) for row in system.rows),
         pattern_rows=tuple(r for r, _ in pattern), pattern_cols=tuple(c for _, c in pattern),
         points=point_names(system), routines=routines,
-        ops_before_cse={name: _count_ops(exprs) for name, exprs in expressions.items()},
+        ops_before_cse={name: _count_ops(exprs)
+                        for name, exprs in {**expressions, **fused}.items()},
         linalg=linalg,
         lu_plan=(sample.sparse_lu_plan(system, pattern)
                  if backend == "c" and linalg == "sparse" else None),
+        shared=tuple(_print(printer, f) for f in shared),
+        constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
     )
 
 
@@ -176,6 +216,30 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]]
     }
 
 
+def _fused_expressions(prepared: dict[str, list[sp.Expr]]
+                       ) -> tuple[dict[str, list[sp.Expr]], list[sp.Expr]]:
+    """The fused routines' expressions, and the values they share.
+
+    ``phi_phi_q`` outputs Phi, the non-zeros of Phi_q and every sine or cosine that Phi or
+    Phi_q and also Phi_t or Gamma use, with one CSE over all of them (so each is evaluated
+    once); ``phi_t_shared`` and ``gamma_shared`` read those values (``shared[k]``) instead of
+    calling sin and cos again. They are evaluated at the same q, t and p, so the values are
+    the same numbers bit for bit.
+    """
+    def trig(names: tuple[str, ...]) -> set[sp.Expr]:
+        found: set[sp.Expr] = set()
+        for name in names:
+            for e in prepared[name]:
+                found |= e.atoms(sp.sin, sp.cos)
+        return found
+
+    shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma")), key=sp.default_sort_key)
+    mapping = {f: sp.Symbol(f"_shared{k}", real=True) for k, f in enumerate(shared)}
+    return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
+            "phi_t_shared": [e.xreplace(mapping) for e in prepared["phi_t"]],
+            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]]}, shared
+
+
 def point_names(system: System) -> tuple[tuple[str, str], ...]:
     """Every named point as (body, point), bodies and points in file order."""
     return tuple((body_name, point) for body_name, body in system.mechanism.bodies.items()
@@ -189,20 +253,55 @@ def point_vectors(system: System) -> list[tuple[sp.Expr, sp.Expr]]:
     return [tuple(ctx.local(body, point)) for body, point in point_names(system)]
 
 
-def _routine(name: str, exprs: list[sp.Expr], printer: Any, cse: bool) -> Routine:
-    temporaries: list[tuple[sp.Symbol, sp.Expr]] = []
-    if cse and exprs:
-        temporaries, exprs = sp.cse(exprs, symbols=sp.numbered_symbols("w", real=True),
-                                    order="canonical")
-        temporaries, exprs = _inline_trivial(temporaries, exprs)
-    used = set().union(*(e.free_symbols for e in [*exprs, *(v for _, v in temporaries)]))
-    used_names = {symbol_text(s.name).split("[")[0] for s in used}
+def _fused_order(prepared: dict[str, list[sp.Expr]], pattern: Sequence[tuple[int, int]],
+                 shared: list[sp.Expr]) -> list[int]:
+    """The fused routine's outputs row by row: Phi's row, that row's non-zeros of Phi_q, then
+    the shared values it first uses; so a part keeps a row's sines and cosines together."""
+    nq, nnz = len(prepared["phi"]), len(pattern)
+    by_row: dict[int, list[int]] = {}
+    for e, (r, _) in enumerate(pattern):
+        by_row.setdefault(r, []).append(e)
+    where = {f: nq + nnz + k for k, f in enumerate(shared)}
+    order: list[int] = []
+    for r in range(nq):
+        row = [r, *(nq + e for e in by_row.get(r, []))]
+        order += row
+        exprs = [prepared["phi"][r], *(prepared["phi_q"][e] for e in by_row.get(r, []))]
+        for e in exprs:
+            for f in sorted(e.atoms(sp.sin, sp.cos) & where.keys(), key=sp.default_sort_key):
+                order.append(where.pop(f))
+    return order + sorted(where.values())
+
+
+def _routine(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
+             sizes: tuple[int, ...] = (), order: Sequence[int] | None = None) -> Routine:
+    positions = list(order) if order is not None else list(range(len(exprs)))
+    chunks = [positions[i:i + PART_OUTPUTS] for i in range(0, len(positions), PART_OUTPUTS)]
+    outputs: list[sp.Expr] = list(exprs)
+    parts, ops, used_names = [], 0, set()
+    for chunk in chunks or [[]]:
+        temporaries: list[tuple[sp.Symbol, sp.Expr]] = []
+        values = [exprs[k] for k in chunk]
+        if cse and values:
+            temporaries, values = sp.cse(values, symbols=sp.numbered_symbols("w", real=True),
+                                         order="canonical")
+            temporaries, values = _inline_trivial(temporaries, values)
+        for k, value in zip(chunk, values):
+            outputs[k] = value
+        used = set().union(*(e.free_symbols for e in [*values, *(v for _, v in temporaries)]))
+        names = {symbol_text(s.name).split("[")[0] for s in used}
+        used_names |= names
+        ops += _count_ops([*values, *(v for _, v in temporaries)])
+        parts.append(Part(
+            temporaries=tuple((str(s), _print(printer, v)) for s, v in temporaries),
+            slots=tuple(chunk),
+            unused=tuple(a for a in ROUTINE_ARGUMENTS[name] if a not in names)))
     return Routine(
         name=name, arguments=ROUTINE_ARGUMENTS[name],
         unused=tuple(a for a in ROUTINE_ARGUMENTS[name] if a not in used_names),
-        temporaries=tuple((str(s), _print(printer, v)) for s, v in temporaries),
-        outputs=tuple(_print(printer, e) for e in exprs),
-        ops=_count_ops([*exprs, *(v for _, v in temporaries)]),
+        temporaries=parts[0].temporaries,
+        outputs=tuple(_print(printer, e) for e in outputs),
+        ops=ops, sizes=sizes, parts=tuple(parts),
     )
 
 

@@ -345,7 +345,8 @@ factorization and three solves, but 4.8 s of gcc against 0.3 s), hence the high 
 
 
 def template_context(plan: LUPlan, part_ops: int = PART_OPS,
-                     style: str | None = None) -> dict[str, object]:
+                     style: str | None = None, constants: Sequence[float | None] | None = None,
+                     real: str = "double", *, prefix: str) -> dict[str, object]:
     """The plan as plain data for ``templates/c/sparse_lu.*.j2`` (key ``lu``).
 
     Args:
@@ -353,14 +354,26 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
         part_ops: operations per generated function in the straight-line style.
         style: "straight" (one C statement per operation) or "tables" (loops over static
             index arrays); by default straight-line up to TABLE_FLOPS operations.
+        constants: per non-zero of Phi_q (pattern order), its value when it is a number at
+            every state; the straight-line code folds them in (codegen.lu_straight). Used in
+            double precision only (a float build would round literals differently).
+        real: the C real type.
+        prefix: the C prefix of the generated functions.
     """
+    from symkin.codegen import lu_straight
+    from symkin.codegen.backends.c import literal
+
     if style is None:
         style = "straight" if plan.flops + plan.solve_flops <= TABLE_FLOPS else "tables"
     if style not in ("straight", "tables"):
         raise ValueError(f"unknown sparse LU style {style!r}: use 'straight' or 'tables'")
+    code = lu_straight.statements(plan, constants if real == "double" else None, literal(real),
+                                  prefix, "fabsf" if real == "float" else "fabs")
     steps = [{"k": s.k, "row": s.row, "col": s.col, "pivot": s.pivot,
               "lower": [list(x) for x in s.lower], "upper": [list(x) for x in s.upper],
-              "updates": [list(x) for x in s.updates]} for s in plan.steps]
+              "updates": [list(x) for x in s.updates], "factor": code.factor[s.k],
+              "cmax": code.uses_cmax[s.k], "forward": code.forward[s.k],
+              "backward": code.backward[plan.n - 1 - s.k]} for s in plan.steps]
     backward = list(reversed(steps))
     return {
         "n_lu": plan.n_lu,
@@ -372,12 +385,24 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
         "col_perm": list(plan.col_perm),
         "fill_slots": list(range(plan.nnz, plan.n_lu)),
         "unchecked": list(plan.unchecked),
-        "ratio_tests": sum(1 for s in plan.steps if s.lower),
-        "factor_parts": _parts(steps, lambda s: 2 + 2 * len(s["lower"]) + len(s["updates"]),
-                               part_ops),
-        "forward_parts": _parts([s for s in steps if s["lower"]], lambda s: len(s["lower"]),
+        "ratio_tests": (code.ratio_tests if style == "straight"
+                        else sum(1 for s in plan.steps if s.lower)),
+        "tiny_check": code.tiny_check if style == "straight" else None,
+        "init": code.init if style == "straight" else [],
+        "init_inv": code.init_inv if style == "straight" else [],
+        "loaded": code.loaded,
+        "known_max": code.known_max,
+        "inv_low": code.inv_low,
+        "inv_high": code.inv_high,
+        "variable_pivots": [k for k in range(plan.n)
+                            if style == "tables" or k not in dict(code.init_inv)],
+        "pivot_ok": code.uses_pivot_ok or style == "tables",
+        "constant_pivots": code.constant_pivots if style == "straight" else 0,
+        "factor_parts": _parts(steps, lambda s: len(s["factor"]), part_ops),
+        "forward_parts": _parts([s for s in steps if s["forward"]], lambda s: len(s["forward"]),
                                 part_ops),
-        "backward_parts": _parts(backward, lambda s: 1 + len(s["upper"]), part_ops),
+        "backward_parts": _parts([s for s in backward if s["backward"]],
+                                 lambda s: len(s["backward"]), part_ops),
         "style": style,
         "tables": _tables(plan),
     }
@@ -414,7 +439,7 @@ def _parts(steps: list[dict[str, Any]], size: Callable[[dict[str, Any]], int],
             total = 0
         runs[-1].append(step)
         total += ops
-    return [{"steps": run, "checks": any(s["lower"] for s in run)} for run in runs]
+    return [{"steps": run, "checks": any(s["cmax"] for s in run)} for run in runs]
 
 
 def solve_with_plan(plan: LUPlan, nz: Sequence[float], b: Sequence[float]) -> np.ndarray:
