@@ -13,7 +13,8 @@ results are the same bits as the unfolded code's.
 The factorization reads only the entries of its input that vary: the others are this
 Phi_q's numbers (the header says so). The workspace still holds every value for any other
 reader of ``lu->v`` and ``lu->inv``: ``<prefix>_lu_init`` stores the final value of every known
-slot and the reciprocal of every constant pivot once; the factorization never overwrites them. The tests that remain at run time still catch every near-singular pivot: a
+slot and the reciprocal of every constant pivot once; the factorization never overwrites them.
+The tests that remain at run time still catch every near-singular pivot: a
 constant pivot c can only fail the tiny-pivot bound (NQ eps max |Phi_q| >= |c|, also true when
 an entry is inf or NaN), tested once for the smallest constant pivot; the threshold test of a
 constant pivot with unknown entries below it stays a run-time test; an unknown pivot keeps both.
