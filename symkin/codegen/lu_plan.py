@@ -396,6 +396,12 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
         "inv_high": code.inv_high,
         "variable_pivots": [k for k in range(plan.n)
                             if style == "tables" or k not in dict(code.init_inv)],
+        # Beyond one part's worth, per-entry code becomes loops over static tables: a
+        # function thousands of lines long costs the compiler far more than the loop costs.
+        "perm_tables": style == "tables" or plan.n > part_ops,
+        "init_tables": style == "straight" and len(code.init) + len(code.init_inv) > part_ops,
+        "loop_tables": style == "straight" and (len(code.loaded) > part_ops
+                                                or plan.n > part_ops),
         "pivot_ok": code.uses_pivot_ok or style == "tables",
         "constant_pivots": code.constant_pivots if style == "straight" else 0,
         "factor_parts": _parts(steps, lambda s: len(s["factor"]), part_ops),
