@@ -173,8 +173,18 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
     fused, shared = _fused_expressions(prepared)
     sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}
     orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
-    routines = tuple(_routine(name, exprs, printer, cse, sizes.get(name, ()), orders.get(name))
-                     for name, exprs in {**prepared, **fused}.items())
+    # Phi and Phi_q alone are the fused routine's pieces: its CSE and printing serve all three.
+    fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse,
+                                 orders["phi_phi_q"])
+    nq, nnz = len(system.q), len(pattern)
+    own = {"phi": _select("phi", fused_parts, {k: k for k in range(nq)}, nq),
+           "phi_q": _select("phi_q", fused_parts, {nq + e: e for e in range(nnz)}, nnz),
+           "phi_phi_q": _assemble("phi_phi_q", fused_parts, len(fused["phi_phi_q"]),
+                                  sizes["phi_phi_q"])}
+    routines = tuple(
+        own[name] if name in own else
+        _assemble(name, _lowered_parts(name, exprs, printer, cse), len(exprs))
+        for name, exprs in {**prepared, **fused}.items())
     return Code(
         backend=backend, real=real, cse=cse, name=system.name,
         spec_sha256=system.mechanism.spec_hash(), nq=len(system.q), n_params=len(system.p),
@@ -183,8 +193,7 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         time_grid=system.time_grid, rows=tuple(str(row) for row in system.rows),
         pattern_rows=tuple(r for r, _ in pattern), pattern_cols=tuple(c for _, c in pattern),
         points=point_names(system), routines=routines,
-        ops_before_cse={name: _count_ops(exprs)
-                        for name, exprs in {**expressions, **fused}.items()},
+        ops_before_cse=_ops_before_cse(expressions, fused, shared),
         linalg=linalg,
         lu_plan=(sample.sparse_lu_plan(system, pattern)
                  if backend == "c" and linalg == "sparse" else None),
@@ -273,12 +282,26 @@ def _fused_order(prepared: dict[str, list[sp.Expr]], pattern: Sequence[tuple[int
     return order + sorted(where.values())
 
 
-def _routine(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
-             sizes: tuple[int, ...] = (), order: Sequence[int] | None = None) -> Routine:
+@dataclass
+class _Lowered:
+    """One part of a routine before it becomes text-only: what each temporary and output
+    needs (the symbols it reads), so that a routine can be a selection of another's parts."""
+
+    temporaries: list[tuple[str, str, frozenset[str], int]]  # name, text, reads, ops
+    slots: list[int]  # output positions
+    outputs: list[tuple[str, frozenset[str], int]]  # text, reads, ops
+
+
+def _reads(expr: sp.Expr) -> frozenset[str]:
+    return frozenset(s.name for s in expr.free_symbols)
+
+
+def _lowered_parts(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
+                   order: Sequence[int] | None = None) -> list[_Lowered]:
+    """CSE and print ``exprs`` in parts of at most PART_OUTPUTS outputs (in ``order``)."""
     positions = list(order) if order is not None else list(range(len(exprs)))
     chunks = [positions[i:i + PART_OUTPUTS] for i in range(0, len(positions), PART_OUTPUTS)]
-    outputs: list[sp.Expr] = list(exprs)
-    parts, ops, used_names = [], 0, set()
+    parts = []
     for chunk in chunks or [[]]:
         temporaries: list[tuple[sp.Symbol, sp.Expr]] = []
         values = [exprs[k] for k in chunk]
@@ -286,23 +309,73 @@ def _routine(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
             temporaries, values = sp.cse(values, symbols=sp.numbered_symbols("w", real=True),
                                          order="canonical")
             temporaries, values = _inline_trivial(temporaries, values)
-        for k, value in zip(chunk, values):
-            outputs[k] = value
-        used = set().union(*(e.free_symbols for e in [*values, *(v for _, v in temporaries)]))
-        names = {symbol_text(s.name).split("[")[0] for s in used}
+        parts.append(_Lowered(
+            temporaries=[(str(t), _print(printer, v), _reads(v), _count_ops([v]))
+                         for t, v in temporaries],
+            slots=list(chunk),
+            outputs=[(_print(printer, v), _reads(v), _count_ops([v])) for v in values]))
+    del name
+    return parts
+
+
+def _argument_names(reads: set[str]) -> set[str]:
+    return {symbol_text(r).split("[")[0] for r in reads if not r.startswith("w")}
+
+
+def _assemble(name: str, parts: list[_Lowered], n_outputs: int,
+              sizes: tuple[int, ...] = ()) -> Routine:
+    """A Routine (plain text) from lowered parts."""
+    outputs = [""] * n_outputs
+    done, ops, used_names = [], 0, set()
+    for part in parts:
+        reads: set[str] = set()
+        for _, _, r, count in part.temporaries:
+            reads |= r
+            ops += count
+        for k, (text, r, count) in zip(part.slots, part.outputs):
+            outputs[k] = text
+            reads |= r
+            ops += count
+        names = _argument_names(reads)
         used_names |= names
-        ops += _count_ops([*values, *(v for _, v in temporaries)])
-        parts.append(Part(
-            temporaries=tuple((str(s), _print(printer, v)) for s, v in temporaries),
-            slots=tuple(chunk),
-            unused=tuple(a for a in ROUTINE_ARGUMENTS[name] if a not in names)))
+        done.append(Part(temporaries=tuple((n, t) for n, t, _, _ in part.temporaries),
+                         slots=tuple(part.slots),
+                         unused=tuple(a for a in ROUTINE_ARGUMENTS[name] if a not in names)))
     return Routine(
         name=name, arguments=ROUTINE_ARGUMENTS[name],
         unused=tuple(a for a in ROUTINE_ARGUMENTS[name] if a not in used_names),
-        temporaries=parts[0].temporaries,
-        outputs=tuple(_print(printer, e) for e in outputs),
-        ops=ops, sizes=sizes, parts=tuple(parts),
-    )
+        temporaries=done[0].temporaries, outputs=tuple(outputs), ops=ops, sizes=sizes,
+        parts=tuple(done))
+
+
+def _select(name: str, parts: list[_Lowered], positions: dict[int, int], n_outputs: int
+            ) -> Routine:
+    """The routine made of some outputs of another's parts (``positions``: theirs -> its),
+    each part with the temporaries its selected outputs need, in their order."""
+    selected = []
+    for part in parts:
+        keep = [(positions[k], out) for k, out in zip(part.slots, part.outputs)
+                if k in positions]
+        needed = set().union(*(r for _, (_, r, _) in keep)) if keep else set()
+        temporaries = []
+        for temporary in reversed(part.temporaries):
+            if temporary[0] in needed:
+                needed |= temporary[2]
+                temporaries.append(temporary)
+        if keep:
+            selected.append(_Lowered(temporaries=temporaries[::-1], slots=[k for k, _ in keep],
+                                     outputs=[out for _, out in keep]))
+    return _assemble(name, selected or [_Lowered([], [], [])], n_outputs)
+
+
+def _ops_before_cse(expressions: dict[str, list[sp.Expr]], fused: dict[str, list[sp.Expr]],
+                    shared: list[sp.Expr]) -> dict[str, int]:
+    """SymPy's count_ops of every routine before CSE; the fused Phi and Phi_q is the sum of
+    its pieces (count_ops of a list is the sum over it), so it is not counted twice."""
+    counts = {name: _count_ops(exprs) for name, exprs in expressions.items()}
+    counts["phi_phi_q"] = counts["phi"] + counts["phi_q"] + _count_ops(shared)
+    counts.update({name: _count_ops(fused[name]) for name in ("phi_t_shared", "gamma_shared")})
+    return counts
 
 
 def _inline_trivial(temporaries: list[tuple[sp.Symbol, sp.Expr]], exprs: list[sp.Expr]

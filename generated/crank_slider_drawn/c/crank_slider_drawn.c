@@ -16,16 +16,22 @@ const crank_slider_drawn_real crank_slider_drawn_p_nominal[CRANK_SLIDER_DRAWN_NP
 
 void crank_slider_drawn_phi(const crank_slider_drawn_real q[], crank_slider_drawn_real t, const crank_slider_drawn_real p[], crank_slider_drawn_real *restrict out)
 {
-    const crank_slider_drawn_real w0 = sin(q[5]);
-    const crank_slider_drawn_real w1 = -p[0] + p[2];
-    const crank_slider_drawn_real w2 = cos(q[5]);
-    const crank_slider_drawn_real w3 = sqrt((p[1]*p[1]) - (w1*w1));
+    const crank_slider_drawn_real w0 = cos(q[2]);
+    const crank_slider_drawn_real w1 = p[0]*w0;
+    const crank_slider_drawn_real w2 = sin(q[2]);
+    const crank_slider_drawn_real w3 = p[0]*w2;
+    const crank_slider_drawn_real w4 = sin(q[5]);
+    const crank_slider_drawn_real w5 = -p[0] + p[2];
+    const crank_slider_drawn_real w6 = w4*w5;
+    const crank_slider_drawn_real w7 = cos(q[5]);
+    const crank_slider_drawn_real w8 = sqrt((p[1]*p[1]) - (w5*w5));
+    const crank_slider_drawn_real w9 = w4*w8 + w5*w7;
     out[0] = -q[0];  /* joints[0] revolute ground-crank (x) */
     out[1] = -q[1];  /* joints[0] revolute ground-crank (y) */
-    out[2] = p[0]*cos(q[2]) + q[0] - q[3];  /* joints[1] revolute crank-rod (x) */
-    out[3] = p[0]*sin(q[2]) + q[1] - q[4];  /* joints[1] revolute crank-rod (y) */
-    out[4] = q[3] - q[6] - w0*w1 + w2*w3;  /* joints[2] revolute rod-slider (x) */
-    out[5] = q[4] - q[7] + w0*w3 + w1*w2;  /* joints[2] revolute rod-slider (y) */
+    out[2] = q[0] - q[3] + w1;  /* joints[1] revolute crank-rod (x) */
+    out[3] = q[1] - q[4] + w3;  /* joints[1] revolute crank-rod (y) */
+    out[4] = q[3] - q[6] - w6 + w7*w8;  /* joints[2] revolute rod-slider (x) */
+    out[5] = q[4] - q[7] + w9;  /* joints[2] revolute rod-slider (y) */
     out[6] = q[8];  /* joints[3] prismatic slider-ground (angle) */
     out[7] = p[2] - q[7];  /* joints[3] prismatic slider-ground (perpendicular) */
     out[8] = q[2] - (t*t) - 1.5707963267948966;  /* drivers[0] angle crank-ground (angle) */
@@ -34,23 +40,29 @@ void crank_slider_drawn_phi(const crank_slider_drawn_real q[], crank_slider_draw
 void crank_slider_drawn_phi_q(const crank_slider_drawn_real q[], crank_slider_drawn_real t, const crank_slider_drawn_real p[], crank_slider_drawn_real *restrict nz)
 {
     (void)t;
-    const crank_slider_drawn_real w0 = cos(q[5]);
-    const crank_slider_drawn_real w1 = -p[0] + p[2];
-    const crank_slider_drawn_real w2 = sin(q[5]);
-    const crank_slider_drawn_real w3 = sqrt((p[1]*p[1]) - (w1*w1));
+    const crank_slider_drawn_real w0 = cos(q[2]);
+    const crank_slider_drawn_real w1 = p[0]*w0;
+    const crank_slider_drawn_real w2 = sin(q[2]);
+    const crank_slider_drawn_real w3 = p[0]*w2;
+    const crank_slider_drawn_real w4 = sin(q[5]);
+    const crank_slider_drawn_real w5 = -p[0] + p[2];
+    const crank_slider_drawn_real w6 = w4*w5;
+    const crank_slider_drawn_real w7 = cos(q[5]);
+    const crank_slider_drawn_real w8 = sqrt((p[1]*p[1]) - (w5*w5));
+    const crank_slider_drawn_real w9 = w4*w8 + w5*w7;
     nz[0] = -1;  /* (0, 0) */
     nz[1] = -1;  /* (1, 1) */
     nz[2] = 1;  /* (2, 0) */
-    nz[3] = -p[0]*sin(q[2]);  /* (2, 2) */
+    nz[3] = -w3;  /* (2, 2) */
     nz[4] = -1;  /* (2, 3) */
     nz[5] = 1;  /* (3, 1) */
-    nz[6] = p[0]*cos(q[2]);  /* (3, 2) */
+    nz[6] = w1;  /* (3, 2) */
     nz[7] = -1;  /* (3, 4) */
     nz[8] = 1;  /* (4, 3) */
-    nz[9] = -w0*w1 - w2*w3;  /* (4, 5) */
+    nz[9] = -w9;  /* (4, 5) */
     nz[10] = -1;  /* (4, 6) */
     nz[11] = 1;  /* (5, 4) */
-    nz[12] = w0*w3 - w1*w2;  /* (5, 5) */
+    nz[12] = -w6 + w7*w8;  /* (5, 5) */
     nz[13] = -1;  /* (5, 7) */
     nz[14] = 1;  /* (6, 8) */
     nz[15] = -1;  /* (7, 7) */

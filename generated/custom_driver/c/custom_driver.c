@@ -16,48 +16,66 @@ const custom_driver_real custom_driver_p_nominal[CUSTOM_DRIVER_NP] = { 1.0, 3.5,
 
 void custom_driver_phi(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real *restrict out)
 {
-    const custom_driver_real w0 = p[0]*cos(q[2]) + q[0];
-    const custom_driver_real w1 = p[0]*sin(q[2]) + q[1];
-    const custom_driver_real w3 = p[2]*t;
-    const custom_driver_real w4 = p[3]*sin(w3) + p[4] + w3;
+    const custom_driver_real w0 = cos(q[2]);
+    const custom_driver_real w1 = p[0]*w0;
+    const custom_driver_real w2 = q[0] + w1;
+    const custom_driver_real w3 = sin(q[2]);
+    const custom_driver_real w4 = p[0]*w3;
+    const custom_driver_real w5 = q[1] + w4;
+    const custom_driver_real w6 = cos(q[5]);
+    const custom_driver_real w7 = p[1]*w6;
+    const custom_driver_real w8 = sin(q[5]);
+    const custom_driver_real w9 = p[1]*w8;
+    const custom_driver_real w11 = p[2]*t;
+    const custom_driver_real w12 = sin(w11);
+    const custom_driver_real w13 = p[3]*w12 + p[4] + w11;
+    const custom_driver_real w14 = cos(w13);
+    const custom_driver_real w15 = sin(w13);
     out[0] = -q[0];  /* joints[0] O revolute ground-crank (x) */
     out[1] = -q[1];  /* joints[0] O revolute ground-crank (y) */
-    out[2] = -q[3] + w0;  /* joints[1] A revolute crank-rod (x) */
-    out[3] = -q[4] + w1;  /* joints[1] A revolute crank-rod (y) */
-    out[4] = p[1]*cos(q[5]) + q[3] - q[6];  /* joints[2] B revolute rod-slider (x) */
-    out[5] = p[1]*sin(q[5]) + q[4] - q[7];  /* joints[2] B revolute rod-slider (y) */
+    out[2] = -q[3] + w2;  /* joints[1] A revolute crank-rod (x) */
+    out[3] = -q[4] + w5;  /* joints[1] A revolute crank-rod (y) */
+    out[4] = q[3] - q[6] + w7;  /* joints[2] B revolute rod-slider (x) */
+    out[5] = q[4] - q[7] + w9;  /* joints[2] B revolute rod-slider (y) */
     out[6] = q[8];  /* joints[3] guide prismatic slider-ground (angle) */
     out[7] = -q[7];  /* joints[3] guide prismatic slider-ground (perpendicular) */
-    out[8] = w0*sin(w4) - w1*cos(w4);  /* drivers[0] slotted_guide custom crank (equation 0) */
+    out[8] = -w14*w5 + w15*w2;  /* drivers[0] slotted_guide custom crank (equation 0) */
 }
 
 void custom_driver_phi_q(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real *restrict nz)
 {
-    const custom_driver_real w0 = p[0]*sin(q[2]);
-    const custom_driver_real w1 = p[0]*cos(q[2]);
-    const custom_driver_real w2 = p[2]*t;
-    const custom_driver_real w3 = p[3]*sin(w2) + p[4] + w2;
-    const custom_driver_real w4 = sin(w3);
-    const custom_driver_real w5 = cos(w3);
+    const custom_driver_real w0 = cos(q[2]);
+    const custom_driver_real w1 = p[0]*w0;
+    const custom_driver_real w3 = sin(q[2]);
+    const custom_driver_real w4 = p[0]*w3;
+    const custom_driver_real w6 = cos(q[5]);
+    const custom_driver_real w7 = p[1]*w6;
+    const custom_driver_real w8 = sin(q[5]);
+    const custom_driver_real w9 = p[1]*w8;
+    const custom_driver_real w11 = p[2]*t;
+    const custom_driver_real w12 = sin(w11);
+    const custom_driver_real w13 = p[3]*w12 + p[4] + w11;
+    const custom_driver_real w14 = cos(w13);
+    const custom_driver_real w15 = sin(w13);
     nz[0] = -1;  /* (0, 0) */
     nz[1] = -1;  /* (1, 1) */
     nz[2] = 1;  /* (2, 0) */
-    nz[3] = -w0;  /* (2, 2) */
+    nz[3] = -w4;  /* (2, 2) */
     nz[4] = -1;  /* (2, 3) */
     nz[5] = 1;  /* (3, 1) */
     nz[6] = w1;  /* (3, 2) */
     nz[7] = -1;  /* (3, 4) */
     nz[8] = 1;  /* (4, 3) */
-    nz[9] = -p[1]*sin(q[5]);  /* (4, 5) */
+    nz[9] = -w9;  /* (4, 5) */
     nz[10] = -1;  /* (4, 6) */
     nz[11] = 1;  /* (5, 4) */
-    nz[12] = p[1]*cos(q[5]);  /* (5, 5) */
+    nz[12] = w7;  /* (5, 5) */
     nz[13] = -1;  /* (5, 7) */
     nz[14] = 1;  /* (6, 8) */
     nz[15] = -1;  /* (7, 7) */
-    nz[16] = w4;  /* (8, 0) */
-    nz[17] = -w5;  /* (8, 1) */
-    nz[18] = -w0*w4 - w1*w5;  /* (8, 2) */
+    nz[16] = w15;  /* (8, 0) */
+    nz[17] = -w14;  /* (8, 1) */
+    nz[18] = -w1*w14 - w15*w4;  /* (8, 2) */
 }
 
 void custom_driver_phi_t(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[], custom_driver_real *restrict out)

@@ -64,20 +64,31 @@ def phi(q, t, p=None):
     if p is None:
         p = P_VALUES
     t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
-    w0 = p[0]*numpy.cos(q[2]) + q[0]
-    w1 = p[0]*numpy.sin(q[2]) + q[1]
-    w3 = p[2]*t
-    w4 = p[3]*numpy.sin(w3) + p[4] + w3
+    w0 = numpy.cos(q[2])
+    w1 = p[0]*w0
+    w2 = q[0] + w1
+    w3 = numpy.sin(q[2])
+    w4 = p[0]*w3
+    w5 = q[1] + w4
+    w6 = numpy.cos(q[5])
+    w7 = p[1]*w6
+    w8 = numpy.sin(q[5])
+    w9 = p[1]*w8
+    w11 = p[2]*t
+    w12 = numpy.sin(w11)
+    w13 = p[3]*w12 + p[4] + w11
+    w14 = numpy.cos(w13)
+    w15 = numpy.sin(w13)
     out = numpy.zeros(9)
     out[0] = -q[0]  # joints[0] O revolute ground-crank (x)
     out[1] = -q[1]  # joints[0] O revolute ground-crank (y)
-    out[2] = -q[3] + w0  # joints[1] A revolute crank-rod (x)
-    out[3] = -q[4] + w1  # joints[1] A revolute crank-rod (y)
-    out[4] = p[1]*numpy.cos(q[5]) + q[3] - q[6]  # joints[2] B revolute rod-slider (x)
-    out[5] = p[1]*numpy.sin(q[5]) + q[4] - q[7]  # joints[2] B revolute rod-slider (y)
+    out[2] = -q[3] + w2  # joints[1] A revolute crank-rod (x)
+    out[3] = -q[4] + w5  # joints[1] A revolute crank-rod (y)
+    out[4] = q[3] - q[6] + w7  # joints[2] B revolute rod-slider (x)
+    out[5] = q[4] - q[7] + w9  # joints[2] B revolute rod-slider (y)
     out[6] = q[8]  # joints[3] guide prismatic slider-ground (angle)
     out[7] = -q[7]  # joints[3] guide prismatic slider-ground (perpendicular)
-    out[8] = w0*numpy.sin(w4) - w1*numpy.cos(w4)  # drivers[0] slotted_guide custom crank (equation 0)
+    out[8] = -w14*w5 + w15*w2  # drivers[0] slotted_guide custom crank (equation 0)
     return out
 
 
@@ -86,32 +97,39 @@ def phi_q_nz(q, t, p=None):
     if p is None:
         p = P_VALUES
     t = numpy.float64(t)  # IEEE semantics, as in C: 1/(t - 0.5) is inf at t = 0.5, not an error
-    w0 = p[0]*numpy.sin(q[2])
-    w1 = p[0]*numpy.cos(q[2])
-    w2 = p[2]*t
-    w3 = p[3]*numpy.sin(w2) + p[4] + w2
-    w4 = numpy.sin(w3)
-    w5 = numpy.cos(w3)
+    w0 = numpy.cos(q[2])
+    w1 = p[0]*w0
+    w3 = numpy.sin(q[2])
+    w4 = p[0]*w3
+    w6 = numpy.cos(q[5])
+    w7 = p[1]*w6
+    w8 = numpy.sin(q[5])
+    w9 = p[1]*w8
+    w11 = p[2]*t
+    w12 = numpy.sin(w11)
+    w13 = p[3]*w12 + p[4] + w11
+    w14 = numpy.cos(w13)
+    w15 = numpy.sin(w13)
     nz = numpy.zeros(19)
     nz[0] = -1  # (0, 0)
     nz[1] = -1  # (1, 1)
     nz[2] = 1  # (2, 0)
-    nz[3] = -w0  # (2, 2)
+    nz[3] = -w4  # (2, 2)
     nz[4] = -1  # (2, 3)
     nz[5] = 1  # (3, 1)
     nz[6] = w1  # (3, 2)
     nz[7] = -1  # (3, 4)
     nz[8] = 1  # (4, 3)
-    nz[9] = -p[1]*numpy.sin(q[5])  # (4, 5)
+    nz[9] = -w9  # (4, 5)
     nz[10] = -1  # (4, 6)
     nz[11] = 1  # (5, 4)
-    nz[12] = p[1]*numpy.cos(q[5])  # (5, 5)
+    nz[12] = w7  # (5, 5)
     nz[13] = -1  # (5, 7)
     nz[14] = 1  # (6, 8)
     nz[15] = -1  # (7, 7)
-    nz[16] = w4  # (8, 0)
-    nz[17] = -w5  # (8, 1)
-    nz[18] = -w0*w4 - w1*w5  # (8, 2)
+    nz[16] = w15  # (8, 0)
+    nz[17] = -w14  # (8, 1)
+    nz[18] = -w1*w14 - w15*w4  # (8, 2)
     return nz
 
 
