@@ -17,6 +17,7 @@ from pathlib import Path
 import jinja2
 import numpy as np
 
+from symkin.codegen import lu_code
 from symkin.codegen import lu_plan as sparse_lu
 from symkin.resources import template_root
 
@@ -94,7 +95,7 @@ def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
     context = {"prefix": prefix, "PREFIX": prefix.upper(), "nq": nq, "nnz": len(rows),
                "n_params": 0, "real": real, "pattern_rows": list(rows),
                "pattern_cols": list(cols), "spec_sha256": "0" * 64,
-               "lu": sparse_lu.template_context(plan, style=style, constants=constants,
+               "lu": lu_code.template_context(plan, style=style, constants=constants,
                                                 real=real, prefix=prefix)}
     return {f"{prefix}_{name[:-3]}": env.get_template(f"c/{name}").render(
                 template=name, header=[f"{prefix}_{name[:-3]}: sparse LU test harness"], **context)

@@ -21,7 +21,7 @@ from typing import Any
 import jinja2
 
 from symkin import resources
-from symkin.codegen import backends, lu_plan
+from symkin.codegen import backends, lu_code
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
 from symkin.errors import BuildError, UsageError
@@ -251,7 +251,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg,
-        **({"lu": lu_plan.template_context(code.lu_plan, constants=code.constant_nz,
+        **({"lu": lu_code.template_context(code.lu_plan, constants=code.constant_nz,
                                            real=code.real, prefix=code.name)}
            if code.lu_plan else {}),
         "newton_defaults": _newton_defaults(code, literal),
