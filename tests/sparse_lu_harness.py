@@ -17,6 +17,7 @@ from pathlib import Path
 import jinja2
 import numpy as np
 
+from symkin.codegen import lu_code
 from symkin.codegen import lu_plan as sparse_lu
 from symkin.resources import template_root
 
@@ -84,8 +85,8 @@ void harness_repeat(long reps, const double *nz, double *b)
 
 
 def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
-           plan: sparse_lu.LUPlan, real: str = "double", style: str | None = None
-           ) -> dict[str, str]:
+           plan: sparse_lu.LUPlan, real: str = "double", style: str | None = None,
+           constants: Sequence[float | None] | None = None) -> dict[str, str]:
     """Render the sparse LU templates and the dense LU they fall back to, with a context
     shaped like the codegen stream's."""
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(template_root()),
@@ -94,7 +95,8 @@ def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
     context = {"prefix": prefix, "PREFIX": prefix.upper(), "nq": nq, "nnz": len(rows),
                "n_params": 0, "real": real, "pattern_rows": list(rows),
                "pattern_cols": list(cols), "spec_sha256": "0" * 64,
-               "lu": sparse_lu.template_context(plan, style=style)}
+               "lu": lu_code.template_context(plan, style=style, constants=constants,
+                                                real=real, prefix=prefix)}
     return {f"{prefix}_{name[:-3]}": env.get_template(f"c/{name}").render(
                 template=name, header=[f"{prefix}_{name[:-3]}: sparse LU test harness"], **context)
             for name in ("sparse_lu.h.j2", "sparse_lu.c.j2", "dense_lu.h.j2", "dense_lu.c.j2")}
@@ -129,13 +131,13 @@ class Library:
 
 
 def write_sources(folder: Path, prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
-                  plan: sparse_lu.LUPlan, real: str = "double", style: str | None = None
-                  ) -> list[Path]:
+                  plan: sparse_lu.LUPlan, real: str = "double", style: str | None = None,
+                  constants: Sequence[float | None] | None = None) -> list[Path]:
     """Write the rendered sparse LU and the stub kernel; return the C sources to compile."""
     folder.mkdir(parents=True, exist_ok=True)
     names = {"p": prefix, "P": prefix.upper(), "nq": nq, "nnz": len(rows), "real": real,
              "rows": ", ".join(map(str, rows)), "cols": ", ".join(map(str, cols))}
-    files = render(prefix, nq, rows, cols, plan, real, style)
+    files = render(prefix, nq, rows, cols, plan, real, style, constants)
     files[f"{prefix}.h"] = _STUB_H.format(**names)
     files[f"{prefix}.c"] = _STUB_C.format(**names)
     for name, text in files.items():
@@ -153,10 +155,12 @@ def compile_library(sources: Sequence[Path], library: Path, flags: Sequence[str]
 
 
 def build(folder: Path, prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
-          plan: sparse_lu.LUPlan, extra_flags: Sequence[str] = (), style: str | None = None
-          ) -> Library:
-    """Render, write and compile the sparse LU with the stub kernel; load it with ctypes."""
-    sources = write_sources(folder, prefix, nq, rows, cols, plan, style=style)
+          plan: sparse_lu.LUPlan, extra_flags: Sequence[str] = (), style: str | None = None,
+          constants: Sequence[float | None] | None = None) -> Library:
+    """Render, write and compile the sparse LU with the stub kernel; load it with ctypes.
+    ``constants``: the non-zeros known to be numbers (the LU then ignores nz's values there)."""
+    sources = write_sources(folder, prefix, nq, rows, cols, plan, style=style,
+                            constants=constants)
     (folder / "harness.c").write_text(_DRIVER_C.format(p=prefix, P=prefix.upper()))
     library = folder / f"lib{prefix}_harness.so"
     compile_library([*sources, folder / "harness.c"], library, extra_flags)

@@ -83,7 +83,11 @@ def build_sparse(folder: Path, optimisation: str = "-O2") -> Solver:
     sample = [float(system.phi_q[r, c].subs(values)) for r, c in pattern]
     plan = sparse_lu.analyse(len(system.q), rows, cols, sample)
     sub = folder / f"sparse{optimisation}"
-    sources = write_sources(sub, "crank_slider", len(system.q), rows, cols, plan)
+    # the numbers among Phi_q's entries folded in, as symkin's codegen does
+    constants = [float(system.phi_q[r, c]) if system.phi_q[r, c].is_Number else None
+                 for r, c in pattern]
+    sources = write_sources(sub, "crank_slider", len(system.q), rows, cols, plan,
+                            constants=constants)
     library = sub / "libcs_sparse.so"
     _gcc([*sources, HERE / "crank_slider.c"], library, [optimisation, "-DSPARSE_LU"])
     return Solver(library)

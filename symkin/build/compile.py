@@ -19,6 +19,7 @@ import subprocess
 import sys
 import sysconfig
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -38,6 +39,17 @@ from symkin.symbolic.derivation import System
 # -march=native would make a cached binary non-portable.
 C_FLAGS = ("-std=c99", "-O2", "-fPIC")
 WRAPPER_FLAGS = ("-O2", "-fPIC")
+# Per file: the straight-line sparse LU gains nothing from GCC's SLP vectoriser (scattered
+# slots), which took most of GCC's time and memory on large mechanisms (at 1001 bodies 46 s
+# and 2.3 GB for that file alone; without it 30 s and 0.4 GB).
+UNIT_FLAGS = {"_sparse_lu.c": ("-fno-tree-slp-vectorize",)}
+# The kernel (<prefix>.c) is straight-line arithmetic whose common subexpressions SymPy has
+# already eliminated: -O1 gives the same instructions (callgrind: 22.11 M against 22.09 M for
+# the crank-slider's 20001 steps, sincos merged alike) in half of -O2's compile time (301-body
+# chain: 6.0 s against 12.0 s).
+KERNEL_FLAGS = ("-O1",)
+JOBS = 2
+"""Compiler processes at once: the generated files are independent translation units."""
 
 
 def compile(system: System, backend: str = "auto", *, real: str = "double", cse: bool = True,
@@ -126,6 +138,8 @@ def _compile_files(files: dict[str, str], name: str, cache: Path, compiler: list
     """Build the C files of one kernel into the cache (unless a verified build is there)."""
     cdef = cdef_from_headers(files)
     key = content_key({"files": files, "cdef": cdef, "compiler": compiler, "flags": C_FLAGS,
+                       "unit_flags": UNIT_FLAGS,
+                       "kernel_flags": KERNEL_FLAGS,
                 "wrapper_flags": WRAPPER_FLAGS, **toolchain.fingerprint(compiler)})
     module_name = f"_symkin_{name}_{key[:20]}"
     folder = cache / module_name
@@ -154,12 +168,26 @@ def _build_c(build: Path, files: dict[str, str], cdef: str, module_name: str,
     # never stand in for a system header included with <...>.
     include = [f"-iquote{build}"] + [f"-I{sysconfig.get_paths()[k]}"
                                      for k in ("include", "platinclude")]
-    objects = []
-    for source in sorted(n for n in files if n.endswith(".c")):
-        objects.append(_object(compiler, [*C_FLAGS, *include], build / source))
-    objects.append(_object(compiler, [*WRAPPER_FLAGS, *include], wrapper))
+    version = toolchain.compiler_version(tuple(compiler)).lower()
+    gcc = ("gcc" in version or version.startswith("cc (")) and "clang" not in version
+    jobs = [(compiler, [*C_FLAGS, *_unit_flags(source, prefix, gcc), *include], build / source)
+            for source in sorted(n for n in files if n.endswith(".c"))]
+    jobs.append((compiler, [*WRAPPER_FLAGS, *include], wrapper))
+    # the largest first, so that the two workers finish together
+    jobs.sort(key=lambda job: -job[2].stat().st_size)
+    with ThreadPoolExecutor(max_workers=JOBS) as pool:
+        objects = sorted(pool.map(lambda job: _object(*job), jobs))
     library = build / (module_name + resources.extension_suffix())
     run([*compiler, *_link_flags(), "-o", str(library), *map(str, objects), "-lm"], build)
+
+
+def _unit_flags(source: str, prefix: str, gcc: bool) -> tuple[str, ...]:
+    """The extra flags of one generated file (GCC's own options only with GCC)."""
+    if source == f"{prefix}.c":
+        return KERNEL_FLAGS
+    if not gcc:
+        return ()
+    return next((flags for suffix, flags in UNIT_FLAGS.items() if source.endswith(suffix)), ())
 
 
 def _object(compiler: list[str], flags: list[str], source: Path) -> Path:

@@ -40,10 +40,33 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "gamma": ("q", "dq", "t", "p"),
     "points": ("p",),
     "phi_p": ("q", "t", "p"),
+    # Fused evaluation (see _fused_expressions): one call per Newton iterate evaluates Phi, the
+    # non-zeros of Phi_q and the shared sines and cosines; Phi_t and Gamma at the converged q
+    # read those instead of calling libm again.
+    "phi_phi_q": ("q", "t", "p"),
+    "phi_t_shared": ("q", "t", "p", "shared"),
+    "gamma_shared": ("q", "dq", "t", "p", "shared"),
 }
+FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
 
 # Characters allowed in a comment of generated code; anything else becomes '?'.
 _COMMENT_UNSAFE = re.compile(r"[^A-Za-z0-9_.,:;()\[\] +=-]")
+
+
+PART_OUTPUTS = 200
+"""Outputs per generated function: a larger routine is split into parts of this many outputs,
+each with its own CSE, so that neither SymPy's CSE nor the C compiler (both superlinear in
+the size of one function) sees more than a bounded piece; the parts are consecutive outputs
+(rows of a chain stay together, so little sharing is lost between parts)."""
+
+
+@dataclass(frozen=True)
+class Part:
+    """A bounded piece of a routine: its temporaries and the output positions it writes."""
+
+    temporaries: tuple[tuple[str, str], ...]
+    slots: tuple[int, ...]
+    unused: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -58,6 +81,10 @@ class Routine:
         temporaries: ``(name, expression)`` pairs, in evaluation order.
         outputs: one expression per output slot.
         ops: operation count after CSE (SymPy's ``count_ops``).
+        sizes: how the outputs split among several output arrays, in order (the fused
+            ``phi_phi_q``: Phi, the non-zeros of Phi_q, the shared values); empty for one.
+        parts: the routine in pieces of at most PART_OUTPUTS outputs (one part when small);
+            ``temporaries`` is then the first part's.
     """
 
     name: str
@@ -66,6 +93,8 @@ class Routine:
     temporaries: tuple[tuple[str, str], ...]
     outputs: tuple[str, ...]
     ops: int
+    sizes: tuple[int, ...] = ()
+    parts: tuple[Part, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -96,6 +125,10 @@ class Code:
     phi_p_rows: tuple[int, ...] = ()
     phi_p_cols: tuple[int, ...] = ()
     """The structural non-zeros of Phi_p (row, parameter), row-major."""
+    shared: tuple[str, ...] = ()
+    """The sines and cosines the fused routine passes to Phi_t and Gamma (printed, in order)."""
+    constant_nz: tuple[float | None, ...] = ()
+    """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
 
     @property
     def nnz(self) -> int:
@@ -144,9 +177,23 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
     p_pattern = parameter_pattern(system)
     expressions = _routine_expressions(system, pattern, p_pattern)
     printer = _printer(backend, real)
+    prepared = {name: [symbols.prepare(e, internal) for e in exprs]
+                for name, exprs in expressions.items()}
+    fused, shared = _fused_expressions(prepared)
+    sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}
+    orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
+    # Phi and Phi_q alone are the fused routine's pieces: its CSE and printing serve all three.
+    fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse,
+                                 orders["phi_phi_q"])
+    nq, nnz = len(system.q), len(pattern)
+    own = {"phi": _select("phi", fused_parts, {k: k for k in range(nq)}, nq),
+           "phi_q": _select("phi_q", fused_parts, {nq + e: e for e in range(nnz)}, nnz),
+           "phi_phi_q": _assemble("phi_phi_q", fused_parts, len(fused["phi_phi_q"]),
+                                  sizes["phi_phi_q"])}
     routines = tuple(
-        _routine(name, [symbols.prepare(e, internal) for e in exprs], printer, cse)
-        for name, exprs in expressions.items())
+        own[name] if name in own else
+        _assemble(name, _lowered_parts(name, exprs, printer, cse), len(exprs))
+        for name, exprs in {**prepared, **fused}.items())
     return Code(
         backend=backend, real=real, cse=cse, name=system.name,
         spec_sha256=system.mechanism.spec_hash(), nq=len(system.q), n_params=len(system.p),
@@ -155,11 +202,13 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         time_grid=system.time_grid, rows=tuple(str(row) for row in system.rows),
         pattern_rows=tuple(r for r, _ in pattern), pattern_cols=tuple(c for _, c in pattern),
         points=point_names(system), routines=routines,
-        ops_before_cse={name: _count_ops(exprs) for name, exprs in expressions.items()},
+        ops_before_cse=_ops_before_cse(expressions, fused, shared),
         linalg=linalg,
         phi_p_rows=tuple(r for r, _ in p_pattern), phi_p_cols=tuple(c for _, c in p_pattern),
         lu_plan=(sample.sparse_lu_plan(system, pattern)
                  if backend == "c" and linalg == "sparse" else None),
+        shared=tuple(_print(printer, f) for f in shared),
+        constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
     )
 
 
@@ -192,6 +241,30 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
     }
 
 
+def _fused_expressions(prepared: dict[str, list[sp.Expr]]
+                       ) -> tuple[dict[str, list[sp.Expr]], list[sp.Expr]]:
+    """The fused routines' expressions, and the values they share.
+
+    ``phi_phi_q`` outputs Phi, the non-zeros of Phi_q and every sine or cosine that Phi or
+    Phi_q and also Phi_t or Gamma use, with one CSE over all of them (so each is evaluated
+    once); ``phi_t_shared`` and ``gamma_shared`` read those values (``shared[k]``) instead of
+    calling sin and cos again. They are evaluated at the same q, t and p, so the values are
+    the same numbers bit for bit.
+    """
+    def trig(names: tuple[str, ...]) -> set[sp.Expr]:
+        found: set[sp.Expr] = set()
+        for name in names:
+            for e in prepared[name]:
+                found |= e.atoms(sp.sin, sp.cos)
+        return found
+
+    shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma")), key=sp.default_sort_key)
+    mapping = {f: sp.Symbol(f"_shared{k}", real=True) for k, f in enumerate(shared)}
+    return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
+            "phi_t_shared": [e.xreplace(mapping) for e in prepared["phi_t"]],
+            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]]}, shared
+
+
 def point_names(system: System) -> tuple[tuple[str, str], ...]:
     """Every named point as (body, point), bodies and points in file order."""
     return tuple((body_name, point) for body_name, body in system.mechanism.bodies.items()
@@ -205,21 +278,120 @@ def point_vectors(system: System) -> list[tuple[sp.Expr, sp.Expr]]:
     return [tuple(ctx.local(body, point)) for body, point in point_names(system)]
 
 
-def _routine(name: str, exprs: list[sp.Expr], printer: Any, cse: bool) -> Routine:
-    temporaries: list[tuple[sp.Symbol, sp.Expr]] = []
-    if cse and exprs:
-        temporaries, exprs = sp.cse(exprs, symbols=sp.numbered_symbols("w", real=True),
-                                    order="canonical")
-        temporaries, exprs = _inline_trivial(temporaries, exprs)
-    used = set().union(*(e.free_symbols for e in [*exprs, *(v for _, v in temporaries)]))
-    used_names = {symbol_text(s.name).split("[")[0] for s in used}
+def _fused_order(prepared: dict[str, list[sp.Expr]], pattern: Sequence[tuple[int, int]],
+                 shared: list[sp.Expr]) -> list[int]:
+    """The fused routine's outputs row by row: Phi's row, that row's non-zeros of Phi_q, then
+    the shared values it first uses; so a part keeps a row's sines and cosines together."""
+    nq, nnz = len(prepared["phi"]), len(pattern)
+    by_row: dict[int, list[int]] = {}
+    for e, (r, _) in enumerate(pattern):
+        by_row.setdefault(r, []).append(e)
+    where = {f: nq + nnz + k for k, f in enumerate(shared)}
+    order: list[int] = []
+    for r in range(nq):
+        row = [r, *(nq + e for e in by_row.get(r, []))]
+        order += row
+        exprs = [prepared["phi"][r], *(prepared["phi_q"][e] for e in by_row.get(r, []))]
+        for e in exprs:
+            for f in sorted(e.atoms(sp.sin, sp.cos) & where.keys(), key=sp.default_sort_key):
+                order.append(where.pop(f))
+    return order + sorted(where.values())
+
+
+@dataclass
+class _Lowered:
+    """One part of a routine before it becomes text-only: what each temporary and output
+    needs (the symbols it reads), so that a routine can be a selection of another's parts."""
+
+    temporaries: list[tuple[str, str, frozenset[str], int]]  # name, text, reads, ops
+    slots: list[int]  # output positions
+    outputs: list[tuple[str, frozenset[str], int]]  # text, reads, ops
+
+
+def _reads(expr: sp.Expr) -> frozenset[str]:
+    return frozenset(s.name for s in expr.free_symbols)
+
+
+def _lowered_parts(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
+                   order: Sequence[int] | None = None) -> list[_Lowered]:
+    """CSE and print ``exprs`` in parts of at most PART_OUTPUTS outputs (in ``order``)."""
+    positions = list(order) if order is not None else list(range(len(exprs)))
+    chunks = [positions[i:i + PART_OUTPUTS] for i in range(0, len(positions), PART_OUTPUTS)]
+    parts = []
+    for chunk in chunks or [[]]:
+        temporaries: list[tuple[sp.Symbol, sp.Expr]] = []
+        values = [exprs[k] for k in chunk]
+        if cse and values:
+            temporaries, values = sp.cse(values, symbols=sp.numbered_symbols("w", real=True),
+                                         order="canonical")
+            temporaries, values = _inline_trivial(temporaries, values)
+        parts.append(_Lowered(
+            temporaries=[(str(t), _print(printer, v), _reads(v), _count_ops([v]))
+                         for t, v in temporaries],
+            slots=list(chunk),
+            outputs=[(_print(printer, v), _reads(v), _count_ops([v])) for v in values]))
+    del name
+    return parts
+
+
+def _argument_names(reads: set[str]) -> set[str]:
+    return {symbol_text(r).split("[")[0] for r in reads if not r.startswith("w")}
+
+
+def _assemble(name: str, parts: list[_Lowered], n_outputs: int,
+              sizes: tuple[int, ...] = ()) -> Routine:
+    """A Routine (plain text) from lowered parts."""
+    outputs = [""] * n_outputs
+    done, ops, used_names = [], 0, set()
+    for part in parts:
+        reads: set[str] = set()
+        for _, _, r, count in part.temporaries:
+            reads |= r
+            ops += count
+        for k, (text, r, count) in zip(part.slots, part.outputs):
+            outputs[k] = text
+            reads |= r
+            ops += count
+        names = _argument_names(reads)
+        used_names |= names
+        done.append(Part(temporaries=tuple((n, t) for n, t, _, _ in part.temporaries),
+                         slots=tuple(part.slots),
+                         unused=tuple(a for a in ROUTINE_ARGUMENTS[name] if a not in names)))
     return Routine(
         name=name, arguments=ROUTINE_ARGUMENTS[name],
         unused=tuple(a for a in ROUTINE_ARGUMENTS[name] if a not in used_names),
-        temporaries=tuple((str(s), _print(printer, v)) for s, v in temporaries),
-        outputs=tuple(_print(printer, e) for e in exprs),
-        ops=_count_ops([*exprs, *(v for _, v in temporaries)]),
-    )
+        temporaries=done[0].temporaries, outputs=tuple(outputs), ops=ops, sizes=sizes,
+        parts=tuple(done))
+
+
+def _select(name: str, parts: list[_Lowered], positions: dict[int, int], n_outputs: int
+            ) -> Routine:
+    """The routine made of some outputs of another's parts (``positions``: theirs -> its),
+    each part with the temporaries its selected outputs need, in their order."""
+    selected = []
+    for part in parts:
+        keep = [(positions[k], out) for k, out in zip(part.slots, part.outputs)
+                if k in positions]
+        needed = set().union(*(r for _, (_, r, _) in keep)) if keep else set()
+        temporaries = []
+        for temporary in reversed(part.temporaries):
+            if temporary[0] in needed:
+                needed |= temporary[2]
+                temporaries.append(temporary)
+        if keep:
+            selected.append(_Lowered(temporaries=temporaries[::-1], slots=[k for k, _ in keep],
+                                     outputs=[out for _, out in keep]))
+    return _assemble(name, selected or [_Lowered([], [], [])], n_outputs)
+
+
+def _ops_before_cse(expressions: dict[str, list[sp.Expr]], fused: dict[str, list[sp.Expr]],
+                    shared: list[sp.Expr]) -> dict[str, int]:
+    """SymPy's count_ops of every routine before CSE; the fused Phi and Phi_q is the sum of
+    its pieces (count_ops of a list is the sum over it), so it is not counted twice."""
+    counts = {name: _count_ops(exprs) for name, exprs in expressions.items()}
+    counts["phi_phi_q"] = counts["phi"] + counts["phi_q"] + _count_ops(shared)
+    counts.update({name: _count_ops(fused[name]) for name in ("phi_t_shared", "gamma_shared")})
+    return counts
 
 
 def _inline_trivial(temporaries: list[tuple[sp.Symbol, sp.Expr]], exprs: list[sp.Expr]

@@ -26,9 +26,8 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -330,91 +329,6 @@ def _structural_message(active: _Active) -> str:
             f"eliminated, column(s) {empty_cols[:10]} and row(s) {empty_rows[:10]} have no "
             "entry left. Some coordinates are not constrained (or some equations repeat); "
             "check the joints and drivers, and that drivers match the degrees of freedom")
-
-
-PART_OPS = 250
-"""Statements per generated C function: gcc's optimiser is superlinear in function size, so
-the straight-line factor and solve are split into parts of about this many operations."""
-
-
-TABLE_FLOPS = 20000
-"""Above this many factor + solve operations the C code walks index tables in loops instead of
-being straight-line: constant code size and compile time. Straight-line code was faster at
-every size measured (chain of 301 bodies, 5,700 operations: 14-18 us against 22 us for one
-factorization and three solves, but 4.8 s of gcc against 0.3 s), hence the high limit."""
-
-
-def template_context(plan: LUPlan, part_ops: int = PART_OPS,
-                     style: str | None = None) -> dict[str, object]:
-    """The plan as plain data for ``templates/c/sparse_lu.*.j2`` (key ``lu``).
-
-    Args:
-        plan: the analysed factorization.
-        part_ops: operations per generated function in the straight-line style.
-        style: "straight" (one C statement per operation) or "tables" (loops over static
-            index arrays); by default straight-line up to TABLE_FLOPS operations.
-    """
-    if style is None:
-        style = "straight" if plan.flops + plan.solve_flops <= TABLE_FLOPS else "tables"
-    if style not in ("straight", "tables"):
-        raise ValueError(f"unknown sparse LU style {style!r}: use 'straight' or 'tables'")
-    steps = [{"k": s.k, "row": s.row, "col": s.col, "pivot": s.pivot,
-              "lower": [list(x) for x in s.lower], "upper": [list(x) for x in s.upper],
-              "updates": [list(x) for x in s.updates]} for s in plan.steps]
-    backward = list(reversed(steps))
-    return {
-        "n_lu": plan.n_lu,
-        "n_fill": plan.n_lu - plan.nnz,
-        "tau": repr(float(plan.tau)),
-        "flops": plan.flops,
-        "solve_flops": plan.solve_flops,
-        "row_perm": list(plan.row_perm),
-        "col_perm": list(plan.col_perm),
-        "fill_slots": list(range(plan.nnz, plan.n_lu)),
-        "unchecked": list(plan.unchecked),
-        "ratio_tests": sum(1 for s in plan.steps if s.lower),
-        "factor_parts": _parts(steps, lambda s: 2 + 2 * len(s["lower"]) + len(s["updates"]),
-                               part_ops),
-        "forward_parts": _parts([s for s in steps if s["lower"]], lambda s: len(s["lower"]),
-                                part_ops),
-        "backward_parts": _parts(backward, lambda s: 1 + len(s["upper"]), part_ops),
-        "style": style,
-        "tables": _tables(plan),
-    }
-
-
-def _tables(plan: LUPlan) -> dict[str, list[int]]:
-    """The plan as compressed index arrays (offsets per pivot), each ending in one zero record
-    so that no C array is empty (C99 forbids it) even when a plan has no such entry."""
-    tables: dict[str, list[int]] = {"pivot": [s.pivot for s in plan.steps]}
-    records: tuple[tuple[str, int, Callable[[Step], Any]], ...] = (
-        ("lower", 2, lambda s: s.lower), ("upper", 2, lambda s: s.upper),
-        ("update", 3, lambda s: s.updates))
-    for name, width, pick in records:
-        start, flat = [0], []
-        for step in plan.steps:
-            for entry in pick(step):
-                flat.extend(entry)
-            start.append(start[-1] + len(pick(step)))
-        tables[f"{name}_start"] = start
-        tables[name] = flat + [0] * width
-    return tables
-
-
-def _parts(steps: list[dict[str, Any]], size: Callable[[dict[str, Any]], int],
-           limit: int) -> list[dict[str, Any]]:
-    """Consecutive runs of steps of at most ``limit`` operations each (at least one step);
-    ``checks`` says whether a run has a ratio test (and so needs its column maximum)."""
-    runs: list[list[dict[str, Any]]] = []
-    total = 0
-    for step in steps:
-        ops = size(step)
-        if not runs or (runs[-1] and total + ops > limit):
-            runs.append([])
-            total = 0
-        runs[-1].append(step)
-        total += ops
-    return [{"steps": run, "checks": any(s["lower"] for s in run)} for run in runs]
 
 
 def solve_with_plan(plan: LUPlan, nz: Sequence[float], b: Sequence[float]) -> np.ndarray:

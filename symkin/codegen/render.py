@@ -21,7 +21,7 @@ from typing import Any
 import jinja2
 
 from symkin import resources
-from symkin.codegen import backends, lu_plan
+from symkin.codegen import backends, lu_code
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
 from symkin.errors import BuildError, UsageError
@@ -31,8 +31,11 @@ from symkin.symbolic.derivation import System
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
-             "phi_p": "nz"}
-_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz"}
+             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out"}
+# The output arrays of a routine with several (Routine.sizes), in order.
+_C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
+_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
+                "phi_phi_q": "phi_phi_q_nz"}
 _PYTHON_DOC = {
     "phi": "Phi(q, t), shape (NQ,).",
     "phi_q": "The non-zeros of Phi_q in pattern order, shape (NNZ,).",
@@ -40,6 +43,10 @@ _PYTHON_DOC = {
     "gamma": "Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,).",
     "points": "Local vectors of the named points, flat (x, y) pairs in POINTS order.",
     "phi_p": "The non-zeros of Phi_p (d Phi / d p) in PHI_P_ROWS/COLS order, shape (NNZ_P,).",
+    "phi_phi_q": "(Phi, the non-zeros of Phi_q, the shared values) with one CSE: each sine "
+                 "and cosine once.",
+    "phi_t_shared": "Phi_t(q, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
+    "gamma_shared": "Gamma(q, dq, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
 }
 
 
@@ -211,6 +218,7 @@ def metadata(code: Code) -> dict[str, Any]:
         "pattern_cols": list(code.pattern_cols), "points": [list(p) for p in code.points],
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
+        "nshared": len(code.shared),
     }
 
 
@@ -223,6 +231,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "prefix": code.name, "PREFIX": code.name.upper(),
         "name_comment": codegen.comment(code.name),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
+        "nshared": len(code.shared),
         "real": code.real, "cse": code.cse, "spec_sha256": code.spec_sha256,
         # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
         "libm_suffix": "f" if code.real == "float" else "",
@@ -247,25 +256,45 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg,
-        **({"lu": lu_plan.template_context(code.lu_plan)} if code.lu_plan else {}),
+        **({"lu": lu_code.template_context(code.lu_plan, constants=code.constant_nz,
+                                           real=code.real, prefix=code.name)}
+           if code.lu_plan else {}),
         "newton_defaults": _newton_defaults(code, literal),
     }
 
 
 def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
     real = f"{code.name}_real"
-    output = _C_OUTPUT[routine.name]
+    names = _C_OUTPUTS.get(routine.name) or (_C_OUTPUT[routine.name],)
+    sizes = routine.sizes or (len(routine.outputs),)
+    labels = _labels(code, routine.name)
+    arrays, start, place = [], 0, []
+    for name, size in zip(names, sizes):
+        arrays.append({"name": name, "size": size, "slots": [
+            (k, routine.outputs[start + k], labels[start + k] if labels else "")
+            for k in range(size)]})
+        place += [(name, k) for k in range(size)]
+        start += size
+    parts = []
+    for part in routine.parts:
+        written = {place[k][0] for k in part.slots}
+        parts.append({
+            "temporaries": list(part.temporaries),
+            "unused": [*part.unused, *(n for n in names if n not in written)],
+            "slots": [(*place[k], routine.outputs[k], labels[k] if labels else "")
+                      for k in part.slots]})
     arguments = [f"{real} t" if a == "t" else f"const {real} {a}[]" for a in routine.arguments]
     python_arguments = [a for a in routine.arguments if a != "p"] + ["p=None"]
     return {
         "name": routine.name, "arguments": list(routine.arguments),
-        "unused": list(routine.unused), "output": output,
+        "unused": list(routine.unused), "output": names[0], "arrays": arrays, "parts": parts,
+        "call": ", ".join([*routine.arguments, *names]),
         "temporaries": list(routine.temporaries), "outputs": list(routine.outputs),
-        # C99 restrict on the output (definitions only; the header keeps plain []): it never
-        # overlaps the inputs, and knowing so lets the compiler keep q[i] in a register across
+        # C99 restrict on the outputs (definitions only; the header keeps plain []): they never
+        # overlap the inputs, and knowing so lets the compiler keep q[i] in a register across
         # the stores, e.g. to merge sin(q[i]) and cos(q[i]) into one sincos call.
-        "signature": ", ".join([*arguments, f"{real} *restrict {output}"]),
-        "labels": _labels(code, routine.name),
+        "signature": ", ".join([*arguments, *(f"{real} *restrict {n}" for n in names)]),
+        "labels": labels,
         "python_name": _PYTHON_NAME.get(routine.name, routine.name),
         "python_signature": ", ".join(python_arguments), "doc": _PYTHON_DOC[routine.name],
         "size": len(routine.outputs),
@@ -279,6 +308,9 @@ def _labels(code: Code, routine: str) -> list[str]:
     if routine == "phi_p":
         return [codegen.comment(f"({r}, {code.parameter_names[k]})")
                 for r, k in zip(code.phi_p_rows, code.phi_p_cols)]
+    if routine == "phi_phi_q":
+        return [*_labels(code, "phi"), *_labels(code, "phi_q"),
+                *(codegen.comment(f) for f in code.shared)]
     if routine == "points":
         return [codegen.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in "xy"]

@@ -14,12 +14,15 @@ from symkin.errors import BuildError, ExpressionError
 from symkin.spec import constants
 from symkin.symbolic.derivation import System
 
-_INTERNAL = re.compile(r"_(q|dq|p)(\d+)\Z")
+_INTERNAL = re.compile(r"_(q|dq|p|shared)(\d+)\Z")
 _TEMPORARY = re.compile(r"w\d+\Z")
 
 
 def symbol_text(name: str) -> str:
     """The code for a symbol: ``_q3`` -> ``q[3]``, ``_t`` -> ``t``, temporaries as they are.
+
+    ``_shared2`` -> ``shared[2]``: a value the fused routine computed once (a sine or cosine of
+    coordinates) and passes on to Phi_t and Gamma at the same q (codegen.lower).
 
     Anything else would be a name from the mechanism file reaching the code, so it is refused.
     """

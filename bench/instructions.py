@@ -1,0 +1,92 @@
+"""Instructions per time step of the generated C solver, counted by callgrind (valgrind).
+
+    python3 bench/instructions.py crank_slider chain:100 tongs:1000 ...
+
+Each argument is an example's name (examples/<name>.yaml, started from its q0) or FAMILY:BODIES
+of bench/scaling_limit.py (started from the closed form). The generated folder is compiled as
+a plain C program (gcc -O2) whose main calls ``<prefix>_solve_grid`` over t = k * dt; the count
+is (instructions of 121 steps - instructions of 21 steps) / 100, so set-up and the first
+assembly cancel. Instruction counts do not depend on the load of a shared machine, unlike
+times. dt is 1.5/20000 for an example (the textbook grid), 0.001 for a family.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+
+MAIN = r"""
+#include <stdio.h>
+#include <stdlib.h>
+#include "@P@_solver.h"
+int main(int argc, char **argv)
+{
+    int n = atoi(argv[1]), k, done;
+    double *t = malloc(sizeof(double) * n);
+    static @P@_workspace w;
+    static @P@_state s;
+    @P@_options o;
+    @P@_report r;
+    for (k = 0; k < n; ++k) t[k] = k * @DT@;
+    @P@_default_options(&o);
+    for (k = 0; k < @U@_NQ; ++k) s.q[k] = @P@_q0[k];
+    s.started = 0;
+    done = @P@_solve_grid(&o, @P@_p_nominal, n, t, &s, 0, 0, 0, &w, &r);
+    printf("%d %lu\n", done, r.fallbacks);
+    return done == n ? 0 : 1;
+}
+"""
+
+
+def _total(program: Path, steps: int) -> int:
+    out = program.parent / f"callgrind.{steps}"
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
+                    str(program), str(steps)], capture_output=True, check=True)
+    text = subprocess.run(["callgrind_annotate", str(out)], capture_output=True, text=True,
+                          check=True).stdout
+    match = re.search(r"([\d,]+) \(100.0%\)\s+PROGRAM TOTALS", text)
+    assert match, text[:500]
+    return int(match.group(1).replace(",", ""))
+
+
+def per_step(spec: str) -> tuple[str, int, float]:
+    import symkin
+    from symkin.spec import validate as model
+
+    if ":" in spec:
+        import scaling_limit
+
+        family, bodies = spec.split(":")
+        data, _ = scaling_limit.mechanism(family, int(bodies))
+        system, dt = symkin.derive(model.from_dict(data)), "0.001"
+    else:
+        system, dt = symkin.derive(ROOT / "examples" / f"{spec}.yaml"), "(1.5 / 20000)"
+    with tempfile.TemporaryDirectory() as folder:
+        build = Path(folder)
+        symkin.generate(system, backend="c", out_dir=build / "c")
+        prefix = system.name
+        (build / "main.c").write_text(
+            MAIN.replace("@P@", prefix).replace("@U@", prefix.upper()).replace("@DT@", dt))
+        sources = [str(p) for p in sorted((build / "c").glob("*.c"))]
+        program = build / "main"
+        subprocess.run(["gcc", "-std=c99", "-O2", f"-I{build / 'c'}", "-o", str(program),
+                        str(build / "main.c"), *sources, "-lm"], check=True)
+        return spec, len(system.q), (_total(program, 121) - _total(program, 21)) / 100
+
+
+def main() -> int:
+    for spec in sys.argv[1:] or ["crank_slider"]:
+        name, nq, count = per_step(spec)
+        print(f"{name:20s} N = {nq:5d}  {count:10.0f} instructions/step", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
