@@ -19,6 +19,7 @@ from symkin.codegen import lu_plan as sparse_lu
 from symkin.codegen import symbols
 from symkin.errors import BuildError, SolveError
 from symkin.runtime import options as runtime_options
+from symkin.runtime.newton import levenberg_marquardt
 from symkin.symbolic.derivation import System
 
 # Assembly tolerances: the runtime's own Newton defaults (a tighter sample changes nothing).
@@ -103,7 +104,7 @@ def _assemble(kernel: Any, q0: np.ndarray, t0: float, p: np.ndarray) -> np.ndarr
     q = _newton(kernel, q0, t0, p)
     if q is not None:
         return q
-    return _newton(kernel, _levenberg_marquardt(kernel, q0, t0, p), t0, p)
+    return _newton(kernel, levenberg_marquardt(kernel, q0, t0, p, NEWTON)[0], t0, p)
 
 
 def _newton(kernel: Any, q: np.ndarray, t: float, p: np.ndarray) -> np.ndarray | None:
@@ -129,27 +130,3 @@ def _newton(kernel: Any, q: np.ndarray, t: float, p: np.ndarray) -> np.ndarray |
         q = q + delta
         step = float(np.abs(delta).max(initial=0.0))
     return None
-
-
-def _levenberg_marquardt(kernel: Any, q: np.ndarray, t: float, p: np.ndarray,
-                         max_iterations: int = 200) -> np.ndarray:
-    """Minimise |Phi|^2 from a poor guess with (J^T J + mu I) dq = -J^T Phi."""
-    q = np.array(q, dtype=float)
-    phi = kernel.phi(q, t, p)
-    cost, mu = float(phi @ phi), 1e-3
-    for _ in range(max_iterations):
-        if math.sqrt(cost) <= NEWTON.tol_phi:
-            break
-        jacobian = kernel.phi_q(q, t, p)
-        normal = jacobian.T @ jacobian
-        scale = mu * max(float(np.max(np.diag(normal))), 1.0)
-        trial = q + np.linalg.solve(normal + scale * np.eye(q.size), -(jacobian.T @ phi))
-        trial_phi = kernel.phi(trial, t, p)
-        trial_cost = float(trial_phi @ trial_phi)
-        if math.isfinite(trial_cost) and trial_cost < cost:
-            q, phi, cost, mu = trial, trial_phi, trial_cost, max(mu / 10, 1e-12)
-        else:
-            mu *= 10
-            if mu > 1e12:
-                break
-    return q
