@@ -34,7 +34,7 @@ _EXPORTS = {
     "generate": ("symkin.codegen.render", "generate"),
     "compile": ("symkin.build.compile", "compile"),
     "solve": ("symkin.runtime.driver", "solve"),
-    "sweep": ("symkin.sweep.api", "sweep"),
+    "sweep": ("symkin.sweeps.api", "sweep"),
     "SymkinError": ("symkin.errors", "SymkinError"),
     "MechanismError": ("symkin.errors", "MechanismError"),
     "SolveError": ("symkin.errors", "SolveError"),

@@ -7,14 +7,17 @@ non-Grashof four-bar from the law of cosines), never the code under test.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from driver_support import BACKENDS, derive, kernel_for
 
+import symkin
 from symkin.errors import SolveError
 from symkin.runtime import driver, newton
 
+ROOT = Path(__file__).resolve().parent.parent
 T_LIMIT = math.acos(-0.25)  # non_grashof.yaml: a = b = c = 2, d = 3; cos(theta*) = -1/4
 
 
@@ -65,6 +68,23 @@ def test_non_grashof_four_bar_reaches_its_limit_position(backend: str) -> None:
     rocker = np.arctan2(to_a[:, 1], to_a[:, 0]) - np.arccos((4 + e**2 - 4) / (4 * e))
     steady = ~partial.flagged
     assert np.abs(_angle(partial.q[steady, 8] - rocker[steady])).max() < 1e-8
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_rod_too_short_for_the_whole_turn_is_a_limit_position(backend: str) -> None:
+    """The textbook crank-slider with a = 1.1, b = 3.5: the rod reaches the slide line y = c = 4
+    only while a sin(phi) >= c - b, phi = t**2 + pi/2. Near that fold Phi_q is only moderately
+    ill-conditioned (sigma_min shrinks like the square root of the distance), so the limit is
+    told by the condition's growth as the substeps close in, not by its size."""
+    system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
+    kernel = kernel_for(system, backend)
+    assert kernel.backend == backend
+    failure = _failure(kernel, params={"a": 1.1, "b": 3.5})
+    t_limit = math.sqrt(math.pi - math.asin(0.5 / 1.1) - math.pi / 2)
+    assert failure.reason == "limit position", str(failure)
+    assert abs(failure.reached - t_limit) < 1e-6
+    assert "drivers[0] angle crank-ground cannot be followed" in str(failure)
+    assert failure.trajectory.t[-1] < t_limit
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

@@ -73,7 +73,7 @@ def handle(args: argparse.Namespace) -> int:
     except UsageError as error:
         return messages.error(f"{args.mechanism}: {error}", EXIT_BAD_INPUT)
     from symkin.runtime.driver import grid
-    from symkin.sweep.api import too_large
+    from symkin.sweeps.api import too_large
 
     problem = too_large(design.shape[0], grid(*kernel.time_grid).size, len(kernel.coordinates))
     if problem:
@@ -103,7 +103,7 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
 
 def _design(kernel: Any, args: argparse.Namespace) -> tuple[Any, Any]:
     """The (M, NP) table of parameter sets, and the parameters' sigmas for Monte-Carlo."""
-    from symkin.sweep import tolerance
+    from symkin.sweeps import tolerance
 
     if args.vary:
         return tolerance.grid_design(kernel, [_vary(text) for text in args.vary]), None
@@ -116,7 +116,7 @@ def _design(kernel: Any, args: argparse.Namespace) -> tuple[Any, Any]:
 
 
 def _vary(text: str) -> Any:
-    from symkin.sweep.tolerance import Vary
+    from symkin.sweeps.tolerance import Vary
 
     match = _VARY.match(text)
     if not match:
@@ -156,7 +156,7 @@ def _finite(text: str, where: str) -> float:
 
 def _run(kernel: Any, args: argparse.Namespace, design: Any, spread: Any) -> int:
     from symkin.cli.outputs import ProgressBar
-    from symkin.sweep.api import sweep
+    from symkin.sweeps.api import sweep
 
     client = _client(args.scheduler) if args.scheduler else None
     progress = ProgressBar(sys.stderr) if sys.stderr.isatty() else None
@@ -187,7 +187,7 @@ def _client(address: str) -> Any:
 
 
 def _report(kernel: Any, result: Any, spread: Any) -> None:
-    from symkin.sweep import tolerance
+    from symkin.sweeps import tolerance
 
     summary = result.summary()
     print(f"solved {summary['solved']} of {summary['sets']} parameter sets over "
@@ -230,7 +230,7 @@ def _write(result: Any, args: argparse.Namespace) -> list[Path]:
         if args.output:
             written.append(result.save(args.output))
         if args.plot and result.ok.any():
-            from symkin.sweep.plots import plot_envelopes
+            from symkin.sweeps.plots import plot_envelopes
 
             written.append(plot_envelopes(result, args.plot))
     except OSError as error:

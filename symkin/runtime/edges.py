@@ -40,6 +40,13 @@ LIMIT_COND = 1e5
 options.max_cond, if lower) is a limit position (sigma_min -> 0 as t_b is approached), not a
 Newton failure."""
 
+LIMIT_GROWTH = 100.0
+"""... and so is one where the condition grew by this factor between the last grid point and
+the last point the substeps reached. At a fold sigma_min shrinks like the square root of the
+distance to it, so substeps that close in by 1e9 raise the condition some 3e4-fold even where
+the mechanism is not badly conditioned in absolute terms; a failure for another reason (a
+driver that is not smooth) shows no such growth."""
+
 
 @dataclass
 class State:
@@ -154,13 +161,13 @@ def resolve(kernel: KinematicsKernel, p: Array, options: Options, previous: Stat
         if blocked - delta > previous.t else (previous, 0.0)
     after = None if early else _over(kernel, p, options, before, blocked, delta, h0)
     if after is None:
-        return _stopped(kernel, p, options, state, failed)
+        return _stopped(kernel, p, options, state, failed, previous)
     passage = _passage(kernel, p, before, after)
     if t <= after.t:
         return Resolution(_through(kernel, p, options, before, after, t), passage)
     rest, failed = march(kernel, p, options, after, t, h0, h_min)
     if failed:
-        stop = _stopped(kernel, p, options, rest, failed)
+        stop = _stopped(kernel, p, options, rest, failed, after)
         stop.passage = passage
         return stop
     return Resolution(rest.point, passage)
@@ -198,10 +205,11 @@ def _passage(kernel: KinematicsKernel, p: Array, before: State, after: State) ->
 
 
 def _stopped(kernel: KinematicsKernel, p: Array, options: Options, state: State,
-             failed: float) -> Resolution:
-    """The motion cannot go on past state.t: a limit position, or no convergence."""
+             failed: float, start: State) -> Resolution:
+    """The motion cannot go on past state.t (reached by substeps from start): a limit
+    position, or no convergence."""
     threshold = min(LIMIT_COND, options.max_cond / 10)
-    limit = state.point.cond > threshold
+    limit = state.point.cond > threshold or state.point.cond > LIMIT_GROWTH * start.point.cond
     stop = Resolution(None, limit=limit, reached=state, failed_at=state.t + failed)
     if limit:
         jacobian = kernel.phi_q(state.point.q, state.t, p)

@@ -22,9 +22,9 @@ from symkin.errors import SolveError
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
 from symkin.runtime.options import Options
-from symkin.sweep import parallel
-from symkin.sweep.batch import Chunk, empty_chunk, solve_chunk
-from symkin.sweep.result import SweepResult
+from symkin.sweeps import parallel
+from symkin.sweeps.batch import Chunk, empty_chunk, solve_chunk
+from symkin.sweeps.result import SweepResult
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]

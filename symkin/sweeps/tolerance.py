@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from symkin.errors import UsageError
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
-from symkin.sweep.result import SweepResult
+from symkin.sweeps.result import SweepResult
 
 Array = NDArray[np.float64]
 DISTRIBUTIONS = ("normal", "uniform")

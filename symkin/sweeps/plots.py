@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from symkin.sweep.result import SweepResult
-from symkin.sweep.tolerance import envelope
+from symkin.sweeps.result import SweepResult
+from symkin.sweeps.tolerance import envelope
 
 
 def plot_envelopes(result: SweepResult, path: str | Path) -> Path:

@@ -30,7 +30,7 @@ from symkin.errors import SolveError
 from symkin.runtime.kernel import Kernel
 from symkin.runtime.kernel import load as load_kernel
 from symkin.runtime.options import Options
-from symkin.sweep.batch import Chunk, solve_chunk
+from symkin.sweeps.batch import Chunk, solve_chunk
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
