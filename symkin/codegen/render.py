@@ -280,7 +280,8 @@ def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
         written = {place[k][0] for k in part.slots}
         parts.append({
             "temporaries": list(part.temporaries),
-            "unused": [*part.unused, *(n for n in names if n not in written)],
+            "unused": list(part.unused),
+            "unwritten": [n for n in names if n not in written],
             "slots": [(*place[k], routine.outputs[k], labels[k] if labels else "")
                       for k in part.slots]})
     arguments = [f"{real} t" if a == "t" else f"const {real} {a}[]" for a in routine.arguments]

@@ -412,7 +412,7 @@ void andrews_squeezer_phi_t_shared(const andrews_squeezer_real q[], andrews_sque
     (void)q;
     (void)t;
     (void)p;
-    (void)shared; /* nothing to write here: e.g. no named points */
+    (void)shared;
     out[0] = 0;  /* joints[0] O revolute ground-crank (x) */
     out[1] = 0;  /* joints[0] O revolute ground-crank (y) */
     out[2] = 0;  /* joints[1] F revolute crank-rod (x) */

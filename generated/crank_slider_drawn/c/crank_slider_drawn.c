@@ -187,7 +187,7 @@ void crank_slider_drawn_phi_t_shared(const crank_slider_drawn_real q[], crank_sl
 {
     (void)q;
     (void)p;
-    (void)shared; /* nothing to write here: e.g. no named points */
+    (void)shared;
     out[0] = 0;  /* joints[0] revolute ground-crank (x) */
     out[1] = 0;  /* joints[0] revolute ground-crank (y) */
     out[2] = 0;  /* joints[1] revolute crank-rod (x) */

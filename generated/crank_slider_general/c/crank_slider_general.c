@@ -252,7 +252,7 @@ void crank_slider_general_phi_t_shared(const crank_slider_general_real q[], cran
 {
     (void)q;
     (void)p;
-    (void)shared; /* nothing to write here: e.g. no named points */
+    (void)shared;
     out[0] = 0;  /* joints[0] revolute ground-crank (x) */
     out[1] = 0;  /* joints[0] revolute ground-crank (y) */
     out[2] = 0;  /* joints[1] revolute crank-rod (x) */

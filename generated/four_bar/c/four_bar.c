@@ -187,7 +187,7 @@ void four_bar_phi_t_shared(const four_bar_real q[], four_bar_real t, const four_
 {
     (void)q;
     (void)t;
-    (void)shared; /* nothing to write here: e.g. no named points */
+    (void)shared;
     out[0] = 0;  /* joints[0] O2 revolute ground-crank (x) */
     out[1] = 0;  /* joints[0] O2 revolute ground-crank (y) */
     out[2] = 0;  /* joints[1] A revolute crank-coupler (x) */

@@ -224,7 +224,7 @@ void quick_return_phi_t_shared(const quick_return_real q[], quick_return_real t,
 {
     (void)q;
     (void)t;
-    (void)shared; /* nothing to write here: e.g. no named points */
+    (void)shared;
     out[0] = 0;  /* joints[0] O2 revolute ground-crank (x) */
     out[1] = 0;  /* joints[0] O2 revolute ground-crank (y) */
     out[2] = 0;  /* joints[1] O4 revolute ground-lever (x) */
