@@ -194,3 +194,21 @@ def test_readme_walkthrough_is_the_drawn_example() -> None:
     example = symkin.load(ROOT / "examples" / "crank_slider_drawn.yaml")
     assert from_readme.canonical_json() == example.canonical_json()
     assert from_readme.units == example.units
+
+
+def test_at_columns_never_run_together() -> None:
+    """The widest numbers %g prints (sign, 12 digits, a three-digit exponent) still leave a
+    space between columns, so every row splits into its numbers."""
+    import numpy as np
+
+    from symkin.cli import outputs
+    from symkin.runtime.results import Trajectory
+
+    widest = np.array([[-1.23456789012e-100, -9.87654321098e-200, -1.1e-16]])
+    trajectory = Trajectory(t=np.zeros(1), q=widest, dq=widest, d2q=widest,
+                            coordinates=("b.x", "b.y", "b.phi"), points=(("b", "P"),),
+                            point_vectors=np.array([[-1.234567891e-100, -2.5e-300]]))
+    text = outputs.configuration(trajectory, "m", "numpy backend")
+    for line in text.splitlines()[3:]:
+        if line and not line.startswith("point"):
+            assert all(np.isfinite(float(v)) for v in line.split()[1:]), line

@@ -93,19 +93,20 @@ def configuration(trajectory: Any, name: str, origin: str) -> str:
     t = float(trajectory.t[0])
     lines = [f"{name} at t = {t:.10g} ({origin})", "",
              f"{'coordinate':<24}{'q':>20}{'dq/dt':>20}{'d2q/dt2':>20}"]
-    # "+ 0.0" below prints a negative zero as 0.
+    # "+ 0.0" below prints a negative zero as 0. Each number has a space before it: the
+    # longest, -1.23456789012e-100, still fills its field without running into the next.
     for k, coordinate in enumerate(trajectory.coordinates):
         lines.append(f"{coordinate:<24}" + "".join(
-            f"{float(values[0, k]) + 0.0:>20.12g}" for values in (trajectory.q, trajectory.dq,
+            f" {float(values[0, k]) + 0.0:>19.12g}" for values in (trajectory.q, trajectory.dq,
                                                             trajectory.d2q)))
     if trajectory.points:
-        lines += ["", f"{'point':<24}" + "".join(f"{h:>16}" for h in
+        lines += ["", f"{'point':<24}" + "".join(f"{h:>18}" for h in
                                                   ("x", "y", "vx", "vy", "ax", "ay"))]
         for body, point in trajectory.points:
             r, dr, ddr = trajectory.point(body, point)
             numbers = np.concatenate([r[0], dr[0], ddr[0]])
             lines.append(f"{body + '.' + point:<24}"
-                         + "".join(f"{float(v) + 0.0:>16.10g}" for v in numbers))
+                         + "".join(f" {float(v) + 0.0:>17.10g}" for v in numbers))
     return "\n".join(lines) + "\n"
 
 
