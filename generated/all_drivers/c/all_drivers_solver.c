@@ -100,8 +100,13 @@ static const all_drivers_real all_drivers_alternating[ALL_DRIVERS_NQ] = {
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
 {
-    all_drivers_real y[ALL_DRIVERS_NQ], estimate = 0, norm, extra = 0;
+    all_drivers_real y[ALL_DRIVERS_NQ], z[ALL_DRIVERS_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, all_drivers_alternating, sizeof z);
+    all_drivers_lu_solve(lu, z);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < ALL_DRIVERS_ESTIMATOR_STEPS; ++step) {
         all_drivers_real dot, best, finite = 0;
         int jmax = 0;
@@ -123,9 +128,11 @@ static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
         estimate = norm;
         all_drivers_lu_solve_transposed(lu, y);
         best = fabs(y[0]);
-        for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const all_drivers_real a = fabs(y[i]);
             finite += y[i] - y[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); jmax = i; }
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
@@ -140,9 +147,6 @@ static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
         }
         j = jmax;
     }
-    memcpy(y, all_drivers_alternating, sizeof y);
-    all_drivers_lu_solve(lu, y);
-    for (i = 0; i < ALL_DRIVERS_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * ALL_DRIVERS_NQ);
     if (extra - extra != 0) return (all_drivers_real)INFINITY;
     return extra > estimate ? extra : estimate;

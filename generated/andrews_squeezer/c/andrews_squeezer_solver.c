@@ -112,8 +112,13 @@ static const andrews_squeezer_real andrews_squeezer_alternating[ANDREWS_SQUEEZER
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeezer_lu *lu)
 {
-    andrews_squeezer_real y[ANDREWS_SQUEEZER_NQ], estimate = 0, norm, extra = 0;
+    andrews_squeezer_real y[ANDREWS_SQUEEZER_NQ], z[ANDREWS_SQUEEZER_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, andrews_squeezer_alternating, sizeof z);
+    andrews_squeezer_lu_solve(lu, z);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < ANDREWS_SQUEEZER_ESTIMATOR_STEPS; ++step) {
         andrews_squeezer_real dot, best, finite = 0;
         int jmax = 0;
@@ -135,9 +140,11 @@ static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeez
         estimate = norm;
         andrews_squeezer_lu_solve_transposed(lu, y);
         best = fabs(y[0]);
-        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const andrews_squeezer_real a = fabs(y[i]);
             finite += y[i] - y[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); jmax = i; }
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
@@ -152,9 +159,6 @@ static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeez
         }
         j = jmax;
     }
-    memcpy(y, andrews_squeezer_alternating, sizeof y);
-    andrews_squeezer_lu_solve(lu, y);
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * ANDREWS_SQUEEZER_NQ);
     if (extra - extra != 0) return (andrews_squeezer_real)INFINITY;
     return extra > estimate ? extra : estimate;

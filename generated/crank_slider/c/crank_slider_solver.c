@@ -88,8 +88,13 @@ static const crank_slider_real crank_slider_alternating[CRANK_SLIDER_NQ] = {
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static crank_slider_real crank_slider_inverse_norm1(const crank_slider_lu *lu)
 {
-    crank_slider_real y[CRANK_SLIDER_NQ], estimate = 0, norm, extra = 0;
+    crank_slider_real y[CRANK_SLIDER_NQ], z[CRANK_SLIDER_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, crank_slider_alternating, sizeof z);
+    crank_slider_lu_solve(lu, z);
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < CRANK_SLIDER_ESTIMATOR_STEPS; ++step) {
         crank_slider_real dot, best, finite = 0;
         int jmax = 0;
@@ -111,9 +116,11 @@ static crank_slider_real crank_slider_inverse_norm1(const crank_slider_lu *lu)
         estimate = norm;
         crank_slider_lu_solve_transposed(lu, y);
         best = fabs(y[0]);
-        for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
+        for (i = 0; i < CRANK_SLIDER_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const crank_slider_real a = fabs(y[i]);
             finite += y[i] - y[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); jmax = i; }
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
@@ -128,9 +135,6 @@ static crank_slider_real crank_slider_inverse_norm1(const crank_slider_lu *lu)
         }
         j = jmax;
     }
-    memcpy(y, crank_slider_alternating, sizeof y);
-    crank_slider_lu_solve(lu, y);
-    for (i = 0; i < CRANK_SLIDER_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * CRANK_SLIDER_NQ);
     if (extra - extra != 0) return (crank_slider_real)INFINITY;
     return extra > estimate ? extra : estimate;

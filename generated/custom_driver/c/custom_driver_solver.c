@@ -88,8 +88,13 @@ static const custom_driver_real custom_driver_alternating[CUSTOM_DRIVER_NQ] = {
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu)
 {
-    custom_driver_real y[CUSTOM_DRIVER_NQ], estimate = 0, norm, extra = 0;
+    custom_driver_real y[CUSTOM_DRIVER_NQ], z[CUSTOM_DRIVER_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, custom_driver_alternating, sizeof z);
+    custom_driver_lu_solve(lu, z);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < CUSTOM_DRIVER_ESTIMATOR_STEPS; ++step) {
         custom_driver_real dot, best, finite = 0;
         int jmax = 0;
@@ -111,9 +116,11 @@ static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu
         estimate = norm;
         custom_driver_lu_solve_transposed(lu, y);
         best = fabs(y[0]);
-        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const custom_driver_real a = fabs(y[i]);
             finite += y[i] - y[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); jmax = i; }
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
@@ -128,9 +135,6 @@ static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu
         }
         j = jmax;
     }
-    memcpy(y, custom_driver_alternating, sizeof y);
-    custom_driver_lu_solve(lu, y);
-    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * CUSTOM_DRIVER_NQ);
     if (extra - extra != 0) return (custom_driver_real)INFINITY;
     return extra > estimate ? extra : estimate;

@@ -88,8 +88,13 @@ static const four_bar_real four_bar_alternating[FOUR_BAR_NQ] = {
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static four_bar_real four_bar_inverse_norm1(const four_bar_lu *lu)
 {
-    four_bar_real y[FOUR_BAR_NQ], estimate = 0, norm, extra = 0;
+    four_bar_real y[FOUR_BAR_NQ], z[FOUR_BAR_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, four_bar_alternating, sizeof z);
+    four_bar_lu_solve(lu, z);
+    for (i = 0; i < FOUR_BAR_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < FOUR_BAR_ESTIMATOR_STEPS; ++step) {
         four_bar_real dot, best, finite = 0;
         int jmax = 0;
@@ -111,9 +116,11 @@ static four_bar_real four_bar_inverse_norm1(const four_bar_lu *lu)
         estimate = norm;
         four_bar_lu_solve_transposed(lu, y);
         best = fabs(y[0]);
-        for (i = 0; i < FOUR_BAR_NQ; ++i) {
+        for (i = 0; i < FOUR_BAR_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const four_bar_real a = fabs(y[i]);
             finite += y[i] - y[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); jmax = i; }
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
@@ -128,9 +135,6 @@ static four_bar_real four_bar_inverse_norm1(const four_bar_lu *lu)
         }
         j = jmax;
     }
-    memcpy(y, four_bar_alternating, sizeof y);
-    four_bar_lu_solve(lu, y);
-    for (i = 0; i < FOUR_BAR_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * FOUR_BAR_NQ);
     if (extra - extra != 0) return (four_bar_real)INFINITY;
     return extra > estimate ? extra : estimate;

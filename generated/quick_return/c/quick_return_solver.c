@@ -94,8 +94,13 @@ static const quick_return_real quick_return_alternating[QUICK_RETURN_NQ] = {
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
 {
-    quick_return_real y[QUICK_RETURN_NQ], estimate = 0, norm, extra = 0;
+    quick_return_real y[QUICK_RETURN_NQ], z[QUICK_RETURN_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, quick_return_alternating, sizeof z);
+    quick_return_lu_solve(lu, z);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < QUICK_RETURN_ESTIMATOR_STEPS; ++step) {
         quick_return_real dot, best, finite = 0;
         int jmax = 0;
@@ -117,9 +122,11 @@ static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
         estimate = norm;
         quick_return_lu_solve_transposed(lu, y);
         best = fabs(y[0]);
-        for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const quick_return_real a = fabs(y[i]);
             finite += y[i] - y[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); jmax = i; }
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
@@ -134,9 +141,6 @@ static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
         }
         j = jmax;
     }
-    memcpy(y, quick_return_alternating, sizeof y);
-    quick_return_lu_solve(lu, y);
-    for (i = 0; i < QUICK_RETURN_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * QUICK_RETURN_NQ);
     if (extra - extra != 0) return (quick_return_real)INFINITY;
     return extra > estimate ? extra : estimate;
