@@ -66,6 +66,24 @@ long harness_solve(int m, const double *nz, double *b, int *status, int *dense, 
     return fallbacks;
 }}
 
+/* As harness_solve, with the transposed solve A^T x = b. */
+long harness_solve_transposed(int m, const double *nz, double *b, int *status, int *dense)
+{{
+    {p}_lu *lu = malloc(sizeof *lu);
+    long fallbacks;
+    int k;
+    if (!lu) return -1;
+    {p}_lu_init(lu);
+    for (k = 0; k < m; ++k) {{
+        status[k] = {p}_lu_factor(nz + (long)k * {P}_NNZ, lu);
+        dense[k] = lu->dense;
+        if (status[k] == 0) {p}_lu_solve_transposed(lu, b + (long)k * {P}_NQ);
+    }}
+    fallbacks = (long)lu->fallbacks;
+    free(lu);
+    return fallbacks;
+}}
+
 /* Timing loop for bench/: factor once and solve three right-hand sides, reps times. */
 void harness_repeat(long reps, const double *nz, double *b)
 {{
@@ -124,6 +142,16 @@ class Library:
                                            _iptr(failed), _ptr(self.ratios))
         return x, status, dense, failed, int(fallbacks)
 
+    def solve_transposed(self, nz: np.ndarray, b: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Factor and solve A^T x = b for a batch: returns x, status, dense flags."""
+        nz = np.ascontiguousarray(np.atleast_2d(nz), dtype=float)
+        x = np.ascontiguousarray(np.atleast_2d(b), dtype=float).copy()
+        m = nz.shape[0]
+        status, dense = (np.zeros(m, dtype=np.intc) for _ in range(2))
+        self.lib.harness_solve_transposed(m, _ptr(nz), _ptr(x), _iptr(status), _iptr(dense))
+        return x, status, dense
+
     def repeat(self, reps: int, nz: np.ndarray, b: np.ndarray) -> None:
         b = np.ascontiguousarray(b, dtype=float).copy()
         self.lib.harness_repeat(ctypes.c_long(reps), _ptr(np.ascontiguousarray(nz, float)),
@@ -166,6 +194,7 @@ def build(folder: Path, prefix: str, nq: int, rows: Sequence[int], cols: Sequenc
     compile_library([*sources, folder / "harness.c"], library, extra_flags)
     lib = ctypes.CDLL(str(library))
     lib.harness_solve.restype = ctypes.c_long
+    lib.harness_solve_transposed.restype = ctypes.c_long
     return Library(lib, nq, len(rows))
 
 

@@ -40,6 +40,8 @@ class Statements:
     factor: list[list[str]] = field(default_factory=list)
     forward: list[list[str]] = field(default_factory=list)
     backward: list[list[str]] = field(default_factory=list)
+    upper_t: list[list[str]] = field(default_factory=list)  # U^T z = w, per step in order
+    lower_t: list[list[str]] = field(default_factory=list)  # L^T v = z, per step reversed
     uses_cmax: list[bool] = field(default_factory=list)
     ratio_tests: int = 0
     uses_pivot_ok: bool = False  # the run-time threshold test of an unknown pivot
@@ -188,6 +190,29 @@ class _Emitter:
             elif inv != 1.0:
                 lines.append(f"x[{s.k}] *= {self.lit(inv)};")
             self.out.backward.append(lines)
+        self._transposed()
+
+    def _transposed(self) -> None:
+        """A^T x = b as U^T z = Pc^T b, L^T v = z: the same operations, in the same order, as
+        the table-driven loops (so the same bits), with the known entries folded."""
+        for s in self.plan.steps:
+            inv = self.inv.get(s.k)
+            lines = []
+            if inv is None:
+                lines.append(f"x[{s.k}] *= inv[{s.k}];")
+            elif inv == -1.0:
+                lines.append(f"x[{s.k}] = -x[{s.k}];")
+            elif inv != 1.0:
+                lines.append(f"x[{s.k}] *= {self.lit(inv)};")
+            lines += [line for j, slot in s.upper
+                      for line in _axpy(f"x[{j}]", self.val[slot], f"v[{slot}]", f"x[{s.k}]",
+                                        self.lit)]
+            self.out.upper_t.append(lines)
+        for s in reversed(self.plan.steps):
+            self.out.lower_t.append([
+                line for i, slot in s.lower
+                for line in _axpy(f"x[{s.k}]", self.val[slot], f"v[{slot}]", f"x[{i}]",
+                                  self.lit)])
 
 
 def _product(left: str, left_value: Value, right: str, right_value: Value) -> str:
@@ -278,7 +303,8 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
               "lower": [list(x) for x in s.lower], "upper": [list(x) for x in s.upper],
               "updates": [list(x) for x in s.updates], "factor": code.factor[s.k],
               "cmax": code.uses_cmax[s.k], "forward": code.forward[s.k],
-              "backward": code.backward[plan.n - 1 - s.k]} for s in plan.steps]
+              "backward": code.backward[plan.n - 1 - s.k], "upper_t": code.upper_t[s.k],
+              "lower_t": code.lower_t[plan.n - 1 - s.k]} for s in plan.steps]
     backward = list(reversed(steps))
     return {
         "n_lu": plan.n_lu,
@@ -314,6 +340,10 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
                                 part_ops),
         "backward_parts": _parts([s for s in backward if s["backward"]],
                                  lambda s: len(s["backward"]), part_ops),
+        "upper_t_parts": _parts([s for s in steps if s["upper_t"]], lambda s: len(s["upper_t"]),
+                                part_ops),
+        "lower_t_parts": _parts([s for s in backward if s["lower_t"]],
+                                lambda s: len(s["lower_t"]), part_ops),
         "style": style,
         "tables": _tables(plan),
     }

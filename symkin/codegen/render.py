@@ -21,7 +21,7 @@ from typing import Any
 import jinja2
 
 from symkin import resources
-from symkin.codegen import backends, lu_code
+from symkin.codegen import backends, lu_code, norm_code
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
 from symkin.errors import BuildError, UsageError
@@ -227,6 +227,8 @@ def metadata(code: Code) -> dict[str, Any]:
 def template_context(code: Code) -> dict[str, Any]:
     """The plain data every template of ``code.backend`` receives."""
     literal = backends.get(code.backend).literal(code.real)
+    lu = (lu_code.template_context(code.lu_plan, constants=code.constant_nz, real=code.real,
+                                   prefix=code.name) if code.lu_plan else None)
     return {
         "prefix": code.name, "PREFIX": code.name.upper(),
         "name_comment": codegen.comment(code.name),
@@ -256,9 +258,11 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg,
-        **({"lu": lu_code.template_context(code.lu_plan, constants=code.constant_nz,
-                                           real=code.real, prefix=code.name)}
-           if code.lu_plan else {}),
+        **({"lu": lu} if lu else {}),
+        # ||Phi_q||_1 straight-line, or a loop where the LU itself is table-driven
+        "norm1": (norm_code.norm1_context(code.pattern_cols, code.nq, code.constant_nz,
+                                          literal, code.real)
+                  if code.backend == "c" and not (lu and lu["style"] == "tables") else None),
         "newton_defaults": _newton_defaults(code, literal),
     }
 

@@ -31,14 +31,14 @@ void all_drivers_default_options(all_drivers_options *options)
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static all_drivers_real all_drivers_max_abs(const all_drivers_real v[])
 {
-    all_drivers_real largest = 0;
-    int i, nan = 0;
+    all_drivers_real largest = 0, sum = 0;
+    int i;
     for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
         all_drivers_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
-        nan |= a != a;
+        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
     }
-    return nan ? (all_drivers_real)NAN : largest;
+    return sum != sum ? (all_drivers_real)NAN : largest;
 }
 
 /* Factor the non-zeros of Phi_q in work->nz into work->lu; SINGULAR when a pivot vanishes or
@@ -57,53 +57,133 @@ static int all_drivers_factor_jacobian(const all_drivers_options *options, all_d
     return ALL_DRIVERS_OK;
 }
 
+/* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
+ * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
+static const all_drivers_real all_drivers_uniform[ALL_DRIVERS_NQ] = {
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+    (all_drivers_real)1 / 15,
+};
+static const all_drivers_real all_drivers_alternating[ALL_DRIVERS_NQ] = {
+    (1 + (all_drivers_real)0 / 14),
+    -(1 + (all_drivers_real)1 / 14),
+    (1 + (all_drivers_real)2 / 14),
+    -(1 + (all_drivers_real)3 / 14),
+    (1 + (all_drivers_real)4 / 14),
+    -(1 + (all_drivers_real)5 / 14),
+    (1 + (all_drivers_real)6 / 14),
+    -(1 + (all_drivers_real)7 / 14),
+    (1 + (all_drivers_real)8 / 14),
+    -(1 + (all_drivers_real)9 / 14),
+    (1 + (all_drivers_real)10 / 14),
+    -(1 + (all_drivers_real)11 / 14),
+    (1 + (all_drivers_real)12 / 14),
+    -(1 + (all_drivers_real)13 / 14),
+    (1 + (all_drivers_real)14 / 14),
+};
+
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * After the first step x is the unit vector e_j, kept as its index j only. */
 static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
 {
-    all_drivers_real x[ALL_DRIVERS_NQ], y[ALL_DRIVERS_NQ], estimate = 0, norm, extra = 0;
-    int i, j, step;
-    for (i = 0; i < ALL_DRIVERS_NQ; ++i) x[i] = (all_drivers_real)1 / ALL_DRIVERS_NQ;
+    all_drivers_real y[ALL_DRIVERS_NQ], z[ALL_DRIVERS_NQ], estimate = 0, norm, extra = 0;
+    int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, all_drivers_alternating, sizeof z);
+    all_drivers_lu_solve(lu, z);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < ALL_DRIVERS_ESTIMATOR_STEPS; ++step) {
-        all_drivers_real dot = 0, best;
-        memcpy(y, x, sizeof y);
+        all_drivers_real dot, best, finite = 0;
+        int jmax = 0;
+        if (step == 0) {
+            memcpy(y, all_drivers_uniform, sizeof y);
+        } else {
+            memset(y, 0, sizeof y);
+            y[j] = 1;
+        }
         all_drivers_lu_solve(lu, y);
         norm = 0;
-        for (i = 0; i < ALL_DRIVERS_NQ; ++i) norm += fabs(y[i]);
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+            norm += fabs(y[i]);
+            /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
+            y[i] = copysign(1, y[i] + 0);
+        }
         if (norm - norm != 0) return (all_drivers_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
         estimate = norm;
-        for (i = 0; i < ALL_DRIVERS_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
         all_drivers_lu_solve_transposed(lu, y);
-        j = 0;
         best = fabs(y[0]);
-        for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
-            dot += y[i] * x[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const all_drivers_real a = fabs(y[i]);
+            finite += y[i] - y[i];
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
-        if (step > 0 && best <= dot) break;
-        for (i = 0; i < ALL_DRIVERS_NQ; ++i) x[i] = 0;
-        x[j] = 1;
+        if (step > 0) {
+            /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
+             * 0 * inf), so that the test is the one runtime.accuracy makes */
+            if (finite == 0) {
+                dot = y[j];
+            } else {
+                dot = 0;
+                for (i = 0; i < ALL_DRIVERS_NQ; ++i) dot += y[i] * (i == j ? 1 : 0);
+            }
+            if (best <= dot) break;
+        }
+        j = jmax;
     }
-    for (i = 0; i < ALL_DRIVERS_NQ; ++i) { /* the alternating-sign test vector */
-        const all_drivers_real size = 1 + (all_drivers_real)i / (ALL_DRIVERS_NQ > 1 ? ALL_DRIVERS_NQ - 1 : 1);
-        y[i] = i % 2 == 0 ? size : -size;
-    }
-    all_drivers_lu_solve(lu, y);
-    for (i = 0; i < ALL_DRIVERS_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * ALL_DRIVERS_NQ);
     if (extra - extra != 0) return (all_drivers_real)INFINITY;
     return extra > estimate ? extra : estimate;
 }
 
+/* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
+ * non-zeros kept), columns 2..10: the largest of them and largest. */
+static all_drivers_real all_drivers_norm1_0(const all_drivers_real nz[], all_drivers_real largest)
+{
+    all_drivers_real s;
+    s = fabs(nz[3]) + fabs(nz[6]);
+    largest = s > largest ? s : largest;
+    s = 1.0 + fabs(nz[10]) + 1.0 + fabs(nz[19]);
+    largest = s > largest ? s : largest;
+    s = 1.0 + fabs(nz[11]) + 1.0 + fabs(nz[20]);
+    largest = s > largest ? s : largest;
+    s = 1.0 + fabs(nz[12]) + fabs(nz[16]) + fabs(nz[18]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[13]) + fabs(nz[21]) + fabs(nz[24]) + fabs(nz[29]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[14]) + fabs(nz[22]) + fabs(nz[25]) + fabs(nz[30]);
+    largest = s > largest ? s : largest;
+    s = 1.0 + fabs(nz[23]) + fabs(nz[26]) + fabs(nz[31]) + 1.0;
+    largest = s > largest ? s : largest;
+    s = fabs(nz[27]) + fabs(nz[32]) + 1.0;
+    largest = s > largest ? s : largest;
+    s = fabs(nz[28]) + fabs(nz[33]) + 1.0;
+    largest = s > largest ? s : largest;
+    return largest;
+}
+
 /* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
 static all_drivers_real all_drivers_norm1(const all_drivers_real nz[])
 {
-    all_drivers_real sums[ALL_DRIVERS_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < ALL_DRIVERS_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) sums[all_drivers_phi_q_col[e]] += fabs(nz[e]);
-    for (j = 0; j < ALL_DRIVERS_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    all_drivers_real largest = 2.0; /* the columns of numbers only */
+    (void)nz;
+    largest = all_drivers_norm1_0(nz, largest);
     return largest;
 }
 
@@ -120,11 +200,10 @@ static all_drivers_real all_drivers_at_least_1(all_drivers_real x)
 
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
 static int all_drivers_flagged(const all_drivers_options *options,
-                                const all_drivers_report *report, const all_drivers_state *state)
+                                const all_drivers_report *report, all_drivers_real nq, all_drivers_real ndq,
+                                all_drivers_real nddq)
 {
     const all_drivers_real u = ALL_DRIVERS_UNIT_ROUNDOFF;
-    const all_drivers_real nq = all_drivers_max_abs(state->q), ndq = all_drivers_max_abs(state->dq);
-    const all_drivers_real nddq = all_drivers_max_abs(state->ddq);
     const all_drivers_real s = report->inv_norm / sqrt((all_drivers_real)ALL_DRIVERS_NQ);
     const all_drivers_real floor = u * (1 + nq);
     all_drivers_real e_q, e_dq, e_ddq;
@@ -224,6 +303,7 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
                             all_drivers_state *state, all_drivers_workspace *work,
                             all_drivers_report *report)
 {
+    all_drivers_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
     report->flagged = 0;
     report->cond = (all_drivers_real)NAN;
@@ -246,13 +326,25 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
     all_drivers_lu_solve(&work->lu, state->dq); /* (2.73) */
     all_drivers_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     all_drivers_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
+     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
+    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
     for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
-        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
-            report->status = ALL_DRIVERS_NOT_FINITE; /* Phi_t or Gamma singular at t */
-            return report->status;
-        }
+        const all_drivers_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
+        const all_drivers_real c = fabs(state->ddq[i]);
+        nq = a > nq ? a : nq;
+        ndq = b > ndq ? b : ndq;
+        nddq = c > nddq ? c : nddq;
+        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
+        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
+        finite_ddq += c - c;
     }
-    report->flagged = all_drivers_flagged(options, report, state);
+    if (finite_dq != 0 || finite_ddq != 0) {
+        report->status = ALL_DRIVERS_NOT_FINITE; /* Phi_t or Gamma singular at t */
+        return report->status;
+    }
+    report->flagged = all_drivers_flagged(options, report, sum_q != sum_q ? (all_drivers_real)NAN : nq,
+                                           ndq, nddq);
     state->t = t;
     state->started = 1;
     return ALL_DRIVERS_OK;

@@ -362,52 +362,101 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
     b[10] = x[14];
 }
 
-/* The factors' structure as index tables, for the transposed solve only (the straight-line
- * code above needs none): see the tables style for their layout. */
-static const int all_drivers_lu_row_perm[ALL_DRIVERS_NQ] = {
-    11, 12, 13, 14, 0, 1, 2, 3, 4, 6, 7, 5, 8, 9, 10
-};
-static const int all_drivers_lu_col_perm[ALL_DRIVERS_NQ] = {
-    11, 12, 13, 14, 0, 1, 2, 3, 5, 4, 8, 6, 7, 9, 10
-};
-static const int all_drivers_lu_lower_start[16] = {
-    0, 0, 0, 0, 0, 1, 2, 3, 6, 9, 12, 16, 19, 21, 22, 22
-};
+/* U^T z = w, columns 0..14 of U^T (rows of U) */
+static void all_drivers_lu_upper_t_0(const all_drivers_real *v,
+        const all_drivers_real *inv, all_drivers_real *x)
+{
+    (void)v;
+    (void)inv;
+    x[10] += x[0];
+    x[13] += x[1];
+    x[14] += x[2];
+    x[4] = -x[4];
+    x[5] = -x[5];
+    x[6] *= inv[6];
+    x[7] += x[6];
+    x[7] *= inv[7];
+    x[9] += x[7];
+    x[8] = -x[8];
+    x[10] -= x[8];
+    x[9] *= inv[9];
+    x[10] -= v[44] * x[9];
+    x[10] *= inv[10];
+    x[11] *= inv[11];
+    x[12] -= v[14] * x[11];
+    x[12] *= inv[12];
+    x[13] *= inv[13];
+    x[14] -= v[28] * x[13];
+    x[14] *= inv[14];
+}
 
-static const int all_drivers_lu_lower[46] = {
-    6, 2, 7, 5, 7, 6, 9, 15, 11, 10, 12, 19, 9, 16, 10, 18, 11, 12, 10, 17, 11, 11, 12, 20, 11,
-    43, 12, 23, 13, 26, 14, 31, 12, 21, 13, 24, 14, 29, 13, 25, 14, 30, 14, 32, 0, 0
-};
-
-static const int all_drivers_lu_upper_start[16] = {
-    0, 1, 2, 3, 3, 3, 3, 4, 5, 6, 7, 7, 8, 8, 9, 9
-};
-
-static const int all_drivers_lu_upper[20] = {
-    10, 34, 13, 36, 14, 38, 7, 4, 9, 7, 10, 9, 10, 44, 12, 14, 14, 28, 0, 0
-};
+/* L^T v = z (unit diagonal), rows 13..4 */
+static void all_drivers_lu_lower_t_0(const all_drivers_real *v, all_drivers_real *x)
+{
+    (void)v;
+    x[13] -= v[32] * x[14];
+    x[12] -= v[25] * x[13];
+    x[12] -= v[30] * x[14];
+    x[11] -= v[21] * x[12];
+    x[11] -= v[24] * x[13];
+    x[11] -= v[29] * x[14];
+    x[10] -= v[43] * x[11];
+    x[10] -= v[23] * x[12];
+    x[10] -= v[26] * x[13];
+    x[10] -= v[31] * x[14];
+    x[9] -= v[17] * x[10];
+    x[9] -= v[11] * x[11];
+    x[9] -= v[20] * x[12];
+    x[8] -= v[16] * x[9];
+    x[8] -= v[18] * x[10];
+    x[8] -= v[12] * x[11];
+    x[7] -= v[15] * x[9];
+    x[7] -= v[10] * x[11];
+    x[7] -= v[19] * x[12];
+    x[6] -= v[6] * x[7];
+    x[5] += x[7];
+    x[4] += x[6];
+}
 
 void all_drivers_lu_solve_transposed(const all_drivers_lu *lu, all_drivers_real b[])
 {
     /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
     all_drivers_real x[ALL_DRIVERS_NQ];
-    int k, e;
     if (lu->dense) {
         all_drivers_dense_lu_solve_transposed(&lu->dense_lu, b);
         return;
     }
-    for (k = 0; k < ALL_DRIVERS_NQ; ++k) x[k] = b[all_drivers_lu_col_perm[k]];
-    for (k = 0; k < ALL_DRIVERS_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
-        const all_drivers_real zk = x[k] * lu->inv[k];
-        x[k] = zk;
-        for (e = all_drivers_lu_upper_start[k]; e < all_drivers_lu_upper_start[k + 1]; ++e)
-            x[all_drivers_lu_upper[2 * e]] -= lu->v[all_drivers_lu_upper[2 * e + 1]] * zk;
-    }
-    for (k = ALL_DRIVERS_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
-        all_drivers_real sum = x[k];
-        for (e = all_drivers_lu_lower_start[k]; e < all_drivers_lu_lower_start[k + 1]; ++e)
-            sum -= lu->v[all_drivers_lu_lower[2 * e + 1]] * x[all_drivers_lu_lower[2 * e]];
-        x[k] = sum;
-    }
-    for (k = 0; k < ALL_DRIVERS_NQ; ++k) b[all_drivers_lu_row_perm[k]] = x[k];
+    /* the column permutation, baked in */
+    x[0] = b[11];
+    x[1] = b[12];
+    x[2] = b[13];
+    x[3] = b[14];
+    x[4] = b[0];
+    x[5] = b[1];
+    x[6] = b[2];
+    x[7] = b[3];
+    x[8] = b[5];
+    x[9] = b[4];
+    x[10] = b[8];
+    x[11] = b[6];
+    x[12] = b[7];
+    x[13] = b[9];
+    x[14] = b[10];
+    all_drivers_lu_upper_t_0(lu->v, lu->inv, x);
+    all_drivers_lu_lower_t_0(lu->v, x);
+    b[11] = x[0];
+    b[12] = x[1];
+    b[13] = x[2];
+    b[14] = x[3];
+    b[0] = x[4];
+    b[1] = x[5];
+    b[2] = x[6];
+    b[3] = x[7];
+    b[4] = x[8];
+    b[6] = x[9];
+    b[7] = x[10];
+    b[5] = x[11];
+    b[8] = x[12];
+    b[9] = x[13];
+    b[10] = x[14];
 }

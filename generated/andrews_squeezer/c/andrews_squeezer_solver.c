@@ -31,14 +31,14 @@ void andrews_squeezer_default_options(andrews_squeezer_options *options)
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static andrews_squeezer_real andrews_squeezer_max_abs(const andrews_squeezer_real v[])
 {
-    andrews_squeezer_real largest = 0;
-    int i, nan = 0;
+    andrews_squeezer_real largest = 0, sum = 0;
+    int i;
     for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
         andrews_squeezer_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
-        nan |= a != a;
+        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
     }
-    return nan ? (andrews_squeezer_real)NAN : largest;
+    return sum != sum ? (andrews_squeezer_real)NAN : largest;
 }
 
 /* Factor the non-zeros of Phi_q in work->nz into work->lu; SINGULAR when a pivot vanishes or
@@ -57,53 +57,141 @@ static int andrews_squeezer_factor_jacobian(const andrews_squeezer_options *opti
     return ANDREWS_SQUEEZER_OK;
 }
 
+/* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
+ * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
+static const andrews_squeezer_real andrews_squeezer_uniform[ANDREWS_SQUEEZER_NQ] = {
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+    (andrews_squeezer_real)1 / 21,
+};
+static const andrews_squeezer_real andrews_squeezer_alternating[ANDREWS_SQUEEZER_NQ] = {
+    (1 + (andrews_squeezer_real)0 / 20),
+    -(1 + (andrews_squeezer_real)1 / 20),
+    (1 + (andrews_squeezer_real)2 / 20),
+    -(1 + (andrews_squeezer_real)3 / 20),
+    (1 + (andrews_squeezer_real)4 / 20),
+    -(1 + (andrews_squeezer_real)5 / 20),
+    (1 + (andrews_squeezer_real)6 / 20),
+    -(1 + (andrews_squeezer_real)7 / 20),
+    (1 + (andrews_squeezer_real)8 / 20),
+    -(1 + (andrews_squeezer_real)9 / 20),
+    (1 + (andrews_squeezer_real)10 / 20),
+    -(1 + (andrews_squeezer_real)11 / 20),
+    (1 + (andrews_squeezer_real)12 / 20),
+    -(1 + (andrews_squeezer_real)13 / 20),
+    (1 + (andrews_squeezer_real)14 / 20),
+    -(1 + (andrews_squeezer_real)15 / 20),
+    (1 + (andrews_squeezer_real)16 / 20),
+    -(1 + (andrews_squeezer_real)17 / 20),
+    (1 + (andrews_squeezer_real)18 / 20),
+    -(1 + (andrews_squeezer_real)19 / 20),
+    (1 + (andrews_squeezer_real)20 / 20),
+};
+
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * After the first step x is the unit vector e_j, kept as its index j only. */
 static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeezer_lu *lu)
 {
-    andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ], y[ANDREWS_SQUEEZER_NQ], estimate = 0, norm, extra = 0;
-    int i, j, step;
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) x[i] = (andrews_squeezer_real)1 / ANDREWS_SQUEEZER_NQ;
+    andrews_squeezer_real y[ANDREWS_SQUEEZER_NQ], z[ANDREWS_SQUEEZER_NQ], estimate = 0, norm, extra = 0;
+    int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, andrews_squeezer_alternating, sizeof z);
+    andrews_squeezer_lu_solve(lu, z);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < ANDREWS_SQUEEZER_ESTIMATOR_STEPS; ++step) {
-        andrews_squeezer_real dot = 0, best;
-        memcpy(y, x, sizeof y);
+        andrews_squeezer_real dot, best, finite = 0;
+        int jmax = 0;
+        if (step == 0) {
+            memcpy(y, andrews_squeezer_uniform, sizeof y);
+        } else {
+            memset(y, 0, sizeof y);
+            y[j] = 1;
+        }
         andrews_squeezer_lu_solve(lu, y);
         norm = 0;
-        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) norm += fabs(y[i]);
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+            norm += fabs(y[i]);
+            /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
+            y[i] = copysign(1, y[i] + 0);
+        }
         if (norm - norm != 0) return (andrews_squeezer_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
         estimate = norm;
-        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
         andrews_squeezer_lu_solve_transposed(lu, y);
-        j = 0;
         best = fabs(y[0]);
-        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-            dot += y[i] * x[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const andrews_squeezer_real a = fabs(y[i]);
+            finite += y[i] - y[i];
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
-        if (step > 0 && best <= dot) break;
-        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) x[i] = 0;
-        x[j] = 1;
+        if (step > 0) {
+            /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
+             * 0 * inf), so that the test is the one runtime.accuracy makes */
+            if (finite == 0) {
+                dot = y[j];
+            } else {
+                dot = 0;
+                for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) dot += y[i] * (i == j ? 1 : 0);
+            }
+            if (best <= dot) break;
+        }
+        j = jmax;
     }
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) { /* the alternating-sign test vector */
-        const andrews_squeezer_real size = 1 + (andrews_squeezer_real)i / (ANDREWS_SQUEEZER_NQ > 1 ? ANDREWS_SQUEEZER_NQ - 1 : 1);
-        y[i] = i % 2 == 0 ? size : -size;
-    }
-    andrews_squeezer_lu_solve(lu, y);
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * ANDREWS_SQUEEZER_NQ);
     if (extra - extra != 0) return (andrews_squeezer_real)INFINITY;
     return extra > estimate ? extra : estimate;
 }
 
+/* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
+ * non-zeros kept), columns 2..20: the largest of them and largest. */
+static andrews_squeezer_real andrews_squeezer_norm1_0(const andrews_squeezer_real nz[], andrews_squeezer_real largest)
+{
+    andrews_squeezer_real s;
+    s = fabs(nz[3]) + fabs(nz[6]) + 1.0;
+    largest = s > largest ? s : largest;
+    s = fabs(nz[9]) + fabs(nz[13]) + fabs(nz[17]) + fabs(nz[20]) + fabs(nz[23]) + fabs(nz[26]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[11]) + fabs(nz[15]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[31]) + fabs(nz[35]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[33]) + fabs(nz[37]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[41]) + fabs(nz[45]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[43]) + fabs(nz[47]);
+    largest = s > largest ? s : largest;
+    return largest;
+}
+
 /* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
 static andrews_squeezer_real andrews_squeezer_norm1(const andrews_squeezer_real nz[])
 {
-    andrews_squeezer_real sums[ANDREWS_SQUEEZER_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < ANDREWS_SQUEEZER_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < ANDREWS_SQUEEZER_NNZ; ++e) sums[andrews_squeezer_phi_q_col[e]] += fabs(nz[e]);
-    for (j = 0; j < ANDREWS_SQUEEZER_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    andrews_squeezer_real largest = 4.0; /* the columns of numbers only */
+    (void)nz;
+    largest = andrews_squeezer_norm1_0(nz, largest);
     return largest;
 }
 
@@ -120,11 +208,10 @@ static andrews_squeezer_real andrews_squeezer_at_least_1(andrews_squeezer_real x
 
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
 static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
-                                const andrews_squeezer_report *report, const andrews_squeezer_state *state)
+                                const andrews_squeezer_report *report, andrews_squeezer_real nq, andrews_squeezer_real ndq,
+                                andrews_squeezer_real nddq)
 {
     const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
-    const andrews_squeezer_real nq = andrews_squeezer_max_abs(state->q), ndq = andrews_squeezer_max_abs(state->dq);
-    const andrews_squeezer_real nddq = andrews_squeezer_max_abs(state->ddq);
     const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
     const andrews_squeezer_real floor = u * (1 + nq);
     andrews_squeezer_real e_q, e_dq, e_ddq;
@@ -224,6 +311,7 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
                             andrews_squeezer_state *state, andrews_squeezer_workspace *work,
                             andrews_squeezer_report *report)
 {
+    andrews_squeezer_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
     report->flagged = 0;
     report->cond = (andrews_squeezer_real)NAN;
@@ -246,13 +334,25 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
     andrews_squeezer_lu_solve(&work->lu, state->dq); /* (2.73) */
     andrews_squeezer_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     andrews_squeezer_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
+     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
+    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
     for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
-            report->status = ANDREWS_SQUEEZER_NOT_FINITE; /* Phi_t or Gamma singular at t */
-            return report->status;
-        }
+        const andrews_squeezer_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
+        const andrews_squeezer_real c = fabs(state->ddq[i]);
+        nq = a > nq ? a : nq;
+        ndq = b > ndq ? b : ndq;
+        nddq = c > nddq ? c : nddq;
+        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
+        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
+        finite_ddq += c - c;
     }
-    report->flagged = andrews_squeezer_flagged(options, report, state);
+    if (finite_dq != 0 || finite_ddq != 0) {
+        report->status = ANDREWS_SQUEEZER_NOT_FINITE; /* Phi_t or Gamma singular at t */
+        return report->status;
+    }
+    report->flagged = andrews_squeezer_flagged(options, report, sum_q != sum_q ? (andrews_squeezer_real)NAN : nq,
+                                           ndq, nddq);
     state->t = t;
     state->started = 1;
     return ANDREWS_SQUEEZER_OK;

@@ -362,53 +362,121 @@ void andrews_squeezer_lu_solve(const andrews_squeezer_lu *lu, andrews_squeezer_r
     b[20] = x[20];
 }
 
-/* The factors' structure as index tables, for the transposed solve only (the straight-line
- * code above needs none): see the tables style for their layout. */
-static const int andrews_squeezer_lu_row_perm[ANDREWS_SQUEEZER_NQ] = {
-    0, 1, 10, 11, 14, 15, 18, 19, 20, 2, 3, 4, 5, 6, 7, 8, 9, 12, 13, 16, 17
-};
-static const int andrews_squeezer_lu_col_perm[ANDREWS_SQUEEZER_NQ] = {
-    0, 1, 6, 7, 12, 13, 18, 19, 2, 3, 4, 8, 5, 9, 10, 15, 16, 11, 14, 17, 20
-};
-static const int andrews_squeezer_lu_lower_start[22] = {
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 13, 16, 17, 21, 22, 23, 24, 25, 26, 26, 27, 27
-};
+/* U^T z = w, columns 0..20 of U^T (rows of U) */
+static void andrews_squeezer_lu_upper_t_0(const andrews_squeezer_real *v,
+        const andrews_squeezer_real *inv, andrews_squeezer_real *x)
+{
+    (void)v;
+    (void)inv;
+    x[0] = -x[0];
+    x[1] = -x[1];
+    x[2] = -x[2];
+    x[3] = -x[3];
+    x[4] = -x[4];
+    x[5] = -x[5];
+    x[6] = -x[6];
+    x[7] = -x[7];
+    x[9] = -x[9];
+    x[10] = -x[10];
+    x[11] *= inv[11];
+    x[12] -= v[9] * x[11];
+    x[12] *= inv[12];
+    x[13] = -x[13];
+    x[14] = -x[14];
+    x[15] = -x[15];
+    x[16] = -x[16];
+    x[17] *= inv[17];
+    x[18] -= v[33] * x[17];
+    x[18] *= inv[18];
+    x[19] *= inv[19];
+    x[20] -= v[43] * x[19];
+    x[20] *= inv[20];
+}
 
-static const int andrews_squeezer_lu_lower[56] = {
-    9, 2, 10, 5, 11, 10, 12, 14, 17, 32, 18, 36, 19, 42, 20, 46, 9, 3, 10, 6, 11, 8, 13, 16, 15,
-    22, 12, 12, 14, 19, 16, 25, 12, 15, 13, 17, 14, 20, 15, 23, 16, 26, 17, 30, 18, 34, 19, 40,
-    20, 44, 18, 35, 20, 45, 0, 0
-};
-
-static const int andrews_squeezer_lu_upper_start[22] = {
-    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 2, 2, 3, 3
-};
-
-static const int andrews_squeezer_lu_upper[8] = {
-    12, 9, 18, 33, 20, 43, 0, 0
-};
+/* L^T v = z (unit diagonal), rows 19..0 */
+static void andrews_squeezer_lu_lower_t_0(const andrews_squeezer_real *v, andrews_squeezer_real *x)
+{
+    (void)v;
+    x[19] -= v[45] * x[20];
+    x[17] -= v[35] * x[18];
+    x[16] += x[20];
+    x[15] += x[19];
+    x[14] += x[18];
+    x[13] += x[17];
+    x[12] -= v[17] * x[13];
+    x[12] -= v[20] * x[14];
+    x[12] -= v[23] * x[15];
+    x[12] -= v[26] * x[16];
+    x[11] -= v[15] * x[12];
+    x[10] += x[12];
+    x[10] += x[14];
+    x[10] += x[16];
+    x[9] += x[11];
+    x[9] += x[13];
+    x[9] += x[15];
+    x[8] -= v[3] * x[9];
+    x[8] -= v[6] * x[10];
+    x[7] -= x[20];
+    x[6] -= x[19];
+    x[5] -= x[18];
+    x[4] -= x[17];
+    x[3] -= x[12];
+    x[2] -= x[11];
+    x[1] += x[10];
+    x[0] += x[9];
+}
 
 void andrews_squeezer_lu_solve_transposed(const andrews_squeezer_lu *lu, andrews_squeezer_real b[])
 {
     /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
     andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ];
-    int k, e;
     if (lu->dense) {
         andrews_squeezer_dense_lu_solve_transposed(&lu->dense_lu, b);
         return;
     }
-    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) x[k] = b[andrews_squeezer_lu_col_perm[k]];
-    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
-        const andrews_squeezer_real zk = x[k] * lu->inv[k];
-        x[k] = zk;
-        for (e = andrews_squeezer_lu_upper_start[k]; e < andrews_squeezer_lu_upper_start[k + 1]; ++e)
-            x[andrews_squeezer_lu_upper[2 * e]] -= lu->v[andrews_squeezer_lu_upper[2 * e + 1]] * zk;
-    }
-    for (k = ANDREWS_SQUEEZER_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
-        andrews_squeezer_real sum = x[k];
-        for (e = andrews_squeezer_lu_lower_start[k]; e < andrews_squeezer_lu_lower_start[k + 1]; ++e)
-            sum -= lu->v[andrews_squeezer_lu_lower[2 * e + 1]] * x[andrews_squeezer_lu_lower[2 * e]];
-        x[k] = sum;
-    }
-    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) b[andrews_squeezer_lu_row_perm[k]] = x[k];
+    /* the column permutation, baked in */
+    x[0] = b[0];
+    x[1] = b[1];
+    x[2] = b[6];
+    x[3] = b[7];
+    x[4] = b[12];
+    x[5] = b[13];
+    x[6] = b[18];
+    x[7] = b[19];
+    x[8] = b[2];
+    x[9] = b[3];
+    x[10] = b[4];
+    x[11] = b[8];
+    x[12] = b[5];
+    x[13] = b[9];
+    x[14] = b[10];
+    x[15] = b[15];
+    x[16] = b[16];
+    x[17] = b[11];
+    x[18] = b[14];
+    x[19] = b[17];
+    x[20] = b[20];
+    andrews_squeezer_lu_upper_t_0(lu->v, lu->inv, x);
+    andrews_squeezer_lu_lower_t_0(lu->v, x);
+    b[0] = x[0];
+    b[1] = x[1];
+    b[10] = x[2];
+    b[11] = x[3];
+    b[14] = x[4];
+    b[15] = x[5];
+    b[18] = x[6];
+    b[19] = x[7];
+    b[20] = x[8];
+    b[2] = x[9];
+    b[3] = x[10];
+    b[4] = x[11];
+    b[5] = x[12];
+    b[6] = x[13];
+    b[7] = x[14];
+    b[8] = x[15];
+    b[9] = x[16];
+    b[12] = x[17];
+    b[13] = x[18];
+    b[16] = x[19];
+    b[17] = x[20];
 }

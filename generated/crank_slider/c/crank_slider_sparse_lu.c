@@ -186,51 +186,55 @@ void crank_slider_lu_solve(const crank_slider_lu *lu, crank_slider_real b[])
     b[8] = x[8];
 }
 
-/* The factors' structure as index tables, for the transposed solve only (the straight-line
- * code above needs none): see the tables style for their layout. */
-static const int crank_slider_lu_row_perm[CRANK_SLIDER_NQ] = {
-    4, 2, 0, 5, 3, 1, 8, 7, 6
-};
-static const int crank_slider_lu_col_perm[CRANK_SLIDER_NQ] = {
-    6, 3, 0, 5, 4, 1, 2, 7, 8
-};
-static const int crank_slider_lu_lower_start[10] = {
-    0, 0, 0, 0, 0, 0, 0, 0, 0, 0
-};
-
-static const int crank_slider_lu_lower[2] = {
-    0, 0
-};
-
-static const int crank_slider_lu_upper_start[10] = {
-    0, 2, 4, 4, 6, 8, 8, 8, 8, 8
-};
-
-static const int crank_slider_lu_upper[18] = {
-    1, 8, 3, 9, 2, 2, 6, 3, 4, 11, 7, 13, 5, 5, 6, 6, 0, 0
-};
+/* U^T z = w, columns 0..7 of U^T (rows of U) */
+static void crank_slider_lu_upper_t_0(const crank_slider_real *v,
+        const crank_slider_real *inv, crank_slider_real *x)
+{
+    (void)v;
+    (void)inv;
+    x[0] = -x[0];
+    x[1] -= x[0];
+    x[3] -= v[9] * x[0];
+    x[1] = -x[1];
+    x[2] -= x[1];
+    x[6] -= v[3] * x[1];
+    x[2] = -x[2];
+    x[3] *= inv[3];
+    x[4] -= x[3];
+    x[7] += x[3];
+    x[4] = -x[4];
+    x[5] -= x[4];
+    x[6] -= v[6] * x[4];
+    x[5] = -x[5];
+    x[7] = -x[7];
+}
 
 void crank_slider_lu_solve_transposed(const crank_slider_lu *lu, crank_slider_real b[])
 {
     /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
     crank_slider_real x[CRANK_SLIDER_NQ];
-    int k, e;
     if (lu->dense) {
         crank_slider_dense_lu_solve_transposed(&lu->dense_lu, b);
         return;
     }
-    for (k = 0; k < CRANK_SLIDER_NQ; ++k) x[k] = b[crank_slider_lu_col_perm[k]];
-    for (k = 0; k < CRANK_SLIDER_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
-        const crank_slider_real zk = x[k] * lu->inv[k];
-        x[k] = zk;
-        for (e = crank_slider_lu_upper_start[k]; e < crank_slider_lu_upper_start[k + 1]; ++e)
-            x[crank_slider_lu_upper[2 * e]] -= lu->v[crank_slider_lu_upper[2 * e + 1]] * zk;
-    }
-    for (k = CRANK_SLIDER_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
-        crank_slider_real sum = x[k];
-        for (e = crank_slider_lu_lower_start[k]; e < crank_slider_lu_lower_start[k + 1]; ++e)
-            sum -= lu->v[crank_slider_lu_lower[2 * e + 1]] * x[crank_slider_lu_lower[2 * e]];
-        x[k] = sum;
-    }
-    for (k = 0; k < CRANK_SLIDER_NQ; ++k) b[crank_slider_lu_row_perm[k]] = x[k];
+    /* the column permutation, baked in */
+    x[0] = b[6];
+    x[1] = b[3];
+    x[2] = b[0];
+    x[3] = b[5];
+    x[4] = b[4];
+    x[5] = b[1];
+    x[6] = b[2];
+    x[7] = b[7];
+    x[8] = b[8];
+    crank_slider_lu_upper_t_0(lu->v, lu->inv, x);
+    b[4] = x[0];
+    b[2] = x[1];
+    b[0] = x[2];
+    b[5] = x[3];
+    b[3] = x[4];
+    b[1] = x[5];
+    b[8] = x[6];
+    b[7] = x[7];
+    b[6] = x[8];
 }

@@ -249,51 +249,71 @@ void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slid
     b[7] = x[8];
 }
 
-/* The factors' structure as index tables, for the transposed solve only (the straight-line
- * code above needs none): see the tables style for their layout. */
-static const int crank_slider_general_lu_row_perm[CRANK_SLIDER_GENERAL_NQ] = {
-    6, 8, 0, 1, 2, 3, 4, 5, 7
-};
-static const int crank_slider_general_lu_col_perm[CRANK_SLIDER_GENERAL_NQ] = {
-    8, 2, 0, 1, 3, 4, 5, 6, 7
-};
-static const int crank_slider_general_lu_lower_start[10] = {
-    0, 3, 7, 8, 9, 10, 11, 12, 13, 13
-};
+/* U^T z = w, columns 2..8 of U^T (rows of U) */
+static void crank_slider_general_lu_upper_t_0(const crank_slider_general_real *v,
+        const crank_slider_general_real *inv, crank_slider_general_real *x)
+{
+    (void)v;
+    (void)inv;
+    x[2] = -x[2];
+    x[3] = -x[3];
+    x[4] = -x[4];
+    x[6] -= v[7] * x[4];
+    x[5] = -x[5];
+    x[6] -= v[11] * x[5];
+    x[6] *= inv[6];
+    x[7] += x[6];
+    x[7] *= inv[7];
+    x[8] += x[7];
+    x[8] *= inv[8];
+}
 
-static const int crank_slider_general_lu_lower[28] = {
-    6, 15, 7, 19, 8, 23, 2, 1, 3, 3, 4, 5, 5, 9, 4, 4, 5, 8, 6, 12, 7, 16, 7, 17, 8, 21, 0, 0
-};
-
-static const int crank_slider_general_lu_upper_start[10] = {
-    0, 0, 0, 0, 0, 1, 2, 3, 4, 4
-};
-
-static const int crank_slider_general_lu_upper[10] = {
-    6, 7, 6, 11, 7, 14, 8, 18, 0, 0
-};
+/* L^T v = z (unit diagonal), rows 7..0 */
+static void crank_slider_general_lu_lower_t_0(const crank_slider_general_real *v, crank_slider_general_real *x)
+{
+    (void)v;
+    x[7] -= v[21] * x[8];
+    x[6] -= v[17] * x[7];
+    x[5] += x[7];
+    x[4] += x[6];
+    x[3] += x[5];
+    x[2] += x[4];
+    x[1] -= v[1] * x[2];
+    x[1] -= v[3] * x[3];
+    x[1] -= v[5] * x[4];
+    x[1] -= v[9] * x[5];
+    x[0] -= v[15] * x[6];
+    x[0] -= v[19] * x[7];
+    x[0] -= v[23] * x[8];
+}
 
 void crank_slider_general_lu_solve_transposed(const crank_slider_general_lu *lu, crank_slider_general_real b[])
 {
     /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
     crank_slider_general_real x[CRANK_SLIDER_GENERAL_NQ];
-    int k, e;
     if (lu->dense) {
         crank_slider_general_dense_lu_solve_transposed(&lu->dense_lu, b);
         return;
     }
-    for (k = 0; k < CRANK_SLIDER_GENERAL_NQ; ++k) x[k] = b[crank_slider_general_lu_col_perm[k]];
-    for (k = 0; k < CRANK_SLIDER_GENERAL_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
-        const crank_slider_general_real zk = x[k] * lu->inv[k];
-        x[k] = zk;
-        for (e = crank_slider_general_lu_upper_start[k]; e < crank_slider_general_lu_upper_start[k + 1]; ++e)
-            x[crank_slider_general_lu_upper[2 * e]] -= lu->v[crank_slider_general_lu_upper[2 * e + 1]] * zk;
-    }
-    for (k = CRANK_SLIDER_GENERAL_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
-        crank_slider_general_real sum = x[k];
-        for (e = crank_slider_general_lu_lower_start[k]; e < crank_slider_general_lu_lower_start[k + 1]; ++e)
-            sum -= lu->v[crank_slider_general_lu_lower[2 * e + 1]] * x[crank_slider_general_lu_lower[2 * e]];
-        x[k] = sum;
-    }
-    for (k = 0; k < CRANK_SLIDER_GENERAL_NQ; ++k) b[crank_slider_general_lu_row_perm[k]] = x[k];
+    /* the column permutation, baked in */
+    x[0] = b[8];
+    x[1] = b[2];
+    x[2] = b[0];
+    x[3] = b[1];
+    x[4] = b[3];
+    x[5] = b[4];
+    x[6] = b[5];
+    x[7] = b[6];
+    x[8] = b[7];
+    crank_slider_general_lu_upper_t_0(lu->v, lu->inv, x);
+    crank_slider_general_lu_lower_t_0(lu->v, x);
+    b[6] = x[0];
+    b[8] = x[1];
+    b[0] = x[2];
+    b[1] = x[3];
+    b[2] = x[4];
+    b[3] = x[5];
+    b[4] = x[6];
+    b[5] = x[7];
+    b[7] = x[8];
 }

@@ -31,14 +31,14 @@ void custom_driver_default_options(custom_driver_options *options)
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static custom_driver_real custom_driver_max_abs(const custom_driver_real v[])
 {
-    custom_driver_real largest = 0;
-    int i, nan = 0;
+    custom_driver_real largest = 0, sum = 0;
+    int i;
     for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
         custom_driver_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
-        nan |= a != a;
+        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
     }
-    return nan ? (custom_driver_real)NAN : largest;
+    return sum != sum ? (custom_driver_real)NAN : largest;
 }
 
 /* Factor the non-zeros of Phi_q in work->nz into work->lu; SINGULAR when a pivot vanishes or
@@ -57,53 +57,111 @@ static int custom_driver_factor_jacobian(const custom_driver_options *options, c
     return CUSTOM_DRIVER_OK;
 }
 
+/* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
+ * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
+static const custom_driver_real custom_driver_uniform[CUSTOM_DRIVER_NQ] = {
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+    (custom_driver_real)1 / 9,
+};
+static const custom_driver_real custom_driver_alternating[CUSTOM_DRIVER_NQ] = {
+    (1 + (custom_driver_real)0 / 8),
+    -(1 + (custom_driver_real)1 / 8),
+    (1 + (custom_driver_real)2 / 8),
+    -(1 + (custom_driver_real)3 / 8),
+    (1 + (custom_driver_real)4 / 8),
+    -(1 + (custom_driver_real)5 / 8),
+    (1 + (custom_driver_real)6 / 8),
+    -(1 + (custom_driver_real)7 / 8),
+    (1 + (custom_driver_real)8 / 8),
+};
+
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * After the first step x is the unit vector e_j, kept as its index j only. */
 static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu)
 {
-    custom_driver_real x[CUSTOM_DRIVER_NQ], y[CUSTOM_DRIVER_NQ], estimate = 0, norm, extra = 0;
-    int i, j, step;
-    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) x[i] = (custom_driver_real)1 / CUSTOM_DRIVER_NQ;
+    custom_driver_real y[CUSTOM_DRIVER_NQ], z[CUSTOM_DRIVER_NQ], estimate = 0, norm, extra = 0;
+    int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, custom_driver_alternating, sizeof z);
+    custom_driver_lu_solve(lu, z);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < CUSTOM_DRIVER_ESTIMATOR_STEPS; ++step) {
-        custom_driver_real dot = 0, best;
-        memcpy(y, x, sizeof y);
+        custom_driver_real dot, best, finite = 0;
+        int jmax = 0;
+        if (step == 0) {
+            memcpy(y, custom_driver_uniform, sizeof y);
+        } else {
+            memset(y, 0, sizeof y);
+            y[j] = 1;
+        }
         custom_driver_lu_solve(lu, y);
         norm = 0;
-        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) norm += fabs(y[i]);
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+            norm += fabs(y[i]);
+            /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
+            y[i] = copysign(1, y[i] + 0);
+        }
         if (norm - norm != 0) return (custom_driver_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
         estimate = norm;
-        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
         custom_driver_lu_solve_transposed(lu, y);
-        j = 0;
         best = fabs(y[0]);
-        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
-            dot += y[i] * x[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const custom_driver_real a = fabs(y[i]);
+            finite += y[i] - y[i];
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
-        if (step > 0 && best <= dot) break;
-        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) x[i] = 0;
-        x[j] = 1;
+        if (step > 0) {
+            /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
+             * 0 * inf), so that the test is the one runtime.accuracy makes */
+            if (finite == 0) {
+                dot = y[j];
+            } else {
+                dot = 0;
+                for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) dot += y[i] * (i == j ? 1 : 0);
+            }
+            if (best <= dot) break;
+        }
+        j = jmax;
     }
-    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) { /* the alternating-sign test vector */
-        const custom_driver_real size = 1 + (custom_driver_real)i / (CUSTOM_DRIVER_NQ > 1 ? CUSTOM_DRIVER_NQ - 1 : 1);
-        y[i] = i % 2 == 0 ? size : -size;
-    }
-    custom_driver_lu_solve(lu, y);
-    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * CUSTOM_DRIVER_NQ);
     if (extra - extra != 0) return (custom_driver_real)INFINITY;
     return extra > estimate ? extra : estimate;
 }
 
+/* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
+ * non-zeros kept), columns 0..5: the largest of them and largest. */
+static custom_driver_real custom_driver_norm1_0(const custom_driver_real nz[], custom_driver_real largest)
+{
+    custom_driver_real s;
+    s = 2.0 + fabs(nz[16]);
+    largest = s > largest ? s : largest;
+    s = 2.0 + fabs(nz[17]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[3]) + fabs(nz[6]) + fabs(nz[18]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[9]) + fabs(nz[12]);
+    largest = s > largest ? s : largest;
+    return largest;
+}
+
 /* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
 static custom_driver_real custom_driver_norm1(const custom_driver_real nz[])
 {
-    custom_driver_real sums[CUSTOM_DRIVER_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < CUSTOM_DRIVER_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e) sums[custom_driver_phi_q_col[e]] += fabs(nz[e]);
-    for (j = 0; j < CUSTOM_DRIVER_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    custom_driver_real largest = 2.0; /* the columns of numbers only */
+    (void)nz;
+    largest = custom_driver_norm1_0(nz, largest);
     return largest;
 }
 
@@ -120,11 +178,10 @@ static custom_driver_real custom_driver_at_least_1(custom_driver_real x)
 
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
 static int custom_driver_flagged(const custom_driver_options *options,
-                                const custom_driver_report *report, const custom_driver_state *state)
+                                const custom_driver_report *report, custom_driver_real nq, custom_driver_real ndq,
+                                custom_driver_real nddq)
 {
     const custom_driver_real u = CUSTOM_DRIVER_UNIT_ROUNDOFF;
-    const custom_driver_real nq = custom_driver_max_abs(state->q), ndq = custom_driver_max_abs(state->dq);
-    const custom_driver_real nddq = custom_driver_max_abs(state->ddq);
     const custom_driver_real s = report->inv_norm / sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
     const custom_driver_real floor = u * (1 + nq);
     custom_driver_real e_q, e_dq, e_ddq;
@@ -224,6 +281,7 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
                             custom_driver_state *state, custom_driver_workspace *work,
                             custom_driver_report *report)
 {
+    custom_driver_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
     report->flagged = 0;
     report->cond = (custom_driver_real)NAN;
@@ -246,13 +304,25 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
     custom_driver_lu_solve(&work->lu, state->dq); /* (2.73) */
     custom_driver_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     custom_driver_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
+     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
+    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
     for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
-        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
-            report->status = CUSTOM_DRIVER_NOT_FINITE; /* Phi_t or Gamma singular at t */
-            return report->status;
-        }
+        const custom_driver_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
+        const custom_driver_real c = fabs(state->ddq[i]);
+        nq = a > nq ? a : nq;
+        ndq = b > ndq ? b : ndq;
+        nddq = c > nddq ? c : nddq;
+        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
+        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
+        finite_ddq += c - c;
     }
-    report->flagged = custom_driver_flagged(options, report, state);
+    if (finite_dq != 0 || finite_ddq != 0) {
+        report->status = CUSTOM_DRIVER_NOT_FINITE; /* Phi_t or Gamma singular at t */
+        return report->status;
+    }
+    report->flagged = custom_driver_flagged(options, report, sum_q != sum_q ? (custom_driver_real)NAN : nq,
+                                           ndq, nddq);
     state->t = t;
     state->started = 1;
     return CUSTOM_DRIVER_OK;

@@ -194,51 +194,58 @@ void custom_driver_lu_solve(const custom_driver_lu *lu, custom_driver_real b[])
     b[8] = x[8];
 }
 
-/* The factors' structure as index tables, for the transposed solve only (the straight-line
- * code above needs none): see the tables style for their layout. */
-static const int custom_driver_lu_row_perm[CUSTOM_DRIVER_NQ] = {
-    4, 2, 5, 3, 8, 0, 1, 7, 6
-};
-static const int custom_driver_lu_col_perm[CUSTOM_DRIVER_NQ] = {
-    6, 3, 5, 4, 2, 0, 1, 7, 8
-};
-static const int custom_driver_lu_lower_start[10] = {
-    0, 0, 0, 0, 0, 0, 0, 0, 0, 0
-};
-
-static const int custom_driver_lu_lower[2] = {
-    0, 0
-};
-
-static const int custom_driver_lu_upper_start[10] = {
-    0, 2, 4, 6, 8, 10, 10, 10, 10, 10
-};
-
-static const int custom_driver_lu_upper[22] = {
-    1, 8, 2, 9, 4, 3, 5, 2, 3, 11, 7, 13, 4, 6, 6, 5, 5, 16, 6, 17, 0, 0
-};
+/* U^T z = w, columns 0..7 of U^T (rows of U) */
+static void custom_driver_lu_upper_t_0(const custom_driver_real *v,
+        const custom_driver_real *inv, custom_driver_real *x)
+{
+    (void)v;
+    (void)inv;
+    x[0] = -x[0];
+    x[1] -= x[0];
+    x[2] -= v[9] * x[0];
+    x[1] = -x[1];
+    x[4] -= v[3] * x[1];
+    x[5] -= x[1];
+    x[2] *= inv[2];
+    x[3] -= x[2];
+    x[7] += x[2];
+    x[3] = -x[3];
+    x[4] -= v[6] * x[3];
+    x[6] -= x[3];
+    x[4] *= inv[4];
+    x[5] -= v[16] * x[4];
+    x[6] -= v[17] * x[4];
+    x[5] = -x[5];
+    x[6] = -x[6];
+    x[7] = -x[7];
+}
 
 void custom_driver_lu_solve_transposed(const custom_driver_lu *lu, custom_driver_real b[])
 {
     /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
     custom_driver_real x[CUSTOM_DRIVER_NQ];
-    int k, e;
     if (lu->dense) {
         custom_driver_dense_lu_solve_transposed(&lu->dense_lu, b);
         return;
     }
-    for (k = 0; k < CUSTOM_DRIVER_NQ; ++k) x[k] = b[custom_driver_lu_col_perm[k]];
-    for (k = 0; k < CUSTOM_DRIVER_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
-        const custom_driver_real zk = x[k] * lu->inv[k];
-        x[k] = zk;
-        for (e = custom_driver_lu_upper_start[k]; e < custom_driver_lu_upper_start[k + 1]; ++e)
-            x[custom_driver_lu_upper[2 * e]] -= lu->v[custom_driver_lu_upper[2 * e + 1]] * zk;
-    }
-    for (k = CUSTOM_DRIVER_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
-        custom_driver_real sum = x[k];
-        for (e = custom_driver_lu_lower_start[k]; e < custom_driver_lu_lower_start[k + 1]; ++e)
-            sum -= lu->v[custom_driver_lu_lower[2 * e + 1]] * x[custom_driver_lu_lower[2 * e]];
-        x[k] = sum;
-    }
-    for (k = 0; k < CUSTOM_DRIVER_NQ; ++k) b[custom_driver_lu_row_perm[k]] = x[k];
+    /* the column permutation, baked in */
+    x[0] = b[6];
+    x[1] = b[3];
+    x[2] = b[5];
+    x[3] = b[4];
+    x[4] = b[2];
+    x[5] = b[0];
+    x[6] = b[1];
+    x[7] = b[7];
+    x[8] = b[8];
+    custom_driver_lu_upper_t_0(lu->v, lu->inv, x);
+    b[4] = x[0];
+    b[2] = x[1];
+    b[5] = x[2];
+    b[3] = x[3];
+    b[8] = x[4];
+    b[0] = x[5];
+    b[1] = x[6];
+    b[7] = x[7];
+    b[6] = x[8];
 }

@@ -31,14 +31,14 @@ void four_bar_default_options(four_bar_options *options)
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static four_bar_real four_bar_max_abs(const four_bar_real v[])
 {
-    four_bar_real largest = 0;
-    int i, nan = 0;
+    four_bar_real largest = 0, sum = 0;
+    int i;
     for (i = 0; i < FOUR_BAR_NQ; ++i) {
         four_bar_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
-        nan |= a != a;
+        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
     }
-    return nan ? (four_bar_real)NAN : largest;
+    return sum != sum ? (four_bar_real)NAN : largest;
 }
 
 /* Factor the non-zeros of Phi_q in work->nz into work->lu; SINGULAR when a pivot vanishes or
@@ -57,53 +57,109 @@ static int four_bar_factor_jacobian(const four_bar_options *options, four_bar_wo
     return FOUR_BAR_OK;
 }
 
+/* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
+ * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
+static const four_bar_real four_bar_uniform[FOUR_BAR_NQ] = {
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+    (four_bar_real)1 / 9,
+};
+static const four_bar_real four_bar_alternating[FOUR_BAR_NQ] = {
+    (1 + (four_bar_real)0 / 8),
+    -(1 + (four_bar_real)1 / 8),
+    (1 + (four_bar_real)2 / 8),
+    -(1 + (four_bar_real)3 / 8),
+    (1 + (four_bar_real)4 / 8),
+    -(1 + (four_bar_real)5 / 8),
+    (1 + (four_bar_real)6 / 8),
+    -(1 + (four_bar_real)7 / 8),
+    (1 + (four_bar_real)8 / 8),
+};
+
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * After the first step x is the unit vector e_j, kept as its index j only. */
 static four_bar_real four_bar_inverse_norm1(const four_bar_lu *lu)
 {
-    four_bar_real x[FOUR_BAR_NQ], y[FOUR_BAR_NQ], estimate = 0, norm, extra = 0;
-    int i, j, step;
-    for (i = 0; i < FOUR_BAR_NQ; ++i) x[i] = (four_bar_real)1 / FOUR_BAR_NQ;
+    four_bar_real y[FOUR_BAR_NQ], z[FOUR_BAR_NQ], estimate = 0, norm, extra = 0;
+    int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, four_bar_alternating, sizeof z);
+    four_bar_lu_solve(lu, z);
+    for (i = 0; i < FOUR_BAR_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < FOUR_BAR_ESTIMATOR_STEPS; ++step) {
-        four_bar_real dot = 0, best;
-        memcpy(y, x, sizeof y);
+        four_bar_real dot, best, finite = 0;
+        int jmax = 0;
+        if (step == 0) {
+            memcpy(y, four_bar_uniform, sizeof y);
+        } else {
+            memset(y, 0, sizeof y);
+            y[j] = 1;
+        }
         four_bar_lu_solve(lu, y);
         norm = 0;
-        for (i = 0; i < FOUR_BAR_NQ; ++i) norm += fabs(y[i]);
+        for (i = 0; i < FOUR_BAR_NQ; ++i) {
+            norm += fabs(y[i]);
+            /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
+            y[i] = copysign(1, y[i] + 0);
+        }
         if (norm - norm != 0) return (four_bar_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
         estimate = norm;
-        for (i = 0; i < FOUR_BAR_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
         four_bar_lu_solve_transposed(lu, y);
-        j = 0;
         best = fabs(y[0]);
-        for (i = 0; i < FOUR_BAR_NQ; ++i) {
-            dot += y[i] * x[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        for (i = 0; i < FOUR_BAR_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const four_bar_real a = fabs(y[i]);
+            finite += y[i] - y[i];
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
-        if (step > 0 && best <= dot) break;
-        for (i = 0; i < FOUR_BAR_NQ; ++i) x[i] = 0;
-        x[j] = 1;
+        if (step > 0) {
+            /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
+             * 0 * inf), so that the test is the one runtime.accuracy makes */
+            if (finite == 0) {
+                dot = y[j];
+            } else {
+                dot = 0;
+                for (i = 0; i < FOUR_BAR_NQ; ++i) dot += y[i] * (i == j ? 1 : 0);
+            }
+            if (best <= dot) break;
+        }
+        j = jmax;
     }
-    for (i = 0; i < FOUR_BAR_NQ; ++i) { /* the alternating-sign test vector */
-        const four_bar_real size = 1 + (four_bar_real)i / (FOUR_BAR_NQ > 1 ? FOUR_BAR_NQ - 1 : 1);
-        y[i] = i % 2 == 0 ? size : -size;
-    }
-    four_bar_lu_solve(lu, y);
-    for (i = 0; i < FOUR_BAR_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * FOUR_BAR_NQ);
     if (extra - extra != 0) return (four_bar_real)INFINITY;
     return extra > estimate ? extra : estimate;
 }
 
+/* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
+ * non-zeros kept), columns 2..8: the largest of them and largest. */
+static four_bar_real four_bar_norm1_0(const four_bar_real nz[], four_bar_real largest)
+{
+    four_bar_real s;
+    s = fabs(nz[3]) + fabs(nz[6]) + 1.0;
+    largest = s > largest ? s : largest;
+    s = fabs(nz[9]) + fabs(nz[13]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[11]) + fabs(nz[15]);
+    largest = s > largest ? s : largest;
+    return largest;
+}
+
 /* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
 static four_bar_real four_bar_norm1(const four_bar_real nz[])
 {
-    four_bar_real sums[FOUR_BAR_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < FOUR_BAR_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < FOUR_BAR_NNZ; ++e) sums[four_bar_phi_q_col[e]] += fabs(nz[e]);
-    for (j = 0; j < FOUR_BAR_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    four_bar_real largest = 2.0; /* the columns of numbers only */
+    (void)nz;
+    largest = four_bar_norm1_0(nz, largest);
     return largest;
 }
 
@@ -120,11 +176,10 @@ static four_bar_real four_bar_at_least_1(four_bar_real x)
 
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
 static int four_bar_flagged(const four_bar_options *options,
-                                const four_bar_report *report, const four_bar_state *state)
+                                const four_bar_report *report, four_bar_real nq, four_bar_real ndq,
+                                four_bar_real nddq)
 {
     const four_bar_real u = FOUR_BAR_UNIT_ROUNDOFF;
-    const four_bar_real nq = four_bar_max_abs(state->q), ndq = four_bar_max_abs(state->dq);
-    const four_bar_real nddq = four_bar_max_abs(state->ddq);
     const four_bar_real s = report->inv_norm / sqrt((four_bar_real)FOUR_BAR_NQ);
     const four_bar_real floor = u * (1 + nq);
     four_bar_real e_q, e_dq, e_ddq;
@@ -224,6 +279,7 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
                             four_bar_state *state, four_bar_workspace *work,
                             four_bar_report *report)
 {
+    four_bar_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
     report->flagged = 0;
     report->cond = (four_bar_real)NAN;
@@ -246,13 +302,25 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
     four_bar_lu_solve(&work->lu, state->dq); /* (2.73) */
     four_bar_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     four_bar_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
+     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
+    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
     for (i = 0; i < FOUR_BAR_NQ; ++i) {
-        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
-            report->status = FOUR_BAR_NOT_FINITE; /* Phi_t or Gamma singular at t */
-            return report->status;
-        }
+        const four_bar_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
+        const four_bar_real c = fabs(state->ddq[i]);
+        nq = a > nq ? a : nq;
+        ndq = b > ndq ? b : ndq;
+        nddq = c > nddq ? c : nddq;
+        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
+        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
+        finite_ddq += c - c;
     }
-    report->flagged = four_bar_flagged(options, report, state);
+    if (finite_dq != 0 || finite_ddq != 0) {
+        report->status = FOUR_BAR_NOT_FINITE; /* Phi_t or Gamma singular at t */
+        return report->status;
+    }
+    report->flagged = four_bar_flagged(options, report, sum_q != sum_q ? (four_bar_real)NAN : nq,
+                                           ndq, nddq);
     state->t = t;
     state->started = 1;
     return FOUR_BAR_OK;

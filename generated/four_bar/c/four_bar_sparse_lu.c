@@ -219,51 +219,63 @@ void four_bar_lu_solve(const four_bar_lu *lu, four_bar_real b[])
     b[8] = x[8];
 }
 
-/* The factors' structure as index tables, for the transposed solve only (the straight-line
- * code above needs none): see the tables style for their layout. */
-static const int four_bar_lu_row_perm[FOUR_BAR_NQ] = {
-    0, 1, 6, 7, 8, 2, 3, 4, 5
-};
-static const int four_bar_lu_col_perm[FOUR_BAR_NQ] = {
-    0, 1, 6, 7, 2, 3, 4, 5, 8
-};
-static const int four_bar_lu_lower_start[10] = {
-    0, 1, 2, 3, 4, 6, 7, 8, 9, 9
-};
+/* U^T z = w, columns 0..8 of U^T (rows of U) */
+static void four_bar_lu_upper_t_0(const four_bar_real *v,
+        const four_bar_real *inv, four_bar_real *x)
+{
+    (void)v;
+    (void)inv;
+    x[0] = -x[0];
+    x[1] = -x[1];
+    x[5] = -x[5];
+    x[6] = -x[6];
+    x[7] *= inv[7];
+    x[8] -= v[11] * x[7];
+    x[8] *= inv[8];
+}
 
-static const int four_bar_lu_lower[20] = {
-    5, 2, 6, 5, 7, 10, 8, 14, 5, 3, 6, 6, 7, 8, 8, 12, 8, 13, 0, 0
-};
-
-static const int four_bar_lu_upper_start[10] = {
-    0, 0, 0, 0, 0, 0, 0, 0, 1, 1
-};
-
-static const int four_bar_lu_upper[4] = {
-    8, 11, 0, 0
-};
+/* L^T v = z (unit diagonal), rows 7..0 */
+static void four_bar_lu_lower_t_0(const four_bar_real *v, four_bar_real *x)
+{
+    (void)v;
+    x[7] -= v[13] * x[8];
+    x[6] += x[8];
+    x[5] += x[7];
+    x[4] -= v[3] * x[5];
+    x[4] -= v[6] * x[6];
+    x[3] += x[8];
+    x[2] += x[7];
+    x[1] += x[6];
+    x[0] += x[5];
+}
 
 void four_bar_lu_solve_transposed(const four_bar_lu *lu, four_bar_real b[])
 {
     /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
     four_bar_real x[FOUR_BAR_NQ];
-    int k, e;
     if (lu->dense) {
         four_bar_dense_lu_solve_transposed(&lu->dense_lu, b);
         return;
     }
-    for (k = 0; k < FOUR_BAR_NQ; ++k) x[k] = b[four_bar_lu_col_perm[k]];
-    for (k = 0; k < FOUR_BAR_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
-        const four_bar_real zk = x[k] * lu->inv[k];
-        x[k] = zk;
-        for (e = four_bar_lu_upper_start[k]; e < four_bar_lu_upper_start[k + 1]; ++e)
-            x[four_bar_lu_upper[2 * e]] -= lu->v[four_bar_lu_upper[2 * e + 1]] * zk;
-    }
-    for (k = FOUR_BAR_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
-        four_bar_real sum = x[k];
-        for (e = four_bar_lu_lower_start[k]; e < four_bar_lu_lower_start[k + 1]; ++e)
-            sum -= lu->v[four_bar_lu_lower[2 * e + 1]] * x[four_bar_lu_lower[2 * e]];
-        x[k] = sum;
-    }
-    for (k = 0; k < FOUR_BAR_NQ; ++k) b[four_bar_lu_row_perm[k]] = x[k];
+    /* the column permutation, baked in */
+    x[0] = b[0];
+    x[1] = b[1];
+    x[2] = b[6];
+    x[3] = b[7];
+    x[4] = b[2];
+    x[5] = b[3];
+    x[6] = b[4];
+    x[7] = b[5];
+    x[8] = b[8];
+    four_bar_lu_upper_t_0(lu->v, lu->inv, x);
+    four_bar_lu_lower_t_0(lu->v, x);
+    b[0] = x[0];
+    b[1] = x[1];
+    b[6] = x[2];
+    b[7] = x[3];
+    b[8] = x[4];
+    b[2] = x[5];
+    b[3] = x[6];
+    b[4] = x[7];
+    b[5] = x[8];
 }

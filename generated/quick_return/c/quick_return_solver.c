@@ -31,14 +31,14 @@ void quick_return_default_options(quick_return_options *options)
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static quick_return_real quick_return_max_abs(const quick_return_real v[])
 {
-    quick_return_real largest = 0;
-    int i, nan = 0;
+    quick_return_real largest = 0, sum = 0;
+    int i;
     for (i = 0; i < QUICK_RETURN_NQ; ++i) {
         quick_return_real a = fabs(v[i]);
         largest = a > largest ? a : largest; /* branch-free max */
-        nan |= a != a;
+        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
     }
-    return nan ? (quick_return_real)NAN : largest;
+    return sum != sum ? (quick_return_real)NAN : largest;
 }
 
 /* Factor the non-zeros of Phi_q in work->nz into work->lu; SINGULAR when a pivot vanishes or
@@ -57,53 +57,123 @@ static int quick_return_factor_jacobian(const quick_return_options *options, qui
     return QUICK_RETURN_OK;
 }
 
+/* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
+ * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
+static const quick_return_real quick_return_uniform[QUICK_RETURN_NQ] = {
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+    (quick_return_real)1 / 12,
+};
+static const quick_return_real quick_return_alternating[QUICK_RETURN_NQ] = {
+    (1 + (quick_return_real)0 / 11),
+    -(1 + (quick_return_real)1 / 11),
+    (1 + (quick_return_real)2 / 11),
+    -(1 + (quick_return_real)3 / 11),
+    (1 + (quick_return_real)4 / 11),
+    -(1 + (quick_return_real)5 / 11),
+    (1 + (quick_return_real)6 / 11),
+    -(1 + (quick_return_real)7 / 11),
+    (1 + (quick_return_real)8 / 11),
+    -(1 + (quick_return_real)9 / 11),
+    (1 + (quick_return_real)10 / 11),
+    -(1 + (quick_return_real)11 / 11),
+};
+
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree. */
+ * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * After the first step x is the unit vector e_j, kept as its index j only. */
 static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
 {
-    quick_return_real x[QUICK_RETURN_NQ], y[QUICK_RETURN_NQ], estimate = 0, norm, extra = 0;
-    int i, j, step;
-    for (i = 0; i < QUICK_RETURN_NQ; ++i) x[i] = (quick_return_real)1 / QUICK_RETURN_NQ;
+    quick_return_real y[QUICK_RETURN_NQ], z[QUICK_RETURN_NQ], estimate = 0, norm, extra = 0;
+    int i, j = -1, step;
+    /* Higham's test vector first: its solve does not depend on the ascent below, so the
+     * processor can overlap the two chains of dependent operations */
+    memcpy(z, quick_return_alternating, sizeof z);
+    quick_return_lu_solve(lu, z);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) extra += fabs(z[i]);
     for (step = 0; step < QUICK_RETURN_ESTIMATOR_STEPS; ++step) {
-        quick_return_real dot = 0, best;
-        memcpy(y, x, sizeof y);
+        quick_return_real dot, best, finite = 0;
+        int jmax = 0;
+        if (step == 0) {
+            memcpy(y, quick_return_uniform, sizeof y);
+        } else {
+            memset(y, 0, sizeof y);
+            y[j] = 1;
+        }
         quick_return_lu_solve(lu, y);
         norm = 0;
-        for (i = 0; i < QUICK_RETURN_NQ; ++i) norm += fabs(y[i]);
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+            norm += fabs(y[i]);
+            /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
+            y[i] = copysign(1, y[i] + 0);
+        }
         if (norm - norm != 0) return (quick_return_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
         estimate = norm;
-        for (i = 0; i < QUICK_RETURN_NQ; ++i) y[i] = y[i] >= 0 ? 1 : -1;
         quick_return_lu_solve_transposed(lu, y);
-        j = 0;
         best = fabs(y[0]);
-        for (i = 0; i < QUICK_RETURN_NQ; ++i) {
-            dot += y[i] * x[i];
-            if (fabs(y[i]) > best) { best = fabs(y[i]); j = i; }
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) { /* the first largest |y_i|, branch-free */
+            const quick_return_real a = fabs(y[i]);
+            finite += y[i] - y[i];
+            jmax = a > best ? i : jmax;
+            best = a > best ? a : best;
         }
-        if (step > 0 && best <= dot) break;
-        for (i = 0; i < QUICK_RETURN_NQ; ++i) x[i] = 0;
-        x[j] = 1;
+        if (step > 0) {
+            /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
+             * 0 * inf), so that the test is the one runtime.accuracy makes */
+            if (finite == 0) {
+                dot = y[j];
+            } else {
+                dot = 0;
+                for (i = 0; i < QUICK_RETURN_NQ; ++i) dot += y[i] * (i == j ? 1 : 0);
+            }
+            if (best <= dot) break;
+        }
+        j = jmax;
     }
-    for (i = 0; i < QUICK_RETURN_NQ; ++i) { /* the alternating-sign test vector */
-        const quick_return_real size = 1 + (quick_return_real)i / (QUICK_RETURN_NQ > 1 ? QUICK_RETURN_NQ - 1 : 1);
-        y[i] = i % 2 == 0 ? size : -size;
-    }
-    quick_return_lu_solve(lu, y);
-    for (i = 0; i < QUICK_RETURN_NQ; ++i) extra += fabs(y[i]);
     extra = 2 * extra / (3 * QUICK_RETURN_NQ);
     if (extra - extra != 0) return (quick_return_real)INFINITY;
     return extra > estimate ? extra : estimate;
 }
 
+/* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
+ * non-zeros kept), columns 0..8: the largest of them and largest. */
+static quick_return_real quick_return_norm1_0(const quick_return_real nz[], quick_return_real largest)
+{
+    quick_return_real s;
+    s = 1.0 + fabs(nz[4]);
+    largest = s > largest ? s : largest;
+    s = 1.0 + fabs(nz[5]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[6]) + 1.0;
+    largest = s > largest ? s : largest;
+    s = 1.0 + fabs(nz[7]) + 1.0;
+    largest = s > largest ? s : largest;
+    s = 1.0 + fabs(nz[8]) + 1.0;
+    largest = s > largest ? s : largest;
+    s = fabs(nz[9]) + fabs(nz[11]) + fabs(nz[14]);
+    largest = s > largest ? s : largest;
+    s = fabs(nz[17]) + fabs(nz[20]);
+    largest = s > largest ? s : largest;
+    return largest;
+}
+
 /* ||Phi_q||_1, the largest column sum, from the non-zeros in work->nz. */
 static quick_return_real quick_return_norm1(const quick_return_real nz[])
 {
-    quick_return_real sums[QUICK_RETURN_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < QUICK_RETURN_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < QUICK_RETURN_NNZ; ++e) sums[quick_return_phi_q_col[e]] += fabs(nz[e]);
-    for (j = 0; j < QUICK_RETURN_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    quick_return_real largest = 2.0; /* the columns of numbers only */
+    (void)nz;
+    largest = quick_return_norm1_0(nz, largest);
     return largest;
 }
 
@@ -120,11 +190,10 @@ static quick_return_real quick_return_at_least_1(quick_return_real x)
 
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
 static int quick_return_flagged(const quick_return_options *options,
-                                const quick_return_report *report, const quick_return_state *state)
+                                const quick_return_report *report, quick_return_real nq, quick_return_real ndq,
+                                quick_return_real nddq)
 {
     const quick_return_real u = QUICK_RETURN_UNIT_ROUNDOFF;
-    const quick_return_real nq = quick_return_max_abs(state->q), ndq = quick_return_max_abs(state->dq);
-    const quick_return_real nddq = quick_return_max_abs(state->ddq);
     const quick_return_real s = report->inv_norm / sqrt((quick_return_real)QUICK_RETURN_NQ);
     const quick_return_real floor = u * (1 + nq);
     quick_return_real e_q, e_dq, e_ddq;
@@ -224,6 +293,7 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
                             quick_return_state *state, quick_return_workspace *work,
                             quick_return_report *report)
 {
+    quick_return_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
     report->flagged = 0;
     report->cond = (quick_return_real)NAN;
@@ -246,13 +316,25 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
     quick_return_lu_solve(&work->lu, state->dq); /* (2.73) */
     quick_return_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     quick_return_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
+     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
+    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
     for (i = 0; i < QUICK_RETURN_NQ; ++i) {
-        if (state->dq[i] - state->dq[i] != 0 || state->ddq[i] - state->ddq[i] != 0) {
-            report->status = QUICK_RETURN_NOT_FINITE; /* Phi_t or Gamma singular at t */
-            return report->status;
-        }
+        const quick_return_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
+        const quick_return_real c = fabs(state->ddq[i]);
+        nq = a > nq ? a : nq;
+        ndq = b > ndq ? b : ndq;
+        nddq = c > nddq ? c : nddq;
+        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
+        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
+        finite_ddq += c - c;
     }
-    report->flagged = quick_return_flagged(options, report, state);
+    if (finite_dq != 0 || finite_ddq != 0) {
+        report->status = QUICK_RETURN_NOT_FINITE; /* Phi_t or Gamma singular at t */
+        return report->status;
+    }
+    report->flagged = quick_return_flagged(options, report, sum_q != sum_q ? (quick_return_real)NAN : nq,
+                                           ndq, nddq);
     state->t = t;
     state->started = 1;
     return QUICK_RETURN_OK;

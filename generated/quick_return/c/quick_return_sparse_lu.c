@@ -217,51 +217,69 @@ void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[])
     b[11] = x[11];
 }
 
-/* The factors' structure as index tables, for the transposed solve only (the straight-line
- * code above needs none): see the tables style for their layout. */
-static const int quick_return_lu_row_perm[QUICK_RETURN_NQ] = {
-    7, 5, 8, 6, 4, 0, 1, 11, 2, 3, 10, 9
-};
-static const int quick_return_lu_col_perm[QUICK_RETURN_NQ] = {
-    9, 6, 8, 7, 5, 0, 1, 2, 3, 4, 10, 11
-};
-static const int quick_return_lu_lower_start[13] = {
-    0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0
-};
-
-static const int quick_return_lu_lower[2] = {
-    0, 0
-};
-
-static const int quick_return_lu_upper_start[13] = {
-    0, 2, 4, 6, 8, 13, 13, 13, 13, 13, 13, 13, 13
-};
-
-static const int quick_return_lu_upper[28] = {
-    1, 16, 2, 17, 4, 11, 8, 10, 3, 19, 10, 21, 4, 14, 9, 13, 5, 4, 6, 5, 7, 6, 8, 7, 9, 8, 0, 0
-};
+/* U^T z = w, columns 0..10 of U^T (rows of U) */
+static void quick_return_lu_upper_t_0(const quick_return_real *v,
+        const quick_return_real *inv, quick_return_real *x)
+{
+    (void)v;
+    (void)inv;
+    x[0] = -x[0];
+    x[1] -= x[0];
+    x[2] -= v[17] * x[0];
+    x[1] = -x[1];
+    x[4] -= v[11] * x[1];
+    x[8] -= x[1];
+    x[2] *= inv[2];
+    x[3] -= x[2];
+    x[10] += x[2];
+    x[3] = -x[3];
+    x[4] -= v[14] * x[3];
+    x[9] -= x[3];
+    x[4] *= inv[4];
+    x[5] -= v[4] * x[4];
+    x[6] -= v[5] * x[4];
+    x[7] -= v[6] * x[4];
+    x[8] -= v[7] * x[4];
+    x[9] -= v[8] * x[4];
+    x[5] = -x[5];
+    x[6] = -x[6];
+    x[8] = -x[8];
+    x[9] = -x[9];
+    x[10] = -x[10];
+}
 
 void quick_return_lu_solve_transposed(const quick_return_lu *lu, quick_return_real b[])
 {
     /* Pr A Pc = L U, so A^T = Pc U^T L^T Pr: U^T z = Pc^T b, L^T v = z, b = Pr^T v. */
     quick_return_real x[QUICK_RETURN_NQ];
-    int k, e;
     if (lu->dense) {
         quick_return_dense_lu_solve_transposed(&lu->dense_lu, b);
         return;
     }
-    for (k = 0; k < QUICK_RETURN_NQ; ++k) x[k] = b[quick_return_lu_col_perm[k]];
-    for (k = 0; k < QUICK_RETURN_NQ; ++k) { /* U^T z = w, by columns of U^T (rows of U) */
-        const quick_return_real zk = x[k] * lu->inv[k];
-        x[k] = zk;
-        for (e = quick_return_lu_upper_start[k]; e < quick_return_lu_upper_start[k + 1]; ++e)
-            x[quick_return_lu_upper[2 * e]] -= lu->v[quick_return_lu_upper[2 * e + 1]] * zk;
-    }
-    for (k = QUICK_RETURN_NQ - 1; k >= 0; --k) { /* L^T v = z, unit diagonal */
-        quick_return_real sum = x[k];
-        for (e = quick_return_lu_lower_start[k]; e < quick_return_lu_lower_start[k + 1]; ++e)
-            sum -= lu->v[quick_return_lu_lower[2 * e + 1]] * x[quick_return_lu_lower[2 * e]];
-        x[k] = sum;
-    }
-    for (k = 0; k < QUICK_RETURN_NQ; ++k) b[quick_return_lu_row_perm[k]] = x[k];
+    /* the column permutation, baked in */
+    x[0] = b[9];
+    x[1] = b[6];
+    x[2] = b[8];
+    x[3] = b[7];
+    x[4] = b[5];
+    x[5] = b[0];
+    x[6] = b[1];
+    x[7] = b[2];
+    x[8] = b[3];
+    x[9] = b[4];
+    x[10] = b[10];
+    x[11] = b[11];
+    quick_return_lu_upper_t_0(lu->v, lu->inv, x);
+    b[7] = x[0];
+    b[5] = x[1];
+    b[8] = x[2];
+    b[6] = x[3];
+    b[4] = x[4];
+    b[0] = x[5];
+    b[1] = x[6];
+    b[11] = x[7];
+    b[2] = x[8];
+    b[3] = x[9];
+    b[10] = x[10];
+    b[9] = x[11];
 }
