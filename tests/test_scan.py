@@ -126,12 +126,41 @@ def test_cli_reports_branches_and_limit_position() -> None:
     assert "B revolute coupler-rocker" in out and "input angle crank-ground cannot go on" in out
 
 
-def test_cli_reports_a_singular_configuration_with_set() -> None:
+def test_cli_reports_a_singular_configuration() -> None:
     result = _cli(str(MECHANISMS / "parallelogram.yaml"), "--backend", "numpy", "--t1", "0.8")
     assert result.returncode == 0, result.stderr
     assert "singular configuration passed at t = 0.50000000" in result.stdout
     assert "loses rank 1" in result.stdout and "reaches the end of the grid, t = 0.8" \
         in result.stdout
+
+
+def test_cli_set_moves_the_limit_position() -> None:
+    # d = 2.5: cos(theta*) = (a^2 + d^2 - (b + c)^2) / (2 a d) = (4 + 6.25 - 16) / 10
+    result = _cli(str(MECHANISMS / "non_grashof.yaml"), "--backend", "numpy", "--set", "d=2.5")
+    assert result.returncode == 0, result.stderr
+    line = next(x for x in result.stdout.splitlines() if "limit position at t = " in x)
+    found = float(line.split("limit position at t = ")[1].split(":")[0])
+    assert abs(found - math.acos(-0.575)) < 1e-6
+
+
+@pytest.mark.parametrize("stop", ["keyboard", "solve"])
+def test_cli_ctrl_c_exits_130(stop: str, monkeypatch: pytest.MonkeyPatch,
+                              capsys: pytest.CaptureFixture[str]) -> None:
+    import symkin.runtime.scan as module
+    from symkin.cli import main
+    from symkin.runtime.results import Trajectory
+
+    def interrupted(*args, **kwargs):
+        if stop == "keyboard":
+            raise KeyboardInterrupt
+        empty = np.zeros((0, 1))
+        raise driver.SolveInterrupted(Trajectory(np.zeros(0), empty, empty, empty, ("a.x",)),
+                                      0.0)
+
+    monkeypatch.setattr(module, "scan", interrupted)
+    status = main(["scan", str(MECHANISMS / "non_grashof.yaml"), "--backend", "numpy"])
+    assert status == 130
+    assert "interrupted" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("args", [("--dt", "0"), ("--t1", "nan"), ("--set", "zz=3"),
@@ -141,3 +170,11 @@ def test_cli_bad_input_exits_2_with_one_paragraph(args: tuple[str, ...]) -> None
     assert result.returncode == 2
     assert result.stdout == ""
     assert result.stderr.startswith("symkin: error:") and result.stderr.count("\n") == 1
+
+
+def test_cli_a_mechanism_that_cannot_close_has_no_branches_and_exits_0() -> None:
+    # d = 10 > a + b + c = 6: no assembly exists at any t.
+    result = _cli(str(MECHANISMS / "non_grashof.yaml"), "--backend", "numpy", "--set", "d=10")
+    assert result.returncode == 0, result.stderr
+    assert "assembly branches at t = 0: 0 (none found" in result.stdout
+    assert "motion from branch" not in result.stdout
