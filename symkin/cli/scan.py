@@ -2,7 +2,7 @@
 positions and flagged stretches over the driver range (symkin.runtime.scan), as a short report.
 
 Exit status 0 when the scan ran, whatever it found (a limit position is a finding, not a
-failure); 2 for bad input; 130 on Ctrl-C.
+failure); 2 for bad input; 1 when the kernel cannot be built or cached; 130 on Ctrl-C.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from symkin.cli import messages, overrides
-from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_OK
+from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 
 
 def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -48,7 +48,10 @@ def handle(args: argparse.Namespace) -> int:
             return messages.error(f"--{option} {value}: give a finite number", EXIT_BAD_INPUT)
     options = cache.Options(backend=resolve_backend(args.backend),
                             parameters=overrides.pairs(args.overrides))
-    kernel = cache.prepare(args.mechanism, options).kernel
+    try:
+        kernel = cache.prepare(args.mechanism, options).kernel
+    except OSError as error:  # e.g. a cache folder that cannot be used at all
+        return messages.error(f"{error.strerror or error}: {error.filename or ''}", EXIT_FAILED)
     t0, t1, dt = kernel.time_grid
     t0, t1, dt = (t0 if args.t0 is None else args.t0, t1 if args.t1 is None else args.t1,
                   dt if args.dt is None else args.dt)
