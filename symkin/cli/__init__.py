@@ -144,8 +144,14 @@ def _add_cache(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     cache.add_parser(commands)
 
 
+def _add_scan(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    from symkin.cli import scan
+
+    scan.add_parser(commands)
+
+
 SUBCOMMANDS: list[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]], None]] = [
-    _add_show, _add_verify, _add_generate, _add_run, _add_cache, _add_sweep]
+    _add_show, _add_verify, _add_generate, _add_run, _add_scan, _add_cache, _add_sweep]
 
 
 class _Version(argparse.Action):

@@ -56,7 +56,7 @@ def assemble(kernel: KinematicsKernel, q0: Array, t0: float, p: Array,
     best: Newton | None = None
     singular: Newton | None = None  # assembled, but in a singular configuration
     residuals = []
-    for count, start in enumerate(_starts(kernel, q0, t0, p), start=1):
+    for count, start in enumerate(starts(kernel, q0, t0, p), start=1):
         q, residual = levenberg_marquardt(kernel, start, t0, p, options)
         polished = newton(kernel, q, t0, p, options)
         polished.iterations += first.iterations
@@ -80,7 +80,10 @@ def _evidence(residuals: list[float]) -> str:
     return "link lengths" if alike >= max(2, len(residuals) // 3) else "a better q0"
 
 
-def _starts(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> Iterator[Array]:
+def starts(kernel: KinematicsKernel, q0: Array, t0: float, p: Array,
+           random_angles: int = RANDOM_ANGLES) -> Iterator[Array]:
+    """The starts of the damped assembly, in order (the module docstring); random_angles sets
+    of random angles at the end (a fixed seed: the same starts every time)."""
     rng = np.random.default_rng(SEED)
     angles = np.array([name.endswith(".phi") for name in kernel.coordinates])
     yield np.array(q0, dtype=float)
@@ -88,7 +91,7 @@ def _starts(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> Iterato
     scale = np.where(angles, 0.5, 0.2 * max(1.0, float(np.abs(q0).max(initial=0.0))))
     for _ in range(PERTURBED):
         yield q0 + scale * rng.standard_normal(q0.size)
-    for _ in range(RANDOM_ANGLES):
+    for _ in range(random_angles):
         q = np.array(q0, dtype=float)
         q[angles] = rng.uniform(-math.pi, math.pi, int(angles.sum()))
         yield _placed(kernel, q, angles, t0, p)

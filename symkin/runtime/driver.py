@@ -73,11 +73,14 @@ class SolveFailure(SolveError):
             "limit position".
         reached: where the step subdivision stopped (the limit time of a limit position: the
             last time solved, bisected to within about 1e-9 of the grid step), else NaN.
+        aligned, drivers: at a limit position, the joints that become aligned and the drivers
+            that cannot be followed beyond it; else ().
     """
 
     def __init__(self, message: str, trajectory: Trajectory, t: float, residual: float,
                  iterations: int, rows: Sequence[str] = (), reason: str = "",
-                 reached: float = math.nan) -> None:
+                 reached: float = math.nan, aligned: Sequence[str] = (),
+                 drivers: Sequence[str] = ()) -> None:
         super().__init__(message)
         self.trajectory = trajectory
         self.t = t
@@ -86,6 +89,8 @@ class SolveFailure(SolveError):
         self.rows = tuple(rows)
         self.reason = reason
         self.reached = reached
+        self.aligned = tuple(aligned)
+        self.drivers = tuple(drivers)
 
 
 # ----- the time grid -------------------------------------------------------------------------
@@ -392,4 +397,5 @@ def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,
     message, reason = failures.explain_stop(stop, t)
     reached = math.nan if stop.reached is None else stop.reached.t
     raise SolveFailure(message, _trajectory(kernel, run, p), t, math.nan, 0,
-                       [row for group in stop.groups for row in group], reason, reached)
+                       [row for group in stop.groups for row in group], reason, reached,
+                       stop.aligned, stop.drivers)
