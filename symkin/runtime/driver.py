@@ -113,7 +113,8 @@ def grid(t0: float, t1: float, dt: float) -> Array:
     return times
 
 
-def _times(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
+def time_points(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
+    """The times to solve at: the file's grid (t None), or t checked (finite, increasing)."""
     if t is None:
         return grid(*kernel.time_grid)
     times = np.atleast_1d(np.asarray(t, dtype=float))
@@ -128,7 +129,8 @@ def _times(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
     return times
 
 
-def _params(kernel: KinematicsKernel, params: Mapping[str, float] | ArrayLike | None) -> Array:
+def parameter_values(kernel: KinematicsKernel,
+                     params: Mapping[str, float] | ArrayLike | None) -> Array:
     """Nominal parameter values, overridden by name (a mapping) or replaced (a sequence)."""
     values = np.array(kernel.p_values, dtype=float)
     if params is None:
@@ -292,8 +294,8 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
 def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
            params: Mapping[str, float] | ArrayLike | None, options: Options,
            progress: Progress | None, use_c_solver: bool) -> Trajectory:
-    times = _times(kernel, t)
-    p = _params(kernel, params)
+    times = time_points(kernel, t)
+    p = parameter_values(kernel, params)
     q = np.array(kernel.q0 if q0 is None else q0, dtype=float)
     if q.shape != (len(kernel.coordinates),):
         raise SolveError(f"q0 has {q.size} values; the mechanism has "

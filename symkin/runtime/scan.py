@@ -108,8 +108,8 @@ def scan(kernel: KinematicsKernel, t: ArrayLike | None = None,
         SolveError: bad t or params (the caller's input), never for what the motion meets.
         SolveInterrupted: on Ctrl-C during a motion.
     """
-    times = driver._times(kernel, t)
-    p = driver._params(kernel, params)
+    times = driver.time_points(kernel, t)
+    p = driver.parameter_values(kernel, params)
     t0 = float(times[0])
     with np.errstate(all="ignore"):
         branches = _branches(kernel, t0, p)

@@ -62,7 +62,7 @@ def sweep(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike,
         SolveError: params, t or q0 that do not fit the mechanism.
     """
     values = parameter_table(kernel, params)
-    times = _times(kernel, t)
+    times = driver.time_points(kernel, t)
     problem = too_large(values.shape[0], times.size, len(kernel.coordinates))
     if problem:
         raise SolveError(problem)
@@ -118,17 +118,6 @@ def too_large(m: int, steps: int, size: int) -> str | None:
     return (f"the sweep has {m} sets x {steps} time points = {m * steps:.3g} points in all, "
             f"more than the {limits.MAX_GRID_POINTS:,} allowed (its results would need "
             f"{need:.3g} GB); sweep fewer sets at a time, or use a coarser time grid")
-
-
-def _times(kernel: Kernel, t: ArrayLike | None) -> Array:
-    if t is None:
-        return driver.grid(*kernel.time_grid)
-    times = np.atleast_1d(np.asarray(t, dtype=float))
-    if times.ndim != 1 or times.size == 0 or not np.all(np.isfinite(times)) \
-            or np.any(np.diff(times) <= 0):
-        raise SolveError("t must be a non-empty, strictly increasing 1-D sequence of finite "
-                         "times")
-    return times
 
 
 def _starts(kernel: Kernel, q0: ArrayLike | None, m: int) -> Array:
