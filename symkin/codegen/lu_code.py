@@ -27,6 +27,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from symkin.codegen import inverse_code
 from symkin.codegen.backends.c import literal
 from symkin.codegen.lu_plan import LUPlan, Step
 
@@ -53,6 +54,8 @@ class Statements:
     inv_low: str = "0.0"  # min and max |1/c| over the constant pivots
     inv_high: str = "0.0"
     constant_pivots: int = 0
+    values: list[Value] = field(default_factory=list)  # per slot, its final number if known
+    inverses: dict[int, float] = field(default_factory=dict)  # constant pivots' 1/c
 
 
 class _Emitter:
@@ -251,6 +254,7 @@ def statements(plan: LUPlan, constants: Sequence[Value] | None, literal: Callabl
     out = emitter.out
     out.init = [(e, literal(c)) for e, c in enumerate(emitter.val) if c is not None and c != 0.0]
     out.init_inv = [(k, literal(c)) for k, c in sorted(emitter.inv.items())]
+    out.values, out.inverses = list(emitter.val), dict(emitter.inv)
     if emitter.inv:
         out.inv_low = literal(min(abs(c) for c in emitter.inv.values()))
         out.inv_high = literal(max(abs(c) for c in emitter.inv.values()))
@@ -297,8 +301,8 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
         style = "straight" if plan.flops + plan.solve_flops <= TABLE_FLOPS else "tables"
     if style not in ("straight", "tables"):
         raise ValueError(f"unknown sparse LU style {style!r}: use 'straight' or 'tables'")
-    code = statements(plan, constants if real == "double" else None, literal(real),
-                                  prefix, "fabsf" if real == "float" else "fabs")
+    fabs = "fabsf" if real == "float" else "fabs"
+    code = statements(plan, constants if real == "double" else None, literal(real), prefix, fabs)
     steps = [{"k": s.k, "row": s.row, "col": s.col, "pivot": s.pivot,
               "lower": [list(x) for x in s.lower], "upper": [list(x) for x in s.upper],
               "updates": [list(x) for x in s.updates], "factor": code.factor[s.k],
@@ -346,6 +350,10 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
                                 lambda s: len(s["lower_t"]), part_ops),
         "style": style,
         "tables": _tables(plan),
+        # ||Phi_q^-1||_1 exactly, where the straight-line code for it is short
+        "inverse": (inverse_code.exact_context(plan, code.values, code.inverses, literal(real),
+                                               f"{prefix}_real", fabs)
+                    if style == "straight" else None),
     }
 
 

@@ -23,6 +23,12 @@ scipy.sparse.linalg.splu): a dense factorization costs O(N^3) and its N x N arra
 memory, while Phi_q has at most about six non-zeros a row (chapter section 2.7). Below it,
 LAPACK on the dense matrix is faster than building a sparse one."""
 
+EXACT_INVERSE_UP_TO = 32
+"""Up to this many coordinates the condition at a solved point uses the exact ||Phi_q^-1||_1,
+the column sums of the inverse from N solves with the factors (cheap at this size); the
+generated C does the same for mechanisms whose inverse columns take few operations
+(codegen.inverse_code), so both backends flag the same points."""
+
 
 @dataclass(frozen=True)
 class Factors:
@@ -36,7 +42,14 @@ class Factors:
     gecon: Callable[..., Any] | None = None  # LAPACK's condition estimate with these factors
 
     def inverse_norm1(self) -> float:
-        """Estimate of ||Phi_q^-1||_1: LAPACK's xGECON, Hager-Higham as the C solver runs it."""
+        """||Phi_q^-1||_1: exact up to EXACT_INVERSE_UP_TO coordinates (as the generated C
+        computes it for small mechanisms), above that LAPACK's xGECON (Hager-Higham, the
+        estimator the C solver runs for large ones)."""
+        n = self.lu.shape[0]
+        if n <= EXACT_INVERSE_UP_TO:
+            inverse = self.solve(np.eye(n))
+            norm = float(np.abs(inverse).sum(axis=0).max(initial=0.0))
+            return norm if math.isfinite(norm) else math.inf
         if self.gecon is None or not self.norm1 > 0:
             return accuracy.inverse_norm1(self.solve, self.solve_transposed, self.lu.shape[0])
         rcond, info = self.gecon(self.lu, self.norm1, norm="1")
