@@ -25,17 +25,19 @@ from typing import Any
 from symkin.codegen.lu_plan import LUPlan
 
 EXACT_OPS = 400
-"""Most arithmetic operations (products, differences, |.|, sums) of the exact norm's code.
-Hager's estimator costs about five solves plus six passes over the vector; the exact columns
-are independent of each other, so the processor overlaps them, where the estimator's steps
-wait for one another. A few hundred operations is where the two meet for small systems;
-beyond that (and always for large ones, whose inverse is dense) the estimate stays."""
+"""Most arithmetic operations (products, differences, |.|) of the exact norm's code. The
+estimator costs about five solves plus passes over the vector, each waiting for the one
+before; the exact columns are independent, so the processor overlaps them. At 260 and 306
+operations (andrews_squeezer, all_drivers) the exact code still took 20-25 % fewer
+instructions a step than the estimate (bench/README.md); the limit keeps the code short, and
+a large mechanism's inverse is dense, far beyond it."""
 
 Value = float | str  # a number known at generation time, or a C expression
 
 
-class _Column:
-    """One unit vector's solve, with the known numbers folded in and the rest as temporaries."""
+class _Code:
+    """The straight-line code of the unit vectors' solves: known numbers folded, the rest one
+    temporary per operation (the same expression once), with a count of the operations."""
 
     def __init__(self, real: str, literal: Callable[[float], str]) -> None:
         self.lines: list[str] = []
@@ -86,18 +88,18 @@ class _Column:
 
 
 def _solve_unit(plan: LUPlan, start: int, slot: Callable[[int], Value],
-                inverse: Callable[[int], Value], column: _Column) -> list[Value]:
+                inverse: Callable[[int], Value], code: _Code) -> list[Value]:
     """L U x = e_start in the permuted order: the forward and back substitution of lu_code."""
     x: list[Value] = [0.0] * plan.n
     x[start] = 1.0
     for s in plan.steps:
         if x[s.k] != 0.0:
             for i, e in s.lower:
-                x[i] = column.minus(x[i], column.times(slot(e), x[s.k]))
+                x[i] = code.minus(x[i], code.times(slot(e), x[s.k]))
     for s in reversed(plan.steps):
         for j, e in s.upper:
-            x[s.k] = column.minus(x[s.k], column.times(slot(e), x[j]))
-        x[s.k] = column.times(x[s.k], inverse(s.k))
+            x[s.k] = code.minus(x[s.k], code.times(slot(e), x[j]))
+        x[s.k] = code.times(x[s.k], inverse(s.k))
     return x
 
 
@@ -118,7 +120,7 @@ def exact_context(plan: LUPlan, values: Sequence[float | None], inverses: dict[i
         limit: the most operations worth generating (default EXACT_OPS).
     """
     limit = EXACT_OPS if limit is None else limit
-    column = _Column(real, literal)
+    code = _Code(real, literal)
 
     def slot(e: int) -> Value:
         value = values[e]
@@ -130,15 +132,15 @@ def exact_context(plan: LUPlan, values: Sequence[float | None], inverses: dict[i
     start = 0.0
     sums: list[str] = []
     for unit in range(plan.n):
-        entries = _solve_unit(plan, unit, slot, inverse, column)
+        entries = _solve_unit(plan, unit, slot, inverse, code)
         known = sum(abs(x) for x in entries if isinstance(x, float))
         terms = [f"{fabs}({x.lstrip('-')})" for x in entries if isinstance(x, str)]
-        column.ops += len(terms)
-        if column.ops > limit:
+        code.ops += len(terms)
+        if code.ops > limit:
             return None
         if terms:
             sums.append(" + ".join(terms + ([literal(known)] if known else [])))
         else:
             start = max(start, known)
-    return {"lines": column.lines, "sums": sums,
-            "start": literal(start), "ops": column.ops}
+    return {"lines": code.lines, "sums": sums,
+            "start": literal(start), "ops": code.ops}
