@@ -1,6 +1,6 @@
 """Instructions per time step of the generated C solver, counted by callgrind (valgrind).
 
-    python3 bench/instructions.py crank_slider chain:100 tongs:1000 ...
+    python3 bench/instructions.py [--tighten-cond C] crank_slider chain:100 tongs:1000 ...
 
 Each argument is an example's name (examples/<name>.yaml, started from its q0) or FAMILY:BODIES
 of bench/scaling_limit.py (started from the closed form). The generated folder is compiled as
@@ -8,6 +8,8 @@ a plain C program (gcc -O2) whose main calls ``<prefix>_solve_grid`` over t = k 
 is (instructions of 121 steps - instructions of 21 steps) / 100, so set-up and the first
 assembly cancel. Instruction counts do not depend on the load of a shared machine, unlike
 times. dt is 1.5/20000 for an example (the textbook grid), 0.001 for a family.
+``--tighten-cond C`` replaces the solver's default ``tighten_cond`` (``inf``: Newton is never
+tightened at ill-conditioned points, so every step does the same work at every size).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 MAIN = r"""
 #include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 #include "@P@_solver.h"
 int main(int argc, char **argv)
@@ -36,6 +39,7 @@ int main(int argc, char **argv)
     @P@_report r;
     for (k = 0; k < n; ++k) t[k] = k * @DT@;
     @P@_default_options(&o);
+    @TIGHTEN@
     for (k = 0; k < @U@_NQ; ++k) s.q[k] = @P@_q0[k];
     s.started = 0;
     done = @P@_solve_grid(&o, @P@_p_nominal, n, t, &s, 0, 0, 0, &w, &r);
@@ -56,7 +60,7 @@ def _total(program: Path, steps: int) -> int:
     return int(match.group(1).replace(",", ""))
 
 
-def per_step(spec: str) -> tuple[str, int, float]:
+def per_step(spec: str, tighten_cond: str | None = None) -> tuple[str, int, float]:
     import symkin
     from symkin.spec import validate as model
 
@@ -72,8 +76,10 @@ def per_step(spec: str) -> tuple[str, int, float]:
         build = Path(folder)
         symkin.generate(system, backend="c", out_dir=build / "c")
         prefix = system.name
+        tighten = "" if tighten_cond is None else f"o.tighten_cond = {tighten_cond};"
         (build / "main.c").write_text(
-            MAIN.replace("@P@", prefix).replace("@U@", prefix.upper()).replace("@DT@", dt))
+            MAIN.replace("@P@", prefix).replace("@U@", prefix.upper()).replace("@DT@", dt)
+            .replace("@TIGHTEN@", tighten))
         sources = [str(p) for p in sorted((build / "c").glob("*.c"))]
         program = build / "main"
         subprocess.run(["gcc", "-std=c99", "-O2", f"-I{build / 'c'}", "-o", str(program),
@@ -82,8 +88,13 @@ def per_step(spec: str) -> tuple[str, int, float]:
 
 
 def main() -> int:
-    for spec in sys.argv[1:] or ["crank_slider"]:
-        name, nq, count = per_step(spec)
+    args = sys.argv[1:]
+    tighten_cond = None
+    if args[:1] == ["--tighten-cond"]:
+        tighten_cond = {"inf": "INFINITY"}.get(args[1], repr(float(args[1])))
+        args = args[2:]
+    for spec in args or ["crank_slider"]:
+        name, nq, count = per_step(spec, tighten_cond)
         print(f"{name:20s} N = {nq:5d}  {count:10.0f} instructions/step", flush=True)
     return 0
 

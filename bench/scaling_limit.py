@@ -1,6 +1,7 @@
 """Cold build and per-step cost from 10 to 1000 bodies, with peak memory, on two families.
 
     python3 bench/scaling_limit.py [--family chain tongs] [--sizes 10 30 100 300 1000]
+                                   [--tighten-cond C]
 
 Families: ``chain`` (bench/scaling_family.py: four-bar loops, every rocker grounded, no
 fill-in) and ``tongs`` (lazy tongs: a ladder of scissor units, grounded only at the first, so
@@ -11,11 +12,15 @@ difference of the two CPU times over 1600 steps (the assembly at t0 and the set-
 Times are CPU seconds of the child plus its compiler processes (robust to other load on the
 machine); peak memory is the largest resident set of the child or of any compiler process
 it ran (getrusage maxrss). The q of both families is checked against their closed forms.
+``--tighten-cond C`` solves with that ``Options.tighten_cond`` instead of the default (``inf``:
+no extra Newton iterations at ill-conditioned points, so a step does the same work at every
+size; the long tongs are ill-conditioned enough to be tightened by default).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import os
@@ -94,9 +99,10 @@ def mechanism(family: str, bodies: int) -> tuple[dict[str, Any], Any]:
                                               for v in st] for s in np.atleast_1d(t)])
 
 
-def child(family: str, bodies: int) -> dict[str, Any]:
+def child(family: str, bodies: int, tighten_cond: float | None = None) -> dict[str, Any]:
     """One measurement, in this (fresh) process."""
     import symkin
+    from symkin.runtime import options as newton
     from symkin.spec import validate as model
 
     data, exact = mechanism(family, bodies)
@@ -113,14 +119,17 @@ def child(family: str, bodies: int) -> dict[str, Any]:
         after = kids()
         gcc = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
         assert kernel.backend == "c"
-        symkin.solve(kernel, t=np.arange(11) * 0.001)  # first call: loading, allocation
+        options = (None if tighten_cond is None else
+                   dataclasses.replace(newton.defaults("double"), tighten_cond=tighten_cond))
+        # first call: loading, allocation
+        symkin.solve(kernel, t=np.arange(11) * 0.001, options=options)
         runs = []
         for n in (401, 2001):
             t = np.arange(n) * 0.001
             best = math.inf
             for _ in range(3):
                 start = cpu()
-                trajectory = symkin.solve(kernel, t=t)
+                trajectory = symkin.solve(kernel, t=t, options=options)
                 best = min(best, cpu() - start)
             runs.append(best)
         error = float(np.abs(trajectory.q - exact(t)).max())
@@ -140,10 +149,11 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--family", nargs="+", default=["chain", "tongs"])
     parser.add_argument("--sizes", type=int, nargs="+", default=[10, 30, 100, 300, 1000])
+    parser.add_argument("--tighten-cond", type=float, default=None)
     parser.add_argument("--child", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        print(json.dumps(child(args.child[0], int(args.child[1]))))
+        print(json.dumps(child(args.child[0], int(args.child[1]), args.tighten_cond)))
         return 0
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     for family in args.family:
@@ -151,8 +161,10 @@ def main() -> int:
         print(f"{family}: bodies  N  derive s  codegen s  gcc s  build s  us/step  "
               f"peak MB  max|q err|", flush=True)
         for bodies in args.sizes:
-            done = subprocess.run([sys.executable, __file__, "--child", family, str(bodies)],
-                                  capture_output=True, text=True, env=env, check=False)
+            tighten = [] if args.tighten_cond is None else ["--tighten-cond",
+                                                            repr(args.tighten_cond)]
+            done = subprocess.run([sys.executable, __file__, "--child", family, str(bodies),
+                                   *tighten], capture_output=True, text=True, env=env, check=False)
             if done.returncode != 0:
                 print(f"  {bodies}: failed\n{done.stderr[-2000:]}", flush=True)
                 continue

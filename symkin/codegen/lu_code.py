@@ -274,11 +274,15 @@ PART_OPS = 250
 the straight-line factor and solve are split into parts of about this many operations."""
 
 
-TABLE_FLOPS = 20000
+TABLE_FLOPS = 40000
 """Above this many factor + solve operations the C code walks index tables in loops instead of
-being straight-line: constant code size and compile time. Straight-line code was faster at
-every size measured (chain of 301 bodies, 5,700 operations: 14-18 us against 22 us for one
-factorization and three solves, but 4.8 s of gcc against 0.3 s), hence the high limit."""
+being straight-line: constant code size and compile time. The straight-line code folds Phi_q's
+numbers in and runs about one instruction per operation, the tables two to three (they load an
+index for every operand and do every operation); its parts keep the compiler's time linear, so
+this limit only bounds one file's compile. Lazy tongs of 1000 bodies (N = 3000, 31,942
+operations, fill-in): straight-line, the file is 1.6 MB, 24 s of gcc -O2 and 334 MB, and the
+solver's 2.75 M instructions per step are linear in N; with the tables 6.60 M (callgrind). At
+the limit about 2 MB, 30 s and 420 MB."""
 
 
 def template_context(plan: LUPlan, part_ops: int = PART_OPS,
