@@ -1,18 +1,18 @@
 """Per-call overhead of symkin.solve with the C backend: what a Python loop over solve pays
 around the generated solver.
 
-    python3 bench/solve_overhead.py [--calls 2000] [--repeat 15] [--points 1 31]
+    python3 bench/solve_overhead.py [--calls 2000] [--repeat 15] [--points 1 31 2001]
 
 The crank-slider (C kernel, symkin.compile's build), at the nominal parameters, from the file's
 q0, on grids of --points time points over 0..1.5. Three ways to solve the same grid in the
-same run, in interleaved rounds, best of --repeat rounds of --calls calls each, CPU time of
-this process per call:
+same run, in interleaved rounds, best of --repeat rounds of --calls calls each (fewer for a long
+grid: --calls * 31 / points, at least 20), CPU time of this process per call:
 
 - ``direct``: the generated ``<prefix>_solve_grid`` called through cffi on arrays, structs and
   pointers made once, with only the state reset (q0 copied in) per call: the floor;
 - ``solve``: ``symkin.solve(kernel, t=t, params=p)``, fresh result arrays each call;
 - ``solve out=``: the same with ``out=`` the previous call's Trajectory (no allocation of
-  result arrays).
+  result arrays: on a long grid, no fresh pages to fault in).
 
 The overhead is ``solve`` minus ``direct``. The script runs against the symkin of the source
 tree it sits in (a version without ``out=`` gets a dash in that column).
@@ -73,7 +73,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--calls", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=15)
-    parser.add_argument("--points", type=int, nargs="+", default=[1, 31])
+    parser.add_argument("--points", type=int, nargs="+", default=[1, 31, 2001])
     args = parser.parse_args()
 
     kernel = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider.yaml"), backend="c")
@@ -88,14 +88,16 @@ def main() -> None:
         reference = symkin.solve(kernel, t=t, params=p)
         ways: dict[str, Callable[[], object]] = {
             "direct": direct_call(kernel, t),
-            "solve": lambda: symkin.solve(kernel, t=t, params=p),
+            "solve": lambda t=t: symkin.solve(kernel, t=t, params=p),
         }
         if has_out:
-            ways["out"] = lambda: symkin.solve(kernel, t=t, params=p, out=reference)
+            ways["out"] = lambda t=t, out=reference: symkin.solve(kernel, t=t, params=p,
+                                                                  out=out)
+        calls = max(20, args.calls * 31 // max(points, 31))
         best = {way: float("inf") for way in ways}
         for _ in range(args.repeat):
             for way, function in ways.items():
-                best[way] = min(best[way], per_call(function, args.calls))
+                best[way] = min(best[way], per_call(function, calls))
         out = f"{best['out'] * 1e6:8.2f} us" if has_out else f"{'-':>11}"
         print(f"{points:>6} {best['direct'] * 1e6:7.2f} us {best['solve'] * 1e6:7.2f} us "
               f"{out} {(best['solve'] - best['direct']) * 1e6:7.2f} us")

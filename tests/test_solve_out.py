@@ -101,7 +101,7 @@ BAD_OUTS = {
     "list member": (lambda: (_rows(), _rows(), [[0.0] * 9] * 31), "must be a NumPy array"),
     "rows": (lambda: (_rows(size=30), _rows(), _rows()), "shape (30, 9); this solve needs (31, 9)"),
     "columns": (lambda: (_rows(), _rows(8), _rows()), "shape (31, 8)"),
-    "float32": (lambda: (_rows(), _rows(), _rows().astype(np.float32)), "dtype float32"),
+    "float32": (lambda: (_rows(), _rows(), np.zeros((31, 9), np.float32)), "dtype float32"),
     "strided": (lambda: (_rows(), np.empty((9, 31)).T, _rows()), "not C-contiguous"),
     "read-only": (lambda: (_rows(), _rows(), _read_only()), "read-only"),
     "same array": (lambda: (lambda a: (a, _rows(), a))(_rows()), "share memory"),
@@ -201,3 +201,15 @@ def test_the_callers_grid_and_parameters_are_copied(c_kernel) -> None:
     times[:] = 0.0
     p[:] = 0.0
     assert result.t[-1] == 1.5 and np.array_equal(result.params, [1.0, 5.0, 4.0])
+
+
+def test_out_into_a_memory_mapped_file(tmp_path, c_kernel) -> None:
+    """Arrays of a file on disk (np.memmap, an ndarray subclass with a base) are written."""
+    shape = (TIMES.size, c_kernel.nq)
+    q, dq, d2q = (np.lib.format.open_memmap(tmp_path / f"{name}.npy", mode="w+",
+                                            dtype=np.float64, shape=shape)
+                  for name in ("q", "dq", "d2q"))
+    result = driver.solve(c_kernel, t=TIMES, out=(q, dq, d2q))
+    assert result.q is q
+    q.flush()
+    assert np.array_equal(np.load(tmp_path / "q.npy"), driver.solve(c_kernel, t=TIMES).q)

@@ -83,8 +83,10 @@ def _reuse(times: Array, n: int, out: Out) -> Run:
     for name, array, shape, dtype in zip(names, arrays, ((size,), rows, rows, rows, (size,),
                                                          (size,)), _DTYPES):
         if not (isinstance(array, np.ndarray) and array.shape == shape
-                and array.dtype == dtype and array.flags.c_contiguous
-                and array.flags.writeable):
+                and array.dtype == dtype):
+            _refuse(name, array, shape, dtype)
+        flags = array.flags
+        if not (flags.c_contiguous and flags.writeable):
             _refuse(name, array, shape, dtype)
     # Two distinct arrays that own their memory (no base) cannot overlap: that settles the
     # usual case, an earlier solve's arrays, without the costlier test of every pair.
