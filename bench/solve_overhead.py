@@ -1,7 +1,7 @@
 """Per-call overhead of symkin.solve with the C backend: what a Python loop over solve pays
 around the generated solver.
 
-    python3 bench/solve_overhead.py [--calls 2000] [--repeat 15] [--points 1 31 2001]
+    python3 bench/solve_overhead.py [--calls 2000] [--repeat 15] [--points 1 31 20001]
 
 The crank-slider (C kernel, symkin.compile's build), at the nominal parameters, from the file's
 q0, on grids of --points time points over 0..1.5. Three ways to solve the same grid in the
@@ -73,7 +73,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--calls", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=15)
-    parser.add_argument("--points", type=int, nargs="+", default=[1, 31, 2001])
+    parser.add_argument("--points", type=int, nargs="+", default=[1, 31, 20001])
     args = parser.parse_args()
 
     kernel = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider.yaml"), backend="c")

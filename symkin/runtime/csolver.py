@@ -70,6 +70,7 @@ class GridSolver:
         self._p_bytes = p.size * np.dtype(self.dtype).itemsize
         self._set_options: Options | None = None
         self._pointers: tuple[Any, ...] | None = None  # of the run's arrays (bind)
+        self._size = 0  # their time points
         # (float64 target, buffer of the real type) pairs, for a float kernel only.
         self._copies: list[tuple[NDArray[Any], NDArray[Any]]] | None = None
         self.pool: SolverPool | None = None
@@ -107,10 +108,15 @@ class GridSolver:
              cond_out: Array, flagged_out: NDArray[np.bool_]) -> None:
         """The run's arrays: the grid and the rows :meth:`advance` writes.
 
-        The time points (T,) and outputs (T, N), (T,) must be C-contiguous (the driver
-        allocates or checks them); float64 outputs of a double kernel are written in place,
-        those of a float kernel through buffers of the real type copied over after each call.
+        The time points (T,), the float64 outputs q, dq, d2q (T, N) and cond (T,) and the bool
+        flags (T,) must be C-contiguous (the driver allocates or checks them; the sizes are
+        checked here). A double kernel writes them in place, a float kernel through buffers
+        of its real type copied over after each call.
         """
+        size = times.size
+        if not (q_out.size == dq_out.size == d2q_out.size == size * self._n
+                and cond_out.size == flagged_out.size == size):
+            raise ValueError(f"GridSolver.bind: arrays of {size} points x {self._n} expected")
         outputs: tuple[NDArray[Any], ...] = (q_out, dq_out, d2q_out, cond_out)
         if self.dtype is np.float64:
             self._copies = None
@@ -121,6 +127,7 @@ class GridSolver:
             times = np.ascontiguousarray(times, dtype=self.dtype)
         # cffi keeps each array alive for as long as its pointer lives.
         from_buffer, real = self._ffi.from_buffer, self._real_array
+        self._size = size
         self._pointers = (from_buffer(real, times), from_buffer(real, buffers[0]),
                           from_buffer(real, buffers[1]), from_buffer(real, buffers[2]),
                           from_buffer(real, buffers[3]),
@@ -130,14 +137,15 @@ class GridSolver:
         """Solve the bound grid's points start..stop-1 (after those already solved, which
         the state continues from); returns how many were solved. :meth:`status` and
         :meth:`outcome` say why it stopped short."""
-        if self._pointers is None:
-            raise RuntimeError("GridSolver.advance before bind")
-        n = self._n
+        if self._pointers is None or not 0 <= start < stop <= self._size:
+            raise ValueError(f"GridSolver.advance({start}, {stop}) outside the bound grid")
         t, q, dq, d2q, cond, flagged = self._pointers
-        solved: int = self._solve_grid(self._options, self._p, stop - start, t + start,
-                                       self._state, q + start * n, dq + start * n,
-                                       d2q + start * n, cond + start, flagged + start,
-                                       self._work, self._report)
+        if start:  # a later chunk: the pointers moved on to its first row
+            rows = start * self._n
+            t, q, dq, d2q = t + start, q + rows, dq + rows, d2q + rows
+            cond, flagged = cond + start, flagged + start
+        solved: int = self._solve_grid(self._options, self._p, stop - start, t, self._state,
+                                       q, dq, d2q, cond, flagged, self._work, self._report)
         if self._copies is not None:
             for target, source in self._copies:
                 target[start:start + solved] = source[start:start + solved]
@@ -159,13 +167,6 @@ class GridSolver:
         return ChunkResult(solved, int(report.status), float(report.t),
                            int(report.iterations), float(report.residual),
                            int(report.fallbacks))
-
-    def solve(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
-              cond_out: Array, flagged_out: NDArray[np.bool_]) -> ChunkResult:
-        """Solve the grid points ``times`` after those already solved, writing their rows,
-        the condition estimate and the flag of each point (one chunk: bind, then advance)."""
-        self.bind(times, q_out, dq_out, d2q_out, cond_out, flagged_out)
-        return self.outcome(self.advance(0, times.size))
 
     def point_vectors(self, count: int) -> Array:
         """The local vectors of the ``count`` named points at the run's parameters, (count, 2)."""
