@@ -3,6 +3,11 @@ time loop lives here, so the driver sees plain NumPy arrays and a :class:`ChunkR
 
 The C solver keeps its state (the last q, dq, ddq and t) between calls, so a grid can be run
 in chunks (for progress reports, interrupts) and continues exactly as one call would.
+
+A solve of a short grid is dominated by what happens around the C call, so everything that
+depends only on the kernel (the structs, the function lookups, the cffi type names) is done
+once per :class:`GridSolver`, and a run's output arrays are bound once (:meth:`GridSolver.bind`)
+and written by the C in place, chunk after chunk, through pointers offset by the chunk's start.
 """
 
 from __future__ import annotations
@@ -55,11 +60,19 @@ class GridSolver:
         self._work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
         self._report = ffi.new(f"{name}_report *")
         self._p = ffi.new(f"{name}_real[]", max(p.size, 1))
-        self._n = q.size
+        self._n, self._np = q.size, p.size
         self._solve_grid = getattr(lib, f"{name}_solve_grid_checked")
-        self._real_pointer = f"{name}_real[]"
+        self._points = getattr(lib, f"{name}_points")
+        self._real_array = f"{name}_real[]"
         self.dtype = np.float32 if real == "float" else np.float64
+        # The bytes of q and p in the real type: they are copied into the structs as they are.
+        self._q_bytes = q.size * np.dtype(self.dtype).itemsize
+        self._p_bytes = p.size * np.dtype(self.dtype).itemsize
         self._set_options: Options | None = None
+        self._pointers: tuple[Any, ...] | None = None  # of the run's arrays (bind)
+        self._size = 0  # their time points
+        # (float64 target, buffer of the real type) pairs, for a float kernel only.
+        self._copies: list[tuple[NDArray[Any], NDArray[Any]]] | None = None
         self.pool: SolverPool | None = None
         self.start(options, q, p)
 
@@ -75,45 +88,92 @@ class GridSolver:
             self._options.target_q, self._options.target_dq = options.target_q, options.target_dq
             self._options.target_ddq = options.target_ddq
             self._set_options = options
-        self._p[0:p.size] = p.tolist()
-        self._state.q[0:q.size] = q.tolist()
+        if p.size != self._np or q.size != self._n:
+            raise ValueError(f"expected {self._n} coordinates and {self._np} parameters, got "
+                             f"{q.size} and {p.size}")
+        # Copied as bytes in the real type: no Python list of floats on the way.
+        memmove, dtype = self._ffi.memmove, self.dtype
+        memmove(self._p, np.ascontiguousarray(p, dtype=dtype), self._p_bytes)
+        memmove(self._state.q, np.ascontiguousarray(q, dtype=dtype), self._q_bytes)
         self._state.started = 0
         return self
 
     def release(self) -> None:
-        """Hand the solver back to its pool for the next run (no-op outside a pool)."""
+        """Forget the run's arrays and hand the solver back to its pool (if it has one)."""
+        self._pointers = self._copies = None
         if self.pool is not None:
             self.pool.put(self)
 
-    def solve(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
-              cond_out: Array, flagged_out: NDArray[np.bool_]) -> ChunkResult:
-        """Solve the grid points ``times`` after those already solved, writing their rows,
-        the condition estimate and the flag of each point.
+    def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
+             cond_out: Array, flagged_out: NDArray[np.bool_]) -> None:
+        """The run's arrays: the grid and the rows :meth:`advance` writes.
 
-        The output arrays are written in place when they are C-contiguous arrays of the
-        kernel's real type (the flags: of bool); otherwise the rows are copied in after.
+        The time points (T,), the float64 outputs q, dq, d2q (T, N) and cond (T,) and the bool
+        flags (T,) must be C-contiguous (the driver allocates or checks them; the sizes are
+        checked here). A double kernel writes them in place, a float kernel through buffers
+        of its real type copied over after each call.
         """
-        chunk = np.ascontiguousarray(times, dtype=self.dtype)
-        outputs = (q_out, dq_out, d2q_out, cond_out)
-        direct = all(a.dtype == self.dtype and a.flags.c_contiguous for a in outputs)
-        buffers = outputs if direct else tuple(np.zeros((chunk.size, *a.shape[1:]),
-                                                        dtype=self.dtype) for a in outputs)
-        flags = flagged_out if flagged_out.dtype == np.bool_ and \
-            flagged_out.flags.c_contiguous else np.zeros(chunk.size, dtype=np.bool_)
-        pointers = [self._ffi.from_buffer(self._real_pointer, a) for a in (chunk, *buffers)]
-        flag_pointer = self._ffi.from_buffer("unsigned char[]", flags)
-        solved = self._solve_grid(self._options, self._p, chunk.size, pointers[0], self._state,
-                                  pointers[1], pointers[2], pointers[3], pointers[4],
-                                  flag_pointer, self._work, self._report)
-        if not direct:
-            for target, source in zip(outputs, buffers):
-                target[:solved] = source[:solved]
-        if flags is not flagged_out:
-            flagged_out[:solved] = flags[:solved]
+        size = times.size
+        if not (q_out.size == dq_out.size == d2q_out.size == size * self._n
+                and cond_out.size == flagged_out.size == size):
+            raise ValueError(f"GridSolver.bind: arrays of {size} points x {self._n} expected")
+        outputs: tuple[NDArray[Any], ...] = (q_out, dq_out, d2q_out, cond_out)
+        if self.dtype is np.float64:
+            self._copies = None
+            buffers = outputs
+        else:
+            buffers = tuple(np.empty(a.shape, dtype=self.dtype) for a in outputs)
+            self._copies = list(zip(outputs, buffers))
+            times = np.ascontiguousarray(times, dtype=self.dtype)
+        # cffi keeps each array alive for as long as its pointer lives.
+        from_buffer, real = self._ffi.from_buffer, self._real_array
+        self._size = size
+        self._pointers = (from_buffer(real, times), from_buffer(real, buffers[0]),
+                          from_buffer(real, buffers[1]), from_buffer(real, buffers[2]),
+                          from_buffer(real, buffers[3]),
+                          from_buffer("unsigned char[]", flagged_out))
+
+    def advance(self, start: int, stop: int) -> int:
+        """Solve the bound grid's points start..stop-1 (after those already solved, which
+        the state continues from); returns how many were solved. :meth:`status` and
+        :meth:`outcome` say why it stopped short."""
+        if self._pointers is None or not 0 <= start < stop <= self._size:
+            raise ValueError(f"GridSolver.advance({start}, {stop}) outside the bound grid")
+        t, q, dq, d2q, cond, flagged = self._pointers
+        if start:  # a later chunk: the pointers moved on to its first row
+            rows = start * self._n
+            t, q, dq, d2q = t + start, q + rows, dq + rows, d2q + rows
+            cond, flagged = cond + start, flagged + start
+        solved: int = self._solve_grid(self._options, self._p, stop - start, t, self._state,
+                                       q, dq, d2q, cond, flagged, self._work, self._report)
+        if self._copies is not None:
+            for target, source in self._copies:
+                target[start:start + solved] = source[start:start + solved]
+        return solved
+
+    @property
+    def status(self) -> int:
+        """newton.OK, NO_CONVERGENCE, SINGULAR or NOT_FINITE at the last point attempted."""
+        return int(self._report.status)
+
+    @property
+    def fallbacks(self) -> int:
+        """The sparse LU's fall-backs to dense LU since :meth:`start`."""
+        return int(self._report.fallbacks)
+
+    def outcome(self, solved: int) -> ChunkResult:
+        """The last call's report, with the count it returned."""
         report = self._report
-        return ChunkResult(int(solved), int(report.status), float(report.t),
+        return ChunkResult(solved, int(report.status), float(report.t),
                            int(report.iterations), float(report.residual),
                            int(report.fallbacks))
+
+    def point_vectors(self, count: int) -> Array:
+        """The local vectors of the ``count`` named points at the run's parameters, (count, 2)."""
+        out = np.empty((count, 2), dtype=self.dtype)
+        if count:
+            self._points(self._p, self._ffi.from_buffer(self._real_array, out))
+        return out if self.dtype is np.float64 else out.astype(np.float64)
 
     def set_state(self, t: float, q: Array, dq: Array, ddq: Array) -> None:
         """Continue from a point solved elsewhere (the driver's treatment of a singular point):

@@ -16,7 +16,10 @@ solve goes to runtime.edges: a too-large step is subdivided, a singular configur
 passed on the predicted branch, a limit position is bisected and reported.
 
 With a C kernel that carries the generated solver, the grid loop runs in C: one call per
-trajectory. Imports NumPy and SciPy only: it is part of the runtime.
+trajectory, written straight into the result arrays (runtime.outputs: fresh, or the caller's
+``out=``). When it solves the whole grid, the usual case, the Trajectory is returned at once;
+only where it stops does the general path above take over, from that point. Imports NumPy and
+SciPy only: it is part of the runtime.
 """
 
 from __future__ import annotations
@@ -25,21 +28,26 @@ import dataclasses
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from symkin import limits
 from symkin.errors import SolveError
 from symkin.runtime import failures
+from symkin.runtime.arguments import first_guess as first_guess
+from symkin.runtime.arguments import grid as grid
+from symkin.runtime.arguments import parameter_values as parameter_values
+from symkin.runtime.arguments import time_points as time_points
 from symkin.runtime.assembly import Assembly, assemble
 from symkin.runtime.csolver import GridSolver
-from symkin.runtime.edges import Passage, Resolution, State, resolve
+from symkin.runtime.edges import Resolution, resolve
 from symkin.runtime.linalg import factor_at
-from symkin.runtime.newton import Newton, Point, kinematics, newton
+from symkin.runtime.newton import Newton, kinematics, newton
 from symkin.runtime.options import NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.options import defaults as newton_defaults
+from symkin.runtime.outputs import Out, allocate
+from symkin.runtime.outputs import Run as _Run
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.results import Trajectory
 
@@ -93,88 +101,7 @@ class SolveFailure(SolveError):
         self.drivers = tuple(drivers)
 
 
-# ----- the time grid -------------------------------------------------------------------------
-
-def grid(t0: float, t1: float, dt: float) -> Array:
-    """t0 + k dt for k = 0, 1, ... up to t1 included, computed per point (no drift).
-
-    The end point is snapped to t1 when the interval holds a whole number of steps, so that
-    0:0.05:1.5 ends at 1.5 exactly, as MATLAB's colon does.
-    """
-    if not (dt > 0 and t1 >= t0 and math.isfinite(t1 - t0)):
-        raise SolveError(f"bad time grid t0={t0}, t1={t1}, dt={dt}: need dt > 0 and t1 >= t0")
-    if limits.grid_points(t0, t1, dt) > limits.MAX_GRID_POINTS:
-        raise SolveError(f"the grid t0={t0}, t1={t1}, dt={dt} has more than "
-                         f"{limits.MAX_GRID_POINTS} points; use a larger dt")
-    steps = math.floor((t1 - t0) / dt + 1e-9)
-    times = t0 + dt * np.arange(steps + 1, dtype=float)
-    if abs(times[-1] - t1) <= 1e-9 * dt:
-        times[-1] = t1
-    return times
-
-
-def time_points(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
-    """The times to solve at: the file's grid (t None), or t checked (finite, increasing)."""
-    if t is None:
-        return grid(*kernel.time_grid)
-    times = np.atleast_1d(np.asarray(t, dtype=float))
-    if times.ndim != 1 or times.size == 0 or not math.isfinite(times[0] + times[-1]):
-        raise SolveError("t must be a non-empty 1-D sequence of finite times")
-    # Strictly increasing steps between finite ends: then every time is finite (a NaN fails
-    # the comparison). One pass, where diff and isfinite would take three.
-    if times.size > 1 and not bool((times[1:] > times[:-1]).all()):
-        if not np.all(np.isfinite(times)):
-            raise SolveError("t must be a non-empty 1-D sequence of finite times")
-        raise SolveError("t must be strictly increasing")
-    return times
-
-
-def parameter_values(kernel: KinematicsKernel,
-                     params: Mapping[str, float] | ArrayLike | None) -> Array:
-    """Nominal parameter values, overridden by name (a mapping) or replaced (a sequence)."""
-    values = np.array(kernel.p_values, dtype=float)
-    if params is None:
-        return values
-    if isinstance(params, Mapping):
-        names = list(kernel.parameter_names)
-        for name, value in params.items():
-            if name not in names:
-                known = ", ".join(names) or "none"
-                raise SolveError(f"unknown parameter {name!r}; the mechanism has: {known}")
-            values[names.index(name)] = float(value)
-        return values
-    given = np.asarray(params, dtype=float)
-    if given.shape != values.shape:
-        raise SolveError(f"params has {given.size} values; the mechanism has {values.size}")
-    return given
-
-
 # ----- the time loop -------------------------------------------------------------------------
-
-@dataclass
-class _Run:
-    """Arrays filled point by point; ``done`` points are valid."""
-
-    t: Array
-    q: Array
-    dq: Array
-    d2q: Array
-    cond: Array
-    flagged: NDArray[np.bool_]
-    done: int = 0
-    fallbacks: int = 0  # the generated sparse LU's fall-backs to dense LU (C solver)
-    passages: list[Passage] = field(default_factory=list)
-
-    def store(self, k: int, point: Point) -> None:
-        self.q[k], self.dq[k], self.d2q[k] = point.q, point.dq, point.ddq
-        self.cond[k], self.flagged[k] = point.cond, point.flagged
-        self.done = k + 1
-
-    def state(self, k: int) -> State:
-        """Point k as the predictor's state."""
-        return State(float(self.t[k]), Point(self.q[k], self.dq[k], self.d2q[k],
-                                             float(self.cond[k]), bool(self.flagged[k])))
-
 
 def _python_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
                  progress: Progress | None) -> Newton:
@@ -209,10 +136,11 @@ class _Chunks:
     Python between calls stays negligible."""
 
     CHUNK_SECONDS = 0.05
+    FIRST = 256  # the first chunk's size: a grid this short is one call
 
     def __init__(self, total: int, reporting: bool) -> None:
         self.limit = max(1, total // 100) if reporting else total
-        self.size = min(256, self.limit)
+        self.size = min(self.FIRST, self.limit)
 
     def took(self, seconds: float) -> None:
         """Scale the next chunk to the time this one took (at most 4x larger at once)."""
@@ -220,41 +148,58 @@ class _Chunks:
         self.size = int(min(self.limit, max(1, self.size * grow)))
 
 
-def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
-            progress: Progress | None) -> Newton:
-    """The grid loop in the generated C solver from point run.done: one call per chunk (one
-    chunk unless a progress callback wants to hear in between)."""
-    chunks = _Chunks(run.t.size, progress is not None)
-    result = None
-    start = run.done
-    while start < run.t.size:
-        stop = min(start + chunks.size, run.t.size)
+def _c_run(run: _Run, solver: GridSolver, progress: Progress | None) -> int:
+    """The grid loop in the generated C solver from point run.done, into the run's arrays
+    (bound to the solver): one call per chunk, one call in all for a grid of up to
+    _Chunks.FIRST points without progress reports. Stops at the first point the plain step
+    cannot solve; returns what the last call solved (its report is the solver's)."""
+    total, start = run.t.size, run.done
+    if progress is None and total - start <= _Chunks.FIRST:
+        solved = solver.advance(start, total)
+        run.done = start + solved
+        return solved
+    chunks = _Chunks(total, progress is not None)
+    solved = 0
+    while start < total:
+        stop = min(start + chunks.size, total)
         began = time.perf_counter()
-        result = solver.solve(run.t[start:stop], run.q[start:stop], run.dq[start:stop],
-                              run.d2q[start:stop], run.cond[start:stop],
-                              run.flagged[start:stop])
+        solved = solver.advance(start, stop)
         chunks.took(time.perf_counter() - began)
-        run.done = start + result.solved
-        run.fallbacks = result.fallbacks
-        if result.status != OK:
-            last = solver.last_q()
-            factors = factor_at(kernel, last, result.t, p) if result.status == SINGULAR \
-                else None
-            return Newton(last, result.status, result.iterations, result.residual, factors)
+        run.done = start + solved
+        if solver.status != OK:
+            break
         if progress is not None:
-            progress(run.done, run.t.size)
+            progress(run.done, total)
         start = stop
+    return solved
+
+
+def _c_outcome(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
+               solved: int) -> Newton:
+    """The Newton outcome where the C grid loop stopped (status OK at the end of the grid)."""
+    run.fallbacks = solver.fallbacks
+    result = solver.outcome(solved)
+    if result.status != OK:
+        last = solver.last_q()
+        factors = factor_at(kernel, last, result.t, p) if result.status == SINGULAR else None
+        return Newton(last, result.status, result.iterations, result.residual, factors)
     # The last row written is the solver's q: no need to read it back from C.
     q = run.q[run.done - 1] if run.done else solver.last_q()
-    return Newton(q, OK, 0 if result is None else result.iterations,
-                  0.0 if result is None else result.residual, None)
+    return Newton(q, OK, result.iterations, result.residual, None)
+
+
+def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
+            progress: Progress | None) -> Newton:
+    """The grid loop in the generated C solver from point run.done, and its outcome."""
+    solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
+    return _c_outcome(kernel, run, solver, p, _c_run(run, solver, progress))
 
 
 def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
           params: Mapping[str, float] | ArrayLike | None = None, *,
           options: Options | None = None, progress: Progress | None = None,
           use_c_solver: bool = True, stop_at_singular: bool = False,
-          sensitivities: bool = False) -> Trajectory:
+          sensitivities: bool = False, out: Out | None = None) -> Trajectory:
     """Positions, velocities and accelerations of a mechanism over a time grid.
 
     Args:
@@ -269,21 +214,24 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         stop_at_singular: stop at the first singular point (SolveFailure) instead of passing
             through it, and do not subdivide a step that fails (the behaviour of old).
         sensitivities: also compute ``q_p`` = dq/dp (T, N, NP) from Phi_q q_p = -Phi_p.
+        out: arrays to write the result into instead of fresh ones (numpy's ``out=``): a
+            Trajectory from an earlier solve with as many time points (its t, q, dq, d2q,
+            cond and flagged are overwritten), or a tuple (q, dq, d2q) of writable
+            C-contiguous float64 arrays of shape (T, N). The returned Trajectory holds these
+            very arrays; the rest of ``out`` (params, singular, ...) is left as it was.
 
     Returns:
         The Trajectory.
 
     Raises:
         SolveFailure (a SolveError) with the partial trajectory when the mechanism cannot be
-        assembled at t[0], Newton does not converge, or Phi_q is singular.
+        assembled at t[0], Newton does not converge, or Phi_q is singular. SolveError for a
+        bad t, q0, params or out.
     """
-    # An expression singular at some t gives inf/NaN there; that is reported as a failure
-    # (status NOT_FINITE), so NumPy's floating-point warnings would only repeat it.
     options = options or default_options(kernel)
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
-    with np.errstate(all="ignore"):
-        trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver)
+    trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver, out)
     if sensitivities:
         from symkin.runtime.sensitivity import with_sensitivities
 
@@ -293,49 +241,55 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
 
 def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
            params: Mapping[str, float] | ArrayLike | None, options: Options,
-           progress: Progress | None, use_c_solver: bool) -> Trajectory:
+           progress: Progress | None, use_c_solver: bool, out: Out | None) -> Trajectory:
+    """Check the arguments, then the C grid loop over the whole grid; only where it stops
+    (a failed assembly from q0, a singular point, a limit, a failure) or without the C
+    solver, the general loop with the assembly and the edge treatments takes over."""
     times = time_points(kernel, t)
     p = parameter_values(kernel, params)
-    q = np.array(kernel.q0 if q0 is None else q0, dtype=float)
-    if q.shape != (len(kernel.coordinates),):
-        raise SolveError(f"q0 has {q.size} values; the mechanism has "
-                         f"{len(kernel.coordinates)} coordinates")
-    shape = (times.size, q.size)
-    # Rows past run.done are never exposed, so the arrays need no zero-filling.
-    run = _Run(times, np.empty(shape), np.empty(shape), np.empty(shape),
-               np.full(times.size, math.nan), np.zeros(times.size, dtype=bool))
-    in_c = use_c_solver and kernel.has_grid_solver
+    q = first_guess(kernel, q0)
+    run = allocate(times, q.size, out)
+    solver = kernel.grid_solver(options, q, p) if use_c_solver and kernel.has_grid_solver \
+        else None
     try:
-        result = _run(kernel, run, q, p, options, progress, in_c)
+        if solver is not None:
+            solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
+            solved = _c_run(run, solver, progress)
+            if run.done == times.size:  # the usual case: nothing left to treat
+                run.fallbacks = solver.fallbacks
+                return _trajectory(kernel, run, p, solver.point_vectors(len(kernel.points)))
+            first = _c_outcome(kernel, run, solver, p, solved)
+        else:
+            first = None
+        # An expression singular at some t gives inf/NaN there; that is reported as a
+        # failure (status NOT_FINITE), so NumPy's floating-point warnings would only repeat it.
+        with np.errstate(all="ignore"):
+            result = _grid(kernel, run, solver, first, q, p, options, progress)
     except KeyboardInterrupt:
         # The rows done so far are whole (run.done counts only finished rows): hand them on.
         stop = float(times[min(run.done, times.size - 1)])
         raise SolveInterrupted(_trajectory(kernel, run, p), stop) from None
-    if isinstance(result, Resolution):
-        _fail_edge(kernel, run, p, result, float(times[run.done]))
-    elif result.status != OK:
-        _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
-    return _trajectory(kernel, run, p)
-
-
-def _run(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, options: Options,
-         progress: Progress | None, in_c: bool) -> Newton | Resolution:
-    """Assemble at t[0], then solve the grid; a point the plain step cannot solve goes to
-    edges.resolve and the loop resumes after it. Returns the outcome that stopped the run
-    (status OK when the grid is done)."""
-    solver = kernel.grid_solver(options, q, p) if in_c else None
-    try:
-        return _grid(kernel, run, solver, q, p, options, progress)
     finally:
         if solver is not None:
             solver.release()  # back to the kernel's pool for the next run
+    with np.errstate(all="ignore"):
+        if isinstance(result, Resolution):
+            _fail_edge(kernel, run, p, result, float(times[run.done]))
+        elif result.status != OK:
+            _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
+        return _trajectory(kernel, run, p)
 
 
-def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: Array, p: Array,
-          options: Options, progress: Progress | None) -> Newton | Resolution:
+def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,
+          first: Newton | None, q: Array, p: Array, options: Options,
+          progress: Progress | None) -> Newton | Resolution:
+    """Go on from where the C grid loop stopped (first: its outcome; None without C):
+    assemble at t[0] if it could not, then solve the grid; a point the plain step cannot
+    solve goes to edges.resolve and the loop resumes after it. Returns the outcome that
+    stopped the run (status OK when the grid is done)."""
     # The C solver assembles t[0] itself by plain Newton from q0; only when that fails does
     # the damped assembly in Python take over (and the grid is run again from its result).
-    result = _c_loop(kernel, run, solver, p, progress) if solver is not None else None
+    result = first
     if result is None or (result.status != OK and run.done == 0):
         assembly = assemble(kernel, q, float(run.t[0]), p, options)
         start = assembly.result
@@ -368,20 +322,20 @@ def _resume(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: A
     return _python_loop(kernel, run, q, p, options, progress)
 
 
-def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array) -> Trajectory:
+def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
+                point_vectors: Array | None = None) -> Trajectory:
+    """The Trajectory of the rows done, over the run's own arrays (p: owned by the run)."""
     done = run.done
-
-    def solved(a: Array) -> Array:  # the run's own arrays (never the caller's): no copy
-        return a if done == a.shape[0] else a[:done].copy()
-
-    return Trajectory(t=run.t[:done].copy(), q=solved(run.q), dq=solved(run.dq),
-                      d2q=solved(run.d2q), coordinates=tuple(kernel.coordinates),
-                      points=tuple(kernel.points),
-                      point_vectors=np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2),
-                      params=p.copy(), lu_fallbacks=run.fallbacks,
-                      flagged=run.flagged[:done].copy(), cond=run.cond[:done].copy(),
-                      singular=tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
-                                     for s in run.passages))
+    arrays: tuple[NDArray[Any], ...] = (run.t, run.q, run.dq, run.d2q, run.flagged, run.cond)
+    if done < run.t.size:  # a partial result: the caller's rows viewed, the run's copied
+        arrays = tuple(a[:done] if run.caller_owned else a[:done].copy() for a in arrays)
+    t, q, dq, d2q, flagged, cond = arrays
+    if point_vectors is None:
+        point_vectors = np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2)
+    singular = tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
+                     for s in run.passages) if run.passages else ()
+    return Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates), tuple(kernel.points),
+                             point_vectors, p, run.fallbacks, flagged, cond, singular)
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,

@@ -69,11 +69,13 @@ class Kernel:
         self.lib = lib
         self._functions = functions
         self._solvers: SolverPool | None = None  # GridSolvers reused from run to run
+        # Looked up once: solve asks on every call.
+        self._has_grid_solver = lib is not None and hasattr(lib, f"{self.name}_solve_grid")
 
     @property
     def has_grid_solver(self) -> bool:
         """True for a C kernel whose generated solver runs whole grids (``solve_grid``)."""
-        return self.lib is not None and hasattr(self.lib, f"{self.name}_solve_grid")
+        return self._has_grid_solver
 
     def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
         """A fresh run of the generated C grid loop from q, or None without a C solver."""

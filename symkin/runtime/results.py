@@ -92,6 +92,24 @@ class Trajectory:
         if self.cond.shape != self.t.shape:
             object.__setattr__(self, "cond", np.full(self.t.shape, np.nan))
 
+    @classmethod
+    def solved(cls, t: NDArray[np.float64], q: NDArray[np.float64], dq: NDArray[np.float64],
+               d2q: NDArray[np.float64], coordinates: tuple[str, ...],
+               points: tuple[tuple[str, str], ...], point_vectors: NDArray[np.float64],
+               params: NDArray[np.float64], lu_fallbacks: int, flagged: NDArray[np.bool_],
+               cond: NDArray[np.float64],
+               singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
+               ) -> Trajectory:
+        """The solver's result, whose arrays are consistent by construction (flagged and cond
+        of shape (T,)): the same object as the constructor's, built without its field-by-field
+        frozen assignment and checks, which cost more than solving a short grid."""
+        self = object.__new__(cls)
+        self.__dict__.update(t=t, q=q, dq=dq, d2q=d2q, coordinates=coordinates, points=points,
+                             point_vectors=point_vectors, params=params,
+                             lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
+                             cond=cond, singular=singular)
+        return self
+
     @property
     def bodies(self) -> tuple[str, ...]:
         """The moving bodies, in coordinate order."""
