@@ -282,7 +282,7 @@ index for every operand and do every operation); its parts keep the compiler's t
 this limit only bounds one file's compile. Lazy tongs of 1000 bodies (N = 3000, 31,942
 operations, fill-in): straight-line, the file is 1.6 MB, 24 s of gcc -O2 and 334 MB, and the
 solver's 2.75 M instructions per step are linear in N; with the tables 6.60 M (callgrind). At
-the limit about 2 MB, 30 s and 420 MB."""
+the limit, extrapolated: about 2 MB, 30 s and 420 MB."""
 
 
 def template_context(plan: LUPlan, part_ops: int = PART_OPS,
