@@ -139,7 +139,9 @@ def exact_context(plan: LUPlan, values: Sequence[float | None], inverses: dict[i
         if code.ops > limit:
             return None
         if terms:
-            sums.append(" + ".join(terms + ([literal(known)] if known else [])))
+            total = " + ".join(terms + ([literal(known)] if known else []))
+            if total not in sums:  # two columns alike (a pair's x and y rows): one test
+                sums.append(total)
         else:
             start = max(start, known)
     return {"lines": code.lines, "sums": sums,

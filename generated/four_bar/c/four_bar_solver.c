@@ -200,12 +200,6 @@ static four_bar_real four_bar_inverse_norm1_exact(const four_bar_real v[], const
     s = fabs(v[3]) + fabs(v[6]) + fabs(w11) + fabs(w8) + 1.0;
     finite += s - s;
     largest = s > largest ? s : largest;
-    s = fabs(w3) + fabs(w0) + 1.0;
-    finite += s - s;
-    largest = s > largest ? s : largest;
-    s = fabs(w5) + fabs(inv[8]) + 1.0;
-    finite += s - s;
-    largest = s > largest ? s : largest;
     s = fabs(w3) + fabs(w0);
     finite += s - s;
     largest = s > largest ? s : largest;
