@@ -43,11 +43,11 @@ _DRIVER_C = """\
 #include <stdlib.h>
 #include "{p}_sparse_lu.h"
 
-/* Factor and solve m systems (nz: m x NNZ, b: m x NQ, solved in place) with one workspace;
- * status[k] is the factor's return code, dense[k] 1 when system k used the fall-back,
- * ratio[k] the pivot ratio min |u_kk| / max |u_kk|. */
+/* Factor and solve m systems (nz: m x NNZ, b: m x NQ, solved in place; A^T x = b when
+ * transposed) with one workspace; status[k] is the factor's return code, dense[k] 1 when
+ * system k used the fall-back, ratio[k] the pivot ratio min |u_kk| / max |u_kk|. */
 long harness_solve(int m, const double *nz, double *b, int *status, int *dense, int *failed,
-                   double *ratio)
+                   double *ratio, int transposed)
 {{
     {p}_lu *lu = malloc(sizeof *lu);
     long fallbacks;
@@ -59,25 +59,12 @@ long harness_solve(int m, const double *nz, double *b, int *status, int *dense, 
         dense[k] = lu->dense;
         failed[k] = lu->failed_pivot;
         ratio[k] = {p}_lu_pivot_ratio(lu);
-        if (status[k] == 0) {p}_lu_solve(lu, b + (long)k * {P}_NQ);
-    }}
-    fallbacks = (long)lu->fallbacks;
-    free(lu);
-    return fallbacks;
-}}
-
-/* As harness_solve, with the transposed solve A^T x = b. */
-long harness_solve_transposed(int m, const double *nz, double *b, int *status, int *dense)
-{{
-    {p}_lu *lu = malloc(sizeof *lu);
-    long fallbacks;
-    int k;
-    if (!lu) return -1;
-    {p}_lu_init(lu);
-    for (k = 0; k < m; ++k) {{
-        status[k] = {p}_lu_factor(nz + (long)k * {P}_NNZ, lu);
-        dense[k] = lu->dense;
-        if (status[k] == 0) {p}_lu_solve_transposed(lu, b + (long)k * {P}_NQ);
+        if (status[k] != 0) continue;
+        if (transposed) {{
+            {p}_lu_solve_transposed(lu, b + (long)k * {P}_NQ);
+        }} else {{
+            {p}_lu_solve(lu, b + (long)k * {P}_NQ);
+        }}
     }}
     fallbacks = (long)lu->fallbacks;
     free(lu);
@@ -129,27 +116,24 @@ class Library:
     nnz: int
     ratios: np.ndarray | None = None
 
-    def solve(self, nz: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                            np.ndarray, int]:
-        """Factor/solve a batch: returns x, status, dense flags, failed pivots, fall-backs
-        (the pivot ratios of the batch are left in ``self.ratios``)."""
+    def solve(self, nz: np.ndarray, b: np.ndarray, transposed: bool = False
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+        """Factor/solve a batch (A^T x = b when transposed): returns x, status, dense flags,
+        failed pivots, fall-backs (the pivot ratios of the batch are left in
+        ``self.ratios``)."""
         nz = np.ascontiguousarray(np.atleast_2d(nz), dtype=float)
         x = np.ascontiguousarray(np.atleast_2d(b), dtype=float).copy()
         m = nz.shape[0]
         status, dense, failed = (np.zeros(m, dtype=np.intc) for _ in range(3))
         self.ratios = np.zeros(m)
         fallbacks = self.lib.harness_solve(m, _ptr(nz), _ptr(x), _iptr(status), _iptr(dense),
-                                           _iptr(failed), _ptr(self.ratios))
+                                           _iptr(failed), _ptr(self.ratios), int(transposed))
         return x, status, dense, failed, int(fallbacks)
 
     def solve_transposed(self, nz: np.ndarray, b: np.ndarray
                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Factor and solve A^T x = b for a batch: returns x, status, dense flags."""
-        nz = np.ascontiguousarray(np.atleast_2d(nz), dtype=float)
-        x = np.ascontiguousarray(np.atleast_2d(b), dtype=float).copy()
-        m = nz.shape[0]
-        status, dense = (np.zeros(m, dtype=np.intc) for _ in range(2))
-        self.lib.harness_solve_transposed(m, _ptr(nz), _ptr(x), _iptr(status), _iptr(dense))
+        x, status, dense, _, _ = self.solve(nz, b, transposed=True)
         return x, status, dense
 
     def repeat(self, reps: int, nz: np.ndarray, b: np.ndarray) -> None:
@@ -194,7 +178,6 @@ def build(folder: Path, prefix: str, nq: int, rows: Sequence[int], cols: Sequenc
     compile_library([*sources, folder / "harness.c"], library, extra_flags)
     lib = ctypes.CDLL(str(library))
     lib.harness_solve.restype = ctypes.c_long
-    lib.harness_solve_transposed.restype = ctypes.c_long
     return Library(lib, nq, len(rows))
 
 

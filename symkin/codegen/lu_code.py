@@ -185,32 +185,26 @@ class _Emitter:
             lines = [line for j, slot in s.upper
                      for line in _axpy(f"x[{s.k}]", self.val[slot], f"v[{slot}]", f"x[{j}]",
                                        self.lit)]
-            inv = self.inv.get(s.k)
-            if inv is None:
-                lines.append(f"x[{s.k}] *= inv[{s.k}];")
-            elif inv == -1.0:
-                lines.append(f"x[{s.k}] = -x[{s.k}];")
-            elif inv != 1.0:
-                lines.append(f"x[{s.k}] *= {self.lit(inv)};")
-            self.out.backward.append(lines)
+            self.out.backward.append(lines + self._divide(s.k))
         self._transposed()
+
+    def _divide(self, k: int) -> list[str]:
+        """``x[k] /= u_kk`` as a multiplication by the reciprocal (known: -1 and 1 folded)."""
+        inv = self.inv.get(k)
+        if inv is None:
+            return [f"x[{k}] *= inv[{k}];"]
+        if inv == -1.0:
+            return [f"x[{k}] = -x[{k}];"]
+        return [] if inv == 1.0 else [f"x[{k}] *= {self.lit(inv)};"]
 
     def _transposed(self) -> None:
         """A^T x = b as U^T z = Pc^T b, L^T v = z: the same operations, in the same order, as
         the table-driven loops (so the same bits), with the known entries folded."""
         for s in self.plan.steps:
-            inv = self.inv.get(s.k)
-            lines = []
-            if inv is None:
-                lines.append(f"x[{s.k}] *= inv[{s.k}];")
-            elif inv == -1.0:
-                lines.append(f"x[{s.k}] = -x[{s.k}];")
-            elif inv != 1.0:
-                lines.append(f"x[{s.k}] *= {self.lit(inv)};")
-            lines += [line for j, slot in s.upper
-                      for line in _axpy(f"x[{j}]", self.val[slot], f"v[{slot}]", f"x[{s.k}]",
-                                        self.lit)]
-            self.out.upper_t.append(lines)
+            self.out.upper_t.append(self._divide(s.k) + [
+                line for j, slot in s.upper
+                for line in _axpy(f"x[{j}]", self.val[slot], f"v[{slot}]", f"x[{s.k}]",
+                                  self.lit)])
         for s in reversed(self.plan.steps):
             self.out.lower_t.append([
                 line for i, slot in s.lower
