@@ -11,7 +11,8 @@ over grids of 401 and 2001 points (best of 3 each, after a warm-up); per step is
 difference of the two CPU times over 1600 steps (the assembly at t0 and the set-up cancel).
 Times are CPU seconds of the child plus its compiler processes (robust to other load on the
 machine); peak memory is the largest resident set of the child or of any compiler process
-it ran (getrusage maxrss). The q of both families is checked against their closed forms.
+it ran (getrusage maxrss). The q of both families is checked against their closed forms
+(largest error over the 2001-point grid; "flagged": the share of its points flagged).
 ``--tighten-cond C`` solves with that ``Options.tighten_cond`` instead of the default (``inf``:
 no extra Newton iterations at ill-conditioned points, so a step does the same work at every
 size; the long tongs are ill-conditioned enough to be tightened by default).
@@ -133,10 +134,11 @@ def child(family: str, bodies: int, tighten_cond: float | None = None) -> dict[s
                 best = min(best, cpu() - start)
             runs.append(best)
         error = float(np.abs(trajectory.q - exact(t)).max())
+        flagged = float(np.mean(trajectory.flagged))
     return {"family": family, "bodies": len(data["bodies"]), "nq": len(system.q),
             "derive_s": derive, "codegen_s": own, "gcc_s": gcc,
             "build_s": derive + own + gcc, "us_per_step": (runs[1] - runs[0]) / 1600 * 1e6,
-            "max_q_error": error,
+            "max_q_error": error, "flagged": flagged,
             "peak_mb": max(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
                            resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss) / 1024}
 
@@ -159,7 +161,7 @@ def main() -> int:
     for family in args.family:
         rows = []
         print(f"{family}: bodies  N  derive s  codegen s  gcc s  build s  us/step  "
-              f"peak MB  max|q err|", flush=True)
+              f"peak MB  max|q err|  flagged", flush=True)
         for bodies in args.sizes:
             tighten = [] if args.tighten_cond is None else ["--tighten-cond",
                                                             repr(args.tighten_cond)]
@@ -172,7 +174,8 @@ def main() -> int:
             rows.append(row)
             print(f"  {row['bodies']:5d} {row['nq']:5d} {row['derive_s']:8.2f} "
                   f"{row['codegen_s']:9.2f} {row['gcc_s']:6.2f} {row['build_s']:8.2f} "
-                  f"{row['us_per_step']:8.2f} {row['peak_mb']:8.0f} {row['max_q_error']:9.1e}",
+                  f"{row['us_per_step']:8.2f} {row['peak_mb']:8.0f} {row['max_q_error']:9.1e}"
+                  f" {row['flagged']:7.0%}",
                   flush=True)
         if len(rows) >= 2:
             n = [r["bodies"] for r in rows]

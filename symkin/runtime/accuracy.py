@@ -89,9 +89,15 @@ def errors(inv_norm: float, residual: float, n: int, nq: float, ndq: float, nddq
 def flagged(inv_norm: float, norm_a: float, residual: float, q: Array, dq: Array, ddq: Array,
             options: Options, unit: float) -> bool:
     """True when the estimated error of q, dq or ddq misses its target (options.target_*)."""
+    nq, ndq, nddq = (float(np.abs(v).max(initial=0.0)) for v in (q, dq, ddq))
+    return flagged_norms(inv_norm, norm_a, residual, q.size, nq, ndq, nddq, options, unit)
+
+
+def flagged_norms(inv_norm: float, norm_a: float, residual: float, n: int, nq: float, ndq: float,
+                  nddq: float, options: Options, unit: float) -> bool:
+    """flagged, from the max norms of q, dq and ddq (N of them each)."""
     if not math.isfinite(inv_norm * norm_a):
         return True
-    nq, ndq, nddq = (float(np.abs(v).max(initial=0.0)) for v in (q, dq, ddq))
-    e_q, e_dq, e_ddq = errors(inv_norm, residual, q.size, nq, ndq, nddq, unit)
+    e_q, e_dq, e_ddq = errors(inv_norm, residual, n, nq, ndq, nddq, unit)
     return (e_q > options.target_q * max(1.0, nq) or e_dq > options.target_dq * max(1.0, ndq)
             or e_ddq > options.target_ddq * max(1.0, nddq))

@@ -110,10 +110,14 @@ def _python_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, option
     result = Newton(q, OK, 0, 0.0, None)
     for k in range(run.done, run.t.size):
         t = float(run.t[k])
+        previous = (0.0, 0.0, 0.0)  # max |q|, |dq|, |ddq| of the last point (error model)
         if k > 0:
             h = t - run.t[k - 1]
             q = run.q[k - 1] + run.dq[k - 1] * h + run.d2q[k - 1] * (h * h / 2)  # (2.76)
-        result = newton(kernel, q, t, p, options)
+            nq, ndq, nddq = (float(np.abs(v[k - 1]).max(initial=0.0))
+                             for v in (run.q, run.dq, run.d2q))
+            previous = (nq, ndq, nddq)
+        result = newton(kernel, q, t, p, options, previous)
         if result.status != OK:
             return result
         point = kinematics(kernel, result, t, p, options)

@@ -40,6 +40,18 @@ class Factors:
     getrs: Callable[..., Any]  # LAPACK's solve with these factors
     norm1: float = math.nan  # ||Phi_q||_1 of the matrix factored
     gecon: Callable[..., Any] | None = None  # LAPACK's condition estimate with these factors
+    matrix: Array | None = None  # Phi_q itself (not a copy)
+
+    @property
+    def exact(self) -> bool:
+        """Whether inverse_norm1 is exact rather than an estimate."""
+        return bool(self.lu.shape[0] <= EXACT_INVERSE_UP_TO)
+
+    def distance1(self, other: Factors | SparseFactors) -> float:
+        """||A - B||_1 of the two matrices factored (NaN when one is not kept)."""
+        if self.matrix is None or not isinstance(other, Factors) or other.matrix is None:
+            return math.nan
+        return float(np.abs(self.matrix - other.matrix).sum(axis=0).max(initial=0.0))
 
     def inverse_norm1(self) -> float:
         """||Phi_q^-1||_1: exact up to EXACT_INVERSE_UP_TO coordinates (as the generated C
@@ -73,6 +85,15 @@ class SparseFactors:
     lu: Any
     pivot_ratio: float
     norm1: float = math.nan  # ||Phi_q||_1 of the matrix factored
+    matrix: Any = None  # Phi_q as a scipy.sparse matrix
+
+    exact = False  # inverse_norm1 is an estimate (this size is above EXACT_INVERSE_UP_TO)
+
+    def distance1(self, other: Factors | SparseFactors) -> float:
+        """||A - B||_1 of the two matrices factored (NaN when one is not kept)."""
+        if self.matrix is None or not isinstance(other, SparseFactors) or other.matrix is None:
+            return math.nan
+        return float(abs(self.matrix - other.matrix).sum(axis=0).max())
 
     def inverse_norm1(self) -> float:
         """Estimate of ||Phi_q^-1||_1 (Hager-Higham, as the C solver runs it)."""
@@ -97,7 +118,8 @@ def factor(jacobian: Array) -> Factors:
 
     lu, pivots, _ = lapack.dgetrf(jacobian)
     norm = float(np.abs(jacobian).sum(axis=0).max(initial=0.0))
-    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs, norm, lapack.dgecon)
+    return Factors(lu, pivots, _ratio(np.abs(np.diag(lu))), lapack.dgetrs, norm, lapack.dgecon,
+                   jacobian)
 
 
 def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values: Array
@@ -113,7 +135,8 @@ def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values
         lu = splu(matrix)
     except RuntimeError:  # SuperLU: "Factor is exactly singular"
         return SparseFactors(None, 0.0)
-    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())), accuracy.norm1(values, cols, n))
+    return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())), accuracy.norm1(values, cols, n),
+                         matrix)
 
 
 def factor_at(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> Factors | SparseFactors:

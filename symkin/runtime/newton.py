@@ -20,6 +20,12 @@ TIGHTEN_STEPS = 3
 """Newton iterations allowed after convergence at an ill-conditioned point (its step stalls at
 the rounding level within one or two)."""
 
+REESTIMATE_SHIFT = 0.05
+"""After those iterations the estimate of ||Phi_q^-1||_1 is not made again where
+theta = ||Phi_q^-1||_1 ||Phi_q' - Phi_q||_1 (the old estimate, the change of Phi_q) is at
+most this: ||Phi_q'^-1||_1 <= ||Phi_q^-1||_1 / (1 - theta) (the Banach lemma) stands for it.
+An exact norm is always made again."""
+
 
 @dataclass
 class Newton:
@@ -51,12 +57,14 @@ class Point:
     flagged: bool
 
 
-def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options) -> Newton:
+def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options,
+           previous: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> Newton:
     """Newton-Raphson that tests the residual of the current iterate (2.72).
 
     Converged when max |Phi(q_k)| <= tol_phi and the step that led to q_k was at most tol_dq
     (or no step was needed). The factors returned are those of Phi_q at the converged q, ready
-    for the velocity and acceleration solves.
+    for the velocity and acceleration solves. ``previous``: max |q|, |dq| and |ddq| of the
+    last point solved, for the error model (_converged; zeros at a first point).
     """
     q = np.array(q, dtype=float)
     step = math.inf
@@ -71,7 +79,7 @@ def newton(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Opti
             return Newton(q, SINGULAR, iteration, residual, factors)
         if residual <= options.tol_phi and (iteration == 0 or step <= options.tol_dq):
             return _converged(kernel, Newton(q, OK, iteration, residual, factors), t, p,
-                              options, phi, step)
+                              options, phi, step, previous)
         if iteration == options.max_iterations:
             break
         delta = factors.solve(-phi)
@@ -88,14 +96,25 @@ def _estimate(result: Newton) -> Newton:
 
 
 def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, options: Options,
-               phi: Array, step: float) -> Newton:
-    """Estimate the condition at a converged point; where it is high, iterate on while the
-    step still shrinks (each at most half the one before): once it stalls it is rounding noise,
-    which a nearly singular Phi_q would only amplify along its null direction. Then estimate
-    again. Above options.max_cond the point counts as singular."""
+               phi: Array, step: float, previous: tuple[float, float, float]) -> Newton:
+    """Estimate the condition at a converged point. Where it is high (above
+    options.tighten_cond), iterate on while the step still shrinks (each at most half the one
+    before: once it stalls it is rounding noise, which a nearly singular Phi_q would only
+    amplify along its null direction): q as exact as rounding allows. Where it is not, but
+    the error model would flag the point (with the last point's max |q|, |dq|, |ddq|:
+    ``previous``), iterate on until it would not (or the step stalls): a point is flagged only
+    for what iterations cannot fix. tighten_cond = inf: neither. Then estimate again. Above
+    options.max_cond the point counts as singular."""
     result = _estimate(result)
-    if result.cond > options.tighten_cond:
-        q, residual, factors, moved = result.q, result.residual, result.factors, False
+    unit = accuracy.UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
+    ill = result.cond > options.tighten_cond
+
+    def would_flag(residual: float) -> bool:
+        return residual > unit * (1.0 + previous[0]) and accuracy.flagged_norms(
+            result.inv_norm, result.norm_a, residual, result.q.size, *previous, options, unit)
+
+    if ill or (options.tighten_cond < math.inf and would_flag(result.residual)):
+        q, residual, factors = result.q, result.residual, result.factors
         assert factors is not None
         for _ in range(TIGHTEN_STEPS):
             delta = factors.solve(-phi)
@@ -104,15 +123,28 @@ def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
                 break
             q = q + delta
             phi = kernel.phi(q, t, p)
-            residual, step, moved = float(np.abs(phi).max(initial=0.0)), size, True
+            residual, step = float(np.abs(phi).max(initial=0.0)), size
             factors = factor_at(kernel, q, t, p)
             if factors.pivot_ratio < options.min_pivot_ratio:
                 return Newton(q, SINGULAR, result.iterations, residual, factors)
-        if moved:
-            result = _estimate(Newton(q, OK, result.iterations, residual, factors))
+            if not ill and not would_flag(residual):
+                break
+        if factors is not result.factors:
+            result = _estimate_again(result, Newton(q, OK, result.iterations, residual, factors))
     if not result.cond <= options.max_cond:
         result.status = SINGULAR
     return result
+
+
+def _estimate_again(before: Newton, after: Newton) -> Newton:
+    """The estimate at ``after`` from the one at ``before`` where REESTIMATE_SHIFT allows it."""
+    assert before.factors is not None and after.factors is not None
+    if not after.factors.exact:
+        theta = before.inv_norm * after.factors.distance1(before.factors)
+        if theta <= REESTIMATE_SHIFT:
+            after.inv_norm, after.norm_a = before.inv_norm / (1.0 - theta), after.factors.norm1
+            return after
+    return _estimate(after)
 
 
 def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, options: Options

@@ -26,6 +26,9 @@ class Options:
             point exceeds this: the point is then handed to the singular-point treatment.
         tighten_cond: above this condition estimate Newton goes on iterating until its step
             stalls near machine precision (the position error is amplified into dq and ddq).
+            Below it, Newton goes on at a point the error model would flag as Newton left it,
+            until it would not. ``inf``: no extra iterations at all (the same work at every
+            step).
         target_q, target_dq, target_ddq: a point is flagged when the estimated error of q, dq
             or ddq exceeds this times max(1, max |x|) (runtime.accuracy).
         stop_at_singular: stop at the first singular point (the behaviour before singular

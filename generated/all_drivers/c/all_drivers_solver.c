@@ -27,6 +27,7 @@ void all_drivers_default_options(all_drivers_options *options)
 #define ALL_DRIVERS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define ALL_DRIVERS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define ALL_DRIVERS_SAFETY ((all_drivers_real)10) /* as runtime.accuracy.SAFETY */
+#define ALL_DRIVERS_REESTIMATE_SHIFT ((all_drivers_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static all_drivers_real all_drivers_max_abs(const all_drivers_real v[])
@@ -435,12 +436,49 @@ static all_drivers_real all_drivers_inverse_norm1_exact(const all_drivers_real v
     return finite == 0 ? largest : (all_drivers_real)INFINITY;
 }
 
+/* Where the estimate is exact (the sparse factors of a mechanism with a short exact code). */
+static int all_drivers_exact_estimate(const all_drivers_workspace *work)
+{
+    return !work->lu.dense;
+}
+
 static void all_drivers_estimate(all_drivers_workspace *work, all_drivers_report *report)
 {
     /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = work->lu.dense ? all_drivers_inverse_norm1(&work->lu)
-                                      : all_drivers_inverse_norm1_exact(work->lu.v, work->lu.inv);
+    report->inv_norm = all_drivers_exact_estimate(work)
+        ? all_drivers_inverse_norm1_exact(work->lu.v, work->lu.inv)
+        : all_drivers_inverse_norm1(&work->lu);
     report->cond = report->inv_norm * all_drivers_norm1(work->nz);
+}
+
+/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
+static all_drivers_real all_drivers_difference_norm1(const all_drivers_real a[], const all_drivers_real b[])
+{
+    all_drivers_real sums[ALL_DRIVERS_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < ALL_DRIVERS_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) sums[all_drivers_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < ALL_DRIVERS_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+/* The estimate again after Newton moved q from where it was made (Phi_q then was in
+ * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
+ * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one, for the price of one pass over the non-zeros. */
+static void all_drivers_estimate_again(all_drivers_workspace *work, all_drivers_report *report)
+{
+    all_drivers_real theta;
+    if (!all_drivers_exact_estimate(work)) {
+        theta = report->inv_norm * all_drivers_difference_norm1(work->nz, work->nz_estimated);
+        if (theta <= ALL_DRIVERS_REESTIMATE_SHIFT) {
+            report->inv_norm /= 1 - theta;
+            report->cond = report->inv_norm * all_drivers_norm1(work->nz);
+            return;
+        }
+    }
+    all_drivers_estimate(work, report);
 }
 
 static all_drivers_real all_drivers_at_least_1(all_drivers_real x)
@@ -466,16 +504,33 @@ static int all_drivers_flagged(const all_drivers_options *options,
         || ALL_DRIVERS_SAFETY * e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
 }
 
-/* At a converged point: estimate the condition; where it is high, go on while the Newton step
- * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
- * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+/* Whether the error model would flag a point with this report's residual and condition and
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+static int all_drivers_would_flag(const all_drivers_options *options,
+                                   const all_drivers_workspace *work,
+                                   const all_drivers_report *report)
+{
+    const all_drivers_real *norms = work->norms;
+    return report->residual > ALL_DRIVERS_UNIT_ROUNDOFF * (1 + norms[0])
+        && all_drivers_flagged(options, report, norms[0], norms[1], norms[2]);
+}
+
+/* At a converged point: estimate the condition. Where it is high (above
+ * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
+ * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
+ * allows. Where it is not, but the error model would flag the point, Newton goes on until it
+ * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
+ * Then the estimate is made again. Above options->max_cond the point counts as singular. */
 static int all_drivers_converged(const all_drivers_options *options, const all_drivers_real p[],
                                   all_drivers_real t, all_drivers_real q[], all_drivers_real step,
                                   all_drivers_workspace *work, all_drivers_report *report)
 {
-    int i, extra, moved = 0;
+    int i, extra, moved = 0, ill;
     all_drivers_estimate(work, report);
-    if (report->cond > options->tighten_cond) {
+    ill = report->cond > options->tighten_cond;
+    /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
+    if (ill || (options->tighten_cond < (all_drivers_real)INFINITY
+                && all_drivers_would_flag(options, work, report))) {
         for (extra = 0; extra < ALL_DRIVERS_TIGHTEN_STEPS; ++extra) {
             all_drivers_real size;
             for (i = 0; i < ALL_DRIVERS_NQ; ++i) work->phi[i] = -work->phi[i];
@@ -483,6 +538,9 @@ static int all_drivers_converged(const all_drivers_options *options, const all_d
             size = all_drivers_max_abs(work->phi);
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < ALL_DRIVERS_NQ; ++i) q[i] += work->phi[i];
+            if (!moved) { /* Phi_q where the estimate was made */
+                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             all_drivers_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = all_drivers_max_abs(work->phi);
@@ -491,9 +549,10 @@ static int all_drivers_converged(const all_drivers_options *options, const all_d
             if (all_drivers_factor_jacobian(options, work, report) != ALL_DRIVERS_OK) {
                 return ALL_DRIVERS_SINGULAR;
             }
+            if (!ill && !all_drivers_would_flag(options, work, report)) break;
         }
         if (moved) {
-            all_drivers_estimate(work, report);
+            all_drivers_estimate_again(work, report);
         }
     }
     return report->cond <= options->max_cond ? ALL_DRIVERS_OK : ALL_DRIVERS_SINGULAR;
@@ -561,6 +620,7 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
         all_drivers_predict(t, state);
     } else {
         all_drivers_lu_init(&work->lu); /* the caller's workspace may hold anything */
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
     }
     report->status = all_drivers_newton(options, p, t, state->q, work, report);
     report->fallbacks = all_drivers_lu_fallbacks(&work->lu);
@@ -595,6 +655,9 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
     }
     report->flagged = all_drivers_flagged(options, report, sum_q != sum_q ? (all_drivers_real)NAN : nq,
                                            ndq, nddq);
+    work->norms[0] = nq; /* for the next point's Newton (converged) */
+    work->norms[1] = ndq;
+    work->norms[2] = nddq;
     state->t = t;
     state->started = 1;
     return ALL_DRIVERS_OK;

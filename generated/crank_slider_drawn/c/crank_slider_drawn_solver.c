@@ -27,6 +27,7 @@ void crank_slider_drawn_default_options(crank_slider_drawn_options *options)
 #define CRANK_SLIDER_DRAWN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define CRANK_SLIDER_DRAWN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define CRANK_SLIDER_DRAWN_SAFETY ((crank_slider_drawn_real)10) /* as runtime.accuracy.SAFETY */
+#define CRANK_SLIDER_DRAWN_REESTIMATE_SHIFT ((crank_slider_drawn_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static crank_slider_drawn_real crank_slider_drawn_max_abs(const crank_slider_drawn_real v[])
@@ -194,12 +195,49 @@ static crank_slider_drawn_real crank_slider_drawn_inverse_norm1_exact(const cran
     return finite == 0 ? largest : (crank_slider_drawn_real)INFINITY;
 }
 
+/* Where the estimate is exact (the sparse factors of a mechanism with a short exact code). */
+static int crank_slider_drawn_exact_estimate(const crank_slider_drawn_workspace *work)
+{
+    return !work->lu.dense;
+}
+
 static void crank_slider_drawn_estimate(crank_slider_drawn_workspace *work, crank_slider_drawn_report *report)
 {
     /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = work->lu.dense ? crank_slider_drawn_inverse_norm1(&work->lu)
-                                      : crank_slider_drawn_inverse_norm1_exact(work->lu.v, work->lu.inv);
+    report->inv_norm = crank_slider_drawn_exact_estimate(work)
+        ? crank_slider_drawn_inverse_norm1_exact(work->lu.v, work->lu.inv)
+        : crank_slider_drawn_inverse_norm1(&work->lu);
     report->cond = report->inv_norm * crank_slider_drawn_norm1(work->nz);
+}
+
+/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
+static crank_slider_drawn_real crank_slider_drawn_difference_norm1(const crank_slider_drawn_real a[], const crank_slider_drawn_real b[])
+{
+    crank_slider_drawn_real sums[CRANK_SLIDER_DRAWN_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < CRANK_SLIDER_DRAWN_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < CRANK_SLIDER_DRAWN_NNZ; ++e) sums[crank_slider_drawn_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < CRANK_SLIDER_DRAWN_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+/* The estimate again after Newton moved q from where it was made (Phi_q then was in
+ * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
+ * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one, for the price of one pass over the non-zeros. */
+static void crank_slider_drawn_estimate_again(crank_slider_drawn_workspace *work, crank_slider_drawn_report *report)
+{
+    crank_slider_drawn_real theta;
+    if (!crank_slider_drawn_exact_estimate(work)) {
+        theta = report->inv_norm * crank_slider_drawn_difference_norm1(work->nz, work->nz_estimated);
+        if (theta <= CRANK_SLIDER_DRAWN_REESTIMATE_SHIFT) {
+            report->inv_norm /= 1 - theta;
+            report->cond = report->inv_norm * crank_slider_drawn_norm1(work->nz);
+            return;
+        }
+    }
+    crank_slider_drawn_estimate(work, report);
 }
 
 static crank_slider_drawn_real crank_slider_drawn_at_least_1(crank_slider_drawn_real x)
@@ -225,16 +263,33 @@ static int crank_slider_drawn_flagged(const crank_slider_drawn_options *options,
         || CRANK_SLIDER_DRAWN_SAFETY * e_ddq > options->target_ddq * crank_slider_drawn_at_least_1(nddq);
 }
 
-/* At a converged point: estimate the condition; where it is high, go on while the Newton step
- * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
- * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+/* Whether the error model would flag a point with this report's residual and condition and
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+static int crank_slider_drawn_would_flag(const crank_slider_drawn_options *options,
+                                   const crank_slider_drawn_workspace *work,
+                                   const crank_slider_drawn_report *report)
+{
+    const crank_slider_drawn_real *norms = work->norms;
+    return report->residual > CRANK_SLIDER_DRAWN_UNIT_ROUNDOFF * (1 + norms[0])
+        && crank_slider_drawn_flagged(options, report, norms[0], norms[1], norms[2]);
+}
+
+/* At a converged point: estimate the condition. Where it is high (above
+ * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
+ * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
+ * allows. Where it is not, but the error model would flag the point, Newton goes on until it
+ * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
+ * Then the estimate is made again. Above options->max_cond the point counts as singular. */
 static int crank_slider_drawn_converged(const crank_slider_drawn_options *options, const crank_slider_drawn_real p[],
                                   crank_slider_drawn_real t, crank_slider_drawn_real q[], crank_slider_drawn_real step,
                                   crank_slider_drawn_workspace *work, crank_slider_drawn_report *report)
 {
-    int i, extra, moved = 0;
+    int i, extra, moved = 0, ill;
     crank_slider_drawn_estimate(work, report);
-    if (report->cond > options->tighten_cond) {
+    ill = report->cond > options->tighten_cond;
+    /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
+    if (ill || (options->tighten_cond < (crank_slider_drawn_real)INFINITY
+                && crank_slider_drawn_would_flag(options, work, report))) {
         for (extra = 0; extra < CRANK_SLIDER_DRAWN_TIGHTEN_STEPS; ++extra) {
             crank_slider_drawn_real size;
             for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) work->phi[i] = -work->phi[i];
@@ -242,6 +297,9 @@ static int crank_slider_drawn_converged(const crank_slider_drawn_options *option
             size = crank_slider_drawn_max_abs(work->phi);
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) q[i] += work->phi[i];
+            if (!moved) { /* Phi_q where the estimate was made */
+                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             crank_slider_drawn_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = crank_slider_drawn_max_abs(work->phi);
@@ -250,9 +308,10 @@ static int crank_slider_drawn_converged(const crank_slider_drawn_options *option
             if (crank_slider_drawn_factor_jacobian(options, work, report) != CRANK_SLIDER_DRAWN_OK) {
                 return CRANK_SLIDER_DRAWN_SINGULAR;
             }
+            if (!ill && !crank_slider_drawn_would_flag(options, work, report)) break;
         }
         if (moved) {
-            crank_slider_drawn_estimate(work, report);
+            crank_slider_drawn_estimate_again(work, report);
         }
     }
     return report->cond <= options->max_cond ? CRANK_SLIDER_DRAWN_OK : CRANK_SLIDER_DRAWN_SINGULAR;
@@ -320,6 +379,7 @@ int crank_slider_drawn_solve_step(const crank_slider_drawn_options *options, con
         crank_slider_drawn_predict(t, state);
     } else {
         crank_slider_drawn_lu_init(&work->lu); /* the caller's workspace may hold anything */
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
     }
     report->status = crank_slider_drawn_newton(options, p, t, state->q, work, report);
     report->fallbacks = crank_slider_drawn_lu_fallbacks(&work->lu);
@@ -354,6 +414,9 @@ int crank_slider_drawn_solve_step(const crank_slider_drawn_options *options, con
     }
     report->flagged = crank_slider_drawn_flagged(options, report, sum_q != sum_q ? (crank_slider_drawn_real)NAN : nq,
                                            ndq, nddq);
+    work->norms[0] = nq; /* for the next point's Newton (converged) */
+    work->norms[1] = ndq;
+    work->norms[2] = nddq;
     state->t = t;
     state->started = 1;
     return CRANK_SLIDER_DRAWN_OK;

@@ -27,6 +27,7 @@ void four_bar_default_options(four_bar_options *options)
 #define FOUR_BAR_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define FOUR_BAR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define FOUR_BAR_SAFETY ((four_bar_real)10) /* as runtime.accuracy.SAFETY */
+#define FOUR_BAR_REESTIMATE_SHIFT ((four_bar_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static four_bar_real four_bar_max_abs(const four_bar_real v[])
@@ -209,12 +210,49 @@ static four_bar_real four_bar_inverse_norm1_exact(const four_bar_real v[], const
     return finite == 0 ? largest : (four_bar_real)INFINITY;
 }
 
+/* Where the estimate is exact (the sparse factors of a mechanism with a short exact code). */
+static int four_bar_exact_estimate(const four_bar_workspace *work)
+{
+    return !work->lu.dense;
+}
+
 static void four_bar_estimate(four_bar_workspace *work, four_bar_report *report)
 {
     /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = work->lu.dense ? four_bar_inverse_norm1(&work->lu)
-                                      : four_bar_inverse_norm1_exact(work->lu.v, work->lu.inv);
+    report->inv_norm = four_bar_exact_estimate(work)
+        ? four_bar_inverse_norm1_exact(work->lu.v, work->lu.inv)
+        : four_bar_inverse_norm1(&work->lu);
     report->cond = report->inv_norm * four_bar_norm1(work->nz);
+}
+
+/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
+static four_bar_real four_bar_difference_norm1(const four_bar_real a[], const four_bar_real b[])
+{
+    four_bar_real sums[FOUR_BAR_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < FOUR_BAR_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < FOUR_BAR_NNZ; ++e) sums[four_bar_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < FOUR_BAR_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+/* The estimate again after Newton moved q from where it was made (Phi_q then was in
+ * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
+ * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one, for the price of one pass over the non-zeros. */
+static void four_bar_estimate_again(four_bar_workspace *work, four_bar_report *report)
+{
+    four_bar_real theta;
+    if (!four_bar_exact_estimate(work)) {
+        theta = report->inv_norm * four_bar_difference_norm1(work->nz, work->nz_estimated);
+        if (theta <= FOUR_BAR_REESTIMATE_SHIFT) {
+            report->inv_norm /= 1 - theta;
+            report->cond = report->inv_norm * four_bar_norm1(work->nz);
+            return;
+        }
+    }
+    four_bar_estimate(work, report);
 }
 
 static four_bar_real four_bar_at_least_1(four_bar_real x)
@@ -240,16 +278,33 @@ static int four_bar_flagged(const four_bar_options *options,
         || FOUR_BAR_SAFETY * e_ddq > options->target_ddq * four_bar_at_least_1(nddq);
 }
 
-/* At a converged point: estimate the condition; where it is high, go on while the Newton step
- * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
- * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+/* Whether the error model would flag a point with this report's residual and condition and
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+static int four_bar_would_flag(const four_bar_options *options,
+                                   const four_bar_workspace *work,
+                                   const four_bar_report *report)
+{
+    const four_bar_real *norms = work->norms;
+    return report->residual > FOUR_BAR_UNIT_ROUNDOFF * (1 + norms[0])
+        && four_bar_flagged(options, report, norms[0], norms[1], norms[2]);
+}
+
+/* At a converged point: estimate the condition. Where it is high (above
+ * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
+ * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
+ * allows. Where it is not, but the error model would flag the point, Newton goes on until it
+ * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
+ * Then the estimate is made again. Above options->max_cond the point counts as singular. */
 static int four_bar_converged(const four_bar_options *options, const four_bar_real p[],
                                   four_bar_real t, four_bar_real q[], four_bar_real step,
                                   four_bar_workspace *work, four_bar_report *report)
 {
-    int i, extra, moved = 0;
+    int i, extra, moved = 0, ill;
     four_bar_estimate(work, report);
-    if (report->cond > options->tighten_cond) {
+    ill = report->cond > options->tighten_cond;
+    /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
+    if (ill || (options->tighten_cond < (four_bar_real)INFINITY
+                && four_bar_would_flag(options, work, report))) {
         for (extra = 0; extra < FOUR_BAR_TIGHTEN_STEPS; ++extra) {
             four_bar_real size;
             for (i = 0; i < FOUR_BAR_NQ; ++i) work->phi[i] = -work->phi[i];
@@ -257,6 +312,9 @@ static int four_bar_converged(const four_bar_options *options, const four_bar_re
             size = four_bar_max_abs(work->phi);
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < FOUR_BAR_NQ; ++i) q[i] += work->phi[i];
+            if (!moved) { /* Phi_q where the estimate was made */
+                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             four_bar_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = four_bar_max_abs(work->phi);
@@ -265,9 +323,10 @@ static int four_bar_converged(const four_bar_options *options, const four_bar_re
             if (four_bar_factor_jacobian(options, work, report) != FOUR_BAR_OK) {
                 return FOUR_BAR_SINGULAR;
             }
+            if (!ill && !four_bar_would_flag(options, work, report)) break;
         }
         if (moved) {
-            four_bar_estimate(work, report);
+            four_bar_estimate_again(work, report);
         }
     }
     return report->cond <= options->max_cond ? FOUR_BAR_OK : FOUR_BAR_SINGULAR;
@@ -335,6 +394,7 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
         four_bar_predict(t, state);
     } else {
         four_bar_lu_init(&work->lu); /* the caller's workspace may hold anything */
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
     }
     report->status = four_bar_newton(options, p, t, state->q, work, report);
     report->fallbacks = four_bar_lu_fallbacks(&work->lu);
@@ -369,6 +429,9 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
     }
     report->flagged = four_bar_flagged(options, report, sum_q != sum_q ? (four_bar_real)NAN : nq,
                                            ndq, nddq);
+    work->norms[0] = nq; /* for the next point's Newton (converged) */
+    work->norms[1] = ndq;
+    work->norms[2] = nddq;
     state->t = t;
     state->started = 1;
     return FOUR_BAR_OK;

@@ -27,6 +27,7 @@ void quick_return_default_options(quick_return_options *options)
 #define QUICK_RETURN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define QUICK_RETURN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define QUICK_RETURN_SAFETY ((quick_return_real)10) /* as runtime.accuracy.SAFETY */
+#define QUICK_RETURN_REESTIMATE_SHIFT ((quick_return_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static quick_return_real quick_return_max_abs(const quick_return_real v[])
@@ -256,12 +257,49 @@ static quick_return_real quick_return_inverse_norm1_exact(const quick_return_rea
     return finite == 0 ? largest : (quick_return_real)INFINITY;
 }
 
+/* Where the estimate is exact (the sparse factors of a mechanism with a short exact code). */
+static int quick_return_exact_estimate(const quick_return_workspace *work)
+{
+    return !work->lu.dense;
+}
+
 static void quick_return_estimate(quick_return_workspace *work, quick_return_report *report)
 {
     /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = work->lu.dense ? quick_return_inverse_norm1(&work->lu)
-                                      : quick_return_inverse_norm1_exact(work->lu.v, work->lu.inv);
+    report->inv_norm = quick_return_exact_estimate(work)
+        ? quick_return_inverse_norm1_exact(work->lu.v, work->lu.inv)
+        : quick_return_inverse_norm1(&work->lu);
     report->cond = report->inv_norm * quick_return_norm1(work->nz);
+}
+
+/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
+static quick_return_real quick_return_difference_norm1(const quick_return_real a[], const quick_return_real b[])
+{
+    quick_return_real sums[QUICK_RETURN_NQ], largest = 0;
+    int e, j;
+    for (j = 0; j < QUICK_RETURN_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < QUICK_RETURN_NNZ; ++e) sums[quick_return_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < QUICK_RETURN_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
+    return largest;
+}
+
+/* The estimate again after Newton moved q from where it was made (Phi_q then was in
+ * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
+ * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one, for the price of one pass over the non-zeros. */
+static void quick_return_estimate_again(quick_return_workspace *work, quick_return_report *report)
+{
+    quick_return_real theta;
+    if (!quick_return_exact_estimate(work)) {
+        theta = report->inv_norm * quick_return_difference_norm1(work->nz, work->nz_estimated);
+        if (theta <= QUICK_RETURN_REESTIMATE_SHIFT) {
+            report->inv_norm /= 1 - theta;
+            report->cond = report->inv_norm * quick_return_norm1(work->nz);
+            return;
+        }
+    }
+    quick_return_estimate(work, report);
 }
 
 static quick_return_real quick_return_at_least_1(quick_return_real x)
@@ -287,16 +325,33 @@ static int quick_return_flagged(const quick_return_options *options,
         || QUICK_RETURN_SAFETY * e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
 }
 
-/* At a converged point: estimate the condition; where it is high, go on while the Newton step
- * still halves (a stalled step is rounding noise, which a nearly singular Phi_q would only
- * amplify), then estimate again. Above options->max_cond the point counts as singular. */
+/* Whether the error model would flag a point with this report's residual and condition and
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+static int quick_return_would_flag(const quick_return_options *options,
+                                   const quick_return_workspace *work,
+                                   const quick_return_report *report)
+{
+    const quick_return_real *norms = work->norms;
+    return report->residual > QUICK_RETURN_UNIT_ROUNDOFF * (1 + norms[0])
+        && quick_return_flagged(options, report, norms[0], norms[1], norms[2]);
+}
+
+/* At a converged point: estimate the condition. Where it is high (above
+ * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
+ * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
+ * allows. Where it is not, but the error model would flag the point, Newton goes on until it
+ * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
+ * Then the estimate is made again. Above options->max_cond the point counts as singular. */
 static int quick_return_converged(const quick_return_options *options, const quick_return_real p[],
                                   quick_return_real t, quick_return_real q[], quick_return_real step,
                                   quick_return_workspace *work, quick_return_report *report)
 {
-    int i, extra, moved = 0;
+    int i, extra, moved = 0, ill;
     quick_return_estimate(work, report);
-    if (report->cond > options->tighten_cond) {
+    ill = report->cond > options->tighten_cond;
+    /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
+    if (ill || (options->tighten_cond < (quick_return_real)INFINITY
+                && quick_return_would_flag(options, work, report))) {
         for (extra = 0; extra < QUICK_RETURN_TIGHTEN_STEPS; ++extra) {
             quick_return_real size;
             for (i = 0; i < QUICK_RETURN_NQ; ++i) work->phi[i] = -work->phi[i];
@@ -304,6 +359,9 @@ static int quick_return_converged(const quick_return_options *options, const qui
             size = quick_return_max_abs(work->phi);
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < QUICK_RETURN_NQ; ++i) q[i] += work->phi[i];
+            if (!moved) { /* Phi_q where the estimate was made */
+                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             quick_return_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = quick_return_max_abs(work->phi);
@@ -312,9 +370,10 @@ static int quick_return_converged(const quick_return_options *options, const qui
             if (quick_return_factor_jacobian(options, work, report) != QUICK_RETURN_OK) {
                 return QUICK_RETURN_SINGULAR;
             }
+            if (!ill && !quick_return_would_flag(options, work, report)) break;
         }
         if (moved) {
-            quick_return_estimate(work, report);
+            quick_return_estimate_again(work, report);
         }
     }
     return report->cond <= options->max_cond ? QUICK_RETURN_OK : QUICK_RETURN_SINGULAR;
@@ -382,6 +441,7 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
         quick_return_predict(t, state);
     } else {
         quick_return_lu_init(&work->lu); /* the caller's workspace may hold anything */
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
     }
     report->status = quick_return_newton(options, p, t, state->q, work, report);
     report->fallbacks = quick_return_lu_fallbacks(&work->lu);
@@ -416,6 +476,9 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
     }
     report->flagged = quick_return_flagged(options, report, sum_q != sum_q ? (quick_return_real)NAN : nq,
                                            ndq, nddq);
+    work->norms[0] = nq; /* for the next point's Newton (converged) */
+    work->norms[1] = ndq;
+    work->norms[2] = nddq;
     state->t = t;
     state->started = 1;
     return QUICK_RETURN_OK;
