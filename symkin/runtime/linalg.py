@@ -47,12 +47,6 @@ class Factors:
         """Whether inverse_norm1 is exact rather than an estimate."""
         return bool(self.lu.shape[0] <= EXACT_INVERSE_UP_TO)
 
-    def distance1(self, other: Factors | SparseFactors) -> float:
-        """||A - B||_1 of the two matrices factored (NaN when one is not kept)."""
-        if self.matrix is None or not isinstance(other, Factors) or other.matrix is None:
-            return math.nan
-        return float(np.abs(self.matrix - other.matrix).sum(axis=0).max(initial=0.0))
-
     def inverse_norm1(self) -> float:
         """||Phi_q^-1||_1: exact up to EXACT_INVERSE_UP_TO coordinates (as the generated C
         computes it for small mechanisms), above that LAPACK's xGECON (Hager-Higham, the
@@ -88,12 +82,6 @@ class SparseFactors:
     matrix: Any = None  # Phi_q as a scipy.sparse matrix
 
     exact = False  # inverse_norm1 is an estimate (this size is above EXACT_INVERSE_UP_TO)
-
-    def distance1(self, other: Factors | SparseFactors) -> float:
-        """||A - B||_1 of the two matrices factored (NaN when one is not kept)."""
-        if self.matrix is None or not isinstance(other, SparseFactors) or other.matrix is None:
-            return math.nan
-        return float(abs(self.matrix - other.matrix).sum(axis=0).max())
 
     def inverse_norm1(self) -> float:
         """Estimate of ||Phi_q^-1||_1 (Hager-Higham, as the C solver runs it)."""
@@ -137,6 +125,14 @@ def factor_sparse(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], values
         return SparseFactors(None, 0.0)
     return SparseFactors(lu, _ratio(np.abs(lu.U.diagonal())), accuracy.norm1(values, cols, n),
                          matrix)
+
+
+def distance1(first: Factors | SparseFactors, second: Factors | SparseFactors) -> float:
+    """||A - B||_1 of the two matrices factored, dense or sparse alike (NaN when one is not
+    kept)."""
+    if first.matrix is None or second.matrix is None:
+        return math.nan
+    return float(abs(first.matrix - second.matrix).sum(axis=0).max())
 
 
 def factor_at(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> Factors | SparseFactors:

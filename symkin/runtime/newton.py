@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.runtime import accuracy
-from symkin.runtime.linalg import Factors, SparseFactors, factor_at
+from symkin.runtime.linalg import Factors, SparseFactors, distance1, factor_at
 from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.protocol import KinematicsKernel
 
@@ -140,7 +140,7 @@ def _estimate_again(before: Newton, after: Newton) -> Newton:
     """The estimate at ``after`` from the one at ``before`` where REESTIMATE_SHIFT allows it."""
     assert before.factors is not None and after.factors is not None
     if not after.factors.exact:
-        theta = before.inv_norm * after.factors.distance1(before.factors)
+        theta = before.inv_norm * distance1(after.factors, before.factors)
         if theta <= REESTIMATE_SHIFT:
             after.inv_norm, after.norm_a = before.inv_norm / (1.0 - theta), after.factors.norm1
             return after
