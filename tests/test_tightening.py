@@ -137,3 +137,93 @@ def test_c_estimate_at_tightened_points_bounds_the_exact_norm(tongs10: symkin.Sy
         ratios.append(report.inv_norm / np.abs(np.linalg.inv(a)).sum(axis=0).max())
     assert min(ratios) >= 1 - 1e-12 and max(ratios) <= 1 / (1 - newton.REESTIMATE_SHIFT)
     assert max(ratios) > 1 + 1e-6  # the bound was used, not a new estimate
+
+
+T_POINT = 0.3
+SHIFT = 8e-11  # within tol_phi (1e-10): Newton accepts the point at its first iterate
+LAST_X = 24  # x of the last rising bar a5 (bodies a1, b1, ..., a5, b5; x, y, phi each)
+
+
+def _displaced(kernel, along_worst: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The exact q of the 10-body tongs at T_POINT displaced so that max |Phi| is about SHIFT,
+    and that displacement. Moving one bar along x by SHIFT is a correction of SHIFT; the
+    column of Phi_q^-1 with the largest max entry, scaled to a residual of SHIFT, is a
+    correction as large as a residual of that size can ask for."""
+    q_exact = closed_form(5, np.array([T_POINT]))[0][0]
+    if along_worst:
+        inverse = np.linalg.inv(kernel.phi_q(q_exact, T_POINT))
+        displacement = SHIFT * inverse[:, np.argmax(np.abs(inverse).max(axis=0))]
+    else:
+        displacement = np.zeros(q_exact.size)
+        displacement[LAST_X] = SHIFT
+    return q_exact + displacement, displacement
+
+
+def _python_point(kernel, q0: np.ndarray) -> tuple[newton.Newton, tuple[float, float, float]]:
+    q, dq, ddq = (x[0] for x in closed_form(5, np.array([T_POINT])))
+    previous = tuple(float(np.abs(x).max()) for x in (q, dq, ddq))
+    options = symkin.runtime.options.defaults("double")
+    result = newton.newton(kernel, q0, T_POINT, np.array(kernel.p_values), options,
+                           previous=previous)
+    return result, previous
+
+
+def test_a_small_correction_clears_a_point_without_a_step(tongs10: symkin.System,
+                                                          tmp_path: Path) -> None:
+    """The residual's bound s r would flag the point; the correction Phi_q^-1 Phi, solved
+    for, is SHIFT, which the targets allow: the point is kept as Newton left it (no extra
+    step) and not flagged, on both backends."""
+    from symkin.runtime import accuracy
+
+    for backend in ("numpy", "c"):
+        kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+        q0, _ = _displaced(kernel, along_worst=False)
+        if backend == "numpy":
+            result, previous = _python_point(kernel, q0)
+            assert result.status == 0 and result.iterations == 0
+            assert np.array_equal(result.q, q0)
+            assert result.correction == pytest.approx(SHIFT, rel=1e-3)
+            unit = accuracy.UNIT_ROUNDOFF["double"]
+            options = symkin.runtime.options.defaults("double")
+            assert accuracy.flagged_norms(result.inv_norm, result.norm_a, result.residual,
+                                          q0.size, *previous, options, unit)  # by s r
+            point = newton.kinematics(kernel, result, T_POINT, np.array(kernel.p_values),
+                                      options)
+            assert point is not None and not point.flagged
+        else:
+            report, q = _c_first_point(kernel, q0)
+            assert report.iterations == 0 and not report.flagged
+            assert np.array_equal(q, q0)
+
+
+def test_a_large_correction_is_stepped(tongs10: symkin.System, tmp_path: Path) -> None:
+    """A residual of the same size along the worst column of Phi_q^-1: the correction is
+    much larger than SHIFT, so Newton steps on and q comes to the exact one."""
+    for backend in ("numpy", "c"):
+        kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+        q0, displacement = _displaced(kernel, along_worst=True)
+        assert np.abs(kernel.phi(q0, T_POINT)).max() <= 1.2 * SHIFT
+        q_exact = q0 - displacement
+        if backend == "numpy":
+            result, _ = _python_point(kernel, q0)
+            assert result.status == 0 and result.iterations == 0
+            q = result.q
+        else:
+            report, q = _c_first_point(kernel, q0)
+            assert report.iterations == 0 and not report.flagged
+        moved = np.abs(q0 - q_exact).max()
+        assert moved > 5 * SHIFT
+        assert np.abs(q - q_exact).max() < 1e-3 * moved
+
+
+def _c_first_point(kernel, q0: np.ndarray):
+    """One C solve_step from q0 as a first point (no predictor): its report and q."""
+    ffi, lib, name, n = kernel.ffi, kernel.lib, kernel.name, kernel.nq
+    options, state = ffi.new(f"{name}_options *"), ffi.new(f"{name}_state *")
+    work, report = ffi.new(f"{name}_workspace *"), ffi.new(f"{name}_report *")
+    getattr(lib, f"{name}_default_options")(options)
+    p = ffi.new(f"{name}_real[]", list(kernel.p_values))
+    state.q[0:n] = list(q0)
+    state.started = 0
+    assert getattr(lib, f"{name}_solve_step")(options, p, T_POINT, state, work, report) == 0
+    return report, np.array(ffi.unpack(state.q, n))

@@ -9,10 +9,14 @@ both backends flag the same points.
 The error model, with u the unit roundoff and s = ||Phi_q^-1||_1 / sqrt(N) (max norms of
 vectors; near a singularity the 1-norm sums the null vector over about N entries, where one
 coordinate's error sees only its share):
-    e_q   = s max(r, u (1 + |q|))                  the residual r, or the rounding of Phi
+    e_q   = max(c, s u (1 + |q|))                  the residual's share, or the rounding of Phi
     e_dq  = s (u |dq| + e_q max(1, |dq|))          the solve's rounding, and Phi_q moved by e_q
     e_ddq = s (u |ddq| + e_q (|ddq| + |dq|^2) + 2 e_dq max(1, |dq|))
 each times SAFETY; a point is flagged when one of them exceeds its target times max(1, |x|).
+c is the error of q the residual r leaves: max |Phi_q^-1 Phi|, the size of the Newton
+correction, where it was solved for (runtime.newton does so before it iterates on to avoid a
+flag), else the bound s r. The correction is the actual error where the bound is the worst
+case: on the 301-body chain of loops of bench/scaling_limit.py it is a tenth of s r (median).
 The errors of a nearly singular Phi_q lie along its null direction and are amplified by s at
 each stage (position into velocity, velocity into acceleration), which is what the chain of
 parallelogram four-bars shows near its singular configuration (tests/test_edges_*.py).
@@ -76,28 +80,32 @@ def norm1(nz: Array, cols: NDArray[np.intp], n: int) -> float:
 
 
 def errors(inv_norm: float, residual: float, n: int, nq: float, ndq: float, nddq: float,
-           unit: float) -> tuple[float, float, float]:
+           unit: float, correction: float = math.nan) -> tuple[float, float, float]:
     """The estimated errors of q, dq and ddq at a solved point (the model of the docstring),
-    from the max norms nq, ndq, nddq of q, dq, ddq (N of them each)."""
+    from the max norms nq, ndq, nddq of q, dq, ddq (N of them each); ``correction``: max
+    |Phi_q^-1 Phi| where it was solved for, NaN where not."""
     s = inv_norm / math.sqrt(n)
-    e_q = s * max(residual, unit * (1.0 + nq))
+    left = correction if correction >= 0 else s * residual
+    e_q = max(left, s * unit * (1.0 + nq))
     e_dq = s * (unit * ndq + e_q * max(1.0, ndq))
     e_ddq = s * (unit * nddq + e_q * (nddq + ndq * ndq) + 2.0 * e_dq * max(1.0, ndq))
     return SAFETY * e_q, SAFETY * e_dq, SAFETY * e_ddq
 
 
 def flagged(inv_norm: float, norm_a: float, residual: float, q: Array, dq: Array, ddq: Array,
-            options: Options, unit: float) -> bool:
+            options: Options, unit: float, correction: float = math.nan) -> bool:
     """True when the estimated error of q, dq or ddq misses its target (options.target_*)."""
     nq, ndq, nddq = (float(np.abs(v).max(initial=0.0)) for v in (q, dq, ddq))
-    return flagged_norms(inv_norm, norm_a, residual, q.size, nq, ndq, nddq, options, unit)
+    return flagged_norms(inv_norm, norm_a, residual, q.size, nq, ndq, nddq, options, unit,
+                         correction)
 
 
 def flagged_norms(inv_norm: float, norm_a: float, residual: float, n: int, nq: float, ndq: float,
-                  nddq: float, options: Options, unit: float) -> bool:
+                  nddq: float, options: Options, unit: float,
+                  correction: float = math.nan) -> bool:
     """flagged, from the max norms of q, dq and ddq (N of them each)."""
     if not math.isfinite(inv_norm * norm_a):
         return True
-    e_q, e_dq, e_ddq = errors(inv_norm, residual, n, nq, ndq, nddq, unit)
+    e_q, e_dq, e_ddq = errors(inv_norm, residual, n, nq, ndq, nddq, unit, correction)
     return (e_q > options.target_q * max(1.0, nq) or e_dq > options.target_dq * max(1.0, ndq)
             or e_ddq > options.target_ddq * max(1.0, nddq))

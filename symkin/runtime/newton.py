@@ -30,7 +30,8 @@ An exact norm is always made again."""
 @dataclass
 class Newton:
     """The outcome of Newton-Raphson at one time point; at a converged point also the estimate
-    of ||Phi_q^-1||_1 and ||Phi_q||_1 (runtime.accuracy)."""
+    of ||Phi_q^-1||_1 and ||Phi_q||_1 and, where it was solved for, max |Phi_q^-1 Phi| at q
+    (runtime.accuracy)."""
 
     q: Array
     status: int
@@ -39,6 +40,7 @@ class Newton:
     factors: Factors | SparseFactors | None
     inv_norm: float = math.nan
     norm_a: float = math.nan
+    correction: float = math.nan
 
     @property
     def cond(self) -> float:
@@ -97,33 +99,41 @@ def _estimate(result: Newton) -> Newton:
 
 def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, options: Options,
                phi: Array, step: float, previous: tuple[float, float, float]) -> Newton:
-    """Estimate the condition at a converged point. Where it is high (above
-    options.tighten_cond), iterate on while the step still shrinks (each at most half the one
-    before: once it stalls it is rounding noise, which a nearly singular Phi_q would only
-    amplify along its null direction): q as exact as rounding allows. Where it is not, but
-    the error model would flag the point (with the last point's max |q|, |dq|, |ddq|:
-    ``previous``), iterate on until it would not (or the step stalls): a point is flagged only
-    for what iterations cannot fix. tighten_cond = inf: neither. Then estimate again. Above
-    options.max_cond the point counts as singular."""
+    """Estimate the condition at a converged point. Where the error model would flag the
+    point as Newton left it (with the last point's max |q|, |dq|, |ddq|: ``previous``), solve
+    for the Newton correction: its size is the error of q the residual leaves (to first
+    order), which judges the point instead of the model's bound from the residual
+    (runtime.accuracy). Where the point would still be flagged, iterate on until it would not
+    (or the step stalls): a point is flagged only for what iterations cannot fix. Where the
+    condition is above options.tighten_cond, iterate on while the step still shrinks (each at
+    most half the one before: once it stalls it is rounding noise, which a nearly singular
+    Phi_q would only amplify along its null direction): q as exact as rounding allows.
+    tighten_cond = inf: neither. After a step, estimate again. Above options.max_cond the
+    point counts as singular."""
     result = _estimate(result)
     unit = accuracy.UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
     ill = result.cond > options.tighten_cond
 
-    def would_flag(residual: float) -> bool:
+    def would_flag(residual: float, correction: float = math.nan) -> bool:
         return residual > unit * (1.0 + previous[0]) and accuracy.flagged_norms(
-            result.inv_norm, result.norm_a, residual, result.q.size, *previous, options, unit)
+            result.inv_norm, result.norm_a, residual, result.q.size, *previous, options, unit,
+            correction)
 
     if ill or (options.tighten_cond < math.inf and would_flag(result.residual)):
         q, residual, factors = result.q, result.residual, result.factors
         assert factors is not None
+        correction = math.nan
         for _ in range(TIGHTEN_STEPS):
             delta = factors.solve(-phi)
             size = float(np.abs(delta).max(initial=0.0))
+            correction = size if math.isfinite(size) else math.nan
+            if not ill and not would_flag(residual, correction):
+                break
             if not 0 < size <= step / 2:
                 break
             q = q + delta
             phi = kernel.phi(q, t, p)
-            residual, step = float(np.abs(phi).max(initial=0.0)), size
+            residual, step, correction = float(np.abs(phi).max(initial=0.0)), size, math.nan
             factors = factor_at(kernel, q, t, p)
             if factors.pivot_ratio < options.min_pivot_ratio:
                 return Newton(q, SINGULAR, result.iterations, residual, factors)
@@ -131,6 +141,7 @@ def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
                 break
         if factors is not result.factors:
             result = _estimate_again(result, Newton(q, OK, result.iterations, residual, factors))
+        result.correction = correction
     if not result.cond <= options.max_cond:
         result.status = SINGULAR
     return result
@@ -160,7 +171,7 @@ def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
         return None
     unit = accuracy.UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
     flag = accuracy.flagged(result.inv_norm, result.norm_a, result.residual, q, dq, ddq,
-                            options, unit)
+                            options, unit, result.correction)
     return Point(q, dq, ddq, result.cond, flag)
 
 

@@ -17,7 +17,7 @@ void all_drivers_default_options(all_drivers_options *options)
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
     options->max_cond = 10000000.0;
-    options->tighten_cond = 10000.0;
+    options->tighten_cond = 10000000.0;
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
@@ -486,17 +486,21 @@ static all_drivers_real all_drivers_at_least_1(all_drivers_real x)
     return x > 1 ? x : 1;
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+ * the residual leaves is the size of the Newton correction where it was solved for
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int all_drivers_flagged(const all_drivers_options *options,
+                                const all_drivers_workspace *work,
                                 const all_drivers_report *report, all_drivers_real nq, all_drivers_real ndq,
                                 all_drivers_real nddq)
 {
     const all_drivers_real u = ALL_DRIVERS_UNIT_ROUNDOFF;
     const all_drivers_real s = report->inv_norm / sqrt((all_drivers_real)ALL_DRIVERS_NQ);
-    const all_drivers_real floor = u * (1 + nq);
+    const all_drivers_real rounding = s * u * (1 + nq);
+    const all_drivers_real left = work->correction >= 0 ? work->correction : s * report->residual;
     all_drivers_real e_q, e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
-    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * all_drivers_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * all_drivers_at_least_1(ndq));
     return ALL_DRIVERS_SAFETY * e_q > options->target_q * all_drivers_at_least_1(nq)
@@ -512,21 +516,25 @@ static int all_drivers_would_flag(const all_drivers_options *options,
 {
     const all_drivers_real *norms = work->norms;
     return report->residual > ALL_DRIVERS_UNIT_ROUNDOFF * (1 + norms[0])
-        && all_drivers_flagged(options, report, norms[0], norms[1], norms[2]);
+        && all_drivers_flagged(options, work, report, norms[0], norms[1], norms[2]);
 }
 
-/* At a converged point: estimate the condition. Where it is high (above
- * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
- * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
- * allows. Where it is not, but the error model would flag the point, Newton goes on until it
- * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
- * Then the estimate is made again. Above options->max_cond the point counts as singular. */
+/* At a converged point: estimate the condition. Where the error model would flag the point
+ * as Newton left it, solve for the Newton correction: its size is the error of q the residual
+ * leaves (to first order), which judges the point instead of the model's bound from the
+ * residual. Where the point would still be flagged, Newton goes on until it would not (or
+ * its step stalls): a point is flagged only for what iterations cannot fix. Where the
+ * condition is above options->tighten_cond, Newton goes on while its step still halves (a
+ * stalled step is rounding noise, which a nearly singular Phi_q would only amplify): q as
+ * exact as rounding allows. After a step the estimate is made again. Above
+ * options->max_cond the point counts as singular. */
 static int all_drivers_converged(const all_drivers_options *options, const all_drivers_real p[],
                                   all_drivers_real t, all_drivers_real q[], all_drivers_real step,
                                   all_drivers_workspace *work, all_drivers_report *report)
 {
     int i, extra, moved = 0, ill;
     all_drivers_estimate(work, report);
+    work->correction = -1;
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (all_drivers_real)INFINITY
@@ -536,6 +544,8 @@ static int all_drivers_converged(const all_drivers_options *options, const all_d
             for (i = 0; i < ALL_DRIVERS_NQ; ++i) work->phi[i] = -work->phi[i];
             all_drivers_lu_solve(&work->lu, work->phi);
             size = all_drivers_max_abs(work->phi);
+            work->correction = size - size == 0 ? size : -1;
+            if (!ill && !all_drivers_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < ALL_DRIVERS_NQ; ++i) q[i] += work->phi[i];
             if (!moved) { /* Phi_q where the estimate was made */
@@ -544,6 +554,7 @@ static int all_drivers_converged(const all_drivers_options *options, const all_d
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             all_drivers_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = all_drivers_max_abs(work->phi);
+            work->correction = -1;
             step = size;
             moved = 1;
             if (all_drivers_factor_jacobian(options, work, report) != ALL_DRIVERS_OK) {
@@ -653,8 +664,8 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
         report->status = ALL_DRIVERS_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = all_drivers_flagged(options, report, sum_q != sum_q ? (all_drivers_real)NAN : nq,
-                                           ndq, nddq);
+    report->flagged = all_drivers_flagged(options, work, report,
+                                           sum_q != sum_q ? (all_drivers_real)NAN : nq, ndq, nddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -30,8 +30,8 @@ typedef struct {
     int max_iterations;                /* Newton iterations per time step                */
     all_drivers_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     all_drivers_real max_cond;        /* ... or the condition estimate is above this     */
-    all_drivers_real tighten_cond;    /* above this, or where the point would be flagged, */
-                                       /* Newton goes on while its step halves           */
+    all_drivers_real tighten_cond;    /* above this, or where the point would be flagged */
+                                       /* by its Newton correction, Newton goes on       */
     all_drivers_real target_q;        /* flagged when the estimated error of q, dq or    */
     all_drivers_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     all_drivers_real target_ddq;
@@ -68,6 +68,7 @@ typedef struct {
     all_drivers_real shared[9]; /* sin, cos of the last iterate (all_drivers_phi_phi_q) */
     all_drivers_real nz_estimated[ALL_DRIVERS_NNZ]; /* Phi_q where the condition was estimated */
     all_drivers_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
+    all_drivers_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } all_drivers_workspace;
 
 /* Tolerances suited to the real type. */

@@ -17,7 +17,7 @@ void andrews_squeezer_default_options(andrews_squeezer_options *options)
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
     options->max_cond = 10000000.0;
-    options->tighten_cond = 10000.0;
+    options->tighten_cond = 10000000.0;
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
@@ -466,17 +466,21 @@ static andrews_squeezer_real andrews_squeezer_at_least_1(andrews_squeezer_real x
     return x > 1 ? x : 1;
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+ * the residual leaves is the size of the Newton correction where it was solved for
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
+                                const andrews_squeezer_workspace *work,
                                 const andrews_squeezer_report *report, andrews_squeezer_real nq, andrews_squeezer_real ndq,
                                 andrews_squeezer_real nddq)
 {
     const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
     const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
-    const andrews_squeezer_real floor = u * (1 + nq);
+    const andrews_squeezer_real rounding = s * u * (1 + nq);
+    const andrews_squeezer_real left = work->correction >= 0 ? work->correction : s * report->residual;
     andrews_squeezer_real e_q, e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
-    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * andrews_squeezer_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * andrews_squeezer_at_least_1(ndq));
     return ANDREWS_SQUEEZER_SAFETY * e_q > options->target_q * andrews_squeezer_at_least_1(nq)
@@ -492,21 +496,25 @@ static int andrews_squeezer_would_flag(const andrews_squeezer_options *options,
 {
     const andrews_squeezer_real *norms = work->norms;
     return report->residual > ANDREWS_SQUEEZER_UNIT_ROUNDOFF * (1 + norms[0])
-        && andrews_squeezer_flagged(options, report, norms[0], norms[1], norms[2]);
+        && andrews_squeezer_flagged(options, work, report, norms[0], norms[1], norms[2]);
 }
 
-/* At a converged point: estimate the condition. Where it is high (above
- * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
- * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
- * allows. Where it is not, but the error model would flag the point, Newton goes on until it
- * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
- * Then the estimate is made again. Above options->max_cond the point counts as singular. */
+/* At a converged point: estimate the condition. Where the error model would flag the point
+ * as Newton left it, solve for the Newton correction: its size is the error of q the residual
+ * leaves (to first order), which judges the point instead of the model's bound from the
+ * residual. Where the point would still be flagged, Newton goes on until it would not (or
+ * its step stalls): a point is flagged only for what iterations cannot fix. Where the
+ * condition is above options->tighten_cond, Newton goes on while its step still halves (a
+ * stalled step is rounding noise, which a nearly singular Phi_q would only amplify): q as
+ * exact as rounding allows. After a step the estimate is made again. Above
+ * options->max_cond the point counts as singular. */
 static int andrews_squeezer_converged(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
                                   andrews_squeezer_real t, andrews_squeezer_real q[], andrews_squeezer_real step,
                                   andrews_squeezer_workspace *work, andrews_squeezer_report *report)
 {
     int i, extra, moved = 0, ill;
     andrews_squeezer_estimate(work, report);
+    work->correction = -1;
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (andrews_squeezer_real)INFINITY
@@ -516,6 +524,8 @@ static int andrews_squeezer_converged(const andrews_squeezer_options *options, c
             for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) work->phi[i] = -work->phi[i];
             andrews_squeezer_lu_solve(&work->lu, work->phi);
             size = andrews_squeezer_max_abs(work->phi);
+            work->correction = size - size == 0 ? size : -1;
+            if (!ill && !andrews_squeezer_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) q[i] += work->phi[i];
             if (!moved) { /* Phi_q where the estimate was made */
@@ -524,6 +534,7 @@ static int andrews_squeezer_converged(const andrews_squeezer_options *options, c
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             andrews_squeezer_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = andrews_squeezer_max_abs(work->phi);
+            work->correction = -1;
             step = size;
             moved = 1;
             if (andrews_squeezer_factor_jacobian(options, work, report) != ANDREWS_SQUEEZER_OK) {
@@ -633,8 +644,8 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
         report->status = ANDREWS_SQUEEZER_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = andrews_squeezer_flagged(options, report, sum_q != sum_q ? (andrews_squeezer_real)NAN : nq,
-                                           ndq, nddq);
+    report->flagged = andrews_squeezer_flagged(options, work, report,
+                                           sum_q != sum_q ? (andrews_squeezer_real)NAN : nq, ndq, nddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -30,8 +30,8 @@ typedef struct {
     int max_iterations;                /* Newton iterations per time step                */
     andrews_squeezer_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     andrews_squeezer_real max_cond;        /* ... or the condition estimate is above this     */
-    andrews_squeezer_real tighten_cond;    /* above this, or where the point would be flagged, */
-                                       /* Newton goes on while its step halves           */
+    andrews_squeezer_real tighten_cond;    /* above this, or where the point would be flagged */
+                                       /* by its Newton correction, Newton goes on       */
     andrews_squeezer_real target_q;        /* flagged when the estimated error of q, dq or    */
     andrews_squeezer_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     andrews_squeezer_real target_ddq;
@@ -68,6 +68,7 @@ typedef struct {
     andrews_squeezer_real shared[14]; /* sin, cos of the last iterate (andrews_squeezer_phi_phi_q) */
     andrews_squeezer_real nz_estimated[ANDREWS_SQUEEZER_NNZ]; /* Phi_q where the condition was estimated */
     andrews_squeezer_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
+    andrews_squeezer_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } andrews_squeezer_workspace;
 
 /* Tolerances suited to the real type. */

@@ -17,7 +17,7 @@ void crank_slider_default_options(crank_slider_options *options)
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
     options->max_cond = 10000000.0;
-    options->tighten_cond = 10000.0;
+    options->tighten_cond = 10000000.0;
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
@@ -245,17 +245,21 @@ static crank_slider_real crank_slider_at_least_1(crank_slider_real x)
     return x > 1 ? x : 1;
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+ * the residual leaves is the size of the Newton correction where it was solved for
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int crank_slider_flagged(const crank_slider_options *options,
+                                const crank_slider_workspace *work,
                                 const crank_slider_report *report, crank_slider_real nq, crank_slider_real ndq,
                                 crank_slider_real nddq)
 {
     const crank_slider_real u = CRANK_SLIDER_UNIT_ROUNDOFF;
     const crank_slider_real s = report->inv_norm / sqrt((crank_slider_real)CRANK_SLIDER_NQ);
-    const crank_slider_real floor = u * (1 + nq);
+    const crank_slider_real rounding = s * u * (1 + nq);
+    const crank_slider_real left = work->correction >= 0 ? work->correction : s * report->residual;
     crank_slider_real e_q, e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
-    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * crank_slider_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * crank_slider_at_least_1(ndq));
     return CRANK_SLIDER_SAFETY * e_q > options->target_q * crank_slider_at_least_1(nq)
@@ -271,21 +275,25 @@ static int crank_slider_would_flag(const crank_slider_options *options,
 {
     const crank_slider_real *norms = work->norms;
     return report->residual > CRANK_SLIDER_UNIT_ROUNDOFF * (1 + norms[0])
-        && crank_slider_flagged(options, report, norms[0], norms[1], norms[2]);
+        && crank_slider_flagged(options, work, report, norms[0], norms[1], norms[2]);
 }
 
-/* At a converged point: estimate the condition. Where it is high (above
- * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
- * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
- * allows. Where it is not, but the error model would flag the point, Newton goes on until it
- * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
- * Then the estimate is made again. Above options->max_cond the point counts as singular. */
+/* At a converged point: estimate the condition. Where the error model would flag the point
+ * as Newton left it, solve for the Newton correction: its size is the error of q the residual
+ * leaves (to first order), which judges the point instead of the model's bound from the
+ * residual. Where the point would still be flagged, Newton goes on until it would not (or
+ * its step stalls): a point is flagged only for what iterations cannot fix. Where the
+ * condition is above options->tighten_cond, Newton goes on while its step still halves (a
+ * stalled step is rounding noise, which a nearly singular Phi_q would only amplify): q as
+ * exact as rounding allows. After a step the estimate is made again. Above
+ * options->max_cond the point counts as singular. */
 static int crank_slider_converged(const crank_slider_options *options, const crank_slider_real p[],
                                   crank_slider_real t, crank_slider_real q[], crank_slider_real step,
                                   crank_slider_workspace *work, crank_slider_report *report)
 {
     int i, extra, moved = 0, ill;
     crank_slider_estimate(work, report);
+    work->correction = -1;
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (crank_slider_real)INFINITY
@@ -295,6 +303,8 @@ static int crank_slider_converged(const crank_slider_options *options, const cra
             for (i = 0; i < CRANK_SLIDER_NQ; ++i) work->phi[i] = -work->phi[i];
             crank_slider_lu_solve(&work->lu, work->phi);
             size = crank_slider_max_abs(work->phi);
+            work->correction = size - size == 0 ? size : -1;
+            if (!ill && !crank_slider_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < CRANK_SLIDER_NQ; ++i) q[i] += work->phi[i];
             if (!moved) { /* Phi_q where the estimate was made */
@@ -303,6 +313,7 @@ static int crank_slider_converged(const crank_slider_options *options, const cra
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             crank_slider_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = crank_slider_max_abs(work->phi);
+            work->correction = -1;
             step = size;
             moved = 1;
             if (crank_slider_factor_jacobian(options, work, report) != CRANK_SLIDER_OK) {
@@ -412,8 +423,8 @@ int crank_slider_solve_step(const crank_slider_options *options, const crank_sli
         report->status = CRANK_SLIDER_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = crank_slider_flagged(options, report, sum_q != sum_q ? (crank_slider_real)NAN : nq,
-                                           ndq, nddq);
+    report->flagged = crank_slider_flagged(options, work, report,
+                                           sum_q != sum_q ? (crank_slider_real)NAN : nq, ndq, nddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -30,8 +30,8 @@ typedef struct {
     int max_iterations;                /* Newton iterations per time step                */
     crank_slider_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     crank_slider_real max_cond;        /* ... or the condition estimate is above this     */
-    crank_slider_real tighten_cond;    /* above this, or where the point would be flagged, */
-                                       /* Newton goes on while its step halves           */
+    crank_slider_real tighten_cond;    /* above this, or where the point would be flagged */
+                                       /* by its Newton correction, Newton goes on       */
     crank_slider_real target_q;        /* flagged when the estimated error of q, dq or    */
     crank_slider_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     crank_slider_real target_ddq;
@@ -68,6 +68,7 @@ typedef struct {
     crank_slider_real shared[4]; /* sin, cos of the last iterate (crank_slider_phi_phi_q) */
     crank_slider_real nz_estimated[CRANK_SLIDER_NNZ]; /* Phi_q where the condition was estimated */
     crank_slider_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
+    crank_slider_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } crank_slider_workspace;
 
 /* Tolerances suited to the real type. */

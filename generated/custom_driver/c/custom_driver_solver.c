@@ -17,7 +17,7 @@ void custom_driver_default_options(custom_driver_options *options)
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
     options->max_cond = 10000000.0;
-    options->tighten_cond = 10000.0;
+    options->tighten_cond = 10000000.0;
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
@@ -268,17 +268,21 @@ static custom_driver_real custom_driver_at_least_1(custom_driver_real x)
     return x > 1 ? x : 1;
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+ * the residual leaves is the size of the Newton correction where it was solved for
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int custom_driver_flagged(const custom_driver_options *options,
+                                const custom_driver_workspace *work,
                                 const custom_driver_report *report, custom_driver_real nq, custom_driver_real ndq,
                                 custom_driver_real nddq)
 {
     const custom_driver_real u = CUSTOM_DRIVER_UNIT_ROUNDOFF;
     const custom_driver_real s = report->inv_norm / sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
-    const custom_driver_real floor = u * (1 + nq);
+    const custom_driver_real rounding = s * u * (1 + nq);
+    const custom_driver_real left = work->correction >= 0 ? work->correction : s * report->residual;
     custom_driver_real e_q, e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
-    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * custom_driver_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * custom_driver_at_least_1(ndq));
     return CUSTOM_DRIVER_SAFETY * e_q > options->target_q * custom_driver_at_least_1(nq)
@@ -294,21 +298,25 @@ static int custom_driver_would_flag(const custom_driver_options *options,
 {
     const custom_driver_real *norms = work->norms;
     return report->residual > CUSTOM_DRIVER_UNIT_ROUNDOFF * (1 + norms[0])
-        && custom_driver_flagged(options, report, norms[0], norms[1], norms[2]);
+        && custom_driver_flagged(options, work, report, norms[0], norms[1], norms[2]);
 }
 
-/* At a converged point: estimate the condition. Where it is high (above
- * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
- * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
- * allows. Where it is not, but the error model would flag the point, Newton goes on until it
- * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
- * Then the estimate is made again. Above options->max_cond the point counts as singular. */
+/* At a converged point: estimate the condition. Where the error model would flag the point
+ * as Newton left it, solve for the Newton correction: its size is the error of q the residual
+ * leaves (to first order), which judges the point instead of the model's bound from the
+ * residual. Where the point would still be flagged, Newton goes on until it would not (or
+ * its step stalls): a point is flagged only for what iterations cannot fix. Where the
+ * condition is above options->tighten_cond, Newton goes on while its step still halves (a
+ * stalled step is rounding noise, which a nearly singular Phi_q would only amplify): q as
+ * exact as rounding allows. After a step the estimate is made again. Above
+ * options->max_cond the point counts as singular. */
 static int custom_driver_converged(const custom_driver_options *options, const custom_driver_real p[],
                                   custom_driver_real t, custom_driver_real q[], custom_driver_real step,
                                   custom_driver_workspace *work, custom_driver_report *report)
 {
     int i, extra, moved = 0, ill;
     custom_driver_estimate(work, report);
+    work->correction = -1;
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (custom_driver_real)INFINITY
@@ -318,6 +326,8 @@ static int custom_driver_converged(const custom_driver_options *options, const c
             for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) work->phi[i] = -work->phi[i];
             custom_driver_lu_solve(&work->lu, work->phi);
             size = custom_driver_max_abs(work->phi);
+            work->correction = size - size == 0 ? size : -1;
+            if (!ill && !custom_driver_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) q[i] += work->phi[i];
             if (!moved) { /* Phi_q where the estimate was made */
@@ -326,6 +336,7 @@ static int custom_driver_converged(const custom_driver_options *options, const c
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             custom_driver_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = custom_driver_max_abs(work->phi);
+            work->correction = -1;
             step = size;
             moved = 1;
             if (custom_driver_factor_jacobian(options, work, report) != CUSTOM_DRIVER_OK) {
@@ -435,8 +446,8 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
         report->status = CUSTOM_DRIVER_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = custom_driver_flagged(options, report, sum_q != sum_q ? (custom_driver_real)NAN : nq,
-                                           ndq, nddq);
+    report->flagged = custom_driver_flagged(options, work, report,
+                                           sum_q != sum_q ? (custom_driver_real)NAN : nq, ndq, nddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

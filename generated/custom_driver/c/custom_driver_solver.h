@@ -30,8 +30,8 @@ typedef struct {
     int max_iterations;                /* Newton iterations per time step                */
     custom_driver_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     custom_driver_real max_cond;        /* ... or the condition estimate is above this     */
-    custom_driver_real tighten_cond;    /* above this, or where the point would be flagged, */
-                                       /* Newton goes on while its step halves           */
+    custom_driver_real tighten_cond;    /* above this, or where the point would be flagged */
+                                       /* by its Newton correction, Newton goes on       */
     custom_driver_real target_q;        /* flagged when the estimated error of q, dq or    */
     custom_driver_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     custom_driver_real target_ddq;
@@ -68,6 +68,7 @@ typedef struct {
     custom_driver_real shared[7]; /* sin, cos of the last iterate (custom_driver_phi_phi_q) */
     custom_driver_real nz_estimated[CUSTOM_DRIVER_NNZ]; /* Phi_q where the condition was estimated */
     custom_driver_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
+    custom_driver_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } custom_driver_workspace;
 
 /* Tolerances suited to the real type. */

@@ -17,7 +17,7 @@ void four_bar_default_options(four_bar_options *options)
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
     options->max_cond = 10000000.0;
-    options->tighten_cond = 10000.0;
+    options->tighten_cond = 10000000.0;
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
@@ -260,17 +260,21 @@ static four_bar_real four_bar_at_least_1(four_bar_real x)
     return x > 1 ? x : 1;
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+ * the residual leaves is the size of the Newton correction where it was solved for
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int four_bar_flagged(const four_bar_options *options,
+                                const four_bar_workspace *work,
                                 const four_bar_report *report, four_bar_real nq, four_bar_real ndq,
                                 four_bar_real nddq)
 {
     const four_bar_real u = FOUR_BAR_UNIT_ROUNDOFF;
     const four_bar_real s = report->inv_norm / sqrt((four_bar_real)FOUR_BAR_NQ);
-    const four_bar_real floor = u * (1 + nq);
+    const four_bar_real rounding = s * u * (1 + nq);
+    const four_bar_real left = work->correction >= 0 ? work->correction : s * report->residual;
     four_bar_real e_q, e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
-    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * four_bar_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * four_bar_at_least_1(ndq));
     return FOUR_BAR_SAFETY * e_q > options->target_q * four_bar_at_least_1(nq)
@@ -286,21 +290,25 @@ static int four_bar_would_flag(const four_bar_options *options,
 {
     const four_bar_real *norms = work->norms;
     return report->residual > FOUR_BAR_UNIT_ROUNDOFF * (1 + norms[0])
-        && four_bar_flagged(options, report, norms[0], norms[1], norms[2]);
+        && four_bar_flagged(options, work, report, norms[0], norms[1], norms[2]);
 }
 
-/* At a converged point: estimate the condition. Where it is high (above
- * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
- * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
- * allows. Where it is not, but the error model would flag the point, Newton goes on until it
- * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
- * Then the estimate is made again. Above options->max_cond the point counts as singular. */
+/* At a converged point: estimate the condition. Where the error model would flag the point
+ * as Newton left it, solve for the Newton correction: its size is the error of q the residual
+ * leaves (to first order), which judges the point instead of the model's bound from the
+ * residual. Where the point would still be flagged, Newton goes on until it would not (or
+ * its step stalls): a point is flagged only for what iterations cannot fix. Where the
+ * condition is above options->tighten_cond, Newton goes on while its step still halves (a
+ * stalled step is rounding noise, which a nearly singular Phi_q would only amplify): q as
+ * exact as rounding allows. After a step the estimate is made again. Above
+ * options->max_cond the point counts as singular. */
 static int four_bar_converged(const four_bar_options *options, const four_bar_real p[],
                                   four_bar_real t, four_bar_real q[], four_bar_real step,
                                   four_bar_workspace *work, four_bar_report *report)
 {
     int i, extra, moved = 0, ill;
     four_bar_estimate(work, report);
+    work->correction = -1;
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (four_bar_real)INFINITY
@@ -310,6 +318,8 @@ static int four_bar_converged(const four_bar_options *options, const four_bar_re
             for (i = 0; i < FOUR_BAR_NQ; ++i) work->phi[i] = -work->phi[i];
             four_bar_lu_solve(&work->lu, work->phi);
             size = four_bar_max_abs(work->phi);
+            work->correction = size - size == 0 ? size : -1;
+            if (!ill && !four_bar_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < FOUR_BAR_NQ; ++i) q[i] += work->phi[i];
             if (!moved) { /* Phi_q where the estimate was made */
@@ -318,6 +328,7 @@ static int four_bar_converged(const four_bar_options *options, const four_bar_re
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             four_bar_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = four_bar_max_abs(work->phi);
+            work->correction = -1;
             step = size;
             moved = 1;
             if (four_bar_factor_jacobian(options, work, report) != FOUR_BAR_OK) {
@@ -427,8 +438,8 @@ int four_bar_solve_step(const four_bar_options *options, const four_bar_real p[]
         report->status = FOUR_BAR_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = four_bar_flagged(options, report, sum_q != sum_q ? (four_bar_real)NAN : nq,
-                                           ndq, nddq);
+    report->flagged = four_bar_flagged(options, work, report,
+                                           sum_q != sum_q ? (four_bar_real)NAN : nq, ndq, nddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

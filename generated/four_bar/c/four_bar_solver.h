@@ -30,8 +30,8 @@ typedef struct {
     int max_iterations;                /* Newton iterations per time step                */
     four_bar_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     four_bar_real max_cond;        /* ... or the condition estimate is above this     */
-    four_bar_real tighten_cond;    /* above this, or where the point would be flagged, */
-                                       /* Newton goes on while its step halves           */
+    four_bar_real tighten_cond;    /* above this, or where the point would be flagged */
+                                       /* by its Newton correction, Newton goes on       */
     four_bar_real target_q;        /* flagged when the estimated error of q, dq or    */
     four_bar_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     four_bar_real target_ddq;
@@ -68,6 +68,7 @@ typedef struct {
     four_bar_real shared[6]; /* sin, cos of the last iterate (four_bar_phi_phi_q) */
     four_bar_real nz_estimated[FOUR_BAR_NNZ]; /* Phi_q where the condition was estimated */
     four_bar_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
+    four_bar_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } four_bar_workspace;
 
 /* Tolerances suited to the real type. */

@@ -17,7 +17,7 @@ void quick_return_default_options(quick_return_options *options)
     options->max_iterations = 25;
     options->min_pivot_ratio = 1e-10;
     options->max_cond = 10000000.0;
-    options->tighten_cond = 10000.0;
+    options->tighten_cond = 10000000.0;
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
@@ -307,17 +307,21 @@ static quick_return_real quick_return_at_least_1(quick_return_real x)
     return x > 1 ? x : 1;
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. */
+/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+ * the residual leaves is the size of the Newton correction where it was solved for
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int quick_return_flagged(const quick_return_options *options,
+                                const quick_return_workspace *work,
                                 const quick_return_report *report, quick_return_real nq, quick_return_real ndq,
                                 quick_return_real nddq)
 {
     const quick_return_real u = QUICK_RETURN_UNIT_ROUNDOFF;
     const quick_return_real s = report->inv_norm / sqrt((quick_return_real)QUICK_RETURN_NQ);
-    const quick_return_real floor = u * (1 + nq);
+    const quick_return_real rounding = s * u * (1 + nq);
+    const quick_return_real left = work->correction >= 0 ? work->correction : s * report->residual;
     quick_return_real e_q, e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
-    e_q = s * (report->residual > floor ? report->residual : floor);
+    e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * quick_return_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * quick_return_at_least_1(ndq));
     return QUICK_RETURN_SAFETY * e_q > options->target_q * quick_return_at_least_1(nq)
@@ -333,21 +337,25 @@ static int quick_return_would_flag(const quick_return_options *options,
 {
     const quick_return_real *norms = work->norms;
     return report->residual > QUICK_RETURN_UNIT_ROUNDOFF * (1 + norms[0])
-        && quick_return_flagged(options, report, norms[0], norms[1], norms[2]);
+        && quick_return_flagged(options, work, report, norms[0], norms[1], norms[2]);
 }
 
-/* At a converged point: estimate the condition. Where it is high (above
- * options->tighten_cond), Newton goes on while its step still halves (a stalled step is
- * rounding noise, which a nearly singular Phi_q would only amplify): q as exact as rounding
- * allows. Where it is not, but the error model would flag the point, Newton goes on until it
- * would not (or the step stalls): the point is flagged only for what iterations cannot fix.
- * Then the estimate is made again. Above options->max_cond the point counts as singular. */
+/* At a converged point: estimate the condition. Where the error model would flag the point
+ * as Newton left it, solve for the Newton correction: its size is the error of q the residual
+ * leaves (to first order), which judges the point instead of the model's bound from the
+ * residual. Where the point would still be flagged, Newton goes on until it would not (or
+ * its step stalls): a point is flagged only for what iterations cannot fix. Where the
+ * condition is above options->tighten_cond, Newton goes on while its step still halves (a
+ * stalled step is rounding noise, which a nearly singular Phi_q would only amplify): q as
+ * exact as rounding allows. After a step the estimate is made again. Above
+ * options->max_cond the point counts as singular. */
 static int quick_return_converged(const quick_return_options *options, const quick_return_real p[],
                                   quick_return_real t, quick_return_real q[], quick_return_real step,
                                   quick_return_workspace *work, quick_return_report *report)
 {
     int i, extra, moved = 0, ill;
     quick_return_estimate(work, report);
+    work->correction = -1;
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (quick_return_real)INFINITY
@@ -357,6 +365,8 @@ static int quick_return_converged(const quick_return_options *options, const qui
             for (i = 0; i < QUICK_RETURN_NQ; ++i) work->phi[i] = -work->phi[i];
             quick_return_lu_solve(&work->lu, work->phi);
             size = quick_return_max_abs(work->phi);
+            work->correction = size - size == 0 ? size : -1;
+            if (!ill && !quick_return_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < QUICK_RETURN_NQ; ++i) q[i] += work->phi[i];
             if (!moved) { /* Phi_q where the estimate was made */
@@ -365,6 +375,7 @@ static int quick_return_converged(const quick_return_options *options, const qui
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             quick_return_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = quick_return_max_abs(work->phi);
+            work->correction = -1;
             step = size;
             moved = 1;
             if (quick_return_factor_jacobian(options, work, report) != QUICK_RETURN_OK) {
@@ -474,8 +485,8 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
         report->status = QUICK_RETURN_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = quick_return_flagged(options, report, sum_q != sum_q ? (quick_return_real)NAN : nq,
-                                           ndq, nddq);
+    report->flagged = quick_return_flagged(options, work, report,
+                                           sum_q != sum_q ? (quick_return_real)NAN : nq, ndq, nddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -30,8 +30,8 @@ typedef struct {
     int max_iterations;                /* Newton iterations per time step                */
     quick_return_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     quick_return_real max_cond;        /* ... or the condition estimate is above this     */
-    quick_return_real tighten_cond;    /* above this, or where the point would be flagged, */
-                                       /* Newton goes on while its step halves           */
+    quick_return_real tighten_cond;    /* above this, or where the point would be flagged */
+                                       /* by its Newton correction, Newton goes on       */
     quick_return_real target_q;        /* flagged when the estimated error of q, dq or    */
     quick_return_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     quick_return_real target_ddq;
@@ -68,6 +68,7 @@ typedef struct {
     quick_return_real shared[6]; /* sin, cos of the last iterate (quick_return_phi_phi_q) */
     quick_return_real nz_estimated[QUICK_RETURN_NNZ]; /* Phi_q where the condition was estimated */
     quick_return_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
+    quick_return_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } quick_return_workspace;
 
 /* Tolerances suited to the real type. */
