@@ -8,12 +8,13 @@ a plain C program (gcc -O2) whose main calls ``<prefix>_solve_grid`` over t = k 
 is (instructions of 121 steps - instructions of 21 steps) / 100, so set-up and the first
 assembly cancel. Instruction counts do not depend on the load of a shared machine, unlike
 times. dt is 1.5/20000 for an example (the textbook grid), 0.001 for a family.
-``--tighten-cond C`` replaces the solver's default ``tighten_cond`` (``inf``: Newton is never
-tightened at ill-conditioned points, so every step does the same work at every size).
+``--tighten-cond C`` replaces the solver's default ``tighten_cond`` (``inf``: no extra Newton
+iterations at all, so every step does the same work at every size).
 """
 
 from __future__ import annotations
 
+import math
 import re
 import subprocess
 import sys
@@ -91,7 +92,8 @@ def main() -> int:
     args = sys.argv[1:]
     tighten_cond = None
     if args[:1] == ["--tighten-cond"]:
-        tighten_cond = {"inf": "INFINITY"}.get(args[1], repr(float(args[1])))
+        value = float(args[1])  # a C literal: INFINITY for inf (any spelling)
+        tighten_cond = "INFINITY" if math.isinf(value) else repr(value)
         args = args[2:]
     for spec in args or ["crank_slider"]:
         name, nq, count = per_step(spec, tighten_cond)

@@ -14,8 +14,7 @@ machine); peak memory is the largest resident set of the child or of any compile
 it ran (getrusage maxrss). The q of both families is checked against their closed forms
 (largest error over the 2001-point grid; "flagged": the share of its points flagged).
 ``--tighten-cond C`` solves with that ``Options.tighten_cond`` instead of the default (``inf``:
-no extra Newton iterations at ill-conditioned points, so a step does the same work at every
-size; the long tongs are ill-conditioned enough to be tightened by default).
+no extra Newton iterations at all, so a step does the same work at every size).
 """
 
 from __future__ import annotations

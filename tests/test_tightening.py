@@ -19,7 +19,8 @@ import numpy as np
 import pytest
 
 import symkin
-from symkin.runtime import linalg, newton
+from symkin.runtime import accuracy, linalg, newton
+from symkin.runtime.options import defaults
 from symkin.spec import validate as model
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
@@ -162,58 +163,54 @@ def _displaced(kernel, along_worst: bool) -> tuple[np.ndarray, np.ndarray]:
 def _python_point(kernel, q0: np.ndarray) -> tuple[newton.Newton, tuple[float, float, float]]:
     q, dq, ddq = (x[0] for x in closed_form(5, np.array([T_POINT])))
     previous = tuple(float(np.abs(x).max()) for x in (q, dq, ddq))
-    options = symkin.runtime.options.defaults("double")
-    result = newton.newton(kernel, q0, T_POINT, np.array(kernel.p_values), options,
+    result = newton.newton(kernel, q0, T_POINT, np.array(kernel.p_values), defaults("double"),
                            previous=previous)
     return result, previous
 
 
-def test_a_small_correction_clears_a_point_without_a_step(tongs10: symkin.System,
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_a_small_correction_clears_a_point_without_a_step(tongs10: symkin.System, backend: str,
                                                           tmp_path: Path) -> None:
     """The residual's bound s r would flag the point; the correction Phi_q^-1 Phi, solved
     for, is SHIFT, which the targets allow: the point is kept as Newton left it (no extra
-    step) and not flagged, on both backends."""
-    from symkin.runtime import accuracy
-
-    for backend in ("numpy", "c"):
-        kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
-        q0, _ = _displaced(kernel, along_worst=False)
-        if backend == "numpy":
-            result, previous = _python_point(kernel, q0)
-            assert result.status == 0 and result.iterations == 0
-            assert np.array_equal(result.q, q0)
-            assert result.correction == pytest.approx(SHIFT, rel=1e-3)
-            unit = accuracy.UNIT_ROUNDOFF["double"]
-            options = symkin.runtime.options.defaults("double")
-            assert accuracy.flagged_norms(result.inv_norm, result.norm_a, result.residual,
-                                          q0.size, *previous, options, unit)  # by s r
-            point = newton.kinematics(kernel, result, T_POINT, np.array(kernel.p_values),
-                                      options)
-            assert point is not None and not point.flagged
-        else:
-            report, q = _c_first_point(kernel, q0)
-            assert report.iterations == 0 and not report.flagged
-            assert np.array_equal(q, q0)
+    step) and not flagged."""
+    kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+    q0, _ = _displaced(kernel, along_worst=False)
+    if backend == "c":
+        report, q = _c_first_point(kernel, q0)
+        assert report.iterations == 0 and not report.flagged
+        assert np.array_equal(q, q0)
+        return
+    result, previous = _python_point(kernel, q0)
+    assert result.status == 0 and result.iterations == 0
+    assert np.array_equal(result.q, q0)
+    assert result.correction == pytest.approx(SHIFT, rel=1e-3)
+    options = defaults("double")
+    assert accuracy.flagged_norms(result.inv_norm, result.norm_a, result.residual, q0.size,
+                                  *previous, options, accuracy.UNIT_ROUNDOFF["double"])  # by s r
+    point = newton.kinematics(kernel, result, T_POINT, np.array(kernel.p_values), options)
+    assert point is not None and not point.flagged
 
 
-def test_a_large_correction_is_stepped(tongs10: symkin.System, tmp_path: Path) -> None:
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_a_large_correction_is_stepped(tongs10: symkin.System, backend: str,
+                                       tmp_path: Path) -> None:
     """A residual of the same size along the worst column of Phi_q^-1: the correction is
     much larger than SHIFT, so Newton steps on and q comes to the exact one."""
-    for backend in ("numpy", "c"):
-        kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
-        q0, displacement = _displaced(kernel, along_worst=True)
-        assert np.abs(kernel.phi(q0, T_POINT)).max() <= 1.2 * SHIFT
-        q_exact = q0 - displacement
-        if backend == "numpy":
-            result, _ = _python_point(kernel, q0)
-            assert result.status == 0 and result.iterations == 0
-            q = result.q
-        else:
-            report, q = _c_first_point(kernel, q0)
-            assert report.iterations == 0 and not report.flagged
-        moved = np.abs(q0 - q_exact).max()
-        assert moved > 5 * SHIFT
-        assert np.abs(q - q_exact).max() < 1e-3 * moved
+    kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+    q0, displacement = _displaced(kernel, along_worst=True)
+    assert np.abs(kernel.phi(q0, T_POINT)).max() <= 1.2 * SHIFT
+    q_exact = q0 - displacement
+    if backend == "c":
+        report, q = _c_first_point(kernel, q0)
+        assert report.iterations == 0 and not report.flagged
+    else:
+        result, _ = _python_point(kernel, q0)
+        assert result.status == 0 and result.iterations == 0
+        q = result.q
+    moved = np.abs(q0 - q_exact).max()
+    assert moved > 5 * SHIFT
+    assert np.abs(q - q_exact).max() < 1e-3 * moved
 
 
 def _c_first_point(kernel, q0: np.ndarray):
