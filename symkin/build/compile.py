@@ -31,6 +31,7 @@ from symkin.build.toolchain import BACKENDS, resolve_backend
 from symkin.codegen import lower as codegen
 from symkin.codegen import render
 from symkin.codegen.cdef import from_headers as cdef_from_headers
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.errors import BuildError
 from symkin.runtime import kernel
 from symkin.symbolic.derivation import System
@@ -86,7 +87,7 @@ def compile(system: System, backend: str = "auto", *, real: str = "double", cse:
 
 def _compile_c(code: codegen.Code, cache: Path, compiler: list[str]) -> kernel.Kernel:
     files = render.render_sources(code)
-    files[resources.manifest_name(code.name)] = render.manifest(code, files)
+    files[manifest_name(code.name)] = render.manifest(code, files)
     return _compile_files(files, code.name, cache, compiler)
 
 
@@ -101,7 +102,7 @@ def from_sources(files: dict[str, str], cache_dir: str | Path | None = None) -> 
         BuildError: the files hold no symkin manifest, or the compiler failed.
         NoCompilerError: they are C and this machine has no C compiler.
     """
-    manifests = [name for name in files if name.endswith(resources.MANIFEST_SUFFIX)]
+    manifests = [name for name in files if name.endswith(MANIFEST_SUFFIX)]
     if len(manifests) != 1:
         raise BuildError(f"expected one symkin manifest among the files, found {len(manifests)}")
     meta = json.loads(files[manifests[0]])
@@ -109,7 +110,7 @@ def from_sources(files: dict[str, str], cache_dir: str | Path | None = None) -> 
     plain = all(isinstance(n, str) and Path(n).name == n and not n.startswith(".")
                 for n in files)
     if not (isinstance(name, str) and name.isidentifier() and plain
-            and manifests[0] == resources.manifest_name(name)
+            and manifests[0] == manifest_name(name)
             and set(files) == {*meta.get("files", {}), manifests[0]}):
         raise BuildError("the files are not one generated symkin folder (names, manifest and "
                          "file list must agree); send the folder symkin.compile built")
@@ -147,7 +148,7 @@ def _compile_files(files: dict[str, str], name: str, cache: Path, compiler: list
     _build_unless_verified(cache, folder, files, lambda build: _build_c(
         build, files, cdef, module_name, compiler, name))
     module = _import_extension(module_name, library)
-    meta = json.loads(files[resources.manifest_name(name)])
+    meta = json.loads(files[manifest_name(name)])
     return kernel.from_cffi(module.ffi, module.lib, meta, folder)
 
 
@@ -236,7 +237,7 @@ def _load_numpy(code: codegen.Code, cache: Path) -> kernel.Kernel:
     module_name = f"_symkin_{code.name}_py_{key[:20]}"
     folder = cache / module_name
     source = folder / f"{code.name}.py"
-    expected = {**files, resources.manifest_name(code.name): render.manifest(code, files)}
+    expected = {**files, manifest_name(code.name): render.manifest(code, files)}
     _build_unless_verified(cache, folder, expected, lambda build: render.write(code, build))
     return kernel.from_module(kernel.import_file(module_name, source, None), folder)
 

@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 from symkin import resources
 from symkin.build import toolchain
 from symkin.build.cache import discard, open_cache, sha256_of
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.runtime import kernel as kernel_module
 from symkin.runtime.kernel import Kernel
 
@@ -203,7 +204,7 @@ def _matches(entry: Any, key: str, options: Options) -> bool:
     return (isinstance(entry, dict) and entry.get("format") == FORMAT
             and entry.get("key") == key and entry.get("backend") == options.backend
             and isinstance(entry.get("files"), dict)
-            and any(str(name).endswith(resources.MANIFEST_SUFFIX) for name in entry["files"]))
+            and any(str(name).endswith(MANIFEST_SUFFIX) for name in entry["files"]))
 
 
 def _intact(folder: Path, files: dict[Any, Any], options: Options) -> bool:
@@ -217,7 +218,7 @@ def _intact(folder: Path, files: dict[Any, Any], options: Options) -> bool:
 
 def _manifest_matches(folder: Path, options: Options) -> bool:
     try:
-        manifest = next(folder.glob("*" + resources.MANIFEST_SUFFIX))
+        manifest = next(folder.glob("*" + MANIFEST_SUFFIX))
         meta = json.loads(manifest.read_text(encoding="utf-8"))
     except (OSError, ValueError, StopIteration):
         return False
@@ -272,7 +273,7 @@ def record(cache: Path, key: str, built: Kernel, outlines: Outlines | None = Non
 
 def _loaded_files(built: Kernel, folder: Path) -> list[str]:
     """The files ``kernel.load`` reads: the manifest and the module or extension."""
-    manifest = resources.manifest_name(built.name)
+    manifest = manifest_name(built.name)
     if built.backend == "numpy":
         return [manifest, f"{built.name}.py"]
     return [manifest, kernel_module.extension_file(folder).name]

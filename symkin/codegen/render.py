@@ -5,9 +5,9 @@ Every ``X.Y.j2`` in ``templates/<backend>/`` becomes one file of the generated f
 and any other ``X.Y.j2 -> <prefix>_X.Y`` (the solver runtime of the C backend). Templates
 whose name starts with ``_`` are partials and are not written out (the cffi declarations come
 from the rendered headers themselves, :mod:`symkin.codegen.cdef`). The folder also gets
-``manifest.json``: the files with their sha256, the op counts and the metadata a runtime
-needs. The output depends only on the input: the same mechanism gives the same bytes on every
-run and machine.
+``<prefix>_manifest.json`` (symkin.contract.manifest): the files with their sha256, the op
+counts and the metadata a runtime needs. The output depends only on the input: the same
+mechanism gives the same bytes on every run and machine.
 """
 
 from __future__ import annotations
@@ -24,8 +24,9 @@ from symkin import resources
 from symkin.codegen import backends, lu_code, norm_code
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
+from symkin.contract import options, status, tuning
+from symkin.contract.manifest import GENERATOR, MANIFEST_SUFFIX, Manifest, Metadata, manifest_name
 from symkin.errors import BuildError, UsageError
-from symkin.runtime import options as runtime_options
 from symkin.symbolic.derivation import System
 
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
@@ -132,7 +133,7 @@ def write(code: Code, out_dir: Path, force: bool = False) -> list[Path]:
     earlier output of this mechanism is replaced (files it no longer has are removed), and a
     file symkin did not write (or that was edited since) is never deleted."""
     files = render_sources(code)
-    manifest_file = resources.manifest_name(code.name)
+    manifest_file = manifest_name(code.name)
     files[manifest_file] = manifest(code, files)
     paths = [out_dir / name for name in files]
     try:
@@ -164,11 +165,11 @@ def _generated_here(folder: Path, prefix: str) -> tuple[set[str], set[str]]:
     file whose bytes differ from the recorded sha256, counts as not symkin's."""
     ours: set[str] = set()
     theirs: set[str] = set()
-    for path in sorted(folder.glob("*" + resources.MANIFEST_SUFFIX)):
+    for path in sorted(folder.glob("*" + MANIFEST_SUFFIX)):
         listed = _intact_files(folder, path)
         if listed is None:
             continue
-        owner = ours if path.name == resources.manifest_name(prefix) else theirs
+        owner = ours if path.name == manifest_name(prefix) else theirs
         owner.update(listed | {path.name})
     return ours, theirs
 
@@ -180,11 +181,11 @@ def _intact_files(folder: Path, manifest_path: Path) -> set[str] | None:
         data = json.loads(manifest_path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-    if not isinstance(data, dict) or data.get("generator") != "symkin":
+    if not isinstance(data, dict) or data.get("generator") != GENERATOR:
         return None
     listed = data.get("files")
     if not isinstance(listed, dict) or \
-            manifest_path.name != resources.manifest_name(str(data.get("name"))):
+            manifest_path.name != manifest_name(str(data.get("name"))):
         return None
     return {name for name, digest in listed.items()
             if isinstance(name, str) and Path(name).name == name
@@ -200,16 +201,16 @@ def _sha256_file(path: Path) -> str | None:
 
 def manifest(code: Code, files: dict[str, str]) -> str:
     """The manifest: file hashes, op counts and the metadata a runtime needs, as JSON."""
-    data = {
-        "generator": "symkin", "backend": code.backend, "real": code.real, "cse": code.cse,
-        "name": code.name, "spec_sha256": code.spec_sha256,
-        "files": {name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()},
-        "ops": code.ops, "ops_before_cse": code.ops_before_cse, **metadata(code),
-    }
+    data = Manifest(
+        generator=GENERATOR, backend=code.backend, real=code.real, cse=code.cse,
+        name=code.name, spec_sha256=code.spec_sha256,
+        files={name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()},
+        ops=code.ops, ops_before_cse=code.ops_before_cse, **metadata(code),
+    )
     return json.dumps(data, indent=1, sort_keys=True) + "\n"
 
 
-def metadata(code: Code) -> dict[str, Any]:
+def metadata(code: Code) -> Metadata:
     """What the runtime Kernel needs besides the compiled functions (plain JSON data)."""
     return {
         "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
@@ -263,7 +264,11 @@ def template_context(code: Code) -> dict[str, Any]:
         "norm1": (norm_code.norm1_context(code.pattern_cols, code.nq, code.constant_nz,
                                           literal, code.real)
                   if code.backend == "c" and not (lu and lu["style"] == "tables") else None),
+        # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
+        "option_fields": list(options.SOLVER_FIELDS),
+        "status": dict(status.CODES),
+        "shared_constants": {name: _c_number(value) for name, value in tuning.SHARED.items()},
     }
 
 
@@ -324,9 +329,14 @@ def _labels(code: Code, routine: str) -> list[str]:
 
 def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
     """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
-    options = runtime_options.defaults(code.real)
+    defaults = options.defaults(code.real)
     return {name: str(value) if isinstance(value, (int, bool)) else literal(value)
-            for name, value in vars(options).items()}
+            for name, value in vars(defaults).items()}
+
+
+def _c_number(value: float) -> str:
+    """The shortest text that reads back as ``value``: ``10``, ``0.05`` (cast where used)."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))
 
 
 def header_lines(code: Code, template: str, file_name: str) -> list[str]:

@@ -21,8 +21,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin import resources
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
+from symkin.contract.options import Options
 from symkin.runtime.csolver import GridSolver, SolverPool
-from symkin.runtime.options import Options
 
 Array = NDArray[np.float64]
 
@@ -259,8 +260,8 @@ def load(folder: str | Path, name: str | None = None) -> Kernel:
 
 def _manifest(folder: Path, name: str | None) -> Path:
     if name is not None:
-        return folder / resources.manifest_name(name)
-    found = sorted(folder.glob("*" + resources.MANIFEST_SUFFIX))
+        return folder / manifest_name(name)
+    found = sorted(folder.glob("*" + MANIFEST_SUFFIX))
     if len(found) != 1:
         raise FileNotFoundError(f"{folder} holds {len(found)} symkin manifests; name the "
                                 "mechanism to load")

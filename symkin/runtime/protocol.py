@@ -7,8 +7,8 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin.contract.options import Options
 from symkin.runtime.csolver import GridSolver
-from symkin.runtime.options import Options
 
 Array = NDArray[np.float64]
 
