@@ -14,8 +14,6 @@ import pytest
 import sympy as sp
 
 import symkin
-from symkin.symbolic import planar as constraints
-from symkin.symbolic import symbols as symbols_module
 
 MECHANISMS = Path(__file__).resolve().parent / "mechanisms"
 BACKENDS = ("numpy", "c")
@@ -44,10 +42,8 @@ class LambdifyKernel:
         self._phi_q = sp.lambdify(args, sp.Matrix(system.phi_q), "numpy")
         self._phi_t = sp.lambdify(args, system.phi_t, "numpy")
         self._gamma = sp.lambdify((system.q, system.dq, system.t, system.p), system.gamma, "numpy")
-        mech = system.mechanism
-        ctx = constraints.Context(mech, symbols_module.make_symbols(mech))
-        self.points = tuple((b, n) for b, body in mech.bodies.items() for n in body.points)
-        vectors = [ctx.vector(mech.bodies[b].points[n]) for b, n in self.points]
+        self.points = tuple((body, name) for body, name, _ in system.points)
+        vectors = [vector for _, _, vector in system.points]
         self._points = sp.lambdify((system.p,), sp.Matrix([[v[0], v[1]] for v in vectors])
                                    if vectors else sp.zeros(0, 2), "numpy")
 

@@ -22,8 +22,6 @@ from symkin.codegen import backends, sample, symbols
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbols import symbol_text
 from symkin.errors import BuildError
-from symkin.symbolic import planar as constraints
-from symkin.symbolic import symbols as symbols_module
 from symkin.symbolic.derivation import System
 
 REAL_TYPES = ("double", "float")
@@ -267,15 +265,12 @@ def _fused_expressions(prepared: dict[str, list[sp.Expr]]
 
 def point_names(system: System) -> tuple[tuple[str, str], ...]:
     """Every named point as (body, point), bodies and points in file order."""
-    return tuple((body_name, point) for body_name, body in system.mechanism.bodies.items()
-                 for point in body.points)
+    return tuple((body, name) for body, name, _ in system.points)
 
 
 def point_vectors(system: System) -> list[tuple[sp.Expr, sp.Expr]]:
     """The local vector s of every named point, as expressions of the parameters."""
-    ctx = constraints.Context(system.mechanism, symbols_module.make_symbols(system.mechanism))
-    # make_symbols creates equal symbols (same names and assumptions) to the System's.
-    return [tuple(ctx.local(body, point)) for body, point in point_names(system)]
+    return [tuple(vector) for _, _, vector in system.points]
 
 
 def _fused_order(prepared: dict[str, list[sp.Expr]], pattern: Sequence[tuple[int, int]],

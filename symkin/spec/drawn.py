@@ -24,11 +24,13 @@ from typing import Any
 import sympy as sp
 import yaml
 
+from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
+from symkin.pairs.fields import GROUND
+from symkin.pairs.kit import Joined, PairType
 from symkin.spec import constants, expressions
 from symkin.spec.schema import MechanismSpec
 
-GROUND = "ground"
 LAYOUTS = ("local", "drawn")
 # Joint points that should coincide may differ by this much, relative to the drawing's size.
 CLOSURE_TOLERANCE = 1e-6
@@ -218,6 +220,84 @@ class Drawing:
     def texts(self, vector: tuple[Q, Q]) -> list[Any]:
         return [self.context.tidy(vector[0]), self.context.tidy(vector[1])]
 
+    # -- what a pair module asks of the drawing (symkin.pairs.kit.Drawing) ------------------
+    def body(self, constraint: Mapping[str, Any], key: str, path: Path_) -> str:
+        """The body a constraint's ``key`` names; an error naming the known ones."""
+        body = constraint.get(key)
+        if body not in self.frames:
+            known = ", ".join(self.frames)
+            raise MechanismError(f"unknown body {body!r}", path + (key,),
+                                 f"Use one of: {known}.")
+        return str(body)
+
+    def point(self, body: str, raw: Any, path: Path_) -> tuple[Any, tuple[Q, Q]]:
+        """A point given by name (on ``body``) or by global coordinates: (local ref, global)."""
+        if isinstance(raw, str):
+            if raw not in self.points.get(body, {}):
+                known = ", ".join(self.points.get(body, {})) or "none"
+                raise MechanismError(f"body {body!r} has no point named {raw!r}", path,
+                                     f"Its points are: {known}; or give global coordinates "
+                                     "[x, y].")
+            point = self.points[body][raw]
+        else:
+            point = self.context.vector(raw, path)
+        if isinstance(raw, str) and body != GROUND:
+            return raw, point
+        return self.texts(self.local(body, point)), point
+
+    def joined(self, data: Mapping[str, Any], path: Path_,
+               keys: frozenset[str] = frozenset()) -> Joined:
+        """Bodies i and j and their shared point, written with at: or a global sA and sB."""
+        i, j = self.body(data, "i", path), self.body(data, "j", path)
+        if "at" in data:
+            if "sA" in data or "sB" in data:
+                raise MechanismError("give either at: or sA and sB, not both", path + ("at",))
+            at = data["at"]
+            if isinstance(at, str):
+                owners = [body for body in (i, j) if at in self.points.get(body, {})]
+                if not owners:
+                    raise MechanismError(f"neither {i!r} nor {j!r} has a point named {at!r}",
+                                         path + ("at",), "Name a point of one of the two "
+                                         "bodies, or give global coordinates [x, y].")
+                drawn = self.points[owners[0]][at]
+                a_raw = at if i in owners else [drawn[0].text, drawn[1].text]
+                b_raw = at if j in owners else [drawn[0].text, drawn[1].text]
+            else:
+                a_raw = b_raw = at
+            sA, A = self.point(i, a_raw, path + ("at",))
+            sB, B = self.point(j, b_raw, path + ("at",))
+        else:
+            for key in ("sA", "sB"):
+                if key not in data:
+                    raise MechanismError("the joint's point is missing", path + ("at",),
+                                         "Give at: POINT | [x, y] (or a global sA and sB).")
+            sA, A = self.point(i, data["sA"], path + ("sA",))
+            sB, B = self.point(j, data["sB"], path + ("sB",))
+        local = {key: data[key] for key in ("type", "name", "i", "j") if key in data}
+        local.update(sA=sA, sB=sB)
+        return Joined(local, i, j, (A[0].value, A[1].value), (B[0].value, B[1].value))
+
+    def slide_normal(self, joined: Joined, data: Mapping[str, Any],
+                     path: Path_) -> tuple[list[Any], float]:
+        """The slide's normal v (the drawn axis turned by +90 degrees, in body j's frame) and
+        how far A lies off the slide through B."""
+        if "axis" not in data:
+            raise MechanismError(f"a {data.get('type')} joint needs axis: [dx, dy]",
+                                 path + ("axis",), "Give the sliding direction as drawn, "
+                                 "e.g. axis: [1, 0].")
+        dx, dy = self.context.vector(data["axis"], path + ("axis",))
+        length = math.hypot(dx.value, dy.value)
+        if length == 0:
+            raise MechanismError("the axis is zero", path + ("axis",), "Give a non-zero "
+                                 "direction, e.g. [1, 0].")
+        (ax, ay), (bx, by) = joined.A, joined.B
+        gap = abs((bx - ax) * -dy.value + (by - ay) * dx.value) / length
+        return self.texts(_to_frame(_neg(dy), dx, self.frames[joined.j].angle)), gap
+
+    def relative_angle(self, i: str, j: str) -> Any:
+        """The angle of body i's frame less body j's, as drawn (a prismatic pair's phi0)."""
+        return self.context.tidy(_sub(self.frames[i].angle, self.frames[j].angle))
+
     def size(self) -> float:
         """The drawing's largest coordinate magnitude (at least 1): the closure scale."""
         values = [abs(c.value) for pts in self.points.values() for p in pts.values() for c in p]
@@ -225,11 +305,6 @@ class Drawing:
 
 
 # ----- the local form ------------------------------------------------------------------------
-
-_PAIR_KEYS = {"revolute": set(), "prismatic": {"axis"}, "pin_slot": {"axis"}}
-_DRIVER_POINTS = {"displacement": ("sA", "sB"), "displacement_local": ("sA", "sB"),
-                  "slide": ("sA", "sB"), "trajectory": ("sB",)}
-
 
 def layout_of(data: Any) -> str:
     """The document's layout ('local' when the key is absent); an error for another value."""
@@ -253,15 +328,15 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
                               "points": {name: drawing.texts(drawing.local(body, point))
                                          for name, point in drawing.points[body].items()}}
                        for body in drawing.frames if body != GROUND}
-    joints, residuals = [], []
-    for index, joint in enumerate(_items(data, "joints")):
-        converted, residual = _joint(drawing, joint, ("joints", index))
-        joints.append(converted)
-        if residual is not None:
-            residuals.append((index, joint, residual))
-    local["joints"] = joints
-    local["drivers"] = [_driver(drawing, driver, ("drivers", index))
-                        for index, driver in enumerate(_items(data, "drivers"))]
+    residuals = []
+    for section in pairs.SECTIONS:
+        converted = []
+        for index, item in enumerate(_items(data, section)):
+            item_local, residual = _constraint(drawing, item, (section, index))
+            converted.append(item_local)
+            if residual is not None:
+                residuals.append((index, item, residual))
+        local[section] = converted
     _check_closure(drawing, residuals)
     return local
 
@@ -273,116 +348,42 @@ def _items(data: Mapping[str, Any], section: str) -> list[Any]:
     return items
 
 
-def _body(drawing: Drawing, constraint: Mapping[str, Any], key: str, path: Path_) -> str:
-    body = constraint.get(key)
-    if body not in drawing.frames:
-        known = ", ".join(drawing.frames)
-        raise MechanismError(f"unknown body {body!r}", path + (key,), f"Use one of: {known}.")
-    return str(body)
-
-
-def _point(drawing: Drawing, body: str, raw: Any, path: Path_) -> tuple[Any, tuple[Q, Q]]:
-    """A point given by name (on ``body``) or by global coordinates: (local ref, global)."""
-    if isinstance(raw, str):
-        if raw not in drawing.points.get(body, {}):
-            known = ", ".join(drawing.points.get(body, {})) or "none"
-            raise MechanismError(f"body {body!r} has no point named {raw!r}", path,
-                                 f"Its points are: {known}; or give global coordinates [x, y].")
-        point = drawing.points[body][raw]
-    else:
-        point = drawing.context.vector(raw, path)
-    if isinstance(raw, str) and body != GROUND:
-        return raw, point
-    return drawing.texts(drawing.local(body, point)), point
-
-
-def _pair_points(drawing: Drawing, pair: Mapping[str, Any], i: str, j: str,
-                 path: Path_) -> tuple[Any, Any, tuple[Q, Q], tuple[Q, Q]]:
-    """sA, sB (local refs) and A, B (global) of a joint written with at: or with sA and sB."""
-    if "at" in pair:
-        if "sA" in pair or "sB" in pair:
-            raise MechanismError("give either at: or sA and sB, not both", path + ("at",))
-        at = pair["at"]
-        if isinstance(at, str):
-            owners = [body for body in (i, j) if at in drawing.points.get(body, {})]
-            if not owners:
-                raise MechanismError(f"neither {i!r} nor {j!r} has a point named {at!r}",
-                                     path + ("at",), "Name a point of one of the two bodies, "
-                                     "or give global coordinates [x, y].")
-            a_raw = at if i in owners else drawing.points[owners[0]][at]
-            b_raw = at if j in owners else drawing.points[owners[0]][at]
-            sA, A = _point(drawing, i, _raw(a_raw), path + ("at",))
-            sB, B = _point(drawing, j, _raw(b_raw), path + ("at",))
-            return sA, sB, A, B
-        sA, A = _point(drawing, i, at, path + ("at",))
-        sB, B = _point(drawing, j, at, path + ("at",))
-        return sA, sB, A, B
-    for key in ("sA", "sB"):
-        if key not in pair:
-            raise MechanismError("the joint's point is missing", path + ("at",),
-                                 "Give at: POINT | [x, y] (or a global sA and sB).")
-    sA, A = _point(drawing, i, pair["sA"], path + ("sA",))
-    sB, B = _point(drawing, j, pair["sB"], path + ("sB",))
-    return sA, sB, A, B
-
-
-def _raw(value: Any) -> Any:
-    """A point name stays a name; a drawn point (Q, Q) becomes its raw coordinates."""
-    return value if isinstance(value, str) else [value[0].text, value[1].text]
-
-
-def _joint(drawing: Drawing, joint: Any,
-           path: Path_) -> tuple[Any, tuple[str, float] | None]:
-    if not isinstance(joint, Mapping) or joint.get("type") not in _PAIR_KEYS:
-        return joint, None  # custom joints and shape errors go to the schema as they are
-    kind = joint["type"]
-    for key in ("v", "phi0"):
-        if key in joint:
-            raise MechanismError(f"{key} is not used in the drawn layout", path + (key,),
-                                 "Give axis: [dx, dy], the sliding direction as drawn; v (the "
-                                 "normal to the slide) and phi0 follow from the drawing.")
-    extra = set(joint) - {"type", "name", "i", "j", "at", "sA", "sB"} - _PAIR_KEYS[kind]
+def _constraint(drawing: Drawing, item: Any, path: Path_) -> tuple[Any, tuple[str, float] | None]:
+    """One joint or driver in the local form, with its closure gap (label, size) if it has
+    one. Shape errors go on to the schema as they are, which names them."""
+    kind = pairs.named(item.get("type")) if isinstance(item, Mapping) else None
+    if kind is None or path[0] not in kind.sections:
+        return item, None
+    extra = sorted(set(item) - kind.drawn_keys)
     if extra:
-        raise MechanismError(f"unknown key {sorted(extra)[0]!r}", path + (sorted(extra)[0],),
-                             "A drawn joint has type, name, i, j, at (or sA, sB) and, for "
-                             "prismatic and pin_slot, axis.")
-    i, j = _body(drawing, joint, "i", path), _body(drawing, joint, "j", path)
-    sA, sB, A, B = _pair_points(drawing, joint, i, j, path)
-    local = {key: joint[key] for key in ("type", "name", "i", "j") if key in joint}
-    local.update(sA=sA, sB=sB)
-    gap = math.hypot(B[0].value - A[0].value, B[1].value - A[1].value)
-    if kind != "revolute":
-        if "axis" not in joint:
-            raise MechanismError(f"a {kind} joint needs axis: [dx, dy]", path + ("axis",),
-                                 "Give the sliding direction as drawn, e.g. axis: [1, 0].")
-        dx, dy = drawing.context.vector(joint["axis"], path + ("axis",))
-        length = math.hypot(dx.value, dy.value)
-        if length == 0:
-            raise MechanismError("the axis is zero", path + ("axis",), "Give a non-zero "
-                                 "direction, e.g. [1, 0].")
-        # The slide's normal v = axis turned by +90 degrees, expressed in body j's frame.
-        local["v"] = drawing.texts(_to_frame(_neg(dy), dx, drawing.frames[j].angle))
-        gap = abs((B[0].value - A[0].value) * -dy.value
-                  + (B[1].value - A[1].value) * dx.value) / length
-        if kind == "prismatic":
-            local["phi0"] = drawing.context.tidy(
-                _sub(drawing.frames[i].angle, drawing.frames[j].angle))
-    return local, (f"{kind} {i}–{j}", gap)
+        hint = ("Give axis: [dx, dy], the sliding direction as drawn; v (the normal to the "
+                "slide) and phi0 follow from the drawing." if extra[0] in ("v", "phi0") else
+                f"A drawn {kind.name} has the keys {', '.join(sorted(kind.drawn_keys))}.")
+        said = f"{extra[0]} is not used in the drawn layout" \
+            if extra[0] in kind.model.model_fields else f"unknown key {extra[0]!r}"
+        raise MechanismError(said, path + (extra[0],), hint)
+    if kind.to_local is None:
+        return _converted(drawing, kind, item, path), None
+    local, gap = kind.to_local(item, drawing, path)
+    bodies = "–".join(str(local.get(key)) for key in kind.bodies)
+    return local, (None if gap is None else (f"{kind.name} {bodies}", gap))
 
 
-def _driver(drawing: Drawing, driver: Any, path: Path_) -> Any:
-    if not isinstance(driver, Mapping) or driver.get("type") not in _DRIVER_POINTS:
-        return driver  # angle and custom drivers keep their meaning; shapes go to the schema
-    local = dict(driver)
-    for key in _DRIVER_POINTS[driver["type"]]:
-        body = _body(drawing, driver, "i" if key == "sA" else "j", path)
-        if key not in driver:
+def _converted(drawing: Drawing, kind: PairType, item: Mapping[str, Any],
+               path: Path_) -> dict[str, Any]:
+    """The generic conversion: each point to the local form of its body, each direction to
+    its body's frame; everything else as written."""
+    local = dict(item)
+    for key, body_key in kind.points:
+        body = drawing.body(item, body_key, path)
+        if key not in item:
             raise MechanismError(f"the required key {key!r} is missing", path + (key,))
-        local[key], _ = _point(drawing, body, driver[key], path + (key,))
-    if "u" in driver:
-        j = _body(drawing, driver, "j", path)
-        dx, dy = drawing.context.vector(driver["u"], path + ("u",))
-        local["u"] = drawing.texts(_to_frame(dx, dy, drawing.frames[j].angle))
+        local[key], _ = drawing.point(body, item[key], path + (key,))
+    for key, body_key in kind.directions:
+        if key in item:
+            body = drawing.body(item, body_key, path)
+            dx, dy = drawing.context.vector(item[key], path + (key,))
+            local[key] = drawing.texts(_to_frame(dx, dy, drawing.frames[body].angle))
     return local
 
 
@@ -401,14 +402,10 @@ def _check_closure(drawing: Drawing, residuals: list[tuple[int, Any, tuple[str, 
                          "coordinates, or give the joint one point with at:.")
 
 
-_KEY_ORDER = ("type", "name", "i", "j", "sA", "sB", "v", "phi0", "u", "f", "theta", "equations")
-
-
 def dump(mech: MechanismSpec) -> str:
     """A mechanism in the local layout as YAML text: a file ``symkin`` reads back unchanged."""
     data = mech.model_dump(mode="json", exclude_none=True)
-    for section in ("joints", "drivers"):
-        data[section] = [{key: item[key] for key in _KEY_ORDER if key in item}
-                         for item in data[section]]
+    for section in pairs.SECTIONS:  # type first, then the keys in their model's order
+        data[section] = [{"type": item["type"], **item} for item in data[section]]
     return str(yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100,
                               allow_unicode=True))

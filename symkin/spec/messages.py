@@ -7,23 +7,11 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
+from symkin import pairs
 from symkin.errors import MechanismError
+from symkin.pairs.fields import kind_of
 from symkin.spec import loader
-from symkin.spec.schema import (
-    Angle,
-    Body,
-    Custom,
-    Displacement,
-    DisplacementLocal,
-    MechanismSpec,
-    PinSlot,
-    Prismatic,
-    Revolute,
-    Slide,
-    TimeGrid,
-    Trajectory,
-    _kind,
-)
+from symkin.spec.schema import Body, MechanismSpec, TimeGrid
 
 
 def translate(error: ValidationError, document: loader.Document) -> MechanismError:
@@ -44,11 +32,11 @@ def translate(error: ValidationError, document: loader.Document) -> MechanismErr
         hint = f"Use one of: {first['ctx']['expected_tags']}."
     elif kind == "union_tag_not_found":
         message = "the key 'type' is missing"
-        kinds = "revolute, prismatic, pin_slot, custom" if path[:1] == ("joints",) else \
-            "displacement, displacement_local, trajectory, angle, slide, custom"
+        section = "joints" if path[:1] == ("joints",) else "drivers"
+        kinds = ", ".join(kind.name for kind in pairs.in_section(section))
         hint = f"Add type: one of {kinds}."
     elif kind in _PYDANTIC_MESSAGES:
-        message = _PYDANTIC_MESSAGES[kind].format(kind=_kind(first.get("input")),
+        message = _PYDANTIC_MESSAGES[kind].format(kind=kind_of(first.get("input")),
                                                   **first.get("ctx", {}))
     return MechanismError(message, path, hint, document.source, document.line_of(path))
 
@@ -89,18 +77,14 @@ def _allowed_keys(path: tuple[str | int, ...], data: Any) -> list[str]:
     if section == "time":
         return list(TimeGrid.model_fields)
     try:
-        model = _CONSTRAINT_MODELS[data[section][path[1]]["type"]]
+        kind = pairs.named(data[section][path[1]]["type"])
     except (KeyError, IndexError, TypeError):
+        kind = None
+    if kind is None:
         return ["type, name and the keys of that type"]
-    return list(model.model_fields)
+    return list(kind.model.model_fields)
 
 
-_CONSTRAINT_MODELS: dict[str, type[BaseModel]] = {
-    model.model_fields["type"].annotation.__args__[0]: model  # type: ignore[union-attr]
-    for model in (Revolute, Prismatic, PinSlot, Custom, Displacement, DisplacementLocal,
-                  Trajectory, Angle, Slide)}
-
-
-_ALL_FIELDS = {name for model in (MechanismSpec, Body, Revolute, Prismatic, PinSlot, Custom,
-                                  Displacement, DisplacementLocal, Trajectory, Angle, Slide,
-                                  TimeGrid) for name in model.model_fields}
+_MODELS: tuple[type[BaseModel], ...] = (MechanismSpec, Body, TimeGrid,
+                                        *(kind.model for kind in pairs.TYPES))
+_ALL_FIELDS = {name for model in _MODELS for name in model.model_fields}

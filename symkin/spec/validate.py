@@ -5,6 +5,7 @@ degree-of-freedom count. Every mistake is a :class:`MechanismError` with the fie
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,17 +14,14 @@ from typing import Any
 import sympy as sp
 from pydantic import ValidationError, model_validator
 
+from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError, UsageError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
+from symkin.pairs.fields import GROUND
 from symkin.spec import constants, drawn, drawn_schema, expressions, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
-from symkin.spec.schema import (
-    GROUND,
-    Custom,
-    MechanismSpec,
-    equation_count,
-)
+from symkin.spec.schema import MechanismSpec, equation_count
 
 
 class Mechanism(MechanismSpec):
@@ -257,48 +255,73 @@ def _point(mech: Mechanism, body: str, ref: Any, symbols: _Names,
         _expression(raw, symbols, path + (k,), values=nominal)
 
 
+@dataclass(frozen=True)
+class _Checks:
+    """What a pair module's own checks are given (:class:`symkin.pairs.kit.Checks`)."""
+
+    mech: Mechanism
+    symbols: _Names
+    nominal: Mapping[sp.Symbol, float]
+
+    def expression(self, raw: Any, path: tuple[str | int, ...], *, time: bool = False,
+                   coordinates: bool = False) -> sp.Expr:
+        return _expression(raw, self.symbols, path, time, coordinates)
+
+    def uses_coordinates(self, expr: sp.Expr) -> bool:
+        return bool(expr.free_symbols & set(self.symbols.q))
+
+    def value(self, expr: sp.Expr, path: tuple[str | int, ...]) -> float:
+        return _numeric(expr, self.nominal, path)
+
+    def point_at_q0(self, body: str, ref: Any) -> tuple[float, float]:
+        """The global position of a (checked) point of ``body`` at its first guess q0."""
+        local = self.mech.bodies[body].points[ref] if isinstance(ref, str) else ref
+        sx, sy = (constants.value(expressions.parse(raw, self.symbols.parameters), self.nominal)
+                  for raw in local)
+        if body == GROUND:
+            return sx, sy
+        x, y, phi = (constants.value(expressions.parse(raw, self.symbols.parameters),
+                                     self.nominal) for raw in self.mech.bodies[body].q0)
+        return (x + math.cos(phi) * sx - math.sin(phi) * sy,
+                y + math.sin(phi) * sx + math.cos(phi) * sy)
+
+
 def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
                       nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
-    kind = "joint" if path[0] == "joints" else "driver"
-    if constraint.name is not None and name_problem(constraint.name, kind):
-        raise MechanismError(str(name_problem(constraint.name, kind)), path + ("name",),
+    """The generic checks, driven by what the pair module says its keys are, then its own."""
+    kind = pairs.of(constraint)
+    role = "joint" if path[0] == "joints" else "driver"
+    if constraint.name is not None and name_problem(constraint.name, role):
+        raise MechanismError(str(name_problem(constraint.name, role)), path + ("name",),
                              "Rename it.")
-    if isinstance(constraint, Custom):
-        for k, text in enumerate(constraint.equations):
-            expr = _expression(text, symbols, path + ("equations", k), time=True,
-                               coordinates=True)
-            if not expr.free_symbols & set(symbols.q):
-                raise MechanismError("this equation uses no coordinate, so it cannot "
-                                     "constrain the mechanism", path + ("equations", k),
-                                     "Use coordinates such as crank.phi or rod.x in it.")
-        return
-    bodies = [key for key in ("i", "j") if hasattr(constraint, key)]
-    for key in bodies:
+    for key in kind.bodies:
         _body_ref(mech, getattr(constraint, key), path + (key,))
-    if constraint.type == "trajectory" and constraint.j == GROUND:
-        raise MechanismError("a trajectory needs a moving body j, not the ground",
-                             path + ("j",), "Name the body whose point should follow f(t).")
-    if len(bodies) == 2 and constraint.i == constraint.j:
-        raise MechanismError(f"a {constraint.type} joins body {constraint.i!r} to itself",
+    if len(kind.bodies) == 2 and len(set(kind.joined_bodies(constraint))) == 1:
+        raise MechanismError(f"a {kind.name} joins body {constraint.i!r} to itself",
                              path + ("j",), "A constraint needs two different bodies.")
-    for key, body_key in (("sA", "i"), ("sB", "j")):
-        if hasattr(constraint, key):
-            _point(mech, getattr(constraint, body_key), getattr(constraint, key), symbols,
-                   nominal, path + (key,))
-    for key in ("v", "u"):
-        if hasattr(constraint, key):
-            vector = [_expression(raw, symbols, path + (key, k), values=nominal)
-                      for k, raw in enumerate(getattr(constraint, key))]
-            _nonzero_vector(vector, nominal, path + (key,))
-    if hasattr(constraint, "phi0"):
-        _expression(constraint.phi0, symbols, path + ("phi0",), values=nominal)
-    for key in ("f", "theta"):
-        if hasattr(constraint, key):
-            value = getattr(constraint, key)
-            items = value if isinstance(value, list) else [value]
-            for k, raw in enumerate(items):
-                _expression(raw, symbols, path + ((key, k) if key == "f" and
-                                                  isinstance(value, list) else (key,)), time=True)
+    if kind.on_ground and GROUND in (getattr(constraint, key) for key in kind.bodies):
+        raise MechanismError(f"a {kind.name} needs a moving body {kind.bodies[0]}, not the "
+                             "ground", path + (kind.bodies[0],), "Name the body whose point "
+                             "should follow f(t).")
+    for key, body_key in kind.points:
+        _point(mech, getattr(constraint, body_key), getattr(constraint, key), symbols,
+               nominal, path + (key,))
+    for key, _ in kind.directions:
+        vector = [_expression(raw, symbols, path + (key, k), values=nominal)
+                  for k, raw in enumerate(getattr(constraint, key))]
+        _nonzero_vector(vector, nominal, path + (key,))
+    for key in kind.constants:
+        if getattr(constraint, key) is not None:
+            _expression(getattr(constraint, key), symbols, path + (key,), values=nominal)
+    for key in kind.time_functions:
+        value = getattr(constraint, key)
+        if isinstance(value, list):
+            for k, raw in enumerate(value):
+                _expression(raw, symbols, path + (key, k), time=True)
+        else:
+            _expression(value, symbols, path + (key,), time=True)
+    if kind.check is not None:
+        kind.check(constraint, _Checks(mech, symbols, nominal), path)
 
 
 def _nonzero_vector(vector: list[sp.Expr], nominal: Mapping[sp.Symbol, float],
@@ -335,8 +358,11 @@ def check_degrees_of_freedom(mech: Mechanism) -> None:
     driving = sum(equation_count(driver) for driver in mech.drivers)
     if dof == driving:
         return
-    p5 = sum(joint.type in ("revolute", "prismatic") for joint in mech.joints)
-    p4 = sum(joint.type == "pin_slot" for joint in mech.joints)
+    # Pairs of class 5 take two freedoms (revolute, prismatic), of class 4 one (pin-in-slot,
+    # distance); the equations the file writes itself are counted apart.
+    counted = [equation_count(joint) for joint in mech.joints
+               if pairs.of(joint).rows is not None]
+    p5, p4 = counted.count(2), counted.count(1)
     formula = f"w = 3·{len(mech.bodies)} − 2·{p5} − {p4}"
     custom = dof - (3 * len(mech.bodies) - 2 * p5 - p4)
     if custom:

@@ -16,10 +16,11 @@ from pathlib import Path
 
 import sympy as sp
 
-from symkin.spec import validate as model
+from symkin import pairs
+from symkin.spec import validate
 from symkin.spec.validate import Mechanism
-from symkin.symbolic import planar as constraints
-from symkin.symbolic import symbols as symbols_module
+from symkin.symbolic.planar import Context
+from symkin.symbolic.symbols import Symbols, make_symbols
 
 
 @dataclass(frozen=True)
@@ -44,8 +45,22 @@ class Row:
 
 
 @dataclass(frozen=True)
+class Placed:
+    """A local vector of a joint or driver, resolved: a point (or direction, ``kind``) of
+    ``body`` that the constraint's ``key`` gives, as expressions of the parameters."""
+
+    section: str
+    index: int
+    key: str
+    body: str
+    vector: sp.ImmutableMatrix
+    kind: str = "point"  # or "direction"
+
+
+@dataclass(frozen=True)
 class System:
-    """The symbolic kinematics of one mechanism (see DESIGN.md, Python API)."""
+    """The symbolic kinematics of one mechanism: Phi, its derivatives, the row labels and
+    the resolved vectors of points, joints and drivers."""
 
     mechanism: Mechanism
     q: tuple[sp.Symbol, ...]
@@ -60,6 +75,12 @@ class System:
     gamma: sp.ImmutableMatrix
     rows: tuple[Row, ...]
     q0: tuple[float, ...]
+    points: tuple[tuple[str, str, sp.ImmutableMatrix], ...]
+    """Every named point as (body, name, local vector), bodies and points in file order."""
+    placed: tuple[Placed, ...]
+    """The points and directions of every joint and driver, resolved once for all stages."""
+    time_grid: tuple[float, float, float]
+    """(t0, t1, dt) at the nominal parameter values."""
     phi_p: sp.ImmutableSparseMatrix | None = None
     """dPhi/dp, N x NP (sparse): Phi_q q_p = -Phi_p gives the sensitivities q_p."""
 
@@ -73,17 +94,7 @@ class System:
 
     @property
     def dof(self) -> int:
-        return model.degrees_of_freedom(self.mechanism)
-
-    @property
-    def time_grid(self) -> tuple[float, float, float]:
-        """(t0, t1, dt) at the nominal parameter values."""
-        values = dict(zip(self.p, self.p_values))
-        symbols = symbols_module.make_symbols(self.mechanism)
-        parse = constraints.Context(self.mechanism, symbols).expr
-        grid = self.mechanism.time
-        t0, t1, dt = (float(parse(raw).subs(values)) for raw in (grid.t0, grid.t1, grid.dt))
-        return t0, t1, dt
+        return validate.degrees_of_freedom(self.mechanism)
 
     def pattern(self) -> list[tuple[int, int]]:
         """Structural non-zeros of Phi_q as (row, column), row-major."""
@@ -93,9 +104,9 @@ class System:
 def derive(mech: Mechanism | str | Path) -> System:
     """Derive Phi, Phi_q, Phi_t and Gamma of a mechanism (a Mechanism or a file path)."""
     if not isinstance(mech, Mechanism):
-        mech = model.load(mech)
-    symbols = symbols_module.make_symbols(mech)
-    ctx = constraints.Context(mech, symbols)
+        mech = validate.load(mech)
+    symbols = make_symbols(mech)
+    ctx = Context(mech, symbols)
     phi, rows = _constraint_rows(mech, ctx)
     column = {q: k for k, q in enumerate(symbols.q)}
     jacobian: dict[tuple[int, int], sp.Expr] = {}
@@ -109,34 +120,61 @@ def derive(mech: Mechanism | str | Path) -> System:
     size = len(symbols.q)
     values = mech.parameter_values()
     p_values = tuple(values[s.name] for s in symbols.p)
+    nominal = dict(zip(symbols.p, p_values))
     return System(
         mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,
         p_values=p_values, coordinates=symbols.coordinates,
         phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
         phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
-        q0=_initial_guess(mech, ctx, dict(zip(symbols.p, p_values))),
+        q0=_initial_guess(mech, ctx, nominal),
+        points=tuple((body, name, sp.ImmutableMatrix(ctx.local(body, name)))
+                     for body, spec in mech.bodies.items() for name in spec.points),
+        placed=_placed(mech, ctx), time_grid=_time_grid(mech, ctx, nominal),
         phi_p=_parameter_jacobian(phi, symbols.p),
     )
 
 
-def _constraint_rows(mech: Mechanism, ctx: constraints.Context
-                     ) -> tuple[list[sp.Expr], tuple[Row, ...]]:
-    """Phi and its row labels: joints in file order, then drivers (DESIGN.md row order)."""
+def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tuple[Row, ...]]:
+    """Phi and its row labels: joints in file order, then drivers (README, "Row order")."""
     phi: list[sp.Expr] = []
     rows: list[Row] = []
-    for section in ("joints", "drivers"):
+    for section in pairs.SECTIONS:
         for index, constraint in enumerate(getattr(mech, section)):
-            equations = constraints.equations(constraint, ctx)
-            parts = constraints.ROW_PARTS.get(constraint.type) or tuple(
-                f"equation {k}" for k in range(len(equations)))
-            bodies = constraints.bodies_of(constraint) or _bodies_touched(equations, ctx)
+            kind = pairs.of(constraint)
+            equations = kind.equations(constraint, ctx)
+            parts = kind.rows or tuple(f"equation {k}" for k in range(len(equations)))
+            bodies = kind.joined_bodies(constraint) or _bodies_touched(equations, ctx)
             phi.extend(equations)
             rows.extend(Row(section, index, constraint.type, bodies, part, constraint.name)
                         for part in parts)
     return phi, tuple(rows)
 
 
-def _bodies_touched(equations: list[sp.Expr], ctx: constraints.Context) -> tuple[str, ...]:
+def _placed(mech: Mechanism, ctx: Context) -> tuple[Placed, ...]:
+    """The local vectors of every joint and driver: its points, then its directions."""
+    found = []
+    for section in pairs.SECTIONS:
+        for index, constraint in enumerate(getattr(mech, section)):
+            kind = pairs.of(constraint)
+            for key, body_key in kind.points:
+                body = getattr(constraint, body_key)
+                vector = ctx.local(body, getattr(constraint, key))
+                found.append(Placed(section, index, key, body, sp.ImmutableMatrix(vector)))
+            for key, body_key in kind.directions:
+                vector = ctx.vector(getattr(constraint, key))
+                found.append(Placed(section, index, key, getattr(constraint, body_key),
+                                    sp.ImmutableMatrix(vector), "direction"))
+    return tuple(found)
+
+
+def _time_grid(mech: Mechanism, ctx: Context,
+               values: dict[sp.Symbol, float]) -> tuple[float, float, float]:
+    grid = mech.time
+    t0, t1, dt = (float(ctx.expr(raw).subs(values)) for raw in (grid.t0, grid.t1, grid.dt))
+    return t0, t1, dt
+
+
+def _bodies_touched(equations: list[sp.Expr], ctx: Context) -> tuple[str, ...]:
     used = set().union(*(e.free_symbols for e in equations))
     return tuple(dict.fromkeys(name.split(".")[0] for name, q in
                                zip(ctx.symbols.coordinates, ctx.symbols.q) if q in used))
@@ -162,7 +200,7 @@ def _parameter_jacobian(phi: list[sp.Expr], p: tuple[sp.Symbol, ...]
 
 
 def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr,
-               symbols: symbols_module.Symbols) -> sp.Expr:
+               symbols: Symbols) -> sp.Expr:
     """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt, from this row's columns."""
     q, dq, t = symbols.q, symbols.dq, symbols.t
     velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))
@@ -171,7 +209,7 @@ def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr,
     return -convective - 2 * mixed - sp.diff(row_t, t)
 
 
-def _initial_guess(mech: Mechanism, ctx: constraints.Context,
+def _initial_guess(mech: Mechanism, ctx: Context,
                    values: dict[sp.Symbol, float]) -> tuple[float, ...]:
     return tuple(float(ctx.expr(raw).subs(values)) for body in mech.bodies.values()
                  for raw in body.q0)

@@ -1,64 +1,83 @@
 """What a drawing of a planar mechanism needs from its derivation: per body, the local
 vectors of its joint and driver attachments and named points, as plain NumPy arrays; the
-points attached to the ground (pivots, under the key ``ground``); and the slide axes of the
-prismatic and pin-in-slot pairs (under ``slide:<body j>``: rows point, direction, point, ...
-in the frame of body j, which carries the slide).
+points attached to the ground (pivots, under the key ``ground``); the slide axes (under
+``slide:<body>``: rows point, direction, point, ... in the frame of the body that carries the
+slide); and the rods with no body of their own (under ``rod:<body i>:<body j>``: rows point on
+i, point on j, ...).
 
-The runtime's plots and the warm-run index take these arrays, never SymPy objects.
+Everything is read from the System's resolved vectors (:attr:`System.placed`); what each pair
+type adds to the drawing its module says (:class:`symkin.pairs.kit.PairType`). The runtime's
+plots and the warm-run index take these arrays, never SymPy objects.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Iterable
 
 import numpy as np
+import sympy as sp
 from numpy.typing import NDArray
 
-from symkin.spec.schema import GROUND, PinSlot, Prismatic, Revolute
-from symkin.symbolic import planar as constraints
-from symkin.symbolic import symbols as symbols_module
-from symkin.symbolic.derivation import System
+from symkin import pairs
+from symkin.pairs.fields import GROUND
+from symkin.symbolic.derivation import Placed, System
+
+Vector = tuple[float, float]
 
 
 def outlines(system: System) -> dict[str, NDArray[np.float64]]:
     """Per body, the local vectors of its joint and driver attachments and its named points,
-    at the nominal parameter values: what ``animate`` draws each body through.
+    at the nominal parameter values: what ``animate`` draws each body through; and the ground's
+    pivots, the slide axes and the rods.
 
     Args:
         system: the derived System.
     """
-    mech = system.mechanism
-    ctx = constraints.Context(mech, symbols_module.make_symbols(mech))
     values = dict(zip(system.p, system.p_values))
-    found: dict[str, list[tuple[float, float]]] = {body: [] for body in mech.bodies}
-    attachments = [(getattr(c, "i", None), getattr(c, "sA", None)) for c in
-                   [*mech.joints, *mech.drivers]]
-    attachments += [(getattr(c, "j", None), getattr(c, "sB", None)) for c in
-                    [*mech.joints, *mech.drivers]]
-    attachments += [(body, name) for body, spec in mech.bodies.items() for name in spec.points]
-    for body, ref in attachments:
-        if body in found and ref is not None:
-            x, y = (float(v.subs(values)) for v in ctx.local(body, ref))
-            vector = (x, y)
-            if vector not in found[body]:
-                found[body].append(vector)
+
+    def at(vector: sp.ImmutableMatrix) -> Vector:
+        x, y = (float(v.subs(values)) for v in vector)
+        return x, y
+
+    mech = system.mechanism
+    found: dict[str, list[Vector]] = {body: [] for body in mech.bodies}
+    # The points on the i side of every joint and driver, then those on the j side.
+    points = [p for p in system.placed if p.kind == "point"]
+    side = {(p.section, p.index, p.key): dict(pairs.of(getattr(mech, p.section)[p.index]).points)
+            [p.key] for p in points}
+    ordered = sorted(points, key=lambda p: side[p.section, p.index, p.key] != "i")
+    attachments = [(p.body, p.vector) for p in ordered]
+    attachments += [(body, vector) for body, _, vector in system.points]
+    for body, vector in attachments:
+        if body in found and at(vector) not in found[body]:
+            found[body].append(at(vector))
     drawn = {body: np.array(v or [(0.0, 0.0)], dtype=float) for body, v in found.items()}
-    # Revolute joints with the ground are its pivots; prismatic and pin-slot pairs carry
-    # a slide axis (on body j, which may be the ground).
-    pivots = {_at(ctx, GROUND, c.sB if c.j == GROUND else c.sA, values)
-              for c in mech.joints if isinstance(c, Revolute) and GROUND in (c.i, c.j)}
+    pivots: set[Vector] = set()
+    slides: dict[str, list[Vector]] = {}
+    rods: dict[str, list[Vector]] = {}
+    for (section, index), placed in _by_constraint(system.placed).items():
+        kind = pairs.of(getattr(mech, section)[index])
+        on_ground = [p for p in placed if p.kind == "point" and p.body == GROUND]
+        if kind.pivot and on_ground:
+            pivots.add(at(on_ground[0].vector))
+        if kind.slide:
+            normal = next(p for p in placed if p.key == kind.slide)
+            point = next(p for p in placed if p.kind == "point" and p.body == normal.body)
+            (vx, vy) = at(normal.vector)
+            slides.setdefault(normal.body, []).extend([at(point.vector), (vy, -vx)])
+        if kind.rod:
+            first, second = (p for p in placed if p.kind == "point")
+            rods.setdefault(f"rod:{first.body}:{second.body}", []).extend(
+                [at(first.vector), at(second.vector)])
     if pivots:
         drawn[GROUND] = np.array(sorted(pivots), dtype=float)
-    for c in mech.joints:
-        if isinstance(c, (Prismatic, PinSlot)):
-            v = [float(ctx.expr(item).subs(values)) for item in c.v]
-            rows = np.array([_at(ctx, c.j, c.sB, values), (v[1], -v[0])])  # axis: v turned -90°
-            key = f"slide:{c.j}"
-            drawn[key] = np.vstack([drawn[key], rows]) if key in drawn else rows
+    drawn.update({f"slide:{body}": np.array(rows, dtype=float) for body, rows in slides.items()})
+    drawn.update({key: np.array(rows, dtype=float) for key, rows in rods.items()})
     return drawn
 
 
-def _at(ctx: constraints.Context, body: str, ref: Any, values: dict[Any, Any]
-        ) -> tuple[float, float]:
-    x, y = (float(v.subs(values)) for v in ctx.local(body, ref))
-    return x, y
+def _by_constraint(placed: Iterable[Placed]) -> dict[tuple[str, int], list[Placed]]:
+    grouped: dict[tuple[str, int], list[Placed]] = {}
+    for p in placed:
+        grouped.setdefault((p.section, p.index), []).append(p)
+    return grouped

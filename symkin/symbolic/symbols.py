@@ -7,7 +7,8 @@ from functools import cached_property
 
 import sympy as sp
 
-from symkin.spec.schema import GROUND, MechanismSpec
+from symkin.pairs.fields import GROUND
+from symkin.spec.schema import MechanismSpec
 
 
 @dataclass(frozen=True)
