@@ -37,6 +37,7 @@ EVERY_CONSTRAINT = {
         "arm": {},
         "tool": {"points": {"P": ["-c", "a/2"]}},
         "free": {},
+        "bar": {"q0": [0.5, 1, 0.3], "points": {"Q": [0.4, "-c"]}},
     },
     "joints": [
         {"type": "revolute", "i": "ground", "j": "crank", "sA": [0.1, -0.2], "sB": [0, 0]},
@@ -47,6 +48,8 @@ EVERY_CONSTRAINT = {
         {"type": "revolute", "i": "tool", "j": "free", "sA": "P", "sB": [-0.5, "b"]},
         {"type": "custom", "name": "cam",
          "equations": ["lever.x**2 + lever.y*arm.phi - a*cos(arm.phi - lever.phi)"]},
+        {"type": "distance", "i": "crank", "j": "bar", "A": "tip", "B": "Q", "length": "a + c"},
+        {"type": "distance", "i": "bar", "j": "ground", "A": [0.1, "b"], "B": [2, -1]},
     ],
     "drivers": [
         {"type": "displacement", "i": "lever", "j": "arm", "sA": "end", "sB": [0.3, -0.4],
@@ -61,6 +64,7 @@ EVERY_CONSTRAINT = {
         {"type": "custom", "name": "coupled",
          "equations": ["sin(w*t)*(free.phi + tool.x) - cos(t)*free.x*free.y + e*t*crank.phi",
                        "free.phi*arm.y + tool.phi*t**2 - e"]},
+        {"type": "angle", "i": "bar", "j": "ground", "theta": "e*t**2"},
     ],
     "time": {"t0": 0, "t1": 2, "dt": 0.1},
 }
@@ -102,9 +106,9 @@ def _close(derived, estimate, what: str) -> None:
 
 def test_every_constraint_type_is_present(system: System) -> None:
     types = {row.type for row in system.rows}
-    assert types == {"revolute", "prismatic", "pin_slot", "custom", "displacement",
+    assert types == {"revolute", "prismatic", "pin_slot", "distance", "custom", "displacement",
                      "displacement_local", "trajectory", "angle", "slide"}
-    assert len(system.q) == len(system.rows) == 18
+    assert len(system.q) == len(system.rows) == 21
 
 
 @pytest.mark.parametrize("state", range(4))

@@ -67,6 +67,23 @@ def slide_axes(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, 
     return axes
 
 
+def rods(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]]:
+    """Every rod with no body of its own (a distance constraint) as its two ends, each (T, 2),
+    in the global frame: the keys ``rod:<body i>:<body j>`` hold rows end on i, end on j."""
+    found = []
+    for key, rows in outlines.items():
+        if not key.startswith("rod:"):
+            continue
+        first, second = key.split(":")[1:3]
+        if not all(body == GROUND or body in trajectory.bodies for body in (first, second)):
+            continue
+        rows = np.asarray(rows, dtype=float).reshape(-1, 2)
+        for a, b in zip(rows[0::2], rows[1::2]):
+            found.append((_global(trajectory, first, a[None])[:, 0],
+                          _global(trajectory, second, b[None])[:, 0]))
+    return found
+
+
 def parse_size(text: str) -> tuple[int, int]:
     """``"900x600"`` -> (900, 600), pixels; UsageError for anything else."""
     width, _, height = text.lower().partition("x")
@@ -88,7 +105,8 @@ def animate(trajectory: Trajectory, path: str | Path, outlines: Outlines, fps: i
         trajectory: the solved run.
         path: the .gif to write.
         outlines: per body, the local vectors to draw it through; ``ground`` pivots and
-            ``slide:<body>`` axes (see :func:`symkin.symbolic.drawing.outlines`).
+            ``slide:<body>`` axes, ``rod:<i>:<j>`` rods (see
+            :func:`symkin.symbolic.drawing.outlines`).
         fps: frames per second; at most MAX_FRAMES frames are drawn, evenly spaced.
         size: width and height in pixels.
         progress: called as progress(frames done, frames) while frames are drawn.
@@ -133,6 +151,7 @@ class _Scene:
         self.ax = ax
         self.shapes = body_shapes(trajectory, outlines)
         self.slides = slide_axes(trajectory, outlines)
+        self.rods = rods(trajectory, outlines)
         x0, x1, y0, y1 = _limits([*self.shapes.values(), _ground(outlines)[None]])
         ax.set_xlim(x0, x1)
         ax.set_ylim(y0, y1)
@@ -143,6 +162,9 @@ class _Scene:
         self.slide_lines = [ax.plot([], [], "-.", color="0.45", linewidth=0.9,
                                     label="slide axis" if k == 0 else None)[0]
                             for k in range(len(self.slides))]
+        self.rod_lines = [ax.plot([], [], "o--", color="0.25", linewidth=1.5, markersize=3,
+                                  label="rod" if k == 0 else None)[0]
+                          for k in range(len(self.rods))]
         _pivots(ax, _ground(outlines), span)
         colours = series.palette(len(self.shapes))
         self.lines = {body: ax.plot([], [], "o-", linewidth=3, markersize=4, color=colour,
@@ -158,7 +180,7 @@ class _Scene:
         # background and draws only the moving artists (an order of magnitude faster than
         # drawing the whole figure per frame).
         self.moving = [*self.lines.values(), *(line for _, line in self.traces),
-                       *self.slide_lines, self.title]
+                       *self.slide_lines, *self.rod_lines, self.title]
         for artist in self.moving:
             artist.set_animated(True)
         canvas = self.figure.canvas
@@ -183,6 +205,8 @@ class _Scene:
         for (at, direction), line in zip(self.slides, self.slide_lines):
             ends = at[k] + np.outer([-self.reach, self.reach], direction[k])
             line.set_data(ends[:, 0], ends[:, 1])
+        for (a, b), line in zip(self.rods, self.rod_lines):
+            line.set_data([a[k, 0], b[k, 0]], [a[k, 1], b[k, 1]])
         self.title.set_text(f"t = {self.trajectory.t[k]:.4g}")
 
 

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from symkin.errors import UsageError
 from symkin.present import series
-from symkin.present.animation import MAX_FRAMES, Outlines, body_shapes, slide_axes
+from symkin.present.animation import MAX_FRAMES, Outlines, body_shapes, rods, slide_axes
 from symkin.present.series import DEFAULT_UNITS, LENGTH, Units
 from symkin.runtime.results import Trajectory
 
@@ -58,7 +58,7 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
         trajectory: the solved run (a partial one works too).
         path: the .html file to write.
         outlines: what :func:`symkin.symbolic.drawing.outlines` gives (bodies, ground
-            pivots, slide axes).
+            pivots, slide axes, rods).
         select: the quantities to plot (coordinates and named points); default
             :func:`series.default_selection`. Vectors are drawn at the selected points.
         units: labels from the file's ``units`` key.
@@ -105,6 +105,7 @@ class _Scene:
         self.trajectory = trajectory
         self.shapes = body_shapes(trajectory, outlines)
         self.slides = slide_axes(trajectory, outlines)
+        self.rods = rods(trajectory, outlines)
         self.ground = np.asarray(outlines.get("ground", np.zeros((0, 2))), float).reshape(-1, 2)
         self.points = list(points)
         every = np.concatenate([s.reshape(-1, 2) for s in self.shapes.values()]
@@ -143,6 +144,10 @@ class _Scene:
             moving.append(self._add(figure, go.Scatter(
                 mode="lines", name="slide axis", showlegend=k == 0, legendgroup="slide",
                 line={"dash": "dashdot", "width": 1, "color": "#777"}, hoverinfo="skip")))
+        for k in range(len(self.rods)):
+            moving.append(self._add(figure, go.Scatter(
+                mode="lines+markers", name="rod", showlegend=k == 0, legendgroup="rods",
+                line={"dash": "dash", "width": 2, "color": "#444"}, marker={"size": 4})))
         for order, colour, word in ((1, VELOCITY, "velocity"), (2, ACCELERATION,
                                                                 "acceleration")):
             unit = self.units.unit(LENGTH, order)
@@ -168,6 +173,8 @@ class _Scene:
         for at, direction in self.slides:
             ends = at[k] + np.outer([-2 * self.span, 2 * self.span], direction[k])
             data.append(go.Scatter(x=ends[:, 0], y=ends[:, 1]))
+        for a, b in self.rods:
+            data.append(go.Scatter(x=[a[k, 0], b[k, 0]], y=[a[k, 1], b[k, 1]]))
         for order in (1, 2):
             for name in self.points:
                 r, tip = self.kinematics[name][0][k], self.kinematics[name][order][k]
