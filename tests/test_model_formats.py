@@ -154,6 +154,8 @@ def test_a_tag_that_does_not_match_its_value_is_refused(text: str) -> None:
     ("key: !!binary aGk=\n", "is not allowed"),
     ("key: !!set {a, b}\n", "is not allowed"),
     ("? [a, b]\n: 1\n", "is not a name"),
+    ("!!binary name: x\n", "the YAML tag 'tag:yaml.org,2002:binary' is not allowed"),  # a key
+    ("!custom key: 1\n", "the YAML tag '!custom' is not allowed"),
 ])
 def test_other_unsafe_yaml_is_refused(text: str, fragment: str) -> None:
     with pytest.raises(MechanismError) as caught:

@@ -198,14 +198,19 @@ def _convert(node: yaml.Node, path: Path_, document: Document) -> Any:
     document.lines[path] = node.start_mark.line + 1
     if len(path) > MAX_NESTING:
         raise _too_deep(document.source, node.start_mark.line + 1)
-    if node.tag not in _ALLOWED_TAGS:
-        raise _fail(document, node, path, f"the YAML tag {node.tag!r} is not allowed",
-                    "Remove the tag; mechanism files hold only plain values.")
+    _check_tag(node, path, document)
     if isinstance(node, yaml.MappingNode):
         return _mapping(node, path, document)
     if isinstance(node, yaml.SequenceNode):
         return [_convert(item, path + (k,), document) for k, item in enumerate(node.value)]
     return _scalar(node, path, document)
+
+
+def _check_tag(node: yaml.Node, path: Path_, document: Document) -> None:
+    """Values and keys alike carry no tag but the core schema's."""
+    if node.tag not in _ALLOWED_TAGS:
+        raise _fail(document, node, path, f"the YAML tag {node.tag!r} is not allowed",
+                    "Remove the tag; mechanism files hold only plain values.")
 
 
 def _mapping(node: yaml.MappingNode, path: Path_, document: Document) -> dict[str, Any]:
@@ -214,6 +219,7 @@ def _mapping(node: yaml.MappingNode, path: Path_, document: Document) -> dict[st
         if isinstance(key_node, yaml.ScalarNode) and key_node.value == "<<":
             raise _fail(document, key_node, path, "merge keys (<<) are not allowed",
                         "Write the keys out.")
+        _check_tag(key_node, path, document)
         key = _scalar(key_node, path, document) if isinstance(key_node, yaml.ScalarNode) else None
         if not isinstance(key, str):
             shown = key_node.value if isinstance(key_node, yaml.ScalarNode) else "a collection"
