@@ -26,6 +26,8 @@ EXPECTED: dict[str, tuple[int, str]] = {
     "unknown_body_key.yaml": (4, "unknown key 'mass'. Allowed keys here: q0, points"),
     "unknown_joint_key.yaml": (6, "at joints[0].v: unknown key 'v'. Allowed keys here: name, i, j"),
     "unknown_time_key.yaml": (9, "unknown key 'steps'. Allowed keys here: t0, t1, dt"),
+    "poly_coefficient_with_t.yaml": (9, "at drivers[0].theta.poly[1]: in expression 't' at "
+                                        "column 1: unknown name 't'"),
     "bad.toml": (11, "at joints[0].colour: unknown key 'colour'"),
     # YAML traps
     "duplicate_key.yaml": (2, "the key 'name' appears twice"),

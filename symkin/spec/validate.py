@@ -220,9 +220,12 @@ def _expression(raw: Any, symbols: _Names | None, path: tuple[str | int, ...],
     names = dict(symbols.parameters) if symbols else {}
     if time and symbols:
         names["t"] = symbols.t
+    if time and symbols and isinstance(raw, Mapping):
+        # {poly: [a0, a1, ...]}: each coefficient a constant (t enters through the powers)
+        for k, coefficient in enumerate(raw["poly"]):
+            _expression(coefficient, symbols, path + ("poly", k))
+        return expressions.parse_time_function(raw, symbols.parameters, symbols.t)
     try:
-        if time and isinstance(raw, Mapping):
-            return expressions.parse_time_function(raw, names, symbols.t)  # type: ignore[union-attr]
         expr = expressions.parse(raw, names, symbols.by_coordinate if coordinates and symbols
                                  else None)
         if time and symbols:
