@@ -254,3 +254,23 @@ def test_show_local_prints_the_derived_local_form(capsys) -> None:
     reread = symkin.from_dict(yaml.safe_load(out))
     assert reread.canonical_json() == symkin.load(
         ROOT / "examples" / "crank_slider_drawn.yaml").canonical_json()
+
+
+@pytest.mark.parametrize(("value", "field", "words"), [
+    ("2.0", "bodies.rod.points.B[0]", "fractional power of a negative number, which is not "
+     "real. A link too short (or too long) to close the drawing at these values? Check the "
+     "parameters it uses: a, b, c."),
+    (".nan", "parameters.b", "nan is not a finite number"),
+    ("-.inf", "parameters.b", "-inf is not a finite number"),
+])
+def test_a_drawing_that_cannot_be_evaluated_names_the_cause(tmp_path: Path, value: str,
+                                                            field: str, words: str) -> None:
+    """The textbook crank-slider drawn with a rod b too short to reach the slide (c - a = 3), or
+    with b not a number: the message names the square root and its parameters, or b itself,
+    not a drawn point that uses it."""
+    path = tmp_path / "short.yaml"
+    path.write_text((ROOT / "examples" / "crank_slider_drawn.yaml").read_text().replace(
+        "b: 5.0", f"b: {value}"))
+    with pytest.raises(MechanismError) as caught:
+        symkin.load(path)
+    assert f"at {field}: " in str(caught.value) and words in str(caught.value)

@@ -62,6 +62,10 @@ class _Context:
         self.symbols = {name: sp.Symbol(name, real=True) for name in parameters}
         self.values: dict[sp.Symbol, float] = {}
         for name, raw in parameters.items():
+            if isinstance(raw, float) and not math.isfinite(raw):
+                # said here: every drawn point that uses it would be blamed instead
+                raise MechanismError(f"{raw} is not a finite number", ("parameters", name),
+                                     "Give the parameter a finite value.")
             try:
                 self.values[self.symbols[name]] = constants.value(expressions.parse(raw, {}))
             except (ExpressionError, TypeError, ValueError):
@@ -79,11 +83,14 @@ class _Context:
                                  "the listed functions.") from None
         try:
             value = constants.value(expr, self.values)
-        except ExpressionError:
-            value = math.nan
-        if not math.isfinite(value):
-            raise MechanismError(f"{raw!r} is not a finite real number at the nominal "
-                                 "parameter values", path)
+        except ExpressionError as error:
+            used = sorted(str(symbol) for symbol in expr.free_symbols)
+            raise MechanismError(
+                f"{raw!r} is not a finite real number at the nominal parameter values: "
+                f"{error.message}", path,
+                "A link too short (or too long) to close the drawing at these values? "
+                + (f"Check the parameters it uses: {', '.join(used)}." if used else
+                   "Check the numbers.")) from None
         return Q(raw, value)
 
     def tidy(self, q: Q) -> Any:
