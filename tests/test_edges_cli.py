@@ -51,3 +51,14 @@ def test_limit_position_exits_1_and_says_how_to_go_on(tmp_path: Path) -> None:
     assert "limit position near t = 1.82347658" in result.stderr
     assert "reversing the driver" in result.stderr
     assert np.load(tmp_path / "out.npz")["t"].size == 37
+
+
+def test_a_run_that_stops_before_its_first_row_writes_the_header(tmp_path: Path) -> None:
+    """The textbook crank-slider with a rod b = 2 that cannot reach the slide (c - a = 3):
+    no row is solved, and -o out.csv still writes the columns (was a traceback, no file)."""
+    text = (ROOT / "examples" / "crank_slider.yaml").read_text().replace("b: 5.0", "b: 2.0")
+    (tmp_path / "short.yaml").write_text(text)
+    result = run("short.yaml", "-o", "out.csv", cwd=tmp_path)
+    assert result.returncode == 1 and "cannot be assembled" in result.stderr
+    lines = (tmp_path / "out.csv").read_text().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("t,crank.x,") and lines[0].endswith(",flagged")

@@ -169,8 +169,9 @@ class Trajectory:
                   *(c + "_tt" for c in self.coordinates), *self._point_columns(), "flagged"]
         r, dr, ddr = self.point_arrays()
         # Per point: x, y, vx, vy, ax, ay (2.14-2.16).
-        points = np.concatenate([r, dr, ddr], axis=2).reshape(self.t.size, -1)
-        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, self.flagged]) \
-            if self.t.size else np.zeros((0, len(header)))
+        # the column count given, not inferred: a run that stopped before its first row
+        # still writes its header
+        points = np.concatenate([r, dr, ddr], axis=2).reshape(self.t.size, 6 * len(self.points))
+        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, self.flagged])
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")
