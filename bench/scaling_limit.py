@@ -102,7 +102,7 @@ def mechanism(family: str, bodies: int) -> tuple[dict[str, Any], Any]:
 def child(family: str, bodies: int, tighten_cond: float | None = None) -> dict[str, Any]:
     """One measurement, in this (fresh) process."""
     import symkin
-    from symkin.runtime import options as newton
+    from symkin.contract.options import defaults
     from symkin.spec import validate as model
 
     data, exact = mechanism(family, bodies)
@@ -120,7 +120,7 @@ def child(family: str, bodies: int, tighten_cond: float | None = None) -> dict[s
         gcc = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
         assert kernel.backend == "c"
         options = (None if tighten_cond is None else
-                   dataclasses.replace(newton.defaults("double"), tighten_cond=tighten_cond))
+                   dataclasses.replace(defaults("double"), tighten_cond=tighten_cond))
         # first call: loading, allocation
         symkin.solve(kernel, t=np.arange(11) * 0.001, options=options)
         runs = []

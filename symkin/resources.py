@@ -1,4 +1,5 @@
-"""Where the package's data lives (the jinja2 templates) and the names of generated files."""
+"""Where the package's data lives (the jinja2 templates) and the suffix of compiled extensions
+(the manifest's name is symkin.contract.manifest's)."""
 
 from __future__ import annotations
 
@@ -14,17 +15,6 @@ def template_root() -> Path:
     if installed.is_dir():
         return installed
     return _PACKAGE.parent / "templates"
-
-
-# The file every generated folder carries, one per mechanism (so that several mechanisms can
-# share a folder): its files with their sha256 and the metadata a runtime needs. Written by
-# codegen.render, read by runtime.kernel and build.index.
-MANIFEST_SUFFIX = "_manifest.json"
-
-
-def manifest_name(prefix: str) -> str:
-    """``crank_slider`` -> ``crank_slider_manifest.json``."""
-    return prefix + MANIFEST_SUFFIX
 
 
 def extension_suffix() -> str:

@@ -19,7 +19,7 @@ import pytest
 import sympy as sp
 
 import symkin
-from symkin.runtime.options import Options
+from symkin.contract.options import Options
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 TIGHT = Options(tol_phi=1e-14, tol_dq=1e-13)

@@ -19,8 +19,9 @@ import numpy as np
 import pytest
 
 import symkin
+from symkin.contract.options import defaults
+from symkin.contract.tuning import REESTIMATE_SHIFT, UNIT_ROUNDOFF
 from symkin.runtime import accuracy, linalg, newton
-from symkin.runtime.options import defaults
 from symkin.spec import validate as model
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bench"))
@@ -70,12 +71,10 @@ def test_tighten_cond_inf_turns_the_extra_iterations_off(tongs10: symkin.System,
                                                          tmp_path: Path) -> None:
     """The same work at every step, for who needs it: the points stay as Newton's tolerance
     left them, and the model flags most of them (their q is still within 1e-9 relative)."""
-    from symkin.runtime import options as defaults
-
     kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
     assert kernel.backend == backend
     t = np.arange(301) * 0.001
-    options = dataclasses.replace(defaults.defaults("double"), tighten_cond=math.inf)
+    options = dataclasses.replace(defaults("double"), tighten_cond=math.inf)
     trajectory = symkin.solve(kernel, t=t, options=options)
     assert trajectory.flagged.mean() > 0.5
     q = closed_form(5, t)[0]
@@ -99,7 +98,7 @@ def test_estimate_after_a_small_move_is_the_banach_bound() -> None:
         exact = np.abs(np.linalg.inv(a)).sum(axis=0).max()
         after = newton._estimate_again(_newton_at(a, exact), _newton_at(a + e))
         theta = exact * np.abs(e).sum(axis=0).max()
-        assert theta <= newton.REESTIMATE_SHIFT
+        assert theta <= REESTIMATE_SHIFT
         assert after.inv_norm == pytest.approx(exact / (1 - theta), rel=1e-12)
         assert after.inv_norm >= np.abs(np.linalg.inv(a + e)).sum(axis=0).max()
         assert after.norm_a == pytest.approx(np.abs(a + e).sum(axis=0).max(), rel=1e-12)
@@ -136,7 +135,7 @@ def test_c_estimate_at_tightened_points_bounds_the_exact_norm(tongs10: symkin.Sy
         assert getattr(lib, f"{name}_solve_step")(options, p, t, state, work, report) == 0
         a = kernel.phi_q(np.array(ffi.unpack(state.q, n)), t)
         ratios.append(report.inv_norm / np.abs(np.linalg.inv(a)).sum(axis=0).max())
-    assert min(ratios) >= 1 - 1e-12 and max(ratios) <= 1 / (1 - newton.REESTIMATE_SHIFT)
+    assert min(ratios) >= 1 - 1e-12 and max(ratios) <= 1 / (1 - REESTIMATE_SHIFT)
     assert max(ratios) > 1 + 1e-6  # the bound was used, not a new estimate
 
 
@@ -187,7 +186,7 @@ def test_a_small_correction_clears_a_point_without_a_step(tongs10: symkin.System
     assert result.correction == pytest.approx(SHIFT, rel=1e-3)
     options = defaults("double")
     assert accuracy.flagged_norms(result.inv_norm, result.norm_a, result.residual, q0.size,
-                                  *previous, options, accuracy.UNIT_ROUNDOFF["double"])  # by s r
+                                  *previous, options, UNIT_ROUNDOFF["double"])  # by s r
     point = newton.kinematics(kernel, result, T_POINT, np.array(kernel.p_values), options)
     assert point is not None and not point.flagged
 

@@ -30,7 +30,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from symkin import resources
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.errors import BuildError, SymkinWarning
 
 RECORD = ".symkin-files.json"
@@ -184,7 +184,7 @@ def checked_manifest(files: Mapping[str, str]) -> dict[str, Any]:
     Raises:
         BuildError: the files are not one generated symkin folder.
     """
-    manifests = [name for name in files if name.endswith(resources.MANIFEST_SUFFIX)]
+    manifests = [name for name in files if name.endswith(MANIFEST_SUFFIX)]
     if len(manifests) != 1:
         raise BuildError(f"expected one symkin manifest among the files, found {len(manifests)}")
     meta: dict[str, Any] = json.loads(files[manifests[0]])
@@ -192,7 +192,7 @@ def checked_manifest(files: Mapping[str, str]) -> dict[str, Any]:
     plain = all(isinstance(n, str) and Path(n).name == n and not n.startswith(".")
                 for n in files)
     if not (isinstance(name, str) and name.isidentifier() and plain
-            and manifests[0] == resources.manifest_name(name)
+            and manifests[0] == manifest_name(name)
             and set(files) == {*meta.get("files", {}), manifests[0]}):
         raise BuildError("the files are not one generated symkin folder (names, manifest and "
                          "file list must agree); send the folder symkin.compile built")

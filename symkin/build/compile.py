@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from symkin import resources
 from symkin.build.backend import Backend
 from symkin.build.cache import open_cache
 from symkin.codegen import lower as codegen
 from symkin.codegen import render
+from symkin.contract.manifest import manifest_name
 from symkin.runtime.kernel import Kernel
 from symkin.symbolic.derivation import System
 
@@ -43,5 +43,5 @@ def compile(system: System, backend: Backend, *, real: str = "double", cse: bool
     cache = open_cache(cache_dir)
     code = codegen.lower(system, backend, real, cse, linalg)
     files = render.render_sources(code)
-    files[resources.manifest_name(code.name)] = render.manifest(code, files)
+    files[manifest_name(code.name)] = render.manifest(code, files)
     return backend.build(files, cache)

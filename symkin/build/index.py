@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 from symkin import resources
 from symkin.build.backend import Backend
 from symkin.build.cache import discard, open_cache, sha256_of
+from symkin.contract.manifest import MANIFEST_SUFFIX
 from symkin.runtime.kernel import Kernel, read_manifest
 
 # Bump when the entry layout or the meaning of a key changes.
@@ -201,7 +202,7 @@ def _matches(entry: Any, key: str, options: Options) -> bool:
     return (isinstance(entry, dict) and entry.get("format") == FORMAT
             and entry.get("key") == key and entry.get("backend") == options.backend.name
             and isinstance(entry.get("files"), dict)
-            and any(str(name).endswith(resources.MANIFEST_SUFFIX) for name in entry["files"]))
+            and any(str(name).endswith(MANIFEST_SUFFIX) for name in entry["files"]))
 
 
 def _intact(folder: Path, files: dict[Any, Any], options: Options) -> dict[str, Any] | None:

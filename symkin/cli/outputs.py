@@ -154,7 +154,7 @@ class ProgressBar:
 def flag_warnings(trajectory: Any) -> list[str]:
     """``warning: ... at t = ...`` for each stretch of flagged points: where, how
     ill-conditioned, and the singular configuration passed there with its dependent rows."""
-    from symkin.runtime.options import Options
+    from symkin.contract.options import Options
 
     targets = Options()
     flagged = list(trajectory.flagged)

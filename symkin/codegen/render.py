@@ -4,10 +4,9 @@ Every template the backend (a ``codegen.target.Target``) lists becomes one file 
 generated folder, named by the backend: ``kernel.h.j2 -> <prefix>.h``, ``kernel.c.j2 ->
 <prefix>.c``, ``kernel.py.j2 -> <prefix>.py`` and any other ``X.Y.j2 -> <prefix>_X.Y`` (the
 solver runtime of the C backend). Templates whose name starts with ``_`` are partials and are
-not written out. The folder also gets
-``manifest.json``: the files with their sha256, the op counts and the metadata a runtime
-needs. The output depends only on the input: the same mechanism gives the same bytes on every
-run and machine.
+not written out. The folder also gets ``<prefix>_manifest.json`` (symkin.contract.manifest):
+the files with their sha256, the op counts and the metadata a runtime needs. The output
+depends only on the input: the same mechanism gives the same bytes on every run and machine.
 """
 
 from __future__ import annotations
@@ -24,8 +23,9 @@ from symkin import resources
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
 from symkin.codegen.target import Target
+from symkin.contract import options, status, tuning
+from symkin.contract.manifest import GENERATOR, MANIFEST_SUFFIX, Manifest, Metadata, manifest_name
 from symkin.errors import BuildError, UsageError
-from symkin.runtime import options as runtime_options
 from symkin.symbolic.derivation import System
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
@@ -121,7 +121,7 @@ def write(code: Code, out_dir: Path, force: bool = False) -> list[Path]:
     earlier output of this mechanism is replaced (files it no longer has are removed), and a
     file symkin did not write (or that was edited since) is never deleted."""
     files = render_sources(code)
-    manifest_file = resources.manifest_name(code.name)
+    manifest_file = manifest_name(code.name)
     files[manifest_file] = manifest(code, files)
     paths = [out_dir / name for name in files]
     try:
@@ -153,11 +153,11 @@ def _generated_here(folder: Path, prefix: str) -> tuple[set[str], set[str]]:
     file whose bytes differ from the recorded sha256, counts as not symkin's."""
     ours: set[str] = set()
     theirs: set[str] = set()
-    for path in sorted(folder.glob("*" + resources.MANIFEST_SUFFIX)):
+    for path in sorted(folder.glob("*" + MANIFEST_SUFFIX)):
         listed = _intact_files(folder, path)
         if listed is None:
             continue
-        owner = ours if path.name == resources.manifest_name(prefix) else theirs
+        owner = ours if path.name == manifest_name(prefix) else theirs
         owner.update(listed | {path.name})
     return ours, theirs
 
@@ -169,11 +169,11 @@ def _intact_files(folder: Path, manifest_path: Path) -> set[str] | None:
         data = json.loads(manifest_path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-    if not isinstance(data, dict) or data.get("generator") != "symkin":
+    if not isinstance(data, dict) or data.get("generator") != GENERATOR:
         return None
     listed = data.get("files")
     if not isinstance(listed, dict) or \
-            manifest_path.name != resources.manifest_name(str(data.get("name"))):
+            manifest_path.name != manifest_name(str(data.get("name"))):
         return None
     return {name for name, digest in listed.items()
             if isinstance(name, str) and Path(name).name == name
@@ -189,16 +189,16 @@ def _sha256_file(path: Path) -> str | None:
 
 def manifest(code: Code, files: dict[str, str]) -> str:
     """The manifest: file hashes, op counts and the metadata a runtime needs, as JSON."""
-    data = {
-        "generator": "symkin", "backend": code.backend.name, "real": code.real, "cse": code.cse,
-        "name": code.name, "spec_sha256": code.spec_sha256,
-        "files": {name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()},
-        "ops": code.ops, "ops_before_cse": code.ops_before_cse, **metadata(code),
-    }
+    data = Manifest(
+        generator=GENERATOR, backend=code.backend.name, real=code.real, cse=code.cse,
+        name=code.name, spec_sha256=code.spec_sha256,
+        files={name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()},
+        ops=code.ops, ops_before_cse=code.ops_before_cse, **metadata(code),
+    )
     return json.dumps(data, indent=1, sort_keys=True) + "\n"
 
 
-def metadata(code: Code) -> dict[str, Any]:
+def metadata(code: Code) -> Metadata:
     """What the runtime Kernel needs besides the compiled functions (plain JSON data)."""
     return {
         "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
@@ -242,7 +242,11 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg,
+        # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
+        "option_fields": list(options.SOLVER_FIELDS),
+        "status": dict(status.CODES),
+        "shared_constants": {name: _c_number(value) for name, value in tuning.SHARED.items()},
         **code.backend.template_context(code),
     }
 
@@ -304,9 +308,14 @@ def _labels(code: Code, routine: str) -> list[str]:
 
 def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
     """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
-    options = runtime_options.defaults(code.real)
+    defaults = options.defaults(code.real)
     return {name: str(value) if isinstance(value, (int, bool)) else literal(value)
-            for name, value in vars(options).items()}
+            for name, value in vars(defaults).items()}
+
+
+def _c_number(value: float) -> str:
+    """The shortest text that reads back as ``value``: ``10``, ``0.05`` (cast where used)."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))
 
 
 def header_lines(code: Code, template: str, file_name: str) -> list[str]:

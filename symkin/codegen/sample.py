@@ -1,13 +1,13 @@
 """A sample configuration of a mechanism, for choices made at generation time.
 
 The pivot order of the generated sparse LU is checked on Phi_q at the mechanism assembled at
-t0. That configuration is found here with plain NumPy (SymPy's lambdify of Phi and Phi_q) and a
-small assembly of its own, so code generation never depends on the runtime driver.
+t0. That configuration is found here with plain NumPy (SymPy's lambdify of Phi and Phi_q) and
+the dense Newton and Levenberg-Marquardt of symkin.contract.dense_solvers, so code generation
+never depends on the runtime.
 """
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -17,13 +17,13 @@ import sympy as sp
 
 from symkin.codegen import lu_plan as sparse_lu
 from symkin.codegen import symbols
+from symkin.contract import dense_solvers
+from symkin.contract.options import defaults
 from symkin.errors import BuildError, SolveError
-from symkin.runtime import options as runtime_options
-from symkin.runtime.newton import levenberg_marquardt
 from symkin.symbolic.derivation import System
 
 # Assembly tolerances: the runtime's own Newton defaults (a tighter sample changes nothing).
-NEWTON = runtime_options.defaults("double")
+NEWTON = defaults("double")
 
 
 def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> sparse_lu.LUPlan:
@@ -46,9 +46,9 @@ def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...
 
     The file's q0 is only a first guess (the chapter starts from q = 0), and a pivot order
     that is numerically good there may be poor on the motion itself; the assembled position
-    is the first point the solver factors. It is found numerically here with the driver's
-    own assembly (Newton, then Levenberg-Marquardt); when that fails, q0 is used and the
-    run-time pivot checks still guard every factorization.
+    is the first point the solver factors. It is found numerically here with dense Newton, then
+    Levenberg-Marquardt (symkin.contract.dense_solvers, the runtime's too); when that fails, q0
+    is used and the run-time pivot checks still guard every factorization.
 
     Args:
         system: the derived kinematics.
@@ -101,32 +101,9 @@ class _SampleKernel:
 
 def _assemble(kernel: Any, q0: np.ndarray, t0: float, p: np.ndarray) -> np.ndarray | None:
     """Newton from q0, else Levenberg-Marquardt then Newton: the assembled q, or None."""
-    q = _newton(kernel, q0, t0, p)
+    q = dense_solvers.newton(kernel, q0, t0, p, NEWTON)
     if q is not None:
         return q
-    return _newton(kernel, levenberg_marquardt(kernel, q0, t0, p, NEWTON)[0], t0, p)
+    start, _ = dense_solvers.levenberg_marquardt(kernel, q0, t0, p, NEWTON)
+    return dense_solvers.newton(kernel, start, t0, p, NEWTON)
 
-
-def _newton(kernel: Any, q: np.ndarray, t: float, p: np.ndarray) -> np.ndarray | None:
-    """Newton-Raphson testing the residual of the iterate; None when it fails or Phi_q is
-    singular (pivot ratio of the LU factors below NEWTON.min_pivot_ratio)."""
-    import scipy.linalg
-
-    q = np.array(q, dtype=float)
-    step = math.inf
-    for iteration in range(NEWTON.max_iterations + 1):
-        phi = kernel.phi(q, t, p)
-        residual = float(np.abs(phi).max(initial=0.0))
-        if not math.isfinite(residual):
-            return None
-        lu, pivots = scipy.linalg.lu_factor(kernel.phi_q(q, t, p), check_finite=False)
-        diagonal = np.abs(np.diag(lu))
-        largest = diagonal.max(initial=0.0)
-        if largest == 0.0 or diagonal.min() / largest < NEWTON.min_pivot_ratio:
-            return None
-        if residual <= NEWTON.tol_phi and (iteration == 0 or step <= NEWTON.tol_dq):
-            return q
-        delta = scipy.linalg.lu_solve((lu, pivots), -phi, check_finite=False)
-        q = q + delta
-        step = float(np.abs(delta).max(initial=0.0))
-    return None

@@ -13,6 +13,7 @@ coordinate's error sees only its share):
     e_dq  = s (u |dq| + e_q max(1, |dq|))          the solve's rounding, and Phi_q moved by e_q
     e_ddq = s (u |ddq| + e_q (|ddq| + |dq|^2) + 2 e_dq max(1, |dq|))
 each times SAFETY; a point is flagged when one of them exceeds its target times max(1, |x|).
+SAFETY, u and the estimator's steps are symkin.contract.tuning's, which the C solver shares.
 c is the error of q the residual r leaves: max |Phi_q^-1 Phi|, the size of the Newton
 correction, where it was solved for (runtime.newton does so before it iterates on to avoid a
 flag), else the bound s r. The correction is the actual error where the bound is the worst
@@ -30,18 +31,11 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.runtime.options import Options
+from symkin.contract.options import Options
+from symkin.contract.tuning import ESTIMATOR_STEPS, SAFETY
 
 Array = NDArray[np.float64]
 Solve = Callable[[Array], Array]
-
-UNIT_ROUNDOFF = {"double": 2.0**-52, "float": 2.0**-23}
-SAFETY = 10.0
-"""The error model's estimates are multiplied by this before they are compared with the
-targets: the condition estimate may be low by a small factor, and the rounding of Phi is only
-known in size."""
-
-ESTIMATOR_STEPS = 5
 
 
 def inverse_norm1(solve: Solve, solve_transposed: Solve, n: int) -> float:

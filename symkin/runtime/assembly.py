@@ -25,8 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.runtime.newton import Newton, levenberg_marquardt, newton
-from symkin.runtime.options import OK, SINGULAR, Options
+from symkin.contract.dense_solvers import levenberg_marquardt
+from symkin.contract.options import Options
+from symkin.contract.status import OK, SINGULAR
+from symkin.runtime.newton import Newton, newton
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]

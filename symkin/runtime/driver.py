@@ -33,6 +33,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin.contract.options import Options
+from symkin.contract.options import defaults as newton_defaults
+from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
 from symkin.runtime import failures
 from symkin.runtime.arguments import first_guess as first_guess
@@ -43,8 +46,6 @@ from symkin.runtime.assembly import Assembly, assemble
 from symkin.runtime.edges import Resolution, resolve
 from symkin.runtime.linalg import factor_at
 from symkin.runtime.newton import Newton, kinematics, newton
-from symkin.runtime.options import NOT_FINITE, OK, SINGULAR, Options
-from symkin.runtime.options import defaults as newton_defaults
 from symkin.runtime.outputs import Out, allocate
 from symkin.runtime.outputs import Run as _Run
 from symkin.runtime.protocol import GridSolver, KinematicsKernel

@@ -25,9 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.options import Options
+from symkin.contract.status import OK
 from symkin.runtime.linalg import dependencies
 from symkin.runtime.newton import Point, kinematics, newton
-from symkin.runtime.options import OK, Options
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]

@@ -10,11 +10,12 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.options import defaults
+from symkin.contract.status import NO_CONVERGENCE, NOT_FINITE, SINGULAR
 from symkin.runtime.assembly import Assembly
 from symkin.runtime.edges import Resolution
 from symkin.runtime.linalg import dependencies
 from symkin.runtime.newton import Newton
-from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, SINGULAR, defaults
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]

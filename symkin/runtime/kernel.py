@@ -21,8 +21,8 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from symkin import resources
-from symkin.runtime.options import Options
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
+from symkin.contract.options import Options
 from symkin.runtime.protocol import BatchSolver, GridSolver
 
 Array = NDArray[np.float64]
@@ -159,8 +159,8 @@ def read_manifest(folder: Path, name: str | None = None) -> dict[str, Any]:
 
 def _manifest(folder: Path, name: str | None) -> Path:
     if name is not None:
-        return folder / resources.manifest_name(name)
-    found = sorted(folder.glob("*" + resources.MANIFEST_SUFFIX))
+        return folder / manifest_name(name)
+    found = sorted(folder.glob("*" + MANIFEST_SUFFIX))
     if len(found) != 1:
         raise FileNotFoundError(f"{folder} holds {len(found)} symkin manifests; name the "
                                 "mechanism to load")

@@ -1,5 +1,7 @@
-"""Positions at one time point: Newton-Raphson (2.72) and, for assembly from a poor guess,
-Levenberg-Marquardt. The status codes are shared with the generated C solver."""
+"""Positions at one time point: Newton-Raphson (2.72) with the condition estimate and the
+error model at the converged point. The status codes are shared with the generated C solver
+(symkin.contract.status); Levenberg-Marquardt, for assembly from a poor guess, is plain dense
+numerics (symkin.contract.dense_solvers)."""
 
 from __future__ import annotations
 
@@ -9,23 +11,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.options import Options
+from symkin.contract.status import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR
+from symkin.contract.tuning import REESTIMATE_SHIFT, TIGHTEN_STEPS, UNIT_ROUNDOFF
 from symkin.runtime import accuracy
 from symkin.runtime.linalg import Factors, SparseFactors, distance1, factor_at
-from symkin.runtime.options import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR, Options
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
-
-TIGHTEN_STEPS = 3
-"""Newton iterations allowed after convergence at an ill-conditioned point (its step stalls at
-the rounding level within one or two)."""
-
-REESTIMATE_SHIFT = 0.05
-"""After those iterations the estimate of ||Phi_q^-1||_1 is not made again where
-theta = ||Phi_q^-1||_1 ||Phi_q' - Phi_q||_1 (the old estimate, the change of Phi_q) is at
-most this: ||Phi_q'^-1||_1 <= ||Phi_q^-1||_1 / (1 - theta) (the Banach lemma) stands for it.
-An exact norm is always made again."""
-
 
 @dataclass
 class Newton:
@@ -111,7 +104,7 @@ def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
     tighten_cond = inf: neither. After a step, estimate again. Above options.max_cond the
     point counts as singular."""
     result = _estimate(result)
-    unit = accuracy.UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
+    unit = UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
     ill = result.cond > options.tighten_cond
 
     def would_flag(residual: float, correction: float = math.nan) -> bool:
@@ -169,39 +162,8 @@ def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
     ddq = factors.solve(kernel.gamma(q, dq, t, p))  # (2.74)
     if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(ddq))):
         return None
-    unit = accuracy.UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
+    unit = UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
     flag = accuracy.flagged(result.inv_norm, result.norm_a, result.residual, q, dq, ddq,
                             options, unit, result.correction)
     return Point(q, dq, ddq, result.cond, flag)
 
-
-def levenberg_marquardt(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options,
-                        max_iterations: int = 200) -> tuple[Array, float]:
-    """Minimise |Phi(q, t)|^2 from a poor guess; returns the best q and its max |Phi|.
-
-    Each step solves (J^T J + mu I) dq = -J^T Phi; mu shrinks after a step that lowers the
-    residual and grows otherwise, so the method moves like Newton near a solution and like
-    gradient descent far from one. It works where Phi_q is singular (e.g. q = 0).
-    """
-    q = np.array(q, dtype=float)
-    phi = kernel.phi(q, t, p)
-    cost = float(phi @ phi)
-    mu = 1e-3
-    for _ in range(max_iterations):
-        if math.sqrt(cost) <= options.tol_phi:
-            break
-        jacobian = kernel.phi_q(q, t, p)
-        normal = jacobian.T @ jacobian
-        gradient = jacobian.T @ phi
-        scale = mu * max(float(np.max(np.diag(normal))), 1.0)
-        delta = np.linalg.solve(normal + scale * np.eye(q.size), -gradient)
-        trial = q + delta
-        trial_phi = kernel.phi(trial, t, p)
-        trial_cost = float(trial_phi @ trial_phi)
-        if math.isfinite(trial_cost) and trial_cost < cost:
-            q, phi, cost, mu = trial, trial_phi, trial_cost, max(mu / 10, 1e-12)
-        else:
-            mu *= 10
-            if mu > 1e12:
-                break
-    return q, float(np.abs(phi).max(initial=0.0))

@@ -8,7 +8,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from symkin.runtime.options import Options
+from symkin.contract.options import Options
 
 Array = NDArray[np.float64]
 
@@ -19,7 +19,7 @@ class ChunkResult:
 
     Attributes:
         solved: how many time points of the chunk were solved.
-        status: newton.OK, NO_CONVERGENCE or SINGULAR at the last point attempted.
+        status: contract.status OK, NO_CONVERGENCE or SINGULAR at the last point attempted.
         t: the time of that point.
         iterations, residual: Newton's count and max |Phi| there.
         fallbacks: the sparse LU's fall-backs to dense LU so far (0 for the dense LU).
@@ -53,7 +53,7 @@ class GridSolver(Protocol):
 
     @property
     def status(self) -> int:
-        """The status at the last point attempted (runtime.options codes)."""
+        """The status at the last point attempted (symkin.contract.status codes)."""
         ...
 
     @property

@@ -20,11 +20,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin.contract.dense_solvers import levenberg_marquardt
+from symkin.contract.status import OK
 from symkin.runtime import driver
 from symkin.runtime.assembly import RANDOM_ANGLES, assemble, starts
 from symkin.runtime.edges import LIMIT_COND
-from symkin.runtime.newton import levenberg_marquardt, newton
-from symkin.runtime.options import OK
+from symkin.runtime.newton import newton
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]

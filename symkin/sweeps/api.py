@@ -18,10 +18,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin import limits
+from symkin.contract.options import Options
 from symkin.errors import SolveError
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
-from symkin.runtime.options import Options
 from symkin.sweeps import parallel
 from symkin.sweeps.batch import Chunk, empty_chunk, solve_chunk
 from symkin.sweeps.result import SweepResult

@@ -16,9 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.options import Options
+from symkin.contract.status import OK
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
-from symkin.runtime.options import OK, Options
 
 Array = NDArray[np.float64]
 

@@ -24,11 +24,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin import backends, resources
+from symkin import backends
 from symkin.build.cache import verified
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
+from symkin.contract.options import Options
 from symkin.errors import SolveError
 from symkin.runtime.kernel import Kernel
-from symkin.runtime.options import Options
 from symkin.sweeps.batch import Chunk, solve_chunk
 
 Array = NDArray[np.float64]
@@ -53,7 +54,7 @@ def payload(kernel: Kernel) -> Payload:
     if folder is None:
         raise SolveError(f"the kernel of {kernel.name} has no build folder to send to workers; "
                          "compile it with symkin.compile")
-    manifest = resources.manifest_name(kernel.name)
+    manifest = manifest_name(kernel.name)
     listed = json.loads((folder / manifest).read_text(encoding="utf-8"))["files"]
     names = [*sorted(listed), manifest]
     return Payload({name: (folder / name).read_text(encoding="utf-8") for name in names},
@@ -81,7 +82,7 @@ def _same_machine(source: Payload) -> Kernel | None:
         if not verified(folder, source.files):
             return None
         name = json.loads(source.files[next(n for n in source.files
-                                            if n.endswith(resources.MANIFEST_SUFFIX))])["name"]
+                                            if n.endswith(MANIFEST_SUFFIX))])["name"]
         return backends.load(folder, name)
     except (OSError, ImportError, ValueError, KeyError, StopIteration):
         return None

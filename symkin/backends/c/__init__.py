@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from symkin import resources
 from symkin.codegen.target import file_name, rendered_templates
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 
 if TYPE_CHECKING:
     from symkin.codegen.lower import Code
@@ -94,8 +95,8 @@ class CBackend:
         toolchain.require()
         compiler = toolchain.c_compiler()
         assert compiler is not None  # require() raised otherwise
-        names = [n for n in files if n.endswith(resources.MANIFEST_SUFFIX)]
-        return cffi_build.build(files, names[0].removesuffix(resources.MANIFEST_SUFFIX), cache,
+        names = [n for n in files if n.endswith(MANIFEST_SUFFIX)]
+        return cffi_build.build(files, names[0].removesuffix(MANIFEST_SUFFIX), cache,
                                 compiler)
 
     def load(self, folder: Path, meta: Mapping[str, Any]) -> Kernel:
@@ -106,7 +107,7 @@ class CBackend:
     def loaded_files(self, folder: Path, name: str) -> list[str]:
         from symkin.backends.c import loader
 
-        return [resources.manifest_name(name), loader.extension_file(folder).name]
+        return [manifest_name(name), loader.extension_file(folder).name]
 
 
 BACKEND = CBackend()

@@ -20,6 +20,7 @@ from symkin.backends.c.cdef import from_headers as cdef_from_headers
 from symkin.backends.c.loader import CKernel, import_extension
 from symkin.backends.c.toolchain import run
 from symkin.build.cache import build_unless_verified, content_key
+from symkin.contract.manifest import manifest_name
 
 # Plain -O2: -ffast-math would break the NaN checks of the solver and reorder sums, and
 # -march=native would make a cached binary non-portable.
@@ -50,7 +51,7 @@ def build(files: dict[str, str], name: str, cache: Path, compiler: list[str]) ->
     library = folder / (module_name + resources.extension_suffix())
     build_unless_verified(cache, folder, files, lambda build: _build_c(
         build, files, cdef, module_name, compiler, name))
-    meta = json.loads(files[resources.manifest_name(name)])
+    meta = json.loads(files[manifest_name(name)])
     return import_extension(module_name, library, meta, folder)
 
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.runtime.options import Options
+from symkin.contract.options import Options
 from symkin.runtime.protocol import ChunkResult
 
 Array = NDArray[np.float64]

@@ -16,8 +16,8 @@ import numpy as np
 from symkin import resources
 from symkin.backends.c import batch
 from symkin.backends.c.csolver import GridSolver, SolverPool
+from symkin.contract.options import Options
 from symkin.runtime.kernel import Array, Kernel, import_file
-from symkin.runtime.options import Options
 from symkin.runtime.protocol import BatchStatus
 
 

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from symkin import resources
 from symkin.codegen.target import file_name, rendered_templates
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 
 if TYPE_CHECKING:
     from symkin.codegen.lower import Code
@@ -83,13 +84,13 @@ class NumPyBackend:
 
     def loaded_files(self, folder: Path, name: str) -> list[str]:
         del folder
-        return [resources.manifest_name(name), f"{name}.py"]
+        return [manifest_name(name), f"{name}.py"]
 
 
 def _name(files: Mapping[str, str]) -> str:
     """The mechanism of a generated folder: its manifest's prefix."""
-    manifest = next(n for n in files if n.endswith(resources.MANIFEST_SUFFIX))
-    return manifest.removesuffix(resources.MANIFEST_SUFFIX)
+    manifest = next(n for n in files if n.endswith(MANIFEST_SUFFIX))
+    return manifest.removesuffix(MANIFEST_SUFFIX)
 
 
 BACKEND = NumPyBackend()

@@ -8,8 +8,8 @@ from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 
-from symkin import resources
 from symkin.build.cache import build_unless_verified, content_key
+from symkin.contract.manifest import manifest_name
 from symkin.runtime.kernel import Array, Kernel, import_file
 
 
@@ -47,7 +47,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
 def build(files: dict[str, str], name: str, cache: Path, backend: str) -> Kernel:
     """Write a generated module and its manifest into the cache (unless a verified copy is
     there) and import it; the folder is keyed by the sources."""
-    manifest = resources.manifest_name(name)
+    manifest = manifest_name(name)
     key = content_key({"files": {n: text for n, text in files.items() if n != manifest}})
     folder = cache / f"_symkin_{name}_py_{key[:20]}"
     build_unless_verified(cache, folder, files, lambda target: _write_files(target, files))

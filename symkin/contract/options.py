@@ -1,15 +1,10 @@
-"""Newton's tolerances and the singularity test, with their defaults per real type, and the
-status codes shared with the generated C solver. Defined once: the generated C's
-``<prefix>_default_options`` is rendered from :data:`DEFAULTS` (codegen.render)."""
+"""Newton's tolerances and the singularity test, with their defaults per real type. Defined
+once: the generated C's ``<prefix>_options`` fields and ``<prefix>_default_options`` are
+rendered from :data:`SOLVER_FIELDS` and :data:`DEFAULTS` (codegen.render)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-# Status codes shared with the generated C solver (templates/c/solver.h.j2).
-# NOT_FINITE: Phi at the predicted q, or the velocity or acceleration, is inf or NaN, i.e. an
-# expression of the mechanism is singular at that time (a time function such as 1/(t - 0.5)).
-OK, NO_CONVERGENCE, SINGULAR, NOT_FINITE = 0, 1, 2, 3
+from dataclasses import dataclass, fields
 
 
 @dataclass(frozen=True)
@@ -61,3 +56,9 @@ DEFAULTS = {
 def defaults(real: str) -> Options:
     """The Newton options for a kernel computing in ``real`` ("double" or "float")."""
     return DEFAULTS[real]
+
+
+SOLVER_FIELDS = tuple(f.name for f in fields(Options) if f.name != "stop_at_singular")
+"""The options the generated C solver reads too, in the order of its ``<prefix>_options``
+struct; ``stop_at_singular`` is the Python driver's alone (it decides what happens after the C
+grid loop stops)."""

@@ -1,0 +1,58 @@
+"""The manifest every generated folder carries, one per mechanism (so that several mechanisms
+can share a folder): its file name and its keys. Written by codegen.render (and build.compile);
+read by runtime.kernel, build.cache, build.index, sweeps.parallel and the backends (the registry's
+load and from_sources, each backend's build and loader)."""
+
+from __future__ import annotations
+
+from typing import TypedDict
+
+MANIFEST_SUFFIX = "_manifest.json"
+
+GENERATOR = "symkin"
+"""The value of ``generator``: a manifest symkin wrote (others are never trusted)."""
+
+
+def manifest_name(prefix: str) -> str:
+    """``crank_slider`` -> ``crank_slider_manifest.json``."""
+    return prefix + MANIFEST_SUFFIX
+
+
+class Metadata(TypedDict):
+    """What a runtime Kernel needs besides the compiled functions (plain JSON data)."""
+
+    coordinates: list[str]
+    parameter_names: list[str]
+    p_values: list[float]
+    q0: list[float]
+    time_grid: list[float]
+    rows: list[str]
+    pattern_rows: list[int]
+    pattern_cols: list[int]
+    points: list[list[str]]
+    phi_p_rows: list[int]
+    phi_p_cols: list[int]
+    nq: int
+    n_params: int
+    nnz: int
+    npoints: int
+    nshared: int
+
+
+class Manifest(Metadata):
+    """The whole manifest: who wrote it, for which backend and real type, the files with their
+    sha256 and the op counts, and the :class:`Metadata`."""
+
+    generator: str
+    backend: str
+    real: str
+    cse: bool
+    name: str
+    spec_sha256: str
+    files: dict[str, str]
+    ops: dict[str, int]
+    ops_before_cse: dict[str, int]
+
+
+KEYS = frozenset(Manifest.__annotations__)
+"""Every key of a manifest (a reader asks for no other)."""

@@ -1,0 +1,18 @@
+"""The status codes of one solved time point, shared by the runtime's Newton and the generated
+C solver (``<PREFIX>_OK`` ... in ``<prefix>_solver.h``, rendered from :data:`CODES`)."""
+
+from __future__ import annotations
+
+OK = 0
+"""Converged."""
+NO_CONVERGENCE = 1
+"""The iteration cap was reached, or the iterates diverged."""
+SINGULAR = 2
+"""Phi_q is singular or ill-conditioned."""
+NOT_FINITE = 3
+"""Phi at the predicted q, or the velocity or acceleration, is inf or NaN, i.e. an expression
+of the mechanism is singular at that time (a time function such as 1/(t - 0.5))."""
+
+CODES = {"OK": OK, "NO_CONVERGENCE": NO_CONVERGENCE, "SINGULAR": SINGULAR,
+         "NOT_FINITE": NOT_FINITE}
+"""Every status by its name (the C macro is ``<PREFIX>_`` + the name)."""

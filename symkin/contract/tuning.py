@@ -1,0 +1,32 @@
+"""The fixed numbers of the condition estimator, the error model and Newton's extra steps,
+which the runtime (runtime.accuracy, runtime.newton) and the generated C solver
+(``<prefix>_solver.c``, its ``#define``s rendered from :data:`SHARED`) both use."""
+
+from __future__ import annotations
+
+UNIT_ROUNDOFF = {"double": 2.0**-52, "float": 2.0**-23}
+"""The unit roundoff of each real type (C's DBL_EPSILON and FLT_EPSILON)."""
+
+ESTIMATOR_STEPS = 5
+"""Steps of Hager's ascent in the estimate of ||Phi_q^-1||_1 (runtime.accuracy.inverse_norm1)."""
+
+SAFETY = 10.0
+"""The error model's estimates are multiplied by this before they are compared with the
+targets: the condition estimate may be low by a small factor, and the rounding of Phi is only
+known in size."""
+
+TIGHTEN_STEPS = 3
+"""Newton iterations allowed after convergence at an ill-conditioned point (its step stalls at
+the rounding level within one or two)."""
+
+REESTIMATE_SHIFT = 0.05
+"""After those iterations the estimate of ||Phi_q^-1||_1 is not made again where
+theta = ||Phi_q^-1||_1 ||Phi_q' - Phi_q||_1 (the old estimate, the change of Phi_q) is at
+most this: ||Phi_q'^-1||_1 <= ||Phi_q^-1||_1 / (1 - theta) (the Banach lemma) stands for it.
+An exact norm is always made again."""
+
+
+SHARED = {"ESTIMATOR_STEPS": ESTIMATOR_STEPS, "TIGHTEN_STEPS": TIGHTEN_STEPS, "SAFETY": SAFETY,
+          "REESTIMATE_SHIFT": REESTIMATE_SHIFT}
+"""The constants the generated C solver defines too, by name (its macro is ``<PREFIX>_`` + the
+name, rendered from this table by codegen.render)."""
