@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import symkin
-from symkin.build import compile as build
+from symkin import backends
 from symkin.codegen import lower as codegen
 from symkin.codegen import render
 from symkin.spec import validate as model
@@ -43,12 +43,12 @@ def _timed(action: Callable[[], Any]) -> tuple[Any, float]:
 def measure(mech: model.Mechanism, cse: bool = True) -> dict[str, Any]:
     """Seconds per stage and op counts for one mechanism."""
     system, derive_s = _timed(lambda: symkin.derive(mech))
-    code, lower_s = _timed(lambda: codegen.lower(system, "c", cse=cse))
+    code, lower_s = _timed(lambda: codegen.lower(system, backends.get("c"), cse=cse))
     with tempfile.TemporaryDirectory() as scratch:
         _, render_s = _timed(lambda: render.write(code, Path(scratch) / "c"))
-        _, compile_s = _timed(lambda: build.compile(system, "c", cse=cse,
+        _, compile_s = _timed(lambda: symkin.compile(system, "c", cse=cse,
                                                     cache_dir=Path(scratch) / "cache"))
-        _, numpy_s = _timed(lambda: build.compile(system, "numpy", cse=cse,
+        _, numpy_s = _timed(lambda: symkin.compile(system, "numpy", cse=cse,
                                                   cache_dir=Path(scratch) / "cache"))
         source_bytes = sum(p.stat().st_size for p in (Path(scratch) / "c").glob(f"{mech.name}.c"))
     return {"name": mech.name, "bodies": len(mech.bodies), "nq": code.nq, "nnz": code.nnz,

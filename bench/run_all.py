@@ -116,7 +116,7 @@ def symkin_solvers(times: np.ndarray, folder: Path) -> list[tuple[str, Callable[
     grid from q = 0, assembly included): built as symkin.compile builds it (-O2), and once more
     with -O3 (into a private cache folder) for the pair with the hand-written -O3 build."""
     import symkin
-    from symkin.build import compile as build
+    from symkin.backends.c import cffi_build as build
 
     system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
 
@@ -138,13 +138,15 @@ def symkin_solvers(times: np.ndarray, folder: Path) -> list[tuple[str, Callable[
 
 def _compile_with(build, system, linalg: str, optimisation: str, folder: Path):
     """symkin.compile, with its -O2 replaced by ``optimisation`` (-O3: in its own cache)."""
+    import symkin
+
     if optimisation == "-O2":
-        return build.compile(system, backend="c", linalg=linalg)
+        return symkin.compile(system, backend="c", linalg=linalg)
     saved = build.C_FLAGS
     build.C_FLAGS = tuple(optimisation if flag == "-O2" else flag for flag in saved)
     try:
-        return build.compile(system, backend="c", linalg=linalg,
-                             cache_dir=folder / f"cache{optimisation}")
+        return symkin.compile(system, backend="c", linalg=linalg,
+                              cache_dir=folder / f"cache{optimisation}")
     finally:
         build.C_FLAGS = saved
 

@@ -37,7 +37,7 @@ WARNINGS = ["-Wall", "-Wextra", "-pedantic", "-Werror"]
 
 def build_c_loop(system, folder: Path) -> Callable[..., int]:
     """Compile bench/sweep_loop.c with the generated folder; return bench_sweep."""
-    from symkin.build.compile import C_FLAGS
+    from symkin.backends.c.cffi_build import C_FLAGS
 
     symkin.generate(system, backend="c", out_dir=folder / "gen")
     sources = sorted(str(p) for p in (folder / "gen").glob("*.c")) + [str(HERE / "sweep_loop.c")]

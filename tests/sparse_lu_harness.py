@@ -17,7 +17,7 @@ from pathlib import Path
 import jinja2
 import numpy as np
 
-from symkin.codegen import lu_code
+from symkin.backends.c import lu_code
 from symkin.codegen import lu_plan as sparse_lu
 from symkin.resources import template_root
 

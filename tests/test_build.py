@@ -16,7 +16,7 @@ import pytest
 from codegen_support import GENERATED, ROOT, compilers, system
 
 import symkin
-from symkin.build import compile as build
+from symkin.backends.c import toolchain
 from symkin.build import cache as build_cache
 from symkin.errors import BuildError
 
@@ -67,7 +67,7 @@ def test_key_covers_the_options(cache: Path) -> None:
 def _build_in_child(cache: str, barrier, queue) -> None:
     barrier.wait()  # all eight start compiling at the same moment
     try:
-        k = build.compile(system("crank_slider"), "c", cache_dir=cache)
+        k = symkin.compile(system("crank_slider"), "c", cache_dir=cache)
         queue.put(("ok", k.phi(np.full(9, 0.5), 0.1).tolist()))
     except Exception as error:  # noqa: BLE001 -- reported to the parent, which fails the test
         queue.put(("error", repr(error)))
@@ -113,7 +113,7 @@ def test_a_real_compile_error_is_reported(tmp_path: Path) -> None:
     source = tmp_path / "bad.c"
     source.write_text("int f(void) { return undeclared; }\n")
     with pytest.raises(BuildError, match="undeclared"):
-        build.run([compilers()[0], "-c", str(source)], tmp_path)
+        toolchain.run([compilers()[0], "-c", str(source)], tmp_path)
 
 
 def test_auto_without_a_compiler_notes_once_and_uses_numpy(
@@ -171,9 +171,9 @@ def test_kernel_metadata_and_nominal_parameters(backend: str, shared_cache: Path
 
 _RUNTIME_ONLY = """
 import sys
-from symkin.runtime import kernel
+from symkin import backends
 for folder in sys.argv[1:]:
-    k = kernel.load(folder)
+    k = backends.load(folder)
     k.gamma(k.q0 + 0.1, k.q0 + 0.2, 0.3)
     k.phi_q(k.q0, 0.0)
 leaked = sorted(m for m in sys.modules if m.split(".")[0] in ("sympy", "jinja2"))
@@ -228,7 +228,7 @@ def test_lu_behind_the_solver_solves_phi_q(linalg: str, shared_cache: Path) -> N
 def test_cdef_is_the_generated_headers(tmp_path: Path) -> None:
     """cffi reads the headers a C user compiles against: every prototype of every header is
     in the cdef, headers come after those they include, and no comment or include is left."""
-    from symkin.codegen.cdef import from_headers
+    from symkin.backends.c.cdef import from_headers
 
     folder = GENERATED / "crank_slider" / "c"
     files = {p.name: p.read_text(encoding="utf-8") for p in folder.iterdir() if p.is_file()}

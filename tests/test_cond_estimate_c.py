@@ -1,7 +1,7 @@
 """The generated C solver's condition at solved points, against NumPy: ||Phi_q||_1 (the
 straight-line column sums, Phi_q's numbers folded in) equals the largest column sum of |Phi_q|;
 ||Phi_q^-1||_1 is exact where the generated code computes the inverse's columns
-(codegen.inverse_code: every example here) and equals the largest column sum of
+(backends.c.inverse_code: every example here) and equals the largest column sum of
 numpy.linalg.inv; where that code would be too long, the solver runs the Hager-Higham estimate
 of runtime.accuracy instead, a lower bound that is usually exact."""
 
@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 import symkin
-from symkin.codegen import inverse_code
+from symkin import backends
+from symkin.backends.c import inverse_code
 from symkin.runtime import accuracy, driver, linalg
 
 EXAMPLES_DIR = Path(__file__).resolve().parent.parent / "examples"
@@ -77,7 +78,7 @@ def test_exact_code_is_refused_beyond_its_budget() -> None:
     from symkin.codegen import lower
 
     system = symkin.derive(EXAMPLES_DIR / "crank_slider.yaml")
-    plan = lower.lower(system, backend="c").lu_plan
+    plan = lower.lower(system, backends.get("c")).lu_plan
     assert plan is not None
     values: list[float | None] = [None] * plan.n_lu
     assert inverse_code.exact_context(plan, values, {}, repr, "double", "fabs", limit=10) is None

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 from codegen_support import ROOT, system
 
+from symkin import backends
 from symkin.codegen import render
 from symkin.codegen.lower import lower
 from symkin.contract import manifest, options, status, tuning
@@ -36,7 +37,7 @@ def _defines(source: str, prefix: str) -> dict[str, str]:
 
 @pytest.fixture(scope="module", params=["double", "float"])
 def rendered(request: pytest.FixtureRequest) -> tuple[str, dict[str, str]]:
-    code = lower(system("crank_slider"), "c", request.param)
+    code = lower(system("crank_slider"), backends.get("c"), request.param)
     return request.param, render.render_sources(code)
 
 
@@ -70,7 +71,7 @@ def test_default_options_are_the_contracts(rendered: tuple[str, dict[str, str]])
 
 
 def test_options_struct_has_the_solver_fields(rendered: tuple[str, dict[str, str]]) -> None:
-    """The C struct and the contract's fields, in order (runtime.csolver copies them by name)."""
+    """The C struct and the contract's fields, in order (backends.c.csolver copies them by name)."""
     _, files = rendered
     struct = files["crank_slider_solver.h"].split("typedef struct {", 1)[1].split("}", 1)[0]
     fields = re.findall(r"^\s+\w+ (\w+);", struct, re.M)
@@ -96,15 +97,16 @@ def test_no_template_spells_a_contract_value() -> None:
 
 
 def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
-    paths = render.generate(system("crank_slider"), out_dir=tmp_path)
+    paths = render.generate(system("crank_slider"), backends.get("c"), out_dir=tmp_path)
     written = paths[-1]
     assert written.name == manifest.manifest_name("crank_slider")
     assert set(json.loads(written.read_text(encoding="utf-8"))) == manifest.KEYS
 
 
 # The modules that read a manifest, and the names their manifest dicts go by.
-READERS = ["symkin/runtime/kernel.py", "symkin/build/compile.py", "symkin/build/index.py",
-           "symkin/sweeps/parallel.py", "symkin/codegen/render.py"]
+READERS = ["symkin/runtime/kernel.py", "symkin/build/cache.py", "symkin/build/index.py",
+           "symkin/sweeps/parallel.py", "symkin/codegen/render.py", "symkin/backends/__init__.py",
+           "symkin/backends/c/loader.py", "symkin/backends/numpy/__init__.py"]
 MANIFEST_NAMES = {"meta", "wanted", "data"}
 
 

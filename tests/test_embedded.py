@@ -20,7 +20,7 @@ from codegen_support import (
     undefined_symbols,
 )
 
-from symkin.codegen import render
+import symkin
 from symkin.spec.names import LIBM_NAMES
 
 ARM_GCC, ARM_NM = shutil.which("arm-none-eabi-gcc"), shutil.which("arm-none-eabi-nm")
@@ -61,7 +61,7 @@ def test_double_folder_needs_only_libm(name: str, tmp_path: Path) -> None:
 @pytest.mark.parametrize("name", example_ids())
 def test_float_folder_needs_only_single_precision_libm(name: str, tmp_path: Path) -> None:
     folder = tmp_path / "src"
-    render.generate(system(name), backend="c", out_dir=folder, real="float")
+    symkin.generate(system(name), backend="c", out_dir=folder, real="float")
     undefined = _undefined(_cross_compile(folder, tmp_path))
     helpers = sorted(s for s in undefined if s.startswith("__aeabi_d"))
     assert not helpers, f"double-precision soft-float helpers in float mode: {helpers}"
@@ -144,7 +144,7 @@ def test_textbook_solver_on_arm_matches_the_host(real: str, tmp_path: Path) -> N
     if host_cc is None:
         pytest.skip("no host C compiler")
     folder = tmp_path / "src"
-    render.generate(system("crank_slider"), backend="c", out_dir=folder, real=real)
+    symkin.generate(system("crank_slider"), backend="c", out_dir=folder, real=real)
     if not (folder / "crank_slider_solver.h").exists():
         pytest.skip("the solver runtime templates are not there yet")
     (tmp_path / "run.c").write_text(_RUN_C)

@@ -33,7 +33,6 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 import symkin
-from symkin.codegen import render
 from symkin.errors import BuildError, MechanismError
 
 T, A, B = (sp.Symbol(name, real=True) for name in ("t", "a", "b"))
@@ -182,7 +181,7 @@ def _compiles_strictly_in_float(system, folder: Path) -> None:
     """The float variant compiles warning-free, or is refused for a constant outside the range
     of a float (named in the message), never left to the compiler to truncate."""
     try:
-        render.generate(system, backend="c", out_dir=folder, real="float")
+        symkin.generate(system, backend="c", out_dir=folder, real="float")
     except BuildError as error:
         assert "outside the range of a float" in str(error), str(error)
         return

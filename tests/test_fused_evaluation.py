@@ -17,6 +17,7 @@ import pytest
 from codegen_support import Reference, random_states, system
 
 import symkin
+from symkin import backends
 from symkin.codegen import lower
 
 MECHANISMS = ["crank_slider", "all_drivers", "andrews_squeezer", "quick_return"]
@@ -48,7 +49,7 @@ def test_c_fused_equals_separate_entry_points(name: str) -> None:
     kernel = symkin.compile(derived, backend="c")
     assert kernel.backend == "c"
     reference = Reference(derived)
-    nshared = len(lower.lower(derived, "c").shared)
+    nshared = len(lower.lower(derived, backends.get("c")).shared)
     for q, dq, t, p in random_states(derived, count=40, seed=11):
         fused = _c_fused(kernel, nshared, q, dq, t, p)
         separate = {"phi": kernel.phi(q, t, p), "nz": kernel.phi_q_nz(q, t, p),
@@ -84,7 +85,7 @@ def test_numpy_fused_equals_separate_entry_points(name: str, tmp_path: Path) -> 
 def test_crank_slider_shares_its_two_angles(crank_slider_system) -> None:  # type: ignore[no-untyped-def]
     """The textbook mechanism: sin and cos of crank.phi and rod.phi, once per iterate; Gamma
     and Phi_t read them and call no trigonometric function at all."""
-    code = lower.lower(crank_slider_system, "c")
+    code = lower.lower(crank_slider_system, backends.get("c"))
     assert sorted(code.shared) == ["cos(q[2])", "cos(q[5])", "sin(q[2])", "sin(q[5])"]
     gamma = code.routine("gamma_shared")
     text = " ".join([*gamma.outputs, *(v for _, v in gamma.temporaries)])

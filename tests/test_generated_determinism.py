@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from codegen_support import example_ids, golden_folder, system
 
-from symkin.codegen import render
+import symkin
 from symkin.codegen import sample as codegen_sample
 
 
@@ -29,7 +29,7 @@ def test_perturbed_sample_gives_the_same_bytes(name: str, tmp_path: Path,
         return tuple(q * (1 + 1e-6 * rng.standard_normal(q.size)) + 1e-9)
 
     monkeypatch.setattr(codegen_sample, "sample_configuration", perturbed)
-    render.generate(system(name), backend="c", out_dir=tmp_path)
+    symkin.generate(system(name), backend="c", out_dir=tmp_path)
     golden = golden_folder(name, "c")
     for path in sorted(golden.iterdir()):
         assert (tmp_path / path.name).read_bytes() == path.read_bytes(), path.name

@@ -1,4 +1,4 @@
-"""The sparse LU with Phi_q's constant entries folded in (codegen.lu_code).
+"""The sparse LU with Phi_q's constant entries folded in (backends.c.lu_code).
 
 Pivots that are numbers (the +-1 of ground joints and revolute joints) get no reciprocal and no
 test at run time, multipliers that are numbers become literals. The solutions must still be

@@ -19,10 +19,9 @@ import numpy as np
 import pytest
 
 import symkin
+from symkin import backends
 from symkin.build import cache as build_cache
-from symkin.codegen import render
 from symkin.errors import SymkinWarning, UsageError
-from symkin.runtime import kernel as kernel_module
 
 ROOT = Path(__file__).resolve().parent.parent
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
@@ -195,8 +194,8 @@ def test_generate_never_deletes_files_a_foreign_manifest_lists(system: symkin.Sy
     (out / "crank_slider_manifest.json").write_text(json.dumps(
         {"generator": "symkin", "name": "crank_slider", "files": {"important.txt": "0"}}))
     with pytest.raises(UsageError, match="files symkin did not write"):
-        render.generate(system, backend="c", out_dir=out)
-    render.generate(system, backend="c", out_dir=out, force=True)
+        symkin.generate(system, backend="c", out_dir=out)
+    symkin.generate(system, backend="c", out_dir=out, force=True)
     assert (out / "important.txt").read_text() == "keep me"
 
 
@@ -217,28 +216,28 @@ def test_generate_refuses_a_folder_of_other_files_with_exit_2(tmp_path: Path) ->
 def test_two_mechanisms_share_a_folder(system: symkin.System, tmp_path: Path) -> None:
     out = tmp_path / "out"
     four_bar = symkin.derive(ROOT / "examples" / "four_bar.yaml")
-    render.generate(system, backend="numpy", out_dir=out)
-    render.generate(four_bar, backend="numpy", out_dir=out)
-    render.generate(system, backend="numpy", out_dir=out)  # regenerate the first: no refusal
+    symkin.generate(system, backend="numpy", out_dir=out)
+    symkin.generate(four_bar, backend="numpy", out_dir=out)
+    symkin.generate(system, backend="numpy", out_dir=out)  # regenerate the first: no refusal
     names = {p.name for p in out.iterdir()}
     assert {"crank_slider.py", "crank_slider_manifest.json", "four_bar.py",
             "four_bar_manifest.json"} <= names
-    loaded = kernel_module.load(out, "four_bar")
+    loaded = backends.load(out, "four_bar")
     assert loaded.name == "four_bar"
     with pytest.raises(FileNotFoundError, match="2 symkin manifests"):
-        kernel_module.load(out)
+        backends.load(out)
 
 
 def test_an_edited_generated_file_is_not_deleted(system: symkin.System, tmp_path: Path) -> None:
     """A generated file the user changed is theirs now: switching to the dense LU (which no
     longer writes the sparse LU files) must not delete the edited one."""
     out = tmp_path / "out"
-    render.generate(system, backend="c", out_dir=out, linalg="sparse")
+    symkin.generate(system, backend="c", out_dir=out, linalg="sparse")
     edited = out / "crank_slider_sparse_lu.c"
     edited.write_text(edited.read_text() + "/* my tuning */\n")
     with pytest.raises(UsageError):
-        render.generate(system, backend="c", out_dir=out, linalg="dense")
-    render.generate(system, backend="c", out_dir=out, linalg="dense", force=True)
+        symkin.generate(system, backend="c", out_dir=out, linalg="dense")
+    symkin.generate(system, backend="c", out_dir=out, linalg="dense", force=True)
     assert edited.read_text().endswith("/* my tuning */\n")
     assert not (out / "crank_slider_sparse_lu.h").exists()  # unedited: symkin's to remove
     shutil.rmtree(out)

@@ -160,7 +160,7 @@ def test_dask_local_cluster_equals_this_process(c_kernel) -> None:
 @pytest.mark.parametrize("backend", ["c", "numpy"])
 def test_a_worker_without_the_build_builds_it_from_the_source(crank_slider_system, backend,
                                                               tmp_path: Path) -> None:
-    from symkin.build.compile import from_sources
+    from symkin.backends import from_sources
     from symkin.sweeps import parallel
 
     kernel = symkin.compile(crank_slider_system, backend=backend)

@@ -18,7 +18,7 @@ import pytest
 import sympy as sp
 from sparse_lu_harness import build, render
 
-from symkin.codegen import lu_code
+from symkin.backends.c import lu_code
 from symkin.codegen import lu_plan as sparse_lu
 from symkin.spec import validate as model
 from symkin.symbolic import derivation

@@ -148,6 +148,7 @@ def test_editing_a_template_misses(tmp_path: Path, snapshot: Path) -> None:
 
 
 def test_corrupt_index_entry_is_rebuilt(snapshot: Path, tmp_path: Path) -> None:
+    from symkin import backends
     from symkin.build import index as cache
 
     folder = tmp_path / "cache"
@@ -156,11 +157,11 @@ def test_corrupt_index_entry_is_rebuilt(snapshot: Path, tmp_path: Path) -> None:
     valid = entry.read_bytes()
     key = entry.stem
     # symkin run's default backend is auto, i.e. C here: its entry is not one for NumPy
-    assert cache.lookup(folder, key, cache.Options(backend="numpy")) is None
+    assert cache.lookup(folder, key, cache.Options(backend=backends.get("numpy"))) is None
     other_key = json.dumps({**json.loads(valid), "key": "0" * 64}).encode()
     for damage in (b"{not json", b"", b"[]", b"\xff\xfe", other_key):
         entry.write_bytes(damage)
-        assert cache.lookup(folder, key, cache.Options(backend="c")) is None
+        assert cache.lookup(folder, key, cache.Options(backend=backends.get("c"))) is None
         assert not entry.exists()  # removed, so the next run records a good one
 
     entry.write_bytes(b"{not json")
@@ -195,6 +196,7 @@ def test_damaged_kernel_is_never_loaded(snapshot: Path, tmp_path: Path, backend:
 
 
 def test_entry_naming_a_folder_outside_the_cache_is_refused(tmp_path: Path) -> None:
+    from symkin import backends
     from symkin.build import index as cache
 
     outside = tmp_path / "outside"
@@ -206,22 +208,23 @@ def test_entry_naming_a_folder_outside_the_cache_is_refused(tmp_path: Path) -> N
     for folder in ("../../outside", "/abs/_symkin_x", "_symkin_x/../../outside", ".hidden"):
         entry.write_text(json.dumps({"format": cache.FORMAT, "key": key, "backend": "numpy",
                                      "folder": folder, "files": {"manifest.json": "0"}}))
-        assert cache.lookup(tmp_path / "cache", key, cache.Options()) is None
+        assert cache.lookup(tmp_path / "cache", key, cache.Options(backends.get("numpy"))) is None
         assert not entry.exists()  # a damaged entry is removed
     assert (outside / "manifest.json").exists()
 
 
 def test_key_changes_with_every_input(tmp_path: Path) -> None:
+    from symkin import backends
     from symkin.build import index as cache
 
     mechanism = tmp_path / "m.yaml"
     mechanism.write_bytes(TEXTBOOK.read_bytes())
-    base = cache.Options(backend="numpy", real="double", cse=True, linalg="dense")
+    base = cache.Options(backend=backends.get("numpy"), real="double", cse=True, linalg="dense")
     keys = {cache.index_key(mechanism, base)}
-    for options in (cache.Options("c", "double", True, "dense"),
-                    cache.Options("c", "float", True, "dense"),
-                    cache.Options("numpy", "double", False, "dense"),
-                    cache.Options("c", "double", True, "sparse")):
+    for options in (cache.Options(backends.get("c"), "double", True, "dense"),
+                    cache.Options(backends.get("c"), "float", True, "dense"),
+                    cache.Options(backends.get("numpy"), "double", False, "dense"),
+                    cache.Options(backends.get("c"), "double", True, "sparse")):
         keys.add(cache.index_key(mechanism, options))
     toml = mechanism.with_suffix(".toml")
     toml.write_bytes(mechanism.read_bytes())  # same bytes, another format
@@ -236,12 +239,13 @@ def test_default_options_are_the_compilers() -> None:
     import inspect
 
     from symkin.build import compile as build
+    from symkin import backends
     from symkin.build import index as cache
 
     defaults = inspect.signature(build.compile).parameters
-    assert cache.Options().real == defaults["real"].default
-    assert cache.Options().cse == defaults["cse"].default
-    assert cache.Options().linalg == defaults["linalg"].default
+    assert cache.Options(backends.get("numpy")).real == defaults["real"].default
+    assert cache.Options(backends.get("numpy")).cse == defaults["cse"].default
+    assert cache.Options(backends.get("numpy")).linalg == defaults["linalg"].default
 
 
 def test_concurrent_cold_runs_leave_one_good_entry(snapshot: Path, tmp_path: Path) -> None:

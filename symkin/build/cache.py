@@ -30,7 +30,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from symkin.errors import SymkinWarning
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
+from symkin.errors import BuildError, SymkinWarning
 
 RECORD = ".symkin-files.json"
 """Inside each kernel folder: {file name: sha256} of everything the build wrote."""
@@ -162,6 +163,40 @@ def verified(folder: Path, expected: Mapping[str, str]) -> bool:
     if not good:
         discard(folder)
     return good
+
+
+def build_unless_verified(cache: Path, folder: Path, expected: dict[str, str],
+                          build: Callable[[Path], Any]) -> None:
+    """Publish a fresh build unless ``folder`` holds a verified one; a folder that fails
+    verification, whoever put it there, is never loaded."""
+    if verified(folder, expected):
+        return
+    publish(cache, folder, build)
+    if not verified(folder, expected):
+        raise BuildError(f"the kernel folder {folder} changed while it was being built; "
+                         "run again, and make sure no other user can write to the cache")
+
+
+def checked_manifest(files: Mapping[str, str]) -> dict[str, Any]:
+    """The manifest of a generated folder given as text (``{file name: text}``), after
+    checking that the names, the manifest and its file list agree.
+
+    Raises:
+        BuildError: the files are not one generated symkin folder.
+    """
+    manifests = [name for name in files if name.endswith(MANIFEST_SUFFIX)]
+    if len(manifests) != 1:
+        raise BuildError(f"expected one symkin manifest among the files, found {len(manifests)}")
+    meta: dict[str, Any] = json.loads(files[manifests[0]])
+    name = meta.get("name")
+    plain = all(isinstance(n, str) and Path(n).name == n and not n.startswith(".")
+                for n in files)
+    if not (isinstance(name, str) and name.isidentifier() and plain
+            and manifests[0] == manifest_name(name)
+            and set(files) == {*meta.get("files", {}), manifests[0]}):
+        raise BuildError("the files are not one generated symkin folder (names, manifest and "
+                         "file list must agree); send the folder symkin.compile built")
+    return meta
 
 
 def discard(folder: Path) -> None:

@@ -34,11 +34,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin import resources
-from symkin.build import toolchain
+from symkin.build.backend import Backend
 from symkin.build.cache import discard, open_cache, sha256_of
-from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
-from symkin.runtime import kernel as kernel_module
-from symkin.runtime.kernel import Kernel
+from symkin.contract.manifest import MANIFEST_SUFFIX
+from symkin.runtime.kernel import Kernel, read_manifest
 
 # Bump when the entry layout or the meaning of a key changes.
 FORMAT = 1
@@ -50,9 +49,13 @@ Outlines = dict[str, NDArray[np.float64]]
 
 @dataclass(frozen=True)
 class Options:
-    """What, besides the file, decides the kernel: see ``symkin.build.compile.compile``."""
+    """What, besides the file, decides the kernel: see ``symkin.build.compile.compile``.
 
-    backend: str = "numpy"
+    ``backend`` is the object (``symkin.backends.resolve``); the key and the entry hold its
+    name.
+    """
+
+    backend: Backend
     real: str = "double"
     cse: bool = True
     linalg: str = "sparse"  # codegen.DEFAULT_LINALG (not imported: it would load SymPy)
@@ -78,7 +81,7 @@ class Prepared:
     system: Any = None
 
 
-def prepare(mechanism: str | Path, options: Options = Options(), *, outlines: bool = False,
+def prepare(mechanism: str | Path, options: Options, *, outlines: bool = False,
             cache_dir: str | Path | None = None) -> Prepared:
     """The kernel of a mechanism file: from the index when it can, else the full pipeline.
 
@@ -103,9 +106,9 @@ def prepare(mechanism: str | Path, options: Options = Options(), *, outlines: bo
     # Not recorded: a C request that fell back to NumPy (no compiler; the next run must try,
     # and warn, again), and a file that changed while it was derived (the kernel may be of
     # other bytes than the key's).
-    if (key is not None and prepared.kernel.backend == options.backend
+    if (key is not None and prepared.kernel.backend == options.backend.name
             and index_key(Path(mechanism), options) == key):
-        record(cache, key, prepared.kernel, prepared.outlines)
+        record(cache, key, prepared.kernel, options.backend, prepared.outlines)
     return prepared
 
 
@@ -135,9 +138,9 @@ def index_key(mechanism: Path, options: Options) -> str | None:
         "format": FORMAT, "file_sha256": hashlib.sha256(raw).hexdigest(),
         # The loader picks TOML or YAML by suffix: the same bytes may mean different things.
         "file_format": "toml" if mechanism.suffix.lower() == ".toml" else "yaml",
-        "options": [options.backend, options.real, options.cse, options.linalg,
+        "options": [options.backend.name, options.real, options.cse, options.linalg,
                     [list(pair) for pair in options.parameters]],
-        "code": code_version(), **environment(options.backend),
+        "code": code_version(), **options.backend.fingerprint(),
     }
     return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()
 
@@ -156,12 +159,6 @@ def code_version() -> str:
                 digest.update(path.relative_to(root).as_posix().encode() + b"\0")
                 digest.update(hashlib.sha256(path.read_bytes()).digest())
     return digest.hexdigest()
-
-
-def environment(backend: str) -> dict[str, Any]:
-    """The interpreter and, for C, the compiler (path and version) a kernel was built for,
-    so a warm run never reaches for a folder built for another interpreter or compiler."""
-    return toolchain.fingerprint(toolchain.c_compiler() if backend == "c" else None)
 
 
 # ----- entries -------------------------------------------------------------------------------
@@ -185,14 +182,15 @@ def lookup(cache: Path, key: str, options: Options, need_outlines: bool = False
     if folder is None:
         _discard(path, None)
         return None
-    if not _intact(folder, entry["files"], options):
+    meta = _intact(folder, entry["files"], options)
+    if meta is None:
         _discard(path, folder)  # the folder changed since it was recorded: never reuse it
         return None
     drawn = _outlines(entry.get("outlines"))
     if need_outlines and drawn is None:
         return None  # a valid entry without outlines: the full pipeline adds them
     try:
-        loaded = kernel_module.load(folder)
+        loaded = options.backend.load(folder, meta)
     except Exception:
         _discard(path, folder)
         return None
@@ -202,30 +200,30 @@ def lookup(cache: Path, key: str, options: Options, need_outlines: bool = False
 def _matches(entry: Any, key: str, options: Options) -> bool:
     """A well-formed entry of this format, key and backend."""
     return (isinstance(entry, dict) and entry.get("format") == FORMAT
-            and entry.get("key") == key and entry.get("backend") == options.backend
+            and entry.get("key") == key and entry.get("backend") == options.backend.name
             and isinstance(entry.get("files"), dict)
             and any(str(name).endswith(MANIFEST_SUFFIX) for name in entry["files"]))
 
 
-def _intact(folder: Path, files: dict[Any, Any], options: Options) -> bool:
-    """Every recorded file is still there with the recorded hash, and the manifest agrees."""
+def _intact(folder: Path, files: dict[Any, Any], options: Options) -> dict[str, Any] | None:
+    """The manifest, when every recorded file is still there with the recorded hash and the
+    manifest agrees with the options; else None."""
     for name, expected in files.items():
         if not (_plain_name(name) and isinstance(expected, str)
                 and sha256_of(folder / name) == expected):
-            return False
-    return _manifest_matches(folder, options)
+            return None
+    return _matching_manifest(folder, options)
 
 
-def _manifest_matches(folder: Path, options: Options) -> bool:
+def _matching_manifest(folder: Path, options: Options) -> dict[str, Any] | None:
     try:
-        manifest = next(folder.glob("*" + MANIFEST_SUFFIX))
-        meta = json.loads(manifest.read_text(encoding="utf-8"))
-    except (OSError, ValueError, StopIteration):
-        return False
-    wanted = {"backend": options.backend, "cse": options.cse}
-    if options.backend == "c":
-        wanted["real"] = options.real
-    return isinstance(meta, dict) and all(meta.get(k) == v for k, v in wanted.items())
+        meta = read_manifest(folder)
+    except (OSError, ValueError):
+        return None
+    wanted = {"backend": options.backend.name, "cse": options.cse, "real": options.real}
+    if isinstance(meta, dict) and all(meta.get(k) == v for k, v in wanted.items()):
+        return meta
+    return None
 
 
 def _named_folder(cache: Path, entry: Any) -> Path | None:
@@ -251,7 +249,8 @@ def _outlines(data: Any) -> Outlines | None:
     return drawn
 
 
-def record(cache: Path, key: str, built: Kernel, outlines: Outlines | None = None) -> None:
+def record(cache: Path, key: str, built: Kernel, backend: Backend,
+           outlines: Outlines | None = None) -> None:
     """Write the entry of ``key`` for a kernel the build cache holds (atomic replace).
 
     Failing to write the index only costs the next run a derivation, so it is not an error.
@@ -259,7 +258,8 @@ def record(cache: Path, key: str, built: Kernel, outlines: Outlines | None = Non
     folder = built.folder
     if folder is None:
         return
-    files = {name: sha256_of(folder / name) for name in _loaded_files(built, folder)}
+    files = {name: sha256_of(folder / name)
+             for name in backend.loaded_files(folder, built.name)}
     if any(digest is None for digest in files.values()):
         return
     entry = {"format": FORMAT, "key": key, "backend": built.backend, "folder": folder.name,
@@ -269,14 +269,6 @@ def record(cache: Path, key: str, built: Kernel, outlines: Outlines | None = Non
                              for body, v in outlines.items()}
     with contextlib.suppress(OSError):  # no entry: the next run derives again, that is all
         _write_atomic(entry_path(cache, key), json.dumps(entry, indent=1, sort_keys=True))
-
-
-def _loaded_files(built: Kernel, folder: Path) -> list[str]:
-    """The files ``kernel.load`` reads: the manifest and the module or extension."""
-    manifest = manifest_name(built.name)
-    if built.backend == "numpy":
-        return [manifest, f"{built.name}.py"]
-    return [manifest, kernel_module.extension_file(folder).name]
 
 
 def _write_atomic(path: Path, text: str) -> None:

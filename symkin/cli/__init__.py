@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
+from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 from symkin.errors import MechanismError, SymkinError, UsageError
@@ -89,15 +90,16 @@ def _add_verify(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -
 
 # Each entry adds one subcommand; its handler returns the exit status.
 def _generate(args: argparse.Namespace) -> int:
-    from symkin.build.toolchain import resolve_backend
     from symkin.codegen import render
     from symkin.symbolic import derivation
 
-    # Writing C source needs no compiler: only "auto" asks whether one is there.
-    backend = resolve_backend("auto") if args.backend == "auto" else args.backend
-    if backend == "numpy" and args.real == "float":
-        return messages.error("--real float is for the C backend; the NumPy backend computes in "
-                              "double precision", EXIT_BAD_INPUT)
+    # Writing C source needs no compiler: only "auto" asks whether one can be built.
+    backend = (backends.resolve(args.backend) if args.backend == backends.AUTO
+               else backends.get(args.backend))
+    if args.real not in backend.real_types:
+        return messages.error(f"--real {args.real} is not for the {backend.title} backend, which "
+                              f"computes in {' or '.join(backend.real_types)} precision",
+                              EXIT_BAD_INPUT)
     system = derivation.derive(_load(args))
     paths = render.generate(system, backend=backend, out_dir=args.output, real=args.real,
                             cse=not args.no_cse, linalg=args.linalg, force=args.force)
@@ -108,7 +110,7 @@ def _generate(args: argparse.Namespace) -> int:
 def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     generate = commands.add_parser("generate", help="write the C or NumPy source of a mechanism")
     generate.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    generate.add_argument("--backend", choices=("auto", "c", "numpy"), default="auto",
+    generate.add_argument("--backend", choices=backends.choices(), default="auto",
                           help="source to write (default auto, as for run: C when a C compiler "
                                "is found, else NumPy with a note)")
     generate.add_argument("-o", "--output", type=Path, required=True, help="output folder")

@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from symkin import limits
+from symkin import backends, limits
 from symkin.cli import messages, outputs, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 from symkin.cli.outputs import CannotWrite, ProgressBar
@@ -32,7 +32,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     run = commands.add_parser(
         "run", help="solve positions, velocities and accelerations over the time grid")
     run.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    run.add_argument("--backend", choices=("auto", "c", "numpy"), default="auto",
+    run.add_argument("--backend", choices=backends.choices(), default="auto",
                      help="kernel to run (default auto: the generated C when a C compiler is "
                           "found, else NumPy; c without a compiler is an error)")
     run.add_argument("--t0", type=float, help="first time (default: the file's)")
@@ -138,10 +138,9 @@ def handle(args: argparse.Namespace) -> int:
 
 def _solve_and_write(args: argparse.Namespace) -> int:
     from symkin.build import index as cache
-    from symkin.build.toolchain import resolve_backend
     from symkin.runtime import driver
 
-    options = cache.Options(backend=resolve_backend(args.backend),
+    options = cache.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
     prepared = cache.prepare(args.mechanism, options,
                              outlines=args.animate is not None or args.html is not None)

@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 
@@ -22,7 +23,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
         "scan", help="list the assembly branches at t0, the singular configurations and the "
                      "limit positions over the driver range")
     scan.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    scan.add_argument("--backend", choices=("auto", "c", "numpy"), default="auto",
+    scan.add_argument("--backend", choices=backends.choices(), default="auto",
                       help="kernel to run (default auto, as for run)")
     scan.add_argument("--t0", type=float, help="first time (default: the file's)")
     scan.add_argument("--t1", type=float, help="last time, included (default: the file's)")
@@ -37,7 +38,6 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 def handle(args: argparse.Namespace) -> int:
     """Run the subcommand; returns the exit status."""
     from symkin.build import index as cache
-    from symkin.build.toolchain import resolve_backend
     from symkin.errors import SolveError
     from symkin.runtime import driver
     from symkin.runtime.scan import scan
@@ -46,7 +46,7 @@ def handle(args: argparse.Namespace) -> int:
         value = getattr(args, option)
         if value is not None and not math.isfinite(value):
             return messages.error(f"--{option} {value}: give a finite number", EXIT_BAD_INPUT)
-    options = cache.Options(backend=resolve_backend(args.backend),
+    options = cache.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
     try:
         kernel = cache.prepare(args.mechanism, options).kernel

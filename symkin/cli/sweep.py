@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 from symkin.errors import SymkinError, UsageError
@@ -46,7 +47,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     sweep.add_argument("--distribution", choices=("normal", "uniform"), default="normal",
                        help="Monte-Carlo draws: normal with ±X as 3 sigma (default), or uniform")
     sweep.add_argument("--seed", type=int, default=0, help="Monte-Carlo random seed (default 0)")
-    sweep.add_argument("--backend", choices=("auto", "c", "numpy"), default="auto")
+    sweep.add_argument("--backend", choices=backends.choices(), default="auto")
     sweep.add_argument("--workers", type=int, help="local processes (default: the cores, "
                        "in this process for small sweeps)")
     sweep.add_argument("--scheduler", metavar="ADDRESS",
@@ -63,9 +64,8 @@ def handle(args: argparse.Namespace) -> int:
     if problem:
         return messages.error(problem, EXIT_BAD_INPUT)
     from symkin.build import index as cache
-    from symkin.build.toolchain import resolve_backend
 
-    options = cache.Options(backend=resolve_backend(args.backend),
+    options = cache.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
     kernel = cache.prepare(args.mechanism, options).kernel
     try:

@@ -18,9 +18,10 @@ from typing import Any
 import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
-from symkin.codegen import backends, sample, symbols
+from symkin.codegen import sample, symbols
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbols import symbol_text
+from symkin.codegen.target import Target
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
 
@@ -99,7 +100,7 @@ class Routine:
 class Code:
     """Everything the templates of one backend need, as plain data."""
 
-    backend: str
+    backend: Target
     real: str
     cse: bool
     name: str
@@ -149,32 +150,28 @@ class Code:
         return next(routine for routine in self.routines if routine.name == name)
 
 
-def _printer(backend: str, real: str) -> CodePrinter:
-    return backends.get(backend).printer(real)
-
-
 # ----- lowering ------------------------------------------------------------------------------
 
-def lower(system: System, backend: str = "c", real: str = "double", cse: bool = True,
+def lower(system: System, backend: Target, real: str = "double", cse: bool = True,
           linalg: str = DEFAULT_LINALG) -> Code:
     """Turn a System into the plain data the templates of ``backend`` render.
 
     Args:
         system: the derived kinematics.
-        backend: ``"c"`` or ``"numpy"``.
-        real: ``"double"`` or ``"float"`` (C only).
+        backend: the target (``symkin.backends.get`` finds one by name).
+        real: one of ``backend.real_types`` (``"double"`` or ``"float"`` for C).
         cse: eliminate common subexpressions within each routine.
         linalg: ``"sparse"`` (default) or ``"dense"``, the LU behind the C solver.
 
     Raises:
-        BuildError: an unknown backend or real type, or an expression the printer cannot print.
+        BuildError: an unknown real type, or an expression the printer cannot print.
     """
     _check_options(backend, real, linalg)
     internal = symbols.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)
     expressions = _routine_expressions(system, pattern, p_pattern)
-    printer = _printer(backend, real)
+    printer: CodePrinter = backend.printer(real)
     prepared = {name: [symbols.prepare(e, internal) for e in exprs]
                 for name, exprs in expressions.items()}
     fused, shared = _fused_expressions(prepared)
@@ -204,22 +201,21 @@ def lower(system: System, backend: str = "c", real: str = "double", cse: bool = 
         linalg=linalg,
         phi_p_rows=tuple(r for r, _ in p_pattern), phi_p_cols=tuple(c for _, c in p_pattern),
         lu_plan=(sample.sparse_lu_plan(system, pattern)
-                 if backend == "c" and linalg == "sparse" else None),
+                 if backend.plans_lu(linalg) else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
     )
 
 
-def _check_options(backend: str, real: str, linalg: str) -> None:
+def _check_options(backend: Target, real: str, linalg: str) -> None:
     if linalg not in LINALG:
         raise BuildError(f"unknown linear algebra {linalg!r}; choose 'dense' or 'sparse'")
-    if backend not in backends.NAMES:
-        raise BuildError(f"unknown backend {backend!r}; choose one of {', '.join(backends.NAMES)}")
     if real not in REAL_TYPES:
         raise BuildError(f"unknown real type {real!r}; choose 'double' or 'float'")
-    if backend == "numpy" and real != "double":
-        raise BuildError("the NumPy backend computes in double precision; use real='double' "
-                         "(real='float' is for the C backend)")
+    if real not in backend.real_types:
+        raise BuildError(f"the {backend.title} backend computes in "
+                         f"{' or '.join(backend.real_types)} precision; use "
+                         f"real={backend.real_types[0]!r}")
 
 
 def parameter_pattern(system: System) -> list[tuple[int, int]]:

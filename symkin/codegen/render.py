@@ -1,13 +1,12 @@
 """Stage 4 — render: jinja2 templates turn the plain data of codegen into files.
 
-Every ``X.Y.j2`` in ``templates/<backend>/`` becomes one file of the generated folder:
-``kernel.h.j2 -> <prefix>.h``, ``kernel.c.j2 -> <prefix>.c``, ``kernel.py.j2 -> <prefix>.py``
-and any other ``X.Y.j2 -> <prefix>_X.Y`` (the solver runtime of the C backend). Templates
-whose name starts with ``_`` are partials and are not written out (the cffi declarations come
-from the rendered headers themselves, :mod:`symkin.codegen.cdef`). The folder also gets
-``<prefix>_manifest.json`` (symkin.contract.manifest): the files with their sha256, the op
-counts and the metadata a runtime needs. The output depends only on the input: the same
-mechanism gives the same bytes on every run and machine.
+Every template the backend (a ``codegen.target.Target``) lists becomes one file of the
+generated folder, named by the backend: ``kernel.h.j2 -> <prefix>.h``, ``kernel.c.j2 ->
+<prefix>.c``, ``kernel.py.j2 -> <prefix>.py`` and any other ``X.Y.j2 -> <prefix>_X.Y`` (the
+solver runtime of the C backend). Templates whose name starts with ``_`` are partials and are
+not written out. The folder also gets ``<prefix>_manifest.json`` (symkin.contract.manifest):
+the files with their sha256, the op counts and the metadata a runtime needs. The output
+depends only on the input: the same mechanism gives the same bytes on every run and machine.
 """
 
 from __future__ import annotations
@@ -21,15 +20,13 @@ from typing import Any
 import jinja2
 
 from symkin import resources
-from symkin.codegen import backends, lu_code, norm_code
 from symkin.codegen import lower as codegen
 from symkin.codegen.lower import Code, Routine
+from symkin.codegen.target import Target
 from symkin.contract import options, status, tuning
 from symkin.contract.manifest import GENERATOR, MANIFEST_SUFFIX, Manifest, Metadata, manifest_name
 from symkin.errors import BuildError, UsageError
 from symkin.symbolic.derivation import System
-
-_LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
              "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out"}
@@ -60,53 +57,44 @@ def environment(root: str | None = None) -> jinja2.Environment:
         lstrip_blocks=True, autoescape=False)
 
 
-def template_names(backend: str, linalg: str = codegen.DEFAULT_LINALG) -> list[str]:
-    """The templates of ``backend`` that each render to one file, sorted.
-
-    ``linalg.*.j2`` (on the dense LU) and ``sparse_lu.*.j2`` define the same functions, so only
-    the chosen one is rendered; ``dense_lu.*.j2``, which both use, always is.
-    """
-    folder = resources.template_root() / backend
-    left_out = _LINALG_TEMPLATES["sparse" if linalg == "dense" else "dense"]
-    return sorted(p.name for p in folder.glob("*.j2")
-                  if not p.name.startswith("_")
-                  and p.name.split(".")[0] != left_out)
-
-
-def output_name(template: str, prefix: str, backend: str = "c") -> str:
-    """``kernel.h.j2 -> crank_slider.h``; ``solver.c.j2 -> crank_slider_solver.c``."""
-    return backends.get(backend).output_name(template, prefix)
+def template_names(backend: Target, linalg: str = codegen.DEFAULT_LINALG) -> list[str]:
+    """The templates of ``backend`` that each render to one file, sorted."""
+    return backend.templates(linalg)
 
 
 def render_sources(code: Code) -> dict[str, str]:
     """Render every template of the backend: ``{file name: text}``, sorted by name."""
     context = template_context(code)
     files = {}
-    for template in template_names(code.backend, code.linalg):
-        name = output_name(template, code.name, code.backend)
-        files[name] = _render(f"{code.backend}/{template}",
+    backend = code.backend
+    for template in template_names(backend, code.linalg):
+        name = backend.output_name(template, code.name)
+        files[name] = _render(backend, template,
                               {**context, "template": template, "file_name": name,
                                "header": header_lines(code, template, name)})
     return dict(sorted(files.items()))
 
 
-def _render(template: str, context: dict[str, Any]) -> str:
+def _render(backend: Target, name: str, context: dict[str, Any]) -> str:
+    template = f"{backend.template_folder}/{name}"
     try:
-        return environment().get_template(template).render(context)
+        root = str(backend.template_root)
+        return environment(root).get_template(template).render(context)
     except jinja2.TemplateError as error:
         line = getattr(error, "lineno", None)
         where = f" (line {line})" if line else ""
         raise BuildError(f"template {template}{where} failed to render: {error}") from None
 
 
-def generate(system: System, backend: str = "c", out_dir: str | Path = "generated",
+def generate(system: System, backend: Target, out_dir: str | Path = "generated",
              real: str = "double", cse: bool = True,
              linalg: str = codegen.DEFAULT_LINALG, force: bool = False) -> list[Path]:
     """Generate the source files of one backend into ``out_dir``.
 
     Args:
         system: the derived kinematics.
-        backend: ``"c"`` (a self-contained C99 folder) or ``"numpy"`` (one Python module).
+        backend: the target (``symkin.generate`` takes its name: ``"c"``, a self-contained
+            C99 folder, or ``"numpy"``, one Python module).
         out_dir: the folder to write; created when missing. It may hold earlier output of
             symkin (this mechanism's is replaced, other mechanisms' is left alone); any other
             file makes it refuse, unless ``force``.
@@ -202,7 +190,7 @@ def _sha256_file(path: Path) -> str | None:
 def manifest(code: Code, files: dict[str, str]) -> str:
     """The manifest: file hashes, op counts and the metadata a runtime needs, as JSON."""
     data = Manifest(
-        generator=GENERATOR, backend=code.backend, real=code.real, cse=code.cse,
+        generator=GENERATOR, backend=code.backend.name, real=code.real, cse=code.cse,
         name=code.name, spec_sha256=code.spec_sha256,
         files={name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()},
         ops=code.ops, ops_before_cse=code.ops_before_cse, **metadata(code),
@@ -227,18 +215,13 @@ def metadata(code: Code) -> Metadata:
 
 def template_context(code: Code) -> dict[str, Any]:
     """The plain data every template of ``code.backend`` receives."""
-    literal = backends.get(code.backend).literal(code.real)
-    lu = (lu_code.template_context(code.lu_plan, constants=code.constant_nz, real=code.real,
-                                   prefix=code.name) if code.lu_plan else None)
+    literal = code.backend.literal(code.real)
     return {
         "prefix": code.name, "PREFIX": code.name.upper(),
         "name_comment": codegen.comment(code.name),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
         "real": code.real, "cse": code.cse, "spec_sha256": code.spec_sha256,
-        # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
-        "libm_suffix": "f" if code.real == "float" else "",
-        "literal_suffix": "F" if code.real == "float" else "",
         "pattern_rows": list(code.pattern_rows), "pattern_cols": list(code.pattern_cols),
         "nnz_p": code.nnz_p,
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
@@ -259,16 +242,12 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg,
-        **({"lu": lu} if lu else {}),
-        # ||Phi_q||_1 straight-line, or a loop where the LU itself is table-driven
-        "norm1": (norm_code.norm1_context(code.pattern_cols, code.nq, code.constant_nz,
-                                          literal, code.real)
-                  if code.backend == "c" and not (lu and lu["style"] == "tables") else None),
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
         "option_fields": list(options.SOLVER_FIELDS),
         "status": dict(status.CODES),
         "shared_constants": {name: _c_number(value) for name, value in tuning.SHARED.items()},
+        **code.backend.template_context(code),
     }
 
 
@@ -343,7 +322,7 @@ def header_lines(code: Code, template: str, file_name: str) -> list[str]:
     """The header every generated file starts with, in one style for every template: what the
     file is, which template made it, the spec's sha256, the real type and op counts; never a
     date, host or version, so the same input gives the same bytes."""
-    purpose = backends.get(code.backend).purpose(template).format(
+    purpose = code.backend.purpose(template).format(
         name=codegen.comment(code.name))
     ops = ", ".join(f"{name} {count}" for name, count in sorted(code.ops.items()))
     after = ", after CSE" if code.cse else ""

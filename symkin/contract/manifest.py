@@ -1,6 +1,7 @@
 """The manifest every generated folder carries, one per mechanism (so that several mechanisms
-can share a folder): its file name and its keys. Written by codegen.render; read by
-runtime.kernel, build.compile, build.index and sweeps.parallel."""
+can share a folder): its file name and its keys. Written by codegen.render (and build.compile);
+read by runtime.kernel, build.cache, build.index, sweeps.parallel and the backends (the registry's
+load and from_sources, each backend's build and loader)."""
 
 from __future__ import annotations
 

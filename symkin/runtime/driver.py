@@ -43,13 +43,12 @@ from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
 from symkin.runtime.assembly import Assembly, assemble
-from symkin.runtime.csolver import GridSolver
 from symkin.runtime.edges import Resolution, resolve
 from symkin.runtime.linalg import factor_at
 from symkin.runtime.newton import Newton, kinematics, newton
 from symkin.runtime.outputs import Out, allocate
 from symkin.runtime.outputs import Run as _Run
-from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.protocol import GridSolver, KinematicsKernel
 from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]

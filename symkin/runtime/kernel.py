@@ -1,18 +1,19 @@
 """The runtime kernel: one mechanism's compiled Phi, Phi_q, Phi_t and Gamma behind one API.
 
-A Kernel wraps either a generated NumPy module or a cffi extension built from the generated C,
-plus the metadata of the mechanism (coordinates, parameters, pattern, grid). It imports only
-NumPy, so running a compiled kernel never loads SymPy or jinja2.
+A Kernel wraps a backend's compiled functions (``_Functions``: a generated NumPy module, a cffi
+extension built from the generated C, ...) plus the metadata of the mechanism (coordinates,
+parameters, pattern, grid). A backend whose generated code also runs whole grids or batches
+subclasses it (``grid_solver``, ``batch_solver``); the backends load kernels
+(``symkin.backends.load``). It imports only NumPy, so running a compiled kernel never loads
+SymPy or jinja2.
 """
 
 from __future__ import annotations
 
-import hashlib
-import importlib.machinery
 import importlib.util
 import json
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Protocol
@@ -20,10 +21,9 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from symkin import resources
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.contract.options import Options
-from symkin.runtime.csolver import GridSolver, SolverPool
+from symkin.runtime.protocol import BatchSolver, GridSolver
 
 Array = NDArray[np.float64]
 
@@ -45,8 +45,12 @@ class Kernel:
     Every function takes ``p=None`` to mean the nominal parameter values.
     """
 
+    # A backend's solve of many parameter sets in one call (None: a sweep solves set by set).
+    batch_solver: BatchSolver | None = None
+
     def __init__(self, backend: str, meta: Mapping[str, Any], functions: _Functions,
-                 ffi: Any = None, lib: Any = None, folder: Path | None = None) -> None:
+                 folder: Path | None = None) -> None:
+        # The backend's name (for messages and the warm-run index; decisions ask the backend).
         self.backend = backend
         # The real type the kernel computes in: "float" only for C kernels built so.
         self.real: str = meta.get("real", "double")
@@ -66,25 +70,17 @@ class Kernel:
         self.phi_p_rows = np.array(meta.get("phi_p_rows", ()), dtype=np.intp)
         self.phi_p_cols = np.array(meta.get("phi_p_cols", ()), dtype=np.intp)
         self.has_phi_p = "phi_p_rows" in meta
-        self.ffi = ffi
-        self.lib = lib
         self._functions = functions
-        self._solvers: SolverPool | None = None  # GridSolvers reused from run to run
-        # Looked up once: solve asks on every call.
-        self._has_grid_solver = lib is not None and hasattr(lib, f"{self.name}_solve_grid")
 
     @property
     def has_grid_solver(self) -> bool:
-        """True for a C kernel whose generated solver runs whole grids (``solve_grid``)."""
-        return self._has_grid_solver
+        """True for a kernel whose generated code runs whole grids (the C solver)."""
+        return False
 
     def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
-        """A fresh run of the generated C grid loop from q, or None without a C solver."""
-        if self._solvers is None:
-            if not self.has_grid_solver:
-                return None
-            self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
-        return self._solvers.take(options, q, p)
+        """A fresh run of the generated grid loop from q, or None without one."""
+        del options, q, p
+        return None
 
     @property
     def nq(self) -> int:
@@ -152,110 +148,13 @@ class Kernel:
         return array
 
 
-# ----- backends ------------------------------------------------------------------------------
+# ----- loading -------------------------------------------------------------------------------
 
-class _ModuleFunctions:
-    """Adapter over a generated NumPy module."""
-
-    def __init__(self, module: ModuleType) -> None:
-        self.phi = module.phi
-        self.phi_q_nz = module.phi_q_nz
-        self.phi_t = module.phi_t
-        self.gamma = module.gamma
-        self.points = module._points
-        self.phi_p_nz: Callable[[Array, float, Array], Array] = getattr(
-            module, "phi_p_nz", _no_phi_p)
-
-
-def _no_phi_p(q: Array, t: float, p: Array) -> Array:
-    raise ValueError("this kernel was generated without Phi_p; rebuild it with symkin.compile")
-
-
-class _CFunctions:
-    """Adapter over a cffi extension: converts arrays to the generated real type and back."""
-
-    def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
-                 npoints: int, nnz_p: int = 0) -> None:
-        self._ffi = ffi
-        self._dtype = np.float32 if real == "float" else np.float64
-        self._ctype = f"{real}[]"
-        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
-                       "phi_p": nnz_p}
-        # getattr with a default: a kernel folder built before phi_p existed has none.
-        self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
-                                   for name in self._sizes}
-
-    def _in(self, array: Array) -> Any:
-        if array.size == 0:
-            return self._ffi.NULL
-        return self._ffi.from_buffer(self._ctype, np.ascontiguousarray(array, self._dtype))
-
-    def _call(self, name: str, *arguments: Any) -> Array:
-        out = np.zeros(self._sizes[name], dtype=self._dtype)
-        target = self._ffi.from_buffer(self._ctype, out) if out.size else self._ffi.NULL
-        self._c[name](*arguments, target)
-        return out.astype(np.float64, copy=False)
-
-    def phi(self, q: Array, t: float, p: Array) -> Array:
-        return self._call("phi", self._in(q), t, self._in(p))
-
-    def phi_q_nz(self, q: Array, t: float, p: Array) -> Array:
-        return self._call("phi_q", self._in(q), t, self._in(p))
-
-    def phi_t(self, q: Array, t: float, p: Array) -> Array:
-        return self._call("phi_t", self._in(q), t, self._in(p))
-
-    def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array:
-        return self._call("gamma", self._in(q), self._in(dq), t, self._in(p))
-
-    def points(self, p: Array) -> Array:
-        return self._call("points", self._in(p))
-
-    def phi_p_nz(self, q: Array, t: float, p: Array) -> Array:
-        return self._call("phi_p", self._in(q), t, self._in(p))
-
-
-def from_module(module: ModuleType, folder: Path | None = None) -> Kernel:
-    """A Kernel over a generated NumPy module (its metadata comes from the module)."""
-    meta = {
-        "name": module.NAME, "coordinates": module.COORDINATES,
-        "parameter_names": module.PARAMETER_NAMES, "p_values": module.P_VALUES,
-        "q0": module.Q0, "time_grid": module.TIME_GRID, "rows": module.ROWS,
-        "pattern_rows": module.PATTERN_ROWS, "pattern_cols": module.PATTERN_COLS,
-        "points": module.POINTS,
-        **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
-           if hasattr(module, "PHI_P_ROWS") else {}),
-    }
-    return Kernel("numpy", meta, _ModuleFunctions(module), folder=folder)
-
-
-def from_cffi(ffi: Any, lib: Any, meta: Mapping[str, Any], folder: Path | None = None) -> Kernel:
-    """A Kernel over a cffi extension built from the generated C; ``meta`` is the manifest."""
-    functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
-                            len(meta["pattern_rows"]), len(meta["points"]),
-                            len(meta.get("phi_p_rows", ())))
-    return Kernel("c", meta, functions, ffi=ffi, lib=lib, folder=folder)
-
-
-def load(folder: str | Path, name: str | None = None) -> Kernel:
-    """Load a built kernel from its folder (a cache entry, or a generated NumPy folder).
-
-    The folder's ``<name>_manifest.json`` says the backend and the mechanism (a folder holding
-    several mechanisms needs ``name``); a C folder must also hold the compiled extension.
-    Needs only NumPy (and cffi for C), never SymPy.
-    """
-    folder = Path(folder)
-    meta = json.loads(_manifest(folder, name).read_text(encoding="utf-8"))
-    if meta["backend"] == "numpy":
-        source = folder / f"{meta['name']}.py"
-        digest = hashlib.sha256(source.read_bytes()).hexdigest()
-        module = import_file(f"_symkin_{meta['name']}_py_{digest[:20]}", source, None)
-        return from_module(module, folder)
-    library = extension_file(folder, meta["name"])
-    name = library.name[: -len(resources.extension_suffix())]
-    loader = importlib.machinery.ExtensionFileLoader(name, str(library))
-    module = import_file(name, library, loader)
-    return from_cffi(module.ffi, module.lib, meta, folder)
+def read_manifest(folder: Path, name: str | None = None) -> dict[str, Any]:
+    """The manifest of a generated or built folder: ``<name>_manifest.json`` (a folder
+    holding several mechanisms needs ``name``). It says the backend and the mechanism."""
+    data: dict[str, Any] = json.loads(_manifest(folder, name).read_text(encoding="utf-8"))
+    return data
 
 
 def _manifest(folder: Path, name: str | None) -> Path:
@@ -266,24 +165,6 @@ def _manifest(folder: Path, name: str | None) -> Path:
         raise FileNotFoundError(f"{folder} holds {len(found)} symkin manifests; name the "
                                 "mechanism to load")
     return found[0]
-
-
-def extension_file(folder: Path, name: str | None = None) -> Path:
-    """The compiled extension in a C kernel folder.
-
-    A build-cache folder is named after its module, so that file is the one; any other folder
-    must hold exactly one ``_symkin_<name>_*`` extension.
-    """
-    own = folder / (folder.name + resources.extension_suffix())
-    if own.is_file():
-        return own
-    pattern = f"_symkin_{name or ''}{'_' if name else ''}*{resources.extension_suffix()}"
-    libraries = sorted(folder.glob(pattern))
-    if len(libraries) != 1:
-        found = "no" if not libraries else "more than one"
-        raise FileNotFoundError(f"{folder} holds {found} compiled extension; build it with "
-                                "symkin.compile")
-    return libraries[0]
 
 
 def import_file(name: str, path: Path, loader: Any) -> ModuleType:

@@ -27,7 +27,7 @@ EXACT_INVERSE_UP_TO = 32
 """Up to this many coordinates the condition at a solved point uses the exact ||Phi_q^-1||_1,
 the column sums of the inverse from N solves with the factors (cheap at this size); the
 generated C does the same for mechanisms whose inverse columns take few operations
-(codegen.inverse_code), so both backends flag the same points."""
+(backends.c.inverse_code), so both backends flag the same points."""
 
 
 @dataclass(frozen=True)

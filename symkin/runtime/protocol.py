@@ -1,16 +1,98 @@
-"""What the driver needs of a kernel, as a typed Protocol."""
+"""What the driver needs of a kernel, and of a backend's grid solver, as typed Protocols."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.options import Options
-from symkin.runtime.csolver import GridSolver
 
 Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """What one call of a grid solver reports.
+
+    Attributes:
+        solved: how many time points of the chunk were solved.
+        status: contract.status OK, NO_CONVERGENCE or SINGULAR at the last point attempted.
+        t: the time of that point.
+        iterations, residual: Newton's count and max |Phi| there.
+        fallbacks: the sparse LU's fall-backs to dense LU so far (0 for the dense LU).
+    """
+
+    solved: int
+    status: int
+    t: float
+    iterations: int
+    residual: float
+    fallbacks: int
+
+
+class GridSolver(Protocol):
+    """One run of a backend's own grid loop (the generated C solver): it keeps its state
+    between calls, so a grid runs in chunks exactly as in one call. A kernel hands one out
+    per run (``Kernel.grid_solver``); the driver releases it after the run."""
+
+    def start(self, options: Options, q: Array, p: Array) -> GridSolver:
+        """Begin a new run from q with parameters p."""
+        ...
+
+    def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
+             cond_out: Array, flagged_out: NDArray[np.bool_]) -> None:
+        """The run's grid and the C-contiguous rows :meth:`advance` writes."""
+        ...
+
+    def advance(self, start: int, stop: int) -> int:
+        """Solve the bound points start..stop-1; returns how many were solved."""
+        ...
+
+    @property
+    def status(self) -> int:
+        """The status at the last point attempted (symkin.contract.status codes)."""
+        ...
+
+    @property
+    def fallbacks(self) -> int:
+        """The sparse LU's fall-backs to dense LU since :meth:`start`."""
+        ...
+
+    def outcome(self, solved: int) -> ChunkResult:
+        """The last call's report, with the count it returned."""
+        ...
+
+    def point_vectors(self, count: int) -> Array:
+        """The local vectors of the named points at the run's parameters, (count, 2)."""
+        ...
+
+    def set_state(self, t: float, q: Array, dq: Array, ddq: Array) -> None:
+        """Continue from a point solved elsewhere."""
+        ...
+
+    def last_q(self) -> Array:
+        """The solver's current q."""
+        ...
+
+    def release(self) -> None:
+        """Forget the run's arrays and hand the solver back."""
+        ...
+
+
+BatchStatus = tuple[NDArray[np.int32], NDArray[np.int32]]
+"""(status, iterations) per parameter set of a batch solve."""
+
+
+class BatchSolver(Protocol):
+    """A backend's solve of many parameter sets in one call (the generated C batch): plain
+    Newton from q0 at t[0] per set, rows written into q, dq, d2q (m, T, N)."""
+
+    def __call__(self, params: Array, t: Array, q0: Array, options: Options,
+                 q: Array, dq: Array, d2q: Array) -> BatchStatus: ...
+
 
 
 class KinematicsKernel(Protocol):

@@ -1,7 +1,7 @@
-"""One chunk of a sweep solved in this process: the generated ``<prefix>_solve_batch`` in C,
-or the driver set by set for a kernel without it (NumPy).
+"""One chunk of a sweep solved in this process: the kernel's batch solver (the generated
+``<prefix>_solve_batch`` of a C kernel), or the driver set by set for a kernel without one.
 
-The C batch runs plain Newton from q0 at t[0], like the first attempt of ``symkin.solve``. A set
+The batch runs plain Newton from q0 at t[0], like the first attempt of ``symkin.solve``. A set
 it cannot solve is then handed to ``symkin.solve`` itself, which adds the damped assembly and
 names the reason (no assembly, singular, no convergence, not finite) — so every set of a sweep
 is exactly what a per-set ``solve`` gives, failures included, and a failed set costs only its
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -73,63 +72,16 @@ def solve_chunk(kernel: Kernel, params: Array, t: Array, q0: Array,
     m, size = params.shape[0], len(kernel.coordinates)
     chunk = empty_chunk(m, t, size) if into is None else into
     starts = np.broadcast_to(q0, (m, size))
-    if hasattr(kernel.lib, f"{kernel.name}_solve_batch"):
-        pending = _c_batch(kernel, params, t, q0, options, chunk)
+    if kernel.batch_solver is not None:
+        status, iterations = kernel.batch_solver(params, t, q0, options, chunk.q, chunk.dq,
+                                                 chunk.d2q)
+        chunk.iterations[:] = iterations
+        pending = np.flatnonzero(status != OK)
     else:
         pending = np.arange(m)
     for j in pending:
         _solve_one(kernel, params[j], t, starts[j], options, chunk, int(j))
     return chunk
-
-
-def _c_batch(kernel: Kernel, params: Array, t: Array, q0: Array, options: Options,
-             chunk: Chunk) -> NDArray[np.intp]:
-    """Run ``<prefix>_solve_batch`` over all sets; returns the indices of failed sets."""
-    ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
-    dtype = np.float32 if kernel.real == "float" else np.float64
-    m = params.shape[0]
-    direct = dtype == np.float64
-    outputs = (chunk.q, chunk.dq, chunk.d2q) if direct else tuple(
-        np.empty(chunk.q.shape, dtype=dtype) for _ in range(3))
-    inputs = [np.ascontiguousarray(a, dtype=dtype) for a in (params, q0, t)]
-    real = f"{name}_real *"
-    pointers = [ffi.cast(real, ffi.from_buffer(a)) if a.size else ffi.NULL
-                for a in (*inputs, *outputs)]
-    c_options = _options(ffi, lib, name, options)
-    state = ffi.new(f"{name}_state *")
-    work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
-    reports = ffi.new(f"{name}_batch_report[]", max(m, 1))
-    stride = len(kernel.coordinates) if q0.ndim == 2 else 0
-    getattr(lib, f"{name}_solve_batch")(
-        c_options, m, pointers[0], pointers[1], stride, t.size, pointers[2], pointers[3],
-        pointers[4], pointers[5], state, work, reports)
-    if not direct:
-        for target, source in zip((chunk.q, chunk.dq, chunk.d2q), outputs):
-            target[...] = source
-    status = np.frombuffer(ffi.buffer(reports, m * ffi.sizeof(f"{name}_batch_report")),
-                           dtype=_report_dtype(ffi, name))
-    chunk.iterations[:] = status["iterations"]
-    return np.flatnonzero(status["status"] != OK)
-
-
-def _report_dtype(ffi: Any, name: str) -> np.dtype[Any]:
-    """The NumPy view of ``<prefix>_batch_report`` (offsets from cffi, not assumed)."""
-    struct = f"{name}_batch_report"
-    real = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
-    fields = {"status": np.int32, "solved": np.int32, "t": real, "iterations": np.int32,
-              "residual": real}
-    return np.dtype({"names": list(fields), "formats": list(fields.values()),
-                     "offsets": [ffi.offsetof(struct, f) for f in fields],
-                     "itemsize": ffi.sizeof(struct)})
-
-
-def _options(ffi: Any, lib: Any, name: str, options: Options) -> Any:
-    c_options = ffi.new(f"{name}_options *")
-    getattr(lib, f"{name}_default_options")(c_options)
-    c_options.tol_phi, c_options.tol_dq = options.tol_phi, options.tol_dq
-    c_options.max_iterations = options.max_iterations
-    c_options.min_pivot_ratio = options.min_pivot_ratio
-    return c_options
 
 
 def _solve_one(kernel: Kernel, p: Array, t: Array, q0: Array, options: Options, chunk: Chunk,

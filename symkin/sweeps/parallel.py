@@ -24,12 +24,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin import backends
 from symkin.build.cache import verified
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.contract.options import Options
 from symkin.errors import SolveError
 from symkin.runtime.kernel import Kernel
-from symkin.runtime.kernel import load as load_kernel
 from symkin.sweeps.batch import Chunk, solve_chunk
 
 Array = NDArray[np.float64]
@@ -83,15 +83,13 @@ def _same_machine(source: Payload) -> Kernel | None:
             return None
         name = json.loads(source.files[next(n for n in source.files
                                             if n.endswith(MANIFEST_SUFFIX))])["name"]
-        return load_kernel(folder, name)
+        return backends.load(folder, name)
     except (OSError, ImportError, ValueError, KeyError, StopIteration):
         return None
 
 
 def _built(source: Payload) -> Kernel:
-    from symkin.build.compile import from_sources  # loads SymPy: only when building
-
-    return from_sources(source.files)
+    return backends.from_sources(source.files)
 
 
 def run_chunk(source: Payload, params: Array, t: Array, q0: Array,

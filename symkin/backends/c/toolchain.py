@@ -1,4 +1,4 @@
-"""The C toolchain: which compiler, and what identifies it in a cache key.
+"""The C toolchain: which compiler, what identifies it in a cache key, and running it.
 
 One place for compiler detection, so the build cache and the warm-run index can never disagree
 about which compiler a kernel was built with.
@@ -14,11 +14,11 @@ import shutil
 import subprocess
 import sys
 import sysconfig
-import warnings
+from pathlib import Path
 from typing import Any
 
 from symkin import resources
-from symkin.errors import NoCompilerError, SymkinWarning
+from symkin.errors import BuildError, NoCompilerError
 
 
 def c_compiler() -> list[str] | None:
@@ -57,28 +57,40 @@ def fingerprint(compiler: list[str] | None) -> dict[str, Any]:
     return found
 
 
-BACKENDS = ("auto", "c", "numpy")
-
-
-def resolve_backend(backend: str) -> str:
-    """The backend to build: ``"auto"`` is C when a compiler is found, else NumPy with a
-    one-line note; an explicit ``"c"`` without a compiler is an error, never a silent NumPy.
-
-    Raises:
-        NoCompilerError: ``"c"`` was asked for and no C compiler is found.
-    """
-    if backend not in ("auto", "c"):
-        return backend
+def missing() -> str | None:
+    """Why C cannot be built here (no compiler), or None when a compiler is found."""
     if c_compiler() is not None:
-        return "c"
-    looked_for = os.environ.get("CC") or "cc"
-    if backend == "c":
+        return None
+    return (f"no C compiler found (looked for {os.environ.get('CC') or 'cc'}): install gcc "
+            "or clang, or set CC, for the C backend")
+
+
+def require() -> None:
+    """Raise NoCompilerError, saying how to install one, when no C compiler is found."""
+    if c_compiler() is None:
         raise NoCompilerError(
-            f"the C backend needs a C compiler and none was found (looked for {looked_for}). "
-            "Install one (Debian/Ubuntu: apt install gcc; macOS: xcode-select --install; "
-            "or conda install c-compiler), set CC to it, or use backend 'numpy' or 'auto'.")
-    warnings.warn(f"no C compiler found (looked for {looked_for}): using the NumPy backend, "
-                  "which gives the same results, more slowly. Install gcc or clang, or set "
-                  "CC, for the C backend.", SymkinWarning,
-                  stacklevel=3)
-    return "numpy"
+            "the C backend needs a C compiler and none was found (looked for "
+            f"{os.environ.get('CC') or 'cc'}). Install one (Debian/Ubuntu: apt install gcc; "
+            "macOS: xcode-select --install; or conda install c-compiler), set CC to it, or "
+            "use backend 'numpy' or 'auto'.")
+
+
+class CompilerError(BuildError):
+    """The C compiler failed: ``command`` is what ran, ``stderr`` what it said."""
+
+    def __init__(self, command: list[str], returncode: int, stderr: str) -> None:
+        self.command = command
+        self.returncode = returncode
+        self.stderr = stderr
+        super().__init__(f"the C compiler failed (exit status {returncode}):\n"
+                         f"  {shlex.join(command)}\n{stderr.strip()}")
+
+
+def run(command: list[str], cwd: Path) -> None:
+    """Run a compiler command; on failure raise CompilerError with the command and its output."""
+    try:
+        result = subprocess.run(command, cwd=cwd, capture_output=True, text=True, check=False)
+    except OSError as error:
+        raise BuildError(f"could not run {shlex.join(command)}: {error}") from None
+    if result.returncode != 0:
+        raise CompilerError(command, result.returncode, result.stderr)

@@ -1,4 +1,4 @@
-"""The C99 backend: its printer, its template folder and how it names files and literals."""
+"""The C99 backend's printer and literals: SymPy expressions as C99 text of the real type."""
 
 from __future__ import annotations
 
@@ -11,7 +11,6 @@ from sympy.codegen.ast import real as real_type
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from symkin.codegen.backends.config import Backend
 from symkin.codegen.symbols import symbol_text
 from symkin.errors import BuildError
 
@@ -94,14 +93,3 @@ def literal(real: str) -> Callable[[float], str]:
         return printed + suffix if any(ch in printed for ch in ".en") else printed + ".0" + suffix
     return text
 
-
-PURPOSES = {
-    "kernel": "kinematic kernel of the mechanism {name}: Phi, Phi_q, Phi_t, Gamma, points",
-    "solver": "position, velocity and acceleration analysis of {name} (Example 2.6)",
-    "linalg": "the solver's linear algebra on the dense LU",
-    "sparse_lu": "sparse LU of Phi_q with its pivot order fixed at generation time",
-    "dense_lu": "dense LU with partial pivoting (also the sparse LU's fall-back)",
-}
-
-BACKEND = Backend(name="c", template_folder="c", printer=CPrinter, literal=literal,
-                  module_template="kernel", purposes=PURPOSES)

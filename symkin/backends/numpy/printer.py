@@ -1,14 +1,11 @@
-"""The NumPy backend: its printer and its template folder (one Python module per mechanism)."""
+"""The NumPy backend's printer: SymPy expressions as NumPy text (double precision only)."""
 
 from __future__ import annotations
-
-from typing import Any
 
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from symkin.codegen.backends.config import Backend
 from symkin.codegen.symbols import symbol_text
 
 
@@ -47,18 +44,3 @@ class PythonPrinter(NumPyPrinter):
             return f"({base}*{base})"
         return str(super()._print_Pow(expr, rational))
 
-
-def _printer(real: str) -> PythonPrinter:
-    # NumPy computes in double; lower() refuses real="float" for this backend.
-    del real
-    return PythonPrinter()
-
-
-def _literal(real: str) -> Any:
-    del real
-    return repr
-
-
-BACKEND = Backend(name="numpy", template_folder="numpy", printer=_printer, literal=_literal,
-                  module_template="kernel",
-                  purposes={"kernel": "kinematic kernel of the mechanism {name}"})

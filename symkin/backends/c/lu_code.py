@@ -27,8 +27,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from symkin.codegen import inverse_code
-from symkin.codegen.backends.c import literal
+from symkin.backends.c import inverse_code
+from symkin.backends.c.printer import literal
 from symkin.codegen.lu_plan import LUPlan, Step
 
 Value = float | None  # a known number, or unknown until run time

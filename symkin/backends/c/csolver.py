@@ -1,5 +1,6 @@
-"""The generated C solver's grid loop, called through cffi: every C call of the runtime's
-time loop lives here, so the driver sees plain NumPy arrays and a :class:`ChunkResult`.
+"""The generated C solver's grid loop, called through cffi (the C backend's
+``runtime.protocol.GridSolver``): every C call of the runtime's time loop lives here, so the
+driver sees plain NumPy arrays and a :class:`ChunkResult`.
 
 The C solver keeps its state (the last q, dq, ddq and t) between calls, so a grid can be run
 in chunks (for progress reports, interrupts) and continues exactly as one call would.
@@ -12,35 +13,15 @@ and written by the C in place, chunk after chunk, through pointers offset by the
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from symkin.contract.options import Options
+from symkin.runtime.protocol import ChunkResult
 
 Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class ChunkResult:
-    """What one call of ``<prefix>_solve_grid`` reports.
-
-    Attributes:
-        solved: how many time points of the chunk were solved.
-        status: newton.OK, NO_CONVERGENCE or SINGULAR at the last point attempted.
-        t: the time of that point.
-        iterations, residual: Newton's count and max |Phi| there.
-        fallbacks: the sparse LU's fall-backs to dense LU so far (0 for the dense LU).
-    """
-
-    solved: int
-    status: int
-    t: float
-    iterations: int
-    residual: float
-    fallbacks: int
 
 
 class GridSolver:

@@ -1,0 +1,27 @@
+"""What the C templates need beyond the common context: the sparse LU as statements or
+tables (lu_code), ||Phi_q||_1 as column sums (norm_code) and the libm and literal suffixes of
+the real type."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from symkin.backends.c import lu_code, norm_code
+from symkin.backends.c.printer import literal
+from symkin.codegen.lower import Code
+
+
+def template_context(code: Code) -> dict[str, Any]:
+    """The C-only entries of the template context of ``code``."""
+    lu = (lu_code.template_context(code.lu_plan, constants=code.constant_nz, real=code.real,
+                                   prefix=code.name) if code.lu_plan else None)
+    return {
+        # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
+        "libm_suffix": "f" if code.real == "float" else "",
+        "literal_suffix": "F" if code.real == "float" else "",
+        **({"lu": lu} if lu else {}),
+        # ||Phi_q||_1 straight-line, or a loop where the LU itself is table-driven
+        "norm1": (norm_code.norm1_context(code.pattern_cols, code.nq, code.constant_nz,
+                                          literal(code.real), code.real)
+                  if not (lu and lu["style"] == "tables") else None),
+    }

@@ -1,0 +1,138 @@
+"""A C kernel loaded through cffi: the generated functions, the grid solver and the batch
+solver of one compiled extension, behind the runtime's Kernel.
+
+Needs only NumPy and cffi: loading a built C kernel never imports SymPy or jinja2.
+"""
+
+from __future__ import annotations
+
+import importlib.machinery
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from symkin import resources
+from symkin.backends.c import batch
+from symkin.backends.c.csolver import GridSolver, SolverPool
+from symkin.contract.options import Options
+from symkin.runtime.kernel import Array, Kernel, import_file
+from symkin.runtime.protocol import BatchStatus
+
+
+class CKernel(Kernel):
+    """A Kernel over a cffi extension built from the generated C.
+
+    Attributes:
+        ffi, lib: the extension's cffi handles, for callers of the generated C functions.
+    """
+
+    def __init__(self, ffi: Any, lib: Any, meta: Mapping[str, Any],
+                 folder: Path | None = None) -> None:
+        functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
+                                len(meta["pattern_rows"]), len(meta["points"]),
+                                len(meta.get("phi_p_rows", ())))
+        super().__init__("c", meta, functions, folder=folder)
+        self.ffi = ffi
+        self.lib = lib
+        self._solvers: SolverPool | None = None  # GridSolvers reused from run to run
+        # Looked up once: solve asks on every call.
+        self._has_grid_solver = hasattr(lib, f"{self.name}_solve_grid")
+        if hasattr(lib, f"{self.name}_solve_batch"):
+            self.batch_solver = self._solve_batch
+
+    @property
+    def has_grid_solver(self) -> bool:
+        """True when the generated solver runs whole grids (``solve_grid``)."""
+        return self._has_grid_solver
+
+    def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
+        """A fresh run of the generated C grid loop from q, or None without a C solver."""
+        if self._solvers is None:
+            if not self.has_grid_solver:
+                return None
+            self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
+        return self._solvers.take(options, q, p)
+
+    def _solve_batch(self, params: Array, t: Array, q0: Array, options: Options,
+                     q: Array, dq: Array, d2q: Array) -> BatchStatus:
+        return batch.solve(self.ffi, self.lib, self.name, self.real, params, t, q0, options,
+                           (q, dq, d2q))
+
+
+class _CFunctions:
+    """Adapter over a cffi extension: converts arrays to the generated real type and back."""
+
+    def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
+                 npoints: int, nnz_p: int = 0) -> None:
+        self._ffi = ffi
+        self._dtype = np.float32 if real == "float" else np.float64
+        self._ctype = f"{real}[]"
+        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
+                       "phi_p": nnz_p}
+        # getattr with a default: a kernel folder built before phi_p existed has none.
+        self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
+                                   for name in self._sizes}
+
+    def _in(self, array: Array) -> Any:
+        if array.size == 0:
+            return self._ffi.NULL
+        return self._ffi.from_buffer(self._ctype, np.ascontiguousarray(array, self._dtype))
+
+    def _call(self, name: str, *arguments: Any) -> Array:
+        out = np.zeros(self._sizes[name], dtype=self._dtype)
+        target = self._ffi.from_buffer(self._ctype, out) if out.size else self._ffi.NULL
+        self._c[name](*arguments, target)
+        return out.astype(np.float64, copy=False)
+
+    def phi(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi", self._in(q), t, self._in(p))
+
+    def phi_q_nz(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi_q", self._in(q), t, self._in(p))
+
+    def phi_t(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi_t", self._in(q), t, self._in(p))
+
+    def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array:
+        return self._call("gamma", self._in(q), self._in(dq), t, self._in(p))
+
+    def points(self, p: Array) -> Array:
+        return self._call("points", self._in(p))
+
+    def phi_p_nz(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("phi_p", self._in(q), t, self._in(p))
+
+
+def load(folder: Path, meta: Mapping[str, Any]) -> CKernel:
+    """Load the compiled extension of a built C folder; ``meta`` is its manifest."""
+    library = extension_file(folder, meta["name"])
+    return import_extension(library.name[: -len(resources.extension_suffix())], library,
+                            meta, folder)
+
+
+def import_extension(module_name: str, library: Path, meta: Mapping[str, Any],
+                     folder: Path) -> CKernel:
+    """The kernel of the extension ``library`` (imported once per process)."""
+    loader = importlib.machinery.ExtensionFileLoader(module_name, str(library))
+    module = import_file(module_name, library, loader)
+    return CKernel(module.ffi, module.lib, meta, folder)
+
+
+def extension_file(folder: Path, name: str | None = None) -> Path:
+    """The compiled extension in a C kernel folder.
+
+    A build-cache folder is named after its module, so that file is the one; any other folder
+    must hold exactly one ``_symkin_<name>_*`` extension.
+    """
+    own = folder / (folder.name + resources.extension_suffix())
+    if own.is_file():
+        return own
+    pattern = f"_symkin_{name or ''}{'_' if name else ''}*{resources.extension_suffix()}"
+    libraries = sorted(folder.glob(pattern))
+    if len(libraries) != 1:
+        found = "no" if not libraries else "more than one"
+        raise FileNotFoundError(f"{folder} holds {found} compiled extension; build it with "
+                                "symkin.compile")
+    return libraries[0]

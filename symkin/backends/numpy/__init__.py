@@ -1,0 +1,96 @@
+"""The NumPy backend: one Python module per mechanism, imported from the build cache; needs
+no compiler. Its pieces: ``printer`` (NumPy text; imported only when generating) and
+``loader`` (the Kernel over the module). Templates: ``templates/numpy/``.
+"""
+
+from __future__ import annotations
+
+import platform
+import sys
+import sysconfig
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from symkin import resources
+from symkin.codegen.target import file_name, rendered_templates
+from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
+
+if TYPE_CHECKING:
+    from symkin.codegen.lower import Code
+    from symkin.runtime.kernel import Kernel
+
+
+class NumPyBackend:
+    """The NumPy backend (see the module docstring)."""
+
+    name = "numpy"
+    title = "NumPy"
+    real_types: tuple[str, ...] = ("double",)  # NumPy computes in double
+    template_folder = "numpy"
+
+    @property
+    def template_root(self) -> Path:
+        return resources.template_root()
+
+    def printer(self, real: str) -> Any:
+        from symkin.backends.numpy.printer import PythonPrinter
+
+        del real  # double only (real_types)
+        return PythonPrinter()
+
+    def literal(self, real: str) -> Callable[[float], str]:
+        del real
+        return repr
+
+    def templates(self, linalg: str) -> list[str]:
+        del linalg  # the Python driver does the linear algebra
+        return rendered_templates(self.template_root / self.template_folder)
+
+    def output_name(self, template: str, prefix: str) -> str:
+        return file_name(template, prefix, "kernel")
+
+    def purpose(self, template: str) -> str:
+        del template  # one file
+        return "kinematic kernel of the mechanism {name}"
+
+    def plans_lu(self, linalg: str) -> bool:
+        del linalg
+        return False
+
+    def template_context(self, code: Code) -> dict[str, Any]:
+        del code
+        return {}
+
+    def unavailable(self) -> str | None:
+        return None
+
+    def require(self) -> None:
+        return None
+
+    def fingerprint(self) -> dict[str, Any]:
+        return {"python": sys.version, "implementation": sys.implementation.cache_tag or "",
+                "platform": sysconfig.get_platform(), "machine": platform.machine()}
+
+    def build(self, files: dict[str, str], cache: Path) -> Kernel:
+        from symkin.backends.numpy import loader
+
+        return loader.build(files, _name(files), cache, self.name)
+
+    def load(self, folder: Path, meta: Mapping[str, Any]) -> Kernel:
+        from symkin.backends.numpy import loader
+
+        return loader.load(folder, meta["name"], self.name)
+
+    def loaded_files(self, folder: Path, name: str) -> list[str]:
+        del folder
+        return [manifest_name(name), f"{name}.py"]
+
+
+def _name(files: Mapping[str, str]) -> str:
+    """The mechanism of a generated folder: its manifest's prefix."""
+    manifest = next(n for n in files if n.endswith(MANIFEST_SUFFIX))
+    return manifest.removesuffix(MANIFEST_SUFFIX)
+
+
+BACKEND = NumPyBackend()
