@@ -1,7 +1,7 @@
 """symkin: symbolic code generation for the kinematic analysis of planar mechanisms.
 
-The public API (see DESIGN.md) is loaded lazily, so that running an already-compiled kernel
-does not pay for importing SymPy.
+The public API (the README's "Python API") is loaded lazily, so that running an
+already-compiled kernel does not pay for importing SymPy.
 """
 
 from __future__ import annotations

@@ -7,16 +7,15 @@ from __future__ import annotations
 from pathlib import Path
 
 from symkin import backends
-from symkin.build import compile as build
-from symkin.codegen import lower as codegen
-from symkin.codegen import render
+from symkin.build.compile import compile as compile_system
+from symkin.codegen import lower, render
 from symkin.runtime.kernel import Kernel
 from symkin.symbolic.derivation import System
 
 
 def generate(system: System, backend: str = "c", out_dir: str | Path = "generated",
              real: str = "double", cse: bool = True,
-             linalg: str = codegen.DEFAULT_LINALG, force: bool = False) -> list[Path]:
+             linalg: str = lower.DEFAULT_LINALG, force: bool = False) -> list[Path]:
     """Generate the source files of one backend into ``out_dir`` (``codegen.render.generate``).
 
     Args:
@@ -36,7 +35,7 @@ def generate(system: System, backend: str = "c", out_dir: str | Path = "generate
 
 
 def compile(system: System, backend: str = backends.AUTO, *, real: str = "double",
-            cse: bool = True, linalg: str = codegen.DEFAULT_LINALG,
+            cse: bool = True, linalg: str = lower.DEFAULT_LINALG,
             cache_dir: str | Path | None = None) -> Kernel:
     """Generate, compile (or find in the cache) and load the kernel of ``system``.
 
@@ -55,5 +54,5 @@ def compile(system: System, backend: str = backends.AUTO, *, real: str = "double
             command and its output).
         NoCompilerError: ``backend="c"`` and no C compiler is found.
     """
-    return build.compile(system, backends.resolve(backend), real=real, cse=cse, linalg=linalg,
+    return compile_system(system, backends.resolve(backend), real=real, cse=cse, linalg=linalg,
                          cache_dir=cache_dir)

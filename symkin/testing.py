@@ -16,14 +16,14 @@ from typing import Any
 
 from symkin.spec.validate import Mechanism
 from symkin.symbolic.derivation import System
-from symkin.verify import numeric as _verify
+from symkin.verify import numeric
 from symkin.verify.report import Report
 
 
-def assert_kinematics_match(mechanism: Mechanism | System | _verify.Derived | str | Path,
-                            hand_module: Any, *, samples: int = _verify.DEFAULT_SAMPLES,
-                            seed: int = 0, spread: float = _verify.DEFAULT_SPREAD,
-                            tolerance: float = _verify.DEFAULT_TOLERANCE) -> Report:
+def assert_kinematics_match(mechanism: Mechanism | System | numeric.Derived | str | Path,
+                            hand_module: Any, *, samples: int = numeric.DEFAULT_SAMPLES,
+                            seed: int = 0, spread: float = numeric.DEFAULT_SPREAD,
+                            tolerance: float = numeric.DEFAULT_TOLERANCE) -> Report:
     """Fail (AssertionError) unless the hand functions match the derived ones.
 
     Args:
@@ -42,7 +42,7 @@ def assert_kinematics_match(mechanism: Mechanism | System | _verify.Derived | st
             wrong shape (the original exception is its ``__cause__``).
     """
     __tracebackhide__ = True  # pytest shows the caller's line, not this helper's
-    report = _verify.verify(mechanism, hand_module, samples=samples, seed=seed, spread=spread,
+    report = numeric.verify(mechanism, hand_module, samples=samples, seed=seed, spread=spread,
                             tolerance=tolerance)
     if not report.ok:
         raise AssertionError("hand derivation does not match the derived kinematics\n"

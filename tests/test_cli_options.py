@@ -201,14 +201,14 @@ def test_at_columns_never_run_together() -> None:
     space between columns, so every row splits into its numbers."""
     import numpy as np
 
-    from symkin.cli import outputs
+    from symkin.cli import run_outputs
     from symkin.runtime.results import Trajectory
 
     widest = np.array([[-1.23456789012e-100, -9.87654321098e-200, -1.1e-16]])
     trajectory = Trajectory(t=np.zeros(1), q=widest, dq=widest, d2q=widest,
                             coordinates=("b.x", "b.y", "b.phi"), points=(("b", "P"),),
                             point_vectors=np.array([[-1.234567891e-100, -2.5e-300]]))
-    text = outputs.configuration(trajectory, "m", "numpy backend")
+    text = run_outputs.configuration(trajectory, "m", "numpy backend")
     for line in text.splitlines()[3:]:
         if line and not line.startswith("point"):
             assert all(np.isfinite(float(v)) for v in line.split()[1:]), line

@@ -24,7 +24,7 @@ from symkin import backends
 from symkin.backends.c import printer as c_printer
 from symkin.backends.numpy import printer as numpy_printer
 from symkin.codegen import lower as codegen
-from symkin.codegen import symbols as codegen_symbols
+from symkin.codegen import symbol_printing
 from symkin.errors import BuildError
 
 
@@ -140,7 +140,7 @@ def test_step_functions_print_their_closed_forms() -> None:
     """H(x) (H(0) = 1/2) + delta(x) + sign(x): delta is dropped, H and sign print directly
     (no Piecewise rewrite, which hangs on nested Abs); the NumPy text gives H + sign."""
     x = sp.Symbol("x", real=True)
-    expr = codegen_symbols.prepare(sp.Heaviside(x, sp.Rational(1, 2)) + sp.DiracDelta(x) + sp.sign(x),
+    expr = symbol_printing.prepare(sp.Heaviside(x, sp.Rational(1, 2)) + sp.DiracDelta(x) + sp.sign(x),
                             {x: _internal("_q0")})
     assert not expr.has(sp.DiracDelta, sp.Piecewise)
     c_text = c_printer.CPrinter().doprint(expr)
@@ -156,7 +156,7 @@ def test_constants_become_correctly_rounded_literals() -> None:
     M_ macros, no truncated integer constant), the nearest doubles of the exact values."""
     q0 = _internal("_q0")
     big = sp.Integer(18446744073709551617)
-    expr = codegen_symbols.prepare(sp.sqrt(2) * q0 + sp.log(2) + sp.pi / 2 + sp.Min(q0, big), {})
+    expr = symbol_printing.prepare(sp.sqrt(2) * q0 + sp.log(2) + sp.pi / 2 + sp.Min(q0, big), {})
     for real in ("double", "float"):
         text = c_printer.CPrinter(real).doprint(expr)
         assert "M_" not in text and "18446744073709551617" not in text, text

@@ -2,7 +2,7 @@
 
 Each test builds a two-body mechanism whose vectors sA, sB, v, u are parameters, so SymPy
 sees them as generic symbols, derives it with symkin, and compares the rows the constraint
-owns with the formulas of the chapter, written out below from REFERENCE.md:
+owns with the formulas of the chapter, written out below from the source chapter (section 2.4):
 
     revolute             Phi_q blocks (2.31)-(2.34), Gamma (2.42)
     prismatic            angle row (2.43)-(2.48), perpendicular row (2.49)-(2.52), (2.59)

@@ -1,4 +1,4 @@
-"""The `symkin run` contract (DESIGN.md): output names, exit codes, partial results, no traceback."""
+"""The `symkin run` contract (README, "Running a mechanism"): output names, exit codes, partial results, no traceback."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from driver_support import MECHANISMS
 
-from symkin.cli.outputs import ProgressBar
+from symkin.cli.run_outputs import ProgressBar
 
 ROOT = Path(__file__).resolve().parent.parent
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"

@@ -18,7 +18,7 @@ from driver_support import BACKENDS, derive, kernel_for
 import symkin
 from symkin.errors import SolveError
 from symkin.runtime import driver
-from symkin.runtime.outputs import allocate
+from symkin.runtime.result_arrays import allocate
 from symkin.runtime.results import Trajectory
 
 ARRAYS = ("t", "q", "dq", "d2q", "cond", "flagged")

@@ -18,7 +18,7 @@ from driver_support import kernel_for
 
 import symkin
 from symkin import backends
-from symkin.cli import outputs
+from symkin.cli import run_outputs
 from symkin.codegen import lower as codegen
 from symkin.codegen import sample as codegen_sample
 from symkin.runtime import driver, linalg
@@ -93,6 +93,6 @@ def test_factor_sparse_solves_and_judges_singularity() -> None:
 
 
 def test_run_mentions_fallbacks_and_that_they_cost_no_accuracy() -> None:
-    assert outputs.fallback_note(1, 31).startswith("1 pivot fall-back to dense LU over 31")
-    note = outputs.fallback_note(3, 31)
+    assert run_outputs.fallback_note(1, 31).startswith("1 pivot fall-back to dense LU over 31")
+    note = run_outputs.fallback_note(3, 31)
     assert note.startswith("3 pivot fall-backs to dense LU") and "not accuracy" in note

@@ -1,4 +1,4 @@
-"""Warm `symkin run`: the kernel index (symkin/cache.py) skips SymPy and never serves a stale or
+"""Warm `symkin run`: the kernel index (symkin/build/index.py) skips SymPy and never serves a stale or
 damaged kernel.
 
 Every run is a real `python -m symkin`-style subprocess with its own cache folder. A wrapper

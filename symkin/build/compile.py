@@ -13,15 +13,14 @@ from pathlib import Path
 
 from symkin.build.backend import Backend
 from symkin.build.cache import open_cache
-from symkin.codegen import lower as codegen
-from symkin.codegen import render
+from symkin.codegen import lower, render
 from symkin.contract.manifest import manifest_name
 from symkin.runtime.kernel import Kernel
 from symkin.symbolic.derivation import System
 
 
 def compile(system: System, backend: Backend, *, real: str = "double", cse: bool = True,
-            linalg: str = codegen.DEFAULT_LINALG, cache_dir: str | Path | None = None
+            linalg: str = lower.DEFAULT_LINALG, cache_dir: str | Path | None = None
             ) -> Kernel:
     """Generate, build (or find in the cache) and load the kernel of ``system``.
 
@@ -41,7 +40,7 @@ def compile(system: System, backend: Backend, *, real: str = "double", cse: bool
     """
     backend.require()
     cache = open_cache(cache_dir)
-    code = codegen.lower(system, backend, real, cse, linalg)
+    code = lower.lower(system, backend, real, cse, linalg)
     files = render.render_sources(code)
     files[manifest_name(code.name)] = render.manifest(code, files)
     return backend.build(files, cache)

@@ -1,6 +1,6 @@
 """The kernel index: from a mechanism file straight to its built kernel, without SymPy.
 
-The build cache (symkin/build.py) is keyed by the generated source, so finding a kernel there
+The build cache (symkin/build/cache.py) is keyed by the generated source, so finding a kernel there
 needs the derivation, and with it SymPy, pydantic and jinja2. This index sits in front of it:
 
     sha256(file bytes, file format, backend, real, cse, linalg, symkin's code and templates,
@@ -114,12 +114,12 @@ def prepare(mechanism: str | Path, options: Options, *, outlines: bool = False,
 
 def _full_pipeline(mechanism: Path, options: Options, cache: Path,
                    want_outlines: bool) -> Prepared:
-    from symkin.build import compile as build
+    from symkin.build.compile import compile as compile_system
     from symkin.spec import validate
     from symkin.symbolic import derivation, drawing
 
     system = derivation.derive(validate.load(mechanism, dict(options.parameters)))
-    kernel = build.compile(system, backend=options.backend, real=options.real,
+    kernel = compile_system(system, backend=options.backend, real=options.real,
                            cse=options.cse, linalg=options.linalg, cache_dir=cache)
     drawn = drawing.outlines(system) if want_outlines else None
     return Prepared(kernel, hit=False, outlines=drawn, system=system)

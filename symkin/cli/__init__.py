@@ -35,19 +35,19 @@ def _show(args: argparse.Namespace) -> int:
 
         print(drawn.dump(_load(args)), end="")
         return EXIT_OK
-    from symkin.symbolic import show as report
+    from symkin.symbolic import show
 
     system = derivation.derive(_load(args))
-    print(report.latex(system) if args.latex else report.text(system), end="")
+    print(show.latex(system) if args.latex else show.text(system), end="")
     return EXIT_OK
 
 
 def _schema(args: argparse.Namespace) -> int:
     import json
 
-    from symkin.spec import validate as model
+    from symkin.spec import validate
 
-    print(json.dumps(model.json_schema(), indent=2))
+    print(json.dumps(validate.json_schema(), indent=2))
     return EXIT_OK
 
 
@@ -129,9 +129,9 @@ def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser])
 
 
 def _add_run(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from symkin.cli import run as runner  # the `run` subcommand lives in its own module
+    from symkin.cli import run  # the `run` subcommand lives in its own module
 
-    runner.add_parser(commands)
+    run.add_parser(commands)
 
 
 def _add_sweep(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -141,9 +141,9 @@ def _add_sweep(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 
 def _add_cache(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from symkin.cli import cache
+    from symkin.cli import cache_command
 
-    cache.add_parser(commands)
+    cache_command.add_parser(commands)
 
 
 def _add_scan(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

@@ -1,12 +1,13 @@
 """``symkin run``: solve a mechanism over its time grid and write the results.
 
 A thin layer over symkin.derive -> symkin.compile -> symkin.solve -> Trajectory.save / plots.
-The kernel comes through the index of symkin/cache.py: a second run of an unchanged file loads
-the cached kernel and its metadata directly, and never imports SymPy, pydantic or jinja2.
+The kernel comes through the warm-run index (symkin/build/index.py): a second run of an
+unchanged file loads the cached kernel and its metadata directly, and never imports SymPy,
+pydantic or jinja2.
 Exit status 0 on success; 1 when the solve fails (the rows solved so far are still written);
 2 for bad input (a message, never a traceback). ``--at T`` solves one configuration (the
 chapter's single-instant problem) and prints it; the files a run writes are in
-:mod:`symkin.cli.outputs`.
+:mod:`symkin.cli.run_outputs`.
 """
 
 from __future__ import annotations
@@ -18,9 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from symkin import backends, limits
-from symkin.cli import messages, outputs, overrides
+from symkin.cli import messages, overrides, run_outputs
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
-from symkin.cli.outputs import CannotWrite, ProgressBar
+from symkin.cli.run_outputs import CannotWrite, ProgressBar
 
 SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png", ".svg", ".pdf"), "animate": (".gif",),
             "html": (".html", ".htm")}
@@ -137,15 +138,15 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def _solve_and_write(args: argparse.Namespace) -> int:
-    from symkin.build import index as cache
+    from symkin.build import index
     from symkin.runtime import driver
 
-    options = cache.Options(backend=backends.resolve(args.backend),
+    options = index.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
-    prepared = cache.prepare(args.mechanism, options,
+    prepared = index.prepare(args.mechanism, options,
                              outlines=args.animate is not None or args.html is not None)
     kernel = prepared.kernel
-    picture = outputs.Pictures.of(args, kernel)  # --select checked before any solving
+    picture = run_outputs.Pictures.of(args, kernel)  # --select checked before any solving
     if args.at is not None:
         times, problem = driver.grid(args.at, args.at, 1.0), None
     else:
@@ -171,14 +172,14 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     written = _write(trajectory, args, prepared.outlines, picture)
     origin = ", cached kernel" if prepared.hit else ""
     if args.at is not None:
-        print(outputs.configuration(trajectory, kernel.name, f"{kernel.backend} backend{origin}"),
-              end="")
+        backend = f"{kernel.backend} backend{origin}"
+        print(run_outputs.configuration(trajectory, kernel.name, backend), end="")
     else:
         print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
               f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
               + "".join(f"; wrote {path}" for path in written))
     if trajectory.lu_fallbacks:
-        messages.note(outputs.fallback_note(trajectory.lu_fallbacks, trajectory.t.size))
+        messages.note(run_outputs.fallback_note(trajectory.lu_fallbacks, trajectory.t.size))
     return EXIT_OK
 
 
@@ -193,7 +194,7 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
         message += f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     try:
-        written = _write(stop.trajectory, args, prepared.outlines, outputs.Pictures.of(
+        written = _write(stop.trajectory, args, prepared.outlines, run_outputs.Pictures.of(
             args, prepared.kernel))
     except CannotWrite as error:
         _error(str(error), EXIT_BAD_INPUT)
@@ -205,15 +206,15 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
 
 def _warn_flagged(trajectory: Any) -> None:
     """One warning line per stretch of consecutive flagged points (the run still succeeds)."""
-    for line in outputs.flag_warnings(trajectory):
+    for line in run_outputs.flag_warnings(trajectory):
         messages.note(line)
 
 
 def _write(trajectory: Any, args: argparse.Namespace, outlines: Any,
-           picture: outputs.Pictures) -> list[Path]:
+           picture: run_outputs.Pictures) -> list[Path]:
     """Save the results and pictures asked for (a partial trajectory too)."""
     try:
-        return outputs.write(trajectory, args, outlines, picture)
+        return run_outputs.write(trajectory, args, outlines, picture)
     except OSError as error:
         raise CannotWrite(f"cannot write {error.filename or 'the output'}: "
                           f"{error.strerror or error}; check the path and its permissions"

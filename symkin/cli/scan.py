@@ -37,7 +37,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def handle(args: argparse.Namespace) -> int:
     """Run the subcommand; returns the exit status."""
-    from symkin.build import index as cache
+    from symkin.build import index
     from symkin.errors import SolveError
     from symkin.runtime import driver
     from symkin.runtime.scan import scan
@@ -46,10 +46,10 @@ def handle(args: argparse.Namespace) -> int:
         value = getattr(args, option)
         if value is not None and not math.isfinite(value):
             return messages.error(f"--{option} {value}: give a finite number", EXIT_BAD_INPUT)
-    options = cache.Options(backend=backends.resolve(args.backend),
+    options = index.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
     try:
-        kernel = cache.prepare(args.mechanism, options).kernel
+        kernel = index.prepare(args.mechanism, options).kernel
     except OSError as error:  # e.g. a cache folder that cannot be used at all
         return messages.error(f"{error.strerror or error}: {error.filename or ''}", EXIT_FAILED)
     t0, t1, dt = kernel.time_grid

@@ -63,11 +63,11 @@ def handle(args: argparse.Namespace) -> int:
     problem = _bad_usage(args)
     if problem:
         return messages.error(problem, EXIT_BAD_INPUT)
-    from symkin.build import index as cache
+    from symkin.build import index
 
-    options = cache.Options(backend=backends.resolve(args.backend),
+    options = index.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
-    kernel = cache.prepare(args.mechanism, options).kernel
+    kernel = index.prepare(args.mechanism, options).kernel
     try:
         design, spread = _design(kernel, args)
     except UsageError as error:
@@ -155,7 +155,7 @@ def _finite(text: str, where: str) -> float:
 
 
 def _run(kernel: Any, args: argparse.Namespace, design: Any, spread: Any) -> int:
-    from symkin.cli.outputs import ProgressBar
+    from symkin.cli.run_outputs import ProgressBar
     from symkin.sweeps.api import sweep
 
     client = _client(args.scheduler) if args.scheduler else None

@@ -18,9 +18,9 @@ from typing import Any
 import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
-from symkin.codegen import sample, symbols
+from symkin.codegen import sample, symbol_printing
 from symkin.codegen.lu_plan import LUPlan
-from symkin.codegen.symbols import symbol_text
+from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.target import Target
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
@@ -167,12 +167,12 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         BuildError: an unknown real type, or an expression the printer cannot print.
     """
     _check_options(backend, real, linalg)
-    internal = symbols.internal_symbols(system)
+    internal = symbol_printing.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)
     expressions = _routine_expressions(system, pattern, p_pattern)
     printer: CodePrinter = backend.printer(real)
-    prepared = {name: [symbols.prepare(e, internal) for e in exprs]
+    prepared = {name: [symbol_printing.prepare(e, internal) for e in exprs]
                 for name, exprs in expressions.items()}
     fused, shared = _fused_expressions(prepared)
     sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}

@@ -20,7 +20,7 @@ from typing import Any
 import jinja2
 
 from symkin import resources
-from symkin.codegen import lower as codegen
+from symkin.codegen import lower
 from symkin.codegen.lower import Code, Routine
 from symkin.codegen.target import Target
 from symkin.contract import options, status, tuning
@@ -57,7 +57,7 @@ def environment(root: str | None = None) -> jinja2.Environment:
         lstrip_blocks=True, autoescape=False)
 
 
-def template_names(backend: Target, linalg: str = codegen.DEFAULT_LINALG) -> list[str]:
+def template_names(backend: Target, linalg: str = lower.DEFAULT_LINALG) -> list[str]:
     """The templates of ``backend`` that each render to one file, sorted."""
     return backend.templates(linalg)
 
@@ -88,7 +88,7 @@ def _render(backend: Target, name: str, context: dict[str, Any]) -> str:
 
 def generate(system: System, backend: Target, out_dir: str | Path = "generated",
              real: str = "double", cse: bool = True,
-             linalg: str = codegen.DEFAULT_LINALG, force: bool = False) -> list[Path]:
+             linalg: str = lower.DEFAULT_LINALG, force: bool = False) -> list[Path]:
     """Generate the source files of one backend into ``out_dir``.
 
     Args:
@@ -112,7 +112,7 @@ def generate(system: System, backend: Target, out_dir: str | Path = "generated",
         UsageError: the folder holds files symkin did not write (and not ``force``), or it
             cannot be written.
     """
-    code = codegen.lower(system, backend, real, cse, linalg)
+    code = lower.lower(system, backend, real, cse, linalg)
     return write(code, Path(out_dir), force=force)
 
 
@@ -218,7 +218,7 @@ def template_context(code: Code) -> dict[str, Any]:
     literal = code.backend.literal(code.real)
     return {
         "prefix": code.name, "PREFIX": code.name.upper(),
-        "name_comment": codegen.comment(code.name),
+        "name_comment": lower.comment(code.name),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
         "real": code.real, "cse": code.cse, "spec_sha256": code.spec_sha256,
@@ -229,11 +229,11 @@ def template_context(code: Code) -> dict[str, Any]:
         "p_literals": [literal(v) for v in code.p_values],
         "q0_literals": [literal(v) for v in code.q0],
         "time_literals": [literal(v) for v in code.time_grid],
-        "coordinate_comments": [f"q[{k}] {codegen.comment(n)}"
+        "coordinate_comments": [f"q[{k}] {lower.comment(n)}"
                                 for k, n in enumerate(code.coordinates)],
-        "parameter_comments": [f"p[{k}] {codegen.comment(n)} = {v!r}" for k, (n, v)
+        "parameter_comments": [f"p[{k}] {lower.comment(n)} = {v!r}" for k, (n, v)
                                in enumerate(zip(code.parameter_names, code.p_values))],
-        "row_comments": [f"{k}: {codegen.comment(r)}" for k, r in enumerate(code.rows)],
+        "row_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.rows)],
         "routines": [_routine_context(code, r) for r in code.routines],
         # Python string literals: repr() of a str is always a valid, inert literal.
         "name_literal": repr(code.name),
@@ -295,15 +295,15 @@ def _labels(code: Code, routine: str) -> list[str]:
     if routine == "phi_q":
         return [f"({r}, {c})" for r, c in zip(code.pattern_rows, code.pattern_cols)]
     if routine == "phi_p":
-        return [codegen.comment(f"({r}, {code.parameter_names[k]})")
+        return [lower.comment(f"({r}, {code.parameter_names[k]})")
                 for r, k in zip(code.phi_p_rows, code.phi_p_cols)]
     if routine == "phi_phi_q":
         return [*_labels(code, "phi"), *_labels(code, "phi_q"),
-                *(codegen.comment(f) for f in code.shared)]
+                *(lower.comment(f) for f in code.shared)]
     if routine == "points":
-        return [codegen.comment(f"{body}.{point}.{axis}") for body, point in code.points
+        return [lower.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in "xy"]
-    return [codegen.comment(row) for row in code.rows]
+    return [lower.comment(row) for row in code.rows]
 
 
 def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
@@ -323,7 +323,7 @@ def header_lines(code: Code, template: str, file_name: str) -> list[str]:
     file is, which template made it, the spec's sha256, the real type and op counts; never a
     date, host or version, so the same input gives the same bytes."""
     purpose = code.backend.purpose(template).format(
-        name=codegen.comment(code.name))
+        name=lower.comment(code.name))
     ops = ", ".join(f"{name} {count}" for name, count in sorted(code.ops.items()))
     after = ", after CSE" if code.cse else ""
     return [f"{file_name}: {purpose}",

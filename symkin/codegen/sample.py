@@ -15,8 +15,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from symkin.codegen import lu_plan as sparse_lu
-from symkin.codegen import symbols
+from symkin.codegen import lu_plan, symbol_printing
 from symkin.contract import dense_solvers
 from symkin.contract.options import defaults
 from symkin.errors import BuildError, SolveError
@@ -26,7 +25,7 @@ from symkin.symbolic.derivation import System
 NEWTON = defaults("double")
 
 
-def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> sparse_lu.LUPlan:
+def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_plan.LUPlan:
     """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration."""
     kernel = _SampleKernel(system, pattern)
     with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -34,7 +33,7 @@ def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> sparse
         warnings.simplefilter("ignore")
         sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
     try:
-        plan = sparse_lu.analyse(len(system.q), [r for r, _ in pattern],
+        plan = lu_plan.analyse(len(system.q), [r for r, _ in pattern],
                                  [c for _, c in pattern], [float(v) for v in sample])
     except SolveError as error:
         raise BuildError(f"cannot plan the sparse LU of Phi_q: {error}") from None
@@ -73,15 +72,15 @@ class _SampleKernel:
     symbols), with the few Kernel attributes the driver's assembly reads."""
 
     def __init__(self, system: System, pattern: Sequence[tuple[int, int]]) -> None:
-        internal = symbols.internal_symbols(system)
+        internal = symbol_printing.internal_symbols(system)
         arguments = ([internal[s] for s in system.q], internal[system.t],
                      [internal[s] for s in system.p])
         self.coordinates = system.coordinates
         self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
         self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
-        self._phi = sp.lambdify(arguments, [symbols.prepare(e, internal) for e in system.phi],
-                                modules="numpy")
-        self._nz = sp.lambdify(arguments, [symbols.prepare(system.phi_q[r, c], internal)
+        phi = [symbol_printing.prepare(e, internal) for e in system.phi]
+        self._phi = sp.lambdify(arguments, phi, modules="numpy")
+        self._nz = sp.lambdify(arguments, [symbol_printing.prepare(system.phi_q[r, c], internal)
                                            for r, c in pattern], modules="numpy")
         self._p = np.array(system.p_values, dtype=float)
 

@@ -36,7 +36,7 @@ class Target(Protocol):
         ...
 
     def printer(self, real: str) -> Any:
-        """A SymPy code printer for ``real`` that maps symbols via ``codegen.symbols``."""
+        """A SymPy code printer for ``real`` that maps symbols via ``codegen.symbol_printing``."""
         ...
 
     def literal(self, real: str) -> Callable[[float], str]:

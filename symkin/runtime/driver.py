@@ -16,7 +16,7 @@ solve goes to runtime.edges: a too-large step is subdivided, a singular configur
 passed on the predicted branch, a limit position is bisected and reported.
 
 With a C kernel that carries the generated solver, the grid loop runs in C: one call per
-trajectory, written straight into the result arrays (runtime.outputs: fresh, or the caller's
+trajectory, written straight into the result arrays (runtime.result_arrays: fresh, or the caller's
 ``out=``). When it solves the whole grid, the usual case, the Trajectory is returned at once;
 only where it stops does the general path above take over, from that point. Imports NumPy and
 SciPy only: it is part of the runtime.
@@ -46,9 +46,9 @@ from symkin.runtime.assembly import Assembly, assemble
 from symkin.runtime.edges import Resolution, resolve
 from symkin.runtime.linalg import factor_at
 from symkin.runtime.newton import Newton, kinematics, newton
-from symkin.runtime.outputs import Out, allocate
-from symkin.runtime.outputs import Run as _Run
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
+from symkin.runtime.result_arrays import Out, allocate
+from symkin.runtime.result_arrays import Run as _Run
 from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]

@@ -40,7 +40,7 @@ class _Functions(Protocol):
 
 
 class Kernel:
-    """The compiled kinematics of one mechanism (DESIGN.md, Python API).
+    """The compiled kinematics of one mechanism (what symkin.compile returns).
 
     Every function takes ``p=None`` to mean the nominal parameter values.
     """

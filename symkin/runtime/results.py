@@ -142,8 +142,9 @@ class Trajectory:
         return r, dr, ddr
 
     def save(self, path: str | Path) -> Path:
-        """Write .npz (all arrays, see DESIGN.md) or .csv (t, q, q_t, q_tt columns, then each
-        named point's x, y, vx, vy, ax, ay)."""
+        """Write .npz (all arrays: t, q, dq, d2q, coordinates, points, r, dr, ddr, flagged,
+        cond) or .csv (t, q, q_t, q_tt columns, then each named point's x, y, vx, vy, ax, ay,
+        then flagged)."""
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix not in SAVE_FORMATS:

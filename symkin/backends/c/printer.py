@@ -11,18 +11,19 @@ from sympy.codegen.ast import real as real_type
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from symkin.codegen.symbols import symbol_text
+from symkin.codegen.symbol_printing import symbol_text
 from symkin.errors import BuildError
 
 
 class CPrinter(C99CodePrinter):
     """C99 printer for generated kernels: array arguments, literal numbers, no ``pow(x, 2)``.
 
-    Constant parts reach it already folded to plain numbers (codegen.symbols.prepare), so the
-    POSIX macros SymPy would print for pi, sqrt(2) or log(2) (``M_PI``, ``M_SQRT2``, ``M_LN2``,
-    not in C99) never appear. Floats print as the shortest literal that round-trips; integers
-    wider than an ``int`` print as real literals (a C integer constant would be truncated). In
-    float mode the base class prints ``sinf``/``0.5F``, so nothing is promoted to double.
+    Constant parts reach it already folded to plain numbers (codegen.symbol_printing.prepare),
+    so the POSIX macros SymPy would print for pi, sqrt(2) or log(2) (``M_PI``, ``M_SQRT2``,
+    ``M_LN2``, not in C99) never appear. Floats print as the shortest literal that
+    round-trips; integers wider than an ``int`` print as real literals (a C integer constant
+    would be truncated). In float mode the base class prints ``sinf``/``0.5F``, so nothing is
+    promoted to double.
     """
 
     def __init__(self, real: str = "double") -> None:

@@ -6,7 +6,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from symkin.codegen.symbols import symbol_text
+from symkin.codegen.symbol_printing import symbol_text
 
 
 class PythonPrinter(NumPyPrinter):

@@ -10,8 +10,7 @@ import argparse
 import shutil
 from pathlib import Path
 
-from symkin.build import cache as build_cache
-from symkin.build import index
+from symkin.build import cache, index
 from symkin.cli import messages
 from symkin.cli.exits import EXIT_OK
 
@@ -27,7 +26,7 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def handle(args: argparse.Namespace) -> int:
     """Run the subcommand; returns the exit status."""
-    root = build_cache.cache_root()
+    root = cache.cache_root()
     owned = _symkins(root)
     if args.action == "clear":
         for path in owned:
@@ -37,11 +36,11 @@ def handle(args: argparse.Namespace) -> int:
                 path.unlink(missing_ok=True)
         print(messages.printable(f"removed {len(owned)} item(s) from {root}"))
         return EXIT_OK
-    kernels = [p for p in owned if p.name.startswith(build_cache.KERNEL_PREFIX)]
+    kernels = [p for p in owned if p.name.startswith(cache.KERNEL_PREFIX)]
     entries = [p for p in owned if p.name == index.INDEX_FOLDER]
     temporaries = [p for p in owned if p.name.startswith(".")]
     size = sum(f.stat().st_size for p in owned for f in _files(p))
-    problem = build_cache.unusable(root) if root.exists() else None
+    problem = cache.unusable(root) if root.exists() else None
     print(messages.printable(
         f"cache: {root}\n"
         f"kernels: {len(kernels)}\n"
@@ -59,7 +58,7 @@ def _symkins(root: Path) -> list[Path]:
     except OSError:
         return []
     return [p for p in entries
-            if p.name.startswith((build_cache.KERNEL_PREFIX, f".{build_cache.KERNEL_PREFIX}",
+            if p.name.startswith((cache.KERNEL_PREFIX, f".{cache.KERNEL_PREFIX}",
                                   ".discarded."))
             or (p.name == index.INDEX_FOLDER and p.is_dir())]
 
