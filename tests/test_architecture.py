@@ -72,3 +72,14 @@ def test_every_subpackage_ships_in_the_wheel() -> None:
     found = {".".join(init.parent.relative_to(ROOT).parts)
              for init in (ROOT / "symkin").rglob("__init__.py")}
     assert found <= listed, f"add to [tool.setuptools] packages: {sorted(found - listed)}"
+
+
+def test_architecture_names_every_module() -> None:
+    """ARCHITECTURE.md is the map of the package: each module appears in it by name."""
+    import re
+
+    text = (ROOT / "ARCHITECTURE.md").read_text(encoding="utf-8")
+    missing = [str(path.relative_to(ROOT)) for path in (ROOT / "symkin").rglob("*.py")
+               if path.stem not in ("__init__", "__main__")
+               and not re.search(rf"\b{re.escape(path.stem)}\b", text)]
+    assert not missing, f"describe these modules in ARCHITECTURE.md: {missing}"
