@@ -4,8 +4,8 @@
 
 For each case: the outcome, the largest error at unflagged points against the closed form
 (q, dq, ddq), and the number of flagged points. The mechanisms are those of the tests
-(tests/mechanisms/); the closed forms are derived in tests/test_edges_singular.py and
-tests/test_edges_limits_assembly.py and repeated here so that the script stands alone.
+(tests/mechanisms/); the closed forms are derived in tests/runtime/test_edges_singular.py and
+tests/runtime/test_edges_limits_assembly.py and repeated here so that the script stands alone.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ flag), else the bound s r. The correction is the actual error where the bound is
 case: on the 301-body chain of loops of bench/scaling_limit.py it is a tenth of s r (median).
 The errors of a nearly singular Phi_q lie along its null direction and are amplified by s at
 each stage (position into velocity, velocity into acceleration), which is what the chain of
-parallelogram four-bars shows near its singular configuration (tests/test_edges_*.py).
+parallelogram four-bars shows near its singular configuration (tests/runtime/test_edges_*.py).
 """
 
 from __future__ import annotations

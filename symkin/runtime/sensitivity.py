@@ -60,7 +60,7 @@ def velocity_sensitivities(kernel: KinematicsKernel, trajectory: Trajectory, q_p
     The two time derivatives along the motion are central differences of the generated Phi_q
     and Phi_p over (q -/+ h dq, t -/+ h), so no further routine is generated (generation time
     and code size stay as they are); for smooth motions the result agrees with differences of
-    whole solves to about 1e-9, see tests/test_sensitivities.py.
+    whole solves to about 1e-9, see tests/runtime/test_sensitivities.py.
     """
     t, q, dq, p = trajectory.t, trajectory.q, trajectory.dq, trajectory.params
     if t.size == 0 or q_p.shape[2] == 0:

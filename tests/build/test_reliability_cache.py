@@ -1,0 +1,243 @@
+"""The kernel cache and generated folders under attack and accident (issue: nothing lost,
+nothing planted): planted and damaged kernels, unusable cache folders, killed and concurrent
+builds, and output folders that hold other people's files — each with its exact outcome."""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import symkin
+from symkin import backends
+from symkin.build import cache as build_cache
+from symkin.errors import SymkinWarning, UsageError
+
+ROOT = Path(__file__).resolve().parents[2]
+TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
+
+
+def _reference(system: symkin.System) -> np.ndarray:
+    """q over the file's grid, from a NumPy kernel built in a cache of its own."""
+    return symkin.solve(symkin.compile(system, backend="numpy")).q
+
+
+def _kernel_folder(cache: Path, backend: str) -> Path:
+    found = [p for p in cache.iterdir() if p.name.startswith("_symkin_crank_slider_")
+             and ("_py_" in p.name) == (backend == "numpy")]
+    assert len(found) == 1, found
+    return found[0]
+
+
+@pytest.fixture
+def system() -> symkin.System:
+    return symkin.derive(TEXTBOOK)
+
+
+def test_a_planted_numpy_kernel_is_never_executed(system: symkin.System, tmp_path: Path) -> None:
+    """Someone knows the (predictable) folder name of a kernel and puts a module there first:
+    it is moved aside and rebuilt, never imported."""
+    first = tmp_path / "first"
+    symkin.compile(system, backend="numpy", cache_dir=first)
+    name = _kernel_folder(first, "numpy").name
+    victim = tmp_path / "victim"
+    planted = victim / name
+    planted.mkdir(parents=True)
+    marker = tmp_path / "PLANTED"
+    (planted / "crank_slider.py").write_text(f"open({str(marker)!r}, 'w').write('x')\n")
+    (planted / "crank_slider_manifest.json").write_text("{}")
+    kernel = symkin.compile(system, backend="numpy", cache_dir=victim)
+    assert not marker.exists()
+    np.testing.assert_allclose(symkin.solve(kernel).q, _reference(system), atol=1e-12)
+
+
+@pytest.mark.parametrize("damage", ["truncate", "random", "edit"])
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_a_damaged_kernel_is_rebuilt_not_loaded(damage: str, backend: str,
+                                                system: symkin.System, tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    # Built and run in other processes: this one must not have the library mapped while the
+    # test rewrites it in place (that would crash this process, not symkin).
+    code = ("import symkin, numpy; s = symkin.derive({p!r}); "
+            "k = symkin.compile(s, backend={b!r}, cache_dir={c!r}); "
+            "print(k.backend, float(symkin.solve(k).q[-1, 6]))").format(
+                p=str(TEXTBOOK), b=backend, c=str(cache))
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    subprocess.run([sys.executable, "-c", code], check=True, env=env, timeout=300)
+    folder = _kernel_folder(cache, backend)
+    target = next(p for p in folder.iterdir()
+                  if p.name.endswith(".so" if backend == "c" else "crank_slider.py"))
+    data = target.read_bytes()
+    if damage == "truncate":
+        target.write_bytes(data[:1000])
+    elif damage == "random":
+        target.write_bytes(np.random.default_rng(1).bytes(len(data)))
+    else:
+        target.write_bytes(data + b"\nraise SystemExit('edited')\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            env=env, timeout=300)
+    assert result.returncode == 0, result.stderr
+    loaded, slider_x = result.stdout.split()
+    assert loaded == backend
+    assert abs(float(slider_x) - _reference(system)[-1, 6]) < 1e-12
+    assert target.read_bytes() != data[:1000] and b"edited" not in target.read_bytes()
+
+
+def test_a_cache_others_can_write_is_not_used(system: symkin.System, tmp_path: Path) -> None:
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o1777)
+    with pytest.warns(SymkinWarning, match="others may write to it"):
+        kernel = symkin.compile(system, backend="numpy", cache_dir=shared)
+    assert list(shared.iterdir()) == []
+    assert kernel.folder is not None and shared not in kernel.folder.parents
+
+
+@pytest.mark.parametrize("how", ["read-only", "a file"])
+def test_an_unusable_cache_folder_falls_back_with_one_note(how: str, tmp_path: Path) -> None:
+    if hasattr(os, "geteuid") and os.geteuid() == 0 and how == "read-only":
+        pytest.skip("root writes into read-only folders")
+    cache = tmp_path / "cache"
+    if how == "a file":
+        cache.write_text("not a folder")
+    else:
+        cache.mkdir(mode=0o500)
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(cache)}
+    result = subprocess.run([sys.executable, "-m", "symkin", "run", str(TEXTBOOK)],
+                            capture_output=True, text=True, env=env, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr.count("\n") == 1 and "is not used" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_a_build_killed_mid_way_leaves_nothing_that_outlives_it(system: symkin.System,
+                                                                tmp_path: Path) -> None:
+    """kill -9 during the C compile leaves its temporary folder; the next run removes it
+    (its process is gone) and builds a good kernel."""
+    cache = tmp_path / "cache"
+    slow = tmp_path / "slow-cc"
+    slow.write_text("#!/bin/sh\nsleep 60\nexec cc \"$@\"\n")
+    slow.chmod(slow.stat().st_mode | stat.S_IXUSR)
+    code = f"import symkin; symkin.compile(symkin.derive({str(TEXTBOOK)!r}), cache_dir={str(cache)!r})"
+    process = subprocess.Popen([sys.executable, "-c", code], start_new_session=True,
+                               env={**os.environ, "PYTHONPATH": str(ROOT), "CC": str(slow)})
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not any(
+            p.name.startswith("._symkin_") for p in (cache.iterdir() if cache.exists() else [])):
+        time.sleep(0.2)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    left = [p for p in cache.iterdir() if p.name.startswith("._symkin_")]
+    assert left, "the build never started"
+    build_cache._clean_stale.cache_clear()
+    kernel = symkin.compile(system, backend="c", cache_dir=cache)
+    assert kernel.backend == "c"
+    assert not any(p.exists() for p in left)
+    np.testing.assert_allclose(symkin.solve(kernel).q, _reference(system), atol=1e-12)
+
+
+def _compile_variant(job: tuple[str, str, str]) -> float:
+    text, name, cache = job
+    mechanism = symkin.from_dict(__import__("yaml").safe_load(text) | {"name": name})
+    kernel = symkin.compile(symkin.derive(mechanism), backend="c", cache_dir=cache)
+    return float(symkin.solve(kernel).q[-1, 6])
+
+
+@pytest.mark.parametrize("distinct", [True, False])
+def test_eight_concurrent_cold_builds(distinct: bool, tmp_path: Path) -> None:
+    """8 processes build at once into one empty cache: 8 different mechanisms, or 8 times the
+    same one; every process gets a correct kernel and the cache holds one folder each."""
+    cache = str(tmp_path / "cache")
+    text = TEXTBOOK.read_text()
+    names = [f"cs{k}" if distinct else "cs" for k in range(8)]
+    with multiprocessing.get_context("fork").Pool(8) as pool:
+        results = pool.map(_compile_variant, [(text, name, cache) for name in names])
+    reference = _reference(symkin.derive(TEXTBOOK))[-1, 6]
+    assert all(abs(value - reference) < 1e-12 for value in results)
+    folders = [p for p in Path(cache).iterdir() if p.name.startswith("_symkin_")]
+    assert len(folders) == len(set(names))
+    assert not [p for p in Path(cache).iterdir() if p.name.startswith(".")]
+
+
+def test_cache_clear_removes_only_what_symkin_wrote(system: symkin.System, tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    symkin.compile(system, backend="numpy", cache_dir=cache)
+    (cache / "notes.txt").write_text("mine")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(cache)}
+    info = subprocess.run([sys.executable, "-m", "symkin", "cache", "info"], env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert info.returncode == 0 and "kernels: 1" in info.stdout
+    cleared = subprocess.run([sys.executable, "-m", "symkin", "cache", "clear"], env=env,
+                             capture_output=True, text=True, timeout=120)
+    assert cleared.returncode == 0
+    assert [p.name for p in cache.iterdir()] == ["notes.txt"]
+
+
+# ----- generated folders ---------------------------------------------------------------------
+
+def test_generate_never_deletes_files_a_foreign_manifest_lists(system: symkin.System,
+                                                                tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "important.txt").write_text("keep me")
+    (out / "manifest.json").write_text(json.dumps({"files": {"important.txt": "0"}}))
+    (out / "crank_slider_manifest.json").write_text(json.dumps(
+        {"generator": "symkin", "name": "crank_slider", "files": {"important.txt": "0"}}))
+    with pytest.raises(UsageError, match="files symkin did not write"):
+        symkin.generate(system, backend="c", out_dir=out)
+    symkin.generate(system, backend="c", out_dir=out, force=True)
+    assert (out / "important.txt").read_text() == "keep me"
+
+
+def test_generate_refuses_a_folder_of_other_files_with_exit_2(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "thesis.tex").write_text("years of work")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    command = [sys.executable, "-m", "symkin", "generate", str(TEXTBOOK), "-o", str(out)]
+    refused = subprocess.run(command, env=env, capture_output=True, text=True, timeout=300)
+    assert refused.returncode == 2 and "thesis.tex" in refused.stderr
+    assert [p.name for p in out.iterdir()] == ["thesis.tex"]
+    forced = subprocess.run([*command, "--force"], env=env, capture_output=True, text=True,
+                            timeout=300)
+    assert forced.returncode == 0 and (out / "thesis.tex").read_text() == "years of work"
+
+
+def test_two_mechanisms_share_a_folder(system: symkin.System, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    four_bar = symkin.derive(ROOT / "examples" / "four_bar.yaml")
+    symkin.generate(system, backend="numpy", out_dir=out)
+    symkin.generate(four_bar, backend="numpy", out_dir=out)
+    symkin.generate(system, backend="numpy", out_dir=out)  # regenerate the first: no refusal
+    names = {p.name for p in out.iterdir()}
+    assert {"crank_slider.py", "crank_slider_manifest.json", "four_bar.py",
+            "four_bar_manifest.json"} <= names
+    loaded = backends.load(out, "four_bar")
+    assert loaded.name == "four_bar"
+    with pytest.raises(FileNotFoundError, match="2 symkin manifests"):
+        backends.load(out)
+
+
+def test_an_edited_generated_file_is_not_deleted(system: symkin.System, tmp_path: Path) -> None:
+    """A generated file the user changed is theirs now: switching to the dense LU (which no
+    longer writes the sparse LU files) must not delete the edited one."""
+    out = tmp_path / "out"
+    symkin.generate(system, backend="c", out_dir=out, linalg="sparse")
+    edited = out / "crank_slider_sparse_lu.c"
+    edited.write_text(edited.read_text() + "/* my tuning */\n")
+    with pytest.raises(UsageError):
+        symkin.generate(system, backend="c", out_dir=out, linalg="dense")
+    symkin.generate(system, backend="c", out_dir=out, linalg="dense", force=True)
+    assert edited.read_text().endswith("/* my tuning */\n")
+    assert not (out / "crank_slider_sparse_lu.h").exists()  # unedited: symkin's to remove
+    shutil.rmtree(out)

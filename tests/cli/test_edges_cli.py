@@ -1,0 +1,64 @@
+"""The command line at the edges: a flagged point is warned about on one line and the run
+exits 0 with a `flagged` column; --stop-at-singular keeps the old stop; a limit position exits
+1 with the rows before it written."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+MECHANISMS = ROOT / "tests" / "mechanisms"
+
+
+def run(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    result = subprocess.run([sys.executable, "-m", "symkin", "run", *args], cwd=cwd, env=env,
+                            check=False, capture_output=True, text=True, timeout=600)
+    assert "Traceback" not in result.stderr, result.stderr
+    return result
+
+
+def test_change_point_is_warned_about_once_and_exits_0(tmp_path: Path) -> None:
+    result = run(str(MECHANISMS / "parallelogram.yaml"), "--backend", "c", "-o", "out.csv",
+                 cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    warnings = [line for line in result.stderr.splitlines() if "warning:" in line]
+    assert len(warnings) == 1 and "at t = 0.5:" in warnings[0]
+    assert "loses rank 1" in warnings[0] and "O0 revolute ground-r0 (x)" in warnings[0]
+    header = (tmp_path / "out.csv").read_text().splitlines()[0].split(",")
+    assert header[-1] == "flagged"
+    table = np.loadtxt(tmp_path / "out.csv", delimiter=",", skiprows=1)
+    assert table.shape[0] == 21 and table[:, -1].tolist() == [float(k == 10) for k in range(21)]
+
+
+def test_stop_at_singular_exits_1_with_the_rows_before(tmp_path: Path) -> None:
+    result = run(str(MECHANISMS / "parallelogram.yaml"), "--stop-at-singular", "-o", "out.npz",
+                 cwd=tmp_path)
+    assert result.returncode == 1
+    assert "Phi_q is singular at t = 0.5" in result.stderr
+    data = np.load(tmp_path / "out.npz")
+    assert data["t"].size == 10 and not data["flagged"].any()
+
+
+def test_limit_position_exits_1_and_says_how_to_go_on(tmp_path: Path) -> None:
+    result = run(str(MECHANISMS / "non_grashof.yaml"), "-o", "out.npz", cwd=tmp_path)
+    assert result.returncode == 1
+    assert "limit position near t = 1.82347658" in result.stderr
+    assert "reversing the driver" in result.stderr
+    assert np.load(tmp_path / "out.npz")["t"].size == 37
+
+
+def test_a_run_that_stops_before_its_first_row_writes_the_header(tmp_path: Path) -> None:
+    """The textbook crank-slider with a rod b = 2 that cannot reach the slide (c - a = 3):
+    no row is solved, and -o out.csv still writes the columns (was a traceback, no file)."""
+    text = (ROOT / "examples" / "crank_slider.yaml").read_text().replace("b: 5.0", "b: 2.0")
+    (tmp_path / "short.yaml").write_text(text)
+    result = run("short.yaml", "-o", "out.csv", cwd=tmp_path)
+    assert result.returncode == 1 and "cannot be assembled" in result.stderr
+    lines = (tmp_path / "out.csv").read_text().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("t,crank.x,") and lines[0].endswith(",flagged")
