@@ -62,3 +62,20 @@ def test_a_run_that_stops_before_its_first_row_writes_the_header(tmp_path: Path)
     assert result.returncode == 1 and "cannot be assembled" in result.stderr
     lines = (tmp_path / "out.csv").read_text().splitlines()
     assert len(lines) == 1 and lines[0].startswith("t,crank.x,") and lines[0].endswith(",flagged")
+
+
+def test_a_step_of_a_non_real_argument_is_not_finite_on_both_backends(tmp_path: Path) -> None:
+    """theta = t**2 + pi/2 + Heaviside(acos(w)) with --set w=2: acos(2) is not real, so the
+    step's argument is NaN. NumPy's heaviside keeps the NaN; the C step did not (NaN > 0 and
+    NaN < 0 are both false: it gave H = 1/2 and a motion), so the backends disagreed."""
+    text = (ROOT / "examples" / "crank_slider.yaml").read_text()
+    text = text.replace("c: 4.0}", "c: 4.0, w: 0.5}").replace(
+        'theta: "t**2 + pi/2"', 'theta: "t**2 + pi/2 + Heaviside(acos(w))"')
+    (tmp_path / "step.yaml").write_text(text)
+    for backend in ("c", "numpy"):
+        good = run("step.yaml", "--backend", backend, "-o", f"{backend}.csv", cwd=tmp_path)
+        assert good.returncode == 0, good.stderr
+        bad = run("step.yaml", "--backend", backend, "--set", "w=2", cwd=tmp_path)
+        assert bad.returncode == 1, (backend, bad.stderr)
+        assert "Phi in row 8 (drivers[0] angle crank-ground (angle)) is not finite at t = 0" \
+            in bad.stderr

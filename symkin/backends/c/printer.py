@@ -50,11 +50,13 @@ class CPrinter(C99CodePrinter):
         return str(int(expr))
 
     def _print_Heaviside(self, expr: sp.Heaviside) -> str:
-        # The step with H(0) = 1/2, the value the parser gives every Heaviside.
+        # The step with H(0) = 1/2, the value the parser gives every Heaviside; a NaN argument
+        # stays NaN (as numpy.heaviside gives), so a non-real argument is seen, not hidden.
         x = self._print(expr.args[0])
         at_zero = self._literal(float(expr.args[1]) if len(expr.args) > 1 else 0.5)
         one, zero = self._literal(1.0), self._literal(0.0)
-        return f"(({x}) > 0 ? {one} : (({x}) < 0 ? {zero} : {at_zero}))"
+        return (f"(({x}) > 0 ? {one} : (({x}) < 0 ? {zero} : "
+                f"(({x}) == 0 ? {at_zero} : ({x}))))")
 
     def _print_Pow(self, expr: sp.Pow) -> str:
         # A square is the most common power in kinematics; a product is exact and cheaper.
