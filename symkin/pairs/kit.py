@@ -16,6 +16,7 @@ sees the stages only through the protocols below, which the stages implement:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -90,7 +91,7 @@ class Joined:
 
     @property
     def gap(self) -> float:
-        return float(sp.sqrt((self.B[0] - self.A[0]) ** 2 + (self.B[1] - self.A[1]) ** 2))
+        return math.hypot(self.B[0] - self.A[0], self.B[1] - self.A[1])
 
 
 # A drawn joint's local form and its closure residual (how far its drawing is from closing).
