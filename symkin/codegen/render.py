@@ -103,7 +103,8 @@ def generate(system: System, backend: Target, out_dir: str | Path = "generated",
         linalg: the LU behind the C solver, ``"sparse"`` (default: the generated sparse LU
             with run-time pivot checks and a dense fall-back) or ``"dense"``.
         force: write even where files symkin did not write are present (they are never
-            deleted; one with the name of a generated file is replaced).
+            deleted; one with the name of a generated file is replaced: a symlink itself,
+            never the file it points to).
 
     Returns:
         The paths written, sorted, the manifest last.
@@ -136,6 +137,8 @@ def write(code: Code, out_dir: Path, force: bool = False) -> list[Path]:
         for name in sorted(ours - set(files)):  # e.g. the dense LU after switching to sparse
             (out_dir / name).unlink(missing_ok=True)
         for path, text in zip(paths, files.values()):
+            if path.is_symlink():  # (foreign, so --force): replace the link, not its target
+                path.unlink()
             path.write_text(text, encoding="utf-8", newline="\n")
     except OSError as error:
         raise UsageError(f"cannot write the generated files into {out_dir}: "
@@ -164,7 +167,7 @@ def _generated_here(folder: Path, prefix: str) -> tuple[set[str], set[str]]:
 
 def _intact_files(folder: Path, manifest_path: Path) -> set[str] | None:
     """The files a symkin manifest lists that still have their recorded hash; None when the
-    manifest is not one symkin wrote."""
+    manifest is not one symkin wrote. symkin writes no symlinks: a symlink is never intact."""
     try:
         data = json.loads(manifest_path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -177,7 +180,7 @@ def _intact_files(folder: Path, manifest_path: Path) -> set[str] | None:
         return None
     return {name for name, digest in listed.items()
             if isinstance(name, str) and Path(name).name == name
-            and _sha256_file(folder / name) == digest}
+            and not (folder / name).is_symlink() and _sha256_file(folder / name) == digest}
 
 
 def _sha256_file(path: Path) -> str | None:

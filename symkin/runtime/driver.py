@@ -195,6 +195,9 @@ def _c_outcome(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array
 def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
             progress: Progress | None) -> Newton:
     """The grid loop in the generated C solver from point run.done, and its outcome."""
+    if run.done == run.t.size:  # the edge treatment solved the last point: the grid is done
+        run.fallbacks = solver.fallbacks  # (the report still holds the failed call's status)
+        return Newton(run.q[run.done - 1], OK, 0, 0.0, None)
     solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
     return _c_outcome(kernel, run, solver, p, _c_run(run, solver, progress))
 

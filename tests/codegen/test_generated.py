@@ -235,3 +235,40 @@ def test_regenerating_removes_files_the_new_output_does_not_have(tmp_path: Path)
     symkin.generate(system("four_bar"), backend="c", out_dir=folder, force=True)
     names = {p.name for p in folder.iterdir()}
     assert names == set(_files(golden_folder("four_bar", "c"))) | {"notes.txt"}
+
+
+def test_force_replaces_a_symlink_and_never_writes_through_it(tmp_path: Path) -> None:
+    """A symlink named like a generated file, pointing outside the folder: --force replaces
+    the link itself with the generated file; the file it pointed to is left as it was."""
+    from symkin import cli
+
+    folder, outside = tmp_path / "out", tmp_path / "outside.c"
+    arguments = ["generate", str(ROOT / "examples" / "crank_slider.yaml"), "--backend", "c",
+                 "-o", str(folder)]
+    assert cli.main(arguments) == 0
+    link = folder / "crank_slider_solver.c"
+    generated = link.read_text()
+    outside.write_text("not symkin's\n")
+    link.unlink()
+    link.symlink_to(outside)
+    assert cli.main([*arguments, "--force"]) == 0
+    assert outside.read_text() == "not symkin's\n"
+    assert not link.is_symlink() and link.read_text() == generated
+
+
+def test_a_symlink_to_a_generated_copy_is_not_symkins(tmp_path: Path,
+                                                       capsys: pytest.CaptureFixture) -> None:
+    """symkin never writes a symlink: one named like a generated file counts as not symkin's
+    even where it points to a copy of it, so generating again without --force refuses."""
+    from symkin import cli
+
+    folder, outside = tmp_path / "out", tmp_path / "outside.c"
+    arguments = ["generate", str(ROOT / "examples" / "crank_slider.yaml"), "--backend", "c",
+                 "-o", str(folder)]
+    assert cli.main(arguments) == 0
+    link = folder / "crank_slider_solver.c"
+    outside.write_text(link.read_text())
+    link.unlink()
+    link.symlink_to(outside)
+    assert cli.main(arguments) == 2
+    assert "crank_slider_solver.c" in capsys.readouterr().err and link.is_symlink()

@@ -212,3 +212,32 @@ def test_dense_and_sparse_lu_agree_on_a_vanished_pivot(scale: float, crank_slide
         status = lib.crank_slider_lu_factor(ffi.new("crank_slider_real[]", nz.tolist()), lu)
         verdicts.append((status != 0, lib.crank_slider_lu_pivot_ratio(lu) < 1e-10))
     assert verdicts == [(True, True), (True, True)]
+
+
+def _solve_or_failure(kernel, progress):
+    """The rows solved and the failure's (class, reason), or None when the whole grid is."""
+    try:
+        return driver.solve(kernel, progress=progress), None
+    except driver.SolveFailure as failure:
+        return failure.trajectory, (type(failure), failure.reason)
+
+
+@pytest.mark.parametrize("progress", [None, lambda done, total: None])
+def test_edge_treatment_of_the_last_point_ends_the_c_run(progress, tmp_path) -> None:
+    """A very fast crank (quick_return, theta = t/0.001: 10 rad a step) sends grid points to
+    the edge treatment in Python, the last one too; the C grid loop must then have nothing
+    left to do, not be asked for points past the end of its grid. C and NumPy agree."""
+    source = (EXAMPLES / "quick_return.yaml").read_text()
+    assert 'theta: "w*t"' in source
+    path = tmp_path / "quick_return.yaml"
+    path.write_text(source.replace('theta: "w*t"', 'theta: "t/0.001"'))
+    system = symkin.derive(path)
+    in_c, failed_c = _solve_or_failure(kernel_for(system, "c"), progress)
+    in_numpy, failed_numpy = _solve_or_failure(kernel_for(system, "numpy"), progress)
+    assert failed_c == failed_numpy
+    assert in_c.t.size == in_numpy.t.size == 101  # NumPy solves the whole grid
+    assert np.array_equal(in_c.t, in_numpy.t)
+    assert np.abs(in_c.q - in_numpy.q).max() <= 1e-9
+    for name in ("dq", "d2q"):  # up to 1e3 rad/s and 1e6 rad/s^2: relative to their size
+        a, b = getattr(in_c, name), getattr(in_numpy, name)
+        assert np.abs(a - b).max() <= 1e-9 * max(1.0, np.abs(b).max()), name
