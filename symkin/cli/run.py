@@ -58,6 +58,8 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
                      help="--animate picture size in pixels (default 900x600)")
     run.add_argument("--fps", type=int, default=20,
                      help="--animate frames per second (default 20)")
+    run.add_argument("-v", "--verbose", action="store_true",
+                     help="say more in notes (why pivot fall-backs cost no accuracy)")
     overrides.add_argument(run)
     run.add_argument("--stop-at-singular", action="store_true",
                      help="stop at the first singular or ill-conditioned point instead of "
@@ -179,7 +181,8 @@ def _solve_and_write(args: argparse.Namespace) -> int:
               f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
               + "".join(f"; wrote {path}" for path in written))
     if trajectory.lu_fallbacks:
-        messages.note(run_outputs.fallback_note(trajectory.lu_fallbacks, trajectory.t.size))
+        messages.note(run_outputs.fallback_note(trajectory.lu_fallbacks, trajectory.t.size,
+                                                args.verbose))
     return EXIT_OK
 
 

@@ -110,13 +110,16 @@ def configuration(trajectory: Any, name: str, origin: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def fallback_note(count: int, points: int) -> str:
-    """Why sparse-LU fall-backs do not matter for the numbers (they cost only time)."""
+def fallback_note(count: int, points: int, verbose: bool = False) -> str:
+    """A line on sparse-LU fall-backs, which cost time, not accuracy; ``verbose`` says why."""
     which = "factorization" if count == 1 else "factorizations"
-    return (f"{count} pivot fall-back{'s' if count != 1 else ''} to dense LU over {points} time "
-            f"points: {count} {which} of the generated sparse LU met a pivot below its "
-            "threshold and were redone with dense LU and partial pivoting. This costs time, "
-            "not accuracy: every pivot is checked, and no result comes from a rejected one")
+    short = (f"{count} pivot fall-back{'s' if count != 1 else ''} to dense LU over {points} "
+             "time points (time, not accuracy")
+    if not verbose:
+        return short + "; -v says why)"
+    return (short + f"): {count} {which} of the generated sparse LU met a pivot below its "
+            "threshold and were redone with dense LU and partial pivoting; every pivot is "
+            "checked, and no result comes from a rejected one")
 
 
 class ProgressBar:

@@ -96,3 +96,7 @@ def test_run_mentions_fallbacks_and_that_they_cost_no_accuracy() -> None:
     assert run_outputs.fallback_note(1, 31).startswith("1 pivot fall-back to dense LU over 31")
     note = run_outputs.fallback_note(3, 31)
     assert note.startswith("3 pivot fall-backs to dense LU") and "not accuracy" in note
+    # one short line by default (every run of such a mechanism prints it); the why with -v
+    assert len(note) < 100 and note.endswith("-v says why)")
+    verbose = run_outputs.fallback_note(3, 31, verbose=True)
+    assert "redone with dense LU and partial pivoting" in verbose and "-v" not in verbose
