@@ -278,13 +278,14 @@ class _Checks:
 
     def point_at_q0(self, body: str, ref: Any) -> tuple[float, float]:
         """The global position of a (checked) point of ``body`` at its first guess q0."""
+        def nominal(raw: Any) -> float:  # checked already: parses and has a value
+            return constants.value(expressions.parse(raw, self.symbols.parameters), self.nominal)
+
         local = self.mech.bodies[body].points[ref] if isinstance(ref, str) else ref
-        sx, sy = (constants.value(expressions.parse(raw, self.symbols.parameters), self.nominal)
-                  for raw in local)
+        sx, sy = map(nominal, local)
         if body == GROUND:
             return sx, sy
-        x, y, phi = (constants.value(expressions.parse(raw, self.symbols.parameters),
-                                     self.nominal) for raw in self.mech.bodies[body].q0)
+        x, y, phi = map(nominal, self.mech.bodies[body].q0)
         return (x + math.cos(phi) * sx - math.sin(phi) * sy,
                 y + math.sin(phi) * sx + math.cos(phi) * sy)
 

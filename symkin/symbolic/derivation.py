@@ -47,12 +47,14 @@ class Row:
 @dataclass(frozen=True)
 class Placed:
     """A local vector of a joint or driver, resolved: a point (or direction, ``kind``) of
-    ``body`` that the constraint's ``key`` gives, as expressions of the parameters."""
+    ``body`` that the constraint's ``key`` gives, as expressions of the parameters; ``side``
+    is the key naming that body (``i`` or ``j``)."""
 
     section: str
     index: int
     key: str
     body: str
+    side: str
     vector: sp.ImmutableMatrix
     kind: str = "point"  # or "direction"
 
@@ -159,11 +161,12 @@ def _placed(mech: Mechanism, ctx: Context) -> tuple[Placed, ...]:
             for key, body_key in kind.points:
                 body = getattr(constraint, body_key)
                 vector = ctx.local(body, getattr(constraint, key))
-                found.append(Placed(section, index, key, body, sp.ImmutableMatrix(vector)))
+                found.append(Placed(section, index, key, body, body_key,
+                                    sp.ImmutableMatrix(vector)))
             for key, body_key in kind.directions:
                 vector = ctx.vector(getattr(constraint, key))
                 found.append(Placed(section, index, key, getattr(constraint, body_key),
-                                    sp.ImmutableMatrix(vector), "direction"))
+                                    body_key, sp.ImmutableMatrix(vector), "direction"))
     return tuple(found)
 
 

@@ -43,9 +43,7 @@ def outlines(system: System) -> dict[str, NDArray[np.float64]]:
     found: dict[str, list[Vector]] = {body: [] for body in mech.bodies}
     # The points on the i side of every joint and driver, then those on the j side.
     points = [p for p in system.placed if p.kind == "point"]
-    side = {(p.section, p.index, p.key): dict(pairs.of(getattr(mech, p.section)[p.index]).points)
-            [p.key] for p in points}
-    ordered = sorted(points, key=lambda p: side[p.section, p.index, p.key] != "i")
+    ordered = sorted(points, key=lambda p: p.side != "i")
     attachments = [(p.body, p.vector) for p in ordered]
     attachments += [(body, vector) for body, _, vector in system.points]
     for body, vector in attachments:
