@@ -185,6 +185,17 @@ def _note_warning(message: Warning | str, category: type[Warning], filename: str
     messages.note(str(message))
 
 
+def _located(error: MechanismError, args: argparse.Namespace) -> MechanismError:
+    """A mistake found after loading (the rank of an over-constrained file at t0) placed in
+    the file the command read."""
+    mechanism = getattr(args, "mechanism", None)
+    if error.source is not None or not isinstance(mechanism, Path):
+        return error
+    from symkin.spec import validate
+
+    return validate.locate(error, mechanism)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = parser().parse_args(argv)
     warnings.showwarning = _note_warning
@@ -192,7 +203,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         status: int = args.handler(args)
         sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
         return status
-    except (MechanismError, UsageError) as error:
+    except MechanismError as error:
+        return messages.error(str(_located(error, args)), EXIT_BAD_INPUT)
+    except UsageError as error:
         return messages.error(str(error), EXIT_BAD_INPUT)
     except SymkinError as error:
         return messages.error(str(error), EXIT_FAILED)

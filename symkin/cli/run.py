@@ -208,7 +208,10 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
 
 
 def _warn_flagged(trajectory: Any) -> None:
-    """One warning line per stretch of consecutive flagged points (the run still succeeds)."""
+    """One warning line per stretch of consecutive flagged points (the run still succeeds),
+    after the note naming the rows removed as redundant, if any."""
+    if getattr(trajectory, "removed", ()):
+        messages.note(run_outputs.removed_note(trajectory))
     for line in run_outputs.flag_warnings(trajectory):
         messages.note(line)
 

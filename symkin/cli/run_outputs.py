@@ -176,6 +176,15 @@ def flag_warnings(trajectory: Any) -> list[str]:
         worst = max(float(c) for c in trajectory.cond[k:end + 1])
         passed = [s for s in trajectory.singular
                   if t0 - _step(trajectory, k) <= s[0] <= t1 + _step(trajectory, end + 1)]
+        broken = _broken_removed(trajectory, k, end, targets.target_q)
+        if broken:
+            lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
+                         f"the equation(s) removed as redundant at t0 do not hold there "
+                         f"({broken}), so the file's joints contradict each other along the "
+                         "motion and q, dq, ddq satisfy only the kept equations (column "
+                         "'flagged'); check the dimensions of the joints named")
+            k = end + 1
+            continue
         detail = "".join(
             f"; a singular configuration is passed at t = {t:.10g} (Phi_q loses rank {rank}; "
             f"dependent rows: {'; '.join('{' + ', '.join(g) + '}' for g in groups)}), its "
@@ -186,6 +195,28 @@ def flag_warnings(trajectory: Any) -> list[str]:
                      f"{targets.target_ddq:g} (column 'flagged'){detail}")
         k = end + 1
     return lines
+
+
+def removed_note(trajectory: Any) -> str:
+    """The note of a run whose file had rows removed as redundant at t0."""
+    count = len(trajectory.removed)
+    return (f"{count} equation{'s' if count > 1 else ''} removed as redundant (dependent on "
+            f"the others at the assembled t0) and checked along the motion: "
+            + "; ".join(trajectory.removed))
+
+
+def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
+    """The removed rows that miss the target between points k and end, with their largest
+    |Phi| there ('' when none does)."""
+    residual = getattr(trajectory, "removed_residual", None)
+    if residual is None or not trajectory.removed:
+        return ""
+    from symkin.runtime import redundant
+
+    stretch = residual[k:end + 1]
+    broken: Any = redundant.exceeded(stretch, trajectory.q[k:end + 1], target).any(axis=0)
+    return "; ".join(f"{label}: |Phi| up to {float(abs(stretch[:, r]).max()):.3g}"
+                     for r, label in enumerate(trajectory.removed) if broken[r])
 
 
 def _step(trajectory: Any, k: int) -> float:

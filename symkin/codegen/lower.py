@@ -39,6 +39,9 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "gamma": ("q", "dq", "t", "p"),
     "points": ("p",),
     "phi_p": ("q", "t", "p"),
+    # The rows of an over-constrained file removed as dependent at t0 (System.removed), for
+    # the check along the motion; emitted only when there are some.
+    "removed": ("q", "t", "p"),
     # Fused evaluation (see _fused_expressions): one call per Newton iterate evaluates Phi, the
     # non-zeros of Phi_q and the shared sines and cosines; Phi_t and Gamma at the converged q
     # read those instead of calling libm again.
@@ -128,6 +131,8 @@ class Code:
     """The sines and cosines the fused routine passes to Phi_t and Gamma (printed, in order)."""
     constant_nz: tuple[float | None, ...] = ()
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
+    removed: tuple[str, ...] = ()
+    """The labels of the rows removed as dependent at t0 (the ``removed`` routine's outputs)."""
 
     @property
     def nnz(self) -> int:
@@ -204,6 +209,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
                  if backend.plans_lu(linalg) else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
+        removed=tuple(str(removed) for removed in system.removed),
     )
 
 
@@ -232,6 +238,8 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
         "gamma": list(system.gamma),
         "points": [component for vector in point_vectors(system) for component in vector],
         "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
+        # Only where rows were removed: every other file's generated code stays as it was.
+        **({"removed": [removed.phi for removed in system.removed]} if system.removed else {}),
     }
 
 

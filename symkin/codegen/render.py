@@ -29,7 +29,7 @@ from symkin.errors import BuildError, UsageError
 from symkin.symbolic.derivation import System
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
-             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out"}
+             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out", "removed": "out"}
 # The output arrays of a routine with several (Routine.sizes), in order.
 _C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
@@ -41,6 +41,7 @@ _PYTHON_DOC = {
     "gamma": "Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,).",
     "points": "Local vectors of the named points, flat (x, y) pairs in POINTS order.",
     "phi_p": "The non-zeros of Phi_p (d Phi / d p) in PHI_P_ROWS/COLS order, shape (NNZ_P,).",
+    "removed": "The rows removed as dependent at t0, in REMOVED order, shape (NREMOVED,).",
     "phi_phi_q": "(Phi, the non-zeros of Phi_q, the shared values) with one CSE: each sine "
                  "and cosine once.",
     "phi_t_shared": "Phi_t(q, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
@@ -203,7 +204,7 @@ def manifest(code: Code, files: dict[str, str]) -> str:
 
 def metadata(code: Code) -> Metadata:
     """What the runtime Kernel needs besides the compiled functions (plain JSON data)."""
-    return {
+    data: Metadata = {
         "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
         "p_values": list(code.p_values), "q0": list(code.q0), "time_grid": list(code.time_grid),
         "rows": list(code.rows), "pattern_rows": list(code.pattern_rows),
@@ -212,6 +213,9 @@ def metadata(code: Code) -> Metadata:
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
     }
+    if code.removed:  # only then: every other manifest stays as it was
+        data["removed"] = list(code.removed)
+    return data
 
 
 # ----- template context ----------------------------------------------------------------------
@@ -243,6 +247,9 @@ def template_context(code: Code) -> dict[str, Any]:
         "coordinate_literals": [repr(n) for n in code.coordinates],
         "parameter_literals": [repr(n) for n in code.parameter_names],
         "row_literals": [repr(r) for r in code.rows],
+        "nremoved": len(code.removed),
+        "removed_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.removed)],
+        "removed_literals": [repr(r) for r in code.removed],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg,
         # What must equal the runtime's, rendered from symkin.contract (never copied):
@@ -303,6 +310,8 @@ def _labels(code: Code, routine: str) -> list[str]:
     if routine == "phi_phi_q":
         return [*_labels(code, "phi"), *_labels(code, "phi_q"),
                 *(lower.comment(f) for f in code.shared)]
+    if routine == "removed":
+        return [lower.comment(row) for row in code.removed]
     if routine == "points":
         return [lower.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in "xy"]

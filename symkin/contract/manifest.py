@@ -5,7 +5,7 @@ load and from_sources, each backend's build and loader)."""
 
 from __future__ import annotations
 
-from typing import TypedDict
+from typing import NotRequired, TypedDict
 
 MANIFEST_SUFFIX = "_manifest.json"
 
@@ -37,6 +37,8 @@ class Metadata(TypedDict):
     nnz: int
     npoints: int
     nshared: int
+    removed: NotRequired[list[str]]
+    """The rows removed as dependent at t0 (only in the manifest of a file that has some)."""
 
 
 class Manifest(Metadata):

@@ -37,7 +37,7 @@ from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime import failures
+from symkin.runtime import failures, redundant
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
@@ -239,6 +239,7 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
     trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver, out)
+    trajectory = redundant.check(kernel, trajectory, options)
     if sensitivities:
         from symkin.runtime.sensitivity import with_sensitivities
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import sys
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Protocol
@@ -37,6 +37,8 @@ class _Functions(Protocol):
     def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array: ...
     def points(self, p: Array) -> Array: ...
     def phi_p_nz(self, q: Array, t: float, p: Array) -> Array: ...
+    # The removed rows' Phi (over-constrained files only; None where there is none).
+    removed: Callable[[Array, float, Array], Array] | None
 
 
 class Kernel:
@@ -70,6 +72,9 @@ class Kernel:
         self.phi_p_rows = np.array(meta.get("phi_p_rows", ()), dtype=np.intp)
         self.phi_p_cols = np.array(meta.get("phi_p_cols", ()), dtype=np.intp)
         self.has_phi_p = "phi_p_rows" in meta
+        # The rows of an over-constrained file removed as dependent at t0 (not in Phi); the
+        # driver checks them along the motion with removed_phi.
+        self.removed: tuple[str, ...] = tuple(meta.get("removed", ()))
         self._functions = functions
 
     @property
@@ -125,6 +130,16 @@ class Kernel:
         dense[self.phi_p_rows, self.phi_p_cols] = self._functions.phi_p_nz(
             self._q(q), float(t), self._p(p))
         return dense
+
+    def removed_phi(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """Phi of the removed rows (``removed``) at (q, t), shape (NREMOVED,)."""
+        if not self.removed:
+            return np.zeros(0)
+        evaluate = self._functions.removed
+        if evaluate is None:
+            raise ValueError(f"the kernel of {self.name} names removed rows but has no "
+                             "routine for them; rebuild it with symkin.compile")
+        return np.asarray(evaluate(self._q(q), float(t), self._p(p)), dtype=float)
 
     def point_vectors(self, p: ArrayLike | None = None) -> Array:
         """Local vectors of the named points, shape (NPOINTS, 2), in ``points`` order."""

@@ -68,6 +68,10 @@ class Trajectory:
         cond: (T,) the estimated 1-norm condition number of Phi_q at each point.
         singular: the singular configurations passed through, as (t, rank loss, groups of
             dependent rows).
+        removed: the rows of an over-constrained file removed as dependent at t0 (their
+            labels); empty for every other file.
+        removed_residual: (T, len(removed)) their Phi along the motion, or None; a point
+            where one exceeds the position target is flagged (runtime.redundant).
     """
 
     t: NDArray[np.float64]
@@ -84,6 +88,8 @@ class Trajectory:
     flagged: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     cond: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
+    removed: tuple[str, ...] = ()
+    removed_residual: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.

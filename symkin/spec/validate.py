@@ -75,6 +75,18 @@ def load(path: str | Path, overrides: Mapping[str, str] | None = None) -> Mechan
     return _validate(document)
 
 
+def locate(error: MechanismError, path: str | Path) -> MechanismError:
+    """An error found after loading (e.g. by the rank analysis of a derived System) that names
+    a field of the file, located in the file ``path``: its name and the field's line."""
+    if error.source is not None:
+        return error
+    try:
+        document = loader.read(path)
+    except MechanismError:
+        return error.located(str(path), None)
+    return error.located(document.source, document.line_of(error.path))
+
+
 def override_parameters(data: Any, overrides: Mapping[str, str], source: str) -> Any:
     """The file's data with parameter values replaced; each new value is checked here."""
     if not isinstance(data, Mapping):
@@ -357,10 +369,15 @@ def degrees_of_freedom(mech: Mechanism) -> int:
 
 
 def check_degrees_of_freedom(mech: Mechanism) -> None:
-    """Check that the drivers supply exactly as many equations as there are DOF."""
+    """Check that the drivers supply at least as many equations as there are DOF.
+
+    More equations than coordinates are not refused by the count: joints may repeat each
+    other (a parallelogram with an extra parallel bar), which only the rank of Phi_q at the
+    assembled t0 can judge (symkin.symbolic.redundancy, when the System is derived).
+    """
     dof = degrees_of_freedom(mech)
     driving = sum(equation_count(driver) for driver in mech.drivers)
-    if dof == driving:
+    if driving >= dof:
         return
     # Pairs of class 5 take two freedoms (revolute, prismatic), of class 4 one (pin-in-slot,
     # distance); the equations the file writes itself are counted apart.
@@ -371,9 +388,6 @@ def check_degrees_of_freedom(mech: Mechanism) -> None:
     custom = dof - (3 * len(mech.bodies) - 2 * p5 - p4)
     if custom:
         formula += f" − {-custom} (custom joint equations)"
-    if driving < dof:
-        fix = f"Add drivers for {dof - driving} more equation(s), or add joints."
-    else:
-        fix = f"Remove {driving - dof} driving equation(s), or check for a missing joint."
+    fix = f"Add drivers for {dof - driving} more equation(s), or add joints."
     raise MechanismError(f"the mechanism has {formula} = {dof} degree(s) of freedom but its "
                          f"drivers give {driving} equation(s)", ("drivers",), fix)

@@ -17,8 +17,10 @@ from pathlib import Path
 import sympy as sp
 
 from symkin import pairs
+from symkin.errors import MechanismError
 from symkin.spec import validate
 from symkin.spec.validate import Mechanism
+from symkin.symbolic import redundancy
 from symkin.symbolic.planar import Context
 from symkin.symbolic.symbols import Symbols, make_symbols
 
@@ -60,6 +62,22 @@ class Placed:
 
 
 @dataclass(frozen=True)
+class Removed:
+    """A row of Phi found dependent at the assembled t0 and removed for the run
+    (symbolic.redundancy); its equation is kept, to be checked along the motion."""
+
+    row: Row
+    phi: sp.Expr
+    index: int
+    """Its place among all the rows the file writes (joints, then drivers)."""
+    dependency: float
+    """Its relative component outside the span of the kept rows at t0 (below the tolerance)."""
+
+    def __str__(self) -> str:
+        return str(self.row)
+
+
+@dataclass(frozen=True)
 class System:
     """The symbolic kinematics of one mechanism: Phi, its derivatives, the row labels and
     the resolved vectors of points, joints and drivers."""
@@ -85,6 +103,8 @@ class System:
     """(t0, t1, dt) at the nominal parameter values."""
     phi_p: sp.ImmutableSparseMatrix | None = None
     """dPhi/dp, N x NP (sparse): Phi_q q_p = -Phi_p gives the sensitivities q_p."""
+    removed: tuple[Removed, ...] = ()
+    """Rows of an over-constrained file dependent at t0, removed so that Phi is square."""
 
     @property
     def name(self) -> str:
@@ -106,10 +126,19 @@ class System:
 def derive(mech: Mechanism | str | Path) -> System:
     """Derive Phi, Phi_q, Phi_t and Gamma of a mechanism (a Mechanism or a file path)."""
     if not isinstance(mech, Mechanism):
-        mech = validate.load(mech)
+        try:
+            return derive(validate.load(mech))
+        except MechanismError as error:
+            raise validate.locate(error, mech) from None
     symbols = make_symbols(mech)
     ctx = Context(mech, symbols)
     phi, rows = _constraint_rows(mech, ctx)
+    values = mech.parameter_values()
+    p_values = tuple(values[s.name] for s in symbols.p)
+    nominal = dict(zip(symbols.p, p_values))
+    q0 = _initial_guess(mech, ctx, nominal)
+    time_grid = _time_grid(mech, ctx, nominal)
+    phi, rows, removed = _remove_redundant(phi, rows, symbols, p_values, q0, time_grid[0])
     column = {q: k for k, q in enumerate(symbols.q)}
     jacobian: dict[tuple[int, int], sp.Expr] = {}
     phi_t, gamma = [], []
@@ -120,20 +149,41 @@ def derive(mech: Mechanism | str | Path) -> System:
         phi_t.append(row_t)
         gamma.append(_row_gamma(entries, row_t, symbols))
     size = len(symbols.q)
-    values = mech.parameter_values()
-    p_values = tuple(values[s.name] for s in symbols.p)
-    nominal = dict(zip(symbols.p, p_values))
     return System(
         mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,
         p_values=p_values, coordinates=symbols.coordinates,
         phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
         phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
-        q0=_initial_guess(mech, ctx, nominal),
+        q0=q0,
         points=tuple((body, name, sp.ImmutableMatrix(ctx.local(body, name)))
                      for body, spec in mech.bodies.items() for name in spec.points),
-        placed=_placed(mech, ctx), time_grid=_time_grid(mech, ctx, nominal),
-        phi_p=_parameter_jacobian(phi, symbols.p),
+        placed=_placed(mech, ctx), time_grid=time_grid,
+        phi_p=_parameter_jacobian(phi, symbols.p), removed=removed,
     )
+
+
+def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbols,
+                      p_values: tuple[float, ...], q0: tuple[float, ...], t0: float
+                      ) -> tuple[list[sp.Expr], tuple[Row, ...], tuple[Removed, ...]]:
+    """A file with more equations than coordinates: the rows dependent at the assembled t0
+    removed (symbolic.redundancy), joint rows before the others, later before earlier. A file
+    with as many (the DOF count passed) is left as it is, untouched."""
+    if len(phi) <= len(symbols.q):
+        return phi, rows, ()
+    priority = ([k for k, row in enumerate(rows) if row.section != "joints"]
+                + [k for k, row in enumerate(rows) if row.section == "joints"])
+    try:
+        found = redundancy.analyse(phi, symbols.q, symbols.t, symbols.p, p_values, q0, t0,
+                                   priority)
+    except redundancy.Refusal as refusal:
+        row = None if refusal.row is None else rows[refusal.row]
+        where = (row.section, row.index) if row else ("joints",)
+        named = f" ({row})" if row else ""
+        raise MechanismError(f"over-constrained: {refusal.message}{named}", where,
+                             refusal.hint) from None
+    removed = tuple(Removed(rows[k], phi[k], k, d)
+                    for k, d in zip(found.removed, found.dependency))
+    return [phi[k] for k in found.kept], tuple(rows[k] for k in found.kept), removed
 
 
 def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tuple[Row, ...]]:

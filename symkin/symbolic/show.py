@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import sympy as sp
 
 from symkin.spec.validate import degrees_of_freedom
@@ -23,7 +25,7 @@ def text(system: System) -> str:
     width = max(len(str(row)) for row in system.rows)
     summary = (f"mechanism {system.name}: {len(system.q)} coordinates, {len(system.rows)} "
                f"equations, {degrees_of_freedom(system.mechanism)} degree(s) of freedom")
-    lines = [summary, "", "coordinates q:"]
+    lines = [summary, *_removed_lines(system, show), "", "coordinates q:"]
     lines += [f"  q[{k}] = {name}" for k, name in enumerate(system.coordinates)]
     lines += ["", "parameters p:"]
     lines += [f"  p[{k}] = {s.name} = {v:g}" for k, (s, v) in
@@ -40,6 +42,19 @@ def text(system: System) -> str:
     lines += [f"  ({r},{k}) d/d {system.coordinates[k]}: {show(value)}"
               for (r, k), value in sorted(entries.items())]
     return "\n".join(lines) + "\n"
+
+
+def _removed_lines(system: System, show: Any) -> list[str]:
+    """What the rank analysis of an over-constrained file removed, and why."""
+    if not system.removed:
+        return []
+    written = len(system.rows) + len(system.removed)
+    lines = ["", f"removed as redundant ({written} equations for {len(system.q)} coordinates; "
+             f"at the configuration assembled at t0 Phi_q has rank {len(system.rows)}, so "
+             f"{len(system.removed)} row(s) depend on the others): each is left out of Phi "
+             "and checked along the motion, where a point that breaks it is flagged:"]
+    lines += [f"  {removed.row}  {show(removed.phi)}" for removed in system.removed]
+    return lines
 
 
 def latex(system: System) -> str:
@@ -61,7 +76,9 @@ def _latex_header(system: System, rename: dict[sp.Symbol, sp.Symbol]) -> list[st
     rows = "\n".join(rf"{r} & {_tex_text(str(row))} \\" for r, row in enumerate(system.rows))
     summary = (rf"Mechanism \texttt{{{_tex_text(system.name)}}}: {len(system.q)} coordinates, "
                rf"{len(system.rows)} equations, {degrees_of_freedom(system.mechanism)} "
-               "degree(s) of freedom.")
+               "degree(s) of freedom."
+               + "".join(rf" Removed as redundant at $t_0$ (checked along the motion): "
+                         rf"{_tex_text(str(r.row))}." for r in system.removed))
     return [summary,
             "\\begin{equation}\n" + rf"\mathbf{{q}} = {q}^T" + "\n\\end{equation}",
             "\\begin{tabular}{rl}\n" + r"row & owner \\" + "\n\\hline\n" + rows

@@ -95,7 +95,6 @@ EXPECTED: dict[str, tuple[int, str]] = {
     # degrees of freedom
     "dof_too_few_drivers.yaml": (7, "w = 3·1 − 2·1 − 0 = 1 degree(s) of freedom but its "
                                     + "drivers give 0 equation(s). Add drivers for 1 more"),
-    "dof_too_many_drivers.yaml": (7, "drivers give 3 equation(s). Remove 2 driving equation(s)"),
     # expressions
     "bad_expression_syntax.yaml": (8, "in expression 't**': this is not a valid expression"),
     "bad_expression_function.yaml": (8, "unknown function 'system'; allowed functions are Abs"),

@@ -7,7 +7,7 @@ Needs only NumPy and cffi: loading a built C kernel never imports SymPy or jinja
 from __future__ import annotations
 
 import importlib.machinery
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +32,7 @@ class CKernel(Kernel):
                  folder: Path | None = None) -> None:
         functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
                                 len(meta["pattern_rows"]), len(meta["points"]),
-                                len(meta.get("phi_p_rows", ())))
+                                len(meta.get("phi_p_rows", ())), len(meta.get("removed", ())))
         super().__init__("c", meta, functions, folder=folder)
         self.ffi = ffi
         self.lib = lib
@@ -65,15 +65,18 @@ class _CFunctions:
     """Adapter over a cffi extension: converts arrays to the generated real type and back."""
 
     def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
-                 npoints: int, nnz_p: int = 0) -> None:
+                 npoints: int, nnz_p: int = 0, nremoved: int = 0) -> None:
         self._ffi = ffi
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
         self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
-                       "phi_p": nnz_p}
+                       "phi_p": nnz_p, "removed": nremoved}
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}
+        # Only an over-constrained file's kernel has it (Kernel.removed_phi).
+        self.removed: Callable[[Array, float, Array], Array] | None = (
+            self._removed if nremoved else None)
 
     def _in(self, array: Array) -> Any:
         if array.size == 0:
@@ -103,6 +106,9 @@ class _CFunctions:
 
     def phi_p_nz(self, q: Array, t: float, p: Array) -> Array:
         return self._call("phi_p", self._in(q), t, self._in(p))
+
+    def _removed(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("removed", self._in(q), t, self._in(p))
 
 
 def load(folder: Path, meta: Mapping[str, Any]) -> CKernel:

@@ -24,6 +24,9 @@ class _ModuleFunctions:
         self.points = module._points
         self.phi_p_nz: Callable[[Array, float, Array], Array] = getattr(
             module, "phi_p_nz", _no_phi_p)
+        # Only the module of an over-constrained file has it (Kernel.removed_phi).
+        self.removed: Callable[[Array, float, Array], Array] | None = getattr(
+            module, "removed", None)
 
 
 def _no_phi_p(q: Array, t: float, p: Array) -> Array:
@@ -40,6 +43,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         "points": module.POINTS,
         **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
            if hasattr(module, "PHI_P_ROWS") else {}),
+        **({"removed": module.REMOVED} if hasattr(module, "REMOVED") else {}),
     }
     return Kernel(backend, meta, _ModuleFunctions(module), folder=folder)
 
