@@ -58,3 +58,7 @@ class Manifest(Metadata):
 
 KEYS = frozenset(Manifest.__annotations__)
 """Every key of a manifest (a reader asks for no other)."""
+
+OPTIONAL_KEYS = frozenset({"removed"})
+"""The keys only some manifests have (``removed``: an over-constrained file's). Written out:
+with postponed annotations the TypedDict cannot see NotRequired in Python 3.11."""

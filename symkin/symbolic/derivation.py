@@ -138,7 +138,7 @@ def derive(mech: Mechanism | str | Path) -> System:
     nominal = dict(zip(symbols.p, p_values))
     q0 = _initial_guess(mech, ctx, nominal)
     time_grid = _time_grid(mech, ctx, nominal)
-    phi, rows, removed = _remove_redundant(phi, rows, symbols, p_values, q0, time_grid[0])
+    phi, rows, removed = _remove_redundant(phi, rows, symbols, p_values, q0, time_grid)
     column = {q: k for k, q in enumerate(symbols.q)}
     jacobian: dict[tuple[int, int], sp.Expr] = {}
     phi_t, gamma = [], []
@@ -163,7 +163,8 @@ def derive(mech: Mechanism | str | Path) -> System:
 
 
 def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbols,
-                      p_values: tuple[float, ...], q0: tuple[float, ...], t0: float
+                      p_values: tuple[float, ...], q0: tuple[float, ...],
+                      grid: tuple[float, float, float]
                       ) -> tuple[list[sp.Expr], tuple[Row, ...], tuple[Removed, ...]]:
     """A file with more equations than coordinates: the rows dependent at the assembled t0
     removed (symbolic.redundancy), joint rows before the others, later before earlier. A file
@@ -173,8 +174,10 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
     priority = ([k for k, row in enumerate(rows) if row.section != "joints"]
                 + [k for k, row in enumerate(rows) if row.section == "joints"])
     try:
+        # A rank short at t0 is checked again half a step later (t0 singular, or a freedom).
+        t0, t1, dt = grid
         found = redundancy.analyse(phi, symbols.q, symbols.t, symbols.p, p_values, q0, t0,
-                                   priority)
+                                   priority, t0 + 0.5 * min(dt, t1 - t0))
     except redundancy.Refusal as refusal:
         row = None if refusal.row is None else rows[refusal.row]
         where = (row.section, row.index) if row else ("joints",)

@@ -28,8 +28,9 @@ would flag every point anyway.
 
 A rank below the number of coordinates is refused: either the mechanism has freedoms no
 driver fixes, or t0 is a singular configuration. The two are told apart at a second, perturbed
-assembly: the configuration is moved along the null space of Phi_q and assembled again; a
-mechanism that really moves keeps its rank there, a singular configuration does not.
+assembly: the configuration is moved along the null space of Phi_q and assembled again half a
+grid step later (the drivers may pin a singular configuration at t0 itself); a mechanism with
+a free motion keeps its rank there, a singular configuration does not.
 
 Needs NumPy and SciPy besides SymPy (lambdify), and the dense solvers of symkin.contract.
 """
@@ -113,7 +114,7 @@ class _Equations:
 
 def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
             p: Sequence[sp.Symbol], p_values: Sequence[float], q0: Sequence[float],
-            t0: float, priority: Sequence[int]) -> Finding:
+            t0: float, priority: Sequence[int], t_near: float | None = None) -> Finding:
     """Assemble all rows at t0, find their rank and which rows to remove.
 
     Args:
@@ -121,6 +122,8 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
         q0: the first guess (the file's q0).
         t0: where to assemble.
         priority: the row indices in the order they are kept (the first independent ones win).
+        t_near: a time near t0 for the second assembly of a rank below the coordinates'
+            count (default t0: moved in configuration only).
 
     Raises:
         Refusal: the rows contradict each other at t0 (no assembly), the rank is below the
@@ -143,7 +146,7 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
                       "Move t0 away from a singular configuration, or remove the nearly "
                       "repeated joint.")
     if rank < equations.size:
-        raise _short_rank(equations, assembled, t0, rank)
+        raise _short_rank(equations, assembled, t0, rank, t0 if t_near is None else t_near)
     removed = tuple(k for k in range(equations.rows) if k not in kept)
     return Finding(kept=tuple(sorted(kept)), removed=removed, rank=rank,
                    q=tuple(float(v) for v in assembled),
@@ -224,11 +227,12 @@ def ordered_selection(scaled: np.ndarray, priority: Sequence[int]
     return kept, outside
 
 
-def _short_rank(equations: _Equations, q: np.ndarray, t0: float, rank: int) -> Refusal:
+def _short_rank(equations: _Equations, q: np.ndarray, t0: float, rank: int, t_near: float
+                ) -> Refusal:
     """The refusal of a rank below the number of coordinates: a freedom no driver fixes, or a
     singular configuration at t0 (the rank rises at a perturbed assembly)."""
     missing = equations.size - rank
-    again = _perturbed_rank(equations, q, t0)
+    again = _perturbed_rank(equations, q, t_near)
     if again is not None and again > rank:
         return Refusal(f"at t0 the {equations.rows} equations have rank {rank} for "
                        f"{equations.size} coordinates, but rank {again} at a configuration "
@@ -240,18 +244,19 @@ def _short_rank(equations: _Equations, q: np.ndarray, t0: float, rank: int) -> R
                    f"Add drivers for {missing} more freedom(s), or check for a missing joint.")
 
 
-def _perturbed_rank(equations: _Equations, q: np.ndarray, t0: float) -> int | None:
-    """The rank at a configuration moved along the null space of Phi_q and assembled again
-    (None when that assembly fails)."""
-    jacobian = equations.phi_q(q, t0)
+def _perturbed_rank(equations: _Equations, q: np.ndarray, t: float) -> int | None:
+    """The rank at a configuration moved along the null space of Phi_q and assembled again at
+    t, a time near t0 (None when that assembly fails). Moving the time matters where the
+    drivers pin the singular configuration at t0 (no other assembly exists there)."""
+    jacobian = equations.phi_q(q, t)
     _, _, vt = np.linalg.svd(equilibrate(jacobian))
     direction = vt[-1] / np.where(np.linalg.norm(jacobian, axis=0) > 0,
                                   np.linalg.norm(jacobian, axis=0), 1.0)
     scale = max(1.0, float(np.abs(q).max(initial=0.0)))
     step = PERTURBATION * scale * direction / max(float(np.abs(direction).max()), 1e-300)
     with np.errstate(all="ignore"):
-        moved = _gauss_newton(equations, q + step, t0, steps=20)
-        residual = float(np.abs(equations.phi(moved, t0)).max(initial=0.0))
+        moved = _gauss_newton(equations, q + step, t, steps=20)
+        residual = float(np.abs(equations.phi(moved, t)).max(initial=0.0))
         if not residual <= ASSEMBLY_TOLERANCE * scale:
             return None
-        return numerical_rank(equilibrate(equations.phi_q(moved, t0)))
+        return numerical_rank(equilibrate(equations.phi_q(moved, t)))
