@@ -113,7 +113,7 @@ class Trajectory:
         self.__dict__.update(t=t, q=q, dq=dq, d2q=d2q, coordinates=coordinates, points=points,
                              point_vectors=point_vectors, params=params,
                              lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
-                             cond=cond, singular=singular)
+                             cond=cond, singular=singular, removed=(), removed_residual=None)
         return self
 
     @property
@@ -149,8 +149,8 @@ class Trajectory:
 
     def save(self, path: str | Path) -> Path:
         """Write .npz (all arrays: t, q, dq, d2q, coordinates, points, r, dr, ddr, flagged,
-        cond) or .csv (t, q, q_t, q_tt columns, then each named point's x, y, vx, vy, ax, ay,
-        then flagged)."""
+        cond; and removed, removed_residual where rows were removed as redundant) or .csv (t,
+        q, q_t, q_tt columns, then each named point's x, y, vx, vy, ax, ay, then flagged)."""
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix not in SAVE_FORMATS:
@@ -167,9 +167,13 @@ class Trajectory:
     def _save_npz(self, path: Path) -> None:
         r, dr, ddr = self.point_arrays()
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
+        # An over-constrained file's removed rows, only then (every other file's NPZ as before).
+        removed = ({"removed": np.array(self.removed, dtype=str),
+                    "removed_residual": self.removed_residual}
+                   if self.removed and self.removed_residual is not None else {})
         np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
                  coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond)
+                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond, **removed)
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),

@@ -186,7 +186,11 @@ def test_cli_run_notes_the_removed_row_and_warns_where_it_breaks(
     err = capsys.readouterr().err
     assert "1 equation removed as redundant" in err and REMOVED in err
     assert "do not hold there" in err and "|Phi| up to" in err
-    assert np.load(out)["flagged"][1:].all()
+    saved = np.load(out)
+    assert saved["flagged"][1:].all()
+    assert saved["removed"].tolist() == [REMOVED]
+    assert saved["removed_residual"].shape == (saved["t"].size, 1)
+    assert abs(saved["removed_residual"][-1, 0]) > 1e-4
 
 
 def test_cli_run_of_the_example_notes_and_does_not_warn(
@@ -264,3 +268,42 @@ def test_a_singular_t0_is_told_apart_from_a_free_mechanism() -> None:
         symkin.derive(from_dict(document))
     message = str(caught.value)
     assert "t0 is a singular configuration" in message and "rank 11" in message
+
+
+def test_the_dependent_row_is_found_among_the_rows_not_just_the_last() -> None:
+    """A driven pendulum listed after the parallelogram: 16 rows on 15 coordinates. The row
+    that depends on the others is the extra bar's (its component outside the kept rows' span
+    is roundoff, far below the tolerance); the pendulum's rows, written last, all stay."""
+    document = _document()
+    document["bodies"]["ground"]["points"]["P0"] = [3, 0]
+    document["bodies"]["pendulum"] = {"points": {"P0": [3, 0], "P1": [4, 0]}}
+    document["joints"].append({"type": "revolute", "name": "P", "i": "ground",
+                               "j": "pendulum", "at": "P0"})
+    document["drivers"].append({"type": "angle", "name": "swing", "i": "pendulum",
+                                "j": "ground", "theta": "t"})
+    system = symkin.derive(from_dict(document))
+    assert len(system.q) == 15
+    assert [str(r) for r in system.removed] == [REMOVED]
+    assert system.removed[0].dependency < 1e-12
+    assert [str(r) for r in system.rows][-4:-2] == ["joints[6] P revolute ground-pendulum (x)",
+                                                    "joints[6] P revolute ground-pendulum (y)"]
+
+
+@pytest.mark.parametrize(("error", "dependent"), [(0.0, True), (1e-16, True), (1e-12, True),
+                                                  (1e-6, False)])
+def test_the_rank_tolerance_sits_between_roundoff_and_a_real_difference(
+        error: float, dependent: bool) -> None:
+    """A row equal to the sum of two others up to ``error`` (what rounding a drawing to 17
+    digits, or an assembly to 1e-13, leaves) counts as dependent; 1e-6 off it does not. The
+    columns differ by 1e6 in scale (millimetres against radians): equilibration hides that."""
+    from symkin.symbolic import redundancy
+
+    rng = np.random.default_rng(7)
+    rows = rng.normal(size=(3, 4))
+    extra = rows[0] + rows[1] + error * rng.normal(size=4)
+    jacobian = np.vstack([rows, extra]) * np.array([1e3, 1e3, 1e-3, 1.0])
+    scaled = redundancy.equilibrate(jacobian)
+    kept, outside = redundancy.ordered_selection(scaled, [0, 1, 2, 3])
+    assert (kept == [0, 1, 2]) is dependent
+    assert redundancy.numerical_rank(scaled) == (3 if dependent else 4)
+    assert (outside[3] < redundancy.RANK_TOLERANCE) is dependent
