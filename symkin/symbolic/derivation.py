@@ -105,6 +105,9 @@ class System:
     """dPhi/dp, N x NP (sparse): Phi_q q_p = -Phi_p gives the sensitivities q_p."""
     removed: tuple[Removed, ...] = ()
     """Rows of an over-constrained file dependent at t0, removed so that Phi is square."""
+    mobility: int | None = None
+    """An over-constrained file's freedoms at t0 by the rank of its joints' rows (the count,
+    ``dof``, cannot judge it); None for every other file."""
 
     @property
     def name(self) -> str:
@@ -138,7 +141,8 @@ def derive(mech: Mechanism | str | Path) -> System:
     nominal = dict(zip(symbols.p, p_values))
     q0 = _initial_guess(mech, ctx, nominal)
     time_grid = _time_grid(mech, ctx, nominal)
-    phi, rows, removed = _remove_redundant(phi, rows, symbols, p_values, q0, time_grid)
+    phi, rows, removed, mobility = _remove_redundant(phi, rows, symbols, p_values, q0,
+                                                     time_grid)
     column = {q: k for k, q in enumerate(symbols.q)}
     jacobian: dict[tuple[int, int], sp.Expr] = {}
     phi_t, gamma = [], []
@@ -158,26 +162,27 @@ def derive(mech: Mechanism | str | Path) -> System:
         points=tuple((body, name, sp.ImmutableMatrix(ctx.local(body, name)))
                      for body, spec in mech.bodies.items() for name in spec.points),
         placed=_placed(mech, ctx), time_grid=time_grid,
-        phi_p=_parameter_jacobian(phi, symbols.p), removed=removed,
+        phi_p=_parameter_jacobian(phi, symbols.p), removed=removed, mobility=mobility,
     )
 
 
 def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbols,
                       p_values: tuple[float, ...], q0: tuple[float, ...],
                       grid: tuple[float, float, float]
-                      ) -> tuple[list[sp.Expr], tuple[Row, ...], tuple[Removed, ...]]:
+                      ) -> tuple[list[sp.Expr], tuple[Row, ...], tuple[Removed, ...],
+                                 int | None]:
     """A file with more equations than coordinates: the rows dependent at the assembled t0
     removed (symbolic.redundancy), joint rows before the others, later before earlier. A file
     with as many (the DOF count passed) is left as it is, untouched."""
     if len(phi) <= len(symbols.q):
-        return phi, rows, ()
-    priority = ([k for k, row in enumerate(rows) if row.section != "joints"]
-                + [k for k, row in enumerate(rows) if row.section == "joints"])
+        return phi, rows, (), None
+    joints = [k for k, row in enumerate(rows) if row.section == "joints"]
+    priority = [k for k, row in enumerate(rows) if row.section != "joints"] + joints
     try:
         # A rank short at t0 is checked again half a step later (t0 singular, or a freedom).
         t0, t1, dt = grid
         found = redundancy.analyse(phi, symbols.q, symbols.t, symbols.p, p_values, q0, t0,
-                                   priority, t0 + 0.5 * min(dt, t1 - t0))
+                                   priority, t0 + 0.5 * min(dt, t1 - t0), joints)
     except redundancy.Refusal as refusal:
         row = None if refusal.row is None else rows[refusal.row]
         where = (row.section, row.index) if row else ("joints",)
@@ -186,7 +191,8 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
                              refusal.hint) from None
     removed = tuple(Removed(rows[k], phi[k], k, d)
                     for k, d in zip(found.removed, found.dependency))
-    return [phi[k] for k in found.kept], tuple(rows[k] for k in found.kept), removed
+    return ([phi[k] for k in found.kept], tuple(rows[k] for k in found.kept), removed,
+            found.mobility)
 
 
 def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tuple[Row, ...]]:

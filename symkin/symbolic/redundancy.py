@@ -71,6 +71,8 @@ class Finding:
         rank: the rank of Phi_q at the assembled t0.
         q: the assembled configuration.
         dependency: per removed row, its relative component outside the kept rows' span.
+        mobility: the freedoms the joints leave at t0: coordinates less the rank of the rows
+            that are not in ``priority``'s leading group (the joints' rows).
     """
 
     kept: tuple[int, ...]
@@ -78,6 +80,7 @@ class Finding:
     rank: int
     q: tuple[float, ...]
     dependency: tuple[float, ...]
+    mobility: int = 0
 
 
 class Refusal(Exception):
@@ -114,7 +117,8 @@ class _Equations:
 
 def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
             p: Sequence[sp.Symbol], p_values: Sequence[float], q0: Sequence[float],
-            t0: float, priority: Sequence[int], t_near: float | None = None) -> Finding:
+            t0: float, priority: Sequence[int], t_near: float | None = None,
+            joints: Sequence[int] = ()) -> Finding:
     """Assemble all rows at t0, find their rank and which rows to remove.
 
     Args:
@@ -124,6 +128,7 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
         priority: the row indices in the order they are kept (the first independent ones win).
         t_near: a time near t0 for the second assembly of a rank below the coordinates'
             count (default t0: moved in configuration only).
+        joints: the joints' rows, whose rank gives the mobility at t0.
 
     Raises:
         Refusal: the rows contradict each other at t0 (no assembly), the rank is below the
@@ -148,9 +153,11 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
     if rank < equations.size:
         raise _short_rank(equations, assembled, t0, rank, t0 if t_near is None else t_near)
     removed = tuple(k for k in range(equations.rows) if k not in kept)
+    joint_rank = numerical_rank(scaled[list(joints)]) if joints else 0
     return Finding(kept=tuple(sorted(kept)), removed=removed, rank=rank,
                    q=tuple(float(v) for v in assembled),
-                   dependency=tuple(dependency[k] for k in removed))
+                   dependency=tuple(dependency[k] for k in removed),
+                   mobility=equations.size - joint_rank)
 
 
 def _assemble(equations: _Equations, q0: np.ndarray, t0: float) -> np.ndarray:

@@ -64,11 +64,13 @@ def test_parallelogram_with_an_extra_bar_loses_exactly_its_one_dependent_row() -
     assert system.removed[0].index == 11  # its place among the 13 rows written
     assert system.rows[-1].section == "drivers"  # the driver is kept
     assert REMOVED not in [str(r) for r in system.rows]
+    # Grübler says 0; the joints' rows have rank 11 on 12 coordinates: it moves, with 1.
+    assert system.dof == 0 and system.mobility == 1
 
 
 def test_a_square_file_is_untouched() -> None:
     system = symkin.derive(ROOT / "examples" / "four_bar.yaml")
-    assert system.removed == ()
+    assert system.removed == () and system.mobility is None
 
 
 def test_joint_rows_are_removed_before_driver_rows() -> None:
@@ -160,6 +162,7 @@ def test_a_slightly_wrong_extra_bar_assembles_and_is_flagged_along_the_motion(
     residual is what the extra bar's kept x-row leaves in y (derived here): flags raised."""
     system = symkin.derive(from_dict(_wrong_bar(1e-3)))
     assert [str(r) for r in system.removed] == [REMOVED]
+    assert system.mobility == 0  # the joints alone leave nothing for the driver: rigid
     trajectory = symkin.solve(symkin.compile(system, backend=backend))
     residual = trajectory.removed_residual[:, 0]
     assert abs(residual[0]) < 1e-12 and not trajectory.flagged[0]
@@ -206,6 +209,7 @@ def test_cli_show_says_which_row_is_removed_and_why(capsys: pytest.CaptureFixtur
     out = capsys.readouterr().out
     assert "removed as redundant (13 equations for 12 coordinates" in out
     assert "rank 12" in out and REMOVED in out
+    assert "degrees of freedom: 0 by the count, 1 by the rank of the joints' rows at t0" in out
 
 
 def test_nan_residual_counts_as_broken() -> None:
