@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -168,12 +169,14 @@ class Trajectory:
         r, dr, ddr = self.point_arrays()
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
         # An over-constrained file's removed rows, only then (every other file's NPZ as before).
-        removed = ({"removed": np.array(self.removed, dtype=str),
-                    "removed_residual": self.removed_residual}
-                   if self.removed and self.removed_residual is not None else {})
-        np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
-                 coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond, **removed)
+        arrays: dict[str, Any] = {
+            "t": self.t, "q": self.q, "dq": self.dq, "d2q": self.d2q,
+            "coordinates": np.array(self.coordinates, dtype=str), "points": names,
+            "r": r, "dr": dr, "ddr": ddr, "flagged": self.flagged, "cond": self.cond}
+        if self.removed and self.removed_residual is not None:
+            arrays.update(removed=np.array(self.removed, dtype=str),
+                          removed_residual=self.removed_residual)
+        np.savez(path, **arrays)
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
