@@ -311,3 +311,17 @@ def test_the_rank_tolerance_sits_between_roundoff_and_a_real_difference(
     assert (kept == [0, 1, 2]) is dependent
     assert redundancy.numerical_rank(scaled) == (3 if dependent else 4)
     assert (outside[3] < redundancy.RANK_TOLERANCE) is dependent
+
+
+def test_a_warm_run_from_the_cache_still_knows_the_removed_rows(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The second run loads the kernel through the warm-run index (no derivation): the
+    manifest's ``removed`` key carries the rows, so the note and the check remain."""
+    for backend in BACKENDS:
+        for _ in range(2):
+            out = tmp_path / f"{backend}.npz"
+            assert cli.main(["run", str(EXAMPLE), "--backend", backend, "-o", str(out)]) == 0
+            captured = capsys.readouterr()
+            assert REMOVED in captured.err
+            assert np.load(out)["removed"].tolist() == [REMOVED]
+        assert "cached kernel" in captured.out
