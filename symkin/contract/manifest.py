@@ -5,7 +5,7 @@ load and from_sources, each backend's build and loader)."""
 
 from __future__ import annotations
 
-from typing import TypedDict
+from typing import NotRequired, TypedDict
 
 MANIFEST_SUFFIX = "_manifest.json"
 
@@ -37,6 +37,9 @@ class Metadata(TypedDict):
     nnz: int
     npoints: int
     nshared: int
+    space: NotRequired[str]
+    """``3d`` for a spatial mechanism (points of 3 components, 7 coordinates per body);
+    absent for a planar one."""
 
 
 class Manifest(Metadata):

@@ -19,8 +19,13 @@ import sympy as sp
 from symkin import pairs
 from symkin.spec import validate
 from symkin.spec.validate import Mechanism
+from symkin.symbolic import spatial
 from symkin.symbolic.planar import Context
 from symkin.symbolic.symbols import Symbols, make_symbols
+
+
+# A spatial body's own row: its Euler parameters' normalisation (section, part).
+NORMALISATION = ("bodies", "normalisation")
 
 
 @dataclass(frozen=True)
@@ -36,7 +41,10 @@ class Row:
 
     @property
     def owner(self) -> str:
-        """``joints[1] revolute crank-rod`` (or the constraint's own name)."""
+        """``joints[1] revolute crank-rod`` (or the constraint's own name); a spatial body's
+        normalisation row: ``bodies[0] crank``."""
+        if self.section == NORMALISATION[0]:
+            return f"{self.section}[{self.index}] {self.name}"
         who = f" {self.name}" if self.name else ""
         return f"{self.section}[{self.index}]{who} {self.type} {'-'.join(self.bodies)}".rstrip()
 
@@ -108,8 +116,10 @@ def derive(mech: Mechanism | str | Path) -> System:
     if not isinstance(mech, Mechanism):
         mech = validate.load(mech)
     symbols = make_symbols(mech)
-    ctx = Context(mech, symbols)
+    ctx = (spatial.SpatialContext if mech.is_spatial else Context)(mech, symbols)
     phi, rows = _constraint_rows(mech, ctx)
+    if mech.is_spatial:
+        phi, rows = _normalised(mech, ctx, phi, rows)
     column = {q: k for k, q in enumerate(symbols.q)}
     jacobian: dict[tuple[int, int], sp.Expr] = {}
     phi_t, gamma = [], []
@@ -150,6 +160,15 @@ def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tupl
             rows.extend(Row(section, index, constraint.type, bodies, part, constraint.name)
                         for part in parts)
     return phi, tuple(rows)
+
+
+def _normalised(mech: Mechanism, ctx: Context, phi: list[sp.Expr], rows: tuple[Row, ...]
+                ) -> tuple[list[sp.Expr], tuple[Row, ...]]:
+    """Phi and its labels with one normalisation row per spatial body, after the drivers."""
+    section, part = NORMALISATION
+    own = [(spatial.normalisation(ctx.pose(body)),  # type: ignore[arg-type]
+            Row(section, k, "", (body,), part, body)) for k, body in enumerate(mech.bodies)]
+    return phi + [row for row, _ in own], rows + tuple(label for _, label in own)
 
 
 def _placed(mech: Mechanism, ctx: Context) -> tuple[Placed, ...]:
