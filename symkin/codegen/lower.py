@@ -133,6 +133,13 @@ class Code:
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
     removed: tuple[str, ...] = ()
     """The labels of the rows removed as dependent at t0 (the ``removed`` routine's outputs)."""
+    space: str = "2d"
+    """``3d`` for a spatial mechanism (its points have three components)."""
+
+    @property
+    def point_axes(self) -> str:
+        """The components of a point vector, in order."""
+        return "xyz" if self.space == "3d" else "xy"
 
     @property
     def nnz(self) -> int:
@@ -196,6 +203,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         for name, exprs in {**prepared, **fused}.items())
     return Code(
         backend=backend, real=real, cse=cse, name=system.name,
+        space="3d" if system.mechanism.is_spatial else "2d",
         spec_sha256=system.mechanism.spec_hash(), nq=len(system.q), n_params=len(system.p),
         coordinates=system.coordinates, parameter_names=system.parameter_names,
         p_values=tuple(float(v) for v in system.p_values), q0=tuple(system.q0),

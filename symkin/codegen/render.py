@@ -203,7 +203,8 @@ def manifest(code: Code, files: dict[str, str]) -> str:
 
 
 def metadata(code: Code) -> Metadata:
-    """What the runtime Kernel needs besides the compiled functions (plain JSON data)."""
+    """What the runtime Kernel needs besides the compiled functions (plain JSON data); the
+    space only for a spatial mechanism (a planar manifest is as it always was)."""
     data: Metadata = {
         "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
         "p_values": list(code.p_values), "q0": list(code.q0), "time_grid": list(code.time_grid),
@@ -215,6 +216,8 @@ def metadata(code: Code) -> Metadata:
     }
     if code.removed:  # only then: every other manifest stays as it was
         data["removed"] = list(code.removed)
+    if code.space == "3d":
+        data["space"] = code.space
     return data
 
 
@@ -251,6 +254,8 @@ def template_context(code: Code) -> dict[str, Any]:
         "removed_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.removed)],
         "removed_literals": [repr(r) for r in code.removed],
         "point_literals": [repr(tuple(p)) for p in code.points],
+        "point_size": len(code.point_axes),
+        "point_tuples": "(x, y, z) triples" if code.space == "3d" else "(x, y) pairs",
         "linalg": code.linalg,
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
@@ -295,9 +300,15 @@ def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
         "signature": ", ".join([*arguments, *(f"{real} *restrict {n}" for n in names)]),
         "labels": labels,
         "python_name": _PYTHON_NAME.get(routine.name, routine.name),
-        "python_signature": ", ".join(python_arguments), "doc": _PYTHON_DOC[routine.name],
+        "python_signature": ", ".join(python_arguments), "doc": _doc(code, routine.name),
         "size": len(routine.outputs),
     }
+
+
+def _doc(code: Code, routine: str) -> str:
+    """The generated function's docstring; a spatial mechanism's points are triples."""
+    doc = _PYTHON_DOC[routine]
+    return doc.replace("(x, y) pairs", "(x, y, z) triples") if code.space == "3d" else doc
 
 
 def _labels(code: Code, routine: str) -> list[str]:
@@ -314,7 +325,7 @@ def _labels(code: Code, routine: str) -> list[str]:
         return [lower.comment(row) for row in code.removed]
     if routine == "points":
         return [lower.comment(f"{body}.{point}.{axis}") for body, point in code.points
-                for axis in "xy"]
+                for axis in code.point_axes]
     return [lower.comment(row) for row in code.rows]
 
 

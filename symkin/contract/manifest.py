@@ -39,6 +39,9 @@ class Metadata(TypedDict):
     nshared: int
     removed: NotRequired[list[str]]
     """The rows removed as dependent at t0 (only in the manifest of a file that has some)."""
+    space: NotRequired[str]
+    """``3d`` for a spatial mechanism (points of 3 components, 7 coordinates per body);
+    absent for a planar one."""
 
 
 class Manifest(Metadata):

@@ -48,6 +48,10 @@ def _point_ref(value: Any) -> Any:
     return value if isinstance(value, str) else _vector(2)(value)
 
 
+def _point_ref3(value: Any) -> Any:
+    return value if isinstance(value, str) else _vector(3)(value)
+
+
 def _time_function(value: Any) -> Any:
     if isinstance(value, Mapping):
         if set(value) != {"poly"} or not isinstance(value["poly"], list) or not value["poly"]:
@@ -65,10 +69,18 @@ Vec2 = Annotated[list[Any], PlainValidator(_vector(2)),
 Vec3 = Annotated[list[Any], PlainValidator(_vector(3)),
                  WithJsonSchema({"type": "array", "items": _EXPR_SCHEMA,
                                  "minItems": 3, "maxItems": 3})]
+# A spatial body's first guess: x, y, z and Euler parameters e0..e3.
+Vec7 = Annotated[list[Any], PlainValidator(_vector(7)),
+                 WithJsonSchema({"type": "array", "items": _EXPR_SCHEMA,
+                                 "minItems": 7, "maxItems": 7})]
 PointRef = Annotated[Any, PlainValidator(_point_ref),
                      WithJsonSchema({"anyOf": [{"type": "string"},
                                                {"type": "array", "items": _EXPR_SCHEMA,
                                                 "minItems": 2, "maxItems": 2}]})]
+PointRef3 = Annotated[Any, PlainValidator(_point_ref3),
+                      WithJsonSchema({"anyOf": [{"type": "string"},
+                                                {"type": "array", "items": _EXPR_SCHEMA,
+                                                 "minItems": 3, "maxItems": 3}]})]
 TimeFunction = Annotated[Any, PlainValidator(_time_function),
                          WithJsonSchema({"anyOf": [*_EXPR_SCHEMA["anyOf"], {
                              "type": "object", "properties": {"poly": {

@@ -265,7 +265,8 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
             solved = _c_run(run, solver, progress)
             if run.done == times.size:  # the usual case: nothing left to treat
                 run.fallbacks = solver.fallbacks
-                return _trajectory(kernel, run, p, solver.point_vectors(len(kernel.points)))
+                return _trajectory(kernel, run, p, solver.point_vectors(len(kernel.points),
+                                                                     _point_size(kernel)))
             first = _c_outcome(kernel, run, solver, p, solved)
         else:
             first = None
@@ -339,11 +340,22 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
         arrays = tuple(a[:done] if run.caller_owned else a[:done].copy() for a in arrays)
     t, q, dq, d2q, flagged, cond = arrays
     if point_vectors is None:
-        point_vectors = np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2)
+        point_vectors = np.asarray(kernel.point_vectors(p), dtype=float).reshape(
+            -1, _point_size(kernel))
     singular = tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
                      for s in run.passages) if run.passages else ()
     return Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates), tuple(kernel.points),
-                             point_vectors, p, run.fallbacks, flagged, cond, singular)
+                             point_vectors, p, run.fallbacks, flagged, cond, singular,
+                             space=_space(kernel))
+
+
+def _space(kernel: KinematicsKernel) -> str:
+    """``3d`` for a spatial kernel (a stand-in kernel without the attribute is planar)."""
+    return str(getattr(kernel, "space", "2d"))
+
+
+def _point_size(kernel: KinematicsKernel) -> int:
+    return 3 if _space(kernel) == "3d" else 2
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,

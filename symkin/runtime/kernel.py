@@ -68,6 +68,8 @@ class Kernel:
         self.pattern_rows = np.array(meta["pattern_rows"], dtype=np.intp)
         self.pattern_cols = np.array(meta["pattern_cols"], dtype=np.intp)
         self.points: tuple[tuple[str, str], ...] = tuple(tuple(p) for p in meta["points"])
+        # "3d" for a spatial mechanism: 7 coordinates per body, points of 3 components.
+        self.space: str = meta.get("space", "2d")
         # The non-zeros of Phi_p (row, parameter); absent from kernels built before Phi_p.
         self.phi_p_rows = np.array(meta.get("phi_p_rows", ()), dtype=np.intp)
         self.phi_p_cols = np.array(meta.get("phi_p_cols", ()), dtype=np.intp)
@@ -86,6 +88,11 @@ class Kernel:
         """A fresh run of the generated grid loop from q, or None without one."""
         del options, q, p
         return None
+
+    @property
+    def point_size(self) -> int:
+        """The components of a point vector: 2, or 3 in a spatial mechanism."""
+        return 3 if self.space == "3d" else 2
 
     @property
     def nq(self) -> int:
@@ -142,8 +149,9 @@ class Kernel:
         return np.asarray(evaluate(self._q(q), float(t), self._p(p)), dtype=float)
 
     def point_vectors(self, p: ArrayLike | None = None) -> Array:
-        """Local vectors of the named points, shape (NPOINTS, 2), in ``points`` order."""
-        return self._functions.points(self._p(p)).reshape(len(self.points), 2)
+        """Local vectors of the named points, shape (NPOINTS, 2) (spatial: 3), in ``points``
+        order."""
+        return self._functions.points(self._p(p)).reshape(len(self.points), self.point_size)
 
     # -- argument checks ----------------------------------------------------------------------
     def _q(self, values: ArrayLike, what: str = "q") -> Array:

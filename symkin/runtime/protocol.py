@@ -65,8 +65,8 @@ class GridSolver(Protocol):
         """The last call's report, with the count it returned."""
         ...
 
-    def point_vectors(self, count: int) -> Array:
-        """The local vectors of the named points at the run's parameters, (count, 2)."""
+    def point_vectors(self, count: int, size: int = 2) -> Array:
+        """The local vectors of the named points at the run's parameters, (count, size)."""
         ...
 
     def set_state(self, t: float, q: Array, dq: Array, ddq: Array) -> None:

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.errors import SymkinError
+from symkin.runtime import spatial
 
 SAVE_FORMATS = (".npz", ".csv")
 
@@ -73,6 +74,8 @@ class Trajectory:
             labels); empty for every other file.
         removed_residual: (T, len(removed)) their Phi along the motion, or None; a point
             where one exceeds the position target is flagged (runtime.redundant).
+        space: ``3d`` for a spatial mechanism: 7 coordinates per body (x, y, z, e0..e3),
+            points of 3 components, and each body's angular velocity and acceleration.
     """
 
     t: NDArray[np.float64]
@@ -91,6 +94,7 @@ class Trajectory:
     singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
     removed: tuple[str, ...] = ()
     removed_residual: NDArray[np.float64] | None = None
+    space: str = "2d"
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.
@@ -105,8 +109,8 @@ class Trajectory:
                points: tuple[tuple[str, str], ...], point_vectors: NDArray[np.float64],
                params: NDArray[np.float64], lu_fallbacks: int, flagged: NDArray[np.bool_],
                cond: NDArray[np.float64],
-               singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
-               ) -> Trajectory:
+               singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = (),
+               space: str = "2d") -> Trajectory:
         """The solver's result, whose arrays are consistent by construction (flagged and cond
         of shape (T,)): the same object as the constructor's, built without its field-by-field
         frozen assignment and checks, which cost more than solving a short grid."""
@@ -114,8 +118,18 @@ class Trajectory:
         self.__dict__.update(t=t, q=q, dq=dq, d2q=d2q, coordinates=coordinates, points=points,
                              point_vectors=point_vectors, params=params,
                              lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
-                             cond=cond, singular=singular, removed=(), removed_residual=None)
+                             cond=cond, singular=singular, removed=(), removed_residual=None,
+                             space=space)
         return self
+
+    @property
+    def spatial(self) -> bool:
+        return self.space == "3d"
+
+    @property
+    def point_size(self) -> int:
+        """A point's components: 2, or 3 in a spatial mechanism."""
+        return 3 if self.spatial else 2
 
     @property
     def bodies(self) -> tuple[str, ...]:
@@ -124,25 +138,37 @@ class Trajectory:
 
     def body(self, name: str
              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """(q, dq, d2q) of one body, each shape (T, 3): x, y, phi."""
+        """(q, dq, d2q) of one body, each shape (T, 3): x, y, phi (spatial: (T, 7): x, y,
+        z, e0..e3)."""
         if name not in self.bodies:
             raise SymkinError(f"no body {name!r}; the bodies are: {', '.join(self.bodies)}")
         start = self.coordinates.index(f"{name}.x")
-        columns = slice(start, start + 3)
+        columns = slice(start, start + (7 if self.spatial else 3))
         return self.q[:, columns], self.dq[:, columns], self.d2q[:, columns]
 
     def point(self, body: str, name: str
               ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """Position, velocity and acceleration of a named point (2.14-2.16), each (T, 2)."""
+        """Position, velocity and acceleration of a named point (2.14-2.16), each (T, 2)
+        (spatial: (T, 3), from the Euler parameters)."""
         if (body, name) not in self.points:
             known = ", ".join(f"{b}.{p}" for b, p in self.points) or "none"
             raise SymkinError(f"no point {body}.{name}; the named points are: {known}")
         s = self.point_vectors[self.points.index((body, name))]
+        if self.spatial:
+            return spatial.point_kinematics(*self.body(body), s)
         return point_kinematics(*self.body(body), s)
 
+    def angular(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """omega and alpha of every body of a spatial mechanism, global, each (T, B, 3)."""
+        found = [spatial.angular(*self.body(body)) for body in self.bodies]
+        shape = (self.t.size, len(found), 3)
+        omega = np.stack([w for w, _ in found], 1) if found else np.zeros(shape)
+        alpha = np.stack([a for _, a in found], 1) if found else np.zeros(shape)
+        return omega, alpha
+
     def point_arrays(self) -> tuple[NDArray[np.float64], ...]:
-        """r, dr, ddr of every named point, each shape (T, P, 2)."""
-        shape = (self.t.size, len(self.points), 2)
+        """r, dr, ddr of every named point, each shape (T, P, 2) (spatial: (T, P, 3))."""
+        shape = (self.t.size, len(self.points), self.point_size)
         r, dr, ddr = (np.zeros(shape) for _ in range(3))
         for k, (body, name) in enumerate(self.points):
             r[:, k], dr[:, k], ddr[:, k] = self.point(body, name)
@@ -161,31 +187,50 @@ class Trajectory:
         return path
 
     def _point_columns(self) -> list[str]:
-        """``<body>.<point>_x, _y, _vx, _vy, _ax, _ay`` for every named point."""
+        """``<body>.<point>_x, _y, _vx, _vy, _ax, _ay`` for every named point (spatial:
+        ``_x, _y, _z, _vx, _vy, _vz, _ax, _ay, _az``)."""
+        axes = "xyz"[:self.point_size]
+        suffixes = [f"{kind}{axis}" for kind in ("", "v", "a") for axis in axes]
         return [f"{body}.{point}_{suffix}" for body, point in self.points
-                for suffix in ("x", "y", "vx", "vy", "ax", "ay")]
+                for suffix in suffixes]
+
+    def _angular_columns(self) -> list[str]:
+        """``<body>.omega_x .. _z, <body>.alpha_x .. _z`` for every body (spatial only)."""
+        return [f"{body}.{kind}_{axis}" for body in self.bodies
+                for kind in ("omega", "alpha") for axis in "xyz"] if self.spatial else []
 
     def _save_npz(self, path: Path) -> None:
         r, dr, ddr = self.point_arrays()
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
-        # An over-constrained file's removed rows, only then (every other file's NPZ as before).
         arrays: dict[str, Any] = {
             "t": self.t, "q": self.q, "dq": self.dq, "d2q": self.d2q,
             "coordinates": np.array(self.coordinates, dtype=str), "points": names,
             "r": r, "dr": dr, "ddr": ddr, "flagged": self.flagged, "cond": self.cond}
+        # An over-constrained file's removed rows, only then (every other file's NPZ as before).
         if self.removed and self.removed_residual is not None:
             arrays.update(removed=np.array(self.removed, dtype=str),
                           removed_residual=self.removed_residual)
+        if self.spatial:
+            omega, alpha = self.angular()
+            arrays.update(omega=omega, alpha=alpha,
+                          bodies=np.array(self.bodies, dtype=str).reshape(-1))
         np.savez(path, **arrays)
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
-                  *(c + "_tt" for c in self.coordinates), *self._point_columns(), "flagged"]
+                  *(c + "_tt" for c in self.coordinates), *self._point_columns(),
+                  *self._angular_columns(), "flagged"]
         r, dr, ddr = self.point_arrays()
-        # Per point: x, y, vx, vy, ax, ay (2.14-2.16).
+        # Per point: x, y, vx, vy, ax, ay (2.14-2.16); spatial: x, y, z, vx, vy, vz, ax...
         # the column count given, not inferred: a run that stopped before its first row
         # still writes its header
-        points = np.concatenate([r, dr, ddr], axis=2).reshape(self.t.size, 6 * len(self.points))
-        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, self.flagged])
+        points = np.concatenate([r, dr, ddr], axis=2).reshape(
+            self.t.size, 3 * self.point_size * len(self.points))
+        columns = [self.t, self.q, self.dq, self.d2q, points]
+        if self.spatial:
+            omega, alpha = self.angular()
+            columns.append(np.concatenate([omega, alpha], axis=2).reshape(
+                self.t.size, 6 * len(self.bodies)))
+        table = np.column_stack([*columns, self.flagged])
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")

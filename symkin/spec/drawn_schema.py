@@ -13,8 +13,8 @@ from typing import Any, Literal
 from pydantic import Field
 
 from symkin import pairs
-from symkin.pairs.fields import Expr, PointRef, Strict, Vec2
-from symkin.spec.schema import Driver, TimeGrid, Units
+from symkin.pairs.fields import Expr, PointRef, PointRef3, Strict, Vec2, Vec3
+from symkin.spec.schema import Driver, SpatialMechanismSpec, TimeGrid, Units
 
 
 class Frame(Strict):
@@ -47,8 +47,38 @@ class DrawnMechanism(Strict):
     units: Units | None = None
 
 
+class SpatialFrame(Strict):
+    """A spatial body's frame origin (its axes are parallel to the global ones as drawn)."""
+
+    origin: PointRef3
+
+
+class SpatialDrawnBody(Strict):
+    """A spatial body as drawn: global [x, y, z] points; the frame at the first point."""
+
+    points: dict[str, Vec3] = Field(default_factory=dict)
+    frame: SpatialFrame | None = None
+
+
+class SpatialDrawnMechanism(Strict):
+    """A ``space: 3d`` file in the drawn layout."""
+
+    space: Literal["3d"]
+    layout: Literal["drawn"]
+    name: str
+    parameters: dict[str, Expr] = Field(default_factory=dict)
+    bodies: dict[str, SpatialDrawnBody] = Field(min_length=1)
+    joints: list[pairs.union("joints", drawn=True, space="3d")] = Field(  # type: ignore[misc]
+        default_factory=list)
+    drivers: list[pairs.union("drivers", drawn=True, space="3d")] = Field(  # type: ignore[misc]
+        default_factory=list)
+    time: TimeGrid
+    units: Units | None = None
+
+
 def json_schema_of(local: type[Any]) -> dict[str, Any]:
-    """The schema of a mechanism file: the local layout or the drawn one."""
+    """The schema of a mechanism file: the local layout or the drawn one, planar or spatial."""
     from pydantic import TypeAdapter
 
-    return TypeAdapter(local | DrawnMechanism).json_schema()  # type: ignore[arg-type]
+    return TypeAdapter(local | DrawnMechanism | SpatialDrawnMechanism  # type: ignore[arg-type]
+                       | SpatialMechanismSpec).json_schema()

@@ -16,7 +16,7 @@ from typing import Annotated, Any, Literal
 from pydantic import Field
 
 from symkin import pairs
-from symkin.pairs.fields import Expr, Strict, Vec2, Vec3
+from symkin.pairs.fields import Expr, Strict, Vec2, Vec3, Vec7
 from symkin.spec import expressions
 
 
@@ -27,9 +27,23 @@ class Body(Strict):
     points: dict[str, Vec2] = Field(default_factory=dict)
 
 
+class SpatialBody(Strict):
+    """A moving body of a ``space: 3d`` file: first guess q0 = [x, y, z, e0, e1, e2, e3]
+    (position of its frame and Euler parameters, e0 the scalar part) and named 3-vectors."""
+
+    q0: Vec7 = Field(default_factory=lambda: [0, 0, 0, 1, 0, 0, 0])
+    points: dict[str, Vec3] = Field(default_factory=dict)
+
+
+# The coordinates of one body, by space: planar x, y, phi; spatial x, y, z and the Euler
+# parameters e0 (scalar part) .. e3.
+COORDINATES = {"2d": ("x", "y", "phi"), "3d": ("x", "y", "z", "e0", "e1", "e2", "e3")}
+
 # The joints and drivers a file may list: each a union of the registered types' models.
 Joint: Any = pairs.union("joints")
 Driver: Any = pairs.union("drivers")
+SpatialJoint: Any = pairs.union("joints", space="3d")
+SpatialDriver: Any = pairs.union("drivers", space="3d")
 
 
 def equation_count(constraint: Any) -> int:
@@ -77,6 +91,16 @@ class MechanismSpec(Strict):
 
     # -- derived views ------------------------------------------------------------------------
     @property
+    def is_spatial(self) -> bool:
+        """True for a ``space: 3d`` file."""
+        return False
+
+    @property
+    def body_coordinates(self) -> tuple[str, ...]:
+        """The names of one body's coordinates (``x``, ``y``, ``phi`` in a planar file)."""
+        return COORDINATES["3d" if self.is_spatial else "2d"]
+
+    @property
     def body_names(self) -> tuple[str, ...]:
         return tuple(self.bodies)
 
@@ -92,3 +116,17 @@ class MechanismSpec(Strict):
 
     def spec_hash(self) -> str:
         return hashlib.sha256(self.canonical_json().encode()).hexdigest()
+
+
+class SpatialMechanismSpec(MechanismSpec):
+    """The fields of a ``space: 3d`` file: 3-vectors, seven coordinates per body and the
+    spatial pair types."""
+
+    space: Literal["3d"]
+    bodies: dict[str, SpatialBody] = Field(min_length=1)  # type: ignore[assignment]
+    joints: list[SpatialJoint] = Field(default_factory=list)
+    drivers: list[SpatialDriver] = Field(default_factory=list)
+
+    @property
+    def is_spatial(self) -> bool:
+        return True

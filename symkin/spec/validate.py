@@ -18,10 +18,10 @@ from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError, UsageError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
 from symkin.pairs.fields import GROUND
-from symkin.spec import constants, drawn, drawn_schema, expressions, loader
+from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
-from symkin.spec.schema import MechanismSpec, equation_count
+from symkin.spec.schema import MechanismSpec, SpatialMechanismSpec, equation_count
 
 
 class Mechanism(MechanismSpec):
@@ -31,6 +31,10 @@ class Mechanism(MechanismSpec):
     def _semantics(self) -> Mechanism:
         _check_semantics(self)
         return self
+
+
+class SpatialMechanism(SpatialMechanismSpec, Mechanism):
+    """A validated spatial mechanism (``space: 3d``)."""
 
 
 @dataclass(frozen=True)
@@ -55,7 +59,7 @@ def _names(mech: MechanismSpec) -> _Names:
         parameters={name: sp.Symbol(name, real=True) for name in mech.parameters},
         t=sp.Symbol("t", real=True),
         by_coordinate={(body, part): sp.Symbol(f"{body}.{part}", real=True)
-                       for body in mech.bodies for part in ("x", "y", "phi")})
+                       for body in mech.bodies for part in mech.body_coordinates})
 
 def load(path: str | Path, overrides: Mapping[str, str] | None = None) -> Mechanism:
     """Read and validate a mechanism file (YAML, or TOML by suffix).
@@ -131,7 +135,10 @@ def _validate(document: loader.Document) -> Mechanism:
                              "joints, drivers, time", source=document.source, line=1)
     try:
         # A drawn document (layout: drawn) is first turned into the local form.
-        return Mechanism.model_validate(drawn.to_local(document.data))
+        if drawn3d.space_of(document.data) == "3d":
+            return SpatialMechanism.model_validate(drawn3d.to_local(document.data))
+        planar = {key: value for key, value in document.data.items() if key != "space"}
+        return Mechanism.model_validate(drawn.to_local(planar))
     except MechanismError as error:
         raise error.located(document.source, document.line_of(error.path)) from None
     except ValidationError as error:
@@ -294,12 +301,27 @@ class _Checks:
             return constants.value(expressions.parse(raw, self.symbols.parameters), self.nominal)
 
         local = self.mech.bodies[body].points[ref] if isinstance(ref, str) else ref
+        if self.mech.is_spatial:
+            return _spatial_point(list(map(nominal, local)), body,
+                                  list(map(nominal, self.mech.bodies[body].q0))
+                                  if body != GROUND else None)
         sx, sy = map(nominal, local)
         if body == GROUND:
             return sx, sy
         x, y, phi = map(nominal, self.mech.bodies[body].q0)
         return (x + math.cos(phi) * sx - math.sin(phi) * sy,
                 y + math.sin(phi) * sx + math.cos(phi) * sy)
+
+
+def _spatial_point(s: list[float], body: str, q0: list[float] | None) -> tuple[float, ...]:
+    """r + A(e) s for a spatial body at q0 = [x, y, z, e0..e3] (the ground: s itself)."""
+    if q0 is None:
+        return tuple(s)
+    e0, e1, e2, e3 = q0[3:]
+    a = ((e0*e0 + e1*e1 - e2*e2 - e3*e3, 2*(e1*e2 - e0*e3), 2*(e1*e3 + e0*e2)),
+         (2*(e1*e2 + e0*e3), e0*e0 - e1*e1 + e2*e2 - e3*e3, 2*(e2*e3 - e0*e1)),
+         (2*(e1*e3 - e0*e2), 2*(e2*e3 + e0*e1), e0*e0 - e1*e1 - e2*e2 + e3*e3))
+    return tuple(q0[k] + sum(a[k][m] * s[m] for m in range(3)) for k in range(3))
 
 
 def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
@@ -364,8 +386,10 @@ def _check_time(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, fl
 
 
 def degrees_of_freedom(mech: Mechanism) -> int:
-    """Grübler's count w = 3n - 2 p5 - p4, less the equations of custom joints."""
-    return 3 * len(mech.bodies) - sum(equation_count(joint) for joint in mech.joints)
+    """Grübler's count w = 3n - 2 p5 - p4, less the equations of custom joints (in space:
+    w = 6n less the joints' equations)."""
+    per_body = 6 if mech.is_spatial else 3
+    return per_body * len(mech.bodies) - sum(equation_count(joint) for joint in mech.joints)
 
 
 def check_degrees_of_freedom(mech: Mechanism) -> None:
@@ -379,6 +403,8 @@ def check_degrees_of_freedom(mech: Mechanism) -> None:
     driving = sum(equation_count(driver) for driver in mech.drivers)
     if driving >= dof:
         return
+    if mech.is_spatial:
+        _spatial_dof_error(mech, dof, driving)
     # Pairs of class 5 take two freedoms (revolute, prismatic), of class 4 one (pin-in-slot,
     # distance); the equations the file writes itself are counted apart.
     counted = [equation_count(joint) for joint in mech.joints
@@ -391,3 +417,13 @@ def check_degrees_of_freedom(mech: Mechanism) -> None:
     fix = f"Add drivers for {dof - driving} more equation(s), or add joints."
     raise MechanismError(f"the mechanism has {formula} = {dof} degree(s) of freedom but its "
                          f"drivers give {driving} equation(s)", ("drivers",), fix)
+
+
+def _spatial_dof_error(mech: Mechanism, dof: int, driving: int) -> None:
+    joints = sum(equation_count(joint) for joint in mech.joints)
+    fix = (f"Add drivers for {dof - driving} more equation(s), or add joints."
+           if driving < dof else f"Remove {driving - dof} driving equation(s), or check for "
+           "a missing joint (a joint with equations that repeat others is not handled yet).")
+    raise MechanismError(f"the mechanism has w = 6·{len(mech.bodies)} − {joints} (joint "
+                         f"equations) = {dof} degree(s) of freedom but its drivers give "
+                         f"{driving} equation(s)", ("drivers",), fix)

@@ -20,9 +20,13 @@ from symkin import pairs
 from symkin.errors import MechanismError
 from symkin.spec import validate
 from symkin.spec.validate import Mechanism
-from symkin.symbolic import redundancy
+from symkin.symbolic import redundancy, spatial
 from symkin.symbolic.planar import Context
 from symkin.symbolic.symbols import Symbols, make_symbols
+
+
+# A spatial body's own row: its Euler parameters' normalisation (section, part).
+NORMALISATION = ("bodies", "normalisation")
 
 
 @dataclass(frozen=True)
@@ -38,7 +42,10 @@ class Row:
 
     @property
     def owner(self) -> str:
-        """``joints[1] revolute crank-rod`` (or the constraint's own name)."""
+        """``joints[1] revolute crank-rod`` (or the constraint's own name); a spatial body's
+        normalisation row: ``bodies[0] crank``."""
+        if self.section == NORMALISATION[0]:
+            return f"{self.section}[{self.index}] {self.name}"
         who = f" {self.name}" if self.name else ""
         return f"{self.section}[{self.index}]{who} {self.type} {'-'.join(self.bodies)}".rstrip()
 
@@ -134,8 +141,10 @@ def derive(mech: Mechanism | str | Path) -> System:
         except MechanismError as error:
             raise validate.locate(error, mech) from None
     symbols = make_symbols(mech)
-    ctx = Context(mech, symbols)
+    ctx = (spatial.SpatialContext if mech.is_spatial else Context)(mech, symbols)
     phi, rows = _constraint_rows(mech, ctx)
+    if mech.is_spatial:
+        phi, rows = _normalised(mech, ctx, phi, rows)
     values = mech.parameter_values()
     p_values = tuple(values[s.name] for s in symbols.p)
     nominal = dict(zip(symbols.p, p_values))
@@ -209,6 +218,15 @@ def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tupl
             rows.extend(Row(section, index, constraint.type, bodies, part, constraint.name)
                         for part in parts)
     return phi, tuple(rows)
+
+
+def _normalised(mech: Mechanism, ctx: Context, phi: list[sp.Expr], rows: tuple[Row, ...]
+                ) -> tuple[list[sp.Expr], tuple[Row, ...]]:
+    """Phi and its labels with one normalisation row per spatial body, after the drivers."""
+    section, part = NORMALISATION
+    own = [(spatial.normalisation(ctx.pose(body)),  # type: ignore[arg-type]
+            Row(section, k, "", (body,), part, body)) for k, body in enumerate(mech.bodies)]
+    return phi + [row for row, _ in own], rows + tuple(label for _, label in own)
 
 
 def _placed(mech: Mechanism, ctx: Context) -> tuple[Placed, ...]:

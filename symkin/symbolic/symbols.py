@@ -20,6 +20,8 @@ class Symbols:
     t: sp.Symbol
     p: tuple[sp.Symbol, ...]
     coordinates: tuple[str, ...]
+    per_body: int = 3
+    """Coordinates per body: 3 in a planar file (x, y, phi), 7 in a spatial one."""
 
     # Built once per Symbols: derivation asks for them for every constraint and expression.
     @cached_property
@@ -28,7 +30,8 @@ class Symbols:
 
     @cached_property
     def by_coordinate(self) -> dict[tuple[str, str], sp.Symbol]:
-        """``(body, "x"|"y"|"phi") -> q symbol``, for custom constraints."""
+        """``(body, "x"|"y"|"phi") -> q symbol`` (spatial: x..z, e0..e3), for custom
+        constraints."""
         pairs = (name.partition(".") for name in self.coordinates)
         return {(body, part): q for (body, _, part), q in zip(pairs, self.q)}
 
@@ -37,19 +40,23 @@ class Symbols:
         """Body name -> index of its x coordinate."""
         return {name[:-2]: k for k, name in enumerate(self.coordinates) if name.endswith(".x")}
 
-    def body(self, name: str, velocities: bool = False) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
-        """(x, y, phi) of a body (or their rates); the ground is fixed at zero."""
+    def body(self, name: str, velocities: bool = False) -> tuple[sp.Expr, ...]:
+        """(x, y, phi) of a body (spatial: x, y, z, e0..e3), or their rates; the ground is
+        fixed at zero (planar) or at the identity (spatial)."""
         if name == GROUND:
-            return (sp.Integer(0),) * 3
+            fixed = (0, 0, 0, 1, 0, 0, 0) if self.per_body == 7 else (0, 0, 0)
+            return tuple(sp.Integer(0 if velocities else value) for value in fixed)
         start = self._first_coordinate[name]
         source = self.dq if velocities else self.q
-        return source[start], source[start + 1], source[start + 2]
+        return tuple(source[start:start + self.per_body])
 
 
 def make_symbols(mech: MechanismSpec) -> Symbols:
-    """Create the symbols of ``mech``; coordinate names are ``body.x``, ``body.y``, ``body.phi``."""
-    coordinates = tuple(f"{b}.{c}" for b in mech.bodies for c in ("x", "y", "phi"))
+    """Create the symbols of ``mech``; coordinate names are ``body.x``, ``body.y``, ``body.phi``
+    (spatial: ``body.x`` .. ``body.z``, ``body.e0`` .. ``body.e3``)."""
+    parts = mech.body_coordinates
+    coordinates = tuple(f"{b}.{c}" for b in mech.bodies for c in parts)
     q = tuple(sp.Symbol(name, real=True) for name in coordinates)
     dq = tuple(sp.Symbol(name + "_t", real=True) for name in coordinates)
     p = tuple(sp.Symbol(name, real=True) for name in mech.parameters)
-    return Symbols(q, dq, sp.Symbol("t", real=True), p, coordinates)
+    return Symbols(q, dq, sp.Symbol("t", real=True), p, coordinates, len(parts))

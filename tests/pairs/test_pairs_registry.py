@@ -18,6 +18,7 @@ from symkin.spec.validate import json_schema
 
 PACKAGE = Path(symkin.__file__).resolve().parent
 PLANAR = PACKAGE / "pairs" / "planar"
+SPATIAL = PACKAGE / "pairs" / "spatial"
 
 # Words that are also a type's name but mean something else where they are written.
 OTHER_MEANINGS = {
@@ -33,15 +34,36 @@ def _string_constants(path: Path) -> set[str]:
             if isinstance(node, ast.Constant) and isinstance(node.value, str)}
 
 
+def _spatial_modules() -> dict[str, set[str]]:
+    """Type name -> the spatial modules that define a type of that name."""
+    owners: dict[str, set[str]] = {}
+    for path in SPATIAL.glob("*.py"):
+        module = importlib.import_module(f"symkin.pairs.spatial.{path.stem}")
+        if hasattr(module, "TYPE"):
+            owners.setdefault(module.TYPE.name, set()).add(f"pairs/spatial/{path.stem}.py")
+    return owners
+
+
 def test_each_type_name_is_written_in_its_own_module_only() -> None:
-    names = {kind.name for kind in pairs.TYPES}
+    names = {kind.name for kind in (*pairs.TYPES, *pairs.SPATIAL_TYPES)}
     found: dict[str, set[str]] = {name: set() for name in names}
     for path in PACKAGE.rglob("*.py"):
         where = path.relative_to(PACKAGE).as_posix()
         for name in _string_constants(path) & names:
             if (name, where) not in OTHER_MEANINGS:
                 found[name].add(where)
-    assert found == {name: {f"pairs/planar/{name}.py"} for name in names}
+    planar = {kind.name for kind in pairs.TYPES}
+    spatial = _spatial_modules()
+    assert found == {name: ({f"pairs/planar/{name}.py"} if name in planar else set())
+                     | spatial.get(name, set()) for name in names}
+
+
+def test_every_spatial_module_with_a_type_is_registered() -> None:
+    registered = {kind.model for kind in pairs.SPATIAL_TYPES}
+    for path in SPATIAL.glob("*.py"):
+        module = importlib.import_module(f"symkin.pairs.spatial.{path.stem}")
+        if hasattr(module, "TYPE"):
+            assert module.TYPE.model in registered, path.stem
 
 
 def test_every_pair_module_is_registered_once() -> None:

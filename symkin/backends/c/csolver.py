@@ -149,9 +149,10 @@ class GridSolver:
                            int(report.iterations), float(report.residual),
                            int(report.fallbacks))
 
-    def point_vectors(self, count: int) -> Array:
-        """The local vectors of the ``count`` named points at the run's parameters, (count, 2)."""
-        out = np.empty((count, 2), dtype=self.dtype)
+    def point_vectors(self, count: int, size: int = 2) -> Array:
+        """The local vectors of the ``count`` named points at the run's parameters,
+        (count, size): size 3 in a spatial mechanism."""
+        out = np.empty((count, size), dtype=self.dtype)
         if count:
             self._points(self._p, self._ffi.from_buffer(self._real_array, out))
         return out if self.dtype is np.float64 else out.astype(np.float64)

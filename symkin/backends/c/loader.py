@@ -31,7 +31,8 @@ class CKernel(Kernel):
     def __init__(self, ffi: Any, lib: Any, meta: Mapping[str, Any],
                  folder: Path | None = None) -> None:
         functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
-                                len(meta["pattern_rows"]), len(meta["points"]),
+                                len(meta["pattern_rows"]),
+                                len(meta["points"]) * (3 if meta.get("space") == "3d" else 2),
                                 len(meta.get("phi_p_rows", ())), len(meta.get("removed", ())))
         super().__init__("c", meta, functions, folder=folder)
         self.ffi = ffi
@@ -65,12 +66,12 @@ class _CFunctions:
     """Adapter over a cffi extension: converts arrays to the generated real type and back."""
 
     def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
-                 npoints: int, nnz_p: int = 0, nremoved: int = 0) -> None:
+                 point_components: int, nnz_p: int = 0, nremoved: int = 0) -> None:
         self._ffi = ffi
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
-        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": 2 * npoints,
-                       "phi_p": nnz_p, "removed": nremoved}
+        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq,
+                       "points": point_components, "phi_p": nnz_p, "removed": nremoved}
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}

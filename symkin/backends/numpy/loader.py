@@ -40,7 +40,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         "parameter_names": module.PARAMETER_NAMES, "p_values": module.P_VALUES,
         "q0": module.Q0, "time_grid": module.TIME_GRID, "rows": module.ROWS,
         "pattern_rows": module.PATTERN_ROWS, "pattern_cols": module.PATTERN_COLS,
-        "points": module.POINTS,
+        "points": module.POINTS, "space": getattr(module, "SPACE", "2d"),
         **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
            if hasattr(module, "PHI_P_ROWS") else {}),
         **({"removed": module.REMOVED} if hasattr(module, "REMOVED") else {}),

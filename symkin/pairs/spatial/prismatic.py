@@ -1,0 +1,32 @@
+"""Prismatic joint: a cylindrical joint that cannot turn (5 equations: the cylindrical four
+and v of j perpendicular to u of i, which holds as drawn)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import sympy as sp
+
+from symkin.pairs import kit
+from symkin.pairs.spatial import basic, cylindrical, revolute
+
+
+class Prismatic(revolute.Revolute):
+    type: Literal["prismatic"]  # type: ignore[assignment]
+
+
+class DrawnPrismatic(revolute.DrawnRevolute):
+    type: Literal["prismatic"]  # type: ignore[assignment]
+
+
+def equations(c: Prismatic, geometry: basic.Geometry) -> list[sp.Expr]:
+    _, u, v = basic.frame_of(geometry.vector(c.axis), geometry)
+    no_turn = basic.perpendicular_vectors(geometry.pose(c.i), u, geometry.pose(c.j), v)
+    return cylindrical.equations(c, geometry) + [no_turn]  # type: ignore[arg-type]
+
+
+TYPE = kit.PairType(
+    name="prismatic", model=Prismatic, drawn_model=DrawnPrismatic, sections=("joints",),
+    equations=equations, rows=("axis u", "axis v", "line u", "line v", "turn"),
+    points=(("sA", "i"), ("sB", "j")), directions=(("axis", "i"),),
+    to_local=revolute.to_local)
