@@ -325,3 +325,15 @@ def test_a_warm_run_from_the_cache_still_knows_the_removed_rows(
             assert REMOVED in captured.err
             assert np.load(out)["removed"].tolist() == [REMOVED]
         assert "cached kernel" in captured.out
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_sweep_says_which_sets_break_the_removed_row(backend: str) -> None:
+    """The extra bar's error as a parameter, nominal 0 (the row removed is found there): the
+    set with delta = 1e-3 breaks it along the motion, the exact ones do not."""
+    system = symkin.derive(from_dict(_wrong_bar(0.0)))
+    kernel = symkin.compile(system, backend=backend)
+    result = symkin.sweep(kernel, {"delta": [0.0, 1e-3, 0.0]}, workers=1)
+    assert result.ok.all()
+    assert result.removed == (REMOVED,)
+    assert result.removed_broken.tolist() == [False, True, False]
