@@ -337,3 +337,24 @@ def test_a_sweep_says_which_sets_break_the_removed_row(backend: str) -> None:
     assert result.ok.all()
     assert result.removed == (REMOVED,)
     assert result.removed_broken.tolist() == [False, True, False]
+
+
+def test_millimetres_and_a_point_and_joint_named_e_change_nothing() -> None:
+    """The example 1000 times larger, with its point C and joint C named E (SymPy's constant's
+    name): the equilibrated rank and the assembly tolerance scale with the drawing."""
+    document = _document()
+    document["parameters"].update(a=1000.0, d=1000.0, e=500.0)
+    for body in ("extra", "coupler"):
+        points = document["bodies"][body]["points"]
+        points["E"] = points.pop("C")
+    document["joints"][5].update(name="E", at="E")
+    system = symkin.derive(from_dict(document))
+    assert [str(r) for r in system.removed] == [REMOVED.replace(" C ", " E ")]
+    assert system.mobility == 1
+    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    # (the condition-based flags of a millimetre drawing are the plain parallelogram's own:
+    # only the removed row's check is asked about here)
+    assert not redundant.exceeded(trajectory.removed_residual, trajectory.q, 1e-8).any()
+    k = trajectory.coordinates.index("coupler.x")
+    np.testing.assert_allclose(trajectory.q[:, k], 1000 * _closed_form(trajectory.t)[
+        "coupler.x"][0], atol=1e-9 * 1000)
