@@ -358,3 +358,16 @@ def test_millimetres_and_a_point_and_joint_named_e_change_nothing() -> None:
     k = trajectory.coordinates.index("coupler.x")
     np.testing.assert_allclose(trajectory.q[:, k], 1000 * _closed_form(trajectory.t)[
         "coupler.x"][0], atol=1e-9 * 1000)
+
+
+def test_scan_lists_only_assemblies_that_keep_the_removed_row() -> None:
+    """With the crank pinned at t0, the parallelogram's rocker has two places (parallel or
+    crossed); the extra bar fits only the parallel one, and the bar's own mirror image meets
+    C's x but not its y. So the file has exactly one assembly at t0."""
+    from symkin.runtime.scan import scan
+
+    kernel = symkin.compile(symkin.derive(EXAMPLE), backend="numpy")
+    report = scan(kernel, t=np.array([0.0, 0.01]))
+    assert len(report.branches) == 1 and report.branches[0].taken
+    k = kernel.coordinates.index("coupler.phi")
+    assert abs(report.branches[0].q[k]) < 1e-9
