@@ -51,6 +51,16 @@ def exceeded(residual: NDArray[np.float64], q: NDArray[np.float64], target: floa
     return ~within
 
 
+def holds(kernel: KinematicsKernel, q: NDArray[np.float64], t: float,
+          p: NDArray[np.float64], target: float) -> bool:
+    """Whether the removed rows (if any) meet the position target at one configuration."""
+    if not getattr(kernel, "removed", ()):
+        return True
+    residual = kernel.removed_phi(q, t, p)  # type: ignore[attr-defined]
+    return not bool(exceeded(np.reshape(residual, (1, -1)), np.reshape(q, (1, -1)),
+                             target).any())
+
+
 def violated(trajectory: Trajectory, target: float) -> tuple[str, ...]:
     """The labels of the removed rows that miss the target somewhere along the trajectory."""
     if trajectory.removed_residual is None or not trajectory.removed:

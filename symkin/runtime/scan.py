@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.status import OK
-from symkin.runtime import driver
+from symkin.runtime import driver, redundant
 from symkin.runtime.assembly import RANDOM_ANGLES, assemble, starts
 from symkin.runtime.edges import LIMIT_COND
 from symkin.runtime.newton import newton
@@ -137,6 +137,10 @@ def _branches(kernel: KinematicsKernel, t0: float, p: Array) -> list[Branch]:
         if result.status != OK:
             continue
         q = _wrapped(result.q, angles)
+        # An over-constrained file's rows removed at t0 must hold too: elsewhere the kept rows
+        # alone are assembled, which is no assembly of the file (runtime.redundant).
+        if not redundant.holds(kernel, result.q, t0, p, options.target_q):
+            continue
         if not any(_same(q, b.q, angles) for b in found):
             found.append(Branch(q, result.cond, False))
     return found

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin import limits
 from symkin.contract.options import Options
 from symkin.errors import SolveError
-from symkin.runtime import driver
+from symkin.runtime import driver, redundant
 from symkin.runtime.kernel import Kernel
 from symkin.sweeps import parallel
 from symkin.sweeps.batch import Chunk, empty_chunk, solve_chunk
@@ -180,4 +180,20 @@ def _result(kernel: Kernel, times: Array, values: Array, chunk: Chunk) -> SweepR
         parameter_names=tuple(kernel.parameter_names), coordinates=tuple(kernel.coordinates),
         reasons=tuple(chunk.reasons), messages=tuple(chunk.messages),
         t_reached=chunk.t_reached, solved=chunk.solved, iterations=chunk.iterations,
-        points_named=tuple(kernel.points), local_vectors=kernel.point_vectors)
+        points_named=tuple(kernel.points), local_vectors=kernel.point_vectors,
+        removed=kernel.removed, removed_broken=_removed_broken(kernel, times, values, chunk))
+
+
+def _removed_broken(kernel: Kernel, times: Array, values: Array, chunk: Chunk
+                    ) -> NDArray[np.bool_] | None:
+    """Per set, whether a row removed as redundant at t0 misses the position target somewhere
+    on the rows solved (the check symkin.solve makes; None without removed rows)."""
+    if not kernel.removed:
+        return None
+    target = driver.default_options(kernel).target_q
+    broken = np.zeros(values.shape[0], dtype=bool)
+    for m, p in enumerate(values):
+        q = chunk.q[m, :int(chunk.solved[m])]
+        residual = np.array([kernel.removed_phi(row, float(t), p) for t, row in zip(times, q)])
+        broken[m] = bool(redundant.exceeded(residual.reshape(q.shape[0], -1), q, target).any())
+    return broken

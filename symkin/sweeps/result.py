@@ -53,6 +53,11 @@ class SweepResult:
     # kinematics are asked for, so a sweep that needs only q pays nothing for them.
     local_vectors: Callable[[Array], Array] | None = field(default=None, repr=False,
                                                             compare=False)
+    # An over-constrained file's rows removed as dependent at t0 (their labels), and per set
+    # whether the solved motion breaks one of them beyond the position target
+    # (runtime.redundant); () and None for every other file.
+    removed: tuple[str, ...] = ()
+    removed_broken: NDArray[np.bool_] | None = None
 
     @functools.cached_property
     def point_vectors(self) -> Array:

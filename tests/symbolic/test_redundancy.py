@@ -325,3 +325,49 @@ def test_a_warm_run_from_the_cache_still_knows_the_removed_rows(
             assert REMOVED in captured.err
             assert np.load(out)["removed"].tolist() == [REMOVED]
         assert "cached kernel" in captured.out
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_sweep_says_which_sets_break_the_removed_row(backend: str) -> None:
+    """The extra bar's error as a parameter, nominal 0 (the row removed is found there): the
+    set with delta = 1e-3 breaks it along the motion, the exact ones do not."""
+    system = symkin.derive(from_dict(_wrong_bar(0.0)))
+    kernel = symkin.compile(system, backend=backend)
+    result = symkin.sweep(kernel, {"delta": [0.0, 1e-3, 0.0]}, workers=1)
+    assert result.ok.all()
+    assert result.removed == (REMOVED,)
+    assert result.removed_broken.tolist() == [False, True, False]
+
+
+def test_millimetres_and_a_point_and_joint_named_e_change_nothing() -> None:
+    """The example 1000 times larger, with its point C and joint C named E (SymPy's constant's
+    name): the equilibrated rank and the assembly tolerance scale with the drawing."""
+    document = _document()
+    document["parameters"].update(a=1000.0, d=1000.0, e=500.0)
+    for body in ("extra", "coupler"):
+        points = document["bodies"][body]["points"]
+        points["E"] = points.pop("C")
+    document["joints"][5].update(name="E", at="E")
+    system = symkin.derive(from_dict(document))
+    assert [str(r) for r in system.removed] == [REMOVED.replace(" C ", " E ")]
+    assert system.mobility == 1
+    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    # (the condition-based flags of a millimetre drawing are the plain parallelogram's own:
+    # only the removed row's check is asked about here)
+    assert not redundant.exceeded(trajectory.removed_residual, trajectory.q, 1e-8).any()
+    k = trajectory.coordinates.index("coupler.x")
+    np.testing.assert_allclose(trajectory.q[:, k], 1000 * _closed_form(trajectory.t)[
+        "coupler.x"][0], atol=1e-9 * 1000)
+
+
+def test_scan_lists_only_assemblies_that_keep_the_removed_row() -> None:
+    """With the crank pinned at t0, the parallelogram's rocker has two places (parallel or
+    crossed); the extra bar fits only the parallel one, and the bar's own mirror image meets
+    C's x but not its y. So the file has exactly one assembly at t0."""
+    from symkin.runtime.scan import scan
+
+    kernel = symkin.compile(symkin.derive(EXAMPLE), backend="numpy")
+    report = scan(kernel, t=np.array([0.0, 0.01]))
+    assert len(report.branches) == 1 and report.branches[0].taken
+    k = kernel.coordinates.index("coupler.phi")
+    assert abs(report.branches[0].q[k]) < 1e-9
