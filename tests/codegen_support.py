@@ -22,7 +22,12 @@ import symkin
 from symkin.spec import expressions
 
 ROOT = Path(__file__).resolve().parent.parent
-EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
+# Examples whose equations are redundant (a Cardan shaft between two revolutes has 3): they
+# derive once redundant equations are removed (another branch); until then they have no
+# goldens and are left out of the tests that take every example.
+AWAITING_REDUNDANCY_REMOVAL = ("cardan",)
+EXAMPLES = sorted(path for path in (ROOT / "examples").glob("*.yaml")
+                  if path.stem not in AWAITING_REDUNDANCY_REMOVAL)
 GENERATED = ROOT / "generated"
 BACKENDS = ("c", "numpy")
 STRICT_FLAGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]

@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from codegen_support import EXAMPLES
 
 from symkin import cli
 
@@ -132,7 +133,7 @@ def test_python_m_symkin_show_from_another_directory(tmp_path: Path,
     assert result.stdout.splitlines()[0].endswith("1 degree(s) of freedom")
 
 
-@pytest.mark.parametrize("path", sorted((ROOT / "examples").glob("*.yaml")), ids=lambda p: p.name)
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)
 def test_show_every_example(path: Path) -> None:
     report = _run_show([str(path)])
     sizes = re.fullmatch(r"mechanism \w+: (\d+) coordinates, (\d+) equations, \d+ "
