@@ -8,14 +8,18 @@ import argparse
 import io
 import os
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
 from symkin.present import series
 from symkin.present.series import Units
+
+if TYPE_CHECKING:
+    from symkin.runtime.start import Moved
 
 
 class CannotWrite(Exception):
@@ -120,6 +124,17 @@ def fallback_note(count: int, points: int, verbose: bool = False) -> str:
     return (short + f"): {count} {which} of the generated sparse LU met a pivot below its "
             "threshold and were redone with dense LU and partial pivoting; every pivot is "
             "checked, and no result comes from a rejected one")
+
+
+def far_start_note(moved: Sequence[Moved], scale: float) -> str:
+    """A line on bodies assembled far from their q0 (runtime.start.far_from_guess)."""
+    said = ", ".join(f"{m.body} (moved {m.distance:.3g}, turned {m.turn:.3g} rad)"
+                     for m in moved)
+    return (f"the assembled start is far from q0 (the mechanism's length scale is "
+            f"{scale:.3g}): {said}. The motion is that of the mechanism the joints describe; "
+            "if it is not the one you meant, check q0, and that each prismatic or pin_slot "
+            "`v` is the slide's normal, not its direction (in the drawn layout `axis` is the "
+            "direction)")
 
 
 class ProgressBar:

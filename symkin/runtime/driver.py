@@ -50,6 +50,7 @@ from symkin.runtime.protocol import GridSolver, KinematicsKernel
 from symkin.runtime.result_arrays import Out, allocate
 from symkin.runtime.result_arrays import Run as _Run
 from symkin.runtime.results import Trajectory
+from symkin.runtime.start import singular_start
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -262,6 +263,7 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         if solver is not None:
             solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
             solved = _c_run(run, solver, progress)
+            _check_start(kernel, run, p, options)
             if run.done == times.size:  # the usual case: nothing left to treat
                 run.fallbacks = solver.fallbacks
                 return _trajectory(kernel, run, p, solver.point_vectors(len(kernel.points)))
@@ -283,6 +285,8 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         if isinstance(result, Resolution):
             _fail_edge(kernel, run, p, result, float(times[run.done]))
         elif result.status != OK:
+            if result.status == SINGULAR and run.done == 0 and result.residual <= options.tol_phi:
+                _check_start(kernel, run, p, options, result.q)  # assembled, singular there
             _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
         return _trajectory(kernel, run, p)
 
@@ -300,11 +304,14 @@ def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,
     if result is None or (result.status != OK and run.done == 0):
         assembly = assemble(kernel, q, float(run.t[0]), p, options)
         start = assembly.result
+        if start.status == SINGULAR and start.residual <= options.tol_phi:
+            _check_start(kernel, run, p, options, start.q)  # assembled, but singular there
         if start.status != OK:
             _fail(kernel, run, p, start, float(run.t[0]), assembling=True, assembly=assembly)
         if solver is not None:
             solver.start(options, start.q, p)
         result = _resume(kernel, run, solver, start.q, p, options, progress)
+        _check_start(kernel, run, p, options)
     while result.status not in (OK, NOT_FINITE) and run.done > 0 \
             and not options.stop_at_singular:
         k = run.done
@@ -343,6 +350,26 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
                      for s in run.passages) if run.passages else ()
     return Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates), tuple(kernel.points),
                              point_vectors, p, run.fallbacks, flagged, cond, singular)
+
+
+def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options,
+                 assembled: Array | None = None) -> None:
+    """Raise SolveFailure (reason "singular") when the start is a singular or limit
+    configuration (runtime.start): the first point solved, keeping only that point (the rows
+    stepped from it are not trusted), or the ``assembled`` q that Newton found singular (no
+    row). Nothing to check before the first point is solved."""
+    if assembled is None and run.done == 0:
+        return
+    t0 = float(run.t[0])
+    singular = singular_start(kernel, run.q[0] if assembled is None else assembled, t0, p,
+                              options)
+    if singular is None:
+        return
+    run.done = 0 if assembled is not None else 1
+    rows = [row for group in singular.groups for row in group]
+    raise SolveFailure(failures.explain_start(singular, t0), _trajectory(kernel, run, p), t0,
+                       math.nan, 0, rows, "singular", math.nan, singular.aligned,
+                       singular.drivers)
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
