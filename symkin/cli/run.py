@@ -198,8 +198,9 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
         message += f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     try:
-        written = _write(stop.trajectory, args, prepared.outlines, run_outputs.Pictures.of(
-            args, prepared.kernel))
+        with run_outputs.interrupts_held():  # a second Ctrl-C must not cut the file short
+            written = _write(stop.trajectory, args, prepared.outlines,
+                             run_outputs.Pictures.of(args, prepared.kernel))
     except CannotWrite as error:
         _error(str(error), EXIT_BAD_INPUT)
         return status

@@ -5,10 +5,13 @@ one configuration (``--at``), progress bars, and notes that say whether an event
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import os
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
@@ -112,6 +115,21 @@ def configuration(trajectory: Any, name: str, origin: str) -> str:
             lines.append(f"{body + '.' + point:<24}"
                          + "".join(f" {float(v) + 0.0:>17.10g}" for v in numbers))
     return "\n".join(lines) + "\n"
+
+
+@contextlib.contextmanager
+def interrupts_held() -> Iterator[None]:
+    """Ctrl-C (SIGINT) ignored while the rows solved so far are written after an interrupt:
+    a second Ctrl-C would otherwise leave no file, or half of one. Only in the main thread
+    (where Python handles signals); elsewhere nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def fallback_note(count: int, points: int, verbose: bool = False) -> str:

@@ -37,7 +37,7 @@ from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime import failures
+from symkin.runtime import failures, units
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
@@ -239,11 +239,34 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     options = options or default_options(kernel)
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
-    trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver, out)
+    trajectory = _solve_in_unit(kernel, t, q0, params, options, progress, use_c_solver, out)
     if sensitivities:
         from symkin.runtime.sensitivity import with_sensitivities
 
         return with_sensitivities(kernel, trajectory)
+    return trajectory
+
+
+def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
+                   params: Mapping[str, float] | ArrayLike | None, options: Options,
+                   progress: Progress | None, use_c_solver: bool, out: Out | None
+                   ) -> Trajectory:
+    """_solve in the unit that brings the mechanism's length scale near 1 (runtime.units),
+    the rows converted back to the kernel's unit (also those a failure or an interrupt
+    carries)."""
+    times = time_points(kernel, t)
+    p = parameter_values(kernel, params)
+    q = first_guess(kernel, q0)
+    unit = units.unit_for(kernel, q, float(times[0]), p) if times.size else 1.0
+    if unit == 1.0:
+        return _solve(kernel, times, q, p, options, progress, use_c_solver, out)
+    scaled = units.ScaledKernel(kernel, unit)
+    try:
+        trajectory = _solve(scaled, times, q / scaled.column, p, options, progress, False, out)
+    except (SolveFailure, SolveInterrupted) as stop:
+        units.to_kernel_unit(scaled, stop.trajectory.q, stop.trajectory.dq, stop.trajectory.d2q)
+        raise
+    units.to_kernel_unit(scaled, trajectory.q, trajectory.dq, trajectory.d2q)
     return trajectory
 
 
