@@ -31,14 +31,7 @@ from numpy.typing import NDArray
 from symkin.contract.options import Options
 from symkin.runtime import accuracy
 from symkin.runtime.edges import LIMIT_COND, limit_motion
-from symkin.runtime.linalg import (
-    SPARSE_FROM,
-    Factors,
-    SparseFactors,
-    dependencies,
-    factor,
-    factor_sparse,
-)
+from symkin.runtime.linalg import SPARSE_FROM, dependencies, factor_sparse
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
@@ -108,19 +101,26 @@ def scaled_nonzeros(kernel: KinematicsKernel, nz: Array) -> tuple[Array, float]:
 
 def scaled_cond(kernel: KinematicsKernel, scaled: Array) -> float:
     """The 1-norm condition number of the scaled Phi_q from its non-zeros (inf when it is
-    singular): dense or sparse LU as for the solve (runtime.linalg)."""
+    singular): exact from NumPy's inverse below SPARSE_FROM coordinates (a warm C run never
+    imports SciPy), estimated with the sparse LU (runtime.linalg) from there on."""
     if not np.all(np.isfinite(scaled)):
         return math.inf
     n = len(kernel.coordinates)
     rows = np.asarray(kernel.pattern_rows, dtype=np.intp)
     cols = np.asarray(kernel.pattern_cols, dtype=np.intp)
     if n < SPARSE_FROM:
-        factors: Factors | SparseFactors = factor(_dense(n, rows, cols, scaled))
+        try:
+            inverse = np.linalg.inv(_dense(n, rows, cols, scaled))
+        except np.linalg.LinAlgError:
+            return math.inf
+        inverse_norm = float(np.abs(inverse).sum(axis=0).max(initial=0.0))
     else:
         factors = factor_sparse(n, rows, cols, scaled)
-    if not factors.pivot_ratio > 0.0:
-        return math.inf
-    return factors.inverse_norm1() * accuracy.norm1(scaled, cols, n)
+        if not factors.pivot_ratio > 0.0:
+            return math.inf
+        inverse_norm = factors.inverse_norm1()
+    cond = inverse_norm * accuracy.norm1(scaled, cols, n)
+    return cond if math.isfinite(cond) else math.inf
 
 
 def _dense(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], nz: Array) -> Array:
