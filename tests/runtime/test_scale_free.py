@@ -110,6 +110,42 @@ def test_the_limit_position_is_found_at_the_same_time_at_any_scale(tmp_path, bac
     np.testing.assert_allclose(crank_x, 2 * s * np.cos(failure.trajectory.t), atol=1e-10 * s)
 
 
+PARALLELOGRAM = """
+name: parallelogram_scaled
+parameters: {{L: {L!r}}}
+bodies:
+  r0: {{q0: [0, 0, 0.5], points: {{tip: [L, 0]}}}}
+  r1: {{q0: [L, 0, 0.5], points: {{tip: [L, 0]}}}}
+  c0: {{q0: [0.88*L, 0.48*L, 0]}}
+joints:
+  - {{type: revolute, name: O0, i: ground, j: r0, sA: [0, 0], sB: [0, 0]}}
+  - {{type: revolute, name: O1, i: ground, j: r1, sA: [L, 0], sB: [0, 0]}}
+  - {{type: revolute, name: A0, i: r0, j: c0, sA: tip, sB: [0, 0]}}
+  - {{type: revolute, name: B0, i: c0, j: r1, sA: [L, 0], sB: tip}}
+drivers:
+  - {{type: angle, name: drive, i: r0, j: ground, theta: "0.5 - t"}}
+time: {{t0: 0, t1: 1, dt: 0.05}}
+"""
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_singular_passage_is_flagged_alike_at_any_scale(tmp_path, backend):
+    """The parallelogram driven through its change point (all bars on the x axis at t = 0.5):
+    the same points flagged and the same passage at every scale; positions L (cos, sin) of
+    the crank angle 0.5 - t."""
+    flags = {}
+    for scale in (1e-6, 1.0, 1e3, 1e6):
+        kernel = _kernel(tmp_path, PARALLELOGRAM.format(L=scale), backend)
+        trajectory = symkin.solve(kernel)
+        flags[scale] = trajectory.flagged.tolist()
+        assert [round(t, 6) for t, _, _ in trajectory.singular] == [0.5]
+        theta = 0.5 - trajectory.t
+        coupler = trajectory.q[:, kernel.coordinates.index("c0.x")]
+        np.testing.assert_allclose(coupler, scale * np.cos(theta), rtol=0, atol=1e-6 * scale)
+    assert any(flags[1.0])  # the passage is flagged ...
+    assert all(flags[scale] == flags[1.0] for scale in flags)  # ... alike at every scale
+
+
 def test_the_unit_is_one_for_a_mechanism_of_ordinary_size():
     from driver_support import derive, kernel_for
 
