@@ -154,3 +154,18 @@ def test_the_unit_is_one_for_a_mechanism_of_ordinary_size():
     assert units.unit_for(kernel, np.asarray(kernel.q0, dtype=float), 0.0, p) == 1.0
     assert units.unit_for(kernel, np.asarray(kernel.q0, dtype=float), 0.0, 1e3 * p) == 1e3
     assert units.unit_for(kernel, np.asarray(kernel.q0, dtype=float), 0.0, 1e-6 * p) == 1e-6
+
+
+@pytest.mark.parametrize("s", (1e-6, 1e3, 1e6))
+def test_scan_finds_the_same_branches_at_any_scale(tmp_path, s):
+    """Two assemblies at t0 (slider right and left of the crank): slider.x = +-sqrt(b^2 - (c -
+    a)^2) = +-4 s, the rod at atan(3/4) or pi - atan(3/4)."""
+    from symkin.runtime.scan import scan
+
+    kernel = _kernel(tmp_path, CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s), "numpy")
+    report = scan(kernel)
+    x = sorted(float(b.q[kernel.coordinates.index("slider.x")]) for b in report.branches)
+    np.testing.assert_allclose(x, [-4 * s, 4 * s], rtol=1e-9)
+    rod = sorted(float(b.q[kernel.coordinates.index("rod.phi")]) for b in report.branches)
+    np.testing.assert_allclose(rod, [math.atan(0.75), math.pi - math.atan(0.75)], atol=1e-9)
+    assert report.motions[0].stop is None and not report.branches[0].near_singular
