@@ -56,6 +56,9 @@ class LambdifyKernel:
     def phi_q(self, q, t, p=None):
         return np.asarray(self._phi_q(q, t, self._p(p)), dtype=float)
 
+    def phi_q_nz(self, q, t, p=None):
+        return self.phi_q(q, t, p)[self.pattern_rows, self.pattern_cols]
+
     def phi_t(self, q, t, p=None):
         return np.asarray(self._phi_t(q, t, self._p(p)), dtype=float).reshape(-1)
 

@@ -180,6 +180,7 @@ def _solve_and_write(args: argparse.Namespace) -> int:
         print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
               f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
               + "".join(f"; wrote {path}" for path in written))
+    _note_far_start(kernel, trajectory)
     if trajectory.lu_fallbacks:
         messages.note(run_outputs.fallback_note(trajectory.lu_fallbacks, trajectory.t.size,
                                                 args.verbose))
@@ -197,14 +198,27 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
         message += f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     try:
-        written = _write(stop.trajectory, args, prepared.outlines, run_outputs.Pictures.of(
-            args, prepared.kernel))
+        with run_outputs.interrupts_held():  # a second Ctrl-C must not cut the file short
+            written = _write(stop.trajectory, args, prepared.outlines,
+                             run_outputs.Pictures.of(args, prepared.kernel))
     except CannotWrite as error:
         _error(str(error), EXIT_BAD_INPUT)
         return status
     if written:
         messages.note("the solved rows are written to " + ", ".join(map(str, written)))
     return status
+
+
+def _note_far_start(kernel: Any, trajectory: Any) -> None:
+    """A note when the start was assembled far from the file's q0 (runtime.start)."""
+    import numpy as np
+
+    from symkin.runtime.start import far_from_guess
+
+    moved, scale = far_from_guess(kernel, np.asarray(kernel.q0, dtype=float), trajectory.q[0],
+                                  float(trajectory.t[0]), trajectory.params)
+    if moved:
+        messages.note(run_outputs.far_start_note(moved, scale))
 
 
 def _warn_flagged(trajectory: Any) -> None:

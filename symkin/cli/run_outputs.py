@@ -5,17 +5,24 @@ one configuration (``--at``), progress bars, and notes that say whether an event
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import os
+import signal
 import sys
+import threading
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
 from symkin.present import series
 from symkin.present.series import Units
+
+if TYPE_CHECKING:
+    from symkin.runtime.start import Moved
 
 
 class CannotWrite(Exception):
@@ -110,6 +117,21 @@ def configuration(trajectory: Any, name: str, origin: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+@contextlib.contextmanager
+def interrupts_held() -> Iterator[None]:
+    """Ctrl-C (SIGINT) ignored while the rows solved so far are written after an interrupt:
+    a second Ctrl-C would otherwise leave no file, or half of one. Only in the main thread
+    (where Python handles signals); elsewhere nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def fallback_note(count: int, points: int, verbose: bool = False) -> str:
     """A line on sparse-LU fall-backs, which cost time, not accuracy; ``verbose`` says why."""
     which = "factorization" if count == 1 else "factorizations"
@@ -120,6 +142,17 @@ def fallback_note(count: int, points: int, verbose: bool = False) -> str:
     return (short + f"): {count} {which} of the generated sparse LU met a pivot below its "
             "threshold and were redone with dense LU and partial pivoting; every pivot is "
             "checked, and no result comes from a rejected one")
+
+
+def far_start_note(moved: Sequence[Moved], scale: float) -> str:
+    """A line on bodies assembled far from their q0 (runtime.start.far_from_guess)."""
+    said = ", ".join(f"{m.body} (moved {m.distance:.3g}, turned {m.turn:.3g} rad)"
+                     for m in moved)
+    return (f"the assembled start is far from q0 (the mechanism's length scale is "
+            f"{scale:.3g}): {said}. The motion is that of the mechanism the joints describe; "
+            "if it is not the one you meant, check q0, and that each prismatic or pin_slot "
+            "`v` is the slide's normal, not its direction (in the drawn layout `axis` is the "
+            "direction)")
 
 
 class ProgressBar:

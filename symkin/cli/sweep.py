@@ -53,6 +53,8 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     sweep.add_argument("--scheduler", metavar="ADDRESS",
                        help="a Dask scheduler (tcp://host:8786): run the sweep on its cluster")
     sweep.add_argument("-o", "--output", type=Path, help="results file, .npz")
+    sweep.add_argument("--compress", action="store_true",
+                       help="write the .npz compressed (smaller, slower to write)")
     sweep.add_argument("--plot", type=Path, help="PNG of the named points' envelopes over t")
     overrides.add_argument(sweep)
     sweep.set_defaults(handler=handle)
@@ -228,7 +230,7 @@ def _write(result: Any, args: argparse.Namespace) -> list[Path]:
     written = []
     try:
         if args.output:
-            written.append(result.save(args.output))
+            written.append(result.save(args.output, compress=args.compress))
         if args.plot and result.ok.any():
             from symkin.sweeps.plots import plot_envelopes
 

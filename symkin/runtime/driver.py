@@ -37,7 +37,7 @@ from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime import failures, redundant
+from symkin.runtime import failures, redundant, units
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
@@ -50,6 +50,7 @@ from symkin.runtime.protocol import GridSolver, KinematicsKernel
 from symkin.runtime.result_arrays import Out, allocate
 from symkin.runtime.result_arrays import Run as _Run
 from symkin.runtime.results import Trajectory
+from symkin.runtime.start import singular_start
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -238,12 +239,35 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     options = options or default_options(kernel)
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
-    trajectory = _solve(kernel, t, q0, params, options, progress, use_c_solver, out)
+    trajectory = _solve_in_unit(kernel, t, q0, params, options, progress, use_c_solver, out)
     trajectory = redundant.check(kernel, trajectory, options)
     if sensitivities:
         from symkin.runtime.sensitivity import with_sensitivities
 
         return with_sensitivities(kernel, trajectory)
+    return trajectory
+
+
+def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
+                   params: Mapping[str, float] | ArrayLike | None, options: Options,
+                   progress: Progress | None, use_c_solver: bool, out: Out | None
+                   ) -> Trajectory:
+    """_solve in the unit that brings the mechanism's length scale near 1 (runtime.units),
+    the rows converted back to the kernel's unit (also those a failure or an interrupt
+    carries)."""
+    times = time_points(kernel, t)
+    p = parameter_values(kernel, params)
+    q = first_guess(kernel, q0)
+    unit = units.unit_for(kernel, q, float(times[0]), p) if times.size else 1.0
+    if unit == 1.0:
+        return _solve(kernel, times, q, p, options, progress, use_c_solver, out)
+    scaled = units.ScaledKernel(kernel, unit)
+    try:
+        trajectory = _solve(scaled, times, q / scaled.column, p, options, progress, False, out)
+    except (SolveFailure, SolveInterrupted) as stop:
+        units.to_kernel_unit(scaled, stop.trajectory.q, stop.trajectory.dq, stop.trajectory.d2q)
+        raise
+    units.to_kernel_unit(scaled, trajectory.q, trajectory.dq, trajectory.d2q)
     return trajectory
 
 
@@ -263,6 +287,7 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         if solver is not None:
             solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
             solved = _c_run(run, solver, progress)
+            _check_start(kernel, run, p, options)
             if run.done == times.size:  # the usual case: nothing left to treat
                 run.fallbacks = solver.fallbacks
                 return _trajectory(kernel, run, p, solver.point_vectors(len(kernel.points),
@@ -285,6 +310,8 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         if isinstance(result, Resolution):
             _fail_edge(kernel, run, p, result, float(times[run.done]))
         elif result.status != OK:
+            if result.status == SINGULAR and run.done == 0 and result.residual <= options.tol_phi:
+                _check_start(kernel, run, p, options, result.q)  # assembled, singular there
             _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
         return _trajectory(kernel, run, p)
 
@@ -302,11 +329,14 @@ def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,
     if result is None or (result.status != OK and run.done == 0):
         assembly = assemble(kernel, q, float(run.t[0]), p, options)
         start = assembly.result
+        if start.status == SINGULAR and start.residual <= options.tol_phi:
+            _check_start(kernel, run, p, options, start.q)  # assembled, but singular there
         if start.status != OK:
             _fail(kernel, run, p, start, float(run.t[0]), assembling=True, assembly=assembly)
         if solver is not None:
             solver.start(options, start.q, p)
         result = _resume(kernel, run, solver, start.q, p, options, progress)
+        _check_start(kernel, run, p, options)
     while result.status not in (OK, NOT_FINITE) and run.done > 0 \
             and not options.stop_at_singular:
         k = run.done
@@ -356,6 +386,26 @@ def _space(kernel: KinematicsKernel) -> str:
 
 def _point_size(kernel: KinematicsKernel) -> int:
     return 3 if _space(kernel) == "3d" else 2
+
+
+def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options,
+                 assembled: Array | None = None) -> None:
+    """Raise SolveFailure (reason "singular") when the start is a singular or limit
+    configuration (runtime.start): the first point solved, keeping only that point (the rows
+    stepped from it are not trusted), or the ``assembled`` q that Newton found singular (no
+    row). Nothing to check before the first point is solved."""
+    if assembled is None and run.done == 0:
+        return
+    t0 = float(run.t[0])
+    singular = singular_start(kernel, run.q[0] if assembled is None else assembled, t0, p,
+                              options)
+    if singular is None:
+        return
+    run.done = 0 if assembled is not None else 1
+    rows = [row for group in singular.groups for row in group]
+    raise SolveFailure(failures.explain_start(singular, t0), _trajectory(kernel, run, p), t0,
+                       math.nan, 0, rows, "singular", math.nan, singular.aligned,
+                       singular.drivers)
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,

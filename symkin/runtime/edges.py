@@ -216,11 +216,12 @@ def _stopped(kernel: KinematicsKernel, p: Array, options: Options, state: State,
         jacobian = kernel.phi_q(state.point.q, state.t, p)
         _, found = dependencies(jacobian, list(kernel.rows), rcond=1.0 / threshold)
         stop.groups = tuple(tuple(group) for group in found)
-        stop.aligned, stop.drivers = _aligned(kernel, jacobian)
+        stop.aligned, stop.drivers = limit_motion(kernel, jacobian)
     return stop
 
 
-def _aligned(kernel: KinematicsKernel, jacobian: Array) -> tuple[tuple[str, ...], tuple[str, ...]]:
+def limit_motion(kernel: KinematicsKernel, jacobian: Array
+                 ) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """The joints that become aligned at a limit position, and the drivers that hold.
 
     The right null vector of Phi_q is the motion the constraints allow with every driver held:

@@ -17,6 +17,7 @@ from symkin.runtime.edges import Resolution
 from symkin.runtime.linalg import dependencies
 from symkin.runtime.newton import Newton
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.start import Singular
 
 Array = NDArray[np.float64]
 
@@ -114,6 +115,21 @@ def explain_stop(stop: Resolution, t: float) -> tuple[str, str]:
                    f"well-conditioned there (condition {reached.point.cond:.3g}), so this is "
                    "not a singular position: check that the drivers are smooth and reachable.")
     return message, reason
+
+
+def explain_start(start: Singular, t: float) -> str:
+    """Why the motion is not stepped from its assembled start at t."""
+    aligned = ", ".join(start.aligned) or "no joint"
+    drivers = " and ".join(start.drivers) or "no driver"
+    groups = "; ".join("{" + ", ".join(group) + "}" for group in start.groups)
+    return (f"the mechanism is assembled at t = {t:.10g} in a singular or limit configuration "
+            f"(condition of Phi_q {start.cond:.3g} in units of the mechanism's length scale "
+            f"{start.scale:.3g}): {aligned} become aligned, the equations of {groups} are "
+            f"dependent, and {drivers} cannot choose the branch to follow from here. The "
+            "motion is not stepped from such a start (its first step could jump to another "
+            "branch or wind an angle). Start the time grid or the drivers away from it, or "
+            "check the pairs' directions: in the drawn layout `axis` is a slide's or slot's "
+            "direction, in the local layout `v` is its normal.")
 
 
 def _not_finite(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> str | None:

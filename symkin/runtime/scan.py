@@ -13,6 +13,7 @@ meets: it is collected. Imports NumPy only: part of the runtime.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -22,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.status import OK
-from symkin.runtime import driver, redundant
+from symkin.runtime import driver, redundant, units
 from symkin.runtime.assembly import RANDOM_ANGLES, assemble, starts
 from symkin.runtime.edges import LIMIT_COND
 from symkin.runtime.newton import newton
@@ -113,7 +114,15 @@ def scan(kernel: KinematicsKernel, t: ArrayLike | None = None,
     p = driver.parameter_values(kernel, params)
     t0 = float(times[0])
     with np.errstate(all="ignore"):
-        branches = _branches(kernel, t0, p)
+        # In the unit that brings the mechanism near unit size (runtime.units), as solve does;
+        # the branches' q back in the kernel's unit.
+        unit = units.unit_for(kernel, np.array(kernel.q0, dtype=float), t0, p)
+        if unit == 1.0:
+            branches = _branches(kernel, t0, p)
+        else:
+            scaled = units.ScaledKernel(kernel, unit)
+            branches = [dataclasses.replace(branch, q=scaled.to_length(branch.q))
+                        for branch in _branches(scaled, t0, p)]
     motions = []
     for index, branch in enumerate(branches):
         if branch.taken or all_branches:

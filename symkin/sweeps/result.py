@@ -106,16 +106,18 @@ class SweepResult:
             result[full] = self.point(body, point)
         return result
 
-    def save(self, path: str | Path) -> Path:
+    def save(self, path: str | Path, compress: bool = False) -> Path:
         """Write an .npz: t, q, dq, d2q, status, params, parameter_names, coordinates,
         reasons, messages, t_reached, solved, iterations, and for the named points
-        ``points`` (names) and r, dr, ddr of shape (M, T, P, 2)."""
+        ``points`` (names) and r, dr, ddr of shape (M, T, P, 2). ``compress``: a compressed
+        .npz (zip deflate; read the same way by numpy.load), smaller, slower to write."""
         path = Path(path)
         if path.suffix.lower() != ".npz":
             raise SymkinError(f"cannot write {path.name}: a sweep is saved as .npz")
         path.parent.mkdir(parents=True, exist_ok=True)
         arrays = self.point_arrays()
-        np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q, status=self.status,
+        write = np.savez_compressed if compress else np.savez
+        write(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q, status=self.status,
                  params=self.params, parameter_names=np.array(self.parameter_names, dtype=str),
                  coordinates=np.array(self.coordinates, dtype=str),
                  reasons=np.array(self.reasons, dtype=str),

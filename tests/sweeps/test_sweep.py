@@ -133,6 +133,37 @@ def test_save_writes_the_arrays(c_kernel, tmp_path: Path) -> None:
         result.save(tmp_path / "sweep.csv")
 
 
+def test_compressed_npz_holds_the_same_arrays_deflated(c_kernel, tmp_path: Path) -> None:
+    import zipfile
+
+    designs = np.column_stack([np.full(200, 1.0), np.linspace(4.5, 5.5, 200), np.full(200, 4.0)])
+    result = symkin.sweep(c_kernel, designs, T)
+    plain = result.save(tmp_path / "plain.npz")
+    packed = result.save(tmp_path / "packed.npz", compress=True)
+    with zipfile.ZipFile(packed) as archive:
+        assert {info.compress_type for info in archive.infolist()} == {zipfile.ZIP_DEFLATED}
+    assert packed.stat().st_size < plain.stat().st_size
+    with np.load(plain) as a, np.load(packed) as b:
+        assert sorted(a.files) == sorted(b.files)
+        for name in a.files:
+            np.testing.assert_array_equal(a[name], b[name])
+
+
+def test_cli_compress(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+    import zipfile
+
+    out = tmp_path / "s.npz"
+    done = subprocess.run([sys.executable, "-m", "symkin", "sweep",
+                           str(EXAMPLES / "crank_slider.yaml"), "--vary", "b=4.5:5.5:5", "-o",
+                           str(out), "--compress"], capture_output=True, text=True,
+                          cwd=EXAMPLES.parent, timeout=600)
+    assert done.returncode == 0, done.stderr
+    with zipfile.ZipFile(out) as archive:
+        assert {info.compress_type for info in archive.infolist()} == {zipfile.ZIP_DEFLATED}
+
+
 def test_local_processes_equal_this_process(c_kernel) -> None:
     designs = _designs(c_kernel, 40, seed=5)
     here = symkin.sweep(c_kernel, designs, T, workers=1)

@@ -1,0 +1,183 @@
+"""The assembled start, checked before the first step: a singular or limit configuration at t0
+is reported up front instead of stepped from.
+
+From a singular start the predictor has no direction to follow (the tangent of the motion is
+not unique there), so the first step may jump to another branch or wind an angle by thousands
+of turns; which one depends on rounding, so two backends could disagree. The check is made on
+the first solved point, whichever backend solved it, by the same Python code: both backends
+take the same decision.
+
+The test is scale-free. Phi_q mixes units: a row that closes a loop is a length, a row that
+holds an angle is dimensionless, and so are the columns of angles against those of positions.
+Its plain condition number therefore grows with the unit a mechanism is drawn in (a
+crank-slider in millimetres looks 1000 times worse conditioned than in metres). The check
+uses the condition of Phi_q with its position columns multiplied by the mechanism's length
+scale L and its length rows divided by it, the Jacobian in the coordinates x/L, y/L, phi:
+drawing the same mechanism in another unit leaves that matrix unchanged. L is the largest
+lever arm in Phi_q: max |dPhi_i/dphi_j| / max_k |dPhi_i/dx_k| over the length rows i (the
+length of a link, the distance of a slide from its body's origin), read from Phi_q at the start.
+
+Imports NumPy only: part of the runtime.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.contract.options import Options
+from symkin.runtime import accuracy
+from symkin.runtime.edges import LIMIT_COND, limit_motion
+from symkin.runtime.linalg import SPARSE_FROM, dependencies, factor_sparse
+from symkin.runtime.protocol import KinematicsKernel
+
+Array = NDArray[np.float64]
+
+POSITION_SUFFIXES = (".x", ".y", ".z")
+"""Coordinates that are lengths; every other coordinate (an angle) is dimensionless."""
+
+
+@dataclass(frozen=True)
+class Singular:
+    """A start at a singular or limit configuration: its scaled condition, the length scale,
+    the dependent rows, the joints the null motion moves and the drivers held."""
+
+    cond: float
+    scale: float
+    groups: tuple[tuple[str, ...], ...]
+    aligned: tuple[str, ...]
+    drivers: tuple[str, ...]
+
+
+def start_threshold(options: Options) -> float:
+    """The scaled condition above which the start counts as singular: the one that makes a
+    stop a limit position (runtime.edges), so the start and the motion are judged alike."""
+    return min(LIMIT_COND, options.max_cond / 10)
+
+
+def positions(kernel: KinematicsKernel) -> NDArray[np.bool_]:
+    """Which columns of Phi_q are lengths (x, y, z of a body)."""
+    return np.array([name.endswith(POSITION_SUFFIXES) for name in kernel.coordinates])
+
+
+def length_rows(kernel: KinematicsKernel) -> NDArray[np.bool_]:
+    """Which rows of Phi are lengths: those with a structural entry in a position column."""
+    rows = np.zeros(len(kernel.rows), dtype=bool)
+    columns = positions(kernel)[np.asarray(kernel.pattern_cols, dtype=np.intp)]
+    rows[np.asarray(kernel.pattern_rows, dtype=np.intp)[columns]] = True
+    return rows
+
+
+def length_scale(kernel: KinematicsKernel, nz: Array) -> float:
+    """L, the largest lever arm in Phi_q (module docstring), from its structural non-zeros
+    ``nz``; 1 where there is none (a mechanism with no rotation, whose matrix needs no
+    scaling)."""
+    rows = np.asarray(kernel.pattern_rows, dtype=np.intp)
+    by_position = positions(kernel)[np.asarray(kernel.pattern_cols, dtype=np.intp)]
+    magnitude = np.abs(nz)
+    moved = np.zeros(len(kernel.rows))
+    turned = np.zeros(len(kernel.rows))
+    np.maximum.at(moved, rows[by_position], magnitude[by_position])
+    np.maximum.at(turned, rows[~by_position], magnitude[~by_position])
+    lengths = moved > 0
+    arms = turned[lengths] / moved[lengths]
+    scale = float(arms.max(initial=0.0))
+    return scale if math.isfinite(scale) and scale > 0 else 1.0
+
+
+def scaled_nonzeros(kernel: KinematicsKernel, nz: Array) -> tuple[Array, float]:
+    """The non-zeros of Phi_q in the coordinates x/L, y/L, phi with its length rows divided
+    by L (same pattern), and L."""
+    scale = length_scale(kernel, nz)
+    column = np.where(positions(kernel), scale, 1.0)
+    row = np.where(length_rows(kernel), scale, 1.0)
+    rows = np.asarray(kernel.pattern_rows, dtype=np.intp)
+    cols = np.asarray(kernel.pattern_cols, dtype=np.intp)
+    return nz * column[cols] / row[rows], scale
+
+
+def scaled_cond(kernel: KinematicsKernel, scaled: Array) -> float:
+    """The 1-norm condition number of the scaled Phi_q from its non-zeros (inf when it is
+    singular): exact from NumPy's inverse below SPARSE_FROM coordinates (a warm C run never
+    imports SciPy), estimated with the sparse LU (runtime.linalg) from there on."""
+    if not np.all(np.isfinite(scaled)):
+        return math.inf
+    n = len(kernel.coordinates)
+    rows = np.asarray(kernel.pattern_rows, dtype=np.intp)
+    cols = np.asarray(kernel.pattern_cols, dtype=np.intp)
+    if n < SPARSE_FROM:
+        try:
+            inverse = np.linalg.inv(_dense(n, rows, cols, scaled))
+        except np.linalg.LinAlgError:
+            return math.inf
+        inverse_norm = float(np.abs(inverse).sum(axis=0).max(initial=0.0))
+    else:
+        factors = factor_sparse(n, rows, cols, scaled)
+        if not factors.pivot_ratio > 0.0:
+            return math.inf
+        inverse_norm = factors.inverse_norm1()
+    cond = inverse_norm * accuracy.norm1(scaled, cols, n)
+    return cond if math.isfinite(cond) else math.inf
+
+
+def _dense(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], nz: Array) -> Array:
+    matrix = np.zeros((n, n))
+    np.add.at(matrix, (rows, cols), nz)
+    return matrix
+
+
+def singular_start(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options
+          ) -> Singular | None:
+    """The start (q at t) judged before the first step: None when Phi_q is regular there."""
+    nz = np.asarray(kernel.phi_q_nz(q, t, p), dtype=np.float64)
+    scaled, scale = scaled_nonzeros(kernel, nz)
+    cond = scaled_cond(kernel, scaled)
+    threshold = start_threshold(options)
+    if cond <= threshold:
+        return None
+    n = len(kernel.coordinates)
+    matrix = _dense(n, np.asarray(kernel.pattern_rows, dtype=np.intp),
+                    np.asarray(kernel.pattern_cols, dtype=np.intp), scaled)
+    _, found = dependencies(matrix, list(kernel.rows), rcond=1.0 / threshold)
+    aligned, drivers = limit_motion(kernel, matrix)
+    return Singular(cond, scale, tuple(tuple(group) for group in found), aligned, drivers)
+
+
+FAR = 0.5
+"""A body's assembled start is far from its q0 when its origin moved by more than this times
+the mechanism's length scale, or its angle by more than this many radians (about 29 deg)."""
+
+
+@dataclass(frozen=True)
+class Moved:
+    """A body whose assembled start is far from its q0: how far its origin moved and how much
+    it turned (radians, in -pi..pi)."""
+
+    body: str
+    distance: float
+    turn: float
+
+
+def far_from_guess(kernel: KinematicsKernel, q0: Array, q: Array, t: float, p: Array
+                   ) -> tuple[tuple[Moved, ...], float]:
+    """The bodies whose assembled start q is far (FAR) from the guess q0, and the length
+    scale L they are judged by. A body whose q0 is all zeros gave no guess (the chapter's
+    start from q = 0) and is never reported."""
+    scale = length_scale(kernel, np.asarray(kernel.phi_q_nz(q, t, p), dtype=np.float64))
+    by_position = positions(kernel)
+    bodies = [name.rsplit(".", 1)[0] for name in kernel.coordinates]
+    moved = []
+    for body in dict.fromkeys(bodies):
+        columns = np.array([b == body for b in bodies])
+        if not np.any(q0[columns]):
+            continue
+        place = columns & by_position
+        distance = float(np.linalg.norm(q[place] - q0[place]))
+        turns = np.angle(np.exp(1j * (q[columns & ~by_position] - q0[columns & ~by_position])))
+        turn = float(np.abs(turns).max(initial=0.0))
+        if distance > FAR * scale or turn > FAR:
+            moved.append(Moved(body, distance, turn))
+    return tuple(moved), scale

@@ -1,0 +1,171 @@
+"""The same mechanism drawn at 10^-9 ... 10^6 times its size solves alike on both backends: the
+motion scaled (against the closed form of Example 2.7, scaled by hand), the same flags, the
+same limit time (the closed form acos(-1/4) of the non-Grashof four-bar).
+
+Before, the crank-slider in millimetres (10^3, 10^4) stopped "singular at t = 0", at 10^5 and
+10^6 it "could not be assembled", at 10^-9 it was "singular", and at 10^-6 every point was
+flagged.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from driver_support import BACKENDS
+
+import symkin
+from symkin.errors import SolveError
+from symkin.runtime import driver, units
+
+SCALES = (1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e4, 1e5, 1e6)
+
+CRANK_SLIDER = """
+name: crank_slider_scaled
+parameters: {{a: {a!r}, b: {b!r}, c: {c!r}}}
+bodies:
+  crank:  {{q0: [0, 0, 0], points: {{tip: [a, 0]}}}}
+  rod:    {{q0: [0, 0, 0], points: {{P: [b, 0]}}}}
+  slider: {{q0: [0, 0, 0]}}
+joints:
+  - {{type: revolute,  i: ground, j: crank,  sA: [0, 0], sB: [0, 0]}}
+  - {{type: revolute,  i: crank,  j: rod,    sA: tip,    sB: [0, 0]}}
+  - {{type: revolute,  i: rod,    j: slider, sA: [b, 0], sB: [0, 0]}}
+  - {{type: prismatic, i: slider, j: ground, sA: [0, 0], sB: [0, c], v: [0, 1], phi0: 0}}
+drivers:
+  - {{type: angle, i: crank, j: ground, theta: "t**2 + pi/2"}}
+time: {{t0: 0, t1: 1.5, dt: 0.05}}
+"""
+
+NON_GRASHOF = """
+name: non_grashof_scaled
+parameters: {{a: {a!r}, d: {d!r}}}
+bodies:
+  crank:   {{q0: [0, 0, 0], points: {{A: [a, 0]}}}}
+  coupler: {{q0: [{x2!r}, 0, 1.3], points: {{B: [a, 0]}}}}
+  rocker:  {{q0: [{x3!r}, 0, 1.8], points: {{B: [a, 0]}}}}
+joints:
+  - {{type: revolute, name: O2, i: ground,  j: crank,   sA: [0, 0], sB: [0, 0]}}
+  - {{type: revolute, name: A,  i: crank,   j: coupler, sA: A,      sB: [0, 0]}}
+  - {{type: revolute, name: B,  i: coupler, j: rocker,  sA: B,      sB: B}}
+  - {{type: revolute, name: O4, i: rocker,  j: ground,  sA: [0, 0], sB: [d, 0]}}
+drivers:
+  - {{type: angle, name: input, i: crank, j: ground, theta: "t"}}
+time: {{t0: 0, t1: 2.5, dt: 0.05}}
+"""
+
+
+def _kernel(tmp_path: Path, text: str, backend: str):
+    path = tmp_path / "m.yaml"
+    path.write_text(text)
+    return symkin.compile(symkin.derive(symkin.load(path)), backend=backend)
+
+
+def _example_2_7(t: np.ndarray, s: float) -> dict[str, np.ndarray]:
+    """The textbook closed form (a, b, c = 1, 5, 4) drawn s times larger."""
+    a, b, c = s, 5 * s, 4 * s
+    phi1 = t**2 + math.pi / 2
+    x2, y2 = a * np.cos(phi1), a * np.sin(phi1)
+    phi2 = np.arcsin((c - y2) / b)
+    return {"crank.phi": phi1, "rod.x": x2, "rod.y": y2, "rod.phi": phi2,
+            "slider.x": x2 + b * np.cos(phi2), "slider.y": np.full_like(t, c)}
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("s", SCALES)
+def test_crank_slider_at_any_scale_follows_the_scaled_closed_form(tmp_path, backend, s):
+    kernel = _kernel(tmp_path, CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s), backend)
+    trajectory = symkin.solve(kernel)
+    assert trajectory.t.size == 31
+    assert not trajectory.flagged.any()  # as at s = 1: no point flagged
+    for name, expected in _example_2_7(trajectory.t, s).items():
+        column = trajectory.q[:, kernel.coordinates.index(name)]
+        tolerance = 1e-10 if name.endswith(".phi") else 1e-10 * s
+        np.testing.assert_allclose(column, expected, rtol=0, atol=tolerance, err_msg=name)
+    # Velocities scale too: the slider's speed against a central difference of the closed
+    # form.
+    h = 1e-6
+    slider = lambda t: _example_2_7(np.array([t]), s)["slider.x"][0]  # noqa: E731
+    k = 10
+    speed = (slider(trajectory.t[k] + h) - slider(trajectory.t[k] - h)) / (2 * h)
+    assert trajectory.dq[k, kernel.coordinates.index("slider.x")] == pytest.approx(
+        speed, rel=1e-6)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("s", (1e-6, 1.0, 1e3, 1e6))
+def test_the_limit_position_is_found_at_the_same_time_at_any_scale(tmp_path, backend, s):
+    text = NON_GRASHOF.format(a=2 * s, d=3 * s, x2=2 * s, x3=3 * s)
+    kernel = _kernel(tmp_path, text, backend)
+    with pytest.raises(SolveError) as caught:
+        symkin.solve(kernel)
+    failure = caught.value
+    assert isinstance(failure, driver.SolveFailure) and failure.reason == "limit position"
+    assert failure.reached == pytest.approx(math.acos(-0.25), abs=1e-8)
+    assert failure.trajectory.t.size == 37  # the grid points before t* = 1.8235
+    assert int(failure.trajectory.flagged.sum()) == 0
+    crank_x = failure.trajectory.q[:, kernel.coordinates.index("coupler.x")]
+    np.testing.assert_allclose(crank_x, 2 * s * np.cos(failure.trajectory.t), atol=1e-10 * s)
+
+
+PARALLELOGRAM = """
+name: parallelogram_scaled
+parameters: {{L: {L!r}}}
+bodies:
+  r0: {{q0: [0, 0, 0.5], points: {{tip: [L, 0]}}}}
+  r1: {{q0: [L, 0, 0.5], points: {{tip: [L, 0]}}}}
+  c0: {{q0: [0.88*L, 0.48*L, 0]}}
+joints:
+  - {{type: revolute, name: O0, i: ground, j: r0, sA: [0, 0], sB: [0, 0]}}
+  - {{type: revolute, name: O1, i: ground, j: r1, sA: [L, 0], sB: [0, 0]}}
+  - {{type: revolute, name: A0, i: r0, j: c0, sA: tip, sB: [0, 0]}}
+  - {{type: revolute, name: B0, i: c0, j: r1, sA: [L, 0], sB: tip}}
+drivers:
+  - {{type: angle, name: drive, i: r0, j: ground, theta: "0.5 - t"}}
+time: {{t0: 0, t1: 1, dt: 0.05}}
+"""
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_singular_passage_is_flagged_alike_at_any_scale(tmp_path, backend):
+    """The parallelogram driven through its change point (all bars on the x axis at t = 0.5):
+    the same points flagged and the same passage at every scale; positions L (cos, sin) of
+    the crank angle 0.5 - t."""
+    flags = {}
+    for scale in (1e-6, 1.0, 1e3, 1e6):
+        kernel = _kernel(tmp_path, PARALLELOGRAM.format(L=scale), backend)
+        trajectory = symkin.solve(kernel)
+        flags[scale] = trajectory.flagged.tolist()
+        assert [round(t, 6) for t, _, _ in trajectory.singular] == [0.5]
+        theta = 0.5 - trajectory.t
+        coupler = trajectory.q[:, kernel.coordinates.index("c0.x")]
+        np.testing.assert_allclose(coupler, scale * np.cos(theta), rtol=0, atol=1e-6 * scale)
+    assert any(flags[1.0])  # the passage is flagged ...
+    assert all(flags[scale] == flags[1.0] for scale in flags)  # ... alike at every scale
+
+
+def test_the_unit_is_one_for_a_mechanism_of_ordinary_size():
+    from driver_support import derive, kernel_for
+
+    kernel = kernel_for(derive("non_grashof"), "numpy")
+    p = np.array(kernel.p_values, dtype=float)
+    assert units.unit_for(kernel, np.asarray(kernel.q0, dtype=float), 0.0, p) == 1.0
+    assert units.unit_for(kernel, np.asarray(kernel.q0, dtype=float), 0.0, 1e3 * p) == 1e3
+    assert units.unit_for(kernel, np.asarray(kernel.q0, dtype=float), 0.0, 1e-6 * p) == 1e-6
+
+
+@pytest.mark.parametrize("s", (1e-6, 1e3, 1e6))
+def test_scan_finds_the_same_branches_at_any_scale(tmp_path, s):
+    """Two assemblies at t0 (slider right and left of the crank): slider.x = +-sqrt(b^2 - (c -
+    a)^2) = +-4 s, the rod at atan(3/4) or pi - atan(3/4)."""
+    from symkin.runtime.scan import scan
+
+    kernel = _kernel(tmp_path, CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s), "numpy")
+    report = scan(kernel)
+    x = sorted(float(b.q[kernel.coordinates.index("slider.x")]) for b in report.branches)
+    np.testing.assert_allclose(x, [-4 * s, 4 * s], rtol=1e-9)
+    rod = sorted(float(b.q[kernel.coordinates.index("rod.phi")]) for b in report.branches)
+    np.testing.assert_allclose(rod, [math.atan(0.75), math.pi - math.atan(0.75)], atol=1e-9)
+    assert report.motions[0].stop is None and not report.branches[0].near_singular
