@@ -45,6 +45,10 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "phi_phi_q": ("q", "t", "p"),
     "phi_t_shared": ("q", "t", "p", "shared"),
     "gamma_shared": ("q", "dq", "t", "p", "shared"),
+    # Inverse dynamics, only for a file with masses or forces (symbolic.dynamics): the
+    # right-hand side Q - M ddq - h of Phi_q^T lam = rhs, and the efforts and reactions of lam.
+    "dynamics_rhs": ("q", "dq", "ddq", "t", "p"),
+    "loads": ("q", "lam", "t", "p"),
 }
 FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
 
@@ -128,6 +132,14 @@ class Code:
     """The sines and cosines the fused routine passes to Phi_t and Gamma (printed, in order)."""
     constant_nz: tuple[float | None, ...] = ()
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
+    driver_names: tuple[str, ...] = ()
+    joint_names: tuple[str, ...] = ()
+    """Inverse dynamics (``dynamics_rhs`` and ``loads`` routines present): the labels of the
+    efforts (one per driver row) and of the joints' reactions."""
+
+    @property
+    def dynamics(self) -> bool:
+        return any(routine.name == "loads" for routine in self.routines)
 
     @property
     def nnz(self) -> int:
@@ -204,6 +216,8 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
                  if backend.plans_lu(linalg) else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
+        driver_names=system.dynamics.driver_names if system.dynamics else (),
+        joint_names=system.dynamics.joint_names if system.dynamics else (),
     )
 
 
@@ -232,6 +246,8 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
         "gamma": list(system.gamma),
         "points": [component for vector in point_vectors(system) for component in vector],
         "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
+        **({"dynamics_rhs": list(system.dynamics.rhs), "loads": list(system.dynamics.loads)}
+           if system.dynamics is not None else {}),
     }
 
 

@@ -29,7 +29,8 @@ from symkin.errors import BuildError, UsageError
 from symkin.symbolic.derivation import System
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
-             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out"}
+             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out",
+             "dynamics_rhs": "out", "loads": "out"}
 # The output arrays of a routine with several (Routine.sizes), in order.
 _C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
@@ -45,6 +46,8 @@ _PYTHON_DOC = {
                  "and cosine once.",
     "phi_t_shared": "Phi_t(q, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
     "gamma_shared": "Gamma(q, dq, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
+    "dynamics_rhs": "Q - M ddq - h(q, dq), the right-hand side of Phi_q^T lam = rhs, (NQ,).",
+    "loads": "The efforts (DRIVER_NAMES) then Fx, Fy, M of each joint (JOINT_NAMES) from lam.",
 }
 
 
@@ -211,6 +214,8 @@ def metadata(code: Code) -> Metadata:
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
+        **({"driver_names": list(code.driver_names), "joint_names": list(code.joint_names)}
+           if code.dynamics else {}),
     }
 
 
@@ -245,6 +250,11 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_literals": [repr(r) for r in code.rows],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "linalg": code.linalg,
+        # Inverse dynamics (only when the file has masses or forces).
+        "dynamics": code.dynamics, "n_efforts": len(code.driver_names),
+        "n_joints": len(code.joint_names),
+        "driver_literals": [repr(n) for n in code.driver_names],
+        "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
         "option_fields": list(options.SOLVER_FIELDS),
@@ -303,6 +313,12 @@ def _labels(code: Code, routine: str) -> list[str]:
     if routine == "phi_phi_q":
         return [*_labels(code, "phi"), *_labels(code, "phi_q"),
                 *(lower.comment(f) for f in code.shared)]
+    if routine == "dynamics_rhs":
+        return [lower.comment(name) for name in code.coordinates]
+    if routine == "loads":
+        return [lower.comment(f"{name}.effort") for name in code.driver_names] + [
+            lower.comment(f"{name}.{part}") for name in code.joint_names
+            for part in ("Fx", "Fy", "M")]
     if routine == "points":
         return [lower.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in "xy"]

@@ -18,7 +18,15 @@ def manifest_name(prefix: str) -> str:
     return prefix + MANIFEST_SUFFIX
 
 
-class Metadata(TypedDict):
+class _Dynamics(TypedDict, total=False):
+    """Present only for a mechanism with masses or forces: the labels of the efforts (one
+    per driver row) and of the joints' reactions."""
+
+    driver_names: list[str]
+    joint_names: list[str]
+
+
+class Metadata(_Dynamics):
     """What a runtime Kernel needs besides the compiled functions (plain JSON data)."""
 
     coordinates: list[str]

@@ -37,7 +37,7 @@ from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime import failures
+from symkin.runtime import failures, forces
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
@@ -341,8 +341,12 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
         point_vectors = np.asarray(kernel.point_vectors(p), dtype=float).reshape(-1, 2)
     singular = tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
                      for s in run.passages) if run.passages else ()
-    return Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates), tuple(kernel.points),
-                             point_vectors, p, run.fallbacks, flagged, cond, singular)
+    trajectory = Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates),
+                                   tuple(kernel.points), point_vectors, p, run.fallbacks,
+                                   flagged, cond, singular)
+    # inverse dynamics (a kernel with masses or forces): efforts and reactions of the rows
+    trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p)
+    return trajectory
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,

@@ -6,12 +6,14 @@ Imports only NumPy: it is part of the runtime. Plots and animation live in symki
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.errors import SymkinError
+from symkin.runtime.forces import Forces
 
 SAVE_FORMATS = (".npz", ".csv")
 
@@ -84,6 +86,8 @@ class Trajectory:
     flagged: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     cond: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
+    forces: Forces | None = None
+    """Efforts and reactions (runtime.forces) when the mechanism has masses or forces."""
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.
@@ -107,8 +111,18 @@ class Trajectory:
         self.__dict__.update(t=t, q=q, dq=dq, d2q=d2q, coordinates=coordinates, points=points,
                              point_vectors=point_vectors, params=params,
                              lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
-                             cond=cond, singular=singular)
+                             cond=cond, singular=singular, forces=None)
         return self
+
+    @property
+    def effort(self) -> NDArray[np.float64] | None:
+        """(T, n_driver_equations): what each driver applies (None without dynamics)."""
+        return None if self.forces is None else self.forces.effort
+
+    @property
+    def reaction(self) -> NDArray[np.float64] | None:
+        """(T, n_joints, 3): Fx, Fy, M body i exerts on body j (None without dynamics)."""
+        return None if self.forces is None else self.forces.reaction
 
     @property
     def bodies(self) -> tuple[str, ...]:
@@ -163,16 +177,28 @@ class Trajectory:
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
         np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
                  coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond)
+                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond,
+                 **self._forces_arrays())
+
+    def _forces_arrays(self) -> dict[str, NDArray[Any]]:
+        """NPZ ``effort``, ``driver_names``, ``reaction``, ``joint_names`` (with dynamics)."""
+        if self.forces is None:
+            return {}
+        f = self.forces
+        return {"effort": f.effort, "driver_names": np.array(f.driver_names, dtype=str),
+                "reaction": f.reaction, "joint_names": np.array(f.joint_names, dtype=str)}
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
-                  *(c + "_tt" for c in self.coordinates), *self._point_columns(), "flagged"]
+                  *(c + "_tt" for c in self.coordinates), *self._point_columns(), "flagged",
+                  *(self.forces.columns() if self.forces is not None else ())]
         r, dr, ddr = self.point_arrays()
         # Per point: x, y, vx, vy, ax, ay (2.14-2.16).
         # the column count given, not inferred: a run that stopped before its first row
         # still writes its header
         points = np.concatenate([r, dr, ddr], axis=2).reshape(self.t.size, 6 * len(self.points))
-        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, self.flagged])
+        forces = [self.forces.table()] if self.forces is not None else []
+        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, self.flagged,
+                                 *forces])
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")

@@ -18,7 +18,9 @@ import sympy as sp
 
 from symkin import pairs
 from symkin.spec import validate
+from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
+from symkin.symbolic import dynamics
 from symkin.symbolic.planar import Context
 from symkin.symbolic.symbols import Symbols, make_symbols
 
@@ -85,6 +87,9 @@ class System:
     """(t0, t1, dt) at the nominal parameter values."""
     phi_p: sp.ImmutableSparseMatrix | None = None
     """dPhi/dp, N x NP (sparse): Phi_q q_p = -Phi_p gives the sensitivities q_p."""
+    dynamics: dynamics.Dynamics | None = None
+    """Mass terms, applied forces, efforts and reactions; None for a file without masses
+    and forces (inverse dynamics, symbolic.dynamics)."""
 
     @property
     def name(self) -> str:
@@ -123,16 +128,20 @@ def derive(mech: Mechanism | str | Path) -> System:
     values = mech.parameter_values()
     p_values = tuple(values[s.name] for s in symbols.p)
     nominal = dict(zip(symbols.p, p_values))
+    phi_q = sp.ImmutableSparseMatrix(size, size, jacobian)
+    placed = _placed(mech, ctx)
     return System(
         mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,
         p_values=p_values, coordinates=symbols.coordinates,
-        phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
+        phi=sp.ImmutableMatrix(phi), phi_q=phi_q,
         phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
         q0=_initial_guess(mech, ctx, nominal),
         points=tuple((body, name, sp.ImmutableMatrix(ctx.local(body, name)))
                      for body, spec in mech.bodies.items() for name in spec.points),
-        placed=_placed(mech, ctx), time_grid=_time_grid(mech, ctx, nominal),
+        placed=placed, time_grid=_time_grid(mech, ctx, nominal),
         phi_p=_parameter_jacobian(phi, symbols.p),
+        dynamics=(dynamics.derive(mech, ctx, phi_q, rows, placed)
+                  if has_dynamics(mech) else None),
     )
 
 

@@ -24,6 +24,9 @@ class _ModuleFunctions:
         self.points = module._points
         self.phi_p_nz: Callable[[Array, float, Array], Array] = getattr(
             module, "phi_p_nz", _no_phi_p)
+        # inverse dynamics, generated only for a mechanism with masses or forces
+        self.dynamics_rhs = getattr(module, "dynamics_rhs", None)
+        self.loads = getattr(module, "loads", None)
 
 
 def _no_phi_p(q: Array, t: float, p: Array) -> Array:
@@ -40,6 +43,8 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         "points": module.POINTS,
         **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
            if hasattr(module, "PHI_P_ROWS") else {}),
+        **({"driver_names": module.DRIVER_NAMES, "joint_names": module.JOINT_NAMES}
+           if hasattr(module, "JOINT_NAMES") else {}),
     }
     return Kernel(backend, meta, _ModuleFunctions(module), folder=folder)
 
