@@ -206,7 +206,7 @@ def manifest(code: Code, files: dict[str, str]) -> str:
 
 def metadata(code: Code) -> Metadata:
     """What the runtime Kernel needs besides the compiled functions (plain JSON data)."""
-    return {
+    data: Metadata = {
         "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
         "p_values": list(code.p_values), "q0": list(code.q0), "time_grid": list(code.time_grid),
         "rows": list(code.rows), "pattern_rows": list(code.pattern_rows),
@@ -214,9 +214,11 @@ def metadata(code: Code) -> Metadata:
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
-        **({"driver_names": list(code.driver_names), "joint_names": list(code.joint_names)}
-           if code.dynamics else {}),
     }
+    if code.dynamics:
+        data["driver_names"] = list(code.driver_names)
+        data["joint_names"] = list(code.joint_names)
+    return data
 
 
 # ----- template context ----------------------------------------------------------------------

@@ -1,8 +1,8 @@
 """Efforts and reactions along a solved trajectory (inverse dynamics), from the kernel's
-generated ``multipliers``: Φ_qᵀ λ = Q − M q̈ − h at every solved row.
+generated ``multipliers``: Φ_qᵀ λ = Q - M q̈ - h at every solved row.
 
-``effort`` (T, n_driver_equations): −λ of each driver row, the generalized force its actuator
-applies along the driver's function (an ``angle`` driver: the torque on body i, −effort on
+``effort`` (T, n_driver_equations): -λ of each driver row, the generalized force its actuator
+applies along the driver's function (an ``angle`` driver: the torque on body i, -effort on
 j; a ``slide``: the force on body j along u). ``reaction`` (T, n_joints, 3): [Fx, Fy]
 (global) and M that body i exerts on body j, M about the joint's point on body i (0 for a
 revolute; a prismatic pair: about A, carried by i). Rows where Φ_q is exactly singular are NaN.

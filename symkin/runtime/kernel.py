@@ -10,6 +10,7 @@ SymPy or jinja2.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import sys
@@ -157,10 +158,9 @@ class Kernel:
         lam = np.full(q.shape, np.nan)
         loads = np.full((t.size, n_loads), np.nan)
         for k in range(t.size):
-            try:
+            # singular Phi_q: no unique multipliers, the row stays NaN and says so
+            with contextlib.suppress(np.linalg.LinAlgError):
                 lam[k] = self.multipliers(q[k], dq[k], d2q[k], t[k], p)
-            except np.linalg.LinAlgError:
-                pass  # singular Phi_q: no unique multipliers, NaN says so
             loads[k] = self.loads(q[k], lam[k], t[k], p)
         return lam, loads
 

@@ -6,8 +6,8 @@ Imports only NumPy: it is part of the runtime. Plots and animation live in symki
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -175,10 +175,13 @@ class Trajectory:
     def _save_npz(self, path: Path) -> None:
         r, dr, ddr = self.point_arrays()
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
-        np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
-                 coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond,
-                 **self._forces_arrays())
+        arrays: dict[str, NDArray[Any]] = dict(
+            t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
+            coordinates=np.array(self.coordinates, dtype=str), points=names,
+            r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond)
+        arrays.update(self._forces_arrays())
+        # (numpy's stub types savez's keywords as its own options, not as arrays)
+        np.savez(path, **arrays)  # type: ignore[arg-type]
 
     def _forces_arrays(self) -> dict[str, NDArray[Any]]:
         """NPZ ``effort``, ``driver_names``, ``reaction``, ``joint_names`` (with dynamics)."""

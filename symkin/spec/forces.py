@@ -18,7 +18,7 @@ whitelist parser only (:mod:`symkin.spec.expressions`).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
 import sympy as sp
 from pydantic import Field
@@ -70,7 +70,7 @@ class Spring(Strict):
     damping: Expr = 0
 
 
-Load = Annotated[Union[Gravity, PointForce, Torque, Spring], Field(discriminator="type")]
+Load = Annotated[Gravity | PointForce | Torque | Spring, Field(discriminator="type")]
 
 # Which keys of each type name a body, and which name a point of which body (key, body key).
 BODY_KEYS = {"gravity": (), "force": ("body",), "torque": ("body",), "spring": ("i", "j")}

@@ -20,7 +20,6 @@ from symkin.pairs.fields import Expr, PointRef, Strict, Vec2, Vec3
 from symkin.spec import expressions
 from symkin.spec.forces import Load
 
-
 DYNAMICS_BODY_KEYS = ("mass", "inertia", "com")
 
 

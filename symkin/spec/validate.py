@@ -370,20 +370,20 @@ def _check_dynamics(mech: Mechanism, symbols: _Names,
             _point(mech, name, body.com, symbols, nominal, ("bodies", name, "com"))
     moving = _Names(symbols.parameters, symbols.t, forces.coordinate_names(mech.bodies))
     for index, load in enumerate(mech.forces):
-        path: tuple[str | int, ...] = ("forces", index)
+        where: tuple[str | int, ...] = ("forces", index)
         for key in forces.BODY_KEYS[load.type]:
-            _body_ref(mech, getattr(load, key), path + (key,))
+            _body_ref(mech, getattr(load, key), where + (key,))
         if load.type in ("force", "torque") and load.body == GROUND:
-            raise MechanismError(f"a {load.type} on the ground does nothing", path + ("body",),
+            raise MechanismError(f"a {load.type} on the ground does nothing", where + ("body",),
                                  "Apply it to a moving body.")
         for key, body_key in forces.POINT_KEYS[load.type]:
             _point(mech, getattr(load, body_key), getattr(load, key), symbols, nominal,
-                   path + (key,))
+                   where + (key,))
         for key in forces.EXPRESSION_KEYS[load.type]:
             raw = getattr(load, key)
             for k, item in (enumerate(raw) if isinstance(raw, list) else [(None, raw)]):
-                where = path + ((key,) if k is None else (key, k))
-                _expression(item, moving, where, time=True, coordinates=True)
+                at: tuple[str | int, ...] = (key,) if k is None else (key, k)
+                _expression(item, moving, where + at, time=True, coordinates=True)
 
 
 def degrees_of_freedom(mech: Mechanism) -> int:

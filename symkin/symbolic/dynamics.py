@@ -2,23 +2,23 @@
 and the efforts and reactions that follow from the Lagrange multipliers.
 
 With the motion known (q, dq, ddq from the kinematic solve), the equations of motion
-M ddq + Φ_qᵀ λ = Q − h(q, dq) give the multipliers from one linear solve with the transposed
+M ddq + Φ_qᵀ λ = Q - h(q, dq) give the multipliers from one linear solve with the transposed
 Jacobian (sign convention, REFERENCE.md "forces"):
 
-    Φ_qᵀ λ = Q − M ddq − h  =: rhs(q, dq, ddq, t)
+    Φ_qᵀ λ = Q - M ddq - h  =: rhs(q, dq, ddq, t)
 
 M and h come from the kinetic energy T of each body with its centre of mass at the local
 vector c (not necessarily the frame's origin): r_c = r + R c, T = ½ m |ṙ_c|² + ½ J φ̇², so
-M = ∂²T/∂q̇², and h = (∂²T/∂q̇∂q) q̇ − ∂T/∂q (Lagrange's equations; zero when c = 0).
+M = ∂²T/∂q̇², and h = (∂²T/∂q̇∂q) q̇ - ∂T/∂q (Lagrange's equations; zero when c = 0).
 Q is the virtual work of the loads: a force F at point P gives Q_k = F·∂r_P/∂q_k, a torque m
 gives Q_φ = m, gravity is the force m g at the centre of mass, and a spring of length L with
-tension k (L − L0) + d L̇ gives Q_k = −tension ∂L/∂q_k.
+tension k (L - L0) + d L̇ gives Q_k = -tension ∂L/∂q_k.
 
-The constraint forces on the bodies are −Φ_qᵀ λ; the rows of one joint give its reaction:
-[Fx, Fy, n] = −(Φ_q rows of the joint, columns of body j)ᵀ λ_joint is what body i exerts on
+The constraint forces on the bodies are -Φ_qᵀ λ; the rows of one joint give its reaction:
+[Fx, Fy, n] = -(Φ_q rows of the joint, columns of body j)ᵀ λ_joint is what body i exerts on
 body j (n about j's frame origin), moved to the joint's point P on body i:
-M = n − (P − r_j) × F. When j is the ground the same is taken from body i and negated
-(action and reaction). A driver row's effort is −λ: the generalized force its actuator
+M = n - (P - r_j) x F. When j is the ground the same is taken from body i and negated
+(action and reaction). A driver row's effort is -λ: the generalized force its actuator
 applies along the driven function (work = effort · δf) — for an ``angle`` driver the torque
 on body i, for ``slide`` the force on body j along u (unit u).
 """
@@ -48,7 +48,7 @@ class Dynamics:
         mass_matrix: M(q), N x N.
         applied: Q(q, dq, t), N x 1.
         velocity_terms: h(q, dq), N x 1 (zero when every frame is at its centre of mass).
-        rhs: Q − M ddq − h, the right-hand side of Φ_qᵀ λ = rhs.
+        rhs: Q - M ddq - h, the right-hand side of Φ_qᵀ λ = rhs.
         kinetic: T(q, dq), for the power balance.
         loads: the efforts (one per driver row) then 3 values per joint (Fx, Fy, M), as
             functions of q, λ, t and p.
@@ -83,7 +83,7 @@ def derive(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any,
         energy = _body_energy(ctx, body, columns, m, inertia, com)
         kinetic += energy
         _lagrange_terms(energy, columns, symbols, mass, velocity_terms)
-    for index, load in enumerate(mech.forces):
+    for load in mech.forces:
         applied += _generalized_force(mech, ctx, load)
     rhs = applied - mass * sp.Matrix(ddq) - velocity_terms
     efforts, reactions, driver_names, joint_names = _loads(mech, ctx, phi_q, rows, placed, lam)
@@ -117,7 +117,7 @@ def _body_energy(ctx: Context, body: str, columns: list[int], m: sp.Expr, inerti
 
 def _lagrange_terms(energy: sp.Expr, columns: list[int], symbols: Any, mass: sp.Matrix,
                     velocity_terms: sp.Matrix) -> None:
-    """Add one body's M = ∂²T/∂q̇² and h = (∂²T/∂q̇∂q) q̇ − ∂T/∂q (its own columns only)."""
+    """Add one body's M = ∂²T/∂q̇² and h = (∂²T/∂q̇∂q) q̇ - ∂T/∂q (its own columns only)."""
     for a in columns:
         momentum = energy.diff(symbols.dq[a])
         for b in columns:
@@ -186,8 +186,11 @@ def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:
 def _loads(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any, placed: Any,
            lam: tuple[sp.Symbol, ...]) -> tuple[list[sp.Expr], list[sp.Expr],
                                                 tuple[str, ...], tuple[str, ...]]:
-    """Efforts (−λ of each driver row) and each joint's [Fx, Fy, M] from its rows' λ."""
-    efforts, reactions, driver_names, joint_names = [], [], [], []
+    """Efforts (-λ of each driver row) and each joint's [Fx, Fy, M] from its rows' λ."""
+    efforts: list[sp.Expr] = []
+    reactions: list[sp.Expr] = []
+    driver_names: list[str] = []
+    joint_names: list[str] = []
     by_owner: dict[tuple[str, int], list[int]] = {}
     for r, row in enumerate(rows):
         by_owner.setdefault((row.section, row.index), []).append(r)

@@ -61,7 +61,7 @@ def _largest(traj) -> float:
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_slider_crank_torque_is_virtual_work(backend: str) -> None:
     """Massless links: T dθ + F·dx = 0, so the motor torque is T = F0 dx/dθ with
-    x(θ) = a cos θ + sqrt(b² − (c − a sin θ)²) (Example 2.7) and the load −F0 along x."""
+    x(θ) = a cos θ + sqrt(b² - (c - a sin θ)²) (Example 2.7) and the load -F0 along x."""
     data = yaml.safe_load((EXAMPLES / "crank_slider_load.yaml").read_text())
     for body in data["bodies"].values():
         for key in ("mass", "inertia", "com"):
@@ -148,7 +148,7 @@ def test_four_bar_newton_euler_per_body(backend: str) -> None:
         apply(i, -f, points_on_i[name], -m)
     apply("crank", np.zeros((T, 2)), bodies["crank"].r, traj.effort[:, 0])  # motor on body i
     scale = _largest(traj)
-    for name, (m, inertia, c) in masses.items():
+    for name, (m, inertia, _c) in masses.items():
         _, _, acc = com[name]
         np.testing.assert_allclose(force[name], m * acc, rtol=0, atol=1e-9 * scale,
                                    err_msg=f"sum of forces on {name}")

@@ -25,12 +25,16 @@ class _ModuleFunctions:
         self.phi_p_nz: Callable[[Array, float, Array], Array] = getattr(
             module, "phi_p_nz", _no_phi_p)
         # inverse dynamics, generated only for a mechanism with masses or forces
-        self.dynamics_rhs = getattr(module, "dynamics_rhs", None)
-        self.loads = getattr(module, "loads", None)
+        self.dynamics_rhs: Callable[..., Array] = getattr(module, "dynamics_rhs", _no_dynamics)
+        self.loads: Callable[..., Array] = getattr(module, "loads", _no_dynamics)
 
 
 def _no_phi_p(q: Array, t: float, p: Array) -> Array:
     raise ValueError("this kernel was generated without Phi_p; rebuild it with symkin.compile")
+
+
+def _no_dynamics(*arguments: object) -> Array:
+    raise ValueError("this mechanism has no masses or forces: no efforts or reactions")
 
 
 def from_module(module: ModuleType, backend: str, folder: Path | None = None) -> Kernel:
