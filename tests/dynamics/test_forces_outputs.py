@@ -1,0 +1,123 @@
+"""The contracts of inverse dynamics: the generated C entry points (one step with the
+solver's own factors, and the whole grid), the NPZ arrays and CSV columns, the CLI, the
+drawn layout's centre of mass, and files without masses or forces left as they were."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import symkin
+from symkin import cli
+from symkin.spec.validate import from_dict
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "examples"
+
+
+def test_c_multipliers_per_step_use_the_solvers_factors() -> None:
+    """<prefix>_solve_step then <prefix>_multipliers (one transposed solve with the factors
+    the step left) give the multipliers of the grid solve, step by step, in compiled C."""
+    kernel = symkin.compile(symkin.derive(EXAMPLES / "four_bar_dynamics.yaml"), backend="c")
+    traj = symkin.solve(kernel)
+    ffi, lib, name, n = kernel.ffi, kernel.lib, kernel.name, kernel.nq
+    options = ffi.new(f"{name}_options *")
+    getattr(lib, f"{name}_default_options")(options)
+    state, work = ffi.new(f"{name}_state *"), ffi.new(f"{name}_workspace *")
+    report = ffi.new(f"{name}_report *")
+    p = ffi.new(f"{name}_real[]", list(kernel.p_values))
+    lam = ffi.new(f"{name}_real[]", n)
+    state.q[0:n] = list(kernel.q0)
+    state.started = 0
+    scale = np.abs(traj.forces.multipliers).max()
+    for k, t in enumerate(traj.t):
+        assert getattr(lib, f"{name}_solve_step")(options, p, t, state, work, report) == 0
+        getattr(lib, f"{name}_multipliers")(p, state, work, lam)
+        np.testing.assert_allclose(np.array(ffi.unpack(lam, n)), traj.forces.multipliers[k],
+                                   rtol=0, atol=1e-10 * scale)
+
+
+def test_backends_agree_and_names_follow_the_file() -> None:
+    system = symkin.derive(EXAMPLES / "four_bar_dynamics.yaml")
+    c, numpy = (symkin.solve(symkin.compile(system, backend=b)) for b in ("c", "numpy"))
+    scale = np.abs(c.reaction).max()
+    np.testing.assert_allclose(c.reaction, numpy.reaction, rtol=0, atol=1e-10 * scale)
+    np.testing.assert_allclose(c.effort, numpy.effort, rtol=0, atol=1e-10 * scale)
+    assert c.forces.driver_names == ("crank_drive",)
+    assert c.forces.joint_names == ("O2", "A", "B", "O4")
+    assert c.effort.shape == (c.t.size, 1) and c.reaction.shape == (c.t.size, 4, 3)
+
+
+def test_npz_and_csv_carry_efforts_and_reactions(tmp_path: Path) -> None:
+    traj = symkin.solve(symkin.compile(symkin.derive(EXAMPLES / "crank_slider_load.yaml"),
+                                       backend="numpy"))
+    data = np.load(traj.save(tmp_path / "run.npz"))
+    assert list(data["driver_names"]) == ["motor"]
+    assert list(data["joint_names"]) == ["O", "A", "B", "slide"]
+    assert data["effort"].shape == (traj.t.size, 1)
+    np.testing.assert_array_equal(data["reaction"], traj.reaction)
+    with open(traj.save(tmp_path / "run.csv"), newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    assert float(rows[3]["motor.effort"]) == traj.effort[3, 0]
+    assert float(rows[3]["slide.Fy"]) == traj.reaction[3, 3, 1]
+    assert float(rows[3]["A.M"]) == traj.reaction[3, 1, 2]
+
+
+def test_cli_run_writes_the_columns(tmp_path: Path) -> None:
+    out = tmp_path / "run.csv"
+    assert cli.main(["run", str(EXAMPLES / "four_bar_dynamics.yaml"), "-o", str(out)]) == 0
+    header = out.read_text().splitlines()[0].split(",")
+    for column in ("crank_drive.effort", "O2.Fx", "O2.Fy", "O2.M", "O4.M"):
+        assert column in header
+
+
+def test_file_without_masses_has_no_forces(tmp_path: Path) -> None:
+    traj = symkin.solve(symkin.compile(symkin.derive(EXAMPLES / "four_bar.yaml"),
+                                       backend="numpy"))
+    assert traj.forces is None and traj.effort is None
+    assert "effort" not in np.load(traj.save(tmp_path / "run.npz")).files
+
+
+PENDULUM_LOCAL = {
+    "name": "pendulum", "parameters": {"L": 2.0, "m": 3.0},
+    "bodies": {"arm": {"q0": [0, 0, 0.3], "points": {"tip": ["L", 0]}, "mass": "m",
+                       "inertia": 0.5, "com": ["L/2", 0.1]}},
+    "joints": [{"type": "revolute", "name": "pivot", "i": "ground", "j": "arm",
+                "sA": [0, 0], "sB": [0, 0]}],
+    "drivers": [{"type": "angle", "name": "motor", "i": "arm", "j": "ground",
+                 "theta": "0.3 + 2*t"}],
+    "forces": [{"type": "gravity", "g": [0, -9.81]},
+               {"type": "force", "name": "tip_load", "body": "arm", "at": "tip",
+                "f": [0, "-5*arm.phi_t"]}],
+    "time": {"t0": 0, "t1": 1, "dt": 0.1},
+}
+
+
+def test_pendulum_closed_form() -> None:
+    """One body about a fixed pivot: T = (J + m|c|²) α − moment of gravity and the load."""
+    traj = symkin.solve(symkin.compile(symkin.derive(from_dict(PENDULUM_LOCAL)),
+                                       backend="numpy"))
+    phi = 0.3 + 2 * traj.t
+    c = np.array([1.0, 0.1])
+    com_x = np.cos(phi) * c[0] - np.sin(phi) * c[1]
+    gravity_moment = com_x * 3.0 * -9.81
+    load_moment = 2.0 * np.cos(phi) * (-5 * 2.0)
+    torque = -(gravity_moment + load_moment)  # alpha = 0
+    np.testing.assert_allclose(traj.effort[:, 0], torque, rtol=1e-12, atol=1e-12)
+
+
+def test_drawn_layout_com_is_global_as_drawn() -> None:
+    """The same pendulum drawn at phi = 0.3: com and the load's point given globally."""
+    c, s = np.cos(0.3), np.sin(0.3)
+    drawn = {**PENDULUM_LOCAL, "layout": "drawn",
+             "bodies": {"arm": {"points": {"O": [0, 0], "tip": [2 * c, 2 * s]},
+                                "frame": {"origin": "O", "angle": 0.3}, "mass": "m",
+                                "inertia": 0.5,
+                                "com": [1.0 * c - 0.1 * s, 1.0 * s + 0.1 * c]}},
+             "joints": [{"type": "revolute", "name": "pivot", "i": "ground", "j": "arm",
+                         "at": "O"}]}
+    local = symkin.solve(symkin.compile(symkin.derive(from_dict(PENDULUM_LOCAL)), "numpy"))
+    from_drawing = symkin.solve(symkin.compile(symkin.derive(from_dict(drawn)), "numpy"))
+    np.testing.assert_allclose(from_drawing.effort, local.effort, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(from_drawing.reaction, local.reaction, rtol=1e-12, atol=1e-9)
