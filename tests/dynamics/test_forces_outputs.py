@@ -8,6 +8,7 @@ import csv
 from pathlib import Path
 
 import numpy as np
+
 import symkin
 from symkin import cli
 from symkin.spec.validate import from_dict
