@@ -198,7 +198,7 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
     if run.done == run.t.size:  # the edge treatment solved the last point: the grid is done
         run.fallbacks = solver.fallbacks  # (the report still holds the failed call's status)
         return Newton(run.q[run.done - 1], OK, 0, 0.0, None)
-    solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
+    solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
     return _c_outcome(kernel, run, solver, p, _c_run(run, solver, progress))
 
 
@@ -260,7 +260,8 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         else None
     try:
         if solver is not None:
-            solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
+            run.forces_out = forces.allocate(kernel, times.size)
+            solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
             solved = _c_run(run, solver, progress)
             if run.done == times.size:  # the usual case: nothing left to treat
                 run.fallbacks = solver.fallbacks
@@ -345,7 +346,8 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
                                    tuple(kernel.points), point_vectors, p, run.fallbacks,
                                    flagged, cond, singular)
     # inverse dynamics (a kernel with masses or forces): efforts and reactions of the rows
-    trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p)
+    given = None if run.forces_out is None else tuple(a[:done] for a in run.forces_out)
+    trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
     return trajectory
 
 

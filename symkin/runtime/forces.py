@@ -41,13 +41,33 @@ class Forces:
         return np.column_stack([self.effort, self.reaction.reshape(rows, -1)])
 
 
-def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array,
-            p: Array) -> Forces | None:
-    """The efforts and reactions of solved rows; None for a kernel without dynamics."""
+def allocate(kernel: Any, size: int) -> tuple[Array, Array] | None:
+    """NaN-filled (lam, loads) rows for a grid loop that computes them as it goes (the
+    generated C solver); None for a kernel without dynamics."""
+    if not getattr(kernel, "has_dynamics", False):
+        return None
+    n_loads = len(kernel.driver_names) + 3 * len(kernel.joint_names)
+    return np.full((size, len(kernel.coordinates)), np.nan), np.full((size, n_loads), np.nan)
+
+
+def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
+            given: tuple[Array, ...] | None = None) -> Forces | None:
+    """The efforts and reactions of solved rows; None for a kernel without dynamics.
+
+    ``given``: (lam, loads) the grid loop already wrote; only the rows it did not (NaN: points
+    the runtime's edge treatment solved) are computed here.
+    """
     if not getattr(kernel, "has_dynamics", False):
         return None
     with np.errstate(all="ignore"):  # a singular row is NaN, said in the docstring
-        lam, loads = kernel.multipliers_grid(t, q, dq, d2q, p)
+        if given is None:
+            lam, loads = kernel.multipliers_grid(t, q, dq, d2q, p)
+        else:
+            lam, loads = given[0].copy(), given[1].copy()
+            missing = np.flatnonzero(np.isnan(lam).any(axis=1))
+            if missing.size:
+                lam[missing], loads[missing] = kernel.multipliers_grid(
+                    t[missing], q[missing], dq[missing], d2q[missing], p)
     n_efforts, n_joints = len(kernel.driver_names), len(kernel.joint_names)
     return Forces(lam, loads[:, :n_efforts], loads[:, n_efforts:].reshape(t.size, n_joints, 3),
                   tuple(kernel.driver_names), tuple(kernel.joint_names))

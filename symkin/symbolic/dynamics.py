@@ -90,7 +90,7 @@ def derive(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any,
     return Dynamics(
         ddq=ddq, lam=lam, mass_matrix=sp.ImmutableMatrix(mass),
         applied=sp.ImmutableMatrix(applied), velocity_terms=sp.ImmutableMatrix(velocity_terms),
-        rhs=sp.ImmutableMatrix(rhs.applyfunc(sp.expand)), kinetic=kinetic,
+        rhs=sp.ImmutableMatrix(rhs), kinetic=kinetic,
         loads=sp.ImmutableMatrix([*efforts, *reactions]),
         driver_names=driver_names, joint_names=joint_names)
 

@@ -433,6 +433,13 @@ int crank_slider_load_solve_step(const crank_slider_load_options *options, const
     return CRANK_SLIDER_LOAD_OK;
 }
 
+void crank_slider_load_multipliers(const crank_slider_load_real p[], const crank_slider_load_state *state,
+                              const crank_slider_load_workspace *work, crank_slider_load_real lam[])
+{
+    crank_slider_load_dynamics_rhs(state->q, state->dq, state->ddq, state->t, p, lam);
+    crank_slider_load_lu_solve_transposed(&work->lu, lam); /* Phi_q^T lam = Q - M ddq - h */
+}
+
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
 static void crank_slider_load_store(crank_slider_load_real out[], int k, const crank_slider_load_real v[])
 {
@@ -446,7 +453,9 @@ int crank_slider_load_solve_grid_checked(const crank_slider_load_options *option
                                     const crank_slider_load_real t[], crank_slider_load_state *state,
                                     crank_slider_load_real q_out[], crank_slider_load_real dq_out[],
                                     crank_slider_load_real ddq_out[], crank_slider_load_real cond_out[],
-                                    unsigned char flagged_out[], crank_slider_load_workspace *work,
+                                    unsigned char flagged_out[],
+
+                                    crank_slider_load_real lam_out[], crank_slider_load_real loads_out[], crank_slider_load_workspace *work,
                                     crank_slider_load_report *report)
 {
     int k;
@@ -460,6 +469,13 @@ int crank_slider_load_solve_grid_checked(const crank_slider_load_options *option
         crank_slider_load_store(ddq_out, k, state->ddq);
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
+        if (lam_out) { /* the factors of this step's Phi_q: one transposed solve */
+            crank_slider_load_real *lam = lam_out + (size_t)k * CRANK_SLIDER_LOAD_NQ;
+            crank_slider_load_multipliers(p, state, work, lam);
+            if (loads_out) {
+                crank_slider_load_loads(state->q, lam, state->t, p, loads_out + (size_t)k * CRANK_SLIDER_LOAD_NLOADS);
+            }
+        }
     }
     return n;
 }
@@ -470,7 +486,7 @@ int crank_slider_load_solve_grid(const crank_slider_load_options *options, const
                             crank_slider_load_report *report)
 {
     return crank_slider_load_solve_grid_checked(options, p, n, t, state, q_out, dq_out, ddq_out, NULL,
-                                           NULL, work, report);
+                                           NULL, NULL, NULL, work, report);
 }
 
 /* Row block `rows` of out, or NULL when out is NULL (no arithmetic on a null pointer). */
@@ -524,13 +540,6 @@ int crank_slider_load_solve_batch(const crank_slider_load_options *options, int 
         solved_sets += k == n;
     }
     return solved_sets;
-}
-
-void crank_slider_load_multipliers(const crank_slider_load_real p[], const crank_slider_load_state *state,
-                              const crank_slider_load_workspace *work, crank_slider_load_real lam[])
-{
-    crank_slider_load_dynamics_rhs(state->q, state->dq, state->ddq, state->t, p, lam);
-    crank_slider_load_lu_solve_transposed(&work->lu, lam); /* Phi_q^T lam = Q - M ddq - h */
 }
 
 int crank_slider_load_multipliers_grid(const crank_slider_load_real p[], int n, const crank_slider_load_real t[],

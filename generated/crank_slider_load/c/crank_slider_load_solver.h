@@ -89,7 +89,11 @@ int crank_slider_load_solve_grid(const crank_slider_load_options *options, const
                             crank_slider_load_report *report);
 
 /* crank_slider_load_solve_grid, and per step k also cond_out[k] (the condition estimate of Phi_q)
- * and flagged_out[k] (1 when q, dq or ddq may miss the targets); either may be NULL. Stops,
+ * and flagged_out[k] (1 when q, dq or ddq may miss the targets); either may be NULL.
+
+ * Inverse dynamics: row k of lam_out (n x NQ) gets the multipliers (crank_slider_load_multipliers,
+ * the step's own factors) and of loads_out (n x NLOADS) the efforts and reactions; NULL
+ * skips them. Stops,
  * like crank_slider_load_solve_grid, at the first step that fails (also one whose condition
  * estimate exceeds options->max_cond: status CRANK_SLIDER_LOAD_SINGULAR), so that the caller can
  * treat that point (pass a singular configuration, bisect to a limit position) and go on. */
@@ -98,7 +102,9 @@ int crank_slider_load_solve_grid_checked(const crank_slider_load_options *option
                                     const crank_slider_load_real t[], crank_slider_load_state *state,
                                     crank_slider_load_real q_out[], crank_slider_load_real dq_out[],
                                     crank_slider_load_real ddq_out[], crank_slider_load_real cond_out[],
-                                    unsigned char flagged_out[], crank_slider_load_workspace *work,
+                                    unsigned char flagged_out[],
+
+                                    crank_slider_load_real lam_out[], crank_slider_load_real loads_out[], crank_slider_load_workspace *work,
                                     crank_slider_load_report *report);
 /* One set's outcome in crank_slider_load_solve_batch. */
 typedef struct {
