@@ -122,3 +122,26 @@ def test_drawn_layout_com_is_global_as_drawn() -> None:
     from_drawing = symkin.solve(symkin.compile(symkin.derive(from_dict(drawn)), "numpy"))
     np.testing.assert_allclose(from_drawing.effort, local.effort, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(from_drawing.reaction, local.reaction, rtol=1e-12, atol=1e-9)
+
+
+def test_sweep_envelope_of_efforts_and_reactions(tmp_path: Path, capsys) -> None:
+    """The sweep's envelope is the min/max over the sets that symkin.solve gives set by set
+    (the peak motor torque over a study), printed by the CLI and saved in its NPZ."""
+    path = EXAMPLES / "crank_slider_load.yaml"
+    kernel = symkin.compile(symkin.derive(path), backend="c")
+    loads = [100.0, 150.0, 200.0]
+    result = symkin.sweep(kernel, {"F0": loads}, workers=1)
+    efforts = [symkin.solve(kernel, params={"F0": f}).effort[:, 0] for f in loads]
+    envelope = {name: (low, high) for name, low, high, _, _ in result.force_envelope()}
+    np.testing.assert_allclose(envelope["motor.effort"], (min(e.min() for e in efforts),
+                                                          max(e.max() for e in efforts)),
+                               rtol=1e-12)
+    out = tmp_path / "sweep.npz"
+    assert cli.main(["sweep", str(path), "--vary", "F0=100:200:3", "--workers", "1",
+                     "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"motor.effort: min {envelope['motor.effort'][0]:.6g}" in printed
+    saved = np.load(out)
+    assert saved["effort"].shape == (3, saved["t"].size, 1)
+    assert list(saved["joint_names"]) == ["O", "A", "B", "slide"]
+    np.testing.assert_allclose(saved["effort"][1, :, 0], efforts[1], rtol=1e-12)
