@@ -181,6 +181,5 @@ def _result(kernel: Kernel, times: Array, values: Array, chunk: Chunk) -> SweepR
         reasons=tuple(chunk.reasons), messages=tuple(chunk.messages),
         t_reached=chunk.t_reached, solved=chunk.solved, iterations=chunk.iterations,
         points_named=tuple(kernel.points), local_vectors=kernel.point_vectors,
-        **({"multipliers_grid": kernel.multipliers_grid,
-            "driver_names": kernel.driver_names, "joint_names": kernel.joint_names}
-           if getattr(kernel, "has_dynamics", False) else {}))
+        multipliers_grid=kernel.multipliers_grid if kernel.has_dynamics else None,
+        driver_names=kernel.driver_names, joint_names=kernel.joint_names)

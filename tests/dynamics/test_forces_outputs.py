@@ -96,7 +96,7 @@ PENDULUM_LOCAL = {
 
 
 def test_pendulum_closed_form() -> None:
-    """One body about a fixed pivot: T = (J + m|c|²) α − moment of gravity and the load."""
+    """One body about a fixed pivot: T = (J + m|c|^2) alpha - moment of gravity and the load."""
     traj = symkin.solve(symkin.compile(symkin.derive(from_dict(PENDULUM_LOCAL)),
                                        backend="numpy"))
     phi = 0.3 + 2 * traj.t
