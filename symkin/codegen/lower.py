@@ -49,7 +49,11 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     # right-hand side Q - M ddq - h of Phi_q^T lam = rhs, and the efforts and reactions of lam.
     "dynamics_rhs": ("q", "dq", "ddq", "t", "p"),
     "loads": ("q", "lam", "t", "p"),
+    # the same from the fused routine's sines and cosines, at the q of the last step
+    "dynamics_rhs_shared": ("q", "dq", "ddq", "t", "p", "shared"),
+    "loads_shared": ("q", "lam", "t", "p", "shared"),
 }
+DYNAMICS = ("dynamics_rhs", "loads")
 FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
 
 # Characters allowed in a comment of generated code; anything else becomes '?'.
@@ -268,11 +272,17 @@ def _fused_expressions(prepared: dict[str, list[sp.Expr]]
                 found |= e.atoms(sp.sin, sp.cos)
         return found
 
-    shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma")), key=sp.default_sort_key)
+    # With inverse dynamics, also those the multipliers' routines use (a file without masses
+    # or forces shares exactly what it did before).
+    dynamics = tuple(name for name in DYNAMICS if name in prepared)
+    shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma", *dynamics)),
+                    key=sp.default_sort_key)
     mapping = {f: sp.Symbol(f"_shared{k}", real=True) for k, f in enumerate(shared)}
     return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
             "phi_t_shared": [e.xreplace(mapping) for e in prepared["phi_t"]],
-            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]]}, shared
+            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]],
+            **{f"{name}_shared": [e.xreplace(mapping) for e in prepared[name]]
+               for name in dynamics}}, shared
 
 
 def point_names(system: System) -> tuple[tuple[str, str], ...]:
@@ -397,7 +407,8 @@ def _ops_before_cse(expressions: dict[str, list[sp.Expr]], fused: dict[str, list
     its pieces (count_ops of a list is the sum over it), so it is not counted twice."""
     counts = {name: _count_ops(exprs) for name, exprs in expressions.items()}
     counts["phi_phi_q"] = counts["phi"] + counts["phi_q"] + _count_ops(shared)
-    counts.update({name: _count_ops(fused[name]) for name in ("phi_t_shared", "gamma_shared")})
+    counts.update({name: _count_ops(exprs) for name, exprs in fused.items()
+                   if name != "phi_phi_q"})
     return counts
 
 

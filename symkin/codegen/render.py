@@ -30,7 +30,8 @@ from symkin.symbolic.derivation import System
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
              "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out",
-             "dynamics_rhs": "out", "loads": "out"}
+             "dynamics_rhs": "out", "loads": "out", "dynamics_rhs_shared": "out",
+             "loads_shared": "out"}
 # The output arrays of a routine with several (Routine.sizes), in order.
 _C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
@@ -48,6 +49,8 @@ _PYTHON_DOC = {
     "gamma_shared": "Gamma(q, dq, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
     "dynamics_rhs": "Q - M ddq - h(q, dq), the right-hand side of Phi_q^T lam = rhs, (NQ,).",
     "loads": "The efforts (DRIVER_NAMES) then Fx, Fy, M of each joint (JOINT_NAMES) from lam.",
+    "dynamics_rhs_shared": "dynamics_rhs from the shared values of phi_phi_q_nz at the same q.",
+    "loads_shared": "loads from the shared values of phi_phi_q_nz at the same q, t, p.",
 }
 
 
@@ -315,6 +318,8 @@ def _labels(code: Code, routine: str) -> list[str]:
     if routine == "phi_phi_q":
         return [*_labels(code, "phi"), *_labels(code, "phi_q"),
                 *(lower.comment(f) for f in code.shared)]
+    if routine.endswith("_shared") and routine[:-len("_shared")] in lower.DYNAMICS:
+        return _labels(code, routine[:-len("_shared")])
     if routine == "dynamics_rhs":
         return [lower.comment(name) for name in code.coordinates]
     if routine == "loads":
