@@ -145,3 +145,13 @@ def test_sweep_envelope_of_efforts_and_reactions(tmp_path: Path, capsys) -> None
     assert saved["effort"].shape == (3, saved["t"].size, 1)
     assert list(saved["joint_names"]) == ["O", "A", "B", "slide"]
     np.testing.assert_allclose(saved["effort"][1, :, 0], efforts[1], rtol=1e-12)
+
+
+def test_cli_plot_writes_the_forces_figure(tmp_path: Path) -> None:
+    plot = tmp_path / "run.png"
+    assert cli.main(["run", str(EXAMPLES / "crank_slider_load.yaml"), "--plot", str(plot)]) == 0
+    assert plot.stat().st_size > 0
+    assert (tmp_path / "run_forces.png").stat().st_size > 0
+    kinematic = tmp_path / "kinematics" / "run.png"
+    assert cli.main(["run", str(EXAMPLES / "four_bar.yaml"), "--plot", str(kinematic)]) == 0
+    assert sorted(p.name for p in kinematic.parent.iterdir()) == ["run.png"]
