@@ -155,3 +155,32 @@ def test_cli_plot_writes_the_forces_figure(tmp_path: Path) -> None:
     kinematic = tmp_path / "kinematics" / "run.png"
     assert cli.main(["run", str(EXAMPLES / "four_bar.yaml"), "--plot", str(kinematic)]) == 0
     assert sorted(p.name for p in kinematic.parent.iterdir()) == ["run.png"]
+
+
+def test_float_and_dense_c_builds_agree() -> None:
+    """The float build (its own tolerances) and the dense-LU build give the same efforts."""
+    system = symkin.derive(EXAMPLES / "four_bar_dynamics.yaml")
+    reference = symkin.solve(symkin.compile(system, "c")).effort
+    scale = np.abs(reference).max()
+    dense = symkin.solve(symkin.compile(system, "c", linalg="dense")).effort
+    single = symkin.solve(symkin.compile(system, "c", real="float")).effort
+    np.testing.assert_allclose(dense, reference, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(single, reference, rtol=0, atol=1e-4 * scale)
+
+
+def test_a_point_named_E_and_a_static_spring() -> None:
+    """A point named E (the constant's name is free for points) as a spring's end; the arm
+    held still by its motor: the effort is the spring's moment, k (L - L0) times its lever."""
+    data = {**PENDULUM_LOCAL,
+            "bodies": {"arm": {"q0": [0, 0, 0], "points": {"E": [2, 0]}}},
+            "drivers": [{"type": "angle", "name": "hold", "i": "arm", "j": "ground",
+                         "theta": 0}],
+            "forces": [{"type": "spring", "name": "s", "i": "arm", "A": "E", "j": "ground",
+                        "B": [2, 3], "k": 10, "length0": 1, "damping": 4}]}
+    for backend in ("c", "numpy"):
+        traj = symkin.solve(symkin.compile(symkin.derive(from_dict(data)), backend))
+        # tension 10 (3 - 1) = 20 pulls E = (2, 0) up towards (2, 3): moment 2 * 20 = 40 CCW,
+        # so the motor holds with -40; the pivot takes the force: ground -> arm (0, -20)
+        np.testing.assert_allclose(traj.effort[:, 0], -40.0, rtol=1e-13)
+        np.testing.assert_allclose(traj.reaction[:, 0, :2], [[0.0, -20.0]] * traj.t.size,
+                                   atol=1e-12)
