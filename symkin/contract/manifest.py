@@ -64,3 +64,5 @@ class Manifest(Metadata):
 
 KEYS = frozenset(Manifest.__annotations__)
 """Every key of a manifest (a reader asks for no other)."""
+DYNAMICS_KEYS = frozenset(_Dynamics.__annotations__)
+"""The keys only a mechanism with masses or forces has."""

@@ -100,7 +100,8 @@ def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
     paths = render.generate(system("crank_slider"), backends.get("c"), out_dir=tmp_path)
     written = paths[-1]
     assert written.name == manifest.manifest_name("crank_slider")
-    assert set(json.loads(written.read_text(encoding="utf-8"))) == manifest.KEYS
+    assert set(json.loads(written.read_text(encoding="utf-8"))) == \
+        manifest.KEYS - manifest.DYNAMICS_KEYS
 
 
 # The modules that read a manifest, and the names their manifest dicts go by.
@@ -139,3 +140,8 @@ def test_manifest_readers_ask_only_for_declared_keys(module: str) -> None:
     keys = _keys_read(ast.parse((ROOT / module).read_text(encoding="utf-8")))
     assert keys, f"{module}: no manifest key found; has the reader's variable been renamed?"
     assert keys <= manifest.KEYS, f"{module} reads undeclared keys {sorted(keys - manifest.KEYS)}"
+
+
+def test_manifest_of_a_mechanism_with_forces_has_every_key(tmp_path: Path) -> None:
+    paths = render.generate(system("crank_slider_load"), backends.get("c"), out_dir=tmp_path)
+    assert set(json.loads(paths[-1].read_text(encoding="utf-8"))) == manifest.KEYS
