@@ -184,3 +184,24 @@ def test_a_point_named_E_and_a_static_spring() -> None:
         np.testing.assert_allclose(traj.effort[:, 0], -40.0, rtol=1e-13)
         np.testing.assert_allclose(traj.reaction[:, 0, :2], [[0.0, -20.0]] * traj.t.size,
                                    atol=1e-12)
+
+
+def test_reaction_arrows_start_at_the_joints_points(tmp_path: Path) -> None:
+    """The mechanism view draws each joint's reaction at its point on body i: the outlines
+    place joint A of the four-bar at the crank's point A, joint B at the coupler's B."""
+    from symkin.present.animation import joint_points
+    from symkin.symbolic.drawing import outlines
+
+    system = symkin.derive(EXAMPLES / "four_bar_dynamics.yaml")
+    traj = symkin.solve(symkin.compile(system, "numpy"))
+    where = joint_points(traj, outlines(system))
+    assert sorted(where) == sorted(traj.forces.joint_names)
+    np.testing.assert_allclose(where["A"], traj.point("crank", "A")[0], atol=1e-12)
+    np.testing.assert_allclose(where["B"], traj.point("coupler", "B")[0], atol=1e-12)
+    np.testing.assert_allclose(where["O2"], 0.0, atol=1e-12)
+    assert not any(key.startswith("joint:") for key in
+                   outlines(symkin.derive(EXAMPLES / "four_bar.yaml")))
+    report = tmp_path / "report.html"
+    assert cli.main(["run", str(EXAMPLES / "four_bar_dynamics.yaml"), "--html",
+                     str(report)]) == 0
+    assert "joint reactions (i on j)" in report.read_text()
