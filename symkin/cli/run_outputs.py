@@ -75,6 +75,11 @@ def write(trajectory: Any, args: argparse.Namespace, outlines: Any,
 
         written.append(plots.plot(trajectory, args.plot, picture.select, picture.units,
                                   picture.title))
+        if trajectory.forces is not None:  # efforts and reactions: a figure of their own
+            from symkin.present import force_plots
+
+            written.append(force_plots.plot_forces(
+                trajectory, force_plots.forces_path(args.plot), picture.title))
     if args.html:
         from symkin.present import html
 

@@ -170,6 +170,7 @@ def _run(kernel: Any, args: argparse.Namespace, design: Any, spread: Any) -> int
         if client is not None:
             client.close()
     _report(kernel, result, spread)
+    _report_forces(result)
     written = _write(result, args)
     if written:
         print("wrote " + ", ".join(map(str, written)))
@@ -224,6 +225,16 @@ def _report(kernel: Any, result: Any, spread: Any) -> None:
                 r_p = estimate[f"{body}.{name}"][1][k, axis]
                 line += f" | first order ±3σ {3 * tolerance.first_order_std(r_p, spread):.3g}"
             print(line)
+
+
+def _report_forces(result: Any) -> None:
+    """The envelope of each effort and reaction: what a motor or a bearing must take."""
+    envelope = result.force_envelope()
+    if envelope:
+        print("efforts and reactions over the solved sets (min, max; the largest magnitude "
+              "at):")
+    for name, low, high, t, j in envelope:
+        print(f"  {name}: min {low:.6g} max {high:.6g} | largest at t = {t:g} (set {j})")
 
 
 def _write(result: Any, args: argparse.Namespace) -> list[Path]:

@@ -48,7 +48,15 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "phi_phi_q": ("q", "t", "p"),
     "phi_t_shared": ("q", "t", "p", "shared"),
     "gamma_shared": ("q", "dq", "t", "p", "shared"),
+    # Inverse dynamics, only for a file with masses or forces (symbolic.dynamics): the
+    # right-hand side Q - M ddq - h of Phi_q^T lam = rhs, and the efforts and reactions of lam.
+    "dynamics_rhs": ("q", "dq", "ddq", "t", "p"),
+    "loads": ("q", "lam", "t", "p"),
+    # the same from the fused routine's sines and cosines, at the q of the last step
+    "dynamics_rhs_shared": ("q", "dq", "ddq", "t", "p", "shared"),
+    "loads_shared": ("q", "lam", "t", "p", "shared"),
 }
+DYNAMICS = ("dynamics_rhs", "loads")
 FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
 
 # Characters allowed in a comment of generated code; anything else becomes '?'.
@@ -141,6 +149,15 @@ class Code:
         """The components of a point vector, in order."""
         return "xyz" if self.space == "3d" else "xy"
 
+    driver_names: tuple[str, ...] = ()
+    joint_names: tuple[str, ...] = ()
+    """Inverse dynamics (``dynamics_rhs`` and ``loads`` routines present): the labels of the
+    efforts (one per driver row) and of the joints' reactions."""
+
+    @property
+    def dynamics(self) -> bool:
+        return any(routine.name == "loads" for routine in self.routines)
+
     @property
     def nnz(self) -> int:
         return len(self.pattern_rows)
@@ -218,6 +235,8 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         removed=tuple(str(removed) for removed in system.removed),
+        driver_names=system.dynamics.driver_names if system.dynamics else (),
+        joint_names=system.dynamics.joint_names if system.dynamics else (),
     )
 
 
@@ -248,6 +267,8 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
         "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
         # Only where rows were removed: every other file's generated code stays as it was.
         **({"removed": [removed.phi for removed in system.removed]} if system.removed else {}),
+        **({"dynamics_rhs": list(system.dynamics.rhs), "loads": list(system.dynamics.loads)}
+           if system.dynamics is not None else {}),
     }
 
 
@@ -268,11 +289,17 @@ def _fused_expressions(prepared: dict[str, list[sp.Expr]]
                 found |= e.atoms(sp.sin, sp.cos)
         return found
 
-    shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma")), key=sp.default_sort_key)
+    # With inverse dynamics, also those the multipliers' routines use (a file without masses
+    # or forces shares exactly what it did before).
+    dynamics = tuple(name for name in DYNAMICS if name in prepared)
+    shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma", *dynamics)),
+                    key=sp.default_sort_key)
     mapping = {f: sp.Symbol(f"_shared{k}", real=True) for k, f in enumerate(shared)}
     return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
             "phi_t_shared": [e.xreplace(mapping) for e in prepared["phi_t"]],
-            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]]}, shared
+            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]],
+            **{f"{name}_shared": [e.xreplace(mapping) for e in prepared[name]]
+               for name in dynamics}}, shared
 
 
 def point_names(system: System) -> tuple[tuple[str, str], ...]:
@@ -397,7 +424,8 @@ def _ops_before_cse(expressions: dict[str, list[sp.Expr]], fused: dict[str, list
     its pieces (count_ops of a list is the sum over it), so it is not counted twice."""
     counts = {name: _count_ops(exprs) for name, exprs in expressions.items()}
     counts["phi_phi_q"] = counts["phi"] + counts["phi_q"] + _count_ops(shared)
-    counts.update({name: _count_ops(fused[name]) for name in ("phi_t_shared", "gamma_shared")})
+    counts.update({name: _count_ops(exprs) for name, exprs in fused.items()
+                   if name != "phi_phi_q"})
     return counts
 
 

@@ -29,7 +29,9 @@ from symkin.errors import BuildError, UsageError
 from symkin.symbolic.derivation import System
 
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
-             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out", "removed": "out"}
+             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out", "removed": "out",
+             "dynamics_rhs": "out", "loads": "out", "dynamics_rhs_shared": "out",
+             "loads_shared": "out"}
 # The output arrays of a routine with several (Routine.sizes), in order.
 _C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
@@ -46,6 +48,10 @@ _PYTHON_DOC = {
                  "and cosine once.",
     "phi_t_shared": "Phi_t(q, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
     "gamma_shared": "Gamma(q, dq, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
+    "dynamics_rhs": "Q - M ddq - h(q, dq), the right-hand side of Phi_q^T lam = rhs, (NQ,).",
+    "loads": "The efforts (DRIVER_NAMES) then Fx, Fy, M of each joint (JOINT_NAMES) from lam.",
+    "dynamics_rhs_shared": "dynamics_rhs from the shared values of phi_phi_q_nz at the same q.",
+    "loads_shared": "loads from the shared values of phi_phi_q_nz at the same q, t, p.",
 }
 
 
@@ -204,7 +210,7 @@ def manifest(code: Code, files: dict[str, str]) -> str:
 
 def metadata(code: Code) -> Metadata:
     """What the runtime Kernel needs besides the compiled functions (plain JSON data); the
-    space only for a spatial mechanism (a planar manifest is as it always was)."""
+    optional keys only where they apply (a planar manifest without them is as it always was)."""
     data: Metadata = {
         "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
         "p_values": list(code.p_values), "q0": list(code.q0), "time_grid": list(code.time_grid),
@@ -218,6 +224,9 @@ def metadata(code: Code) -> Metadata:
         data["removed"] = list(code.removed)
     if code.space == "3d":
         data["space"] = code.space
+    if code.dynamics:
+        data["driver_names"] = list(code.driver_names)
+        data["joint_names"] = list(code.joint_names)
     return data
 
 
@@ -257,6 +266,11 @@ def template_context(code: Code) -> dict[str, Any]:
         "point_size": len(code.point_axes),
         "point_tuples": "(x, y, z) triples" if code.space == "3d" else "(x, y) pairs",
         "linalg": code.linalg,
+        # Inverse dynamics (only when the file has masses or forces).
+        "dynamics": code.dynamics, "n_efforts": len(code.driver_names),
+        "n_joints": len(code.joint_names),
+        "driver_literals": [repr(n) for n in code.driver_names],
+        "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
         "option_fields": list(options.SOLVER_FIELDS),
@@ -323,6 +337,14 @@ def _labels(code: Code, routine: str) -> list[str]:
                 *(lower.comment(f) for f in code.shared)]
     if routine == "removed":
         return [lower.comment(row) for row in code.removed]
+    if routine.endswith("_shared") and routine[:-len("_shared")] in lower.DYNAMICS:
+        return _labels(code, routine[:-len("_shared")])
+    if routine == "dynamics_rhs":
+        return [lower.comment(name) for name in code.coordinates]
+    if routine == "loads":
+        return [lower.comment(f"{name}.effort") for name in code.driver_names] + [
+            lower.comment(f"{name}.{part}") for name in code.joint_names
+            for part in ("Fx", "Fy", "M")]
     if routine == "points":
         return [lower.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in code.point_axes]

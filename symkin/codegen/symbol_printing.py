@@ -14,7 +14,7 @@ from symkin.errors import BuildError, ExpressionError
 from symkin.spec import constants
 from symkin.symbolic.derivation import System
 
-_INTERNAL = re.compile(r"_(q|dq|p|shared)(\d+)\Z")
+_INTERNAL = re.compile(r"_(q|dq|ddq|lam|p|shared)(\d+)\Z")
 _TEMPORARY = re.compile(r"w\d+\Z")
 
 
@@ -40,7 +40,10 @@ def symbol_text(name: str) -> str:
 def internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:
     """User symbols -> internal symbols whose names the printers turn into array accesses."""
     mapping = {system.t: sp.Symbol("_t", real=True)}
-    for prefix, symbols in (("q", system.q), ("dq", system.dq), ("p", system.p)):
+    arrays = [("q", system.q), ("dq", system.dq), ("p", system.p)]
+    if system.dynamics is not None:  # accelerations and multipliers (inverse dynamics)
+        arrays += [("ddq", system.dynamics.ddq), ("lam", system.dynamics.lam)]
+    for prefix, symbols in arrays:
         mapping.update({s: sp.Symbol(f"_{prefix}{k}", real=True) for k, s in enumerate(symbols)})
     return mapping
 

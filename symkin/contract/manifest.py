@@ -18,7 +18,15 @@ def manifest_name(prefix: str) -> str:
     return prefix + MANIFEST_SUFFIX
 
 
-class Metadata(TypedDict):
+class _Dynamics(TypedDict, total=False):
+    """Present only for a mechanism with masses or forces: the labels of the efforts (one
+    per driver row) and of the joints' reactions."""
+
+    driver_names: list[str]
+    joint_names: list[str]
+
+
+class Metadata(_Dynamics):
     """What a runtime Kernel needs besides the compiled functions (plain JSON data)."""
 
     coordinates: list[str]
@@ -62,6 +70,10 @@ class Manifest(Metadata):
 KEYS = frozenset(Manifest.__annotations__)
 """Every key of a manifest (a reader asks for no other)."""
 
-OPTIONAL_KEYS = frozenset({"removed"})
-"""The keys only some manifests have (``removed``: an over-constrained file's). Written out:
-with postponed annotations the TypedDict cannot see NotRequired in Python 3.11."""
+DYNAMICS_KEYS = frozenset(_Dynamics.__annotations__)
+"""The keys only a mechanism with masses or forces has."""
+
+OPTIONAL_KEYS = frozenset({"removed", "space"}) | DYNAMICS_KEYS
+"""The keys only some manifests have (``removed``: an over-constrained file's; ``space``: a
+spatial one's; the dynamics keys). Written out: with postponed annotations the TypedDict
+cannot see NotRequired in Python 3.11."""

@@ -67,6 +67,20 @@ def slide_axes(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, 
     return axes
 
 
+def joint_points(trajectory: Trajectory, outlines: Outlines) -> dict[str, Array]:
+    """Where each joint's reaction acts (its point on body i), (T, 2) in the global frame,
+    by joint name: the keys ``joint:<name>:<body i>`` (files with masses or forces)."""
+    found = {}
+    for key, rows in outlines.items():
+        if not key.startswith("joint:"):
+            continue
+        name, body = key.split(":")[1:3]
+        if body == GROUND or body in trajectory.bodies:
+            local = np.asarray(rows, dtype=float).reshape(-1, 2)[:1]
+            found[name] = _global(trajectory, body, local)[:, 0]
+    return found
+
+
 def rods(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]]:
     """Every rod with no body of its own (a distance constraint) as its two ends, each (T, 2),
     in the global frame: the keys ``rod:<body i>:<body j>`` hold rows end on i, end on j."""

@@ -21,13 +21,21 @@ from numpy.typing import NDArray
 
 from symkin.errors import UsageError
 from symkin.present import series
-from symkin.present.animation import MAX_FRAMES, Outlines, body_shapes, rods, slide_axes
+from symkin.present.animation import (
+    MAX_FRAMES,
+    Outlines,
+    body_shapes,
+    joint_points,
+    rods,
+    slide_axes,
+)
 from symkin.present.series import DEFAULT_UNITS, LENGTH, Units
 from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
 VECTOR_SHARE = 0.15  # the longest vector of the run drawn this long, relative to the picture
 VELOCITY, ACCELERATION = "#d62728", "#1f77b4"
+REACTION = "#2ca02c"  # joint reactions (inverse dynamics): body i on body j
 
 
 def available() -> bool:
@@ -115,6 +123,21 @@ class _Scene:
         self.kinematics = {name: trajectory.point(*name.rsplit(".", 1)) for name in points}
         self.scales = {order: self._scale(order) for order in (1, 2)}
         self.units = units
+        # inverse dynamics: each joint's reaction (on body j) drawn at its point on body i
+        self.reactions = self._reactions(trajectory, outlines)
+
+    def _reactions(self, trajectory: Trajectory, outlines: Outlines
+                   ) -> list[tuple[str, Array, Array]]:
+        forces = trajectory.forces
+        if forces is None:
+            return []
+        where = joint_points(trajectory, outlines)
+        found = [(name, where[name], forces.reaction[:, k, :2])
+                 for k, name in enumerate(forces.joint_names) if name in where]
+        largest = max([float(np.nanmax(np.hypot(*f.T), initial=0.0)) for _, _, f in found]
+                      + [0.0])
+        self.force_scale = VECTOR_SHARE * self.span / largest if largest > 0 else 0.0
+        return found
 
     def _scale(self, order: int) -> float:
         """Picture length per unit of velocity (order 1) or acceleration (order 2)."""
@@ -159,6 +182,13 @@ class _Scene:
                     marker={"symbol": "arrow", "angleref": "previous", "size": [0, 11],
                             "color": colour},
                     hovertemplate=f"{name} {word}<extra></extra>")))
+        for k, (name, _, _) in enumerate(self.reactions):
+            moving.append(self._add(figure, go.Scatter(
+                mode="lines+markers", name="joint reactions (i on j)", legendgroup="reactions",
+                showlegend=k == 0, line={"width": 2, "color": REACTION},
+                marker={"symbol": "arrow", "angleref": "previous", "size": [0, 11],
+                        "color": REACTION},
+                hovertemplate=f"{name} reaction<extra></extra>")))
         return moving
 
     @staticmethod
@@ -181,6 +211,10 @@ class _Scene:
                 end = r + self.scales[order] * tip
                 data.append(go.Scatter(x=[r[0], end[0]], y=[r[1], end[1]],
                                        customdata=[tip, tip]))
+        for _, point, force in self.reactions:
+            r, end = point[k], point[k] + self.force_scale * force[k]
+            data.append(go.Scatter(x=[r[0], end[0]], y=[r[1], end[1]],
+                                   customdata=[force[k], force[k]]))
         return data
 
 

@@ -37,7 +37,7 @@ from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime import failures, redundant, units
+from symkin.runtime import failures, forces, redundant, units
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
@@ -199,7 +199,7 @@ def _c_loop(kernel: KinematicsKernel, run: _Run, solver: GridSolver, p: Array,
     if run.done == run.t.size:  # the edge treatment solved the last point: the grid is done
         run.fallbacks = solver.fallbacks  # (the report still holds the failed call's status)
         return Newton(run.q[run.done - 1], OK, 0, 0.0, None)
-    solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
+    solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
     return _c_outcome(kernel, run, solver, p, _c_run(run, solver, progress))
 
 
@@ -285,7 +285,8 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         else None
     try:
         if solver is not None:
-            solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged)
+            run.forces_out = forces.allocate(kernel, times.size)
+            solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
             solved = _c_run(run, solver, progress)
             _check_start(kernel, run, p, options)
             if run.done == times.size:  # the usual case: nothing left to treat
@@ -374,9 +375,13 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
             -1, _point_size(kernel))
     singular = tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
                      for s in run.passages) if run.passages else ()
-    return Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates), tuple(kernel.points),
-                             point_vectors, p, run.fallbacks, flagged, cond, singular,
-                             space=_space(kernel))
+    trajectory = Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates),
+                                   tuple(kernel.points), point_vectors, p, run.fallbacks,
+                                   flagged, cond, singular, space=_space(kernel))
+    # inverse dynamics (a kernel with masses or forces): efforts and reactions of the rows
+    given = None if run.forces_out is None else tuple(a[:done] for a in run.forces_out)
+    trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
+    return trajectory
 
 
 def _space(kernel: KinematicsKernel) -> str:

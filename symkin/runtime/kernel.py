@@ -10,6 +10,7 @@ SymPy or jinja2.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import json
 import sys
@@ -39,6 +40,9 @@ class _Functions(Protocol):
     def phi_p_nz(self, q: Array, t: float, p: Array) -> Array: ...
     # The removed rows' Phi (over-constrained files only; None where there is none).
     removed: Callable[[Array, float, Array], Array] | None
+    # inverse dynamics (kernels of mechanisms with masses or forces only)
+    def dynamics_rhs(self, q: Array, dq: Array, ddq: Array, t: float, p: Array) -> Array: ...
+    def loads(self, q: Array, lam: Array, t: float, p: Array) -> Array: ...
 
 
 class Kernel:
@@ -77,6 +81,10 @@ class Kernel:
         # The rows of an over-constrained file removed as dependent at t0 (not in Phi); the
         # driver checks them along the motion with removed_phi.
         self.removed: tuple[str, ...] = tuple(meta.get("removed", ()))
+        # Inverse dynamics: present when the file has masses or forces.
+        self.has_dynamics = "joint_names" in meta
+        self.driver_names: tuple[str, ...] = tuple(meta.get("driver_names", ()))
+        self.joint_names: tuple[str, ...] = tuple(meta.get("joint_names", ()))
         self._functions = functions
 
     @property
@@ -147,6 +155,40 @@ class Kernel:
             raise ValueError(f"the kernel of {self.name} names removed rows but has no "
                              "routine for them; rebuild it with symkin.compile")
         return np.asarray(evaluate(self._q(q), float(t), self._p(p)), dtype=float)
+    # -- inverse dynamics ---------------------------------------------------------------------
+    def multipliers(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, t: float,
+                    p: ArrayLike | None = None) -> Array:
+        """lam of Phi_q^T lam = Q - M ddq - h(q, dq) at one state, shape (N,)."""
+        self._require_dynamics()
+        q, p = self._q(q), self._p(p)
+        rhs = self._functions.dynamics_rhs(q, self._q(dq, "dq"), self._q(ddq, "ddq"),
+                                           float(t), p)
+        return np.asarray(np.linalg.solve(self.phi_q(q, t, p).T, rhs), dtype=float)
+
+    def loads(self, q: ArrayLike, lam: ArrayLike, t: float,
+              p: ArrayLike | None = None) -> Array:
+        """The efforts (one per driver row) then Fx, Fy, M of each joint, from lam."""
+        self._require_dynamics()
+        return self._functions.loads(self._q(q), self._q(lam, "lam"), float(t), self._p(p))
+
+    def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array,
+                         p: Array) -> tuple[Array, Array]:
+        """lam (T, N) and the loads (T, NLOADS) of solved rows; NaN where Phi_q is singular.
+        A backend whose generated code does it in one call overrides this loop."""
+        n_loads = len(self.driver_names) + 3 * len(self.joint_names)
+        lam = np.full(q.shape, np.nan)
+        loads = np.full((t.size, n_loads), np.nan)
+        for k in range(t.size):
+            # singular Phi_q: no unique multipliers, the row stays NaN and says so
+            with contextlib.suppress(np.linalg.LinAlgError):
+                lam[k] = self.multipliers(q[k], dq[k], d2q[k], t[k], p)
+            loads[k] = self.loads(q[k], lam[k], t[k], p)
+        return lam, loads
+
+    def _require_dynamics(self) -> None:
+        if not self.has_dynamics:
+            raise ValueError(f"{self.name} has no masses or forces: give bodies a mass or "
+                             "add a forces section to compute efforts and reactions")
 
     def point_vectors(self, p: ArrayLike | None = None) -> Array:
         """Local vectors of the named points, shape (NPOINTS, 2) (spatial: 3), in ``points``

@@ -43,8 +43,10 @@ class GridSolver(Protocol):
         ...
 
     def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
-             cond_out: Array, flagged_out: NDArray[np.bool_]) -> None:
-        """The run's grid and the C-contiguous rows :meth:`advance` writes."""
+             cond_out: Array, flagged_out: NDArray[np.bool_],
+             forces_out: tuple[Array, Array] | None = None) -> None:
+        """The run's grid and the C-contiguous rows :meth:`advance` writes (and, for a
+        kernel with inverse dynamics, the multipliers and loads of each row)."""
         ...
 
     def advance(self, start: int, stop: int) -> int:

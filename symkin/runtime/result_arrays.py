@@ -30,6 +30,8 @@ class Run:
         t: the time points (T,), owned by the run (a copy of the caller's grid).
         q, dq, d2q: (T, N) rows; cond (T,) the condition estimates; flagged (T,) the flags.
         done: how many leading rows are solved.
+        forces_out: (lam (T, N), loads (T, NLOADS)) for the C grid loop of a kernel with
+            inverse dynamics, NaN where it did not write; None otherwise.
         fallbacks: the generated sparse LU's fall-backs to dense LU (C solver).
         passages: the singular configurations passed through.
         caller_owned: the arrays are the caller's (``out=``): a partial result views them
@@ -37,7 +39,7 @@ class Run:
     """
 
     __slots__ = ("caller_owned", "cond", "d2q", "done", "dq", "fallbacks", "flagged",
-                 "passages", "q", "t")
+                 "forces_out", "passages", "q", "t")
 
     def __init__(self, t: Array, q: Array, dq: Array, d2q: Array, cond: Array,
                  flagged: NDArray[np.bool_], caller_owned: bool = False) -> None:
@@ -47,6 +49,8 @@ class Run:
         self.fallbacks = 0
         self.passages: list[Passage] = []
         self.caller_owned = caller_owned
+        # inverse dynamics: (lam, loads) rows the C grid loop fills (NaN: not filled there)
+        self.forces_out: tuple[Array, Array] | None = None
 
     def store(self, k: int, point: Point) -> None:
         self.q[k], self.dq[k], self.d2q[k] = point.q, point.dq, point.ddq

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin.errors import SymkinError
 from symkin.runtime import spatial
+from symkin.runtime.forces import Forces
 
 SAVE_FORMATS = (".npz", ".csv")
 
@@ -95,6 +96,8 @@ class Trajectory:
     removed: tuple[str, ...] = ()
     removed_residual: NDArray[np.float64] | None = None
     space: str = "2d"
+    forces: Forces | None = None
+    """Efforts and reactions (runtime.forces) when the mechanism has masses or forces."""
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.
@@ -119,7 +122,7 @@ class Trajectory:
                              point_vectors=point_vectors, params=params,
                              lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
                              cond=cond, singular=singular, removed=(), removed_residual=None,
-                             space=space)
+                             space=space, forces=None)
         return self
 
     @property
@@ -130,6 +133,16 @@ class Trajectory:
     def point_size(self) -> int:
         """A point's components: 2, or 3 in a spatial mechanism."""
         return 3 if self.spatial else 2
+
+    @property
+    def effort(self) -> NDArray[np.float64] | None:
+        """(T, n_driver_equations): what each driver applies (None without dynamics)."""
+        return None if self.forces is None else self.forces.effort
+
+    @property
+    def reaction(self) -> NDArray[np.float64] | None:
+        """(T, n_joints, 3): Fx, Fy, M body i exerts on body j (None without dynamics)."""
+        return None if self.forces is None else self.forces.reaction
 
     @property
     def bodies(self) -> tuple[str, ...]:
@@ -214,12 +227,22 @@ class Trajectory:
             omega, alpha = self.angular()
             arrays.update(omega=omega, alpha=alpha,
                           bodies=np.array(self.bodies, dtype=str).reshape(-1))
+        arrays.update(self._forces_arrays())
         np.savez(path, **arrays)
+
+    def _forces_arrays(self) -> dict[str, NDArray[Any]]:
+        """NPZ ``effort``, ``driver_names``, ``reaction``, ``joint_names`` (with dynamics)."""
+        if self.forces is None:
+            return {}
+        f = self.forces
+        return {"effort": f.effort, "driver_names": np.array(f.driver_names, dtype=str),
+                "reaction": f.reaction, "joint_names": np.array(f.joint_names, dtype=str)}
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
                   *(c + "_tt" for c in self.coordinates), *self._point_columns(),
-                  *self._angular_columns(), "flagged"]
+                  *self._angular_columns(), "flagged",
+                  *(self.forces.columns() if self.forces is not None else ())]
         r, dr, ddr = self.point_arrays()
         # Per point: x, y, vx, vy, ax, ay (2.14-2.16); spatial: x, y, z, vx, vy, vz, ax...
         # the column count given, not inferred: a run that stopped before its first row
@@ -231,6 +254,7 @@ class Trajectory:
             omega, alpha = self.angular()
             columns.append(np.concatenate([omega, alpha], axis=2).reshape(
                 self.t.size, 6 * len(self.bodies)))
-        table = np.column_stack([*columns, self.flagged])
+        forces = [self.forces.table()] if self.forces is not None else []
+        table = np.column_stack([*columns, self.flagged, *forces])
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")

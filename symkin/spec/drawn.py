@@ -28,10 +28,13 @@ from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
 from symkin.pairs.fields import GROUND
 from symkin.pairs.kit import Joined, PairType
-from symkin.spec import constants, expressions
+from symkin.spec import constants, expressions, forces
 from symkin.spec.schema import MechanismSpec
 
 LAYOUTS = ("local", "drawn")
+# The keys of inverse dynamics a drawn body may have besides points and frame.
+DYNAMICS_KEYS = ("mass", "inertia", "com")
+
 # Joint points that should coincide may differ by this much, relative to the drawing's size.
 CLOSURE_TOLERANCE = 1e-6
 
@@ -173,7 +176,7 @@ class Drawing:
         path: Path_ = ("bodies", body)
         if not isinstance(spec, Mapping):
             raise MechanismError("expected a mapping with points (and frame)", path)
-        allowed = {"points"} if body == GROUND else {"points", "frame"}
+        allowed = {"points"} if body == GROUND else {"points", "frame", *DYNAMICS_KEYS}
         for key in spec:
             if key not in allowed:
                 hint = ("In the drawn layout q0 follows from the drawing: give the body's "
@@ -333,8 +336,12 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
     drawing = Drawing(data)
     local["bodies"] = {body: {"q0": drawing.q0(body),
                               "points": {name: drawing.texts(drawing.local(body, point))
-                                         for name, point in drawing.points[body].items()}}
+                                         for name, point in drawing.points[body].items()},
+                              **_dynamics(drawing, body, data["bodies"][body])}
                        for body in drawing.frames if body != GROUND}
+    if "forces" in data:
+        local["forces"] = [_load(drawing, item, ("forces", index))
+                           for index, item in enumerate(_items(data, "forces"))]
     residuals = []
     for section in pairs.SECTIONS:
         converted = []
@@ -345,6 +352,27 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
                 residuals.append((index, item, residual))
         local[section] = converted
     _check_closure(drawing, residuals)
+    return local
+
+
+def _dynamics(drawing: Drawing, body: str, spec: Mapping[str, Any]) -> dict[str, Any]:
+    """A body's mass and inertia as written; its centre of mass in its own frame."""
+    found = {key: spec[key] for key in DYNAMICS_KEYS if key in spec}
+    if "com" in found:
+        found["com"] = drawing.point(body, found["com"], ("bodies", body, "com"))[0]
+    return found
+
+
+def _load(drawing: Drawing, item: Any, path: Path_) -> Any:
+    """A load with its points (drawn globally) in the frames of their bodies; unknown
+    bodies and shapes go on to validation, which names them."""
+    if not isinstance(item, Mapping):
+        return item
+    local = dict(item)
+    for key, body_key in forces.POINT_KEYS.get(item.get("type"), ()):  # type: ignore[arg-type]
+        body = item.get(body_key)
+        if key in item and isinstance(body, str) and body in drawing.frames:
+            local[key] = drawing.point(body, item[key], path + (key,))[0]
     return local
 
 

@@ -14,6 +14,7 @@ from pydantic import Field
 
 from symkin import pairs
 from symkin.pairs.fields import Expr, PointRef, PointRef3, Strict, Vec2, Vec3
+from symkin.spec.forces import Load
 from symkin.spec.schema import Driver, SpatialMechanismSpec, TimeGrid, Units
 
 
@@ -29,6 +30,9 @@ class DrawnBody(Strict):
 
     points: dict[str, Vec2] = Field(default_factory=dict)
     frame: Frame | None = None
+    mass: Expr | None = None
+    inertia: Expr | None = None
+    com: PointRef | None = None  # a point name, or global [x, y] as drawn
 
 
 DrawnJoint: Any = pairs.union("joints", drawn=True)
@@ -43,6 +47,7 @@ class DrawnMechanism(Strict):
     bodies: dict[str, DrawnBody] = Field(min_length=1)
     joints: list[DrawnJoint] = Field(default_factory=list)
     drivers: list[Driver] = Field(default_factory=list)
+    forces: list[Load] = Field(default_factory=list)  # points global as drawn
     time: TimeGrid
     units: Units | None = None
 

@@ -90,6 +90,10 @@ def number(value: float) -> sp.Expr:
     return sp.Rational(repr(value))
 
 
+# body.x, body.y, body.phi and (in forces) their rates body.x_t, body.y_t, body.phi_t.
+_COORDINATE_ATTRIBUTES = ("x", "y", "phi", "x_t", "y_t", "phi_t")
+
+
 class _Builder:
     """Walks a checked AST and builds the SymPy expression."""
 
@@ -133,7 +137,7 @@ class _Builder:
             key = (node.value.id, node.attr)
             if key in self.coordinates:
                 return self.coordinates[key]
-            if self.coordinates and node.attr in ("x", "y", "phi"):
+            if self.coordinates and node.attr in _COORDINATE_ATTRIBUTES:
                 bodies = ", ".join(dict.fromkeys(body for body, _ in self.coordinates))
                 raise self.fail(node, f"unknown coordinate '{key[0]}.{key[1]}'; use body.x, "
                                       f"body.y or body.phi of a body among {bodies}")

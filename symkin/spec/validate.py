@@ -18,7 +18,7 @@ from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError, UsageError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
 from symkin.pairs.fields import GROUND
-from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, loader
+from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, forces, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
 from symkin.spec.schema import MechanismSpec, SpatialMechanismSpec, equation_count
@@ -169,6 +169,7 @@ def _check_semantics(mech: Mechanism) -> None:
             if constraint.name is not None:
                 named[constraint.name] = path
     _check_time(mech, symbols, nominal)
+    _check_dynamics(mech, symbols, nominal)
     check_degrees_of_freedom(mech)
 
 
@@ -383,6 +384,40 @@ def _check_time(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, fl
     if grid_points(grid["t0"], grid["t1"], grid["dt"]) > MAX_GRID_POINTS:
         raise MechanismError(f"the grid has more than {MAX_GRID_POINTS} points", ("time", "dt"),
                              "Use a larger dt or a shorter interval.")
+
+
+def _check_dynamics(mech: Mechanism, symbols: _Names,
+                    nominal: Mapping[sp.Symbol, float]) -> None:
+    """Masses and inertias are constants >= 0; a load names known bodies and points, and its
+    expressions use only t, parameters, coordinates and their rates."""
+    for name, body in mech.bodies.items():
+        for key in ("mass", "inertia"):
+            raw = getattr(body, key)
+            if raw is None:
+                continue
+            path = ("bodies", name, key)
+            value = _numeric(_expression(raw, symbols, path), nominal, path)
+            if value < 0:
+                raise MechanismError(f"the {key} {value:g} is negative", path,
+                                     f"A {key} is zero or positive.")
+        if body.com is not None:
+            _point(mech, name, body.com, symbols, nominal, ("bodies", name, "com"))
+    moving = _Names(symbols.parameters, symbols.t, forces.coordinate_names(mech.bodies))
+    for index, load in enumerate(mech.forces):
+        where: tuple[str | int, ...] = ("forces", index)
+        for key in forces.BODY_KEYS[load.type]:
+            _body_ref(mech, getattr(load, key), where + (key,))
+        if load.type in ("force", "torque") and load.body == GROUND:
+            raise MechanismError(f"a {load.type} on the ground does nothing", where + ("body",),
+                                 "Apply it to a moving body.")
+        for key, body_key in forces.POINT_KEYS[load.type]:
+            _point(mech, getattr(load, body_key), getattr(load, key), symbols, nominal,
+                   where + (key,))
+        for key in forces.EXPRESSION_KEYS[load.type]:
+            raw = getattr(load, key)
+            for k, item in (enumerate(raw) if isinstance(raw, list) else [(None, raw)]):
+                at: tuple[str | int, ...] = (key,) if k is None else (key, k)
+                _expression(item, moving, where + at, time=True, coordinates=True)
 
 
 def degrees_of_freedom(mech: Mechanism) -> int:

@@ -181,7 +181,9 @@ def _result(kernel: Kernel, times: Array, values: Array, chunk: Chunk) -> SweepR
         reasons=tuple(chunk.reasons), messages=tuple(chunk.messages),
         t_reached=chunk.t_reached, solved=chunk.solved, iterations=chunk.iterations,
         points_named=tuple(kernel.points), local_vectors=kernel.point_vectors,
-        removed=kernel.removed, removed_broken=_removed_broken(kernel, times, values, chunk))
+        removed=kernel.removed, removed_broken=_removed_broken(kernel, times, values, chunk),
+        multipliers_grid=kernel.multipliers_grid if kernel.has_dynamics else None,
+        driver_names=kernel.driver_names, joint_names=kernel.joint_names)
 
 
 def _removed_broken(kernel: Kernel, times: Array, values: Array, chunk: Chunk

@@ -58,6 +58,47 @@ class SweepResult:
     # (runtime.redundant); () and None for every other file.
     removed: tuple[str, ...] = ()
     removed_broken: NDArray[np.bool_] | None = None
+    # Inverse dynamics (a kernel with masses or forces): the kernel's multipliers_grid, and
+    # the labels of the efforts and reactions; computed only when asked for, like the points.
+    multipliers_grid: Callable[..., tuple[Array, Array]] | None = field(
+        default=None, repr=False, compare=False)
+    driver_names: tuple[str, ...] = ()
+    joint_names: tuple[str, ...] = ()
+
+    @functools.cached_property
+    def forces(self) -> tuple[Array, Array] | None:
+        """(effort (M, T, n_driver_equations), reaction (M, T, n_joints, 3)) of every set's
+        solved rows (NaN beyond them); None for a mechanism without masses or forces."""
+        if self.multipliers_grid is None:
+            return None
+        m, size = self.q.shape[:2]
+        n_efforts, n_joints = len(self.driver_names), len(self.joint_names)
+        effort = np.full((m, size, n_efforts), np.nan)
+        reaction = np.full((m, size, n_joints, 3), np.nan)
+        for j in range(m):
+            done = int(self.solved[j])
+            _, loads = self.multipliers_grid(self.t[:done], self.q[j, :done], self.dq[j, :done],
+                                             self.d2q[j, :done], self.params[j])
+            effort[j, :done] = loads[:, :n_efforts]
+            reaction[j, :done] = loads[:, n_efforts:].reshape(done, n_joints, 3)
+        return effort, reaction
+
+    def force_envelope(self) -> list[tuple[str, float, float, float, int]]:
+        """Per effort and reaction component (``motor.effort``, ``O.Fx``...) over the solved
+        sets and times: (name, min, max, time of the largest magnitude, its set)."""
+        if self.forces is None or not self.ok.any():
+            return []
+        effort, reaction = self.forces
+        sets = np.flatnonzero(self.ok)
+        columns = [(f"{n}.effort", effort[sets, :, k]) for k, n in enumerate(self.driver_names)]
+        columns += [(f"{n}.{part}", reaction[sets, :, k, c]) for k, n in
+                    enumerate(self.joint_names) for c, part in enumerate(("Fx", "Fy", "M"))]
+        found = []
+        for name, values in columns:
+            j, k = np.unravel_index(int(np.nanargmax(np.abs(values))), values.shape)
+            found.append((name, float(np.nanmin(values)), float(np.nanmax(values)),
+                          float(self.t[k]), int(sets[j])))
+        return found
 
     @functools.cached_property
     def point_vectors(self) -> Array:
@@ -109,22 +150,29 @@ class SweepResult:
     def save(self, path: str | Path, compress: bool = False) -> Path:
         """Write an .npz: t, q, dq, d2q, status, params, parameter_names, coordinates,
         reasons, messages, t_reached, solved, iterations, and for the named points
-        ``points`` (names) and r, dr, ddr of shape (M, T, P, 2). ``compress``: a compressed
-        .npz (zip deflate; read the same way by numpy.load), smaller, slower to write."""
+        ``points`` (names) and r, dr, ddr of shape (M, T, P, 2); with masses or forces also
+        ``effort`` (M, T, n_driver_equations), ``reaction`` (M, T, n_joints, 3),
+        ``driver_names`` and ``joint_names``. ``compress``: a compressed .npz (zip deflate;
+        read the same way by numpy.load), smaller, slower to write."""
         path = Path(path)
         if path.suffix.lower() != ".npz":
             raise SymkinError(f"cannot write {path.name}: a sweep is saved as .npz")
         path.parent.mkdir(parents=True, exist_ok=True)
         arrays = self.point_arrays()
+        forces: dict[str, Any] = {}
+        if self.forces is not None:
+            forces = {"effort": self.forces[0], "reaction": self.forces[1],
+                      "driver_names": np.array(self.driver_names, dtype=str),
+                      "joint_names": np.array(self.joint_names, dtype=str)}
         write = np.savez_compressed if compress else np.savez
-        write(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q, status=self.status,
-                 params=self.params, parameter_names=np.array(self.parameter_names, dtype=str),
-                 coordinates=np.array(self.coordinates, dtype=str),
-                 reasons=np.array(self.reasons, dtype=str),
-                 messages=np.array(self.messages, dtype=str), t_reached=self.t_reached,
-                 solved=self.solved, iterations=self.iterations,
-                 points=np.array([f"{b}.{p}" for b, p in self.points_named], dtype=str),
-                 r=arrays[0], dr=arrays[1], ddr=arrays[2])
+        write(path, **forces, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q, status=self.status,
+              params=self.params, parameter_names=np.array(self.parameter_names, dtype=str),
+              coordinates=np.array(self.coordinates, dtype=str),
+              reasons=np.array(self.reasons, dtype=str),
+              messages=np.array(self.messages, dtype=str), t_reached=self.t_reached,
+              solved=self.solved, iterations=self.iterations,
+              points=np.array([f"{b}.{p}" for b, p in self.points_named], dtype=str),
+              r=arrays[0], dr=arrays[1], ddr=arrays[2])
         return path
 
     def point_arrays(self) -> tuple[Array, Array, Array]:

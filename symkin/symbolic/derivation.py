@@ -19,8 +19,9 @@ import sympy as sp
 from symkin import pairs
 from symkin.errors import MechanismError
 from symkin.spec import validate
+from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
-from symkin.symbolic import redundancy, spatial
+from symkin.symbolic import dynamics, redundancy, spatial
 from symkin.symbolic.planar import Context
 from symkin.symbolic.symbols import Symbols, make_symbols
 
@@ -115,6 +116,9 @@ class System:
     mobility: int | None = None
     """An over-constrained file's freedoms at t0 by the rank of its joints' rows (the count,
     ``dof``, cannot judge it); None for every other file."""
+    dynamics: dynamics.Dynamics | None = None
+    """Mass terms, applied forces, efforts and reactions; None for a file without masses
+    and forces (inverse dynamics, symbolic.dynamics)."""
 
     @property
     def name(self) -> str:
@@ -162,16 +166,20 @@ def derive(mech: Mechanism | str | Path) -> System:
         phi_t.append(row_t)
         gamma.append(_row_gamma(entries, row_t, symbols))
     size = len(symbols.q)
+    phi_q = sp.ImmutableSparseMatrix(size, size, jacobian)
+    placed = _placed(mech, ctx)
     return System(
         mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,
         p_values=p_values, coordinates=symbols.coordinates,
-        phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
+        phi=sp.ImmutableMatrix(phi), phi_q=phi_q,
         phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
         q0=q0,
         points=tuple((body, name, sp.ImmutableMatrix(ctx.local(body, name)))
                      for body, spec in mech.bodies.items() for name in spec.points),
-        placed=_placed(mech, ctx), time_grid=time_grid,
+        placed=placed, time_grid=time_grid,
         phi_p=_parameter_jacobian(phi, symbols.p), removed=removed, mobility=mobility,
+        dynamics=(dynamics.derive(mech, ctx, phi_q, rows, placed)
+                  if has_dynamics(mech) else None),
     )
 
 

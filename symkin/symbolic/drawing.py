@@ -13,6 +13,7 @@ plots and the warm-run index take these arrays, never SymPy objects.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -71,7 +72,22 @@ def outlines(system: System) -> dict[str, NDArray[np.float64]]:
         drawn[GROUND] = np.array(sorted(pivots), dtype=float)
     drawn.update({f"slide:{body}": np.array(rows, dtype=float) for body, rows in slides.items()})
     drawn.update({key: np.array(rows, dtype=float) for key, rows in rods.items()})
+    drawn.update(_joint_points(system, at))
     return drawn
+
+
+def _joint_points(system: System, at: Any) -> dict[str, NDArray[np.float64]]:
+    """With inverse dynamics, where each joint's reaction acts: ``joint:<name>:<body i>``
+    holds the joint's point on body i (its local vector), the point its moment is about."""
+    if system.dynamics is None:
+        return {}
+    found: dict[str, NDArray[np.float64]] = {}
+    names = system.dynamics.joint_names
+    for p in system.placed:
+        if (p.section, p.side, p.kind) == ("joints", "i", "point"):
+            key = f"joint:{names[p.index]}:{p.body}"
+            found.setdefault(key, np.array([at(p.vector)], dtype=float))
+    return found
 
 
 def _by_constraint(placed: Iterable[Placed]) -> dict[tuple[str, int], list[Placed]]:

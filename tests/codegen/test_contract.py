@@ -103,10 +103,11 @@ def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
     assert set(json.loads(written.read_text(encoding="utf-8"))) == \
         manifest.KEYS - manifest.OPTIONAL_KEYS
     assert manifest.OPTIONAL_KEYS <= manifest.KEYS
-    # An over-constrained file's manifest has them all.
+    # An over-constrained file's manifest has its removed rows.
     paths = render.generate(system("parallelogram_extra_bar"), backends.get("c"),
                             out_dir=tmp_path / "redundant")
-    assert set(json.loads(paths[-1].read_text(encoding="utf-8"))) == manifest.KEYS
+    assert set(json.loads(paths[-1].read_text(encoding="utf-8"))) == \
+        manifest.KEYS - manifest.OPTIONAL_KEYS | {"removed"}
 
 
 # The modules that read a manifest, and the names their manifest dicts go by.
@@ -145,3 +146,8 @@ def test_manifest_readers_ask_only_for_declared_keys(module: str) -> None:
     keys = _keys_read(ast.parse((ROOT / module).read_text(encoding="utf-8")))
     assert keys, f"{module}: no manifest key found; has the reader's variable been renamed?"
     assert keys <= manifest.KEYS, f"{module} reads undeclared keys {sorted(keys - manifest.KEYS)}"
+
+
+def test_manifest_of_a_mechanism_with_forces_has_every_key(tmp_path: Path) -> None:
+    paths = render.generate(system("crank_slider_load"), backends.get("c"), out_dir=tmp_path)
+    assert set(json.loads(paths[-1].read_text(encoding="utf-8"))) == manifest.KEYS

@@ -23,7 +23,8 @@ CORPUS = Path(__file__).resolve().parents[1] / "bad_mechanisms"
 EXPECTED: dict[str, tuple[int, str]] = {
     # unknown keys
     "unknown_top_key.yaml": (10, "unknown key 'colour'. Allowed keys here: name, parameters"),
-    "unknown_body_key.yaml": (4, "unknown key 'mass'. Allowed keys here: q0, points"),
+    "unknown_body_key.yaml": (4, "unknown key 'density'. Allowed keys here: q0, points, mass, "
+                                 "inertia, com"),
     "unknown_joint_key.yaml": (6, "at joints[0].v: unknown key 'v'. Allowed keys here: name, i, j"),
     "unknown_time_key.yaml": (9, "unknown key 'steps'. Allowed keys here: t0, t1, dt"),
     "poly_coefficient_with_t.yaml": (9, "at drivers[0].theta.poly[1]: in expression 't' at "
@@ -104,6 +105,14 @@ EXPECTED: dict[str, tuple[int, str]] = {
     "empty_poly.yaml": (8, "a polynomial is written {poly: [a0, a1, a2]}"),
     "custom_unknown_coordinate.yaml": (8, "attribute access is not allowed (only body.x"),
     "custom_unknown_body.yaml": (8, "unknown coordinate 'rod.phi'"),
+    # inverse dynamics
+    "negative_mass.yaml": (4, "at bodies.crank.mass: the mass -2 is negative"),
+    "force_unknown_body.yaml": (10, "at forces[0].body: unknown body 'rod'. Use one of: "
+                                   "ground, crank"),
+    "force_unknown_coordinate.yaml": (11, "at forces[0].m: in expression '-c*rocker.phi_t' at "
+                                          "column 4: unknown coordinate 'rocker.phi_t'"),
+    "force_unknown_point.yaml": (4, "at bodies.crank.com: body 'crank' has no point named "
+                                    "'middle'"),
 }
 
 

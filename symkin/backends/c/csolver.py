@@ -43,6 +43,8 @@ class GridSolver:
         self._p = ffi.new(f"{name}_real[]", max(p.size, 1))
         self._n, self._np = q.size, p.size
         self._solve_grid = getattr(lib, f"{name}_solve_grid_checked")
+        # inverse dynamics: the grid loop then takes lam_out and loads_out too
+        self._dynamics = hasattr(lib, f"{name}_multipliers")
         self._points = getattr(lib, f"{name}_points")
         self._real_array = f"{name}_real[]"
         self.dtype = np.float32 if real == "float" else np.float64
@@ -86,7 +88,8 @@ class GridSolver:
             self.pool.put(self)
 
     def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
-             cond_out: Array, flagged_out: NDArray[np.bool_]) -> None:
+             cond_out: Array, flagged_out: NDArray[np.bool_],
+             forces_out: tuple[Array, Array] | None = None) -> None:
         """The run's arrays: the grid and the rows :meth:`advance` writes.
 
         The time points (T,), the float64 outputs q, dq, d2q (T, N) and cond (T,) and the bool
@@ -99,6 +102,9 @@ class GridSolver:
                 and cond_out.size == flagged_out.size == size):
             raise ValueError(f"GridSolver.bind: arrays of {size} points x {self._n} expected")
         outputs: tuple[NDArray[Any], ...] = (q_out, dq_out, d2q_out, cond_out)
+        # lam (T, N) and loads (T, NLOADS), written by the grid loop of a dynamics kernel
+        if self._dynamics and forces_out is not None:
+            outputs += forces_out
         if self.dtype is np.float64:
             self._copies = None
             buffers = outputs
@@ -113,6 +119,11 @@ class GridSolver:
                           from_buffer(real, buffers[1]), from_buffer(real, buffers[2]),
                           from_buffer(real, buffers[3]),
                           from_buffer("unsigned char[]", flagged_out))
+        self._forces: tuple[Any, ...] = ()
+        if self._dynamics:  # NULL: the loop skips them
+            self._forces = tuple(
+                (from_buffer(real, b) if b.size else self._ffi.NULL, b.shape[1])
+                for b in buffers[4:6]) or ((self._ffi.NULL, 0), (self._ffi.NULL, 0))
 
     def advance(self, start: int, stop: int) -> int:
         """Solve the bound grid's points start..stop-1 (after those already solved, which
@@ -125,8 +136,11 @@ class GridSolver:
             rows = start * self._n
             t, q, dq, d2q = t + start, q + rows, dq + rows, d2q + rows
             cond, flagged = cond + start, flagged + start
+        forces = tuple(pointer + start * width if start and width else pointer
+                       for pointer, width in self._forces)
         solved: int = self._solve_grid(self._options, self._p, stop - start, t, self._state,
-                                       q, dq, d2q, cond, flagged, self._work, self._report)
+                                       q, dq, d2q, cond, flagged, *forces, self._work,
+                                       self._report)
         if self._copies is not None:
             for target, source in self._copies:
                 target[start:start + solved] = source[start:start + solved]

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from symkin import resources
-from symkin.backends.c import batch
+from symkin.backends.c import batch, multipliers
 from symkin.backends.c.csolver import GridSolver, SolverPool
 from symkin.contract.options import Options
 from symkin.runtime.kernel import Array, Kernel, import_file
@@ -30,10 +30,12 @@ class CKernel(Kernel):
 
     def __init__(self, ffi: Any, lib: Any, meta: Mapping[str, Any],
                  folder: Path | None = None) -> None:
+        n_loads = len(meta.get("driver_names", ())) + 3 * len(meta.get("joint_names", ()))
         functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
                                 len(meta["pattern_rows"]),
                                 len(meta["points"]) * (3 if meta.get("space") == "3d" else 2),
-                                len(meta.get("phi_p_rows", ())), len(meta.get("removed", ())))
+                                len(meta.get("phi_p_rows", ())), len(meta.get("removed", ())),
+                                n_loads)
         super().__init__("c", meta, functions, folder=folder)
         self.ffi = ffi
         self.lib = lib
@@ -56,6 +58,12 @@ class CKernel(Kernel):
             self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
         return self._solvers.take(options, q, p)
 
+    def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array,
+                         p: Array) -> tuple[Array, Array]:
+        """lam and the loads of solved rows in one call of the generated C."""
+        return multipliers.grid(self.ffi, self.lib, self.name, self.real, t, q, dq, d2q, p,
+                                len(self.driver_names) + 3 * len(self.joint_names))
+
     def _solve_batch(self, params: Array, t: Array, q0: Array, options: Options,
                      q: Array, dq: Array, d2q: Array) -> BatchStatus:
         return batch.solve(self.ffi, self.lib, self.name, self.real, params, t, q0, options,
@@ -66,12 +74,14 @@ class _CFunctions:
     """Adapter over a cffi extension: converts arrays to the generated real type and back."""
 
     def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
-                 point_components: int, nnz_p: int = 0, nremoved: int = 0) -> None:
+                 point_components: int, nnz_p: int = 0, nremoved: int = 0,
+                 n_loads: int = 0) -> None:
         self._ffi = ffi
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
         self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq,
-                       "points": point_components, "phi_p": nnz_p, "removed": nremoved}
+                       "points": point_components, "phi_p": nnz_p, "removed": nremoved,
+                       "dynamics_rhs": nq, "loads": n_loads}
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}
@@ -110,6 +120,13 @@ class _CFunctions:
 
     def _removed(self, q: Array, t: float, p: Array) -> Array:
         return self._call("removed", self._in(q), t, self._in(p))
+
+    def dynamics_rhs(self, q: Array, dq: Array, ddq: Array, t: float, p: Array) -> Array:
+        return self._call("dynamics_rhs", self._in(q), self._in(dq), self._in(ddq), t,
+                          self._in(p))
+
+    def loads(self, q: Array, lam: Array, t: float, p: Array) -> Array:
+        return self._call("loads", self._in(q), self._in(lam), t, self._in(p))
 
 
 def load(folder: Path, meta: Mapping[str, Any]) -> CKernel:

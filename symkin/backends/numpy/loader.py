@@ -27,10 +27,17 @@ class _ModuleFunctions:
         # Only the module of an over-constrained file has it (Kernel.removed_phi).
         self.removed: Callable[[Array, float, Array], Array] | None = getattr(
             module, "removed", None)
+        # inverse dynamics, generated only for a mechanism with masses or forces
+        self.dynamics_rhs: Callable[..., Array] = getattr(module, "dynamics_rhs", _no_dynamics)
+        self.loads: Callable[..., Array] = getattr(module, "loads", _no_dynamics)
 
 
 def _no_phi_p(q: Array, t: float, p: Array) -> Array:
     raise ValueError("this kernel was generated without Phi_p; rebuild it with symkin.compile")
+
+
+def _no_dynamics(*arguments: object) -> Array:
+    raise ValueError("this mechanism has no masses or forces: no efforts or reactions")
 
 
 def from_module(module: ModuleType, backend: str, folder: Path | None = None) -> Kernel:
@@ -44,6 +51,8 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
            if hasattr(module, "PHI_P_ROWS") else {}),
         **({"removed": module.REMOVED} if hasattr(module, "REMOVED") else {}),
+        **({"driver_names": module.DRIVER_NAMES, "joint_names": module.JOINT_NAMES}
+           if hasattr(module, "JOINT_NAMES") else {}),
     }
     return Kernel(backend, meta, _ModuleFunctions(module), folder=folder)
 

@@ -1,0 +1,55 @@
+"""Stage 7 — results, pictures of inverse dynamics: the efforts of the drivers and the
+reactions of the joints against time, in one figure beside the kinematics' (``--plot``
+writes ``NAME_forces.png`` next to ``NAME.png`` when the file has masses or forces).
+
+Three panels: the efforts (one curve per driver equation), the joints' force magnitudes
+|F| = sqrt(Fx² + Fy²), and their moments M (zero for revolutes, so those are left out).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from symkin.present.plots import _pyplot, _save
+from symkin.runtime.results import Trajectory
+
+
+def forces_path(path: str | Path) -> Path:
+    """``run.png`` -> ``run_forces.png``: where the forces' figure goes."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}_forces{path.suffix}")
+
+
+def plot_forces(trajectory: Trajectory, path: str | Path, title: str | None = None) -> Path:
+    """Write the efforts and reactions of ``trajectory`` (which has ``forces``) to ``path``."""
+    forces = trajectory.forces
+    if forces is None:
+        raise ValueError("the trajectory has no efforts or reactions to plot")
+    plt = _pyplot()
+    figure, axes = plt.subplots(3, 1, figsize=(7.0, 8.8), sharex=True, layout="constrained")
+    t = trajectory.t
+    for k, name in enumerate(forces.driver_names):
+        axes[0].plot(t, forces.effort[:, k], label=name, linewidth=1.4)
+    axes[0].set_ylabel("effort (torque or force)")
+    magnitude = np.hypot(forces.reaction[..., 0], forces.reaction[..., 1])
+    moments = forces.reaction[..., 2]
+    for k, name in enumerate(forces.joint_names):
+        axes[1].plot(t, magnitude[:, k], label=name, linewidth=1.4)
+        if np.nanmax(np.abs(moments[:, k]), initial=0.0) > 1e-9 * max(
+                np.nanmax(magnitude, initial=0.0), 1.0):
+            axes[2].plot(t, moments[:, k], label=name, linewidth=1.4)
+    if not axes[2].get_lines():
+        axes[2].text(0.5, 0.5, "no joint carries a moment (revolute pairs only)",
+                     transform=axes[2].transAxes, ha="center", va="center")
+    axes[1].set_ylabel("joint force |F|")
+    axes[2].set_ylabel("joint moment M")
+    axes[2].set_xlabel("t")
+    for ax in axes:
+        ax.grid(True, linewidth=0.4, alpha=0.5)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize="small", frameon=False)
+    if title:
+        figure.suptitle(f"{title}: efforts and reactions")
+    return _save(figure, plt, Path(path))

@@ -1,0 +1,73 @@
+"""Efforts and reactions along a solved trajectory (inverse dynamics), from the kernel's
+generated ``multipliers``: Φ_qᵀ λ = Q - M q̈ - h at every solved row.
+
+``effort`` (T, n_driver_equations): -λ of each driver row, the generalized force its actuator
+applies along the driver's function (an ``angle`` driver: the torque on body i, -effort on
+j; a ``slide``: the force on body j along u). ``reaction`` (T, n_joints, 3): [Fx, Fy]
+(global) and M that body i exerts on body j, M about the joint's point on body i (0 for a
+revolute; a prismatic pair: about A, carried by i). Rows where Φ_q is exactly singular are NaN.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+REACTION_PARTS = ("Fx", "Fy", "M")
+
+
+@dataclass(frozen=True)
+class Forces:
+    """The inverse dynamics of a trajectory's rows."""
+
+    multipliers: Array  # (T, N): lambda
+    effort: Array  # (T, n_driver_equations)
+    reaction: Array  # (T, n_joints, 3): Fx, Fy, M
+    driver_names: tuple[str, ...]
+    joint_names: tuple[str, ...]
+
+    def columns(self) -> list[str]:
+        """The CSV columns: ``DRIVER.effort``, then ``JOINT.Fx``, ``JOINT.Fy``, ``JOINT.M``."""
+        return [f"{name}.effort" for name in self.driver_names] + [
+            f"{name}.{part}" for name in self.joint_names for part in REACTION_PARTS]
+
+    def table(self) -> Array:
+        """The values of :meth:`columns`, (T, n_driver_equations + 3 n_joints)."""
+        rows = self.effort.shape[0]
+        return np.column_stack([self.effort, self.reaction.reshape(rows, -1)])
+
+
+def allocate(kernel: Any, size: int) -> tuple[Array, Array] | None:
+    """NaN-filled (lam, loads) rows for a grid loop that computes them as it goes (the
+    generated C solver); None for a kernel without dynamics."""
+    if not getattr(kernel, "has_dynamics", False):
+        return None
+    n_loads = len(kernel.driver_names) + 3 * len(kernel.joint_names)
+    return np.full((size, len(kernel.coordinates)), np.nan), np.full((size, n_loads), np.nan)
+
+
+def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
+            given: tuple[Array, ...] | None = None) -> Forces | None:
+    """The efforts and reactions of solved rows; None for a kernel without dynamics.
+
+    ``given``: (lam, loads) the grid loop already wrote; only the rows it did not (NaN: points
+    the runtime's edge treatment solved) are computed here.
+    """
+    if not getattr(kernel, "has_dynamics", False):
+        return None
+    with np.errstate(all="ignore"):  # a singular row is NaN, said in the docstring
+        if given is None:
+            lam, loads = kernel.multipliers_grid(t, q, dq, d2q, p)
+        else:
+            lam, loads = given[0].copy(), given[1].copy()
+            missing = np.flatnonzero(np.isnan(lam).any(axis=1))
+            if missing.size:
+                lam[missing], loads[missing] = kernel.multipliers_grid(
+                    t[missing], q[missing], dq[missing], d2q[missing], p)
+    n_efforts, n_joints = len(kernel.driver_names), len(kernel.joint_names)
+    return Forces(lam, loads[:, :n_efforts], loads[:, n_efforts:].reshape(t.size, n_joints, 3),
+                  tuple(kernel.driver_names), tuple(kernel.joint_names))
