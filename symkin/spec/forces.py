@@ -97,7 +97,9 @@ def coordinate_names(bodies: Mapping[str, Any],
 def has_dynamics(mech: Any) -> bool:
     """True when the file states a mass, an inertia or a force: then efforts and reactions
     are computed (a file of kinematics alone generates exactly the code it did before)."""
-    return bool(mech.forces) or any(body.mass is not None or body.inertia is not None
+    # (a spatial body has no mass keys: getattr)
+    return bool(mech.forces) or any(getattr(body, "mass", None) is not None or
+                                    getattr(body, "inertia", None) is not None
                                     for body in mech.bodies.values())
 
 

@@ -127,7 +127,7 @@ class MechanismSpec(Strict):
             del data["forces"]
         for body in data["bodies"].values():
             for key in DYNAMICS_BODY_KEYS:
-                if body[key] is None:
+                if key in body and body[key] is None:
                     del body[key]
         return json.dumps(data, sort_keys=True, separators=(",", ":"))
 

@@ -390,6 +390,13 @@ def _check_dynamics(mech: Mechanism, symbols: _Names,
                     nominal: Mapping[sp.Symbol, float]) -> None:
     """Masses and inertias are constants >= 0; a load names known bodies and points, and its
     expressions use only t, parameters, coordinates and their rates."""
+    if mech.is_spatial:
+        # a spatial body has no mass keys (its schema refuses them); forces are planar so far
+        if mech.forces:
+            raise MechanismError("forces are not available in a space: 3d file yet",
+                                 ("forces",), "Remove the forces section: inverse dynamics "
+                                 "is planar for now.")
+        return
     for name, body in mech.bodies.items():
         for key in ("mass", "inertia"):
             raw = getattr(body, key)
