@@ -93,7 +93,8 @@ def _limit(kernel: Kernel, p: Array, t: Array, q0: Array, options: Options, chun
            j: int, solved: int) -> bool:
     """Set j, stopped by the batch after ``solved`` rows, ended here when those rows show a
     limit position (as symkin.solve would end it); False: it must be re-run."""
-    stop = limit_stop(kernel, p, t, chunk.q[j], solved, q0, options)
+    stop = limit_stop(kernel, p, t, (chunk.q[j], chunk.dq[j], chunk.d2q[j]), solved, q0,
+                      options)
     if stop is None:
         return False
     chunk.status[j] = REASON_CODES.get(stop.reason, max(REASON_CODES.values()) + 1)

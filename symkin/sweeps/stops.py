@@ -13,7 +13,8 @@ points show, all of it required:
 
 - the smallest singular value of Phi_q falls from t[k-2] to t[k-1], and at a fold it falls as
   the square root of the distance to it: sigma_min^2, extrapolated linearly, reaches zero
-  before t[k] + LIMIT_REACH grid steps;
+  after t[k-1] and before t[k] (within FOLD_MARGIN grid steps of it, a few substeps towards
+  t[k] and the same extrapolation from the last of them decide: none may reach t[k]);
 - the drivers take part in the dependency: the left singular vector of sigma_min puts at least
   DRIVER_SHARE of its weight on the driver rows. At a singular configuration the motion can
   pass through (a parallelogram's change point), the constraints without the drivers are
@@ -27,6 +28,7 @@ Imports NumPy and the runtime only.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,7 +36,8 @@ from numpy.typing import NDArray
 
 from symkin.contract.options import Options
 from symkin.runtime import units
-from symkin.runtime.edges import limit_motion
+from symkin.runtime.edges import State, limit_motion, march
+from symkin.runtime.newton import Point
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.start import singular_start
 
@@ -45,9 +48,17 @@ DRIVER_SHARE = 0.02
 rows for a stop to be a limit position (the crank-slider near its limit: 0.13); at a passable
 singular configuration it tends to 0 (the parallelogram a grid step before it: 6e-4)."""
 
-LIMIT_REACH = 1.0
-"""How many grid steps past the failing point t[k] the extrapolated fold may lie: the square
-root law holds only near the fold, and a fold just past t[k] still stops the plain step."""
+FOLD_MARGIN = 0.05
+"""How far (in grid steps) before the failing point t[k] the extrapolated fold must lie. A fold
+past t[k] is reached by ``symkin.solve``'s substeps, which then stop at a later grid point, so
+a fold near t[k] is left to the re-run. The extrapolation from two points is off by 0.002 ..
+0.02 of a grid step on the crank-slider's 31-point grid (0.2 .. 0.3 late on an 11-point grid,
+0.01 early on a 151-point one). A fold extrapolated nearer t[k] than this is looked at closer
+(_closer_fold_before)."""
+
+CLOSER_STEPS = (1 / 64, 1 / 4096)
+"""The closer look's substeps go down to these fractions of the grid step in turn (a few
+Newton solves each)."""
 
 
 @dataclass(frozen=True)
@@ -59,29 +70,70 @@ class Limit:
     t: float  # the grid point t[k], as symkin.solve reports it
 
 
-def limit_stop(kernel: KinematicsKernel, p: Array, t: Array, q: Array, solved: int,
-               q0: Array, options: Options) -> Limit | None:
-    """The limit position a set stopped on after ``solved`` rows ``q`` (T, N), or None when
-    the rows do not show one for sure (the set is then re-run)."""
+def limit_stop(kernel: KinematicsKernel, p: Array, t: Array, rows: tuple[Array, Array, Array],
+               solved: int, q0: Array, options: Options) -> Limit | None:
+    """The limit position a set stopped on after ``solved`` rows (q, dq, ddq, each (T, N)), or
+    None when the rows do not show one for sure (the set is then re-run)."""
     if solved < 2 or solved >= t.size:
         return None
     if units.unit_for(kernel, q0, float(t[0]), p) != 1.0:
         return None
+    q = rows[0]
+    t2, t1, failed = (float(t[solved - 2]), float(t[solved - 1]), float(t[solved]))
     with np.errstate(all="ignore"):
-        before = _smallest(kernel, q[solved - 2], float(t[solved - 2]), p)
-        last = _smallest(kernel, q[solved - 1], float(t[solved - 1]), p)
-    if before is None or last is None:
-        return None
-    if not _fold_ahead(before[0], last[0], t, solved):
-        return None
-    drivers = np.array([label.startswith("drivers") for label in kernel.rows])
-    if not drivers.any() or float(np.sum(last[1][drivers] ** 2)) < DRIVER_SHARE:
-        return None
-    if singular_start(kernel, q[0], float(t[0]), p, options) is not None:
-        return None
-    jacobian = np.asarray(kernel.phi_q(q[solved - 1], float(t[solved - 1]), p), dtype=float)
+        before = _smallest(kernel, q[solved - 2], t2, p)
+        last = _smallest(kernel, q[solved - 1], t1, p)
+        if before is None or last is None:
+            return None
+        zero = _fold_time(t2, before[0], t1, last[0])
+        if not t1 < zero <= failed + (failed - t1):
+            return None
+        drivers = np.array([label.startswith("drivers") for label in kernel.rows])
+        if not drivers.any() or float(np.sum(last[1][drivers] ** 2)) < DRIVER_SHARE:
+            return None
+        if zero > failed - FOLD_MARGIN * (failed - t1) and \
+                not _closer_fold_before(kernel, p, options, rows, solved, t, last[0]):
+            return None
+        if singular_start(kernel, q[0], float(t[0]), p, options) is not None:
+            return None
+        jacobian = np.asarray(kernel.phi_q(q[solved - 1], t1, p), dtype=float)
     aligned, held = limit_motion(kernel, jacobian)
-    return Limit("limit position", _message(t, solved, aligned, held), float(t[solved]))
+    return Limit("limit position", _message(t, solved, aligned, held), failed)
+
+
+def _closer_fold_before(kernel: KinematicsKernel, p: Array, options: Options,
+                        rows: tuple[Array, Array, Array], solved: int, t: Array,
+                        sigma: float) -> bool:
+    """For a fold extrapolated near t[k]: substeps towards t[k] (runtime.edges.march, down to
+    each of CLOSER_STEPS of the grid step in turn, a few Newton solves each), and the fold
+    extrapolated again from the last two points reached, each pair nearer to it. True when
+    that places it before t[k] for sure; False (re-run) when the substeps reach t[k]."""
+    t1, failed = float(t[solved - 1]), float(t[solved])
+    h = failed - t1
+    q, dq, ddq = (np.array(r[solved - 1], dtype=float) for r in rows)
+    point = Point(q, dq, ddq, 0.0, False)
+    state, previous = State(t1, point), (t1, sigma)
+    for fraction in CLOSER_STEPS:
+        reached, stuck = march(kernel, p, options, state, failed, h, h * fraction)
+        if not stuck:
+            return False
+        near = _smallest(kernel, reached.point.q, reached.t, p) if reached.t > state.t \
+            else None
+        if near is None:
+            return False
+        zero = _fold_time(previous[0], previous[1], reached.t, near[0])
+        if reached.t <= zero <= failed - FOLD_MARGIN * (reached.t - previous[0]):
+            return True
+        state, previous = reached, (reached.t, near[0])
+    return False
+
+
+def _fold_time(t2: float, before: float, t1: float, last: float) -> float:
+    """Where sigma_min^2 (relative), falling from t2 to t1, reaches zero if extrapolated
+    linearly (a fold: sigma_min ~ sqrt of the distance); inf when it does not fall."""
+    if not last < before:
+        return math.inf
+    return t1 + last**2 * (t1 - t2) / (before**2 - last**2)
 
 
 def _smallest(kernel: KinematicsKernel, q: Array, t: float, p: Array
@@ -95,16 +147,6 @@ def _smallest(kernel: KinematicsKernel, q: Array, t: float, p: Array
     if sigma[0] <= 0:
         return None
     return float(sigma[-1] / sigma[0]), u[:, -1]
-
-
-def _fold_ahead(before: float, last: float, t: Array, solved: int) -> bool:
-    """sigma_min^2 (relative) falling from t[k-2] to t[k-1] and, extrapolated linearly,
-    zero before t[k] + LIMIT_REACH grid steps."""
-    if not last < before:
-        return False
-    t2, t1, failed = (float(t[solved - 2]), float(t[solved - 1]), float(t[solved]))
-    zero = t1 + last**2 * (t1 - t2) / (before**2 - last**2)
-    return zero <= failed + LIMIT_REACH * (failed - t1)
 
 
 def _message(t: Array, solved: int, aligned: tuple[str, ...], held: tuple[str, ...]) -> str:
