@@ -24,9 +24,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 
-import symkin  # noqa: E402
 from sweep import best, build_c_loop  # noqa: E402
 
+import symkin  # noqa: E402
 from symkin.sweeps import batch  # noqa: E402
 
 
