@@ -36,8 +36,7 @@ from numpy.typing import NDArray
 
 from symkin.contract.options import Options
 from symkin.runtime import units
-from symkin.runtime.edges import State, limit_motion, march
-from symkin.runtime.newton import Point
+from symkin.runtime.edges import limit_motion
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.start import singular_start
 
@@ -56,9 +55,13 @@ a fold near t[k] is left to the re-run. The extrapolation from two points is off
 0.01 early on a 151-point one). A fold extrapolated nearer t[k] than this is looked at closer
 (_closer_fold_before)."""
 
-CLOSER_STEPS = (1 / 64, 1 / 4096)
-"""The closer look's substeps go down to these fractions of the grid step in turn (a few
-Newton solves each)."""
+CLOSER_STEPS = (1 / 16, 1 / 256, 1 / 4096)
+"""The closer look's substeps go down to these fractions of the grid step in turn, the next
+only while the fold is not yet placed."""
+
+CLOSER_ITERATIONS = 8
+"""Newton iterations per substep of the closer look: from the predictor a substep converges in
+a few; one that fails only makes the look stop short, and the set is then re-run."""
 
 
 @dataclass(frozen=True)
@@ -104,28 +107,71 @@ def limit_stop(kernel: KinematicsKernel, p: Array, t: Array, rows: tuple[Array, 
 def _closer_fold_before(kernel: KinematicsKernel, p: Array, options: Options,
                         rows: tuple[Array, Array, Array], solved: int, t: Array,
                         sigma: float) -> bool:
-    """For a fold extrapolated near t[k]: substeps towards t[k] (runtime.edges.march, down to
-    each of CLOSER_STEPS of the grid step in turn, a few Newton solves each), and the fold
-    extrapolated again from the last two points reached, each pair nearer to it. True when
-    that places it before t[k] for sure; False (re-run) when the substeps reach t[k]."""
+    """For a fold extrapolated near t[k]: substeps towards t[k] (_march, down to each of
+    CLOSER_STEPS of the grid step in turn), and the fold extrapolated again from the last two
+    points reached, each pair nearer to it. True when that places it before t[k] for sure;
+    False (re-run) when the substeps reach t[k]."""
     t1, failed = float(t[solved - 1]), float(t[solved])
     h = failed - t1
     q, dq, ddq = (np.array(r[solved - 1], dtype=float) for r in rows)
-    point = Point(q, dq, ddq, 0.0, False)
-    state, previous = State(t1, point), (t1, sigma)
+    state, previous = (t1, q, dq, ddq), (t1, sigma)
     for fraction in CLOSER_STEPS:
-        reached, stuck = march(kernel, p, options, state, failed, h, h * fraction)
-        if not stuck:
+        reached = _march(kernel, p, options, state, failed, h, h * fraction)
+        if reached is None:
             return False
-        near = _smallest(kernel, reached.point.q, reached.t, p) if reached.t > state.t \
-            else None
+        near = _smallest(kernel, reached[1], reached[0], p) if reached[0] > state[0] else None
         if near is None:
             return False
-        zero = _fold_time(previous[0], previous[1], reached.t, near[0])
-        if reached.t <= zero <= failed - FOLD_MARGIN * (reached.t - previous[0]):
+        zero = _fold_time(previous[0], previous[1], reached[0], near[0])
+        if reached[0] <= zero <= failed - FOLD_MARGIN * (reached[0] - previous[0]):
             return True
-        state, previous = reached, (reached.t, near[0])
+        state, previous = reached, (reached[0], near[0])
     return False
+
+
+Motion = tuple[float, Array, Array, Array]  # t, q, dq, ddq
+
+
+def _march(kernel: KinematicsKernel, p: Array, options: Options, state: Motion,
+           target: float, h0: float, h_min: float) -> Motion | None:
+    """Substeps from state towards target as runtime.edges.march takes them (halved on
+    failure, doubled on success) but with plain Newton and no condition estimates (they
+    would cost more than the whole sweep): the last point reached before a step of h_min
+    failed, or None when target was reached."""
+    h = h0
+    while state[0] < target:
+        step = min(h, target - state[0])
+        following = _step(kernel, p, options, state, state[0] + step)
+        if following is None:
+            if step <= h_min:
+                return state
+            h = step / 2
+        else:
+            state, h = following, min(2 * step, h0)
+    return None
+
+
+def _step(kernel: KinematicsKernel, p: Array, options: Options, state: Motion, t: float
+          ) -> Motion | None:
+    """Predict (2.76), plain Newton at t, velocities and accelerations; None on failure."""
+    h = t - state[0]
+    q = state[1] + state[2] * h + state[3] * (h * h / 2)
+    for _ in range(CLOSER_ITERATIONS):
+        jacobian = np.asarray(kernel.phi_q(q, t, p), dtype=float)
+        phi = np.asarray(kernel.phi(q, t, p), dtype=float)
+        if not (np.all(np.isfinite(jacobian)) and np.all(np.isfinite(phi))):
+            return None
+        try:
+            delta = np.linalg.solve(jacobian, -phi)
+        except np.linalg.LinAlgError:
+            return None
+        q = q + delta
+        if np.abs(delta).max(initial=0.0) <= options.tol_dq and \
+                np.abs(kernel.phi(q, t, p)).max(initial=0.0) <= options.tol_phi:
+            dq = np.linalg.solve(jacobian, -np.asarray(kernel.phi_t(q, t, p), dtype=float))
+            ddq = np.linalg.solve(jacobian, np.asarray(kernel.gamma(q, dq, t, p), dtype=float))
+            return (t, q, dq, ddq) if np.all(np.isfinite(ddq)) else None
+    return None
 
 
 def _fold_time(t2: float, before: float, t1: float, last: float) -> float:

@@ -163,3 +163,22 @@ def test_a_fold_just_before_or_past_a_grid_point_stops_where_solve_stops(crank_s
     failure = _same_as_solve(kernel, result, 0, designs[0], T)
     assert failure is not None and failure.reason == "limit position"
     assert result.t_reached[0] == pytest.approx(1.4 if offset < 0 else 1.45)
+
+
+@pytest.mark.parametrize("offset", [-0.003, 0.003])
+def test_the_closer_look_tells_a_fold_just_before_t_k_from_one_just_past(crank_slider_system,
+                                                                        offset) -> None:
+    """Rows up to t[k-1] = 1.35 (k = 28, t[k] = 1.4) and a limit at 1.4 + offset grid steps:
+    the two-point extrapolation cannot tell on which side of t[k] it lies; the closer look
+    must (past t[k]: symkin.solve's substeps reach t[k], so None, the set is re-run)."""
+    kernel = symkin.compile(crank_slider_system, backend="c")
+    options = symkin.runtime.driver.default_options(kernel)
+    h = T[1] - T[0]
+    p = np.array([1.0, 5.0, 5.0 + np.cos((1.4 + offset * h) ** 2)])
+    solution = symkin.solve(kernel, t=T[:28], params=p)
+    rows = (solution.q, solution.dq, solution.d2q)
+    stop = stops.limit_stop(kernel, p, T, rows, 28, kernel.q0, options)
+    if offset < 0:
+        assert stop is not None and stop.t == T[28] and stop.reason == "limit position"
+    else:
+        assert stop is None
