@@ -84,8 +84,9 @@ class GridSolver(Protocol):
         ...
 
 
-BatchStatus = tuple[NDArray[np.int32], NDArray[np.int32]]
-"""(status, iterations) per parameter set of a batch solve."""
+BatchStatus = tuple[NDArray[np.int32], NDArray[np.int32], NDArray[np.int32]]
+"""(status, iterations, solved) per parameter set of a batch solve; solved: the rows written
+(a failed set stopped at the grid point t[solved])."""
 
 
 class BatchSolver(Protocol):

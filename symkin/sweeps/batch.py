@@ -2,10 +2,12 @@
 ``<prefix>_solve_batch`` of a C kernel), or the driver set by set for a kernel without one.
 
 The batch runs plain Newton from q0 at t[0], like the first attempt of ``symkin.solve``. A set
-it cannot solve is then handed to ``symkin.solve`` itself, which adds the damped assembly and
-names the reason (no assembly, singular, no convergence, not finite) — so every set of a sweep
-is exactly what a per-set ``solve`` gives, failures included, and a failed set costs only its
-own re-run.
+it stops on at a limit position is finished from its rows (sweeps.stops: two SVDs, no re-run);
+any other set it cannot solve is handed to ``symkin.solve`` itself, which adds the damped
+assembly, the passage through singular configurations, and names the reason (no assembly,
+singular, no convergence, not finite) — so every set of a sweep is what a per-set ``solve``
+gives, failures included (same reason, stop time and rows; a limit's message gives the grid
+interval, not the bisected time), and a failed set costs at most its own re-run.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from symkin.contract.options import Options
 from symkin.contract.status import OK
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
+from symkin.sweeps.stops import limit_stop
 
 Array = NDArray[np.float64]
 
@@ -73,15 +76,33 @@ def solve_chunk(kernel: Kernel, params: Array, t: Array, q0: Array,
     chunk = empty_chunk(m, t, size) if into is None else into
     starts = np.broadcast_to(q0, (m, size))
     if kernel.batch_solver is not None:
-        status, iterations = kernel.batch_solver(params, t, q0, options, chunk.q, chunk.dq,
-                                                 chunk.d2q)
+        status, iterations, solved = kernel.batch_solver(params, t, q0, options, chunk.q,
+                                                         chunk.dq, chunk.d2q)
         chunk.iterations[:] = iterations
-        pending = np.flatnonzero(status != OK)
+        pending = [int(j) for j in np.flatnonzero(status != OK)
+                   if not _limit(kernel, params[j], t, starts[j], options, chunk, int(j),
+                                 int(solved[j]))]
     else:
-        pending = np.arange(m)
+        pending = list(range(m))
     for j in pending:
-        _solve_one(kernel, params[j], t, starts[j], options, chunk, int(j))
+        _solve_one(kernel, params[j], t, starts[j], options, chunk, j)
     return chunk
+
+
+def _limit(kernel: Kernel, p: Array, t: Array, q0: Array, options: Options, chunk: Chunk,
+           j: int, solved: int) -> bool:
+    """Set j, stopped by the batch after ``solved`` rows, ended here when those rows show a
+    limit position (as symkin.solve would end it); False: it must be re-run."""
+    stop = limit_stop(kernel, p, t, (chunk.q[j], chunk.dq[j], chunk.d2q[j]), solved, q0,
+                      options)
+    if stop is None:
+        return False
+    chunk.status[j] = REASON_CODES.get(stop.reason, max(REASON_CODES.values()) + 1)
+    chunk.reasons[j], chunk.messages[j] = stop.reason, stop.message
+    chunk.t_reached[j], chunk.solved[j] = stop.t, solved
+    for target in (chunk.q, chunk.dq, chunk.d2q):
+        target[j, solved:] = np.nan
+    return True
 
 
 def _solve_one(kernel: Kernel, p: Array, t: Array, q0: Array, options: Options, chunk: Chunk,

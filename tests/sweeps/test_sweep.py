@@ -39,7 +39,11 @@ def _check_against_solve(kernel, result, designs) -> tuple[int, int]:
         except SolveError as failure:
             failed += 1
             assert result.status[j] != 0
-            assert result.reasons[j] == failure.reason and result.messages[j] == str(failure)
+            assert result.reasons[j] == failure.reason
+            # A limit the C batch stopped on is not bisected in a sweep (sweeps.stops).
+            assert result.messages[j] == str(failure) or (
+                failure.reason == "limit position" and result.messages[j].startswith(
+                    "the driven motion reaches a limit position between t = "))
             assert result.t_reached[j] == failure.t
             done = failure.trajectory.t.size
             assert result.solved[j] == done

@@ -21,7 +21,7 @@ Array = NDArray[np.float64]
 def solve(ffi: Any, lib: Any, name: str, real: str, params: Array, t: Array, q0: Array,
           options: Options, rows: tuple[Array, Array, Array]) -> BatchStatus:
     """Run ``<prefix>_solve_batch`` over all sets into ``rows`` = (q, dq, d2q), each
-    (m, T, N) float64; returns (status, iterations) per set."""
+    (m, T, N) float64; returns (status, iterations, solved) per set."""
     dtype = np.float32 if real == "float" else np.float64
     m = params.shape[0]
     direct = dtype == np.float64
@@ -43,7 +43,8 @@ def solve(ffi: Any, lib: Any, name: str, real: str, params: Array, t: Array, q0:
             target[...] = source
     status = np.frombuffer(ffi.buffer(reports, m * ffi.sizeof(f"{name}_batch_report")),
                            dtype=_report_dtype(ffi, name))
-    found: BatchStatus = (status["status"].astype(np.int32), status["iterations"].astype(np.int32))
+    found: BatchStatus = (status["status"].astype(np.int32), status["iterations"].astype(np.int32),
+                          status["solved"].astype(np.int32))
     return found
 
 
