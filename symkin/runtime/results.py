@@ -112,8 +112,9 @@ class Trajectory:
 
     @property
     def bodies(self) -> tuple[str, ...]:
-        """The moving bodies, in coordinate order."""
-        return tuple(dict.fromkeys(name.rsplit(".", 1)[0] for name in self.coordinates))
+        """The moving bodies, in coordinate order (a pair's own coordinate ``NAME.s`` is no
+        body's: each body has an ``.x``)."""
+        return tuple(name[:-2] for name in self.coordinates if name.endswith(".x"))
 
     def body(self, name: str
              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:

@@ -301,6 +301,55 @@ class Drawing:
         gap = abs((bx - ax) * -dy.value + (by - ay) * dx.value) / length
         return self.texts(_to_frame(_neg(dy), dx, self.frames[joined.j].angle)), gap
 
+    def direction(self, body: str, raw: Any, path: Path_) -> list[Any]:
+        """A direction as drawn (global), in the frame of ``body``."""
+        dx, dy = self.context.vector(raw, path)
+        return self.texts(_to_frame(dx, dy, self.frames[body].angle))
+
+    def curve(self, body: str, raw: Any, path: Path_) -> tuple[list[str], Any]:
+        """A curve [x(s), y(s)] as drawn (global), in the frame of ``body`` that carries it:
+        its components' text, and a function giving the drawn curve's point at a value of s.
+        Each component is parsed alone first (the whitelist parser), as every drawn piece."""
+        if not isinstance(raw, (list, tuple)) or len(raw) != 2:
+            raise MechanismError("expected a curve [x(s), y(s)]", path)
+        s = sp.Symbol("s", real=True)
+        parsed = []
+        for k, item in enumerate(raw):
+            try:
+                parsed.append(expressions.parse(item, {**self.context.symbols, "s": s}))
+            except ExpressionError as error:
+                raise MechanismError(str(error), path + (k,), "Use numbers, parameter names, "
+                                     "s, pi, E and the listed functions.") from None
+        frame = self.frames[body]
+        ox, oy, angle = (f"({q.text})" for q in (frame.x, frame.y, frame.angle))
+        dx, dy = (f"({item}) - {o}" for item, o in zip(raw, (ox, oy)))
+        texts = [f"cos({angle})*({dx}) + sin({angle})*({dy})",
+                 f"-sin({angle})*({dx}) + cos({angle})*({dy})"]
+        if _numeric(frame.angle) and frame.angle.value == 0:
+            texts = [dx, dy]
+
+        def at(value: float) -> tuple[float, float]:
+            point = [constants.value(expr.subs(s, value), self.context.values) for expr in parsed]
+            return point[0], point[1]
+        return texts, at
+
+    def polar(self, body: str, rho: Any, path: Path_) -> Any:
+        """A polar profile rho(s) about ``body``'s frame origin, s the angle from the global x
+        axis as drawn, in the frame of ``body``: as written when the frame is not turned."""
+        self.curve(body, [rho, 0], path)  # parsed alone, as every drawn piece
+        angle = self.frames[body].angle
+        if _numeric(angle) and angle.value == 0:
+            return {"polar": rho}
+        return [f"({rho})*cos(s - ({angle.text}))", f"({rho})*sin(s - ({angle.text}))"]
+
+    def value(self, raw: Any, path: Path_) -> float:
+        """A drawn number or expression at the nominal parameters."""
+        return self.context.quantity(raw, path).value
+
+    def tolerance(self) -> float:
+        """How far drawn points that should coincide may be apart."""
+        return CLOSURE_TOLERANCE * self.size()
+
     def relative_angle(self, i: str, j: str) -> Any:
         """The angle of body i's frame less body j's, as drawn (a prismatic pair's phi0)."""
         return self.context.tidy(_sub(self.frames[i].angle, self.frames[j].angle))
