@@ -454,7 +454,8 @@ def _check_closure(drawing: Drawing, residuals: list[tuple[int, Any, tuple[str, 
                      f" ({label}) is off by {gap:.6g}" for index, joint, label, gap in open_joints)
     raise MechanismError(f"the drawing does not close: {said}", ("joints", open_joints[0][0]),
                          f"The two points of each joint must coincide (revolute) or lie on the "
-                         f"slide (prismatic, pin_slot) within {tolerance:.3g}; correct their "
+                         f"slide (prismatic, pin_slot), a point on its curve at s0 (point_on_curve) "
+                         f"within {tolerance:.3g}; correct their "
                          "coordinates, or give the joint one point with at:.")
 
 
