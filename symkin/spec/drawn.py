@@ -28,7 +28,7 @@ from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
 from symkin.pairs.fields import GROUND
 from symkin.pairs.kit import Joined, PairType
-from symkin.spec import constants, expressions
+from symkin.spec import constants, drawn_curves, expressions
 from symkin.spec.schema import MechanismSpec
 
 LAYOUTS = ("local", "drawn")
@@ -307,48 +307,24 @@ class Drawing:
         return self.texts(_to_frame(dx, dy, self.frames[body].angle))
 
     def curve(self, body: str, raw: Any, path: Path_) -> tuple[list[str], Any]:
-        """A curve [x(s), y(s)] as drawn (global), in the frame of ``body`` that carries it:
-        its components' text, and a function giving the drawn curve's point at a value of s.
-        Each component is parsed alone first (the whitelist parser), as every drawn piece."""
-        if not isinstance(raw, (list, tuple)) or len(raw) != 2:
-            raise MechanismError("expected a curve [x(s), y(s)]", path)
-        s = sp.Symbol("s", real=True)
-        parsed = []
-        for k, item in enumerate(raw):
-            try:
-                parsed.append(expressions.parse(item, {**self.context.symbols, "s": s}))
-            except ExpressionError as error:
-                raise MechanismError(str(error), path + (k,), "Use numbers, parameter names, "
-                                     "s, pi, E and the listed functions.") from None
+        """A curve [x(s), y(s)] as drawn, in the frame of ``body`` that carries it."""
         frame = self.frames[body]
-        ox, oy, angle = (f"({q.text})" for q in (frame.x, frame.y, frame.angle))
-        dx, dy = (f"({item}) - {o}" for item, o in zip(raw, (ox, oy)))
-        texts = [f"cos({angle})*({dx}) + sin({angle})*({dy})",
-                 f"-sin({angle})*({dx}) + cos({angle})*({dy})"]
-        if _numeric(frame.angle) and frame.angle.value == 0:
-            texts = [dx, dy]
-
-        def at(value: float) -> tuple[float, float]:
-            point = [constants.value(expr.subs(s, value), self.context.values) for expr in parsed]
-            return point[0], point[1]
-        return texts, at
+        return drawn_curves.in_frame(raw, (frame.x.text, frame.y.text), frame.angle.text,
+                                     self._turned(body), self.context.symbols,
+                                     self.context.values, path)
 
     def polar(self, body: str, rho: Any, path: Path_) -> Any:
-        """A polar profile rho(s) about ``body``'s frame origin, s the angle from the global x
-        axis as drawn, in the frame of ``body``: as written when the frame is not turned."""
-        self.curve(body, [rho, 0], path)  # parsed alone, as every drawn piece
+        """A polar profile rho(s) as drawn, in the frame of ``body`` that carries it."""
+        return drawn_curves.polar_in_frame(rho, self.frames[body].angle.text,
+                                           self._turned(body), self.context.symbols, path)
+
+    def _turned(self, body: str) -> bool:
         angle = self.frames[body].angle
-        if _numeric(angle) and angle.value == 0:
-            return {"polar": rho}
-        return [f"({rho})*cos(s - ({angle.text}))", f"({rho})*sin(s - ({angle.text}))"]
+        return not (_numeric(angle) and angle.value == 0)
 
     def value(self, raw: Any, path: Path_) -> float:
         """A drawn number or expression at the nominal parameters."""
         return self.context.quantity(raw, path).value
-
-    def tolerance(self) -> float:
-        """How far drawn points that should coincide may be apart."""
-        return CLOSURE_TOLERANCE * self.size()
 
     def relative_angle(self, i: str, j: str) -> Any:
         """The angle of body i's frame less body j's, as drawn (a prismatic pair's phi0)."""
@@ -454,9 +430,9 @@ def _check_closure(drawing: Drawing, residuals: list[tuple[int, Any, tuple[str, 
                      f" ({label}) is off by {gap:.6g}" for index, joint, label, gap in open_joints)
     raise MechanismError(f"the drawing does not close: {said}", ("joints", open_joints[0][0]),
                          f"The two points of each joint must coincide (revolute) or lie on the "
-                         f"slide (prismatic, pin_slot), a point on its curve at s0 (point_on_curve) "
-                         f"within {tolerance:.3g}; correct their "
-                         "coordinates, or give the joint one point with at:.")
+                         f"slide (prismatic, pin_slot) or its curve at s0 (point_on_curve) "
+                         f"within {tolerance:.3g}; correct their coordinates, or give the "
+                         "joint one point with at:.")
 
 
 def dump(mech: MechanismSpec) -> str:

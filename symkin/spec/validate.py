@@ -418,7 +418,8 @@ def check_degrees_of_freedom(mech: Mechanism) -> None:
     if dof == driving:
         return
     # Pairs of class 5 take two freedoms (revolute, prismatic), of class 4 one (pin-in-slot,
-    # distance, gear, rack, point on a curve, cam); the equations the file writes itself are counted apart.
+    # distance, gear, rack, point on a curve, cam); the equations the file writes itself are
+    # counted apart.
     counted = [_freedoms_taken(joint) for joint in mech.joints
                if pairs.of(joint).rows is not None]
     p5, p4 = counted.count(2), counted.count(1)

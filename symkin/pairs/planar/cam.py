@@ -28,7 +28,7 @@ from typing import Any, Literal
 import numpy as np
 import sympy as sp
 
-from symkin.errors import ExpressionError, MechanismError
+from symkin.errors import MechanismError
 from symkin.pairs import kit
 from symkin.pairs.fields import Expr, PointRef, Strict, Vec2
 
@@ -45,14 +45,14 @@ class Roller(Strict):
     """A roller of radius ``roller`` centred at ``at`` (a point of j)."""
 
     roller: Expr
-    at: PointRef = [0, 0]
+    at: PointRef = (0, 0)  # the frame origin of its body
 
 
 class Flat(Strict):
     """A flat face through ``at`` (a point of j) with ``normal`` fixed in j."""
 
     flat: Literal[True]
-    at: PointRef = [0, 0]
+    at: PointRef = (0, 0)  # the frame origin of its body
     normal: Vec2
 
 
@@ -210,5 +210,5 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
 
 
 TYPE = kit.PairType(
-    name="cam", model=Cam, sections=("joints",), equations=equations, rows=("contact 1", "contact 2"),
-    check=check, to_local=to_local, coordinate="s0")
+    name="cam", model=Cam, sections=("joints",), equations=equations,
+    rows=("contact 1", "contact 2"), check=check, to_local=to_local, coordinate="s0")

@@ -34,7 +34,7 @@ class Rack(Strict):
     j: str
     radius: Expr
     axis: Vec2
-    at: PointRef = [0, 0]
+    at: PointRef = (0, 0)  # the frame origin of its body
     offset: Expr | None = None
 
 
