@@ -56,6 +56,7 @@ class Geometry(Protocol):
     def equation(self, text: str) -> sp.Expr: ...
     def coordinate(self, name: str) -> sp.Symbol: ...
     def sign_at_nominal(self, expr: sp.Expr) -> int: ...
+    def rate(self, expr: sp.Expr) -> sp.Expr: ...
     def curve(self, raw: Any, s: sp.Symbol) -> sp.Expr: ...
 
 
@@ -138,6 +139,10 @@ class PairType:
         slide: the key of a slide's normal (the slide is drawn on body j along the normal
             turned by -90 degrees).
         rod: drawn as a line from its first point to its second (a rod with no body).
+        outputs: what it reports along a motion beyond the coordinates (a cam's pressure
+            angle and radius of curvature), as {key: (expression of q, dq, t and the
+            parameters, guard)}: reported as ``NAME.key``, NaN where the guard (an expression
+            too, or None) is below 1e-9 of its largest value over the run (undefined there).
         coordinate: the key of the first guess of the coordinate ``NAME.s`` the pair adds
             (a contact or curve parameter, solved like the bodies' coordinates); None: the
             pair adds no coordinate.
@@ -161,6 +166,7 @@ class PairType:
     slide: str | None = None
     rod: bool = False
     coordinate: str | None = None
+    outputs: Callable[[Any, Geometry], dict[str, tuple[sp.Expr, sp.Expr | None]]] | None = None
 
     def extra_coordinates(self, constraint: Any) -> tuple[tuple[str, Any], ...]:
         """The coordinates ``constraint`` adds, as (name, first guess): ``NAME.s``."""

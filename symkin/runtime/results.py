@@ -68,6 +68,9 @@ class Trajectory:
         cond: (T,) the estimated 1-norm condition number of Phi_q at each point.
         singular: the singular configurations passed through, as (t, rank loss, groups of
             dependent rows).
+        outputs: what pairs report beyond the coordinates, as (name, values of shape (T,)):
+            a cam's ``NAME.pressure_angle`` and ``NAME.curvature_radius``
+            (symkin.symbolic.outputs); written after the points.
     """
 
     t: NDArray[np.float64]
@@ -84,6 +87,7 @@ class Trajectory:
     flagged: NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
     cond: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     singular: tuple[tuple[float, int, tuple[tuple[str, ...], ...]], ...] = ()
+    outputs: tuple[tuple[str, NDArray[np.float64]], ...] = ()
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.
@@ -107,7 +111,7 @@ class Trajectory:
         self.__dict__.update(t=t, q=q, dq=dq, d2q=d2q, coordinates=coordinates, points=points,
                              point_vectors=point_vectors, params=params,
                              lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
-                             cond=cond, singular=singular)
+                             cond=cond, singular=singular, outputs=())
         return self
 
     @property
@@ -144,8 +148,8 @@ class Trajectory:
 
     def save(self, path: str | Path) -> Path:
         """Write .npz (all arrays: t, q, dq, d2q, coordinates, points, r, dr, ddr, flagged,
-        cond) or .csv (t, q, q_t, q_tt columns, then each named point's x, y, vx, vy, ax, ay,
-        then flagged)."""
+        cond, and each output by its name) or .csv (t, q, q_t, q_tt columns, then each named
+        point's x, y, vx, vy, ax, ay, then the outputs, then flagged)."""
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix not in SAVE_FORMATS:
@@ -164,16 +168,20 @@ class Trajectory:
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
         np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
                  coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond)
+                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond,
+                 **dict(self.outputs))
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
-                  *(c + "_tt" for c in self.coordinates), *self._point_columns(), "flagged"]
+                  *(c + "_tt" for c in self.coordinates), *self._point_columns(),
+                  *(name for name, _ in self.outputs), "flagged"]
         r, dr, ddr = self.point_arrays()
         # Per point: x, y, vx, vy, ax, ay (2.14-2.16).
         # the column count given, not inferred: a run that stopped before its first row
         # still writes its header
         points = np.concatenate([r, dr, ddr], axis=2).reshape(self.t.size, 6 * len(self.points))
-        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, self.flagged])
+        extra = np.column_stack([values for _, values in self.outputs]) if self.outputs \
+            else np.zeros((self.t.size, 0))
+        table = np.column_stack([self.t, self.q, self.dq, self.d2q, points, extra, self.flagged])
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")

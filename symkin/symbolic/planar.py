@@ -92,6 +92,13 @@ class Context:
                                  for name, symbol in self.symbols.parameters.items()}))
         return 1 if value > 0 else -1 if value < 0 else 0
 
+    def rate(self, expr: sp.Expr) -> sp.Expr:
+        """d expr / dt along the motion: sum of d expr / dq_k dq_k, plus d expr / dt."""
+        symbols = self.symbols
+        used = expr.free_symbols
+        return sp.Add(*(sp.diff(expr, q) * dq for q, dq in zip(symbols.q, symbols.dq)
+                        if q in used), sp.diff(expr, symbols.t))
+
     def equation(self, text: str) -> sp.Expr:
         """An equation written by the user: coordinates, t and parameters."""
         names = {**self.symbols.parameters, "t": self.symbols.t}

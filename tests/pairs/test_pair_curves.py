@@ -300,3 +300,25 @@ def test_drawn_cam_polar_profile_turns_with_its_frame() -> None:
     assert np.abs(runs[0] - runs[1]).max() < 1e-12
     assert runs[0][0] == pytest.approx(2.8, abs=1e-12)
     assert not math.isclose(runs[0].min(), runs[0].max())
+
+
+def test_cam_pressure_angle_and_curvature_radius_follow_the_law(cam, tmp_path: Path) -> None:
+    """For a radial roller follower, tan(pressure angle) = y'(theta) / (R0 + y(theta)) (the
+    pitch curve's normal against the follower's axis), undefined (NaN) in the dwells where
+    the follower rests; the profile's radius of curvature is the pitch curve's, of the polar
+    curve R = R0 + y: (R^2 + R'^2)^(3/2) / (R^2 + 2 R'^2 - R R''), less the roller's radius.
+    Written as CSV columns and NPZ arrays k1.pressure_angle and k1.curvature_radius."""
+    run = symkin.with_outputs(cam, symkin.solve(kernel_for(cam, "numpy")))
+    outputs = dict(run.outputs)
+    y, dy, d2y = _derivatives(_cycloidal(T), run.t)
+    moving = np.abs(dy) > 1e-6
+    angle = outputs["k1.pressure_angle"]
+    assert np.abs(angle[moving] - np.arctan(np.abs(dy[moving]) / (R0 + y[moving]))).max() < 1e-9
+    assert np.isnan(angle[np.abs(dy) == 0]).all()
+    R = R0 + y
+    pitch = (R**2 + dy**2) ** 1.5 / (R**2 + 2 * dy**2 - R * d2y)
+    assert np.abs(outputs["k1.curvature_radius"] - (pitch - 0.5)).max() < 1e-9
+    header = next(csv.reader(run.save(tmp_path / "cam.csv").open()))
+    assert header[-3:] == ["k1.pressure_angle", "k1.curvature_radius", "flagged"]
+    saved = np.load(run.save(tmp_path / "cam.npz"))
+    assert np.array_equal(saved["k1.curvature_radius"], outputs["k1.curvature_radius"])

@@ -105,6 +105,34 @@ def equations(c: Cam, geometry: kit.Geometry) -> list[sp.Expr]:
     return [(face.T * (cam.point(curve) - at))[0], (face.T * cam.R * curve.diff(s))[0]]
 
 
+def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr | None]]:
+    """What a cam designer checks along the motion, at the contact s:
+
+    - ``pressure_angle``: the angle (radians, 0 to pi/2) between the contact normal and the
+      velocity of the follower's point (the roller's centre, or the face's point F);
+      undefined (NaN) where that point is at rest (a dwell), which has no direction;
+    - ``curvature_radius``: the profile's radius of curvature |c'|^3 / (c' x c''), positive
+      where the profile is convex, negative where it is hollow (a roller needs a radius
+      smaller than the hollow's)."""
+    s = geometry.coordinate(f"{c.name}.s")
+    curve = _profile(c, s, geometry)
+    cam, follower = geometry.pose(c.i), geometry.pose(c.j)
+    t, t2 = curve.diff(s), curve.diff(s, 2)
+    turning = (curve[0] * t[1] - curve[1] * t[0]).subs(s, geometry.expr(c.s0))
+    sense = geometry.sign_at_nominal(turning)
+    speed = sp.sqrt((t.T * t)[0])
+    if isinstance(c.follower, Roller):
+        normal = cam.R * sp.Matrix([t[1], -t[0]])
+    else:
+        normal = follower.R * geometry.vector(c.follower.normal)
+    velocity = geometry.rate(follower.point(geometry.local(c.j, c.follower.at)))
+    across = normal[0] * velocity[1] - normal[1] * velocity[0]
+    along = (normal.T * velocity)[0]
+    return {"pressure_angle": (sp.atan2(sp.Abs(across), sp.Abs(along)),
+                               sp.sqrt((velocity.T * velocity)[0])),
+            "curvature_radius": (sense * speed**3 / (t[0] * t2[1] - t[1] * t2[0]), None)}
+
+
 def check(c: Cam, checks: kit.Checks, path: kit.Path) -> None:
     """The follower's point and sizes; the profile smooth, and followable over one turn."""
     s0 = checks.value(checks.expression(c.s0, path + ("s0",)), path + ("s0",))
@@ -211,4 +239,5 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
 
 TYPE = kit.PairType(
     name="cam", model=Cam, sections=("joints",), equations=equations,
-    rows=("contact 1", "contact 2"), check=check, to_local=to_local, coordinate="s0")
+    rows=("contact 1", "contact 2"), check=check, to_local=to_local, coordinate="s0",
+    outputs=outputs)
