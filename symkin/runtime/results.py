@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -166,10 +167,12 @@ class Trajectory:
     def _save_npz(self, path: Path) -> None:
         r, dr, ddr = self.point_arrays()
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
-        np.savez(path, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q,
-                 coordinates=np.array(self.coordinates, dtype=str), points=names,
-                 r=r, dr=dr, ddr=ddr, flagged=self.flagged, cond=self.cond,
-                 **dict(self.outputs))
+        arrays: dict[str, NDArray[Any]] = {
+            "t": self.t, "q": self.q, "dq": self.dq, "d2q": self.d2q,
+            "coordinates": np.array(self.coordinates, dtype=str), "points": names,
+            "r": r, "dr": dr, "ddr": ddr, "flagged": self.flagged, "cond": self.cond,
+            **dict(self.outputs)}
+        np.savez(path, **arrays)  # type: ignore[arg-type]
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),

@@ -28,7 +28,7 @@ from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
 from symkin.pairs.fields import GROUND
 from symkin.pairs.kit import Joined, PairType
-from symkin.spec import constants, drawn_curves, expressions
+from symkin.spec import constants, drawn_curves, drawn_slots, expressions
 from symkin.spec.schema import MechanismSpec
 
 LAYOUTS = ("local", "drawn")
@@ -370,6 +370,7 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
                 residuals.append((index, item, residual))
         local[section] = converted
     _check_closure(drawing, residuals)
+    drawn_slots.name_slot_copies(data, local)
     return local
 
 
