@@ -110,6 +110,10 @@ class Joined:
         return math.hypot(self.B[0] - self.A[0], self.B[1] - self.A[1])
 
 
+# A drawn mark: (body, label, [x(s), y(s)] in the body's frame, (s from, s to)).
+Mark = tuple[str, str, sp.Matrix, tuple[sp.Expr, sp.Expr]]
+S_MARK = sp.Symbol("s", real=True)  # the variable of a mark's curve
+
 # A drawn joint's local form and its closure residual (how far its drawing is from closing).
 DrawnResult = tuple[dict[str, Any], float | None]
 
@@ -143,6 +147,9 @@ class PairType:
             angle and radius of curvature), as {key: (expression of q, dq, t and the
             parameters, guard)}: reported as ``NAME.key``, NaN where the guard (an expression
             too, or None) is below 1e-9 of its largest value over the run (undefined there).
+        marks: what the drawing shows of it beyond points and slides, as (body, label,
+            curve [x(s), y(s)] in that body's frame, (s from, s to)): pitch circles and their
+            turning mark, a rack's line, a curve or a cam profile.
         coordinate: the key of the first guess of the coordinate ``NAME.s`` the pair adds
             (a contact or curve parameter, solved like the bodies' coordinates); None: the
             pair adds no coordinate.
@@ -167,6 +174,7 @@ class PairType:
     rod: bool = False
     coordinate: str | None = None
     outputs: Callable[[Any, Geometry], dict[str, tuple[sp.Expr, sp.Expr | None]]] | None = None
+    marks: Callable[[Any, Geometry], list[Mark]] | None = None
 
     def extra_coordinates(self, constraint: Any) -> tuple[tuple[str, Any], ...]:
         """The coordinates ``constraint`` adds, as (name, first guess): ``NAME.s``."""

@@ -21,7 +21,14 @@ from numpy.typing import NDArray
 
 from symkin.errors import UsageError
 from symkin.present import series
-from symkin.present.animation import MAX_FRAMES, Outlines, body_shapes, rods, slide_axes
+from symkin.present.animation import (
+    MAX_FRAMES,
+    Outlines,
+    body_shapes,
+    marks,
+    rods,
+    slide_axes,
+)
 from symkin.present.series import DEFAULT_UNITS, LENGTH, Units
 from symkin.runtime.results import Trajectory
 
@@ -106,9 +113,11 @@ class _Scene:
         self.shapes = body_shapes(trajectory, outlines)
         self.slides = slide_axes(trajectory, outlines)
         self.rods = rods(trajectory, outlines)
+        self.marks = marks(trajectory, outlines)
         self.ground = np.asarray(outlines.get("ground", np.zeros((0, 2))), float).reshape(-1, 2)
         self.points = list(points)
         every = np.concatenate([s.reshape(-1, 2) for s in self.shapes.values()]
+                               + [p.reshape(-1, 2) for _, p in self.marks]
                                + [self.ground, np.zeros((1, 2))])
         self.low, self.high = every.min(axis=0), every.max(axis=0)
         self.span = max(float(np.max(self.high - self.low)), 1e-9)
@@ -148,6 +157,12 @@ class _Scene:
             moving.append(self._add(figure, go.Scatter(
                 mode="lines+markers", name="rod", showlegend=k == 0, legendgroup="rods",
                 line={"dash": "dash", "width": 2, "color": "#444"}, marker={"size": 4})))
+        shown: set[str] = set()
+        for label, _ in self.marks:
+            moving.append(self._add(figure, go.Scatter(
+                mode="lines", name=label, showlegend=label not in shown, legendgroup=label,
+                line={"width": 1, "color": "#555"}, hoverinfo="skip")))
+            shown.add(label)
         for order, colour, word in ((1, VELOCITY, "velocity"), (2, ACCELERATION,
                                                                 "acceleration")):
             unit = self.units.unit(LENGTH, order)
@@ -175,6 +190,8 @@ class _Scene:
             data.append(go.Scatter(x=ends[:, 0], y=ends[:, 1]))
         for a, b in self.rods:
             data.append(go.Scatter(x=[a[k, 0], b[k, 0]], y=[a[k, 1], b[k, 1]]))
+        for _, polyline in self.marks:
+            data.append(go.Scatter(x=polyline[k, :, 0], y=polyline[k, :, 1]))
         for order in (1, 2):
             for name in self.points:
                 r, tip = self.kinematics[name][0][k], self.kinematics[name][order][k]

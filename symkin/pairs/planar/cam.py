@@ -237,7 +237,13 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
     return local, None
 
 
+def marks(c: Cam, geometry: kit.Geometry) -> list[kit.Mark]:
+    """The profile, over one turn of s from s0."""
+    s0 = geometry.expr(c.s0)
+    return [(c.i, "cam profile", _profile(c, kit.S_MARK, geometry), (s0, s0 + 2 * sp.pi))]
+
+
 TYPE = kit.PairType(
     name="cam", model=Cam, sections=("joints",), equations=equations,
     rows=("contact 1", "contact 2"), check=check, to_local=to_local, coordinate="s0",
-    outputs=outputs)
+    outputs=outputs, marks=marks)

@@ -72,6 +72,17 @@ def check(c: Gear, checks: kit.Checks, path: kit.Path) -> None:
                              "internal: false.")
 
 
+def marks(c: Gear, geometry: kit.Geometry) -> list[kit.Mark]:
+    """Each gear's pitch circle about its frame origin, with a radius that turns with it."""
+    s, found = kit.S_MARK, []
+    for body, raw in zip((c.i, c.j), c.radii):
+        r = geometry.expr(raw)
+        found.append((body, "pitch circle", sp.Matrix([r * sp.cos(s), r * sp.sin(s)]),
+                      (sp.Integer(0), 2 * sp.pi)))
+        found.append((body, "pitch circle", sp.Matrix([s, 0]), (sp.Integer(0), r)))
+    return found
+
+
 TYPE = kit.PairType(
     name="gear", model=Gear, sections=("joints",), equations=equations, rows=("rolling",),
-    bodies=("i", "j", "carrier"), constants=("offset",), check=check)
+    bodies=("i", "j", "carrier"), constants=("offset",), check=check, marks=marks)

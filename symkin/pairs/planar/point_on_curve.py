@@ -81,7 +81,13 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
     return local, float(((px - cx) ** 2 + (py - cy) ** 2) ** 0.5)
 
 
+def marks(c: PointOnCurve, geometry: kit.Geometry) -> list[kit.Mark]:
+    """The curve, over s0 - pi to s0 + pi (where it is real)."""
+    s0 = geometry.expr(c.s0)
+    return [(c.i, "curve", curve_of(c.curve, kit.S_MARK, geometry), (s0 - sp.pi, s0 + sp.pi))]
+
+
 TYPE = kit.PairType(
     name="point_on_curve", model=PointOnCurve, sections=("joints",), equations=equations,
     rows=("x", "y"), points=(("point", "j"),), check=check, to_local=to_local,
-    coordinate="s0")
+    coordinate="s0", marks=marks)

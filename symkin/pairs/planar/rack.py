@@ -90,7 +90,15 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
     return local, None
 
 
+def marks(c: Rack, geometry: kit.Geometry) -> list[kit.Mark]:
+    """The rack's line along its axis through its frame origin (20 radii long)."""
+    axis = geometry.vector(c.axis)
+    u = axis / sp.sqrt((axis.T * axis)[0])
+    reach = 10 * geometry.expr(c.radius)
+    return [(c.j, "rack", kit.S_MARK * u, (-reach, reach))]
+
+
 TYPE = kit.PairType(
     name="rack", model=Rack, sections=("joints",), equations=equations, rows=("rolling",),
     points=(("at", "i"),), directions=(("axis", "j"),), constants=("offset", "radius"),
-    check=check, to_local=to_local)
+    check=check, to_local=to_local, marks=marks)
