@@ -8,7 +8,11 @@ range, a missing or clashing name."""
 from __future__ import annotations
 
 import csv
+import json
 import math
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -322,3 +326,30 @@ def test_cam_pressure_angle_and_curvature_radius_follow_the_law(cam, tmp_path: P
     assert header[-3:] == ["k1.pressure_angle", "k1.curvature_radius", "flagged"]
     saved = np.load(run.save(tmp_path / "cam.npz"))
     assert np.array_equal(saved["k1.curvature_radius"], outputs["k1.curvature_radius"])
+
+
+def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    result = subprocess.run([sys.executable, "-m", "symkin", "run", *args], cwd=cwd, env=env,
+                            check=False, capture_output=True, text=True, timeout=600)
+    assert "Traceback" not in result.stderr, result.stderr
+    return result
+
+
+def test_cli_undercut_exits_2_and_curve_end_exits_1(tmp_path: Path) -> None:
+    """Undercutting is a mistake in the file (exit 2, located, no traceback); the end of a
+    curve met during the motion stops the run at its time naming the pair (exit 1), with the
+    rows solved so far written (the CSV has the column c1.s)."""
+    data = _cam({"polar": "2 + 0.4*cos(3*s)"}, {"roller": 1.5, "at": "R"})
+    bad = tmp_path / "undercut.yaml"
+    bad.write_text(json.dumps(data))
+    result = _cli(str(bad), "--backend", "numpy", cwd=tmp_path)
+    assert result.returncode == 2
+    assert "joints[2].profile.polar: undercutting" in result.stderr
+    mechanism = Path(__file__).resolve().parents[1] / "mechanisms" / "half_circle_end.yaml"
+    result = _cli(str(mechanism), "--backend", "numpy", "-o", "half.csv", cwd=tmp_path)
+    assert result.returncode == 1
+    assert "near t = 0.79999" in result.stderr and "c1 point_on_curve" in result.stderr
+    header = next(csv.reader((tmp_path / "half.csv").open()))
+    assert "c1.s" in header
