@@ -23,6 +23,7 @@ __all__ = [
     "load",
     "solve",
     "sweep",
+    "with_outputs",
 ]
 
 _EXPORTS = {
@@ -35,6 +36,7 @@ _EXPORTS = {
     "compile": ("symkin.public", "compile"),
     "solve": ("symkin.runtime.driver", "solve"),
     "sweep": ("symkin.sweeps.api", "sweep"),
+    "with_outputs": ("symkin.symbolic.outputs", "with_outputs"),
     "SymkinError": ("symkin.errors", "SymkinError"),
     "MechanismError": ("symkin.errors", "MechanismError"),
     "SolveError": ("symkin.errors", "SolveError"),

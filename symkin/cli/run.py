@@ -171,6 +171,7 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     if progress:
         progress.finish()
     _warn_flagged(trajectory)
+    trajectory = _with_pair_outputs(trajectory, args)
     written = _write(trajectory, args, prepared.outlines, picture)
     origin = ", cached kernel" if prepared.hit else ""
     if args.at is not None:
@@ -198,8 +199,9 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
         message += f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     try:
+        trajectory = _with_pair_outputs(stop.trajectory, args)
         with run_outputs.interrupts_held():  # a second Ctrl-C must not cut the file short
-            written = _write(stop.trajectory, args, prepared.outlines,
+            written = _write(trajectory, args, prepared.outlines,
                              run_outputs.Pictures.of(args, prepared.kernel))
     except CannotWrite as error:
         _error(str(error), EXIT_BAD_INPUT)
@@ -219,6 +221,24 @@ def _note_far_start(kernel: Any, trajectory: Any) -> None:
                                   float(trajectory.t[0]), trajectory.params)
     if moved:
         messages.note(run_outputs.far_start_note(moved, scale))
+
+
+def _with_pair_outputs(trajectory: Any, args: argparse.Namespace) -> Any:
+    """The trajectory with what its pairs report (a cam's pressure angle and radius of
+    curvature) when a results file is written and the mechanism has such pairs: only then
+    is the file read and derived again (a warm run of other mechanisms stays free of it)."""
+    if not args.output or trajectory.t.size == 0:
+        return trajectory
+    from symkin import pairs
+    from symkin.spec import validate
+
+    mech = validate.load(args.mechanism, overrides.parse(args.overrides))
+    if not any(pairs.of(c).outputs for section in pairs.SECTIONS
+               for c in getattr(mech, section)):
+        return trajectory
+    from symkin.symbolic import derivation, outputs
+
+    return outputs.with_outputs(derivation.derive(mech), trajectory)
 
 
 def _warn_flagged(trajectory: Any) -> None:

@@ -18,12 +18,16 @@ from pydantic import Field
 from symkin.pairs.kit import PairType
 from symkin.pairs.planar import (
     angle,
+    cam,
     custom,
     displacement,
     displacement_local,
     distance,
+    gear,
     pin_slot,
+    point_on_curve,
     prismatic,
+    rack,
     revolute,
     slide,
     trajectory,
@@ -42,6 +46,7 @@ from symkin.pairs.spatial import universal as spatial_universal
 # In the order the schema lists them (joints, then drivers; custom in both).
 TYPES: tuple[PairType, ...] = (
     revolute.TYPE, prismatic.TYPE, pin_slot.TYPE, distance.TYPE,
+    gear.TYPE, rack.TYPE, point_on_curve.TYPE, cam.TYPE,
     displacement.TYPE, displacement_local.TYPE, trajectory.TYPE, angle.TYPE, slide.TYPE,
     custom.TYPE,
 )

@@ -54,6 +54,10 @@ class Geometry(Protocol):
     def vector(self, raw: list[Any]) -> sp.Matrix: ...
     def time_function(self, raw: Any) -> sp.Expr: ...
     def equation(self, text: str) -> sp.Expr: ...
+    def coordinate(self, name: str) -> sp.Symbol: ...
+    def sign_at_nominal(self, expr: sp.Expr) -> int: ...
+    def rate(self, expr: sp.Expr) -> sp.Expr: ...
+    def curve(self, raw: Any, s: sp.Symbol) -> sp.Expr: ...
 
 
 class Checks(Protocol):
@@ -65,6 +69,11 @@ class Checks(Protocol):
     def uses_coordinates(self, expr: sp.Expr) -> bool: ...
     def value(self, expr: sp.Expr, path: Path) -> float: ...
     def point_at_q0(self, body: str, ref: Any) -> tuple[float, float]: ...
+    def curve(self, raw: Any, path: Path, order: int = 2) -> sp.Expr: ...
+    def curve_value(self, expr: sp.Expr, s: float, path: Path) -> float: ...
+    def body_names(self) -> tuple[str, ...]: ...
+    def point(self, body: str, ref: Any, path: Path) -> None: ...
+    def at_nominal(self, expr: sp.Expr) -> sp.Expr: ...
 
 
 class Drawing(Protocol):
@@ -75,6 +84,13 @@ class Drawing(Protocol):
     def slide_normal(self, joined: Joined, data: Mapping[str, Any],
                      path: Path) -> tuple[list[Any], float]: ...
     def relative_angle(self, i: str, j: str) -> Any: ...
+    def body(self, constraint: Mapping[str, Any], key: str, path: Path) -> str: ...
+    def point(self, body: str, raw: Any, path: Path) -> tuple[Any, Any]: ...
+    def direction(self, body: str, raw: Any, path: Path) -> list[Any]: ...
+    def curve(self, body: str, raw: Any, path: Path) -> tuple[list[str], Callable[[float],
+                                                                 tuple[float, float]]]: ...
+    def polar(self, body: str, rho: Any, path: Path) -> Any: ...
+    def value(self, raw: Any, path: Path) -> float: ...
 
 
 @dataclass(frozen=True)
@@ -93,6 +109,10 @@ class Joined:
     def gap(self) -> float:
         return math.hypot(self.B[0] - self.A[0], self.B[1] - self.A[1])
 
+
+# A drawn mark: (body, label, [x(s), y(s)] in the body's frame, (s from, s to)).
+Mark = tuple[str, str, sp.Matrix, tuple[sp.Expr, sp.Expr]]
+S_MARK = sp.Symbol("s", real=True)  # the variable of a mark's curve
 
 # A drawn joint's local form and its closure residual (how far its drawing is from closing).
 DrawnResult = tuple[dict[str, Any], float | None]
@@ -123,6 +143,16 @@ class PairType:
         slide: the key of a slide's normal (the slide is drawn on body j along the normal
             turned by -90 degrees).
         rod: drawn as a line from its first point to its second (a rod with no body).
+        outputs: what it reports along a motion beyond the coordinates (a cam's pressure
+            angle and radius of curvature), as {key: (expression of q, dq, t and the
+            parameters, guard)}: reported as ``NAME.key``, NaN where the guard (an expression
+            too, or None) is below 1e-9 of its largest value over the run (undefined there).
+        marks: what the drawing shows of it beyond points and slides, as (body, label,
+            curve [x(s), y(s)] in that body's frame, (s from, s to)): pitch circles and their
+            turning mark, a rack's line, a curve or a cam profile.
+        coordinate: the key of the first guess of the coordinate ``NAME.s`` the pair adds
+            (a contact or curve parameter, solved like the bodies' coordinates); None: the
+            pair adds no coordinate.
     """
 
     name: str
@@ -142,6 +172,15 @@ class PairType:
     pivot: bool = False
     slide: str | None = None
     rod: bool = False
+    coordinate: str | None = None
+    outputs: Callable[[Any, Geometry], dict[str, tuple[sp.Expr, sp.Expr | None]]] | None = None
+    marks: Callable[[Any, Geometry], list[Mark]] | None = None
+
+    def extra_coordinates(self, constraint: Any) -> tuple[tuple[str, Any], ...]:
+        """The coordinates ``constraint`` adds, as (name, first guess): ``NAME.s``."""
+        if self.coordinate is None:
+            return ()
+        return ((f"{constraint.name}.s", getattr(constraint, self.coordinate)),)
 
     def equation_count(self, constraint: Any) -> int:
         """How many rows of Phi ``constraint`` owns."""

@@ -98,6 +98,21 @@ def rods(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]
     return found
 
 
+def marks(trajectory: Trajectory, outlines: Outlines) -> list[tuple[str, Array]]:
+    """The higher pairs' marks (``curve:<body>:<label>:<k>``: pitch circles, rack lines,
+    curves, cam profiles) as (label, polyline (T, K, 2)) in the global frame."""
+    found = []
+    for key, rows in outlines.items():
+        if not key.startswith("curve:"):
+            continue
+        body, label = key.split(":")[1:3]
+        if body != GROUND and body not in trajectory.bodies:
+            continue
+        local = np.asarray(rows, dtype=float).reshape(-1, 2)
+        found.append((label, _global(trajectory, body, local)))
+    return found
+
+
 def parse_size(text: str) -> tuple[int, int]:
     """``"900x600"`` -> (900, 600), pixels; UsageError for anything else."""
     width, _, height = text.lower().partition("x")
@@ -166,7 +181,9 @@ class _Scene:
         self.shapes = body_shapes(trajectory, outlines)
         self.slides = slide_axes(trajectory, outlines)
         self.rods = rods(trajectory, outlines)
-        x0, x1, y0, y1 = _limits([*self.shapes.values(), _ground(outlines)[None]])
+        self.marks = marks(trajectory, outlines)
+        x0, x1, y0, y1 = _limits([*self.shapes.values(), _ground(outlines)[None],
+                                  *(polyline for _, polyline in self.marks)])
         ax.set_xlim(x0, x1)
         ax.set_ylim(y0, y1)
         ax.set_aspect("equal", adjustable="box")
@@ -179,6 +196,10 @@ class _Scene:
         self.rod_lines = [ax.plot([], [], "o--", color="0.25", linewidth=1.5, markersize=3,
                                   label="rod" if k == 0 else None)[0]
                           for k in range(len(self.rods))]
+        first = {label: k for k, (label, _) in reversed(list(enumerate(self.marks)))}
+        self.mark_lines = [ax.plot([], [], "-", color="0.35", linewidth=0.9,
+                                   label=label if first[label] == k else None)[0]
+                           for k, (label, _) in enumerate(self.marks)]
         _pivots(ax, _ground(outlines), span)
         colours = series.palette(len(self.shapes))
         self.lines = {body: ax.plot([], [], "o-", linewidth=3, markersize=4, color=colour,
@@ -194,7 +215,7 @@ class _Scene:
         # background and draws only the moving artists (an order of magnitude faster than
         # drawing the whole figure per frame).
         self.moving = [*self.lines.values(), *(line for _, line in self.traces),
-                       *self.slide_lines, *self.rod_lines, self.title]
+                       *self.slide_lines, *self.rod_lines, *self.mark_lines, self.title]
         for artist in self.moving:
             artist.set_animated(True)
         canvas = self.figure.canvas
@@ -221,6 +242,8 @@ class _Scene:
             line.set_data(ends[:, 0], ends[:, 1])
         for (a, b), line in zip(self.rods, self.rod_lines):
             line.set_data([a[k, 0], b[k, 0]], [a[k, 1], b[k, 1]])
+        for (_, polyline), line in zip(self.marks, self.mark_lines):
+            line.set_data(polyline[k, :, 0], polyline[k, :, 1])
         self.title.set_text(f"t = {self.trajectory.t[k]:.4g}")
 
 

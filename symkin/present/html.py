@@ -26,6 +26,7 @@ from symkin.present.animation import (
     Outlines,
     body_shapes,
     joint_points,
+    marks,
     rods,
     slide_axes,
 )
@@ -114,9 +115,11 @@ class _Scene:
         self.shapes = body_shapes(trajectory, outlines)
         self.slides = slide_axes(trajectory, outlines)
         self.rods = rods(trajectory, outlines)
+        self.marks = marks(trajectory, outlines)
         self.ground = np.asarray(outlines.get("ground", np.zeros((0, 2))), float).reshape(-1, 2)
         self.points = list(points)
         every = np.concatenate([s.reshape(-1, 2) for s in self.shapes.values()]
+                               + [p.reshape(-1, 2) for _, p in self.marks]
                                + [self.ground, np.zeros((1, 2))])
         self.low, self.high = every.min(axis=0), every.max(axis=0)
         self.span = max(float(np.max(self.high - self.low)), 1e-9)
@@ -171,6 +174,12 @@ class _Scene:
             moving.append(self._add(figure, go.Scatter(
                 mode="lines+markers", name="rod", showlegend=k == 0, legendgroup="rods",
                 line={"dash": "dash", "width": 2, "color": "#444"}, marker={"size": 4})))
+        shown: set[str] = set()
+        for label, _ in self.marks:
+            moving.append(self._add(figure, go.Scatter(
+                mode="lines", name=label, showlegend=label not in shown, legendgroup=label,
+                line={"width": 1, "color": "#555"}, hoverinfo="skip")))
+            shown.add(label)
         for order, colour, word in ((1, VELOCITY, "velocity"), (2, ACCELERATION,
                                                                 "acceleration")):
             unit = self.units.unit(LENGTH, order)
@@ -205,6 +214,8 @@ class _Scene:
             data.append(go.Scatter(x=ends[:, 0], y=ends[:, 1]))
         for a, b in self.rods:
             data.append(go.Scatter(x=[a[k, 0], b[k, 0]], y=[a[k, 1], b[k, 1]]))
+        for _, polyline in self.marks:
+            data.append(go.Scatter(x=polyline[k, :, 0], y=polyline[k, :, 1]))
         for order in (1, 2):
             for name in self.points:
                 r, tip = self.kinematics[name][0][k], self.kinematics[name][order][k]

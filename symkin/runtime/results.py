@@ -77,6 +77,9 @@ class Trajectory:
             where one exceeds the position target is flagged (runtime.redundant).
         space: ``3d`` for a spatial mechanism: 7 coordinates per body (x, y, z, e0..e3),
             points of 3 components, and each body's angular velocity and acceleration.
+        outputs: what pairs report beyond the coordinates, as (name, values of shape (T,)):
+            a cam's ``NAME.pressure_angle`` and ``NAME.curvature_radius``
+            (symkin.symbolic.outputs); written after the points.
     """
 
     t: NDArray[np.float64]
@@ -98,6 +101,7 @@ class Trajectory:
     space: str = "2d"
     forces: Forces | None = None
     """Efforts and reactions (runtime.forces) when the mechanism has masses or forces."""
+    outputs: tuple[tuple[str, NDArray[np.float64]], ...] = ()
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.
@@ -122,7 +126,7 @@ class Trajectory:
                              point_vectors=point_vectors, params=params,
                              lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
                              cond=cond, singular=singular, removed=(), removed_residual=None,
-                             space=space, forces=None)
+                             space=space, forces=None, outputs=())
         return self
 
     @property
@@ -146,8 +150,9 @@ class Trajectory:
 
     @property
     def bodies(self) -> tuple[str, ...]:
-        """The moving bodies, in coordinate order."""
-        return tuple(dict.fromkeys(name.rsplit(".", 1)[0] for name in self.coordinates))
+        """The moving bodies, in coordinate order (a pair's own coordinate ``NAME.s`` is no
+        body's: each body has an ``.x``)."""
+        return tuple(name[:-2] for name in self.coordinates if name.endswith(".x"))
 
     def body(self, name: str
              ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -189,8 +194,9 @@ class Trajectory:
 
     def save(self, path: str | Path) -> Path:
         """Write .npz (all arrays: t, q, dq, d2q, coordinates, points, r, dr, ddr, flagged,
-        cond; and removed, removed_residual where rows were removed as redundant) or .csv (t,
-        q, q_t, q_tt columns, then each named point's x, y, vx, vy, ax, ay, then flagged)."""
+        cond; removed, removed_residual where rows were removed as redundant; each pair
+        output by its name) or .csv (t, q, q_t, q_tt columns, then each named point's x, y,
+        vx, vy, ax, ay, then the pair outputs, then flagged)."""
         path = Path(path)
         suffix = path.suffix.lower()
         if suffix not in SAVE_FORMATS:
@@ -218,7 +224,8 @@ class Trajectory:
         arrays: dict[str, Any] = {
             "t": self.t, "q": self.q, "dq": self.dq, "d2q": self.d2q,
             "coordinates": np.array(self.coordinates, dtype=str), "points": names,
-            "r": r, "dr": dr, "ddr": ddr, "flagged": self.flagged, "cond": self.cond}
+            "r": r, "dr": dr, "ddr": ddr, "flagged": self.flagged, "cond": self.cond,
+            **dict(self.outputs)}
         # An over-constrained file's removed rows, only then (every other file's NPZ as before).
         if self.removed and self.removed_residual is not None:
             arrays.update(removed=np.array(self.removed, dtype=str),
@@ -241,7 +248,7 @@ class Trajectory:
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
                   *(c + "_tt" for c in self.coordinates), *self._point_columns(),
-                  *self._angular_columns(), "flagged",
+                  *self._angular_columns(), *(name for name, _ in self.outputs), "flagged",
                   *(self.forces.columns() if self.forces is not None else ())]
         r, dr, ddr = self.point_arrays()
         # Per point: x, y, vx, vy, ax, ay (2.14-2.16); spatial: x, y, z, vx, vy, vz, ax...
@@ -254,6 +261,7 @@ class Trajectory:
             omega, alpha = self.angular()
             columns.append(np.concatenate([omega, alpha], axis=2).reshape(
                 self.t.size, 6 * len(self.bodies)))
+        columns += [values for _, values in self.outputs]
         forces = [self.forces.table()] if self.forces is not None else []
         table = np.column_stack([*columns, self.flagged, *forces])
         np.savetxt(path, table, delimiter=",", header=",".join(header), comments="",

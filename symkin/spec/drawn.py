@@ -28,7 +28,7 @@ from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
 from symkin.pairs.fields import GROUND
 from symkin.pairs.kit import Joined, PairType
-from symkin.spec import constants, expressions, forces
+from symkin.spec import constants, drawn_curves, drawn_slots, expressions, forces
 from symkin.spec.schema import MechanismSpec
 
 LAYOUTS = ("local", "drawn")
@@ -304,6 +304,31 @@ class Drawing:
         gap = abs((bx - ax) * -dy.value + (by - ay) * dx.value) / length
         return self.texts(_to_frame(_neg(dy), dx, self.frames[joined.j].angle)), gap
 
+    def direction(self, body: str, raw: Any, path: Path_) -> list[Any]:
+        """A direction as drawn (global), in the frame of ``body``."""
+        dx, dy = self.context.vector(raw, path)
+        return self.texts(_to_frame(dx, dy, self.frames[body].angle))
+
+    def curve(self, body: str, raw: Any, path: Path_) -> tuple[list[str], Any]:
+        """A curve [x(s), y(s)] as drawn, in the frame of ``body`` that carries it."""
+        frame = self.frames[body]
+        return drawn_curves.in_frame(raw, (frame.x.text, frame.y.text), frame.angle.text,
+                                     self._turned(body), self.context.symbols,
+                                     self.context.values, path)
+
+    def polar(self, body: str, rho: Any, path: Path_) -> Any:
+        """A polar profile rho(s) as drawn, in the frame of ``body`` that carries it."""
+        return drawn_curves.polar_in_frame(rho, self.frames[body].angle.text,
+                                           self._turned(body), self.context.symbols, path)
+
+    def _turned(self, body: str) -> bool:
+        angle = self.frames[body].angle
+        return not (_numeric(angle) and angle.value == 0)
+
+    def value(self, raw: Any, path: Path_) -> float:
+        """A drawn number or expression at the nominal parameters."""
+        return self.context.quantity(raw, path).value
+
     def relative_angle(self, i: str, j: str) -> Any:
         """The angle of body i's frame less body j's, as drawn (a prismatic pair's phi0)."""
         return self.context.tidy(_sub(self.frames[i].angle, self.frames[j].angle))
@@ -352,6 +377,7 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
                 residuals.append((index, item, residual))
         local[section] = converted
     _check_closure(drawing, residuals)
+    drawn_slots.name_slot_copies(data, local)
     return local
 
 
@@ -433,8 +459,9 @@ def _check_closure(drawing: Drawing, residuals: list[tuple[int, Any, tuple[str, 
                      f" ({label}) is off by {gap:.6g}" for index, joint, label, gap in open_joints)
     raise MechanismError(f"the drawing does not close: {said}", ("joints", open_joints[0][0]),
                          f"The two points of each joint must coincide (revolute) or lie on the "
-                         f"slide (prismatic, pin_slot) within {tolerance:.3g}; correct their "
-                         "coordinates, or give the joint one point with at:.")
+                         f"slide (prismatic, pin_slot) or its curve at s0 (point_on_curve) "
+                         f"within {tolerance:.3g}; correct their coordinates, or give the "
+                         "joint one point with at:.")
 
 
 def dump(mech: MechanismSpec) -> str:

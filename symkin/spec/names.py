@@ -36,6 +36,7 @@ PYTHON_MODULES = frozenset(["numpy", "scipy", "cffi", "symkin", "math", "sys", "
 #                  no libm function, no system header;
 #   parameter, body -> names in expressions: anything but what an expression means otherwise;
 #   point, joint, driver -> labels only (rows, columns, comments): any identifier, E and p too.
+SLOT_SUFFIX = "@slot"
 KINDS = ("mechanism", "parameter", "body", "point", "joint", "driver")
 
 
@@ -43,6 +44,9 @@ def name_problem(name: object, kind: str = "mechanism") -> str | None:
     """Say what is wrong with ``name`` as a name of ``kind`` (one of :data:`KINDS`), or None."""
     if not isinstance(name, str):
         return f"{name!r} is not a name"
+    if kind == "point" and name.endswith(SLOT_SUFFIX):
+        # the drawn layout's name for a slotted body's copy of a shared point (drawn_slots)
+        name = name[: -len(SLOT_SUFFIX)]
     if not _IDENTIFIER.match(name):
         return (f"{name!r} is not a plain ASCII identifier (a letter, then letters, digits "
                 f"or '_')")

@@ -160,6 +160,7 @@ def _check_semantics(mech: Mechanism) -> None:
     for section in ("joints", "drivers"):
         for index, constraint in enumerate(getattr(mech, section)):
             path = (section, index)
+            _check_coordinate_name(mech, constraint, path)
             _check_constraint(mech, constraint, symbols, nominal, path)
             if constraint.name in named:
                 raise MechanismError(f"the name {constraint.name!r} is already used by "
@@ -202,6 +203,22 @@ def _check_names(mech: Mechanism) -> None:
                              "Rename them. Parameters and bodies may not be t, pi, E, a function "
                              "name, True/False/None or a Python keyword, and must differ from "
                              "each other; point, joint and driver names are free identifiers.")
+
+
+def _check_coordinate_name(mech: Mechanism, constraint: Any,
+                           path: tuple[str | int, ...]) -> None:
+    """A pair that adds a coordinate NAME.s needs a name that no body has."""
+    kind = pairs.of(constraint)
+    if kind.coordinate is None:
+        return
+    if constraint.name is None:
+        raise MechanismError(f"a {kind.name} pair needs a name", path + ("name",),
+                             f"It adds the coordinate NAME.s (solved and reported like the "
+                             f"bodies'); give it one, e.g. name: {kind.name[0]}1.")
+    if constraint.name in mech.bodies or constraint.name == GROUND:
+        raise MechanismError(f"the name {constraint.name!r} is a body's", path + ("name",),
+                             f"Its coordinate {constraint.name}.s would read as a coordinate "
+                             "of that body; use another name.")
 
 
 def _check_parameters(mech: Mechanism) -> dict[str, float]:
@@ -295,6 +312,38 @@ class _Checks:
 
     def value(self, expr: sp.Expr, path: tuple[str | int, ...]) -> float:
         return _numeric(expr, self.nominal, path)
+
+    def curve(self, raw: Any, path: tuple[str | int, ...], order: int = 2) -> sp.Expr:
+        """A curve's component: an expression of the parameters and ``s``, whose derivatives
+        in s up to ``order`` (what Phi_q and Gamma need) are printable."""
+        s = sp.Symbol("s", real=True)
+        if "s" in self.symbols.parameters:
+            raise MechanismError("a parameter is called s, the curve's own parameter",
+                                 ("parameters", "s"), "Rename the parameter.")
+        try:
+            expr = expressions.parse(raw, {**self.symbols.parameters, "s": s})
+            lower = sp.diff(expr, s, order - 2) if order > 2 else expr
+            expressions.check_derivatives(lower, [s], str(raw))
+        except ExpressionError as error:
+            raise MechanismError(str(error), path, "Use numbers, parameter names, s, pi, E, "
+                                 "+ - * / ** and the listed functions.") from None
+        return expr
+
+    def curve_value(self, expr: sp.Expr, s: float, path: tuple[str | int, ...]) -> float:
+        """A curve's expression at the nominal parameters and ``s``."""
+        at_s = expr.subs(self.nominal).subs(sp.Symbol("s", real=True), s)
+        return _numeric(at_s, {}, path)
+
+    def body_names(self) -> tuple[str, ...]:
+        return tuple(self.mech.bodies)
+
+    def at_nominal(self, expr: sp.Expr) -> sp.Expr:
+        """``expr`` with the parameters at their nominal values."""
+        return expr.subs(self.nominal)
+
+    def point(self, body: str, ref: Any, path: tuple[str | int, ...]) -> None:
+        """A point of ``body`` by name, or a vector of constant expressions."""
+        _point(self.mech, body, ref, self.symbols, self.nominal, path)
 
     def point_at_q0(self, body: str, ref: Any) -> tuple[float, float]:
         """The global position of a (checked) point of ``body`` at its first guess q0."""
@@ -427,11 +476,17 @@ def _check_dynamics(mech: Mechanism, symbols: _Names,
                 _expression(item, moving, where + at, time=True, coordinates=True)
 
 
+def _freedoms_taken(joint: Any) -> int:
+    """How many freedoms a joint takes: its rows less the coordinates it adds (a point on a
+    curve writes 2 equations and adds s: it takes one freedom, as a pair of class 4)."""
+    return equation_count(joint) - len(pairs.of(joint).extra_coordinates(joint))
+
+
 def degrees_of_freedom(mech: Mechanism) -> int:
     """Grübler's count w = 3n - 2 p5 - p4, less the equations of custom joints (in space:
     w = 6n less the joints' equations)."""
     per_body = 6 if mech.is_spatial else 3
-    return per_body * len(mech.bodies) - sum(equation_count(joint) for joint in mech.joints)
+    return per_body * len(mech.bodies) - sum(_freedoms_taken(joint) for joint in mech.joints)
 
 
 def check_degrees_of_freedom(mech: Mechanism) -> None:
@@ -448,8 +503,9 @@ def check_degrees_of_freedom(mech: Mechanism) -> None:
     if mech.is_spatial:
         _spatial_dof_error(mech, dof, driving)
     # Pairs of class 5 take two freedoms (revolute, prismatic), of class 4 one (pin-in-slot,
-    # distance); the equations the file writes itself are counted apart.
-    counted = [equation_count(joint) for joint in mech.joints
+    # distance, gear, rack, point on a curve, cam); the equations the file writes itself are
+    # counted apart.
+    counted = [_freedoms_taken(joint) for joint in mech.joints
                if pairs.of(joint).rows is not None]
     p5, p4 = counted.count(2), counted.count(1)
     formula = f"w = 3·{len(mech.bodies)} − 2·{p5} − {p4}"

@@ -23,7 +23,7 @@ from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
 from symkin.symbolic import dynamics, redundancy, spatial
 from symkin.symbolic.planar import Context
-from symkin.symbolic.symbols import Symbols, make_symbols
+from symkin.symbolic.symbols import Symbols, extra_coordinates, make_symbols
 
 
 # A spatial body's own row: its Euler parameters' normalisation (section, part).
@@ -299,5 +299,7 @@ def _row_gamma(entries: dict[int, sp.Expr], row_t: sp.Expr,
 
 def _initial_guess(mech: Mechanism, ctx: Context,
                    values: dict[sp.Symbol, float]) -> tuple[float, ...]:
-    return tuple(float(ctx.expr(raw).subs(values)) for body in mech.bodies.values()
-                 for raw in body.q0)
+    """The bodies' q0, then the first guesses (s0) of the pairs' own coordinates."""
+    raws = [raw for body in mech.bodies.values() for raw in body.q0]
+    raws += [raw for _, raw in extra_coordinates(mech)]
+    return tuple(float(ctx.expr(raw).subs(values)) for raw in raws)

@@ -2,8 +2,10 @@
 vectors of its joint and driver attachments and named points, as plain NumPy arrays; the
 points attached to the ground (pivots, under the key ``ground``); the slide axes (under
 ``slide:<body>``: rows point, direction, point, ... in the frame of the body that carries the
-slide); and the rods with no body of their own (under ``rod:<body i>:<body j>``: rows point on
-i, point on j, ...).
+slide); the rods with no body of their own (under ``rod:<body i>:<body j>``: rows point on
+i, point on j, ...); and the higher pairs' marks (under ``curve:<body>:<label>:<k>``: a
+polyline in the body's frame — pitch circles with a turning radius, rack lines, curves, cam
+profiles).
 
 Everything is read from the System's resolved vectors (:attr:`System.placed`); what each pair
 type adds to the drawing its module says (:class:`symkin.pairs.kit.PairType`). The runtime's
@@ -68,6 +70,7 @@ def outlines(system: System) -> dict[str, NDArray[np.float64]]:
             first, second = (p for p in placed if p.kind == "point")
             rods.setdefault(f"rod:{first.body}:{second.body}", []).extend(
                 [at(first.vector), at(second.vector)])
+    drawn.update(_marks(system, values))
     if pivots:
         drawn[GROUND] = np.array(sorted(pivots), dtype=float)
     drawn.update({f"slide:{body}": np.array(rows, dtype=float) for body, rows in slides.items()})
@@ -87,6 +90,36 @@ def _joint_points(system: System, at: Any) -> dict[str, NDArray[np.float64]]:
         if (p.section, p.side, p.kind) == ("joints", "i", "point"):
             key = f"joint:{names[p.index]}:{p.body}"
             found.setdefault(key, np.array([at(p.vector)], dtype=float))
+    return found
+
+
+MARK_SAMPLES = 121
+
+
+def _marks(system: System, values: dict[sp.Symbol, float]) -> dict[str, NDArray[np.float64]]:
+    """The pairs' own marks (pitch circles, rack lines, curves, cam profiles) sampled at the
+    nominal parameters, under ``curve:<body>:<label>:<k>`` (rows: points in the body's frame;
+    points where a curve has no real value are left out)."""
+    from symkin.pairs.kit import S_MARK
+    from symkin.symbolic.planar import Context
+    from symkin.symbolic.symbols import make_symbols
+
+    mech = system.mechanism
+    ctx = Context(mech, make_symbols(mech))
+    found: dict[str, NDArray[np.float64]] = {}
+    for section in pairs.SECTIONS:
+        for constraint in getattr(mech, section):
+            marks = pairs.of(constraint).marks
+            for body, label, curve, (start, stop) in marks(constraint, ctx) if marks else ():
+                s = np.linspace(float(start.subs(values)), float(stop.subs(values)),
+                                MARK_SAMPLES)
+                with np.errstate(all="ignore"):
+                    xy = np.column_stack([np.broadcast_to(np.asarray(sp.lambdify(
+                        S_MARK, item.subs(values), "numpy")(s), dtype=float), s.shape)
+                        for item in curve])
+                xy = xy[np.isfinite(xy).all(axis=1)]
+                if len(xy) > 1:
+                    found[f"curve:{body}:{label}:{len(found)}"] = xy
     return found
 
 

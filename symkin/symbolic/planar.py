@@ -75,6 +75,30 @@ class Context:
     def time_function(self, raw: Any) -> sp.Expr:
         return expressions.parse_time_function(raw, self.symbols.parameters, self.symbols.t)
 
+    def coordinate(self, name: str) -> sp.Symbol:
+        """The symbol of a coordinate a pair adds (``NAME.s``)."""
+        return self.symbols.q[self.symbols.coordinates.index(name)]
+
+    def curve(self, raw: Any, s: sp.Symbol) -> sp.Expr:
+        """A component of a curve: an expression of the parameters and its parameter ``s``."""
+        return expressions.parse(raw, {**self.symbols.parameters, "s": s})
+
+    def sign_at_nominal(self, expr: sp.Expr) -> int:
+        """The sign of an expression of the parameters at their nominal values: a choice the
+        file's first configuration makes once (which side, which sense), not a function of
+        the parameters to differentiate."""
+        values = self.mech.parameter_values()
+        value = float(expr.subs({symbol: values[name]
+                                 for name, symbol in self.symbols.parameters.items()}))
+        return 1 if value > 0 else -1 if value < 0 else 0
+
+    def rate(self, expr: sp.Expr) -> sp.Expr:
+        """d expr / dt along the motion: sum of d expr / dq_k dq_k, plus d expr / dt."""
+        symbols = self.symbols
+        used = expr.free_symbols
+        return sp.Add(*(sp.diff(expr, q) * dq for q, dq in zip(symbols.q, symbols.dq)
+                        if q in used), sp.diff(expr, symbols.t))
+
     def equation(self, text: str) -> sp.Expr:
         """An equation written by the user: coordinates, t and parameters."""
         names = {**self.symbols.parameters, "t": self.symbols.t}

@@ -94,5 +94,5 @@ def _tex_text(text: str) -> str:
 
 def _latex_name(coordinate: str) -> str:
     body, part = coordinate.split(".")
-    symbol = {"x": "x", "y": "y", "phi": "\\varphi"}[part]
+    symbol = {"x": "x", "y": "y", "phi": "\\varphi", "s": "s"}[part]  # s: a pair's own
     return f"{symbol}_{{\\mathrm{{{body.replace('_', '-')}}}}}"

@@ -7,6 +7,7 @@ from functools import cached_property
 
 import sympy as sp
 
+from symkin import pairs
 from symkin.pairs.fields import GROUND
 from symkin.spec.schema import MechanismSpec
 
@@ -51,11 +52,20 @@ class Symbols:
         return tuple(source[start:start + self.per_body])
 
 
+def extra_coordinates(mech: MechanismSpec) -> tuple[tuple[str, object], ...]:
+    """The coordinates pairs add beyond the bodies' (``NAME.s`` of a curve or cam pair), with
+    their first guesses, in file order."""
+    return tuple(extra for section in pairs.SECTIONS for constraint in getattr(mech, section)
+                 for extra in pairs.of(constraint).extra_coordinates(constraint))
+
+
 def make_symbols(mech: MechanismSpec) -> Symbols:
     """Create the symbols of ``mech``; coordinate names are ``body.x``, ``body.y``, ``body.phi``
-    (spatial: ``body.x`` .. ``body.z``, ``body.e0`` .. ``body.e3``)."""
+    (spatial: ``body.x`` .. ``body.z``, ``body.e0`` .. ``body.e3``), then the pairs' own
+    coordinates (``NAME.s``) after all the bodies'."""
     parts = mech.body_coordinates
     coordinates = tuple(f"{b}.{c}" for b in mech.bodies for c in parts)
+    coordinates += tuple(name for name, _ in extra_coordinates(mech))
     q = tuple(sp.Symbol(name, real=True) for name in coordinates)
     dq = tuple(sp.Symbol(name + "_t", real=True) for name in coordinates)
     p = tuple(sp.Symbol(name, real=True) for name in mech.parameters)

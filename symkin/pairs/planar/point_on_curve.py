@@ -1,0 +1,93 @@
+"""Point on a curve: a point P of body j stays on a curve [x(s), y(s)] fixed in body i (a
+slot of any shape, a guide, a track). The curve parameter s is a coordinate of its own,
+``NAME.s``, solved with the bodies' (first guess ``s0``):
+
+    r_j + R_j s_P - r_i - R_i c(s) = 0                                   (2 rows: x, y)
+
+In the local layout c(s) is written in i's frame; in the drawn layout it is global, as
+drawn, and carried by i (converted to i's frame here), and P must lie on it at s0.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, Literal
+
+import sympy as sp
+
+from symkin.errors import ExpressionError, MechanismError
+from symkin.pairs import kit
+from symkin.pairs.fields import Expr, PointRef, Strict, Vec2
+
+S = "s"
+
+
+class PointOnCurve(Strict):
+    """Point ``point`` of body j on ``curve`` [x(s), y(s)] of body i; s starts at ``s0``."""
+
+    type: Literal["point_on_curve"]
+    name: str | None = None
+    i: str
+    j: str
+    point: PointRef
+    curve: Vec2
+    s0: Expr = 0
+
+
+def curve_of(raw: list[Any], s: sp.Symbol, geometry: kit.Geometry) -> sp.Matrix:
+    """The curve's point c(s) in its body's frame."""
+    return sp.Matrix([geometry.curve(item, s) for item in raw])
+
+
+def equations(c: PointOnCurve, geometry: kit.Geometry) -> list[sp.Expr]:
+    """r_j + R_j s_P - (r_i + R_i c(s)) = 0."""
+    s = geometry.coordinate(f"{c.name}.{S}")
+    on_j = geometry.pose(c.j).point(geometry.local(c.j, c.point))
+    on_i = geometry.pose(c.i).point(curve_of(c.curve, s, geometry))
+    return list(on_j - on_i)
+
+
+def check(c: PointOnCurve, checks: kit.Checks, path: kit.Path) -> None:
+    """Each component an expression of s (its derivatives printable), real at s0."""
+    s0 = checks.value(checks.expression(c.s0, path + ("s0",)), path + ("s0",))
+    for k, raw in enumerate(c.curve):
+        expr = checks.curve(raw, path + ("curve", k))
+        checks.curve_value(expr, s0, path + ("curve", k))
+
+
+def drawn_curve(drawing: kit.Drawing, data: Mapping[str, Any], raw: Any, path: kit.Path,
+                ) -> tuple[list[str], Any]:
+    """A drawn curve in the frame of body i, and the drawn curve's point at s0."""
+    body = drawing.body(data, "i", path)
+    texts, at = drawing.curve(body, raw, path)
+    s0 = drawing.value(data.get("s0", 0), path + ("s0",))
+    try:
+        return texts, at(s0)
+    except ExpressionError as error:
+        raise MechanismError(f"the curve has no finite real point at s0 = {s0:g}: "
+                             f"{error.message}", path, "Give s0 inside the curve's range.") \
+            from None
+
+
+def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> kit.DrawnResult:
+    """The curve to i's frame; the point to j's; the gap between the point and c(s0)."""
+    local = dict(data)
+    if "curve" not in data or "point" not in data:
+        return local, None  # the schema names the missing key
+    local["curve"], (cx, cy) = drawn_curve(drawing, data, data["curve"], path + ("curve",))
+    j = drawing.body(data, "j", path)
+    local["point"], drawn_point = drawing.point(j, data["point"], path + ("point",))
+    px, py = (q.value for q in drawn_point)
+    return local, float(((px - cx) ** 2 + (py - cy) ** 2) ** 0.5)
+
+
+def marks(c: PointOnCurve, geometry: kit.Geometry) -> list[kit.Mark]:
+    """The curve, over s0 - pi to s0 + pi (where it is real)."""
+    s0 = geometry.expr(c.s0)
+    return [(c.i, "curve", curve_of(c.curve, kit.S_MARK, geometry), (s0 - sp.pi, s0 + sp.pi))]
+
+
+TYPE = kit.PairType(
+    name="point_on_curve", model=PointOnCurve, sections=("joints",), equations=equations,
+    rows=("x", "y"), points=(("point", "j"),), check=check, to_local=to_local,
+    coordinate="s0", marks=marks)

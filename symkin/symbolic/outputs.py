@@ -1,0 +1,81 @@
+"""What pairs report along a motion beyond the coordinates — a cam's pressure angle and
+radius of curvature at the contact — as named expressions of q, dq, t and the parameters, and
+their values on a solved Trajectory (NumPy functions made once per System).
+
+Each pair type says what it reports (:attr:`symkin.pairs.kit.PairType.outputs`); they are
+named ``NAME.key`` after the pair, and written with the Trajectory (CSV columns after the
+points, NPZ arrays by name).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import sympy as sp
+from numpy.typing import NDArray
+
+from symkin import pairs
+from symkin.symbolic.derivation import System
+from symkin.symbolic.planar import Context
+from symkin.symbolic.symbols import make_symbols
+
+UNDEFINED_BELOW = 1e-9
+"""An output is NaN where its guard is below this fraction of the guard's largest value."""
+
+
+@dataclass(frozen=True)
+class Output:
+    """One reported quantity: ``NAME.key``, its expression, and where it is undefined."""
+
+    name: str
+    expr: sp.Expr
+    guard: sp.Expr | None
+
+
+def pair_outputs(system: System) -> tuple[Output, ...]:
+    """Every pair's outputs, joints then drivers in file order."""
+    mech = system.mechanism
+    ctx = Context(mech, make_symbols(mech))
+    found = []
+    for section in pairs.SECTIONS:
+        for constraint in getattr(mech, section):
+            report = pairs.of(constraint).outputs
+            if report is None:
+                continue
+            for key, (expr, guard) in report(constraint, ctx).items():
+                found.append(Output(f"{constraint.name}.{key}", expr, guard))
+    return tuple(found)
+
+
+def _numeric(system: System, expr: sp.Expr) -> Callable[..., NDArray[np.float64]]:
+    arguments = [*system.q, *system.dq, system.t, *system.p]
+    return sp.lambdify(arguments, expr, "numpy")  # type: ignore[no-any-return]
+
+
+def evaluate(system: System, trajectory: Any) -> tuple[tuple[str, NDArray[np.float64]],
+                                                             ...]:
+    """The outputs' values at every solved point of a Trajectory (its t, q, dq and params),
+    shape (T,) each."""
+    columns = [*trajectory.q.T, *trajectory.dq.T, trajectory.t, *trajectory.params]
+    values = []
+    for output in pair_outputs(system):
+        with np.errstate(all="ignore"):
+            value = np.broadcast_to(np.asarray(_numeric(system, output.expr)(*columns),
+                                               dtype=float), trajectory.t.shape).copy()
+            if output.guard is not None and trajectory.t.size:
+                guard = np.abs(np.broadcast_to(np.asarray(
+                    _numeric(system, output.guard)(*columns), dtype=float),
+                    trajectory.t.shape))
+                value[guard <= UNDEFINED_BELOW * np.max(guard)] = np.nan
+        values.append((output.name, value))
+    return tuple(values)
+
+
+def with_outputs(system: System, trajectory: Any) -> Any:
+    """A Trajectory carrying the pairs' outputs (the same Trajectory if there are none)."""
+    values = evaluate(system, trajectory)
+    return dataclasses.replace(trajectory, outputs=values) if values else trajectory
