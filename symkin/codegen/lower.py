@@ -128,6 +128,8 @@ class Code:
     """The sines and cosines the fused routine passes to Phi_t and Gamma (printed, in order)."""
     constant_nz: tuple[float | None, ...] = ()
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
+    input_names: tuple[str, ...] = ()
+    """The input drivers (System.inputs): their u, du, ddu follow the parameters in p[]."""
 
     @property
     def nnz(self) -> int:
@@ -204,6 +206,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
                  if backend.plans_lu(linalg) else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
+        input_names=system.input_names,
     )
 
 

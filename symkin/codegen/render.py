@@ -211,6 +211,8 @@ def metadata(code: Code) -> Metadata:
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
+        # Only a mechanism with input drivers has the key: the others' manifests stay the same.
+        **({"input_names": list(code.input_names)} if code.input_names else {}),
     }
 
 
@@ -237,6 +239,9 @@ def template_context(code: Code) -> dict[str, Any]:
         "parameter_comments": [f"p[{k}] {lower.comment(n)} = {v!r}" for k, (n, v)
                                in enumerate(zip(code.parameter_names, code.p_values))],
         "row_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.rows)],
+        "nu": len(code.input_names),
+        "input_comments": [f"u[{k}] {lower.comment(n)}" for k, n in enumerate(code.input_names)],
+        "input_literals": [repr(n) for n in code.input_names],
         "routines": [_routine_context(code, r) for r in code.routines],
         # Python string literals: repr() of a str is always a valid, inert literal.
         "name_literal": repr(code.name),

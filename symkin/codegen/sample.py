@@ -56,7 +56,7 @@ def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...
 
     q0 = np.array(system.q0, dtype=float)
     kernel = kernel or _SampleKernel(system, system.pattern())
-    p = np.array(system.p_values, dtype=float)
+    p = np.array(system.code_p_values, dtype=float)
     try:
         with np.errstate(all="ignore"):
             q = _assemble(kernel, q0, float(system.time_grid[0]), p)
@@ -74,7 +74,7 @@ class _SampleKernel:
     def __init__(self, system: System, pattern: Sequence[tuple[int, int]]) -> None:
         internal = symbol_printing.internal_symbols(system)
         arguments = ([internal[s] for s in system.q], internal[system.t],
-                     [internal[s] for s in system.p])
+                     [internal[s] for s in system.code_parameters])
         self.coordinates = system.coordinates
         self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
         self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
@@ -82,7 +82,7 @@ class _SampleKernel:
         self._phi = sp.lambdify(arguments, phi, modules="numpy")
         self._nz = sp.lambdify(arguments, [symbol_printing.prepare(system.phi_q[r, c], internal)
                                            for r, c in pattern], modules="numpy")
-        self._p = np.array(system.p_values, dtype=float)
+        self._p = np.array(system.code_p_values, dtype=float)
 
     # t as a NumPy float: IEEE semantics as in the generated code (inf, NaN), never a Python
     # ZeroDivisionError or a complex power.

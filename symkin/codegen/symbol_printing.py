@@ -40,7 +40,8 @@ def symbol_text(name: str) -> str:
 def internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:
     """User symbols -> internal symbols whose names the printers turn into array accesses."""
     mapping = {system.t: sp.Symbol("_t", real=True)}
-    for prefix, symbols in (("q", system.q), ("dq", system.dq), ("p", system.p)):
+    # The inputs' u, du, ddu follow the parameters in p[] (System.code_parameters).
+    for prefix, symbols in (("q", system.q), ("dq", system.dq), ("p", system.code_parameters)):
         mapping.update({s: sp.Symbol(f"_{prefix}{k}", real=True) for k, s in enumerate(symbols)})
     return mapping
 

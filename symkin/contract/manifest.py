@@ -5,7 +5,7 @@ load and from_sources, each backend's build and loader)."""
 
 from __future__ import annotations
 
-from typing import TypedDict
+from typing import NotRequired, TypedDict
 
 MANIFEST_SUFFIX = "_manifest.json"
 
@@ -37,6 +37,8 @@ class Metadata(TypedDict):
     nnz: int
     npoints: int
     nshared: int
+    input_names: NotRequired[list[str]]
+    """The input drivers, in the order of u[] (only a mechanism that has them)."""
 
 
 class Manifest(Metadata):

@@ -40,6 +40,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         "points": module.POINTS,
         **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
            if hasattr(module, "PHI_P_ROWS") else {}),
+        "input_names": getattr(module, "INPUT_NAMES", ()),
     }
     return Kernel(backend, meta, _ModuleFunctions(module), folder=folder)
 
