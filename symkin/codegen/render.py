@@ -203,7 +203,7 @@ def manifest(code: Code, files: dict[str, str]) -> str:
 
 def metadata(code: Code) -> Metadata:
     """What the runtime Kernel needs besides the compiled functions (plain JSON data)."""
-    return {
+    data: Metadata = {
         "coordinates": list(code.coordinates), "parameter_names": list(code.parameter_names),
         "p_values": list(code.p_values), "q0": list(code.q0), "time_grid": list(code.time_grid),
         "rows": list(code.rows), "pattern_rows": list(code.pattern_rows),
@@ -211,9 +211,10 @@ def metadata(code: Code) -> Metadata:
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
-        # Only a mechanism with input drivers has the key: the others' manifests stay the same.
-        **({"input_names": list(code.input_names)} if code.input_names else {}),
     }
+    if code.input_names:  # only then: the other mechanisms' manifests stay the same
+        data["input_names"] = list(code.input_names)
+    return data
 
 
 # ----- template context ----------------------------------------------------------------------

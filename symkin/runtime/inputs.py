@@ -10,7 +10,6 @@ position-only run never pretends to know them. A C kernel solves each point in i
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any, Protocol
 
@@ -167,10 +166,9 @@ def _python_points(kernel: Any, run: Run, inputs: Inputs, first: Newton, p: Arra
     for k in range(run.t.size):
         t, pu = float(run.t[k]), inputs.row(kernel, p, k)
         if k > 0:
-            previous = tuple(float(np.abs(v[k - 1]).max(initial=0.0))
-                             for v in (run.q, run.dq, run.d2q))
-            result = newton(kernel, run.q[k - 1].copy(), t, pu, options,
-                            tuple(0.0 if math.isnan(v) else v for v in previous))
+            nq, ndq, nddq = (float(np.nan_to_num(np.abs(v[k - 1])).max(initial=0.0))
+                             for v in (run.q, run.dq, run.d2q))  # NaN: not asked for
+            result = newton(kernel, run.q[k - 1].copy(), t, pu, options, (nq, ndq, nddq))
             if result.status != OK:
                 return result, pu
         point = kinematics(kernel, result, t, pu, options)

@@ -146,17 +146,21 @@ def derive(mech: Mechanism | str | Path) -> System:
     values = mech.parameter_values()
     p_values = tuple(values[s.name] for s in symbols.p)
     nominal = dict(zip(symbols.p, p_values))
+    q0 = _initial_guess(mech, ctx, nominal)
+    time_grid = _time_grid(mech, ctx, nominal)
     return System(
         mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,
         p_values=p_values, coordinates=symbols.coordinates,
         phi=sp.ImmutableMatrix(phi), phi_q=sp.ImmutableSparseMatrix(size, size, jacobian),
         phi_t=sp.ImmutableMatrix(phi_t), gamma=sp.ImmutableMatrix(gamma), rows=rows,
-        q0=_initial_guess(mech, ctx, nominal),
+        q0=q0,
         points=tuple((body, name, sp.ImmutableMatrix(ctx.local(body, name)))
                      for body, spec in mech.bodies.items() for name in spec.points),
-        placed=_placed(mech, ctx), time_grid=_time_grid(mech, ctx, nominal),
+        placed=_placed(mech, ctx), time_grid=time_grid,
         phi_p=_parameter_jacobian(phi, symbols.p),
-        inputs=symbols.inputs, input_values=_input_values(phi, symbols, ctx, nominal),
+        inputs=symbols.inputs,
+        input_values=_input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
+                                                  symbols.t: time_grid[0]}),
     )
 
 
@@ -181,15 +185,14 @@ def _with_inputs(constraint: Any, symbols: Symbols, index: int) -> Any:
     return constraint.model_copy(update=update) if update else constraint
 
 
-def _input_values(phi: list[sp.Expr], symbols: Symbols, ctx: Context,
-                  nominal: dict[sp.Symbol, float]) -> tuple[float, ...]:
-    """Each input's value at the file's q0 (rates zero): its row, linear in u, solved for u;
-    0 where that has no finite value. Only generation-time samples use it."""
+def _input_values(phi: list[sp.Expr], symbols: Symbols,
+                  at_start: dict[sp.Symbol, float]) -> tuple[float, ...]:
+    """Each input's value at the file's q0 and t0 (``at_start``, rates zero): its row, linear
+    in u, solved for u; 0 where that has no finite value. Only generation-time samples use
+    it."""
     if not symbols.inputs:
         return ()
-    at_q0: dict[sp.Symbol, Any] = dict(zip(symbols.q, _initial_guess(ctx.mech, ctx, nominal)))
-    at_q0.update(nominal)
-    at_q0[symbols.t] = _time_grid(ctx.mech, ctx, nominal)[0]
+    at_q0: dict[sp.Symbol, Any] = dict(at_start)
     for item in symbols.inputs:
         at_q0.update({item.u: 0, item.du: 0, item.ddu: 0})
     values = []
