@@ -58,3 +58,6 @@ class Manifest(Metadata):
 
 KEYS = frozenset(Manifest.__annotations__)
 """Every key of a manifest (a reader asks for no other)."""
+
+OPTIONAL_KEYS = frozenset({"input_names"})
+"""The keys only some mechanisms' manifests have (input_names: those with input drivers)."""

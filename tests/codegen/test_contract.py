@@ -100,7 +100,11 @@ def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
     paths = render.generate(system("crank_slider"), backends.get("c"), out_dir=tmp_path)
     written = paths[-1]
     assert written.name == manifest.manifest_name("crank_slider")
-    assert set(json.loads(written.read_text(encoding="utf-8"))) == manifest.KEYS
+    keys = set(json.loads(written.read_text(encoding="utf-8")))
+    assert keys == manifest.KEYS - manifest.OPTIONAL_KEYS
+    inputs = render.generate(system("crank_slider_input"), backends.get("c"),
+                             out_dir=tmp_path / "inputs")[-1]
+    assert set(json.loads(inputs.read_text(encoding="utf-8"))) == manifest.KEYS
 
 
 # The modules that read a manifest, and the names their manifest dicts go by.

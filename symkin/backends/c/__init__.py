@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 PURPOSES = {
     "kernel": "kinematic kernel of the mechanism {name}: Phi, Phi_q, Phi_t, Gamma, points",
-    "solver": "position, velocity and acceleration analysis of {name} (Example 2.6)",
+    "solver": "position, velocity and acceleration analysis of {name}, one call a step",
     "linalg": "the solver's linear algebra on the dense LU",
     "sparse_lu": "sparse LU of Phi_q with its pivot order fixed at generation time",
     "dense_lu": "dense LU with partial pivoting (also the sparse LU's fall-back)",
