@@ -1,14 +1,14 @@
 /* Timing harness of Stewart-Gough forward kinematics along a pose trajectory.
  *
  * For each tilt amplitude, the poses of stewart_trajectory are turned into leg lengths by the
- * closed-form inverse kinematics; every solver in SOLVERS then recovers the poses from the leg
+ * closed-form inverse kinematics; every solver of the table in main then recovers the poses from the leg
  * lengths, each solve starting from the previous solution (as in a servo loop). Printed per
  * solver and tilt: microseconds per solve (best of the repeats, wall clock over the whole
  * trajectory), mean and largest iteration counts, the largest pose error (position and angle)
  * against the prescribed poses, the largest leg-length error of the returned poses, and the
  * solves that reported failure.
  *
- * Another solver is timed by adding a line to SOLVERS: its function has the signature of
+ * Another solver is timed by adding a line to the solvers table of main: its function has the signature of
  * fk_solve_fn (stewart.h) and its context pointer is passed through unchanged.
  *
  * Usage: fk_bench [POSES [REPEATS]]   (default 10000 poses, best of 5)

@@ -55,7 +55,8 @@ def test_closed_form_leg_lengths(tmp_path: Path) -> None:
     exe = tmp_path / "probe"
     subprocess.run(["gcc", *FLAGS, f"-I{BENCH}", "-o", str(exe), str(probe),
                     str(BENCH / "stewart.c"), "-lm"], check=True)
-    lines = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout.split("\n")
+    run = subprocess.run([str(exe)], check=True, capture_output=True, text=True)
+    lines = run.stdout.split("\n")
     legs = np.array([float(v) for v in lines[:6]])
     joints = np.array([[float(v) for v in line.split()] for line in lines[6:12]])
     x, a, b, c = np.array([0.1, -0.05, 0.9]), 0.3, -0.2, 0.4
