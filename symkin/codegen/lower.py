@@ -130,6 +130,8 @@ class Code:
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
     input_names: tuple[str, ...] = ()
     """The input drivers (System.inputs): their u, du, ddu follow the parameters in p[]."""
+    input_values: tuple[float, ...] = ()
+    """The inputs' values that the file's q0 satisfies (System.input_values)."""
 
     @property
     def nnz(self) -> int:
@@ -206,7 +208,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
                  if backend.plans_lu(linalg) else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
-        input_names=system.input_names,
+        input_names=system.input_names, input_values=system.input_values,
     )
 
 

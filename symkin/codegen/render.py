@@ -246,6 +246,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "nu": len(code.input_names),
         "input_comments": [f"u[{k}] {lower.comment(n)}" for k, n in enumerate(code.input_names)],
         "input_literals": [repr(n) for n in code.input_names],
+        "input_value_literals": [literal(v) for v in code.input_values],
         "routines": [_routine_context(code, r) for r in code.routines],
         # Python string literals: repr() of a str is always a valid, inert literal.
         "name_literal": repr(code.name),

@@ -69,6 +69,20 @@ class Inputs:
                                   None if self.ddu is None else self.ddu[k])
 
 
+def refuse_inputs(kernel: Any, what: str) -> None:
+    """Refuse ``what`` (a sweep, a scan) for a mechanism with input drivers: it runs over t
+    alone, and the generated functions would read inputs nobody gave.
+
+    Raises:
+        SolveError: the kernel has input drivers.
+    """
+    names = tuple(getattr(kernel, "input_names", ()))
+    if names:
+        raise SolveError(f"{what} of a mechanism with input drivers ({', '.join(names)}) is "
+                         "not supported: it runs over t alone. Solve it with symkin.solve("
+                         "..., inputs=...) or symkin run --inputs TABLE.csv")
+
+
 def check_inputs(kernel: InputKernel, times: Array, inputs: InputValues | None,
           rates: InputValues | None, accels: InputValues | None) -> Inputs:
     """The inputs as arrays (T, NU), refused with a message saying what is wrong where.

@@ -16,6 +16,7 @@ import pytest
 
 import symkin
 from symkin.errors import MechanismError, SolveError
+from symkin.runtime.scan import scan
 
 ROOT = Path(__file__).resolve().parents[2]
 BACKENDS = ("c", "numpy")
@@ -181,3 +182,13 @@ def test_the_generated_c_declares_the_contract(tmp_path: Path) -> None:
     assert "int crank_slider_input_solve_inputs(const crank_slider_input_options *options, " \
            "const crank_slider_input_real p[]," in " ".join(solver.split())
     assert files
+
+
+def test_sweep_and_scan_of_an_input_mechanism_are_refused() -> None:
+    """They run over t alone: the generated functions would read inputs nobody gave."""
+    kernel = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
+                            backend="c")
+    with pytest.raises(SolveError, match="a sweep of a mechanism with input drivers"):
+        symkin.sweep(kernel, {"a": [1.0, 1.1]})
+    with pytest.raises(SolveError, match="a scan of a mechanism with input drivers"):
+        scan(kernel)
