@@ -248,6 +248,9 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
     if getattr(kernel, "input_names", ()) or inputs is not None:
+        if sensitivities:
+            raise SolveError("sensitivities= is not supported for a mechanism with input "
+                             "drivers (q_p would need the inputs at every point)")
         trajectory = _solve_inputs(kernel, t, q0, params, options, out,
                                    (inputs, input_rates, input_accels))
     elif input_rates is not None or input_accels is not None:

@@ -192,3 +192,21 @@ def test_sweep_and_scan_of_an_input_mechanism_are_refused() -> None:
         symkin.sweep(kernel, {"a": [1.0, 1.1]})
     with pytest.raises(SolveError, match="a scan of a mechanism with input drivers"):
         scan(kernel)
+
+
+def test_sensitivities_of_an_input_run_are_refused() -> None:
+    kernel = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
+                            backend="numpy")
+    with pytest.raises(SolveError, match="sensitivities= is not supported"):
+        symkin.solve(kernel, t=T, inputs=T + 1.5, sensitivities=True)
+
+
+def test_float_c_kernel_solves_inputs_to_float_accuracy() -> None:
+    reference = symkin.compile(symkin.derive(ROOT / "examples/crank_slider.yaml"), backend="c")
+    single = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
+                            backend="c", real="float")
+    expected = symkin.solve(reference, t=T)
+    got = symkin.solve(single, t=T, inputs=T**2 + np.pi / 2, input_rates=2 * T,
+                       input_accels=np.full(T.size, 2.0))
+    for name in ("q", "dq", "d2q"):
+        assert _close(getattr(got, name), getattr(expected, name)) < 2e-5, name
