@@ -132,6 +132,8 @@ class Code:
     """The input drivers (System.inputs): their u, du, ddu follow the parameters in p[]."""
     input_values: tuple[float, ...] = ()
     """The inputs' values that the file's q0 satisfies (System.input_values)."""
+    input_places: tuple[str, ...] = ()
+    """Where each input is in the file (System.input_places)."""
 
     @property
     def nnz(self) -> int:
@@ -209,6 +211,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         input_names=system.input_names, input_values=system.input_values,
+        input_places=system.input_places,
     )
 
 

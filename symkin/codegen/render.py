@@ -244,7 +244,8 @@ def template_context(code: Code) -> dict[str, Any]:
                            for k, (body, name) in enumerate(code.points)],
         "point_bodies": [_body_index(code, body) for body, _ in code.points],
         "nu": len(code.input_names),
-        "input_comments": [f"u[{k}] {lower.comment(n)}" for k, n in enumerate(code.input_names)],
+        "input_comments": [f"u[{k}] {lower.comment(n)}: {lower.comment(place)}" for k, (n, place)
+                           in enumerate(zip(code.input_names, code.input_places))],
         "input_literals": [repr(n) for n in code.input_names],
         "input_value_literals": [literal(v) for v in code.input_values],
         "routines": [_routine_context(code, r) for r in code.routines],

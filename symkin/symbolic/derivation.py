@@ -98,6 +98,13 @@ class System:
         return tuple(item.name for item in self.inputs)
 
     @property
+    def input_places(self) -> tuple[str, ...]:
+        """Where each input is in the file: ``drivers[0] angle theta``, ``... f[1]``."""
+        drivers = self.mechanism.drivers
+        return tuple(f"drivers[{i.driver}] {drivers[i.driver].type} {i.key}"
+                     + ("" if i.component is None else f"[{i.component}]") for i in self.inputs)
+
+    @property
     def code_parameters(self) -> tuple[sp.Symbol, ...]:
         """The generated functions' p[]: the parameters, then every input's u, du, ddu."""
         return (self.p + tuple(i.u for i in self.inputs) + tuple(i.du for i in self.inputs)

@@ -37,7 +37,7 @@ typedef double crank_slider_input_real;
  *   p[1] b = 5.0
  *   p[2] c = 4.0
  * Inputs u[] (rates du[], accelerations ddu[] in the same order):
- *   u[0] crank_angle
+ *   u[0] crank_angle: drivers[0] angle theta
  * Named points (index: body.point), in the order of crank_slider_input_points and
  * crank_slider_input_point_kinematics:
  *   0: crank.tip
