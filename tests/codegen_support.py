@@ -61,19 +61,20 @@ class Reference:
     """Phi, Phi_q, Phi_t, Gamma and the point vectors of a System, by SymPy + mpmath."""
 
     def __init__(self, system) -> None:
-        q, dq, t, p = system.q, system.dq, system.t, system.p
+        # p[] of the generated functions: the parameters, then any inputs' u, du, ddu.
+        q, dq, t, p = system.q, system.dq, system.t, system.code_parameters
         self.nq = len(q)
         dense = sp.Matrix(system.phi_q)
         # The point vectors straight from the file's text (the parser, not codegen's own
         # point_vectors, which is under test), in file order: bodies, then their points.
-        by_name = {symbol.name: symbol for symbol in p}
+        by_name = {symbol.name: symbol for symbol in system.p}
         vectors = [expressions.parse(raw, by_name) for body in system.mechanism.bodies.values()
                    for vector in body.points.values() for raw in vector]
-        self._phi = sp.lambdify((q, t, p), list(system.phi), MPMATH)
-        self._phi_q = sp.lambdify((q, t, p), list(dense), MPMATH)
-        self._phi_t = sp.lambdify((q, t, p), list(system.phi_t), MPMATH)
-        self._gamma = sp.lambdify((q, dq, t, p), list(system.gamma), MPMATH)
-        self._points = sp.lambdify((p,), vectors or [sp.Integer(0)], MPMATH)
+        self._phi = sp.lambdify((q, t, p), list(system.phi), MPMATH, dummify=True)
+        self._phi_q = sp.lambdify((q, t, p), list(dense), MPMATH, dummify=True)
+        self._phi_t = sp.lambdify((q, t, p), list(system.phi_t), MPMATH, dummify=True)
+        self._gamma = sp.lambdify((q, dq, t, p), list(system.gamma), MPMATH, dummify=True)
+        self._points = sp.lambdify((p,), vectors or [sp.Integer(0)], MPMATH, dummify=True)
         self._n_points = len(vectors)
 
     @staticmethod
@@ -109,9 +110,13 @@ def random_states(system, count: int = N_STATES, seed: int = 7
     rng = np.random.default_rng(seed)
     t0, t1, _ = system.time_grid
     nominal = np.array(system.p_values, dtype=float)
+    inputs = 3 * len(system.inputs)  # u, du, ddu of input drivers, after the parameters
     for _ in range(count):
-        yield (rng.uniform(-2, 2, len(system.q)), rng.uniform(-3, 3, len(system.q)),
-               float(rng.uniform(t0, t1)), nominal * rng.uniform(0.8, 1.2, nominal.shape))
+        state = (rng.uniform(-2, 2, len(system.q)), rng.uniform(-3, 3, len(system.q)),
+                 float(rng.uniform(t0, t1)), nominal * rng.uniform(0.8, 1.2, nominal.shape))
+        if inputs:
+            state = (*state[:3], np.concatenate([state[3], rng.uniform(-2, 2, inputs)]))
+        yield state
 
 
 def assert_close(actual, expected, rtol: float = 1e-12, what: str = "") -> None:

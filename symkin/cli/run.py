@@ -42,6 +42,10 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     run.add_argument("--at", type=float, metavar="T",
                      help="solve the single configuration at time T and print q, dq, d2q and "
                           "the named points (no grid)")
+    run.add_argument("--inputs", type=Path, metavar="TABLE.csv",
+                     help="values of the input drivers (functions written `input`): CSV "
+                          "columns t (the grid), then each input's name, optionally followed "
+                          "by NAME_t (rate) and NAME_tt (acceleration)")
     run.add_argument("-o", "--output", type=Path, help="results file, .npz or .csv")
     run.add_argument("--plot", type=Path,
                      help="figure of position, velocity and acceleration against t: .png, "
@@ -86,6 +90,12 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
         if clash:
             return (f"--at solves one configuration; {', '.join(clash)} need a time grid. "
                     "Leave out --at, or those options")
+    if args.inputs is not None:
+        clash = [f"--{option}" for option in ("t0", "t1", "dt", "at")
+                 if getattr(args, option) is not None]
+        if clash:
+            return (f"--inputs {args.inputs}: its column t is the time grid; leave out "
+                    f"{', '.join(clash)}")
     if not 1 <= args.fps <= 100:
         return f"--fps {args.fps}: give 1 to 100 frames per second"
     if args.html is not None:
@@ -116,6 +126,30 @@ def _times(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
                       f"points, more than the {limits.MAX_GRID_POINTS:,} allowed (its results "
                       f"would need {_size(need)}); use a larger --dt or a shorter interval")
     return driver.grid(t0, t1, dt), None
+
+
+def _input_table(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
+    """The --inputs table of a mechanism with input drivers, or the whole message of what is
+    wrong: a table for a mechanism without inputs, inputs without a table, a mistake in the
+    table (located in the table by input_table)."""
+    from symkin.cli import input_table
+
+    names = tuple(getattr(kernel, "input_names", ()))
+    if args.inputs is None:
+        if names:
+            return None, (f"{args.mechanism}: the drivers {', '.join(names)} are inputs "
+                          "(written `input`): give their values with --inputs TABLE.csv, "
+                          "whose columns are "
+                          f"{input_table.expected(names)}")
+        return None, None
+    if not names:
+        return None, (f"{args.mechanism}: --inputs {args.inputs}: this mechanism has no "
+                      "input drivers (a "
+                      "driver function written `input`); leave out --inputs")
+    try:
+        return input_table.read(args.inputs, names), None
+    except input_table.TableError as error:
+        return None, str(error)
 
 
 def _size(count: float) -> str:
@@ -149,16 +183,23 @@ def _solve_and_write(args: argparse.Namespace) -> int:
                              outlines=args.animate is not None or args.html is not None)
     kernel = prepared.kernel
     picture = run_outputs.Pictures.of(args, kernel)  # --select checked before any solving
-    if args.at is not None:
+    table, problem = _input_table(kernel, args)
+    if problem:
+        return _error(problem, EXIT_BAD_INPUT)
+    if table is not None:
+        times = table.t
+    elif args.at is not None:
         times, problem = driver.grid(args.at, args.at, 1.0), None
     else:
         times, problem = _times(kernel, args)
     if problem:
         return _error(f"{args.mechanism}: {problem}", EXIT_BAD_INPUT)
     progress = ProgressBar(sys.stderr) if sys.stderr.isatty() and args.at is None else None
+    given = {} if table is None else {"inputs": table.u, "input_rates": table.du,
+                                      "input_accels": table.ddu}
     try:
         trajectory = driver.solve(kernel, t=times, progress=progress,
-                                  stop_at_singular=args.stop_at_singular)
+                                  stop_at_singular=args.stop_at_singular, **given)
     except driver.SolveInterrupted as interrupted:
         if progress:
             progress.finish()

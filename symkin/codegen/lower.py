@@ -158,6 +158,13 @@ class Code:
     def dynamics(self) -> bool:
         return any(routine.name == "loads" for routine in self.routines)
 
+    input_names: tuple[str, ...] = ()
+    """The input drivers (System.inputs): their u, du, ddu follow the parameters in p[]."""
+    input_values: tuple[float, ...] = ()
+    """The inputs' values that the file's q0 satisfies (System.input_values)."""
+    input_places: tuple[str, ...] = ()
+    """Where each input is in the file (System.input_places)."""
+
     @property
     def nnz(self) -> int:
         return len(self.pattern_rows)
@@ -237,6 +244,8 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         removed=tuple(str(removed) for removed in system.removed),
         driver_names=system.dynamics.driver_names if system.dynamics else (),
         joint_names=system.dynamics.joint_names if system.dynamics else (),
+        input_names=system.input_names, input_values=system.input_values,
+        input_places=system.input_places,
     )
 
 

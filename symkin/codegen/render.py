@@ -227,6 +227,8 @@ def metadata(code: Code) -> Metadata:
     if code.dynamics:
         data["driver_names"] = list(code.driver_names)
         data["joint_names"] = list(code.joint_names)
+    if code.input_names:  # only then: the other mechanisms' manifests stay the same
+        data["input_names"] = list(code.input_names)
     return data
 
 
@@ -253,6 +255,14 @@ def template_context(code: Code) -> dict[str, Any]:
         "parameter_comments": [f"p[{k}] {lower.comment(n)} = {v!r}" for k, (n, v)
                                in enumerate(zip(code.parameter_names, code.p_values))],
         "row_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.rows)],
+        "point_comments": [f"{k}: {lower.comment(f'{body}.{name}')}"
+                           for k, (body, name) in enumerate(code.points)],
+        "point_bodies": [_body_index(code, body) for body, _ in code.points],
+        "nu": len(code.input_names),
+        "input_comments": [f"u[{k}] {lower.comment(n)}: {lower.comment(place)}" for k, (n, place)
+                           in enumerate(zip(code.input_names, code.input_places))],
+        "input_literals": [repr(n) for n in code.input_names],
+        "input_value_literals": [literal(v) for v in code.input_values],
         "routines": [_routine_context(code, r) for r in code.routines],
         # Python string literals: repr() of a str is always a valid, inert literal.
         "name_literal": repr(code.name),
@@ -278,6 +288,12 @@ def template_context(code: Code) -> dict[str, Any]:
         "shared_constants": {name: _c_number(value) for name, value in tuning.SHARED.items()},
         **code.backend.template_context(code),
     }
+
+
+def _body_index(code: Code, body: str) -> int:
+    """Where a body's x is in q[] (-1: the ground, which has no coordinates)."""
+    name = f"{body}.x"
+    return code.coordinates.index(name) if name in code.coordinates else -1
 
 
 def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:

@@ -25,19 +25,59 @@ from symkin.symbolic.derivation import System
 NEWTON = defaults("double")
 
 
+# The motion is sampled at this many times of the file's grid (evenly spread), each reached
+# from the last by dense Newton over CONTINUATION_STEPS smaller steps; only for systems up to
+# MAX_SAMPLED_NQ coordinates (the samples are solved and replayed in Python).
+MOTION_SAMPLES = 32
+CONTINUATION_STEPS = 4
+MAX_SAMPLED_NQ = 150
+# A sample this ill-conditioned is a singular configuration: no pivot order survives it, so
+# it does not vote (the run-time test and the edge treatment handle the passage).
+SINGULAR_COND = 1e10
+
+
 def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_plan.LUPlan:
-    """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration."""
+    """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration and
+    checked over the motion (lu_plan.analyse_over), so that a step's cost is predictable."""
     kernel = _SampleKernel(system, pattern)
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         # A singular first guess (SciPy's LinAlgWarning) is expected here and handled.
         warnings.simplefilter("ignore")
-        sample = kernel.phi_q_nz(sample_configuration(system, kernel), system.time_grid[0])
+        start = sample_configuration(system, kernel)
+        samples = [kernel.phi_q_nz(q, t) for q, t in motion_configurations(system, kernel,
+                                                                           start)]
     try:
-        plan = lu_plan.analyse(len(system.q), [r for r, _ in pattern],
-                                 [c for _, c in pattern], [float(v) for v in sample])
+        plan = lu_plan.analyse_over(len(system.q), [r for r, _ in pattern],
+                                    [c for _, c in pattern],
+                                    [[float(v) for v in sample] for sample in samples])
     except SolveError as error:
         raise BuildError(f"cannot plan the sparse LU of Phi_q: {error}") from None
     return plan
+
+
+def motion_configurations(system: System, kernel: Any, start: Sequence[float]
+                          ) -> list[tuple[np.ndarray, float]]:
+    """(q, t) at the assembled start, then at up to MOTION_SAMPLES times of the file's grid,
+    each followed from the last by dense Newton; the walk stops where Newton fails (a limit
+    position or a singular passage), and ill-conditioned samples are left out."""
+    t0, t1, _ = system.time_grid
+    q = np.array(start, dtype=float)
+    found = [(q, float(t0))]
+    if len(system.q) > MAX_SAMPLED_NQ or system.inputs or not t1 > t0:
+        return found
+    p = np.array(system.code_p_values, dtype=float)
+    times = np.linspace(t0, t1, MOTION_SAMPLES * CONTINUATION_STEPS + 1)[1:]
+    for k, t in enumerate(times, start=1):
+        try:
+            next_q = dense_solvers.newton(kernel, q, float(t), p, NEWTON)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+            next_q = None
+        if next_q is None or not np.all(np.isfinite(next_q)):
+            break
+        q = next_q
+        if k % CONTINUATION_STEPS == 0 and np.linalg.cond(kernel.phi_q(q, t)) < SINGULAR_COND:
+            found.append((q, float(t)))
+    return found
 
 
 def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...]:
@@ -56,7 +96,7 @@ def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...
 
     q0 = np.array(system.q0, dtype=float)
     kernel = kernel or _SampleKernel(system, system.pattern())
-    p = np.array(system.p_values, dtype=float)
+    p = np.array(system.code_p_values, dtype=float)
     try:
         with np.errstate(all="ignore"):
             q = _assemble(kernel, q0, float(system.time_grid[0]), p)
@@ -74,7 +114,7 @@ class _SampleKernel:
     def __init__(self, system: System, pattern: Sequence[tuple[int, int]]) -> None:
         internal = symbol_printing.internal_symbols(system)
         arguments = ([internal[s] for s in system.q], internal[system.t],
-                     [internal[s] for s in system.p])
+                     [internal[s] for s in system.code_parameters])
         self.coordinates = system.coordinates
         self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
         self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
@@ -82,7 +122,7 @@ class _SampleKernel:
         self._phi = sp.lambdify(arguments, phi, modules="numpy")
         self._nz = sp.lambdify(arguments, [symbol_printing.prepare(system.phi_q[r, c], internal)
                                            for r, c in pattern], modules="numpy")
-        self._p = np.array(system.p_values, dtype=float)
+        self._p = np.array(system.code_p_values, dtype=float)
 
     # t as a NumPy float: IEEE semantics as in the generated code (inf, NaN), never a Python
     # ZeroDivisionError or a complex power.

@@ -40,7 +40,8 @@ def symbol_text(name: str) -> str:
 def internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:
     """User symbols -> internal symbols whose names the printers turn into array accesses."""
     mapping = {system.t: sp.Symbol("_t", real=True)}
-    arrays = [("q", system.q), ("dq", system.dq), ("p", system.p)]
+    # The inputs' u, du, ddu follow the parameters in p[] (System.code_parameters).
+    arrays = [("q", system.q), ("dq", system.dq), ("p", system.code_parameters)]
     if system.dynamics is not None:  # accelerations and multipliers (inverse dynamics)
         arrays += [("ddq", system.dynamics.ddq), ("lam", system.dynamics.lam)]
     for prefix, symbols in arrays:

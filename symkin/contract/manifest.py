@@ -50,6 +50,8 @@ class Metadata(_Dynamics):
     space: NotRequired[str]
     """``3d`` for a spatial mechanism (points of 3 components, 7 coordinates per body);
     absent for a planar one."""
+    input_names: NotRequired[list[str]]
+    """The input drivers, in the order of u[] (only a mechanism that has them)."""
 
 
 class Manifest(Metadata):
@@ -73,7 +75,7 @@ KEYS = frozenset(Manifest.__annotations__)
 DYNAMICS_KEYS = frozenset(_Dynamics.__annotations__)
 """The keys only a mechanism with masses or forces has."""
 
-OPTIONAL_KEYS = frozenset({"removed", "space"}) | DYNAMICS_KEYS
+OPTIONAL_KEYS = frozenset({"removed", "space", "input_names"}) | DYNAMICS_KEYS
 """The keys only some manifests have (``removed``: an over-constrained file's; ``space``: a
-spatial one's; the dynamics keys). Written out: with postponed annotations the TypedDict
-cannot see NotRequired in Python 3.11."""
+spatial one's; ``input_names``: one with input drivers; the dynamics keys). Written out:
+with postponed annotations the TypedDict cannot see NotRequired in Python 3.11."""

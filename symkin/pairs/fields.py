@@ -18,6 +18,15 @@ from pydantic_core import PydanticCustomError
 # The fixed body every mechanism has: it needs no entry in `bodies`, its q is zero.
 GROUND = "ground"
 
+# A driver's function written ``input``: its value, rate and acceleration come from the caller
+# at run time (a sensor, an encoder), not from a formula in t.
+INPUT = "input"
+
+
+def is_input(raw: Any) -> bool:
+    """True for a time function written ``input`` (the exact word, nothing around it)."""
+    return isinstance(raw, str) and raw.strip() == INPUT
+
 
 def kind_of(value: object) -> str:
     """How a value of the wrong type is named in a message: ``a mapping``, ``a list``, ..."""

@@ -44,6 +44,7 @@ from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
 from symkin.runtime.assembly import Assembly, assemble
 from symkin.runtime.edges import Resolution, resolve
+from symkin.runtime.inputs import InputValues, check_inputs, solve_points
 from symkin.runtime.linalg import factor_at
 from symkin.runtime.newton import Newton, kinematics, newton
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
@@ -207,7 +208,9 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
           params: Mapping[str, float] | ArrayLike | None = None, *,
           options: Options | None = None, progress: Progress | None = None,
           use_c_solver: bool = True, stop_at_singular: bool = False,
-          sensitivities: bool = False, out: Out | None = None) -> Trajectory:
+          sensitivities: bool = False, out: Out | None = None,
+          inputs: InputValues | None = None, input_rates: InputValues | None = None,
+          input_accels: InputValues | None = None) -> Trajectory:
     """Positions, velocities and accelerations of a mechanism over a time grid.
 
     Args:
@@ -227,6 +230,12 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
             cond and flagged are overwritten), or a tuple (q, dq, d2q) of writable
             C-contiguous float64 arrays of shape (T, N). The returned Trajectory holds these
             very arrays; the rest of ``out`` (params, singular, ...) is left as it was.
+        inputs: for a mechanism with input drivers (a driver function written ``input``),
+            their values at every t: an array (T, NU) in ``kernel.input_names`` order or a
+            dict by driver name of arrays (T,). Each point is then solved from the last
+            solution (runtime.inputs); t defaults to the file's grid as above.
+        input_rates, input_accels: the inputs' rates and accelerations, the same shapes;
+            without them dq (and d2q) are NaN: positions only.
 
     Returns:
         The Trajectory.
@@ -239,7 +248,18 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     options = options or default_options(kernel)
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
-    trajectory = _solve_in_unit(kernel, t, q0, params, options, progress, use_c_solver, out)
+    if getattr(kernel, "input_names", ()) or inputs is not None:
+        if sensitivities:
+            raise SolveError("sensitivities= is not supported for a mechanism with input "
+                             "drivers (q_p would need the inputs at every point)")
+        trajectory = _solve_inputs(kernel, t, q0, params, options, out,
+                                   (inputs, input_rates, input_accels))
+    elif input_rates is not None or input_accels is not None:
+        raise SolveError("input_rates= and input_accels= need inputs= (and a mechanism with "
+                         "input drivers)")
+    else:
+        trajectory = _solve_in_unit(kernel, t, q0, params, options, progress, use_c_solver,
+                                    out)
     trajectory = redundant.check(kernel, trajectory, options)
     if sensitivities:
         from symkin.runtime.sensitivity import with_sensitivities
@@ -315,6 +335,24 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
                 _check_start(kernel, run, p, options, result.q)  # assembled, singular there
             _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
         return _trajectory(kernel, run, p)
+
+
+def _solve_inputs(kernel: Any, t: ArrayLike | None, q0: ArrayLike | None,
+                  params: Mapping[str, float] | ArrayLike | None, options: Options,
+                  out: Out | None, given: tuple[InputValues | None, ...]) -> Trajectory:
+    """A run driven by inputs (runtime.inputs), failures raised as by the time loop."""
+    times = time_points(kernel, t)
+    table = check_inputs(kernel, times, *given)
+    p = parameter_values(kernel, params)
+    run = allocate(times, kernel.nq, out)
+    with np.errstate(all="ignore"):
+        result, pu, assembly = solve_points(kernel, run, table, first_guess(kernel, q0), p,
+                                          options)
+        if result.status != OK:
+            at = float(times[run.done])
+            _fail(kernel, run, pu, result, at, assembling=run.done == 0, assembly=assembly
+                  if run.done == 0 else None, params=p)
+    return _trajectory(kernel, run, p)
 
 
 def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,
@@ -414,11 +452,14 @@ def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
-          assembling: bool, assembly: Assembly | None = None) -> None:
-    """Raise SolveFailure with a message that says where, why and what to try."""
+          assembling: bool, assembly: Assembly | None = None,
+          params: Array | None = None) -> None:
+    """Raise SolveFailure with a message that says where, why and what to try (p: the
+    kernel's p[] at t; params: the parameters, when p also holds inputs)."""
     last = None if run.done == 0 else (float(run.t[run.done - 1]), run.q[run.done - 1])
     message, reason, rows = failures.explain(kernel, p, result, t, assembling, assembly, last)
-    raise SolveFailure(message, _trajectory(kernel, run, p), t, result.residual,
+    params = p if params is None else params
+    raise SolveFailure(message, _trajectory(kernel, run, params), t, result.residual,
                        result.iterations, rows, reason)
 
 

@@ -85,6 +85,8 @@ class Kernel:
         self.has_dynamics = "joint_names" in meta
         self.driver_names: tuple[str, ...] = tuple(meta.get("driver_names", ()))
         self.joint_names: tuple[str, ...] = tuple(meta.get("joint_names", ()))
+        # The input drivers (u[] order); their u, du, ddu follow the parameters in p[].
+        self.input_names: tuple[str, ...] = tuple(meta.get("input_names", ()))
         self._functions = functions
 
     @property
@@ -95,6 +97,11 @@ class Kernel:
     def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
         """A fresh run of the generated grid loop from q, or None without one."""
         del options, q, p
+        return None
+
+    def input_stepper(self) -> Any:
+        """A backend's generated one-point solve at given inputs (runtime.inputs), or None:
+        then the runtime's Newton solves each point."""
         return None
 
     @property
@@ -203,10 +210,31 @@ class Kernel:
                              f"got {array.shape}")
         return array
 
+    @property
+    def nu(self) -> int:
+        """The number of input drivers."""
+        return len(self.input_names)
+
+    def with_inputs(self, p: ArrayLike | None, u: ArrayLike, du: ArrayLike | None = None,
+                    ddu: ArrayLike | None = None) -> Array:
+        """The generated functions' p[] of a mechanism with inputs: the parameters (None:
+        nominal), then u, du, ddu (zero when None), each (NU,)."""
+        base = self.p_values if p is None else np.asarray(p, dtype=float)
+        zero = np.zeros(self.nu)
+        parts = [np.asarray(v, dtype=float).reshape(self.nu) if v is not None else zero
+                 for v in (u, du, ddu)]
+        return np.ascontiguousarray(np.concatenate([base, *parts]))
+
     def _p(self, values: ArrayLike | None) -> Array:
         if values is None:
-            return self.p_values
+            values = self.p_values
         array = np.ascontiguousarray(values, dtype=float)
+        if self.nu and array.shape == self.p_values.shape:
+            # The generated functions read p[NP + 3 NU]: without inputs they are taken as zero
+            # (symkin.solve refuses a run of such a mechanism without them).
+            return self.with_inputs(array, np.zeros(self.nu))
+        if self.nu and array.shape == (self.p_values.size + 3 * self.nu,):
+            return array
         if array.shape != self.p_values.shape:
             raise ValueError(f"p must have shape {self.p_values.shape} (parameters "
                              f"{', '.join(self.parameter_names)}), got {array.shape}")

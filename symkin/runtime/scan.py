@@ -26,6 +26,7 @@ from symkin.contract.status import OK
 from symkin.runtime import driver, redundant, units
 from symkin.runtime.assembly import RANDOM_ANGLES, assemble, starts
 from symkin.runtime.edges import LIMIT_COND
+from symkin.runtime.inputs import refuse_inputs
 from symkin.runtime.newton import newton
 from symkin.runtime.protocol import KinematicsKernel
 
@@ -110,6 +111,7 @@ def scan(kernel: KinematicsKernel, t: ArrayLike | None = None,
         SolveError: bad t or params (the caller's input), never for what the motion meets.
         SolveInterrupted: on Ctrl-C during a motion.
     """
+    refuse_inputs(kernel, "a scan")
     times = driver.time_points(kernel, t)
     p = driver.parameter_values(kernel, params)
     t0 = float(times[0])

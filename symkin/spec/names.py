@@ -20,7 +20,7 @@ LIBM_NAMES = frozenset(["acos", "acosh", "asin", "asinh", "atan", "atan2", "atan
 
 # What an expression could mean instead of a parameter or a body: the time, the constants, the
 # functions of the expression language and the literals Python's parser treats specially.
-EXPRESSION_NAMES = frozenset({"t", "pi", "E", "Piecewise", "True", "False", "None"}
+EXPRESSION_NAMES = frozenset({"t", "pi", "E", "Piecewise", "True", "False", "None", "input"}
                              | set(FUNCTIONS))
 
 # Standard C and POSIX header names: a mechanism named "string" would generate string.h,
@@ -64,6 +64,7 @@ def name_problem(name: object, kind: str = "mechanism") -> str | None:
 def _expression_clash(name: str, kind: str) -> str | None:
     if name in EXPRESSION_NAMES:
         meaning = ("the time" if name == "t" else "a constant" if name in ("pi", "E") else
+                   "the word of a driver whose values the caller gives" if name == "input" else
                    "a function" if name in FUNCTIONS or
                    name == "Piecewise" else "a Python literal")
         return f"{name!r} is {meaning} in expressions"

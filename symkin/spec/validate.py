@@ -17,7 +17,7 @@ from pydantic import ValidationError, model_validator
 from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError, UsageError, format_path
 from symkin.limits import MAX_GRID_POINTS, grid_points
-from symkin.pairs.fields import GROUND
+from symkin.pairs.fields import GROUND, is_input
 from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, forces, loader
 from symkin.spec.messages import translate
 from symkin.spec.names import name_problem
@@ -403,11 +403,10 @@ def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
             _expression(getattr(constraint, key), symbols, path + (key,), values=nominal)
     for key in kind.time_functions:
         value = getattr(constraint, key)
-        if isinstance(value, list):
-            for k, raw in enumerate(value):
-                _expression(raw, symbols, path + (key, k), time=True)
-        else:
-            _expression(value, symbols, path + (key,), time=True)
+        for k, raw in enumerate(value) if isinstance(value, list) else ((None, value),):
+            if not is_input(raw):  # an input has no formula to check
+                _expression(raw, symbols, path + ((key, k) if k is not None else (key,)),
+                            time=True)
     if kind.check is not None:
         kind.check(constraint, _Checks(mech, symbols, nominal), path)
 

@@ -21,6 +21,7 @@ from symkin import limits
 from symkin.contract.options import Options
 from symkin.errors import SolveError
 from symkin.runtime import driver, redundant
+from symkin.runtime.inputs import refuse_inputs
 from symkin.runtime.kernel import Kernel
 from symkin.sweeps import parallel
 from symkin.sweeps.batch import Chunk, empty_chunk, solve_chunk
@@ -61,6 +62,7 @@ def sweep(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike,
     Raises:
         SolveError: params, t or q0 that do not fit the mechanism.
     """
+    refuse_inputs(kernel, "a sweep")
     values = parameter_table(kernel, params)
     times = driver.time_points(kernel, t)
     problem = too_large(values.shape[0], times.size, len(kernel.coordinates))

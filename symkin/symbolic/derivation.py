@@ -11,8 +11,10 @@ solution Phi(q(p), t, p) = 0, so Phi_q q_p = -Phi_p.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import sympy as sp
 
@@ -22,8 +24,8 @@ from symkin.spec import validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
 from symkin.symbolic import dynamics, redundancy, spatial
-from symkin.symbolic.planar import Context
-from symkin.symbolic.symbols import Symbols, extra_coordinates, make_symbols
+from symkin.symbolic.planar import TAU, Context, input_slot
+from symkin.symbolic.symbols import Input, Symbols, extra_coordinates, make_symbols
 
 
 # A spatial body's own row: its Euler parameters' normalisation (section, part).
@@ -119,6 +121,33 @@ class System:
     dynamics: dynamics.Dynamics | None = None
     """Mass terms, applied forces, efforts and reactions; None for a file without masses
     and forces (inverse dynamics, symbolic.dynamics)."""
+    inputs: tuple[Input, ...] = ()
+    """The driver functions written ``input``: Phi holds their values u, Phi_t their rates du,
+    Gamma their accelerations ddu (symbols of each Input)."""
+    input_values: tuple[float, ...] = ()
+    """Each input's value that the file's q0 satisfies (for generation-time samples)."""
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        return tuple(item.name for item in self.inputs)
+
+    @property
+    def input_places(self) -> tuple[str, ...]:
+        """Where each input is in the file: ``drivers[0] angle theta``, ``... f[1]``."""
+        drivers = self.mechanism.drivers
+        return tuple(f"drivers[{i.driver}] {drivers[i.driver].type} {i.key}"
+                     + ("" if i.component is None else f"[{i.component}]") for i in self.inputs)
+
+    @property
+    def code_parameters(self) -> tuple[sp.Symbol, ...]:
+        """The generated functions' p[]: the parameters, then every input's u, du, ddu."""
+        return (self.p + tuple(i.u for i in self.inputs) + tuple(i.du for i in self.inputs)
+                + tuple(i.ddu for i in self.inputs))
+
+    @property
+    def code_p_values(self) -> tuple[float, ...]:
+        """Nominal values of code_parameters: inputs at input_values, at rest."""
+        return self.p_values + self.input_values + (0.0,) * (2 * len(self.inputs))
 
     @property
     def name(self) -> str:
@@ -161,10 +190,11 @@ def derive(mech: Mechanism | str | Path) -> System:
     phi_t, gamma = [], []
     for r, row in enumerate(phi):
         entries = _row_jacobian(row, column, symbols.q)
-        jacobian.update({(r, k): value for k, value in entries.items()})
         row_t = sp.diff(row, symbols.t)
-        phi_t.append(row_t)
-        gamma.append(_row_gamma(entries, row_t, symbols))
+        jacobian.update({(r, k): _at_tau(value, symbols) for k, value in entries.items()})
+        phi_t.append(_at_tau(row_t, symbols))
+        gamma.append(_at_tau(_row_gamma(entries, row_t, symbols), symbols))
+    phi = [_at_tau(row, symbols) for row in phi]
     size = len(symbols.q)
     phi_q = sp.ImmutableSparseMatrix(size, size, jacobian)
     placed = _placed(mech, ctx)
@@ -180,6 +210,9 @@ def derive(mech: Mechanism | str | Path) -> System:
         phi_p=_parameter_jacobian(phi, symbols.p), removed=removed, mobility=mobility,
         dynamics=(dynamics.derive(mech, ctx, phi_q, rows, placed)
                   if has_dynamics(mech) else None),
+        inputs=symbols.inputs,
+        input_values=_input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
+                                                  symbols.t: time_grid[0]}),
     )
 
 
@@ -193,6 +226,13 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
     with as many (the DOF count passed) is left as it is, untouched."""
     if len(phi) <= len(symbols.q):
         return phi, rows, (), None
+    if symbols.inputs:
+        # the rank is judged at an assembled t0, which inputs known only at run time lack
+        raise MechanismError(
+            f"over-constrained: {len(phi)} equations for {len(symbols.q)} coordinates, and "
+            "the file has input drivers", ("drivers",),
+            "Redundant equations are found at the assembled start, which needs drivers "
+            "that are functions of t: remove the repeated joint, or drive it by a function.")
     joints = [k for k, row in enumerate(rows) if row.section == "joints"]
     priority = [k for k, row in enumerate(rows) if row.section != "joints"] + joints
     try:
@@ -212,6 +252,48 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
             found.mobility)
 
 
+def _at_tau(expr: sp.Expr, symbols: Symbols) -> sp.Expr:
+    """An expression derived from inputs' Taylor polynomials, taken at tau = t."""
+    return expr.xreplace({TAU: symbols.t}) if symbols.inputs else expr
+
+
+def _with_inputs(constraint: Any, symbols: Symbols, index: int) -> Any:
+    """The driver with each ``input`` function replaced by its slot (planar.input_slot)."""
+    update: dict[str, Any] = {}
+    for item in symbols.inputs:
+        if item.driver != index:
+            continue
+        slot = input_slot(item.u, item.du, item.ddu, symbols.t)
+        if item.component is None:
+            update[item.key] = slot
+        else:
+            value = list(update.get(item.key, getattr(constraint, item.key)))
+            value[item.component] = slot
+            update[item.key] = value
+    return constraint.model_copy(update=update) if update else constraint
+
+
+def _input_values(phi: list[sp.Expr], symbols: Symbols,
+                  at_start: dict[sp.Symbol, float]) -> tuple[float, ...]:
+    """Each input's value at the file's q0 and t0 (``at_start``, rates zero): its row, linear
+    in u, solved for u; 0 where that has no finite value. Only generation-time samples use
+    it."""
+    if not symbols.inputs:
+        return ()
+    at_q0: dict[sp.Symbol, Any] = dict(at_start)
+    for item in symbols.inputs:
+        at_q0.update({item.u: 0, item.du: 0, item.ddu: 0})
+    values = []
+    for item in symbols.inputs:
+        row = next(row for row in phi if item.u in row.free_symbols)
+        try:
+            value = float(-row.subs(at_q0) / sp.diff(row, item.u).subs(at_q0))
+        except (TypeError, ValueError, ZeroDivisionError):
+            value = 0.0
+        values.append(value if math.isfinite(value) else 0.0)
+    return tuple(values)
+
+
 def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tuple[Row, ...]]:
     """Phi and its row labels: joints in file order, then drivers (README, "Row order")."""
     phi: list[sp.Expr] = []
@@ -219,6 +301,8 @@ def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tupl
     for section in pairs.SECTIONS:
         for index, constraint in enumerate(getattr(mech, section)):
             kind = pairs.of(constraint)
+            if section == "drivers":
+                constraint = _with_inputs(constraint, ctx.symbols, index)
             equations = kind.equations(constraint, ctx)
             parts = kind.rows or tuple(f"equation {k}" for k in range(len(equations)))
             bodies = kind.joined_bodies(constraint) or _bodies_touched(equations, ctx)

@@ -18,6 +18,26 @@ from symkin.spec import expressions
 from symkin.spec.schema import MechanismSpec
 from symkin.symbolic.symbols import Symbols
 
+# Around the time of the call, an input's function of t is its Taylor polynomial
+# u + du (t - tau) + ddu (t - tau)^2 / 2: differentiated like any time function, then taken at
+# tau = t, it gives Phi the value u, Phi_t the rate du and Gamma the acceleration ddu.
+TAU = sp.Dummy("tau", real=True)
+
+
+@dataclass(frozen=True)
+class InputSlot:
+    """What derivation puts in place of a driver's ``input`` before its equations are
+    written: the input's function of t (see TAU)."""
+
+    expression: sp.Expr
+
+
+def input_slot(u: sp.Symbol, du: sp.Symbol, ddu: sp.Symbol, t: sp.Symbol) -> InputSlot:
+    """The slot of one input: its Taylor polynomial about TAU in t."""
+    h = t - TAU
+    return InputSlot(u + du * h + ddu * h**2 / 2)
+
+
 OMEGA = sp.Matrix([[0, -1], [1, 0]])  # (2.41)
 
 
@@ -73,6 +93,8 @@ class Context:
         return self.vector(ref)
 
     def time_function(self, raw: Any) -> sp.Expr:
+        if isinstance(raw, InputSlot):
+            return raw.expression
         return expressions.parse_time_function(raw, self.symbols.parameters, self.symbols.t)
 
     def coordinate(self, name: str) -> sp.Symbol:

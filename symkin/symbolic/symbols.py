@@ -8,8 +8,23 @@ from functools import cached_property
 import sympy as sp
 
 from symkin import pairs
-from symkin.pairs.fields import GROUND
+from symkin.pairs.fields import GROUND, is_input
 from symkin.spec.schema import MechanismSpec
+
+
+@dataclass(frozen=True)
+class Input:
+    """A driver function written ``input``: which driver, key and component it is, its name
+    (the driver's, ``_x``/``_y`` per component of a vector; ``drivers[k]`` when unnamed) and
+    the symbols of its value, rate and acceleration."""
+
+    name: str
+    driver: int
+    key: str
+    component: int | None
+    u: sp.Symbol
+    du: sp.Symbol
+    ddu: sp.Symbol
 
 
 @dataclass(frozen=True)
@@ -23,6 +38,7 @@ class Symbols:
     coordinates: tuple[str, ...]
     per_body: int = 3
     """Coordinates per body: 3 in a planar file (x, y, phi), 7 in a spatial one."""
+    inputs: tuple[Input, ...] = ()
 
     # Built once per Symbols: derivation asks for them for every constraint and expression.
     @cached_property
@@ -69,4 +85,26 @@ def make_symbols(mech: MechanismSpec) -> Symbols:
     q = tuple(sp.Symbol(name, real=True) for name in coordinates)
     dq = tuple(sp.Symbol(name + "_t", real=True) for name in coordinates)
     p = tuple(sp.Symbol(name, real=True) for name in mech.parameters)
-    return Symbols(q, dq, sp.Symbol("t", real=True), p, coordinates, len(parts))
+    return Symbols(q, dq, sp.Symbol("t", real=True), p, coordinates, len(parts),
+                   find_inputs(mech))
+
+
+def find_inputs(mech: MechanismSpec) -> tuple[Input, ...]:
+    """Every driver function written ``input``, drivers in file order, components in order.
+
+    Their symbols are named ``input:NAME`` (and ``_t``, ``_tt``): no parameter or coordinate
+    can have such a name, so they never clash with one.
+    """
+    found = []
+    for index, driver in enumerate(mech.drivers):
+        base = driver.name or f"drivers[{index}]"
+        for key in pairs.of(driver).time_functions:
+            value = getattr(driver, key)
+            components = enumerate(value) if isinstance(value, list) else ((None, value),)
+            for component, raw in components:
+                if is_input(raw):
+                    name = base if component is None else f"{base}_{'xyz'[component]}"
+                    u, du, ddu = (sp.Symbol(f"input:{name}{suffix}", real=True)
+                                  for suffix in ("", "_t", "_tt"))
+                    found.append(Input(name, index, key, component, u, du, ddu))
+    return tuple(found)

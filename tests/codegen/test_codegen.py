@@ -62,19 +62,28 @@ def test_backends_match_sympy_at_random_states(name: str, cache: Path) -> None:
 @pytest.mark.parametrize("name", example_ids())
 def test_jacobian_and_gamma_match_finite_differences(name: str, cache: Path) -> None:
     """Phi_q by central differences of Phi; Gamma = -d2/ds2 Phi(q + s dq, t + s) at s = 0,
-    which holds because (2.74) is the second time derivative of Phi along a path with ddq = 0."""
+    which holds because (2.74) is the second time derivative of Phi along a path with ddq = 0.
+    Input drivers move along that path too: u + s du + s^2/2 ddu (their p[] entries)."""
     kernel = _kernels(name, cache).get("c") or _kernels(name, cache)["numpy"]
     h = 1e-4
+    nu, n_params = len(system(name).inputs), len(system(name).p)
+
+    def moved(p: np.ndarray, s: float) -> np.ndarray:
+        if not nu:
+            return p
+        u, du, ddu = (p[n_params + k * nu:n_params + (k + 1) * nu] for k in range(3))
+        return np.concatenate([p[:n_params], u + s * du + s * s / 2 * ddu, du + s * ddu, ddu])
+
     for q, dq, t, p in random_states(system(name), count=10, seed=11):
         columns = [(kernel.phi(q + h * e, t, p) - kernel.phi(q - h * e, t, p)) / (2 * h)
                    for e in np.eye(len(q))]
         assert_close(kernel.phi_q(q, t, p), np.array(columns).T, rtol=1e-6, what="phi_q")
         assert_close(kernel.phi_t(q, t, p),
-                     (kernel.phi(q, t + h, p) - kernel.phi(q, t - h, p)) / (2 * h), rtol=1e-6,
-                     what="phi_t")
+                     (kernel.phi(q, t + h, moved(p, h)) - kernel.phi(q, t - h, moved(p, -h)))
+                     / (2 * h), rtol=1e-6, what="phi_t")
         g = 1e-3
-        second = (kernel.phi(q + g * dq, t + g, p) - 2 * kernel.phi(q, t, p)
-                  + kernel.phi(q - g * dq, t - g, p)) / g**2
+        second = (kernel.phi(q + g * dq, t + g, moved(p, g)) - 2 * kernel.phi(q, t, p)
+                  + kernel.phi(q - g * dq, t - g, moved(p, -g))) / g**2
         assert_close(kernel.gamma(q, dq, t, p), -second, rtol=1e-4, what="gamma")
 
 

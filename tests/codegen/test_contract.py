@@ -100,14 +100,19 @@ def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
     paths = render.generate(system("crank_slider"), backends.get("c"), out_dir=tmp_path)
     written = paths[-1]
     assert written.name == manifest.manifest_name("crank_slider")
-    assert set(json.loads(written.read_text(encoding="utf-8"))) == \
-        manifest.KEYS - manifest.OPTIONAL_KEYS
+    keys = set(json.loads(written.read_text(encoding="utf-8")))
+    assert keys == manifest.KEYS - manifest.OPTIONAL_KEYS
     assert manifest.OPTIONAL_KEYS <= manifest.KEYS
     # An over-constrained file's manifest has its removed rows.
     paths = render.generate(system("parallelogram_extra_bar"), backends.get("c"),
                             out_dir=tmp_path / "redundant")
     assert set(json.loads(paths[-1].read_text(encoding="utf-8"))) == \
         manifest.KEYS - manifest.OPTIONAL_KEYS | {"removed"}
+    # One with input drivers has their names.
+    inputs = render.generate(system("crank_slider_input"), backends.get("c"),
+                             out_dir=tmp_path / "inputs")[-1]
+    assert set(json.loads(inputs.read_text(encoding="utf-8"))) == \
+        manifest.KEYS - manifest.OPTIONAL_KEYS | {"input_names"}
 
 
 # The modules that read a manifest, and the names their manifest dicts go by.

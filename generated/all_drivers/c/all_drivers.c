@@ -370,3 +370,49 @@ void all_drivers_gamma_shared(const all_drivers_real q[], const all_drivers_real
 
 const int all_drivers_phi_p_row[ALL_DRIVERS_NNZ_P] = { 2, 3, 6, 6, 6, 6, 7, 7, 7, 7, 8, 8, 8, 10, 11, 12, 13, 14 };
 const int all_drivers_phi_p_col[ALL_DRIVERS_NNZ_P] = { 0, 0, 1, 2, 4, 7, 1, 3, 4, 7, 5, 6, 7, 7, 7, 7, 7, 7 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int all_drivers_point_body[ALL_DRIVERS_NPOINTS] = { 0, 3, 9 };
+
+void all_drivers_point_kinematics(const all_drivers_real q[], const all_drivers_real dq[],
+                                   const all_drivers_real ddq[], const all_drivers_real p[],
+                                   all_drivers_real r[], all_drivers_real dr[],
+                                   all_drivers_real ddr[])
+{
+    all_drivers_real s[2 * ALL_DRIVERS_NPOINTS];
+    int k;
+    all_drivers_points(p, s);
+    for (k = 0; k < ALL_DRIVERS_NPOINTS; ++k) {
+        const int b = all_drivers_point_body[k];
+        all_drivers_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        all_drivers_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const all_drivers_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const all_drivers_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

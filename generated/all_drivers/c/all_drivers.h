@@ -43,6 +43,11 @@ typedef double all_drivers_real;
  *   p[5] s0 = 0.5
  *   p[6] s1 = 0.3
  *   p[7] w = 6.283185307179586
+ * Named points (index: body.point), in the order of all_drivers_points and
+ * all_drivers_point_kinematics:
+ *   0: arm1.elbow
+ *   1: arm2.tip
+ *   2: gripper.jaw
  * Rows of Phi:
  *   0: joints[0] shoulder revolute ground-arm1 (x)
  *   1: joints[0] shoulder revolute ground-arm1 (y)
@@ -86,6 +91,14 @@ void all_drivers_gamma(const all_drivers_real q[], const all_drivers_real dq[], 
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void all_drivers_points(const all_drivers_real p[], all_drivers_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * all_drivers_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void all_drivers_point_kinematics(const all_drivers_real q[], const all_drivers_real dq[],
+                                   const all_drivers_real ddq[], const all_drivers_real p[],
+                                   all_drivers_real r[], all_drivers_real dr[],
+                                   all_drivers_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * all_drivers_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

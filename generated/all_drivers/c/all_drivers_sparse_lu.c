@@ -32,6 +32,8 @@ void all_drivers_lu_init(all_drivers_lu *lu)
     lu->v[7] = -1.0;
     lu->v[8] = -1.0;
     lu->v[9] = 1.0;
+    lu->v[15] = -1.0;
+    lu->v[17] = 1.0;
     lu->v[34] = -1.0;
     lu->v[35] = 1.0;
     lu->v[36] = -1.0;
@@ -45,7 +47,9 @@ void all_drivers_lu_init(all_drivers_lu *lu)
     lu->inv[3] = 1.0;
     lu->inv[4] = -1.0;
     lu->inv[5] = -1.0;
+    lu->inv[7] = -1.0;
     lu->inv[8] = -1.0;
+    lu->inv[9] = 1.0;
 }
 
 /* The pivot passes when it is above the tiny bound and at least tau times the largest entry of
@@ -109,59 +113,52 @@ static int all_drivers_lu_factor_0(all_drivers_real *v, all_drivers_real *inv,
     /* pivot 3: row 14, column 14 */
     /* pivot 4: row 0, column 0 */
     /* pivot 5: row 1, column 1 */
-    /* pivot 6: row 2, column 2 */
-    cmax = fabs(v[3]);
-    cmax = all_drivers_lu_amax(cmax, v[6]);
-    if (!all_drivers_lu_pivot_ok(v[3], cmax, tiny)) return 7;
-    inv[6] = 1 / v[3];
-    v[6] *= inv[6];
-    v[41] = -(v[6] * (-1.0));
-    /* pivot 7: row 3, column 3 */
-    cmax = fabs(v[41]);
-    cmax = all_drivers_lu_amax(cmax, (1.0));
+    /* pivot 6: row 3, column 2 */
+    cmax = fabs(v[6]);
+    cmax = all_drivers_lu_amax(cmax, v[3]);
+    if (!all_drivers_lu_pivot_ok(v[6], cmax, tiny)) return 7;
+    inv[6] = 1 / v[6];
+    v[3] *= inv[6];
+    v[41] = -(v[3] * (-1.0));
+    /* pivot 7: row 2, column 3 */
+    cmax = 1.0;
     cmax = all_drivers_lu_amax(cmax, v[10]);
     cmax = all_drivers_lu_amax(cmax, v[19]);
-    if (!all_drivers_lu_pivot_ok(v[41], cmax, tiny)) return 8;
-    inv[7] = 1 / v[41];
-    v[15] = 1.0 * inv[7];
-    v[10] *= inv[7];
-    v[19] *= inv[7];
-    v[11] -= v[10] * (-1.0);
-    v[42] = -(v[15] * (-1.0));
-    v[20] -= v[19] * (-1.0);
+    if (!(1.0 >= ALL_DRIVERS_LU_TAU * cmax)) return 8;
+    v[10] = -v[10];
+    v[19] = -v[19];
+    v[11] -= v[10] * v[41];
+    v[42] = -((-1.0) * v[41]);
+    v[20] -= v[19] * v[41];
     /* pivot 8: row 4, column 5 */
     cmax = 1.0;
-    cmax = all_drivers_lu_amax(cmax, v[16]);
     cmax = all_drivers_lu_amax(cmax, v[18]);
+    cmax = all_drivers_lu_amax(cmax, v[16]);
     cmax = all_drivers_lu_amax(cmax, v[12]);
     if (!(1.0 >= ALL_DRIVERS_LU_TAU * cmax)) return 9;
-    v[16] = -v[16];
     v[18] = -v[18];
+    v[16] = -v[16];
     v[12] = -v[12];
     v[43] = -(v[12]);
     v[44] = -(v[16]);
     v[45] = -(v[18]);
-    /* pivot 9: row 6, column 4 */
-    cmax = fabs(v[42]);
-    cmax = all_drivers_lu_amax(cmax, (1.0));
+    /* pivot 9: row 7, column 4 */
+    cmax = 1.0;
+    cmax = all_drivers_lu_amax(cmax, v[42]);
     cmax = all_drivers_lu_amax(cmax, v[11]);
     cmax = all_drivers_lu_amax(cmax, v[20]);
-    if (!all_drivers_lu_pivot_ok(v[42], cmax, tiny)) return 10;
-    inv[9] = 1 / v[42];
-    v[17] = 1.0 * inv[9];
-    v[11] *= inv[9];
-    v[20] *= inv[9];
-    v[43] -= v[11] * v[44];
-    v[45] -= v[17] * v[44];
-    v[23] -= v[20] * v[44];
-    /* pivot 10: row 7, column 8 */
-    cmax = fabs(v[45]);
+    if (!(1.0 >= ALL_DRIVERS_LU_TAU * cmax)) return 10;
+    v[43] -= v[11] * v[45];
+    v[44] -= v[42] * v[45];
+    v[23] -= v[20] * v[45];
+    /* pivot 10: row 6, column 8 */
+    cmax = fabs(v[44]);
     cmax = all_drivers_lu_amax(cmax, v[43]);
     cmax = all_drivers_lu_amax(cmax, v[23]);
     cmax = all_drivers_lu_amax(cmax, v[26]);
     cmax = all_drivers_lu_amax(cmax, v[31]);
-    if (!all_drivers_lu_pivot_ok(v[45], cmax, tiny)) return 11;
-    inv[10] = 1 / v[45];
+    if (!all_drivers_lu_pivot_ok(v[44], cmax, tiny)) return 11;
+    inv[10] = 1 / v[44];
     v[43] *= inv[10];
     v[23] *= inv[10];
     v[26] *= inv[10];
@@ -187,16 +184,16 @@ static int all_drivers_lu_factor_0(all_drivers_real *v, all_drivers_real *inv,
     inv[12] = 1 / v[22];
     v[25] *= inv[12];
     v[30] *= inv[12];
-    /* pivot 13: row 9, column 9 */
-    cmax = fabs(v[27]);
-    cmax = all_drivers_lu_amax(cmax, v[32]);
-    if (!all_drivers_lu_pivot_ok(v[27], cmax, tiny)) return 14;
-    inv[13] = 1 / v[27];
-    v[32] *= inv[13];
-    v[33] -= v[32] * v[28];
-    /* pivot 14: row 10, column 10 */
-    if (!(fabs(v[33]) > tiny)) return 15;
-    inv[14] = 1 / v[33];
+    /* pivot 13: row 9, column 10 */
+    cmax = fabs(v[28]);
+    cmax = all_drivers_lu_amax(cmax, v[33]);
+    if (!all_drivers_lu_pivot_ok(v[28], cmax, tiny)) return 14;
+    inv[13] = 1 / v[28];
+    v[33] *= inv[13];
+    v[32] -= v[33] * v[27];
+    /* pivot 14: row 10, column 9 */
+    if (!(fabs(v[32]) > tiny)) return 15;
+    inv[14] = 1 / v[32];
     return 0;
 }
 
@@ -204,7 +201,7 @@ int all_drivers_lu_factor_sparse(const all_drivers_real nz[], all_drivers_lu *lu
 {
     const all_drivers_real tiny = all_drivers_lu_load(nz, lu->v);
     int status;
-    /* 7 pivots are numbers known at generation time (their entries of Phi_q are
+    /* 9 pivots are numbers known at generation time (their entries of Phi_q are
      * constants, unchanged by the elimination): no reciprocal, no test, except this one for the
      * smallest, which fails when max |Phi_q| is huge or not finite. */
     if (!(tiny < 1.0)) return 1;
@@ -247,10 +244,6 @@ all_drivers_real all_drivers_lu_pivot_ratio(const all_drivers_lu *lu)
     (void)k;
     low = fabs(lu->inv[6]) < low ? fabs(lu->inv[6]) : low;
     high = fabs(lu->inv[6]) > high ? fabs(lu->inv[6]) : high;
-    low = fabs(lu->inv[7]) < low ? fabs(lu->inv[7]) : low;
-    high = fabs(lu->inv[7]) > high ? fabs(lu->inv[7]) : high;
-    low = fabs(lu->inv[9]) < low ? fabs(lu->inv[9]) : low;
-    high = fabs(lu->inv[9]) > high ? fabs(lu->inv[9]) : high;
     low = fabs(lu->inv[10]) < low ? fabs(lu->inv[10]) : low;
     high = fabs(lu->inv[10]) > high ? fabs(lu->inv[10]) : high;
     low = fabs(lu->inv[11]) < low ? fabs(lu->inv[11]) : low;
@@ -268,16 +261,16 @@ all_drivers_real all_drivers_lu_pivot_ratio(const all_drivers_lu *lu)
 static void all_drivers_lu_forward_0(const all_drivers_real *v, all_drivers_real *x)
 {
     (void)v;
-    x[6] += x[4];
-    x[7] += x[5];
-    x[7] -= v[6] * x[6];
-    x[9] -= v[15] * x[7];
+    x[7] += x[4];
+    x[6] += x[5];
+    x[7] -= v[3] * x[6];
+    x[10] += x[7];
     x[11] -= v[10] * x[7];
     x[12] -= v[19] * x[7];
-    x[9] -= v[16] * x[8];
-    x[10] -= v[18] * x[8];
+    x[9] -= v[18] * x[8];
+    x[10] -= v[16] * x[8];
     x[11] -= v[12] * x[8];
-    x[10] -= v[17] * x[9];
+    x[10] -= v[42] * x[9];
     x[11] -= v[11] * x[9];
     x[12] -= v[20] * x[9];
     x[11] -= v[43] * x[10];
@@ -289,7 +282,7 @@ static void all_drivers_lu_forward_0(const all_drivers_real *v, all_drivers_real
     x[14] -= v[29] * x[11];
     x[13] -= v[25] * x[12];
     x[14] -= v[30] * x[12];
-    x[14] -= v[32] * x[13];
+    x[14] -= v[33] * x[13];
 }
 
 /* U z = y, rows 14..0 */
@@ -299,24 +292,23 @@ static void all_drivers_lu_backward_0(const all_drivers_real *v,
     (void)v;
     (void)inv;
     x[14] *= inv[14];
-    x[13] -= v[28] * x[14];
+    x[13] -= v[27] * x[14];
     x[13] *= inv[13];
     x[12] *= inv[12];
     x[11] -= v[14] * x[12];
     x[11] *= inv[11];
     x[10] *= inv[10];
-    x[9] -= v[44] * x[10];
-    x[9] *= inv[9];
+    x[9] -= v[45] * x[10];
     x[8] -= x[10];
     x[8] = -x[8];
-    x[7] += x[9];
-    x[7] *= inv[7];
-    x[6] += x[7];
+    x[7] -= v[41] * x[9];
+    x[7] = -x[7];
+    x[6] += x[9];
     x[6] *= inv[6];
     x[5] = -x[5];
     x[4] = -x[4];
-    x[2] += x[14];
-    x[1] += x[13];
+    x[2] += x[13];
+    x[1] += x[14];
     x[0] += x[10];
 }
 
@@ -334,11 +326,11 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
     x[3] = b[14];
     x[4] = b[0];
     x[5] = b[1];
-    x[6] = b[2];
-    x[7] = b[3];
+    x[6] = b[3];
+    x[7] = b[2];
     x[8] = b[4];
-    x[9] = b[6];
-    x[10] = b[7];
+    x[9] = b[7];
+    x[10] = b[6];
     x[11] = b[5];
     x[12] = b[8];
     x[13] = b[9];
@@ -358,8 +350,8 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
     b[8] = x[10];
     b[6] = x[11];
     b[7] = x[12];
-    b[9] = x[13];
-    b[10] = x[14];
+    b[10] = x[13];
+    b[9] = x[14];
 }
 
 /* U^T z = w, columns 0..14 of U^T (rows of U) */
@@ -369,24 +361,23 @@ static void all_drivers_lu_upper_t_0(const all_drivers_real *v,
     (void)v;
     (void)inv;
     x[10] += x[0];
-    x[13] += x[1];
-    x[14] += x[2];
+    x[14] += x[1];
+    x[13] += x[2];
     x[4] = -x[4];
     x[5] = -x[5];
     x[6] *= inv[6];
-    x[7] += x[6];
-    x[7] *= inv[7];
-    x[9] += x[7];
+    x[9] += x[6];
+    x[7] = -x[7];
+    x[9] -= v[41] * x[7];
     x[8] = -x[8];
     x[10] -= x[8];
-    x[9] *= inv[9];
-    x[10] -= v[44] * x[9];
+    x[10] -= v[45] * x[9];
     x[10] *= inv[10];
     x[11] *= inv[11];
     x[12] -= v[14] * x[11];
     x[12] *= inv[12];
     x[13] *= inv[13];
-    x[14] -= v[28] * x[13];
+    x[14] -= v[27] * x[13];
     x[14] *= inv[14];
 }
 
@@ -394,7 +385,7 @@ static void all_drivers_lu_upper_t_0(const all_drivers_real *v,
 static void all_drivers_lu_lower_t_0(const all_drivers_real *v, all_drivers_real *x)
 {
     (void)v;
-    x[13] -= v[32] * x[14];
+    x[13] -= v[33] * x[14];
     x[12] -= v[25] * x[13];
     x[12] -= v[30] * x[14];
     x[11] -= v[21] * x[12];
@@ -404,18 +395,18 @@ static void all_drivers_lu_lower_t_0(const all_drivers_real *v, all_drivers_real
     x[10] -= v[23] * x[12];
     x[10] -= v[26] * x[13];
     x[10] -= v[31] * x[14];
-    x[9] -= v[17] * x[10];
+    x[9] -= v[42] * x[10];
     x[9] -= v[11] * x[11];
     x[9] -= v[20] * x[12];
-    x[8] -= v[16] * x[9];
-    x[8] -= v[18] * x[10];
+    x[8] -= v[18] * x[9];
+    x[8] -= v[16] * x[10];
     x[8] -= v[12] * x[11];
-    x[7] -= v[15] * x[9];
+    x[7] += x[10];
     x[7] -= v[10] * x[11];
     x[7] -= v[19] * x[12];
-    x[6] -= v[6] * x[7];
-    x[5] += x[7];
-    x[4] += x[6];
+    x[6] -= v[3] * x[7];
+    x[5] += x[6];
+    x[4] += x[7];
 }
 
 void all_drivers_lu_solve_transposed(const all_drivers_lu *lu, all_drivers_real b[])
@@ -440,8 +431,8 @@ void all_drivers_lu_solve_transposed(const all_drivers_lu *lu, all_drivers_real 
     x[10] = b[8];
     x[11] = b[6];
     x[12] = b[7];
-    x[13] = b[9];
-    x[14] = b[10];
+    x[13] = b[10];
+    x[14] = b[9];
     all_drivers_lu_upper_t_0(lu->v, lu->inv, x);
     all_drivers_lu_lower_t_0(lu->v, x);
     b[11] = x[0];
@@ -450,11 +441,11 @@ void all_drivers_lu_solve_transposed(const all_drivers_lu *lu, all_drivers_real 
     b[14] = x[3];
     b[0] = x[4];
     b[1] = x[5];
-    b[2] = x[6];
-    b[3] = x[7];
+    b[3] = x[6];
+    b[2] = x[7];
     b[4] = x[8];
-    b[6] = x[9];
-    b[7] = x[10];
+    b[7] = x[9];
+    b[6] = x[10];
     b[5] = x[11];
     b[8] = x[12];
     b[9] = x[13];

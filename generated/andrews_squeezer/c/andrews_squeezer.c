@@ -474,3 +474,49 @@ void andrews_squeezer_gamma_shared(const andrews_squeezer_real q[], const andrew
 
 const int andrews_squeezer_phi_p_row[ANDREWS_SQUEEZER_NNZ_P] = { 2, 3, 4, 4, 5, 5, 6, 7, 8, 9, 10, 11, 12, 12, 13, 13, 14, 15, 16, 16, 17, 17, 18, 19, 20 };
 const int andrews_squeezer_phi_p_col[ANDREWS_SQUEEZER_NNZ_P] = { 6, 6, 7, 8, 7, 8, 7, 7, 7, 7, 2, 3, 11, 12, 11, 12, 0, 1, 13, 14, 13, 14, 0, 1, 15 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int andrews_squeezer_point_body[ANDREWS_SQUEEZER_NPOINTS] = { 0, 0, 3, 3, 6, 6, 6, 9, 9, 12, 12, 15, 15, 18, 18 };
+
+void andrews_squeezer_point_kinematics(const andrews_squeezer_real q[], const andrews_squeezer_real dq[],
+                                   const andrews_squeezer_real ddq[], const andrews_squeezer_real p[],
+                                   andrews_squeezer_real r[], andrews_squeezer_real dr[],
+                                   andrews_squeezer_real ddr[])
+{
+    andrews_squeezer_real s[2 * ANDREWS_SQUEEZER_NPOINTS];
+    int k;
+    andrews_squeezer_points(p, s);
+    for (k = 0; k < ANDREWS_SQUEEZER_NPOINTS; ++k) {
+        const int b = andrews_squeezer_point_body[k];
+        andrews_squeezer_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        andrews_squeezer_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const andrews_squeezer_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const andrews_squeezer_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

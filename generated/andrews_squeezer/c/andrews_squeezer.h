@@ -57,6 +57,23 @@ typedef double andrews_squeezer_real;
  *   p[13] zf = 0.02
  *   p[14] u = 0.04
  *   p[15] beta0 = -0.06171389001427645
+ * Named points (index: body.point), in the order of andrews_squeezer_points and
+ * andrews_squeezer_point_kinematics:
+ *   0: crank.O
+ *   1: crank.F
+ *   2: rod.F
+ *   3: rod.E
+ *   4: link3.B
+ *   5: link3.E
+ *   6: link3.D
+ *   7: link4.E
+ *   8: link4.G
+ *   9: link5.A
+ *   10: link5.G
+ *   11: link6.E
+ *   12: link6.H
+ *   13: link7.A
+ *   14: link7.H
  * Rows of Phi:
  *   0: joints[0] O revolute ground-crank (x)
  *   1: joints[0] O revolute ground-crank (y)
@@ -106,6 +123,14 @@ void andrews_squeezer_gamma(const andrews_squeezer_real q[], const andrews_squee
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void andrews_squeezer_points(const andrews_squeezer_real p[], andrews_squeezer_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * andrews_squeezer_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void andrews_squeezer_point_kinematics(const andrews_squeezer_real q[], const andrews_squeezer_real dq[],
+                                   const andrews_squeezer_real ddq[], const andrews_squeezer_real p[],
+                                   andrews_squeezer_real r[], andrews_squeezer_real dr[],
+                                   andrews_squeezer_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * andrews_squeezer_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -250,3 +250,49 @@ void custom_driver_gamma_shared(const custom_driver_real q[], const custom_drive
 
 const int custom_driver_phi_p_row[CUSTOM_DRIVER_NNZ_P] = { 2, 3, 4, 5, 8, 8, 8, 8 };
 const int custom_driver_phi_p_col[CUSTOM_DRIVER_NNZ_P] = { 0, 0, 1, 1, 0, 2, 3, 4 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int custom_driver_point_body[CUSTOM_DRIVER_NPOINTS] = { 0, 3, 3 };
+
+void custom_driver_point_kinematics(const custom_driver_real q[], const custom_driver_real dq[],
+                                   const custom_driver_real ddq[], const custom_driver_real p[],
+                                   custom_driver_real r[], custom_driver_real dr[],
+                                   custom_driver_real ddr[])
+{
+    custom_driver_real s[2 * CUSTOM_DRIVER_NPOINTS];
+    int k;
+    custom_driver_points(p, s);
+    for (k = 0; k < CUSTOM_DRIVER_NPOINTS; ++k) {
+        const int b = custom_driver_point_body[k];
+        custom_driver_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        custom_driver_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const custom_driver_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const custom_driver_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

@@ -34,6 +34,11 @@ typedef double custom_driver_real;
  *   p[2] w = 6.283185307179586
  *   p[3] k = 0.2
  *   p[4] psi0 = 0.7853981633974483
+ * Named points (index: body.point), in the order of custom_driver_points and
+ * custom_driver_point_kinematics:
+ *   0: crank.A
+ *   1: rod.B
+ *   2: rod.M
  * Rows of Phi:
  *   0: joints[0] O revolute ground-crank (x)
  *   1: joints[0] O revolute ground-crank (y)
@@ -71,6 +76,14 @@ void custom_driver_gamma(const custom_driver_real q[], const custom_driver_real 
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void custom_driver_points(const custom_driver_real p[], custom_driver_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * custom_driver_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void custom_driver_point_kinematics(const custom_driver_real q[], const custom_driver_real dq[],
+                                   const custom_driver_real ddq[], const custom_driver_real p[],
+                                   custom_driver_real r[], custom_driver_real dr[],
+                                   custom_driver_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * custom_driver_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -35,6 +35,12 @@ typedef double four_bar_real;
  *   p[3] d = 4.5
  *   p[4] w = 6.283185307179586
  *   p[5] theta0 = 1.5707963267948966
+ * Named points (index: body.point), in the order of four_bar_points and
+ * four_bar_point_kinematics:
+ *   0: crank.A
+ *   1: coupler.B
+ *   2: coupler.P
+ *   3: rocker.B
  * Rows of Phi:
  *   0: joints[0] O2 revolute ground-crank (x)
  *   1: joints[0] O2 revolute ground-crank (y)
@@ -72,6 +78,14 @@ void four_bar_gamma(const four_bar_real q[], const four_bar_real dq[], four_bar_
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void four_bar_points(const four_bar_real p[], four_bar_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * four_bar_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void four_bar_point_kinematics(const four_bar_real q[], const four_bar_real dq[],
+                                   const four_bar_real ddq[], const four_bar_real p[],
+                                   four_bar_real r[], four_bar_real dr[],
+                                   four_bar_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * four_bar_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -265,3 +265,49 @@ void quick_return_gamma_shared(const quick_return_real q[], const quick_return_r
 
 const int quick_return_phi_p_row[QUICK_RETURN_NNZ_P] = { 1, 4, 5, 6, 7, 8, 10, 11 };
 const int quick_return_phi_p_col[QUICK_RETURN_NNZ_P] = { 1, 0, 2, 2, 3, 3, 4, 5 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int quick_return_point_body[QUICK_RETURN_NPOINTS] = { 0, 3, 6, 9 };
+
+void quick_return_point_kinematics(const quick_return_real q[], const quick_return_real dq[],
+                                   const quick_return_real ddq[], const quick_return_real p[],
+                                   quick_return_real r[], quick_return_real dr[],
+                                   quick_return_real ddr[])
+{
+    quick_return_real s[2 * QUICK_RETURN_NPOINTS];
+    int k;
+    quick_return_points(p, s);
+    for (k = 0; k < QUICK_RETURN_NPOINTS; ++k) {
+        const int b = quick_return_point_body[k];
+        quick_return_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        quick_return_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const quick_return_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const quick_return_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

@@ -38,6 +38,12 @@ typedef double quick_return_real;
  *   p[3] link_len = 2.0
  *   p[4] guide_y = 5.5
  *   p[5] w = 6.283185307179586
+ * Named points (index: body.point), in the order of quick_return_points and
+ * quick_return_point_kinematics:
+ *   0: crank.A
+ *   1: lever.C
+ *   2: link.D
+ *   3: ram.tool
  * Rows of Phi:
  *   0: joints[0] O2 revolute ground-crank (x)
  *   1: joints[0] O2 revolute ground-crank (y)
@@ -78,6 +84,14 @@ void quick_return_gamma(const quick_return_real q[], const quick_return_real dq[
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void quick_return_points(const quick_return_real p[], quick_return_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * quick_return_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void quick_return_point_kinematics(const quick_return_real q[], const quick_return_real dq[],
+                                   const quick_return_real ddq[], const quick_return_real p[],
+                                   quick_return_real r[], quick_return_real dr[],
+                                   quick_return_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * quick_return_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -23,10 +23,11 @@ if TYPE_CHECKING:
 
 PURPOSES = {
     "kernel": "kinematic kernel of the mechanism {name}: Phi, Phi_q, Phi_t, Gamma, points",
-    "solver": "position, velocity and acceleration analysis of {name} (Example 2.6)",
+    "solver": "position, velocity and acceleration analysis of {name}, one call a step",
     "linalg": "the solver's linear algebra on the dense LU",
     "sparse_lu": "sparse LU of Phi_q with its pivot order fixed at generation time",
     "dense_lu": "dense LU with partial pivoting (also the sparse LU's fall-back)",
+    "README": "how to build and call the solver of {name} in a controller loop",
 }
 # linalg.*.j2 (on the dense LU) and sparse_lu.*.j2 define the same functions: only the chosen
 # one is rendered; dense_lu.*.j2, which both use, always is.

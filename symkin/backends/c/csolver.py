@@ -24,6 +24,18 @@ from symkin.runtime.protocol import ChunkResult
 Array = NDArray[np.float64]
 
 
+def fill_options(lib: Any, name: str, target: Any, options: Options) -> None:
+    """The C options struct ``target`` set from the runtime's Options."""
+    getattr(lib, f"{name}_default_options")(target)
+    target.tol_phi, target.tol_dq = options.tol_phi, options.tol_dq
+    target.max_iterations = options.max_iterations
+    target.min_pivot_ratio = options.min_pivot_ratio
+    target.max_cond = options.max_cond
+    target.tighten_cond = options.tighten_cond
+    target.target_q, target.target_dq = options.target_q, options.target_dq
+    target.target_ddq = options.target_ddq
+
+
 class GridSolver:
     """One run of the generated C grid loop: options, state, workspace and report structs.
 
@@ -62,14 +74,7 @@ class GridSolver:
     def start(self, options: Options, q: Array, p: Array) -> GridSolver:
         """Begin a new run from q with parameters p (the state is reset, not reallocated)."""
         if options is not self._set_options:
-            getattr(self._lib, f"{self._name}_default_options")(self._options)
-            self._options.tol_phi, self._options.tol_dq = options.tol_phi, options.tol_dq
-            self._options.max_iterations = options.max_iterations
-            self._options.min_pivot_ratio = options.min_pivot_ratio
-            self._options.max_cond = options.max_cond
-            self._options.tighten_cond = options.tighten_cond
-            self._options.target_q, self._options.target_dq = options.target_q, options.target_dq
-            self._options.target_ddq = options.target_ddq
+            fill_options(self._lib, self._name, self._options, options)
             self._set_options = options
         if p.size != self._np or q.size != self._n:
             raise ValueError(f"expected {self._n} coordinates and {self._np} parameters, got "

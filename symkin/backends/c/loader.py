@@ -15,6 +15,7 @@ import numpy as np
 
 from symkin import resources
 from symkin.backends.c import batch, multipliers
+from symkin.backends.c.cinputs import InputStepper
 from symkin.backends.c.csolver import GridSolver, SolverPool
 from symkin.contract.options import Options
 from symkin.runtime.kernel import Array, Kernel, import_file
@@ -63,6 +64,12 @@ class CKernel(Kernel):
         """lam and the loads of solved rows in one call of the generated C."""
         return multipliers.grid(self.ffi, self.lib, self.name, self.real, t, q, dq, d2q, p,
                                 len(self.driver_names) + 3 * len(self.joint_names))
+
+    def input_stepper(self) -> InputStepper | None:
+        """The generated solve_inputs, for a mechanism with input drivers (else None)."""
+        if not self.nu or not hasattr(self.lib, f"{self.name}_solve_inputs"):
+            return None
+        return InputStepper(self.ffi, self.lib, self.name, self.real, self.nq)
 
     def _solve_batch(self, params: Array, t: Array, q0: Array, options: Options,
                      q: Array, dq: Array, d2q: Array) -> BatchStatus:

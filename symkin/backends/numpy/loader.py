@@ -53,6 +53,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         **({"removed": module.REMOVED} if hasattr(module, "REMOVED") else {}),
         **({"driver_names": module.DRIVER_NAMES, "joint_names": module.JOINT_NAMES}
            if hasattr(module, "JOINT_NAMES") else {}),
+        "input_names": getattr(module, "INPUT_NAMES", ()),
     }
     return Kernel(backend, meta, _ModuleFunctions(module), folder=folder)
 
