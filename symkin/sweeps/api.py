@@ -180,4 +180,5 @@ def _result(kernel: Kernel, times: Array, values: Array, chunk: Chunk) -> SweepR
         parameter_names=tuple(kernel.parameter_names), coordinates=tuple(kernel.coordinates),
         reasons=tuple(chunk.reasons), messages=tuple(chunk.messages),
         t_reached=chunk.t_reached, solved=chunk.solved, iterations=chunk.iterations,
-        points_named=tuple(kernel.points), local_vectors=kernel.point_vectors)
+        points_named=tuple(kernel.points), local_vectors=kernel.point_vectors,
+        space=getattr(kernel, "space", "2d"))
