@@ -209,6 +209,10 @@ def _constraint(drawing: Drawing3d, item: Any, path: Path_) -> Any:
     kind = pairs.named_in(item.get("type"), path[0], "3d") \
         if isinstance(item, Mapping) else None
     if kind is None:
+        if isinstance(item, Mapping) and isinstance(item.get("type"), str):
+            listed = ", ".join(k.name for k in pairs.in_section(path[0], "3d"))
+            raise MechanismError(f"{item['type']!r} is not a type of a space: 3d file's "
+                                 f"{path[0]}", path + ("type",), f"Use one of: {listed}.")
         return item
     extra = sorted(set(item) - kind.drawn_keys)
     if extra:
