@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -194,7 +195,7 @@ class Trajectory:
     def _save_npz(self, path: Path) -> None:
         r, dr, ddr = self.point_arrays()
         names = np.array([f"{b}.{p}" for b, p in self.points], dtype=str).reshape(-1)
-        extra = {}
+        extra: dict[str, Any] = {}
         if self.spatial:
             omega, alpha = self.angular()
             extra = {"omega": omega, "alpha": alpha,

@@ -42,7 +42,7 @@ def point_kinematics(q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, s: ArrayLike
     s = np.asarray(s, dtype=float)
     e, de, dde = q[..., 3:], dq[..., 3:], ddq[..., 3:]
     def times_s(matrix: Array) -> Array:  # broadcasts s of shape (..., 3) too
-        return np.einsum("...ij,...j->...i", matrix, s)
+        return np.asarray(np.einsum("...ij,...j->...i", matrix, s), dtype=np.float64)
 
     r = q[..., :3] + times_s(rotation(e))
     dr = dq[..., :3] + 2.0 * times_s(_bilinear(e, de))

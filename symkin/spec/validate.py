@@ -283,7 +283,7 @@ class _Checks:
     def value(self, expr: sp.Expr, path: tuple[str | int, ...]) -> float:
         return _numeric(expr, self.nominal, path)
 
-    def point_at_q0(self, body: str, ref: Any) -> tuple[float, float]:
+    def point_at_q0(self, body: str, ref: Any) -> tuple[float, ...]:
         """The global position of a (checked) point of ``body`` at its first guess q0."""
         def nominal(raw: Any) -> float:  # checked already: parses and has a value
             return constants.value(expressions.parse(raw, self.symbols.parameters), self.nominal)

@@ -92,8 +92,10 @@ class SweepResult:
         start = self.coordinates.index(f"{body}.x")
         s = self.point_vectors[:, self.points_named.index((body, name)), None, :]  # (M, 1, 2)
         if self.space == "3d":
-            return spatial.point_kinematics(*(a[:, :, start:start + 7]
-                                              for a in (self.q, self.dq, self.d2q)), s)
+            body_columns = slice(start, start + 7)
+            return spatial.point_kinematics(self.q[:, :, body_columns],
+                                            self.dq[:, :, body_columns],
+                                            self.d2q[:, :, body_columns], s)
         q, dq, d2q = (a[:, :, start:start + 3] for a in (self.q, self.dq, self.d2q))
         cos, sin = np.cos(q[..., 2]), np.sin(q[..., 2])
         rs = np.stack([cos * s[..., 0] - sin * s[..., 1], sin * s[..., 0] + cos * s[..., 1]], -1)

@@ -23,7 +23,6 @@ from symkin.symbolic import spatial
 from symkin.symbolic.planar import Context
 from symkin.symbolic.symbols import Symbols, make_symbols
 
-
 # A spatial body's own row: its Euler parameters' normalisation (section, part).
 NORMALISATION = ("bodies", "normalisation")
 

@@ -70,8 +70,8 @@ class _CFunctions:
         self._ffi = ffi
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
-        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq, "points": point_components,
-                       "phi_p": nnz_p}
+        self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq,
+                       "points": point_components, "phi_p": nnz_p}
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}
