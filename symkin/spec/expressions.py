@@ -136,7 +136,8 @@ class _Builder:
             parts = tuple(dict.fromkeys(part for _, part in self.coordinates))
             if self.coordinates and node.attr in ("x", "y", "phi", *parts):
                 bodies = ", ".join(dict.fromkeys(body for body, _ in self.coordinates))
-                said = ("body.x, body.y or body.phi" if parts == ("x", "y", "phi") else
+                planar = set(parts) <= {"x", "y", "phi"}
+                said = ("body.x, body.y or body.phi" if planar else
                         ", ".join(f"body.{part}" for part in parts))
                 raise self.fail(node, f"unknown coordinate '{key[0]}.{key[1]}'; use {said} "
                                       f"of a body among {bodies}")
