@@ -5,7 +5,7 @@ load and from_sources, each backend's build and loader)."""
 
 from __future__ import annotations
 
-from typing import NotRequired, TypedDict
+from typing import TypedDict
 
 MANIFEST_SUFFIX = "_manifest.json"
 
@@ -18,7 +18,13 @@ def manifest_name(prefix: str) -> str:
     return prefix + MANIFEST_SUFFIX
 
 
-class Metadata(TypedDict):
+class _SpaceOnly(TypedDict, total=False):
+    space: str
+    """``3d`` for a spatial mechanism (points of 3 components, 7 coordinates per body);
+    absent for a planar one."""
+
+
+class Metadata(_SpaceOnly):
     """What a runtime Kernel needs besides the compiled functions (plain JSON data)."""
 
     coordinates: list[str]
@@ -37,9 +43,6 @@ class Metadata(TypedDict):
     nnz: int
     npoints: int
     nshared: int
-    space: NotRequired[str]
-    """``3d`` for a spatial mechanism (points of 3 components, 7 coordinates per body);
-    absent for a planar one."""
 
 
 class Manifest(Metadata):
@@ -59,3 +62,6 @@ class Manifest(Metadata):
 
 KEYS = frozenset(Manifest.__annotations__)
 """Every key of a manifest (a reader asks for no other)."""
+
+OPTIONAL_KEYS = frozenset(Manifest.__optional_keys__)
+"""The keys only some manifests have (``space``: only a spatial mechanism's)."""

@@ -100,7 +100,17 @@ def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
     paths = render.generate(system("crank_slider"), backends.get("c"), out_dir=tmp_path)
     written = paths[-1]
     assert written.name == manifest.manifest_name("crank_slider")
-    assert set(json.loads(written.read_text(encoding="utf-8"))) == manifest.KEYS
+    assert set(json.loads(written.read_text(encoding="utf-8"))) == \
+        manifest.KEYS - manifest.OPTIONAL_KEYS
+
+
+def test_a_spatial_manifest_says_its_space(tmp_path: Path) -> None:
+    import symkin
+
+    spatial = symkin.derive(ROOT / "examples" / "rssr.yaml")
+    written = render.generate(spatial, backends.get("c"), out_dir=tmp_path)[-1]
+    data = json.loads(written.read_text(encoding="utf-8"))
+    assert set(data) == manifest.KEYS and data["space"] == "3d"
 
 
 # The modules that read a manifest, and the names their manifest dicts go by.
