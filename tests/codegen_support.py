@@ -22,12 +22,7 @@ import symkin
 from symkin.spec import expressions
 
 ROOT = Path(__file__).resolve().parent.parent
-# Examples whose equations are redundant (a Cardan shaft between two revolutes has 3): they
-# derive once redundant equations are removed (another branch); until then they have no
-# goldens and are left out of the tests that take every example.
-AWAITING_REDUNDANCY_REMOVAL = ("cardan",)
-EXAMPLES = sorted(path for path in (ROOT / "examples").glob("*.yaml")
-                  if path.stem not in AWAITING_REDUNDANCY_REMOVAL)
+EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
 GENERATED = ROOT / "generated"
 BACKENDS = ("c", "numpy")
 STRICT_FLAGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
@@ -76,6 +71,7 @@ class Reference:
         self._gamma = sp.lambdify((q, dq, t, p), list(system.gamma), MPMATH, dummify=True)
         self._points = sp.lambdify((p,), vectors or [sp.Integer(0)], MPMATH, dummify=True)
         self._n_points = len(vectors)
+        self._point_size = 3 if system.mechanism.is_spatial else 2  # spatial: (x, y, z)
 
     @staticmethod
     def _floats(values) -> np.ndarray:
@@ -100,7 +96,7 @@ class Reference:
         return self._call(self._gamma, q, dq, t, p)
 
     def points(self, p):
-        return self._call(self._points, p)[: self._n_points].reshape(-1, 2)
+        return self._call(self._points, p)[: self._n_points].reshape(-1, self._point_size)
 
 
 def random_states(system, count: int = N_STATES, seed: int = 7

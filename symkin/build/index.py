@@ -121,7 +121,9 @@ def _full_pipeline(mechanism: Path, options: Options, cache: Path,
     system = derivation.derive(validate.load(mechanism, dict(options.parameters)))
     kernel = compile_system(system, backend=options.backend, real=options.real,
                            cse=options.cse, linalg=options.linalg, cache_dir=cache)
-    drawn = drawing.outlines(system) if want_outlines else None
+    # the pictures of a spatial mechanism are not drawn (the run refuses to make them)
+    drawn = drawing.outlines(system) if want_outlines and not system.mechanism.is_spatial \
+        else None
     return Prepared(kernel, hit=False, outlines=drawn, system=system)
 
 

@@ -207,7 +207,10 @@ def _report(kernel: Any, result: Any, spread: Any) -> None:
     if not result.ok.any() or not result.points_named:
         return
     estimate = None
-    if spread is not None:
+    if spread is not None and result.space == "3d":
+        messages.note("no first-order estimate: it is computed for planar mechanisms only "
+                      "(the Monte-Carlo spread below is)")
+    elif spread is not None:
         try:
             estimate = tolerance.point_sensitivities(kernel, result.t)
         except SymkinError as error:  # the nominal design itself fails: no linearisation
@@ -216,7 +219,7 @@ def _report(kernel: Any, result: Any, spread: Any) -> None:
     print("named points, position over the solved sets at the time of widest spread:")
     for body, name in result.points_named:
         band = tolerance.envelope(result, body, name)
-        for axis, label in enumerate("xy"):
+        for axis, label in enumerate("xyz"[:result.point_size]):
             k = int(np.nanargmax(band.high[:, axis] - band.low[:, axis]))
             line = (f"  {body}.{name}.{label} at t = {result.t[k]:g}: min {band.low[k, axis]:.6g}"
                     f" max {band.high[k, axis]:.6g} mean {band.mean[k, axis]:.6g} "

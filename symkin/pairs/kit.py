@@ -68,7 +68,7 @@ class Checks(Protocol):
                    coordinates: bool = False) -> sp.Expr: ...
     def uses_coordinates(self, expr: sp.Expr) -> bool: ...
     def value(self, expr: sp.Expr, path: Path) -> float: ...
-    def point_at_q0(self, body: str, ref: Any) -> tuple[float, float]: ...
+    def point_at_q0(self, body: str, ref: Any) -> tuple[float, ...]: ...
     def curve(self, raw: Any, path: Path, order: int = 2) -> sp.Expr: ...
     def curve_value(self, expr: sp.Expr, s: float, path: Path) -> float: ...
     def body_names(self) -> tuple[str, ...]: ...
@@ -158,7 +158,9 @@ class PairType:
     name: str
     model: type[BaseModel]
     sections: tuple[str, ...]
-    equations: Callable[[Any, Geometry], list[sp.Expr]]
+    # given the Geometry of the type's family: Geometry here (planar), or
+    # pairs.spatial.basic.Geometry (spatial)
+    equations: Callable[[Any, Any], list[sp.Expr]]
     rows: tuple[str, ...] | None
     bodies: tuple[str, ...] = ("i", "j")
     on_ground: bool = False
@@ -168,7 +170,8 @@ class PairType:
     time_functions: tuple[str, ...] = ()
     check: Callable[[Any, Checks, Path], None] | None = None
     drawn_model: type[BaseModel] | None = None
-    to_local: Callable[[Mapping[str, Any], Drawing, Path], DrawnResult] | None = None
+    # given the family's drawing: Drawing here, or pairs.spatial.basic.Drawing
+    to_local: Callable[[Mapping[str, Any], Any, Path], DrawnResult] | None = None
     pivot: bool = False
     slide: str | None = None
     rod: bool = False

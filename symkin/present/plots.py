@@ -21,7 +21,7 @@ from symkin.present.series import DEFAULT_UNITS, Units
 from symkin.runtime.results import Trajectory
 
 FORMATS = (".png", ".svg", ".pdf")
-_STYLES: dict[str, Any] = {"": "-", "x": "-", "y": "--"}
+_STYLES: dict[str, Any] = {"": "-", "x": "-", "y": "--", "z": ":"}
 
 
 def _pyplot() -> Any:
@@ -89,9 +89,10 @@ def _legend(ax: Any, curves: Sequence[series.Curve]) -> None:
 
     handles = [Line2D([], [], color=c.colour, linewidth=2) for c in curves]
     labels = [c.name for c in curves]
-    if any(len(c.components) == 2 for c in curves):
-        handles += [Line2D([], [], color="black", linestyle=_STYLES[part]) for part in "xy"]
-        labels += ["x (points)", "y (points)"]
+    parts = max((c.components for c in curves if len(c.components) > 1), key=len, default=())
+    if parts:
+        handles += [Line2D([], [], color="black", linestyle=_STYLES[part]) for part in parts]
+        labels += [f"{part} (points)" for part in parts]
     ax.legend(handles, labels, loc="lower left", bbox_to_anchor=(0.0, 1.02, 1.0, 0.1),
               mode="expand", ncol=min(3, len(labels)), fontsize="small", frameon=False,
               borderaxespad=0.0)

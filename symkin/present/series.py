@@ -169,7 +169,7 @@ class Curve:
     Attributes:
         name: as selected, ``crank.phi`` or ``coupler.P``.
         kind: LENGTH or ANGLE (which column, which unit).
-        components: ("",) for a coordinate, ("x", "y") for a point.
+        components: ("",) for a coordinate, ("x", "y") for a point (spatial: x, y, z).
         values: position, velocity, acceleration, each (T, len(components)), in the units shown.
         colour: its colour, unique within its column.
     """
@@ -200,7 +200,7 @@ def _quantity(trajectory: Trajectory, name: str
         return name, kind, ("",), (trajectory.q[:, k:k + 1], trajectory.dq[:, k:k + 1],
                                    trajectory.d2q[:, k:k + 1])
     body, point = name.rsplit(".", 1)
-    return name, LENGTH, ("x", "y"), trajectory.point(body, point)
+    return name, LENGTH, tuple("xyz"[:trajectory.point_size]), trajectory.point(body, point)
 
 
 def kinds(selected: Sequence[Curve]) -> list[str]:

@@ -37,13 +37,16 @@ def _bilinear(a: Array, b: Array) -> Array:
 def point_kinematics(q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, s: ArrayLike
                      ) -> tuple[Array, Array, Array]:
     """r, dr, ddr of a point with local vector s (3,) of a body whose [x, y, z, e0..e3] and
-    derivatives are q, dq, ddq, shape (7,) or (T, 7); each result (3,) or (T, 3)."""
+    derivatives are q, dq, ddq, shape (7,) or (..., 7); each result (3,) or (..., 3)."""
     q, dq, ddq = (np.asarray(a, dtype=float) for a in (q, dq, ddq))
     s = np.asarray(s, dtype=float)
     e, de, dde = q[..., 3:], dq[..., 3:], ddq[..., 3:]
-    r = q[..., :3] + rotation(e) @ s
-    dr = dq[..., :3] + 2.0 * _bilinear(e, de) @ s
-    ddr = ddq[..., :3] + (2.0 * rotation(de) + 2.0 * _bilinear(e, dde)) @ s
+    def times_s(matrix: Array) -> Array:  # broadcasts s of shape (..., 3) too
+        return np.asarray(np.einsum("...ij,...j->...i", matrix, s), dtype=np.float64)
+
+    r = q[..., :3] + times_s(rotation(e))
+    dr = dq[..., :3] + 2.0 * times_s(_bilinear(e, de))
+    ddr = ddq[..., :3] + times_s(2.0 * rotation(de) + 2.0 * _bilinear(e, dde))
     return r, dr, ddr
 
 

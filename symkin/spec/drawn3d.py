@@ -11,7 +11,7 @@ from pieces each parsed alone by the whitelist parser.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from symkin import pairs
@@ -100,7 +100,7 @@ class Drawing3d:
         x, y, z = (self.context.quantity(item, path + (k,)) for k, item in enumerate(raw))
         return x, y, z
 
-    def texts(self, vector: Vector) -> list[Any]:
+    def texts(self, vector: Sequence[Q]) -> list[Any]:
         return [self.context.tidy(q) for q in vector]
 
     def local(self, body: str, point: Vector) -> list[Any]:
@@ -206,9 +206,14 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
 
 def _constraint(drawing: Drawing3d, item: Any, path: Path_) -> Any:
     """One joint or driver in the local form; shape errors go on to the schema as they are."""
-    kind = pairs.named_in(item.get("type"), path[0], "3d") \
+    section = str(path[0])
+    kind = pairs.named_in(item.get("type"), section, "3d") \
         if isinstance(item, Mapping) else None
     if kind is None:
+        if isinstance(item, Mapping) and isinstance(item.get("type"), str):
+            listed = ", ".join(k.name for k in pairs.in_section(section, "3d"))
+            raise MechanismError(f"{item['type']!r} is not a type of a space: 3d file's "
+                                 f"{section}", path + ("type",), f"Use one of: {listed}.")
         return item
     extra = sorted(set(item) - kind.drawn_keys)
     if extra:
@@ -217,5 +222,5 @@ def _constraint(drawing: Drawing3d, item: Any, path: Path_) -> Any:
                              f"{', '.join(sorted(kind.drawn_keys))}.")
     if kind.to_local is None:
         return item
-    local, _ = kind.to_local(item, drawing, path)  # type: ignore[arg-type]
+    local, _ = kind.to_local(item, drawing, path)
     return local

@@ -52,6 +52,10 @@ class DrawnMechanism(Strict):
     units: Units | None = None
 
 
+SpatialDrawnJoint: Any = pairs.union("joints", drawn=True, space="3d")
+SpatialDrawnDriver: Any = pairs.union("drivers", drawn=True, space="3d")
+
+
 class SpatialFrame(Strict):
     """A spatial body's frame origin (its axes are parallel to the global ones as drawn)."""
 
@@ -73,10 +77,8 @@ class SpatialDrawnMechanism(Strict):
     name: str
     parameters: dict[str, Expr] = Field(default_factory=dict)
     bodies: dict[str, SpatialDrawnBody] = Field(min_length=1)
-    joints: list[pairs.union("joints", drawn=True, space="3d")] = Field(  # type: ignore[misc]
-        default_factory=list)
-    drivers: list[pairs.union("drivers", drawn=True, space="3d")] = Field(  # type: ignore[misc]
-        default_factory=list)
+    joints: list[SpatialDrawnJoint] = Field(default_factory=list)
+    drivers: list[SpatialDrawnDriver] = Field(default_factory=list)
     time: TimeGrid
     units: Units | None = None
 

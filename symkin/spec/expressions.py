@@ -137,10 +137,14 @@ class _Builder:
             key = (node.value.id, node.attr)
             if key in self.coordinates:
                 return self.coordinates[key]
-            if self.coordinates and node.attr in _COORDINATE_ATTRIBUTES:
+            parts = tuple(dict.fromkeys(part for _, part in self.coordinates))
+            if self.coordinates and node.attr in (*_COORDINATE_ATTRIBUTES, *parts):
                 bodies = ", ".join(dict.fromkeys(body for body, _ in self.coordinates))
-                raise self.fail(node, f"unknown coordinate '{key[0]}.{key[1]}'; use body.x, "
-                                      f"body.y or body.phi of a body among {bodies}")
+                planar = set(parts) <= {"x", "y", "phi"}
+                said = ("body.x, body.y or body.phi" if planar else
+                        ", ".join(f"body.{part}" for part in parts))
+                raise self.fail(node, f"unknown coordinate '{key[0]}.{key[1]}'; use {said} "
+                                      f"of a body among {bodies}")
         raise self.fail(node, "attribute access is not allowed (only body.x, body.y, "
                               "body.phi in custom constraints)")
 

@@ -345,7 +345,7 @@ class _Checks:
         """A point of ``body`` by name, or a vector of constant expressions."""
         _point(self.mech, body, ref, self.symbols, self.nominal, path)
 
-    def point_at_q0(self, body: str, ref: Any) -> tuple[float, float]:
+    def point_at_q0(self, body: str, ref: Any) -> tuple[float, ...]:
         """The global position of a (checked) point of ``body`` at its first guess q0."""
         def nominal(raw: Any) -> float:  # checked already: parses and has a value
             return constants.value(expressions.parse(raw, self.symbols.parameters), self.nominal)

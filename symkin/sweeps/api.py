@@ -185,7 +185,8 @@ def _result(kernel: Kernel, times: Array, values: Array, chunk: Chunk) -> SweepR
         points_named=tuple(kernel.points), local_vectors=kernel.point_vectors,
         removed=kernel.removed, removed_broken=_removed_broken(kernel, times, values, chunk),
         multipliers_grid=kernel.multipliers_grid if kernel.has_dynamics else None,
-        driver_names=kernel.driver_names, joint_names=kernel.joint_names)
+        driver_names=kernel.driver_names, joint_names=kernel.joint_names,
+        space=getattr(kernel, "space", "2d"))
 
 
 def _removed_broken(kernel: Kernel, times: Array, values: Array, chunk: Chunk

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import SymkinError
+from symkin.runtime import spatial
 
 Array = NDArray[np.float64]
 
@@ -100,16 +101,24 @@ class SweepResult:
                           float(self.t[k]), int(sets[j])))
         return found
 
+    # "3d" for a spatial mechanism: 7 coordinates per body, points of 3 components.
+    space: str = "2d"
+
+    @property
+    def point_size(self) -> int:
+        return 3 if self.space == "3d" else 2
+
     @functools.cached_property
     def point_vectors(self) -> Array:
-        """(M, P, 2): the named points' local vectors for each set's parameters."""
-        count = len(self.points_named)
+        """(M, P, 2): the named points' local vectors for each set's parameters (spatial:
+        (M, P, 3))."""
+        count, size = len(self.points_named), self.point_size
         if not count or not self.params.shape[0]:
-            return np.zeros((self.params.shape[0], count, 2))
+            return np.zeros((self.params.shape[0], count, size))
         if self.local_vectors is None:  # never a silent zero vector
             raise SymkinError("this result carries no point vectors; sweep with symkin.sweep")
         vectors = self.local_vectors
-        return np.stack([np.asarray(vectors(p), dtype=float).reshape(count, 2)
+        return np.stack([np.asarray(vectors(p), dtype=float).reshape(count, size)
                          for p in self.params])
 
     @property
@@ -128,8 +137,13 @@ class SweepResult:
             known = ", ".join(f"{b}.{p}" for b, p in self.points_named) or "none"
             raise SymkinError(f"no point {body}.{name}; the named points are: {known}")
         start = self.coordinates.index(f"{body}.x")
-        q, dq, d2q = (a[:, :, start:start + 3] for a in (self.q, self.dq, self.d2q))
         s = self.point_vectors[:, self.points_named.index((body, name)), None, :]  # (M, 1, 2)
+        if self.space == "3d":
+            body_columns = slice(start, start + 7)
+            return spatial.point_kinematics(self.q[:, :, body_columns],
+                                            self.dq[:, :, body_columns],
+                                            self.d2q[:, :, body_columns], s)
+        q, dq, d2q = (a[:, :, start:start + 3] for a in (self.q, self.dq, self.d2q))
         cos, sin = np.cos(q[..., 2]), np.sin(q[..., 2])
         rs = np.stack([cos * s[..., 0] - sin * s[..., 1], sin * s[..., 0] + cos * s[..., 1]], -1)
         omega_rs = np.stack([-rs[..., 1], rs[..., 0]], -1)  # Omega R s
@@ -177,7 +191,7 @@ class SweepResult:
 
     def point_arrays(self) -> tuple[Array, Array, Array]:
         """r, dr, ddr of every named point, each (M, T, P, 2)."""
-        shape = (*self.q.shape[:2], len(self.points_named), 2)
+        shape = (*self.q.shape[:2], len(self.points_named), self.point_size)
         r, dr, ddr = (np.zeros(shape) for _ in range(3))
         for k, (body, name) in enumerate(self.points_named):
             r[:, :, k], dr[:, :, k], ddr[:, :, k] = self.point(body, name)

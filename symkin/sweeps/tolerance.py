@@ -121,7 +121,7 @@ def envelope(result: SweepResult, body: str, point: str) -> Envelope:
     """min, max, mean and standard deviation of the point's position over the solved sets."""
     r = result.point(body, point)[0][result.ok]
     if r.shape[0] == 0:
-        empty = np.full((result.t.size, 2), np.nan)
+        empty = np.full((result.t.size, result.point_size), np.nan)
         return Envelope(empty, empty, empty, empty)
     return Envelope(r.min(axis=0), r.max(axis=0), r.mean(axis=0),
                     r.std(axis=0, ddof=1) if r.shape[0] > 1 else np.zeros_like(r[0]))

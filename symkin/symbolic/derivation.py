@@ -27,7 +27,6 @@ from symkin.symbolic import dynamics, redundancy, spatial
 from symkin.symbolic.planar import TAU, Context, input_slot
 from symkin.symbolic.symbols import Input, Symbols, extra_coordinates, make_symbols
 
-
 # A spatial body's own row: its Euler parameters' normalisation (section, part).
 NORMALISATION = ("bodies", "normalisation")
 

@@ -94,5 +94,9 @@ def _tex_text(text: str) -> str:
 
 def _latex_name(coordinate: str) -> str:
     body, part = coordinate.split(".")
-    symbol = {"x": "x", "y": "y", "phi": "\\varphi", "s": "s"}[part]  # s: a pair's own
+    # spatial: z and the Euler parameters e0..e3 as e_{0..3}; s: a pair's own coordinate
+    symbol = ({"x": "x", "y": "y", "z": "z", "phi": "\\varphi", "s": "s"}.get(part)
+              or f"e_{part[1:]}")
+    if part.startswith("e"):
+        return f"{{{symbol}}}_{{\\mathrm{{{body.replace('_', '-')}}}}}"
     return f"{symbol}_{{\\mathrm{{{body.replace('_', '-')}}}}}"

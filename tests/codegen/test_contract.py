@@ -115,6 +115,16 @@ def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
         manifest.KEYS - manifest.OPTIONAL_KEYS | {"input_names"}
 
 
+def test_a_spatial_manifest_says_its_space(tmp_path: Path) -> None:
+    import symkin
+
+    spatial = symkin.derive(ROOT / "examples" / "rssr.yaml")
+    written = render.generate(spatial, backends.get("c"), out_dir=tmp_path)[-1]
+    data = json.loads(written.read_text(encoding="utf-8"))
+    assert set(data) == manifest.KEYS - manifest.OPTIONAL_KEYS | {"space"}
+    assert data["space"] == "3d"
+
+
 # The modules that read a manifest, and the names their manifest dicts go by.
 READERS = ["symkin/runtime/kernel.py", "symkin/build/cache.py", "symkin/build/index.py",
            "symkin/sweeps/parallel.py", "symkin/codegen/render.py", "symkin/backends/__init__.py",

@@ -76,7 +76,6 @@ def _three_planets() -> dict:
             "time": {"t0": 0, "t1": 1, "dt": 0.1}}
 
 
-@pytest.mark.xfail(strict=True, reason="needs the removal of redundant equations")
 def test_three_planets_are_accepted_and_follow_willis() -> None:
     system = symkin.derive(symkin.from_dict(_three_planets()))
     run = symkin.solve(kernel_for(system, "numpy"))

@@ -113,7 +113,6 @@ def test_delta_robot_rods_keep_their_length_and_the_platform_its_orientation(
         assert np.abs(np.sum(d * ddd, 1) + np.sum(dd * dd, 1)).max() < 1e-8
 
 
-@pytest.mark.xfail(strict=True, reason="needs the removal of redundant equations")
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_cardan_shaft_speed_ratio_against_the_closed_form(backend: str) -> None:
     beta = np.pi / 6

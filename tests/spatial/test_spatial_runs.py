@@ -141,3 +141,47 @@ def test_a_tumble_through_plus_minus_90_degrees_of_pitch(backend: str) -> None:
     assert np.abs(r - 0.8 * expected[:, :, 0]).max() < 1e-10
     assert np.abs(dr - np.cross(omega, r)).max() < 1e-9
     assert np.abs(ddr - np.cross(alpha, r) - np.cross(omega, np.cross(omega, r))).max() < 1e-7
+
+
+def test_float_and_dense_builds_of_a_spatial_kernel() -> None:
+    """--real float (C) agrees with double to float precision; the dense LU to rounding."""
+    system = symkin.derive(EXAMPLES / "rssr.yaml")
+    double = symkin.solve(symkin.compile(system, backend="c"))
+    single = symkin.solve(symkin.compile(system, backend="c", real="float"))
+    dense = symkin.solve(symkin.compile(system, backend="c", linalg="dense"))
+    assert np.abs(single.q - double.q).max() < 1e-5
+    assert np.abs(dense.q - double.q).max() < 1e-12
+
+
+def test_spatial_outputs_csv_and_npz(tmp_path: Path) -> None:
+    """The file contracts: r, dr, ddr (n_t, n_points, 3), omega and alpha (n_t, n_bodies, 3)
+    with bodies in the NPZ; the CSV's point and angular columns; each CSV value equal to the
+    NPZ's."""
+    import subprocess
+    import sys
+
+    root = EXAMPLES.parent
+    for name in ("run.csv", "run.npz"):
+        result = subprocess.run([sys.executable, "-m", "symkin", "run", "examples/rssr.yaml",
+                                 "--backend", "numpy", "-o", str(tmp_path / name)],
+                                capture_output=True, text=True, timeout=300, check=False,
+                                cwd=root)
+        assert result.returncode == 0, result.stderr
+    data = np.load(tmp_path / "run.npz")
+    n_t = data["t"].size
+    assert list(data["points"]) == ["crank.A0", "crank.A", "rocker.B0", "rocker.B"]
+    assert data["r"].shape == data["dr"].shape == data["ddr"].shape == (n_t, 4, 3)
+    assert list(data["bodies"]) == ["crank", "rocker"]
+    assert data["omega"].shape == data["alpha"].shape == (n_t, 2, 3)
+    header = (tmp_path / "run.csv").read_text().splitlines()[0].split(",")
+    table = np.loadtxt(tmp_path / "run.csv", delimiter=",", skiprows=1)
+    column = {name: table[:, k] for k, name in enumerate(header)}
+    start = header.index("rocker.B_x")
+    assert header[start:start + 9] == [f"rocker.B_{s}" for s in
+                                       ("x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az")]
+    assert header[-13:-1] == [f"{b}.{k}_{a}" for b in ("crank", "rocker")
+                              for k in ("omega", "alpha") for a in "xyz"]
+    assert header[-1] == "flagged"
+    assert np.array_equal(column["rocker.B_vz"], data["dr"][:, 3, 2])
+    assert np.array_equal(column["rocker.alpha_x"], data["alpha"][:, 1, 0])
+    assert np.array_equal(column["crank.e3_tt"], data["d2q"][:, header.index("crank.e3") - 1])

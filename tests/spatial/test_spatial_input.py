@@ -1,0 +1,98 @@
+"""Bad spatial input is refused with a located message (exit 2 on the CLI), never a
+traceback; a planar file is unchanged by the spatial family."""
+
+from __future__ import annotations
+
+import copy
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+import symkin
+from symkin.errors import MechanismError
+
+ROOT = Path(__file__).resolve().parents[2]
+RSSR = yaml.safe_load((ROOT / "examples" / "rssr.yaml").read_text())
+
+
+def _universal_askew(d):
+    d["joints"][1] = {"type": "universal", "name": "rocker_pivot", "i": "ground",
+                      "j": "rocker", "at": "B0", "axes": [[1, 0, 0], [1, 1, 0]]}
+
+
+CASES = {
+    "unknown_point": (lambda d: d["joints"][0].update(at="Q"), "joints[0].at",
+                      "has a point named 'Q'"),
+    "zero_axis": (lambda d: d["joints"][0].update(axis=[0, 0, 0]), "joints[0].axis",
+                  "the axis is zero"),
+    "two_vector_point": (lambda d: d["bodies"]["crank"]["points"].update(A=[0.1, 0]),
+                         "bodies.crank.points.A", "expected a vector [x, y, z]"),
+    "two_vector_axis": (lambda d: d["joints"][0].update(axis=[0, 1]), "joints[0].axis",
+                        "expected a vector [x, y, z]"),
+    "unknown_space": (lambda d: d.update(space="4d"), "space", "unknown space '4d'"),
+    "angle_on_a_rod": (lambda d: d["drivers"][0].update(joint="coupler"), "drivers[0].joint",
+                       "has no axis to drive"),
+    "angle_on_no_joint": (lambda d: d["drivers"][0].update(joint="nope"), "drivers[0].joint",
+                          "no joint named 'nope'"),
+    "universal_askew": (_universal_askew, "joints[1].axes", "not perpendicular"),
+    "planar_type": (lambda d: d["joints"][0].update(type="pin_slot"), "joints[0].type",
+                    "'pin_slot' is not a type of a space: 3d file"),
+    "too_many_drivers": (lambda d: d["drivers"].append(
+        {"type": "angle", "joint": "rocker_pivot", "theta": "t"}), "drivers",
+        "w = 6·2 − 11"),
+    "planar_coordinate": (lambda d: d["drivers"].__setitem__(
+        0, {"type": "custom", "equations": ["crank.phi - t"]}), "drivers[0].equations[0]",
+        "use body.x, body.y, body.z, body.e0"),
+    "parameter_named_E": (lambda d: d["parameters"].update(E=1), "parameters.E",
+                          "'E' is a constant"),
+    "frame_angle": (lambda d: d["bodies"]["crank"].update(frame={"origin": "A", "angle": 1}),
+                    "bodies.crank.frame", "give only its origin"),
+    "rod_of_no_length": (lambda d: d["joints"][2].update(length=0), "joints[2].length",
+                         "is not positive"),
+    "huge_time_step_count": (lambda d: d["time"].update(dt=1e-12), "time.dt",
+                             "more than"),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_bad_spatial_input_is_refused_where_it_is(case: str) -> None:
+    edit, where, said = CASES[case]
+    data = copy.deepcopy(RSSR)
+    edit(data)
+    with pytest.raises(MechanismError) as caught:
+        symkin.from_dict(data)
+    assert f"at {where}:" in str(caught.value)
+    assert said in str(caught.value)
+
+
+def test_the_cli_exits_2_with_the_line(tmp_path: Path) -> None:
+    data = copy.deepcopy(RSSR)
+    data["joints"][0]["axis"] = [0, 0, 0]
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    result = subprocess.run([sys.executable, "-m", "symkin", "run", str(path)],
+                            capture_output=True, text=True, timeout=300, check=False,
+                            cwd=ROOT)
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    assert f"{path}:" in result.stderr and "the axis is zero" in result.stderr
+
+
+def test_animate_of_a_spatial_file_exits_2(tmp_path: Path) -> None:
+    result = subprocess.run([sys.executable, "-m", "symkin", "run", "examples/rssr.yaml",
+                             "--backend", "numpy", "--animate", str(tmp_path / "a.gif")],
+                            capture_output=True, text=True, timeout=300, check=False,
+                            cwd=ROOT)
+    assert result.returncode == 2 and "planar mechanisms only" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_a_planar_file_with_space_2d_is_the_planar_file() -> None:
+    data = yaml.safe_load((ROOT / "examples" / "crank_slider.yaml").read_text())
+    plain = symkin.from_dict(data)
+    marked = symkin.from_dict({**data, "space": "2d"})
+    assert not marked.is_spatial
+    assert marked.spec_hash() == plain.spec_hash()
