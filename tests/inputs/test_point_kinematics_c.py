@@ -59,3 +59,44 @@ def test_null_rates_are_skipped() -> None:
                                       ffi.from_buffer("double[]", r),
                                       ffi.from_buffer("double[]", dr), ffi.NULL)
     assert np.all(dr == 7.0) and np.isfinite(r).all()
+
+
+def _rotation(e: np.ndarray) -> np.ndarray:
+    """The rotation matrix of unit Euler parameters (e0 the scalar part), written out."""
+    e0, e1, e2, e3 = e
+    return np.array([
+        [e0**2 + e1**2 - e2**2 - e3**2, 2 * (e1 * e2 - e0 * e3), 2 * (e1 * e3 + e0 * e2)],
+        [2 * (e1 * e2 + e0 * e3), e0**2 - e1**2 + e2**2 - e3**2, 2 * (e2 * e3 - e0 * e1)],
+        [2 * (e1 * e3 - e0 * e2), 2 * (e2 * e3 + e0 * e1), e0**2 - e1**2 - e2**2 + e3**2]])
+
+
+def test_spatial_point_kinematics_in_c() -> None:
+    """A spatial mechanism (the RSSR four-bar): (x, y, z) triples, positions against r + A(e) s
+    written out here, rates against central differences of the C positions."""
+    system = symkin.derive(ROOT / "examples/rssr.yaml")
+    kernel = symkin.compile(system, backend="c")
+    ffi, lib = kernel.ffi, kernel.lib
+    t0, t1, _ = system.time_grid
+    t = np.linspace(t0, t0 + 0.25 * (t1 - t0), 2001)
+    traj = symkin.solve(kernel, t=t)
+    n = len(kernel.points)
+    s = np.asarray(kernel.point_vectors(), dtype=float)
+    assert s.shape == (n, 3)
+    buf = lambda a: ffi.from_buffer("double[]", np.ascontiguousarray(a, dtype=float))  # noqa: E731
+    r, dr, ddr = (np.zeros((t.size, 3 * n)) for _ in range(3))
+    for k in range(t.size):
+        lib.rssr_point_kinematics(buf(traj.q[k]), buf(traj.dq[k]), buf(traj.d2q[k]),
+                                  buf(kernel.p_values), buf(r[k]), buf(dr[k]), buf(ddr[k]))
+    r, dr, ddr = (a.reshape(t.size, n, 3) for a in (r, dr, ddr))
+    for k, (body, _) in enumerate(kernel.points):
+        if body == "ground":
+            expected = np.broadcast_to(s[k], (t.size, 3))
+        else:
+            start = kernel.coordinates.index(f"{body}.x")
+            q = traj.q[:, start:start + 7]
+            expected = q[:, :3] + np.array([_rotation(e) @ s[k] for e in q[:, 3:]])
+        assert np.abs(r[:, k] - expected).max() < 1e-12
+    h = t[1] - t[0]
+    assert np.abs((r[2:] - r[:-2]) / (2 * h) - dr[1:-1]).max() < 1e-5
+    assert np.abs((dr[2:] - dr[:-2]) / (2 * h) - ddr[1:-1]).max() < 1e-4
+    assert np.abs(dr).max() > 0.1 and np.abs(ddr).max() > 0.1  # the points really move

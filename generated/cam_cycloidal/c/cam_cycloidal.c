@@ -1683,3 +1683,49 @@ void cam_cycloidal_gamma_shared(const cam_cycloidal_real q[], const cam_cycloida
 
 const int cam_cycloidal_phi_p_row[CAM_CYCLOIDAL_NNZ_P] = { 4, 4, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5 };
 const int cam_cycloidal_phi_p_col[CAM_CYCLOIDAL_NNZ_P] = { 0, 1, 2, 3, 4, 5, 0, 1, 2, 3, 4, 5 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int cam_cycloidal_point_body[CAM_CYCLOIDAL_NPOINTS] = { 3 };
+
+void cam_cycloidal_point_kinematics(const cam_cycloidal_real q[], const cam_cycloidal_real dq[],
+                                   const cam_cycloidal_real ddq[], const cam_cycloidal_real p[],
+                                   cam_cycloidal_real r[], cam_cycloidal_real dr[],
+                                   cam_cycloidal_real ddr[])
+{
+    cam_cycloidal_real s[2 * CAM_CYCLOIDAL_NPOINTS];
+    int k;
+    cam_cycloidal_points(p, s);
+    for (k = 0; k < CAM_CYCLOIDAL_NPOINTS; ++k) {
+        const int b = cam_cycloidal_point_body[k];
+        cam_cycloidal_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        cam_cycloidal_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const cam_cycloidal_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const cam_cycloidal_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

@@ -33,6 +33,9 @@ typedef double cam_cycloidal_real;
  *   p[3] c = 5.0
  *   p[4] R0 = 3.0
  *   p[5] r = 0.5
+ * Named points (index: body.point), in the order of cam_cycloidal_points and
+ * cam_cycloidal_point_kinematics:
+ *   0: follower.R
  * Rows of Phi:
  *   0: joints[0] revolute ground-cam (x)
  *   1: joints[0] revolute ground-cam (y)
@@ -68,6 +71,14 @@ void cam_cycloidal_gamma(const cam_cycloidal_real q[], const cam_cycloidal_real 
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void cam_cycloidal_points(const cam_cycloidal_real p[], cam_cycloidal_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * cam_cycloidal_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void cam_cycloidal_point_kinematics(const cam_cycloidal_real q[], const cam_cycloidal_real dq[],
+                                   const cam_cycloidal_real ddq[], const cam_cycloidal_real p[],
+                                   cam_cycloidal_real r[], cam_cycloidal_real dr[],
+                                   cam_cycloidal_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * cam_cycloidal_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

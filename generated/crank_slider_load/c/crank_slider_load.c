@@ -281,3 +281,49 @@ void crank_slider_load_loads_shared(const crank_slider_load_real q[], const cran
 
 const int crank_slider_load_phi_p_row[CRANK_SLIDER_LOAD_NNZ_P] = { 2, 3, 4, 5, 7 };
 const int crank_slider_load_phi_p_col[CRANK_SLIDER_LOAD_NNZ_P] = { 0, 0, 1, 1, 2 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int crank_slider_load_point_body[CRANK_SLIDER_LOAD_NPOINTS] = { 0, 3 };
+
+void crank_slider_load_point_kinematics(const crank_slider_load_real q[], const crank_slider_load_real dq[],
+                                   const crank_slider_load_real ddq[], const crank_slider_load_real p[],
+                                   crank_slider_load_real r[], crank_slider_load_real dr[],
+                                   crank_slider_load_real ddr[])
+{
+    crank_slider_load_real s[2 * CRANK_SLIDER_LOAD_NPOINTS];
+    int k;
+    crank_slider_load_points(p, s);
+    for (k = 0; k < CRANK_SLIDER_LOAD_NPOINTS; ++k) {
+        const int b = crank_slider_load_point_body[k];
+        crank_slider_load_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        crank_slider_load_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const crank_slider_load_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const crank_slider_load_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

@@ -36,6 +36,10 @@ typedef double crank_slider_load_real;
  *   p[4] m2 = 5.0
  *   p[5] m3 = 3.0
  *   p[6] F0 = 100.0
+ * Named points (index: body.point), in the order of crank_slider_load_points and
+ * crank_slider_load_point_kinematics:
+ *   0: crank.tip
+ *   1: rod.P
  * Rows of Phi:
  *   0: joints[0] O revolute ground-crank (x)
  *   1: joints[0] O revolute ground-crank (y)
@@ -73,6 +77,14 @@ void crank_slider_load_gamma(const crank_slider_load_real q[], const crank_slide
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void crank_slider_load_points(const crank_slider_load_real p[], crank_slider_load_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * crank_slider_load_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void crank_slider_load_point_kinematics(const crank_slider_load_real q[], const crank_slider_load_real dq[],
+                                   const crank_slider_load_real ddq[], const crank_slider_load_real p[],
+                                   crank_slider_load_real r[], crank_slider_load_real dr[],
+                                   crank_slider_load_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * crank_slider_load_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -3450,3 +3450,49 @@ void delta_gamma_shared(const delta_real q[], const delta_real dq[], delta_real 
     out[26] = -2*(dq[17]*dq[17]) - 2*(dq[18]*dq[18]) - 2*(dq[19]*dq[19]) - 2*(dq[20]*dq[20]);  /* bodies[2] arm3 (normalisation) */
     out[27] = -2*(dq[24]*dq[24]) - 2*(dq[25]*dq[25]) - 2*(dq[26]*dq[26]) - 2*(dq[27]*dq[27]);  /* bodies[3] platform (normalisation) */
 }
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int delta_point_body[DELTA_NPOINTS] = { 0, 0, 0, 7, 7, 7, 14, 14, 14, 21, 21, 21, 21, 21, 21, 21 };
+
+void delta_point_kinematics(const delta_real q[], const delta_real dq[],
+                                   const delta_real ddq[], const delta_real p[],
+                                   delta_real r[], delta_real dr[],
+                                   delta_real ddr[])
+{
+    delta_real s[2 * DELTA_NPOINTS];
+    int k;
+    delta_points(p, s);
+    for (k = 0; k < DELTA_NPOINTS; ++k) {
+        const int b = delta_point_body[k];
+        delta_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        delta_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const delta_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const delta_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

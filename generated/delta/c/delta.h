@@ -48,6 +48,24 @@ typedef double delta_real;
  *   q[26] platform.e2
  *   q[27] platform.e3
  * Parameters p[] (nominal values in delta_p_nominal):
+ * Named points (index: body.point), in the order of delta_points and
+ * delta_point_kinematics:
+ *   0: arm1.S1
+ *   1: arm1.E1a
+ *   2: arm1.E1b
+ *   3: arm2.S2
+ *   4: arm2.E2a
+ *   5: arm2.E2b
+ *   6: arm3.S3
+ *   7: arm3.E3a
+ *   8: arm3.E3b
+ *   9: platform.C
+ *   10: platform.P1a
+ *   11: platform.P1b
+ *   12: platform.P2a
+ *   13: platform.P2b
+ *   14: platform.P3a
+ *   15: platform.P3b
  * Rows of Phi:
  *   0: joints[0] shoulder1 revolute ground-arm1 (x)
  *   1: joints[0] shoulder1 revolute ground-arm1 (y)
@@ -102,6 +120,14 @@ void delta_gamma(const delta_real q[], const delta_real dq[], delta_real t, cons
 
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void delta_points(const delta_real p[], delta_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * delta_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void delta_point_kinematics(const delta_real q[], const delta_real dq[],
+                                   const delta_real ddq[], const delta_real p[],
+                                   delta_real r[], delta_real dr[],
+                                   delta_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * delta_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -348,3 +348,49 @@ void four_bar_dynamics_loads_shared(const four_bar_dynamics_real q[], const four
 
 const int four_bar_dynamics_phi_p_row[FOUR_BAR_DYNAMICS_NNZ_P] = { 2, 3, 4, 4, 5, 5, 6, 8, 8 };
 const int four_bar_dynamics_phi_p_col[FOUR_BAR_DYNAMICS_NNZ_P] = { 0, 0, 1, 2, 1, 2, 3, 4, 5 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int four_bar_dynamics_point_body[FOUR_BAR_DYNAMICS_NPOINTS] = { 0, 3, 3, 6 };
+
+void four_bar_dynamics_point_kinematics(const four_bar_dynamics_real q[], const four_bar_dynamics_real dq[],
+                                   const four_bar_dynamics_real ddq[], const four_bar_dynamics_real p[],
+                                   four_bar_dynamics_real r[], four_bar_dynamics_real dr[],
+                                   four_bar_dynamics_real ddr[])
+{
+    four_bar_dynamics_real s[2 * FOUR_BAR_DYNAMICS_NPOINTS];
+    int k;
+    four_bar_dynamics_points(p, s);
+    for (k = 0; k < FOUR_BAR_DYNAMICS_NPOINTS; ++k) {
+        const int b = four_bar_dynamics_point_body[k];
+        four_bar_dynamics_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        four_bar_dynamics_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const four_bar_dynamics_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const four_bar_dynamics_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

@@ -42,6 +42,12 @@ typedef double four_bar_dynamics_real;
  *   p[10] l0 = 2.0
  *   p[11] d0 = 5.0
  *   p[12] cr = 2.0
+ * Named points (index: body.point), in the order of four_bar_dynamics_points and
+ * four_bar_dynamics_point_kinematics:
+ *   0: crank.A
+ *   1: coupler.B
+ *   2: coupler.P
+ *   3: rocker.B
  * Rows of Phi:
  *   0: joints[0] O2 revolute ground-crank (x)
  *   1: joints[0] O2 revolute ground-crank (y)
@@ -79,6 +85,14 @@ void four_bar_dynamics_gamma(const four_bar_dynamics_real q[], const four_bar_dy
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void four_bar_dynamics_points(const four_bar_dynamics_real p[], four_bar_dynamics_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * four_bar_dynamics_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void four_bar_dynamics_point_kinematics(const four_bar_dynamics_real q[], const four_bar_dynamics_real dq[],
+                                   const four_bar_dynamics_real ddq[], const four_bar_dynamics_real p[],
+                                   four_bar_dynamics_real r[], four_bar_dynamics_real dr[],
+                                   four_bar_dynamics_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * four_bar_dynamics_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -326,3 +326,49 @@ void parallelogram_extra_bar_gamma_shared(const parallelogram_extra_bar_real q[]
 
 const int parallelogram_extra_bar_phi_p_row[PARALLELOGRAM_EXTRA_BAR_NNZ_P] = { 2, 4, 4, 5, 5, 6, 6, 6, 7, 7, 7, 8, 10, 10, 10 };
 const int parallelogram_extra_bar_phi_p_col[PARALLELOGRAM_EXTRA_BAR_NNZ_P] = { 1, 0, 3, 0, 3, 0, 1, 3, 0, 1, 3, 2, 0, 2, 3 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int parallelogram_extra_bar_point_body[PARALLELOGRAM_EXTRA_BAR_NPOINTS] = { 0, 0, 3, 3, 6, 6, 9, 9, 9 };
+
+void parallelogram_extra_bar_point_kinematics(const parallelogram_extra_bar_real q[], const parallelogram_extra_bar_real dq[],
+                                   const parallelogram_extra_bar_real ddq[], const parallelogram_extra_bar_real p[],
+                                   parallelogram_extra_bar_real r[], parallelogram_extra_bar_real dr[],
+                                   parallelogram_extra_bar_real ddr[])
+{
+    parallelogram_extra_bar_real s[2 * PARALLELOGRAM_EXTRA_BAR_NPOINTS];
+    int k;
+    parallelogram_extra_bar_points(p, s);
+    for (k = 0; k < PARALLELOGRAM_EXTRA_BAR_NPOINTS; ++k) {
+        const int b = parallelogram_extra_bar_point_body[k];
+        parallelogram_extra_bar_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        parallelogram_extra_bar_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const parallelogram_extra_bar_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const parallelogram_extra_bar_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

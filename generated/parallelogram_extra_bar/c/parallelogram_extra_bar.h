@@ -36,6 +36,17 @@ typedef double parallelogram_extra_bar_real;
  *   p[1] d = 1.0
  *   p[2] e = 0.5
  *   p[3] th0 = 1.0471975511965979
+ * Named points (index: body.point), in the order of parallelogram_extra_bar_points and
+ * parallelogram_extra_bar_point_kinematics:
+ *   0: crank.O0
+ *   1: crank.A
+ *   2: rocker.O1
+ *   3: rocker.B
+ *   4: extra.O2
+ *   5: extra.C
+ *   6: coupler.A
+ *   7: coupler.C
+ *   8: coupler.B
  * Rows of Phi:
  *   0: joints[0] O0 revolute ground-crank (x)
  *   1: joints[0] O0 revolute ground-crank (y)
@@ -76,6 +87,14 @@ void parallelogram_extra_bar_gamma(const parallelogram_extra_bar_real q[], const
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void parallelogram_extra_bar_points(const parallelogram_extra_bar_real p[], parallelogram_extra_bar_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * parallelogram_extra_bar_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void parallelogram_extra_bar_point_kinematics(const parallelogram_extra_bar_real q[], const parallelogram_extra_bar_real dq[],
+                                   const parallelogram_extra_bar_real ddq[], const parallelogram_extra_bar_real p[],
+                                   parallelogram_extra_bar_real r[], parallelogram_extra_bar_real dr[],
+                                   parallelogram_extra_bar_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * parallelogram_extra_bar_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

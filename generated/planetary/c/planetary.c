@@ -182,3 +182,49 @@ void planetary_gamma_shared(const planetary_real q[], const planetary_real dq[],
 
 const int planetary_phi_p_row[PLANETARY_NNZ_P] = { 4, 4, 5, 5, 6, 6, 7, 7, 8 };
 const int planetary_phi_p_col[PLANETARY_NNZ_P] = { 0, 1, 0, 1, 0, 1, 0, 1, 2 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int planetary_point_body[PLANETARY_NPOINTS] = { 3 };
+
+void planetary_point_kinematics(const planetary_real q[], const planetary_real dq[],
+                                   const planetary_real ddq[], const planetary_real p[],
+                                   planetary_real r[], planetary_real dr[],
+                                   planetary_real ddr[])
+{
+    planetary_real s[2 * PLANETARY_NPOINTS];
+    int k;
+    planetary_points(p, s);
+    for (k = 0; k < PLANETARY_NPOINTS; ++k) {
+        const int b = planetary_point_body[k];
+        planetary_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        planetary_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const planetary_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const planetary_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

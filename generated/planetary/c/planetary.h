@@ -32,6 +32,9 @@ typedef double planetary_real;
  *   p[0] rs = 1.0
  *   p[1] rp = 0.5
  *   p[2] w = 2.0
+ * Named points (index: body.point), in the order of planetary_points and
+ * planetary_point_kinematics:
+ *   0: arm.hub
  * Rows of Phi:
  *   0: joints[0] revolute ground-sun (x)
  *   1: joints[0] revolute ground-sun (y)
@@ -69,6 +72,14 @@ void planetary_gamma(const planetary_real q[], const planetary_real dq[], planet
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void planetary_points(const planetary_real p[], planetary_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * planetary_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void planetary_point_kinematics(const planetary_real q[], const planetary_real dq[],
+                                   const planetary_real ddq[], const planetary_real p[],
+                                   planetary_real r[], planetary_real dr[],
+                                   planetary_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * planetary_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

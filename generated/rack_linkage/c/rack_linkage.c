@@ -262,3 +262,49 @@ void rack_linkage_gamma_shared(const rack_linkage_real q[], const rack_linkage_r
 
 const int rack_linkage_phi_p_row[RACK_LINKAGE_NNZ_P] = { 1, 4, 7, 7, 8, 8, 9, 10 };
 const int rack_linkage_phi_p_col[RACK_LINKAGE_NNZ_P] = { 0, 0, 1, 2, 1, 2, 3, 4 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int rack_linkage_point_body[RACK_LINKAGE_NPOINTS] = { 3, 9 };
+
+void rack_linkage_point_kinematics(const rack_linkage_real q[], const rack_linkage_real dq[],
+                                   const rack_linkage_real ddq[], const rack_linkage_real p[],
+                                   rack_linkage_real r[], rack_linkage_real dr[],
+                                   rack_linkage_real ddr[])
+{
+    rack_linkage_real s[2 * RACK_LINKAGE_NPOINTS];
+    int k;
+    rack_linkage_points(p, s);
+    for (k = 0; k < RACK_LINKAGE_NPOINTS; ++k) {
+        const int b = rack_linkage_point_body[k];
+        rack_linkage_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        rack_linkage_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const rack_linkage_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const rack_linkage_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

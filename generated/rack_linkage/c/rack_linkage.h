@@ -37,6 +37,10 @@ typedef double rack_linkage_real;
  *   p[2] c = 1.0
  *   p[3] dx = 1.5
  *   p[4] dy = 1.5
+ * Named points (index: body.point), in the order of rack_linkage_points and
+ * rack_linkage_point_kinematics:
+ *   0: rack.P
+ *   1: rocker.tip
  * Rows of Phi:
  *   0: joints[0] revolute ground-pinion (x)
  *   1: joints[0] revolute ground-pinion (y)
@@ -77,6 +81,14 @@ void rack_linkage_gamma(const rack_linkage_real q[], const rack_linkage_real dq[
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void rack_linkage_points(const rack_linkage_real p[], rack_linkage_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * rack_linkage_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void rack_linkage_point_kinematics(const rack_linkage_real q[], const rack_linkage_real dq[],
+                                   const rack_linkage_real ddq[], const rack_linkage_real p[],
+                                   rack_linkage_real r[], rack_linkage_real dr[],
+                                   rack_linkage_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * rack_linkage_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -739,3 +739,49 @@ void rssr_gamma_shared(const rssr_real q[], const rssr_real dq[], rssr_real t, c
 
 const int rssr_phi_p_row[RSSR_NNZ_P] = { 5, 7, 10, 10, 10, 10 };
 const int rssr_phi_p_col[RSSR_NNZ_P] = { 1, 2, 0, 1, 2, 3 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int rssr_point_body[RSSR_NPOINTS] = { 0, 0, 7, 7 };
+
+void rssr_point_kinematics(const rssr_real q[], const rssr_real dq[],
+                                   const rssr_real ddq[], const rssr_real p[],
+                                   rssr_real r[], rssr_real dr[],
+                                   rssr_real ddr[])
+{
+    rssr_real s[2 * RSSR_NPOINTS];
+    int k;
+    rssr_points(p, s);
+    for (k = 0; k < RSSR_NPOINTS; ++k) {
+        const int b = rssr_point_body[k];
+        rssr_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        rssr_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const rssr_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const rssr_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

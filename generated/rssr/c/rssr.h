@@ -38,6 +38,12 @@ typedef double rssr_real;
  *   p[1] d = 0.5
  *   p[2] h = 0.4
  *   p[3] c = 0.4
+ * Named points (index: body.point), in the order of rssr_points and
+ * rssr_point_kinematics:
+ *   0: crank.A0
+ *   1: crank.A
+ *   2: rocker.B0
+ *   3: rocker.B
  * Rows of Phi:
  *   0: joints[0] crank_pivot revolute ground-crank (x)
  *   1: joints[0] crank_pivot revolute ground-crank (y)
@@ -80,6 +86,14 @@ void rssr_gamma(const rssr_real q[], const rssr_real dq[], rssr_real t, const rs
 
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void rssr_points(const rssr_real p[], rssr_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * rssr_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void rssr_point_kinematics(const rssr_real q[], const rssr_real dq[],
+                                   const rssr_real ddq[], const rssr_real p[],
+                                   rssr_real r[], rssr_real dr[],
+                                   rssr_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * rssr_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

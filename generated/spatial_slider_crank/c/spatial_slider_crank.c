@@ -839,3 +839,49 @@ void spatial_slider_crank_gamma_shared(const spatial_slider_crank_real q[], cons
 
 const int spatial_slider_crank_phi_p_row[SPATIAL_SLIDER_CRANK_NNZ_P] = { 1, 2, 5, 6, 7, 8, 8, 8, 8, 9, 9, 9, 9, 10, 10, 10, 10, 11, 11, 11, 11 };
 const int spatial_slider_crank_phi_p_col[SPATIAL_SLIDER_CRANK_NNZ_P] = { 2, 3, 0, 0, 0, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int spatial_slider_crank_point_body[SPATIAL_SLIDER_CRANK_NPOINTS] = { 0, 0, 7, 7, 14 };
+
+void spatial_slider_crank_point_kinematics(const spatial_slider_crank_real q[], const spatial_slider_crank_real dq[],
+                                   const spatial_slider_crank_real ddq[], const spatial_slider_crank_real p[],
+                                   spatial_slider_crank_real r[], spatial_slider_crank_real dr[],
+                                   spatial_slider_crank_real ddr[])
+{
+    spatial_slider_crank_real s[2 * SPATIAL_SLIDER_CRANK_NPOINTS];
+    int k;
+    spatial_slider_crank_points(p, s);
+    for (k = 0; k < SPATIAL_SLIDER_CRANK_NPOINTS; ++k) {
+        const int b = spatial_slider_crank_point_body[k];
+        spatial_slider_crank_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        spatial_slider_crank_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const spatial_slider_crank_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const spatial_slider_crank_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

@@ -45,6 +45,13 @@ typedef double spatial_slider_crank_real;
  *   p[1] L = 0.3
  *   p[2] h = 0.1
  *   p[3] k = 0.12
+ * Named points (index: body.point), in the order of spatial_slider_crank_points and
+ * spatial_slider_crank_point_kinematics:
+ *   0: crank.O
+ *   1: crank.A
+ *   2: rod.A
+ *   3: rod.B
+ *   4: slider.B
  * Rows of Phi:
  *   0: joints[0] crank_bearing revolute ground-crank (x)
  *   1: joints[0] crank_bearing revolute ground-crank (y)
@@ -94,6 +101,14 @@ void spatial_slider_crank_gamma(const spatial_slider_crank_real q[], const spati
 
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void spatial_slider_crank_points(const spatial_slider_crank_real p[], spatial_slider_crank_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * spatial_slider_crank_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void spatial_slider_crank_point_kinematics(const spatial_slider_crank_real q[], const spatial_slider_crank_real dq[],
+                                   const spatial_slider_crank_real ddq[], const spatial_slider_crank_real p[],
+                                   spatial_slider_crank_real r[], spatial_slider_crank_real dr[],
+                                   spatial_slider_crank_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * spatial_slider_crank_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

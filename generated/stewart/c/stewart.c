@@ -1592,3 +1592,49 @@ void stewart_gamma_shared(const stewart_real q[], const stewart_real dq[], stewa
 
 const int stewart_phi_p_row[STEWART_NNZ_P] = { 0, 1, 2, 3, 4, 5 };
 const int stewart_phi_p_col[STEWART_NNZ_P] = { 0, 0, 0, 0, 0, 0 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int stewart_point_body[STEWART_NPOINTS] = { 0, 0, 0, 0, 0, 0 };
+
+void stewart_point_kinematics(const stewart_real q[], const stewart_real dq[],
+                                   const stewart_real ddq[], const stewart_real p[],
+                                   stewart_real r[], stewart_real dr[],
+                                   stewart_real ddr[])
+{
+    stewart_real s[2 * STEWART_NPOINTS];
+    int k;
+    stewart_points(p, s);
+    for (k = 0; k < STEWART_NPOINTS; ++k) {
+        const int b = stewart_point_body[k];
+        stewart_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        stewart_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const stewart_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const stewart_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

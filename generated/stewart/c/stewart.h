@@ -28,6 +28,14 @@ typedef double stewart_real;
  *   q[6] platform.e3
  * Parameters p[] (nominal values in stewart_p_nominal):
  *   p[0] zp = 1.0
+ * Named points (index: body.point), in the order of stewart_points and
+ * stewart_point_kinematics:
+ *   0: platform.P1
+ *   1: platform.P2
+ *   2: platform.P3
+ *   3: platform.P4
+ *   4: platform.P5
+ *   5: platform.P6
  * Rows of Phi:
  *   0: drivers[0] leg1 distance ground-platform (length)
  *   1: drivers[1] leg2 distance ground-platform (length)
@@ -63,6 +71,14 @@ void stewart_gamma(const stewart_real q[], const stewart_real dq[], stewart_real
 
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void stewart_points(const stewart_real p[], stewart_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * stewart_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void stewart_point_kinematics(const stewart_real q[], const stewart_real dq[],
+                                   const stewart_real ddq[], const stewart_real p[],
+                                   stewart_real r[], stewart_real dr[],
+                                   stewart_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * stewart_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -9467,3 +9467,50 @@ void stewart_legs_gamma_shared(const stewart_legs_real q[], const stewart_legs_r
 
 const int stewart_legs_phi_p_row[STEWART_LEGS_NNZ_P] = { 72, 73, 74, 75, 76, 77 };
 const int stewart_legs_phi_p_col[STEWART_LEGS_NNZ_P] = { 0, 0, 0, 0, 0, 0 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int stewart_legs_point_body[STEWART_LEGS_NPOINTS] = { 0, 0, 0, 0, 0, 0, 7, 7, 14, 14, 21, 21, 28, 28, 35, 35, 42, 42, 49, 49, 56, 56, 63, 63,
+    70, 70, 77, 77, 84, 84 };
+
+void stewart_legs_point_kinematics(const stewart_legs_real q[], const stewart_legs_real dq[],
+                                   const stewart_legs_real ddq[], const stewart_legs_real p[],
+                                   stewart_legs_real r[], stewart_legs_real dr[],
+                                   stewart_legs_real ddr[])
+{
+    stewart_legs_real s[2 * STEWART_LEGS_NPOINTS];
+    int k;
+    stewart_legs_points(p, s);
+    for (k = 0; k < STEWART_LEGS_NPOINTS; ++k) {
+        const int b = stewart_legs_point_body[k];
+        stewart_legs_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        stewart_legs_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const stewart_legs_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const stewart_legs_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

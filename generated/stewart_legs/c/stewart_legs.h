@@ -112,6 +112,38 @@ typedef double stewart_legs_real;
  *   q[90] piston6.e3
  * Parameters p[] (nominal values in stewart_legs_p_nominal):
  *   p[0] zp = 1.0
+ * Named points (index: body.point), in the order of stewart_legs_points and
+ * stewart_legs_point_kinematics:
+ *   0: platform.P1
+ *   1: platform.P2
+ *   2: platform.P3
+ *   3: platform.P4
+ *   4: platform.P5
+ *   5: platform.P6
+ *   6: cylinder1.B1
+ *   7: cylinder1.M1
+ *   8: piston1.M1
+ *   9: piston1.P1
+ *   10: cylinder2.B2
+ *   11: cylinder2.M2
+ *   12: piston2.M2
+ *   13: piston2.P2
+ *   14: cylinder3.B3
+ *   15: cylinder3.M3
+ *   16: piston3.M3
+ *   17: piston3.P3
+ *   18: cylinder4.B4
+ *   19: cylinder4.M4
+ *   20: piston4.M4
+ *   21: piston4.P4
+ *   22: cylinder5.B5
+ *   23: cylinder5.M5
+ *   24: piston5.M5
+ *   25: piston5.P5
+ *   26: cylinder6.B6
+ *   27: cylinder6.M6
+ *   28: piston6.M6
+ *   29: piston6.P6
  * Rows of Phi:
  *   0: joints[0] base1 universal ground-cylinder1 (x)
  *   1: joints[0] base1 universal ground-cylinder1 (y)
@@ -231,6 +263,14 @@ void stewart_legs_gamma(const stewart_legs_real q[], const stewart_legs_real dq[
 
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void stewart_legs_points(const stewart_legs_real p[], stewart_legs_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * stewart_legs_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void stewart_legs_point_kinematics(const stewart_legs_real q[], const stewart_legs_real dq[],
+                                   const stewart_legs_real ddq[], const stewart_legs_real p[],
+                                   stewart_legs_real r[], stewart_legs_real dr[],
+                                   stewart_legs_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * stewart_legs_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */

@@ -273,3 +273,49 @@ void whitworth_drawn_gamma_shared(const whitworth_drawn_real q[], const whitwort
 
 const int whitworth_drawn_phi_p_row[WHITWORTH_DRAWN_NNZ_P] = { 11 };
 const int whitworth_drawn_phi_p_col[WHITWORTH_DRAWN_NNZ_P] = { 0 };
+
+/* Where each named point's body is in q[]: the index of its x (-1: the ground). */
+static const int whitworth_drawn_point_body[WHITWORTH_DRAWN_NPOINTS] = { 0, 0, 3, 3, 6, 6, 9, 9 };
+
+void whitworth_drawn_point_kinematics(const whitworth_drawn_real q[], const whitworth_drawn_real dq[],
+                                   const whitworth_drawn_real ddq[], const whitworth_drawn_real p[],
+                                   whitworth_drawn_real r[], whitworth_drawn_real dr[],
+                                   whitworth_drawn_real ddr[])
+{
+    whitworth_drawn_real s[2 * WHITWORTH_DRAWN_NPOINTS];
+    int k;
+    whitworth_drawn_points(p, s);
+    for (k = 0; k < WHITWORTH_DRAWN_NPOINTS; ++k) {
+        const int b = whitworth_drawn_point_body[k];
+        whitworth_drawn_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
+        whitworth_drawn_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
+        if (b >= 0) {
+            const whitworth_drawn_real c = cos(q[b + 2]), n = sin(q[b + 2]);
+            const whitworth_drawn_real sx = gx;
+            gx = c * sx - n * gy;
+            gy = n * sx + c * gy;
+            x = q[b];
+            y = q[b + 1];
+            if (dq) {
+                vx = dq[b];
+                vy = dq[b + 1];
+                w = dq[b + 2];
+            }
+            if (ddq) {
+                ax = ddq[b];
+                ay = ddq[b + 1];
+                a = ddq[b + 2];
+            }
+        }
+        r[2 * k] = x + gx; /* (2.14) */
+        r[2 * k + 1] = y + gy;
+        if (dr && dq) { /* (2.15): + Omega R s phi_t */
+            dr[2 * k] = vx - w * gy;
+            dr[2 * k + 1] = vy + w * gx;
+        }
+        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
+            ddr[2 * k] = ax - a * gy - w * w * gx;
+            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        }
+    }
+}

@@ -33,6 +33,16 @@ typedef double whitworth_drawn_real;
  *   q[11] ram.phi
  * Parameters p[] (nominal values in whitworth_drawn_p_nominal):
  *   p[0] w = 6.283185307179586
+ * Named points (index: body.point), in the order of whitworth_drawn_points and
+ * whitworth_drawn_point_kinematics:
+ *   0: crank.O2
+ *   1: crank.A
+ *   2: lever.O4
+ *   3: lever.C
+ *   4: link.C
+ *   5: link.D
+ *   6: ram.D
+ *   7: ram.tool
  * Rows of Phi:
  *   0: joints[0] O2 revolute ground-crank (x)
  *   1: joints[0] O2 revolute ground-crank (y)
@@ -73,6 +83,14 @@ void whitworth_drawn_gamma(const whitworth_drawn_real q[], const whitworth_drawn
 
 /* Local vectors of the named points, (x, y) pairs in file order: out[2*NPOINTS]. */
 void whitworth_drawn_points(const whitworth_drawn_real p[], whitworth_drawn_real out[]);
+
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
+ * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+ * whitworth_drawn_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
+void whitworth_drawn_point_kinematics(const whitworth_drawn_real q[], const whitworth_drawn_real dq[],
+                                   const whitworth_drawn_real ddq[], const whitworth_drawn_real p[],
+                                   whitworth_drawn_real r[], whitworth_drawn_real dr[],
+                                   whitworth_drawn_real ddr[]);
 
 /* Design sensitivities: Phi_p = d Phi / d p, whose non-zeros (row, parameter) are listed in
  * whitworth_drawn_phi_p_row/_col. Along a solution Phi_q q_p = -Phi_p gives q_p = dq/dp. */
