@@ -85,8 +85,8 @@ void cardan_gamma(const cardan_real q[], const cardan_real dq[], cardan_real t, 
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void cardan_points(const cardan_real p[], cardan_real out[]);
 
-/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
- * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y, z) triples in
+ * the order listed above (r[3*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
  * cardan_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
 void cardan_point_kinematics(const cardan_real q[], const cardan_real dq[],
                                    const cardan_real ddq[], const cardan_real p[],

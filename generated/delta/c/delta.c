@@ -3454,45 +3454,76 @@ void delta_gamma_shared(const delta_real q[], const delta_real dq[], delta_real 
 /* Where each named point's body is in q[]: the index of its x (-1: the ground). */
 static const int delta_point_body[DELTA_NPOINTS] = { 0, 0, 0, 7, 7, 7, 14, 14, 14, 21, 21, 21, 21, 21, 21, 21 };
 
+/* A(e) s for Euler parameters e (not assumed normalised: the quadratic form itself), so that
+ * its derivatives follow from the same routine: d(A s) = 2 B(e, de) s with
+ * B(a, b) s = (A(a + b) s - A(a - b) s) / 4, and d2(A s) = 2 A(de) s + 2 B(e, dde) s. */
+static void delta_rotate(const delta_real e[4], const delta_real s[3],
+                                delta_real out[3])
+{
+    const delta_real w = e[0] * e[0] - e[1] * e[1] - e[2] * e[2] - e[3] * e[3];
+    const delta_real d = 2 * (e[1] * s[0] + e[2] * s[1] + e[3] * s[2]);
+    out[0] = w * s[0] + d * e[1] + 2 * e[0] * (e[2] * s[2] - e[3] * s[1]);
+    out[1] = w * s[1] + d * e[2] + 2 * e[0] * (e[3] * s[0] - e[1] * s[2]);
+    out[2] = w * s[2] + d * e[3] + 2 * e[0] * (e[1] * s[1] - e[2] * s[0]);
+}
+
+/* 2 B(e, f) s = (A(e + f) s - A(e - f) s) / 2 */
+static void delta_rotate_rate(const delta_real e[4], const delta_real f[4],
+                                     const delta_real s[3], delta_real out[3])
+{
+    delta_real plus[4], minus[4], a[3], b[3];
+    int i;
+    for (i = 0; i < 4; ++i) {
+        plus[i] = e[i] + f[i];
+        minus[i] = e[i] - f[i];
+    }
+    delta_rotate(plus, s, a);
+    delta_rotate(minus, s, b);
+    for (i = 0; i < 3; ++i) {
+        out[i] = (a[i] - b[i]) / 2;
+    }
+}
+
 void delta_point_kinematics(const delta_real q[], const delta_real dq[],
                                    const delta_real ddq[], const delta_real p[],
                                    delta_real r[], delta_real dr[],
                                    delta_real ddr[])
 {
-    delta_real s[2 * DELTA_NPOINTS];
-    int k;
+    delta_real s[3 * DELTA_NPOINTS];
+    int k, i;
     delta_points(p, s);
     for (k = 0; k < DELTA_NPOINTS; ++k) {
         const int b = delta_point_body[k];
-        delta_real gx = s[2 * k], gy = s[2 * k + 1]; /* R s: global offset from the body's origin */
-        delta_real x = 0, y = 0, vx = 0, vy = 0, ax = 0, ay = 0, w = 0, a = 0;
-        if (b >= 0) {
-            const delta_real c = cos(q[b + 2]), n = sin(q[b + 2]);
-            const delta_real sx = gx;
-            gx = c * sx - n * gy;
-            gy = n * sx + c * gy;
-            x = q[b];
-            y = q[b + 1];
-            if (dq) {
-                vx = dq[b];
-                vy = dq[b + 1];
-                w = dq[b + 2];
+        const delta_real *local = s + 3 * k;
+        delta_real g[3], v[3], a[3], twice[3];
+        if (b < 0) { /* a point of the ground */
+            for (i = 0; i < 3; ++i) {
+                r[3 * k + i] = local[i];
+                if (dr && dq) {
+                    dr[3 * k + i] = 0;
+                }
+                if (ddr && dq && ddq) {
+                    ddr[3 * k + i] = 0;
+                }
             }
-            if (ddq) {
-                ax = ddq[b];
-                ay = ddq[b + 1];
-                a = ddq[b + 2];
+            continue;
+        }
+        delta_rotate(q + b + 3, local, g);
+        for (i = 0; i < 3; ++i) {
+            r[3 * k + i] = q[b + i] + g[i];
+        }
+        if (dr && dq) {
+            delta_rotate_rate(q + b + 3, dq + b + 3, local, v);
+            for (i = 0; i < 3; ++i) {
+                dr[3 * k + i] = dq[b + i] + v[i];
             }
         }
-        r[2 * k] = x + gx; /* (2.14) */
-        r[2 * k + 1] = y + gy;
-        if (dr && dq) { /* (2.15): + Omega R s phi_t */
-            dr[2 * k] = vx - w * gy;
-            dr[2 * k + 1] = vy + w * gx;
-        }
-        if (ddr && dq && ddq) { /* (2.16): + Omega R s phi_tt - R s phi_t^2 */
-            ddr[2 * k] = ax - a * gy - w * w * gx;
-            ddr[2 * k + 1] = ay + a * gx - w * w * gy;
+        if (ddr && dq && ddq) {
+            delta_rotate(dq + b + 3, local, twice);
+            delta_rotate_rate(q + b + 3, ddq + b + 3, local, a);
+            for (i = 0; i < 3; ++i) {
+                ddr[3 * k + i] = ddq[b + i] + 2 * twice[i] + a[i];
+            }
         }
     }
 }

@@ -121,8 +121,8 @@ void delta_gamma(const delta_real q[], const delta_real dq[], delta_real t, cons
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void delta_points(const delta_real p[], delta_real out[]);
 
-/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
- * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y, z) triples in
+ * the order listed above (r[3*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
  * delta_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
 void delta_point_kinematics(const delta_real q[], const delta_real dq[],
                                    const delta_real ddq[], const delta_real p[],

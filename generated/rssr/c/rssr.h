@@ -87,8 +87,8 @@ void rssr_gamma(const rssr_real q[], const rssr_real dq[], rssr_real t, const rs
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void rssr_points(const rssr_real p[], rssr_real out[]);
 
-/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
- * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y, z) triples in
+ * the order listed above (r[3*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
  * rssr_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
 void rssr_point_kinematics(const rssr_real q[], const rssr_real dq[],
                                    const rssr_real ddq[], const rssr_real p[],

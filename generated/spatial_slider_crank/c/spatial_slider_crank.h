@@ -102,8 +102,8 @@ void spatial_slider_crank_gamma(const spatial_slider_crank_real q[], const spati
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void spatial_slider_crank_points(const spatial_slider_crank_real p[], spatial_slider_crank_real out[]);
 
-/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
- * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y, z) triples in
+ * the order listed above (r[3*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
  * spatial_slider_crank_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
 void spatial_slider_crank_point_kinematics(const spatial_slider_crank_real q[], const spatial_slider_crank_real dq[],
                                    const spatial_slider_crank_real ddq[], const spatial_slider_crank_real p[],

@@ -264,8 +264,8 @@ void stewart_legs_gamma(const stewart_legs_real q[], const stewart_legs_real dq[
 /* Local vectors of the named points, (x, y, z) triples in file order: out[3*NPOINTS]. */
 void stewart_legs_points(const stewart_legs_real p[], stewart_legs_real out[]);
 
-/* Global position r, velocity dr and acceleration ddr of every named point, (x, y) pairs in
- * the order listed above (r[2*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
+/* Global position r, velocity dr and acceleration ddr of every named point, (x, y, z) triples in
+ * the order listed above (r[3*NPOINTS]), from q, dq, ddq (2.14-2.16); p as for
  * stewart_legs_points. dr (ddr) is skipped when it or dq (or ddq) is NULL. */
 void stewart_legs_point_kinematics(const stewart_legs_real q[], const stewart_legs_real dq[],
                                    const stewart_legs_real ddq[], const stewart_legs_real p[],
