@@ -274,6 +274,10 @@ def _with_pair_outputs(trajectory: Any, args: argparse.Namespace) -> Any:
     is the file read and derived again (a warm run of other mechanisms stays free of it)."""
     if not args.output or trajectory.t.size == 0:
         return trajectory
+    # Only a pair with its own coordinate NAME.s (a curve or a cam) reports outputs: any other
+    # mechanism's warm run must not import the file's schema or SymPy.
+    if not any(name.endswith(".s") for name in trajectory.coordinates):
+        return trajectory
     from symkin import pairs
     from symkin.spec import validate
 

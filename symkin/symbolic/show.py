@@ -24,7 +24,7 @@ def text(system: System) -> str:
 
     width = max(len(str(row)) for row in system.rows)
     summary = (f"mechanism {system.name}: {len(system.q)} coordinates, {len(system.rows)} "
-               f"equations, {degrees_of_freedom(system.mechanism)} degree(s) of freedom")
+               f"equations, {_freedoms(system)} degree(s) of freedom")
     lines = [summary, *_removed_lines(system, show), "", "coordinates q:"]
     lines += [f"  q[{k}] = {name}" for k, name in enumerate(system.coordinates)]
     lines += ["", "parameters p:"]
@@ -77,7 +77,7 @@ def _latex_header(system: System, rename: dict[sp.Symbol, sp.Symbol]) -> list[st
     q = sp.latex(sp.Matrix(system.q).xreplace(rename).T)
     rows = "\n".join(rf"{r} & {_tex_text(str(row))} \\" for r, row in enumerate(system.rows))
     summary = (rf"Mechanism \texttt{{{_tex_text(system.name)}}}: {len(system.q)} coordinates, "
-               rf"{len(system.rows)} equations, {degrees_of_freedom(system.mechanism)} "
+               rf"{len(system.rows)} equations, {_freedoms(system)} "
                "degree(s) of freedom."
                + "".join(rf" Removed as redundant at $t_0$ (checked along the motion): "
                          rf"{_tex_text(str(r.row))}." for r in system.removed))
@@ -100,3 +100,11 @@ def _latex_name(coordinate: str) -> str:
     if part.startswith("e"):
         return f"{{{symbol}}}_{{\\mathrm{{{body.replace('_', '-')}}}}}"
     return f"{symbol}_{{\\mathrm{{{body.replace('_', '-')}}}}}"
+
+
+def _freedoms(system: System) -> int:
+    """The freedoms to report: an over-constrained file's by the rank of its joints' rows at t0
+    (its count can be negative: a Cardan shaft counts -2 and moves with 1), else the count."""
+    if system.mobility is not None:
+        return system.mobility
+    return degrees_of_freedom(system.mechanism)
