@@ -5,7 +5,7 @@ load and from_sources, each backend's build and loader)."""
 
 from __future__ import annotations
 
-from typing import TypedDict
+from typing import NotRequired, TypedDict
 
 MANIFEST_SUFFIX = "_manifest.json"
 
