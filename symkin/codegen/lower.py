@@ -11,7 +11,7 @@ user's name can never collide with a temporary (``w0``...) or reach the generate
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -19,6 +19,7 @@ import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
 from symkin.codegen import sample, symbol_printing
+from symkin.codegen.cse_tidy import _count_ops, _inline_trivial, _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.target import Target
@@ -427,41 +428,11 @@ def _select(name: str, parts: list[_Lowered], positions: dict[int, int], n_outpu
     return _assemble(name, selected or [_Lowered([], [], [])], n_outputs)
 
 
-def _ops_before_cse(expressions: dict[str, list[sp.Expr]], fused: dict[str, list[sp.Expr]],
-                    shared: list[sp.Expr]) -> dict[str, int]:
-    """SymPy's count_ops of every routine before CSE; the fused Phi and Phi_q is the sum of
-    its pieces (count_ops of a list is the sum over it), so it is not counted twice."""
-    counts = {name: _count_ops(exprs) for name, exprs in expressions.items()}
-    counts["phi_phi_q"] = counts["phi"] + counts["phi_q"] + _count_ops(shared)
-    counts.update({name: _count_ops(exprs) for name, exprs in fused.items()
-                   if name != "phi_phi_q"})
-    return counts
-
-
-def _inline_trivial(temporaries: list[tuple[sp.Symbol, sp.Expr]], exprs: list[sp.Expr]
-                    ) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
-    """Put back temporaries that only name a symbol or its negative (``w0 = -q[7]``)."""
-    kept: list[tuple[sp.Symbol, sp.Expr]] = []
-    trivial: dict[sp.Symbol, sp.Expr] = {}
-    for symbol, value in temporaries:
-        value = value.xreplace(trivial)
-        # (a relational temporary, e.g. from Max(t, 1 - t), has no negative)
-        if value.is_Atom or (isinstance(value, sp.Expr) and (-value).is_Atom):
-            trivial[symbol] = value
-        else:
-            kept.append((symbol, value))
-    return kept, [e.xreplace(trivial) for e in exprs]
-
-
 def _print(printer: Any, expr: sp.Expr) -> str:
     try:
         return str(printer.doprint(expr))
     except (TypeError, ValueError, NotImplementedError) as error:
         raise BuildError(f"cannot generate code for the expression {expr}: {error}") from None
-
-
-def _count_ops(exprs: Iterable[sp.Expr]) -> int:
-    return int(sum(sp.count_ops(e) for e in exprs))
 
 
 def comment(text: str) -> str:

@@ -17,7 +17,8 @@ from typing import Any
 from symkin import pairs
 from symkin.errors import MechanismError
 from symkin.pairs.fields import GROUND
-from symkin.spec.drawn import Q, _Context, _sub, layout_of
+from symkin.spec.drawn import layout_of
+from symkin.spec.drawn_quantities import Q, _Context, _sub
 
 SPACES = ("2d", "3d")
 Vector = tuple[Q, Q, Q]

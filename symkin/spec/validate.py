@@ -20,8 +20,11 @@ from symkin.limits import MAX_GRID_POINTS, grid_points
 from symkin.pairs.fields import GROUND, is_input
 from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, forces, loader
 from symkin.spec.messages import translate
+from symkin.spec.mobility import check_degrees_of_freedom
+from symkin.spec.mobility import degrees_of_freedom as degrees_of_freedom
+from symkin.spec.name_checks import _check_coordinate_name, _check_names
 from symkin.spec.names import name_problem
-from symkin.spec.schema import MechanismSpec, SpatialMechanismSpec, equation_count
+from symkin.spec.schema import MechanismSpec, SpatialMechanismSpec
 
 
 class Mechanism(MechanismSpec):
@@ -172,53 +175,6 @@ def _check_semantics(mech: Mechanism) -> None:
     _check_time(mech, symbols, nominal)
     _check_dynamics(mech, symbols, nominal)
     check_degrees_of_freedom(mech)
-
-
-def _check_names(mech: Mechanism) -> None:
-    """Every name by the rules of its kind (spec.names); all clashes reported at once."""
-    problem = name_problem(mech.name, "mechanism")
-    if problem:
-        raise MechanismError(problem, ("name",), "Use a plain identifier such as crank_slider; "
-                             "it becomes the C prefix and the file names.")
-    problems: list[tuple[tuple[str | int, ...], str]] = []
-    seen: dict[str, tuple[str | int, ...]] = {}
-    for section, kind in (("parameters", "parameter"), ("bodies", "body")):
-        for name in getattr(mech, section):
-            path = (section, name)
-            problem = name_problem(name, kind)
-            if problem is None and name in seen:
-                problem = f"{name!r} is already used at {format_path(seen[name])}"
-            if problem:
-                problems.append((path, problem))
-            seen.setdefault(name, path)
-    for body, spec in mech.bodies.items():
-        for point in spec.points:
-            problem = name_problem(point, "point")
-            if problem:
-                problems.append((("bodies", body, "points", point), problem))
-    if problems:
-        listed = problems[0][1] if len(problems) == 1 else f"{len(problems)} names cannot be " \
-            "used: " + "; ".join(f"{format_path(path)}: {problem}" for path, problem in problems)
-        raise MechanismError(listed, problems[0][0],
-                             "Rename them. Parameters and bodies may not be t, pi, E, a function "
-                             "name, True/False/None or a Python keyword, and must differ from "
-                             "each other; point, joint and driver names are free identifiers.")
-
-
-def _check_coordinate_name(mech: Mechanism, constraint: Any,
-                           path: tuple[str | int, ...]) -> None:
-    """A pair that adds a coordinate NAME.s needs a name that no body has."""
-    kind = pairs.of(constraint)
-    if kind.coordinate is None:
-        return
-    if constraint.name is None:
-        raise MechanismError(f"a {kind.name} pair needs a name", path + ("name",),
-                             f"It adds the coordinate NAME.s (solved and reported like the "
-                             f"bodies'); give it one, e.g. name: {kind.name[0]}1.")
-    if constraint.name in mech.bodies or constraint.name == GROUND:
-        raise MechanismError(f"the name {constraint.name!r} is a body's", path + ("name",),
-                             f"Its coordinate {constraint.name}.s would read as a coordinate "
-                             "of that body; use another name.")
 
 
 def _check_parameters(mech: Mechanism) -> dict[str, float]:
@@ -473,54 +429,3 @@ def _check_dynamics(mech: Mechanism, symbols: _Names,
             for k, item in (enumerate(raw) if isinstance(raw, list) else [(None, raw)]):
                 at: tuple[str | int, ...] = (key,) if k is None else (key, k)
                 _expression(item, moving, where + at, time=True, coordinates=True)
-
-
-def _freedoms_taken(joint: Any) -> int:
-    """How many freedoms a joint takes: its rows less the coordinates it adds (a point on a
-    curve writes 2 equations and adds s: it takes one freedom, as a pair of class 4)."""
-    return equation_count(joint) - len(pairs.of(joint).extra_coordinates(joint))
-
-
-def degrees_of_freedom(mech: Mechanism) -> int:
-    """Grübler's count w = 3n - 2 p5 - p4, less the equations of custom joints (in space:
-    w = 6n less the joints' equations)."""
-    per_body = 6 if mech.is_spatial else 3
-    return per_body * len(mech.bodies) - sum(_freedoms_taken(joint) for joint in mech.joints)
-
-
-def check_degrees_of_freedom(mech: Mechanism) -> None:
-    """Check that the drivers supply at least as many equations as there are DOF.
-
-    More equations than coordinates are not refused by the count: joints may repeat each
-    other (a parallelogram with an extra parallel bar), which only the rank of Phi_q at the
-    assembled t0 can judge (symkin.symbolic.redundancy, when the System is derived).
-    """
-    dof = degrees_of_freedom(mech)
-    driving = sum(equation_count(driver) for driver in mech.drivers)
-    if driving >= dof:
-        return
-    if mech.is_spatial:
-        _spatial_dof_error(mech, dof, driving)
-    # Pairs of class 5 take two freedoms (revolute, prismatic), of class 4 one (pin-in-slot,
-    # distance, gear, rack, point on a curve, cam); the equations the file writes itself are
-    # counted apart.
-    counted = [_freedoms_taken(joint) for joint in mech.joints
-               if pairs.of(joint).rows is not None]
-    p5, p4 = counted.count(2), counted.count(1)
-    formula = f"w = 3·{len(mech.bodies)} − 2·{p5} − {p4}"
-    custom = dof - (3 * len(mech.bodies) - 2 * p5 - p4)
-    if custom:
-        formula += f" − {-custom} (custom joint equations)"
-    fix = f"Add drivers for {dof - driving} more equation(s), or add joints."
-    raise MechanismError(f"the mechanism has {formula} = {dof} degree(s) of freedom but its "
-                         f"drivers give {driving} equation(s)", ("drivers",), fix)
-
-
-def _spatial_dof_error(mech: Mechanism, dof: int, driving: int) -> None:
-    joints = sum(equation_count(joint) for joint in mech.joints)
-    fix = (f"Add drivers for {dof - driving} more equation(s), or add joints."
-           if driving < dof else f"Remove {driving - dof} driving equation(s), or check for "
-           "a missing joint (a joint with equations that repeat others is not handled yet).")
-    raise MechanismError(f"the mechanism has w = 6·{len(mech.bodies)} − {joints} (joint "
-                         f"equations) = {dof} degree(s) of freedom but its drivers give "
-                         f"{driving} equation(s)", ("drivers",), fix)
