@@ -50,12 +50,9 @@ def available() -> bool:
 
 
 def _plotly() -> Any:
-    try:
-        import plotly.graph_objects as go
-    except ImportError:
-        raise UsageError("--html needs the plotly package, which draws the report: "
-                         "pip install 'symkin[html]' (or pip install plotly)") from None
-    return go
+    from symkin.present.view3d import graph_objects
+
+    return graph_objects()
 
 
 def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,

@@ -75,6 +75,16 @@ def _bounds(lines: dict[str, Array]) -> tuple[Array, Array]:
 # --- the HTML report --------------------------------------------------------------------------
 
 
+def graph_objects() -> Any:
+    """plotly's figure module, or a UsageError saying how to install it (both reports)."""
+    try:
+        import plotly.graph_objects as go
+    except ImportError:
+        raise UsageError("--html needs the plotly package, which draws the report: "
+                         "pip install 'symkin[html]' (or pip install plotly)") from None
+    return go
+
+
 def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNITS,
            title: str = "symkin") -> Path:
     """Write the self-contained 3D report: bodies moving under a time slider (play / pause).
@@ -88,23 +98,20 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
     path = Path(path)
     if path.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"cannot write a report to {path.name}: use a file ending in .html")
-    from symkin.present.html import _plotly
-
-    go = _plotly()
+    go = graph_objects()
     lines = _drawable(trajectory)
     frames = frame_indices(trajectory)
     figure = go.Figure()
     for body, points in lines.items():
         for k, (_, name) in enumerate(p for p in trajectory.points if p[0] == body):
             track = points[:, k, :]
-            if np.nanmax(np.ptp(track, axis=0)) > 1e-12 * max(1.0, float(np.nanmax(
-                    np.abs(track)))):
+            if _moves(track):
                 figure.add_trace(go.Scatter3d(
                     x=track[:, 0], y=track[:, 1], z=track[:, 2], mode="lines",
                     name=f"path {body}.{name}", legendgroup="paths", showlegend=False,
                     line={"dash": "dot", "width": 2, "color": "#777"}, hoverinfo="skip"))
     moving = []
-    for (body, points), colour in zip(lines.items(), series.palette(len(lines))):
+    for body, colour in zip(lines, series.palette(len(lines))):
         names = [f"{body}.{p}" for b, p in trajectory.points if b == body]
         figure.add_trace(go.Scatter3d(
             mode="lines+markers", name=body, text=names, hoverinfo="text+x+y+z",
@@ -124,6 +131,14 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
                       config={"displaylogo": False, "responsive": True},
                       div_id="symkin-report")
     return path
+
+
+def _moves(track: Array) -> bool:
+    """Whether a point's (T, 3) positions change (NaN rows of a partial run ignored)."""
+    solved = track[np.all(np.isfinite(track), axis=1)]
+    if solved.shape[0] < 2:
+        return False
+    return bool(np.ptp(solved, axis=0).max() > 1e-12 * max(1.0, float(np.abs(solved).max())))
 
 
 def _at(go: Any, points: Array) -> Any:
