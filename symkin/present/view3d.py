@@ -142,7 +142,14 @@ def _moves(track: Array) -> bool:
 
 
 def _at(go: Any, points: Array) -> Any:
-    return go.Scatter3d(x=points[:, 0], y=points[:, 1], z=points[:, 2])
+    ring = closed(points)
+    return go.Scatter3d(x=ring[:, 0], y=ring[:, 1], z=ring[:, 2])
+
+
+def closed(points: Array) -> Array:
+    """A body's (n, d) points as drawn: a closed polygon when it has more than two, so that a
+    plate (a Stewart platform's six attachments) reads as one body."""
+    return np.vstack([points, points[:1]]) if len(points) > 2 else points
 
 
 def _layout(figure: Any, trajectory: Trajectory, frames: Array, lines: dict[str, Array],
@@ -218,7 +225,7 @@ def animate(trajectory: Trajectory, path: str | Path, fps: int = 20,
         images = []
         for done, k in enumerate(frames, start=1):
             for body, line in drawn.items():
-                line.set_data(lines[body][k, :, 0], lines[body][k, :, 1])
+                line.set_data(*closed(lines[body][k]).T)
             ax.set_title(f"t = {trajectory.t[k]:.4g} (isometric view, z up)")
             figure.canvas.draw()
             rgb = Image.fromarray(np.asarray(figure.canvas.buffer_rgba())).convert("RGB")

@@ -183,3 +183,19 @@ def test_a_partial_run_draws_without_warnings(tmp_path: Path) -> None:
     _, _, layout = _figure(page)
     for axis in "xyz":
         assert all(np.isfinite(layout["scene"][f"{axis}axis"]["range"]))
+
+
+def test_a_body_with_more_than_two_points_is_a_closed_polygon(tmp_path: Path) -> None:
+    """The Stewart platform's six attachments: seven vertices per frame, the last the first."""
+    import symkin
+
+    spec = ROOT / "examples" / "stewart.yaml"
+    trajectory = symkin.solve(symkin.compile(symkin.derive(symkin.load(spec)), backend="numpy"))
+    r, _, _ = trajectory.point_arrays()
+    columns = [k for k, (body, _) in enumerate(trajectory.points) if body == "platform"]
+    assert len(columns) == 6
+    _, frames, _ = _figure(view3d.report(trajectory, tmp_path / "s.html"))
+    for k, frame in enumerate(frames):
+        drawn = np.stack([_numbers(frame["data"][0][axis]) for axis in "xyz"], axis=1)
+        np.testing.assert_array_equal(drawn[:6], r[k, columns])
+        np.testing.assert_array_equal(drawn[6], r[k, columns[0]])
