@@ -182,10 +182,6 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     prepared = index.prepare(args.mechanism, options,
                              outlines=args.animate is not None or args.html is not None)
     kernel = prepared.kernel
-    if getattr(kernel, "space", "2d") == "3d" and (args.animate or args.html):
-        return _error(f"{args.mechanism}: --animate and --html draw planar mechanisms only; "
-                      "for a spatial one use --plot (point coordinates against time) and -o "
-                      "(every coordinate, point, omega and alpha)", EXIT_BAD_INPUT)
     picture = run_outputs.Pictures.of(args, kernel)  # --select checked before any solving
     table, problem = _input_table(kernel, args)
     if problem:

@@ -140,6 +140,10 @@ def animate(trajectory: Trajectory, path: str | Path, outlines: Outlines, fps: i
         size: width and height in pixels.
         progress: called as progress(frames done, frames) while frames are drawn.
     """
+    if trajectory.spatial:  # no planar outlines: an isometric view of the points
+        from symkin.present import view3d
+
+        return view3d.animate(trajectory, path, fps, size, progress)
     if trajectory.t.size == 0:
         raise SymkinError("nothing to animate: no time point was solved")
     if not 1 <= fps <= 100:

@@ -50,12 +50,9 @@ def available() -> bool:
 
 
 def _plotly() -> Any:
-    try:
-        import plotly.graph_objects as go
-    except ImportError:
-        raise UsageError("--html needs the plotly package, which draws the report: "
-                         "pip install 'symkin[html]' (or pip install plotly)") from None
-    return go
+    from symkin.present.view3d import graph_objects
+
+    return graph_objects()
 
 
 def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
@@ -73,6 +70,10 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
         units: labels from the file's ``units`` key.
         title: the page's title, e.g. the mechanism's name.
     """
+    if trajectory.spatial:  # no planar outlines: the 3D view draws from the points alone
+        from symkin.present import view3d
+
+        return view3d.report(trajectory, path, units, title)
     path = Path(path)
     if path.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"cannot write a report to {path.name}: use a file ending in .html")

@@ -1,0 +1,268 @@
+"""Stage 7 for spatial mechanisms: the 3D report (plotly) and the projected GIF (matplotlib).
+
+A spatial run carries no outlines (those are planar local vectors), so the picture is read
+from the trajectory alone: each moving body is a line through its named points in file order,
+every named point is marked (the examples name a point at each joint), and the dotted path of
+every moving point stays in the view. The HTML report is a rotatable plotly scene with one
+frame per shown time and a slider; the GIF is an isometric projection of the same lines.
+
+Names in the figure come from a validated file and reach the browser as JSON data only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.errors import SymkinError, UsageError
+from symkin.present import series
+from symkin.present.series import DEFAULT_UNITS, Units
+from symkin.runtime.results import Trajectory
+
+Array = NDArray[np.float64]
+Progress = Callable[[int, int], None]
+
+MAX_FRAMES = 200
+DEFAULT_SIZE = (900, 600)  # pixels
+DPI = 100
+# Isometric view with z up: the x axis drawn down to the right, y down to the left.
+ISO_ANGLE = np.pi / 6
+
+
+def body_lines(trajectory: Trajectory) -> dict[str, Array]:
+    """Per body with named points, the global positions of its points, shape (T, n, 3)."""
+    r, _, _ = trajectory.point_arrays()
+    lines: dict[str, list[int]] = {}
+    for k, (body, _) in enumerate(trajectory.points):
+        lines.setdefault(body, []).append(k)
+    return {body: r[:, columns, :] for body, columns in lines.items()}
+
+
+def frame_indices(trajectory: Trajectory) -> Array:
+    """The time indices drawn: at most MAX_FRAMES, evenly spaced, first and last included."""
+    return np.unique(np.linspace(0, trajectory.t.size - 1, MAX_FRAMES).astype(int))
+
+
+def isometric(points: Array) -> Array:
+    """(..., 3) points as (..., 2) picture coordinates of the isometric projection."""
+    x, y, z = points[..., 0], points[..., 1], points[..., 2]
+    across = (x - y) * np.cos(ISO_ANGLE)
+    up = z - (x + y) * np.sin(ISO_ANGLE)
+    return np.stack([across, up], axis=-1)
+
+
+def _drawable(trajectory: Trajectory) -> dict[str, Array]:
+    if trajectory.t.size == 0:
+        raise UsageError("nothing to draw: no time point was solved")
+    lines = body_lines(trajectory)
+    if not lines:
+        raise UsageError("nothing to draw: the mechanism names no point on a moving body "
+                         "(add points to its bodies to see them in the 3D view)")
+    return lines
+
+
+def _bounds(lines: dict[str, Array]) -> tuple[Array, Array]:
+    """Low and high corners of everything drawn (NaN rows of a partial run ignored)."""
+    every = np.concatenate([a.reshape(-1, 3) for a in lines.values()] + [np.zeros((1, 3))])
+    every = every[np.all(np.isfinite(every), axis=1)]
+    return every.min(axis=0), every.max(axis=0)
+
+
+# --- the HTML report --------------------------------------------------------------------------
+
+
+def graph_objects() -> Any:
+    """plotly's figure module, or a UsageError saying how to install it (both reports)."""
+    try:
+        import plotly.graph_objects as go
+    except ImportError:
+        raise UsageError("--html needs the plotly package, which draws the report: "
+                         "pip install 'symkin[html]' (or pip install plotly)") from None
+    return go
+
+
+def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNITS,
+           title: str = "symkin") -> Path:
+    """Write the self-contained 3D report: bodies moving under a time slider (play / pause).
+
+    Args:
+        trajectory: the solved spatial run (a partial one works too).
+        path: the .html file to write.
+        units: labels from the file's ``units`` key.
+        title: the page's title, e.g. the mechanism's name.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in (".html", ".htm"):
+        raise UsageError(f"cannot write a report to {path.name}: use a file ending in .html")
+    go = graph_objects()
+    lines = _drawable(trajectory)
+    frames = frame_indices(trajectory)
+    figure = go.Figure()
+    for body, points in lines.items():
+        for k, (_, name) in enumerate(p for p in trajectory.points if p[0] == body):
+            track = points[:, k, :]
+            if _moves(track):
+                figure.add_trace(go.Scatter3d(
+                    x=track[:, 0], y=track[:, 1], z=track[:, 2], mode="lines",
+                    name=f"path {body}.{name}", legendgroup="paths", showlegend=False,
+                    line={"dash": "dot", "width": 2, "color": "#777"}, hoverinfo="skip"))
+    moving = []
+    for body, colour in zip(lines, series.palette(len(lines))):
+        names = [f"{body}.{p}" for b, p in trajectory.points if b == body]
+        figure.add_trace(go.Scatter3d(
+            mode="lines+markers", name=body, text=names, hoverinfo="text+x+y+z",
+            line={"width": 8, "color": colour},
+            marker={"size": 5, "color": "black", "symbol": "circle"}))
+        moving.append(len(figure.data) - 1)
+    built = [go.Frame(name=f"{float(trajectory.t[k]):.6g}", traces=moving,
+                      data=[_at(go, points[k]) for points in lines.values()])
+             for k in frames]
+    figure.frames = built
+    for index, trace in zip(moving, built[0].data):
+        figure.data[index].x, figure.data[index].y, figure.data[index].z = \
+            trace.x, trace.y, trace.z
+    _layout(figure, trajectory, frames, lines, units, title)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
+                      config={"displaylogo": False, "responsive": True},
+                      div_id="symkin-report")
+    return path
+
+
+def _moves(track: Array) -> bool:
+    """Whether a point's (T, 3) positions change (NaN rows of a partial run ignored)."""
+    solved = track[np.all(np.isfinite(track), axis=1)]
+    if solved.shape[0] < 2:
+        return False
+    return bool(np.ptp(solved, axis=0).max() > 1e-12 * max(1.0, float(np.abs(solved).max())))
+
+
+def _at(go: Any, points: Array) -> Any:
+    ring = closed(points)
+    return go.Scatter3d(x=ring[:, 0], y=ring[:, 1], z=ring[:, 2])
+
+
+def closed(points: Array) -> Array:
+    """A body's (n, d) points as drawn: a closed polygon when it has more than two, so that a
+    plate (a Stewart platform's six attachments) reads as one body."""
+    return np.vstack([points, points[:1]]) if len(points) > 2 else points
+
+
+def _layout(figure: Any, trajectory: Trajectory, frames: Array, lines: dict[str, Array],
+            units: Units, title: str) -> None:
+    low, high = _bounds(lines)
+    # One cube around the mechanism, so that lengths look the same along every axis.
+    centre, half = (low + high) / 2, 0.55 * max(float(np.max(high - low)), 1e-9)
+    unit = f" [{units.length}]" if units.length else ""
+    axes = {f"{axis}axis": {"range": [centre[k] - half, centre[k] + half],
+                            "title": {"text": f"{axis}{unit}"}}
+            for k, axis in enumerate("xyz")}
+    # 3D frames need a redraw (a scene cannot be updated in place the way a 2D plot can).
+    step = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
+            "transition": {"duration": 0}}
+    steps = [{"method": "animate", "label": f"{float(trajectory.t[k]):.4g}",
+              "args": [[f"{float(trajectory.t[k]):.6g}"], step]} for k in frames]
+    play = {"frame": {"duration": 50, "redraw": True}, "fromcurrent": True,
+            "transition": {"duration": 0}}
+    figure.update_layout(
+        title={"text": f"{title}: {trajectory.t.size} time points, t = "
+                       f"{trajectory.t[0]:.4g} to {trajectory.t[-1]:.4g} "
+                       "(drag to turn the view)"},
+        height=760, template="plotly_white",
+        scene={**axes, "aspectmode": "cube",
+               "camera": {"up": {"x": 0, "y": 0, "z": 1},
+                          "eye": {"x": 1.5, "y": -1.5, "z": 1.0}}},
+        legend={"x": 1.0, "y": 1.0, "xanchor": "left", "yanchor": "top"},
+        margin={"t": 60, "b": 110},
+        sliders=[{"active": 0, "steps": steps, "y": 0.0, "x": 0.08, "len": 0.9,
+                  "font": {"color": "rgba(0,0,0,0)"}, "ticklen": 0, "minorticklen": 0,
+                  "currentvalue": {"prefix": f"{units.time_label()} = ",
+                                   "font": {"color": "#222"}},
+                  "pad": {"t": 40}}],
+        updatemenus=[{"type": "buttons", "direction": "left", "x": 0.0, "y": 0.0,
+                      "xanchor": "left", "yanchor": "top", "pad": {"t": 40, "r": 10},
+                      "buttons": [
+                          {"label": "▶", "method": "animate", "args": [None, play]},
+                          {"label": "❚❚", "method": "animate",
+                           "args": [[None], {"mode": "immediate",
+                                             "frame": {"duration": 0, "redraw": False}}]}]}])
+
+
+# --- the GIF ---------------------------------------------------------------------------------
+
+
+def animate(trajectory: Trajectory, path: str | Path, fps: int = 20,
+            size: tuple[int, int] = DEFAULT_SIZE, progress: Progress | None = None) -> Path:
+    """Write a GIF of the spatial mechanism moving, in isometric projection (z up).
+
+    Args:
+        trajectory: the solved spatial run.
+        path: the .gif to write.
+        fps: frames per second; at most MAX_FRAMES frames are drawn, evenly spaced.
+        size: width and height in pixels.
+        progress: called as progress(frames done, frames) while frames are drawn.
+    """
+    if trajectory.t.size == 0:
+        raise SymkinError("nothing to animate: no time point was solved")
+    if not 1 <= fps <= 100:
+        raise UsageError(f"--fps {fps}: give 1 to 100 frames per second")
+    from PIL import Image
+
+    from symkin.present.plots import _pyplot
+
+    lines = {body: isometric(points) for body, points in _drawable(trajectory).items()}
+    plt = _pyplot()
+    figure, ax = plt.subplots(figsize=(size[0] / DPI, size[1] / DPI), dpi=DPI,
+                              layout="constrained")
+    try:
+        drawn = _projected_scene(ax, trajectory, lines)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small")
+        frames = frame_indices(trajectory)
+        images = []
+        for done, k in enumerate(frames, start=1):
+            for body, line in drawn.items():
+                line.set_data(*closed(lines[body][k]).T)
+            ax.set_title(f"t = {trajectory.t[k]:.4g} (isometric view, z up)")
+            figure.canvas.draw()
+            rgb = Image.fromarray(np.asarray(figure.canvas.buffer_rgba())).convert("RGB")
+            images.append(rgb.quantize(method=Image.Quantize.FASTOCTREE,
+                                       dither=Image.Dither.NONE))
+            if progress is not None:
+                progress(done, frames.size)
+    finally:
+        plt.close(figure)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000 / fps),
+                   loop=0)
+    return path
+
+
+def _projected_scene(ax: Any, trajectory: Trajectory, lines: dict[str, Array]) -> dict[str, Any]:
+    """Axes, projected coordinate axes, point paths; returns the line of each body."""
+    every = np.concatenate([a.reshape(-1, 2) for a in lines.values()] + [np.zeros((1, 2))])
+    every = every[np.all(np.isfinite(every), axis=1)]
+    low, high = every.min(axis=0), every.max(axis=0)
+    span = max(float(np.max(high - low)), 1e-9)
+    margin = 0.12 * span
+    ax.set_xlim(low[0] - margin, high[0] + margin)
+    ax.set_ylim(low[1] - margin, high[1] + margin)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    # The global axes at the origin, a fifth of the picture long, so the view can be read.
+    for k, label in enumerate("xyz"):
+        tip = isometric(np.eye(3)[k] * 0.2 * span)
+        ax.annotate("", xy=tuple(tip), xytext=(0.0, 0.0),
+                    arrowprops={"arrowstyle": "->", "color": "0.5"})
+        ax.text(*(1.12 * tip), label, color="0.4", ha="center", va="center")
+    for points in lines.values():
+        for k in range(points.shape[1]):
+            ax.plot(points[:, k, 0], points[:, k, 1], ":", linewidth=0.8, color="0.5")
+    return {body: ax.plot([], [], "o-", linewidth=3, markersize=5, color=colour,
+                          markerfacecolor="black", label=body)[0]
+            for body, colour in zip(lines, series.palette(len(lines)))}
