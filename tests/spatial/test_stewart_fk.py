@@ -3,11 +3,11 @@
 bodies): the generated C ``solve_inputs`` (through symkin.solve with a C kernel) and the
 NumPy backend recover the prescribed poses from the leg lengths.
 
-The reference is independent of symkin: poses written in closed form (roll, pitch, yaw as in
-bench/stewart/stewart.h), their leg lengths |r + R P_i - B_i| by NumPy, their rates and
-accelerations by complex-step-free central differences of that closed form in t are not
-needed: the pose itself is compared (position, and the rotation matrix A(e) from the solved
-Euler parameters against R), and the solved rates against differences of the solved poses.
+The reference is independent of symkin: the benchmark's poses (stewart_trajectory of
+bench/stewart/stewart.c, roll, pitch, yaw as in stewart.h) and their leg lengths
+|r + R P_i - B_i| by NumPy; the solved pose is compared with the prescribed one (position, and
+the rotation matrix A(e) of the solved Euler parameters against R), and the solved rates and
+accelerations with central differences of the solved positions.
 """
 
 from __future__ import annotations
