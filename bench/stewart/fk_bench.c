@@ -20,6 +20,11 @@
 #include <time.h>
 
 #include "linuxcnc_style_fk.h"
+#ifdef FK_EXTRA_SOLVERS
+/* Solvers compiled in by another script (symkin_fk.py): the header declares them and
+ * defines FK_EXTRA_SOLVERS_TABLE, lines of the solvers table below. */
+#include "extra_solvers.h"
+#endif
 
 typedef struct {
     const char *name;
@@ -92,6 +97,9 @@ int main(int argc, char **argv)
     const int n = argc > 1 ? atoi(argv[1]) : 10000, repeats = argc > 2 ? atoi(argv[2]) : 5;
     fk_solver solvers[] = {
         {"linuxcnc_style", linuxcnc_style_fk, &geometry},
+#ifdef FK_EXTRA_SOLVERS
+        FK_EXTRA_SOLVERS_TABLE
+#endif
     };
     size_t s, t;
     if (n < 1 || repeats < 1) {
