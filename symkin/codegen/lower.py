@@ -165,6 +165,9 @@ class Code:
     """The inputs' values that the file's q0 satisfies (System.input_values)."""
     input_places: tuple[str, ...] = ()
     """Where each input is in the file (System.input_places)."""
+    nonlinear: tuple[int, ...] = ()
+    """The coordinates that enter Phi_q or Phi_t (angles, Euler parameters, the positions of
+    a prismatic pair's bodies): only their errors move Phi_q (runtime.accuracy)."""
 
     @property
     def nnz(self) -> int:
@@ -246,8 +249,14 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         driver_names=system.dynamics.driver_names if system.dynamics else (),
         joint_names=system.dynamics.joint_names if system.dynamics else (),
         input_names=system.input_names, input_values=system.input_values,
-        input_places=system.input_places,
+        input_places=system.input_places, nonlinear=nonlinear_coordinates(system),
     )
+
+
+def nonlinear_coordinates(system: System) -> tuple[int, ...]:
+    """The indices of the coordinates Phi_q or Phi_t depends on."""
+    entered = system.phi_q.free_symbols | system.phi_t.free_symbols
+    return tuple(k for k, symbol in enumerate(system.q) if symbol in entered)
 
 
 def _check_options(backend: Target, real: str, linalg: str) -> None:

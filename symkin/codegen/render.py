@@ -218,7 +218,7 @@ def metadata(code: Code) -> Metadata:
         "pattern_cols": list(code.pattern_cols), "points": [list(p) for p in code.points],
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
-        "nshared": len(code.shared),
+        "nshared": len(code.shared), "nonlinear": list(code.nonlinear),
     }
     if code.removed:  # only then: every other manifest stays as it was
         data["removed"] = list(code.removed)
@@ -244,6 +244,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "nshared": len(code.shared),
         "real": code.real, "cse": code.cse, "spec_sha256": code.spec_sha256,
         "pattern_rows": list(code.pattern_rows), "pattern_cols": list(code.pattern_cols),
+        "nonlinear_mask": [int(k in code.nonlinear) for k in range(code.nq)],
         "nnz_p": code.nnz_p,
         "phi_p_rows": list(code.phi_p_rows), "phi_p_cols": list(code.phi_p_cols),
         "ops": sorted(code.ops.items()),

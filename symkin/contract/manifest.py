@@ -45,6 +45,9 @@ class Metadata(_Dynamics):
     nnz: int
     npoints: int
     nshared: int
+    nonlinear: NotRequired[list[int]]
+    """The coordinates that enter Phi_q or Phi_t (the error model's; absent from kernels
+    generated before it: every coordinate then counts)."""
     removed: NotRequired[list[str]]
     """The rows removed as dependent at t0 (only in the manifest of a file that has some)."""
     space: NotRequired[str]

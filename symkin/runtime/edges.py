@@ -141,11 +141,20 @@ def _through(kernel: KinematicsKernel, p: Array, options: Options, before: State
     """The flagged point at t between the two sides of a singular configuration."""
     q, dq, ddq = hermite(before, after, t)
     jacobian = kernel.phi_q(q, t, p)
-    # Minimum norm, the nearly singular directions cut off: it moves nothing along them.
-    correction = np.linalg.lstsq(jacobian, -kernel.phi(q, t, p), rcond=1e-6)[0]
-    q = q + correction
+    q = q + _minimum_norm_correction(jacobian, kernel.phi(q, t, p))
     cond = float(np.linalg.cond(jacobian, 1)) if np.all(np.isfinite(jacobian)) else math.inf
     return Point(q, dq, ddq, cond, True)
+
+
+def _minimum_norm_correction(jacobian: Array, phi: Array) -> Array:
+    """The minimum-norm step against phi, the nearly singular directions cut off: it moves
+    nothing along them. LAPACK's least-squares driver may fail to converge at an exactly
+    singular Phi_q (the chain of parallelograms on a grid point at its change point) where
+    the SVD converges; where both fail, no step (the point is flagged anyway)."""
+    try:
+        return np.asarray(np.linalg.pinv(jacobian, rcond=1e-6) @ -phi)
+    except np.linalg.LinAlgError:
+        return np.zeros_like(phi)
 
 
 def resolve(kernel: KinematicsKernel, p: Array, options: Options, previous: State,

@@ -71,6 +71,10 @@ class Kernel:
         self.rows: tuple[str, ...] = tuple(meta["rows"])
         self.pattern_rows = np.array(meta["pattern_rows"], dtype=np.intp)
         self.pattern_cols = np.array(meta["pattern_cols"], dtype=np.intp)
+        # The coordinates that enter Phi_q or Phi_t (runtime.accuracy's refined model); every
+        # coordinate for a kernel generated before it.
+        self.nonlinear = np.zeros(len(self.coordinates), dtype=bool)
+        self.nonlinear[list(meta.get("nonlinear", range(len(self.coordinates))))] = True
         self.points: tuple[tuple[str, str], ...] = tuple(tuple(p) for p in meta["points"])
         # "3d" for a spatial mechanism: 7 coordinates per body, points of 3 components.
         self.space: str = meta.get("space", "2d")

@@ -163,7 +163,10 @@ def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
     if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(ddq))):
         return None
     unit = UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
-    flag = accuracy.flagged(result.inv_norm, result.norm_a, result.residual, q, dq, ddq,
-                            options, unit, result.correction)
+    flag = accuracy.flagged(
+        result.inv_norm, result.norm_a, result.residual, q, dq, ddq, options, unit,
+        result.correction, nonlinear=getattr(kernel, "nonlinear", None),
+        rows_inverse_norm=lambda rows: accuracy.inverse_norm1(
+            factors.solve, factors.solve_transposed, q.size, rows))
     return Point(q, dq, ddq, result.cond, flag)
 

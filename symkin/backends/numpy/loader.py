@@ -54,6 +54,8 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         **({"driver_names": module.DRIVER_NAMES, "joint_names": module.JOINT_NAMES}
            if hasattr(module, "JOINT_NAMES") else {}),
         "input_names": getattr(module, "INPUT_NAMES", ()),
+        **({"nonlinear": [k for k, entered in enumerate(module.NONLINEAR) if entered]}
+           if hasattr(module, "NONLINEAR") else {}),
     }
     return Kernel(backend, meta, _ModuleFunctions(module), folder=folder)
 
