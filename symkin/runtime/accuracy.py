@@ -14,6 +14,16 @@ coordinate's error sees only its share):
     e_ddq = s (u |ddq| + e_q (|ddq| + |dq|^2) + 2 e_dq max(1, |dq|))
 each times SAFETY; a point is flagged when one of them exceeds its target times max(1, |x|).
 SAFETY, u and the estimator's steps are symkin.contract.tuning's, which the C solver shares.
+Only the coordinates that enter Phi_q or Phi_t (kernel.nonlinear: angles, Euler parameters,
+a prismatic pair's positions) move Phi_q and Phi_t. Where the model above flags a point, a
+refined one decides: with s_n = ||P Phi_q^-1||_1 / sqrt(N), P the rows of those coordinates,
+and their max norms ndq_n, nddq_n,
+    e_n   = max(min(c, s_n r), s_n u (1 + |q|))       their error
+    e_dq  = s (u |dq| + e_n max(1, ndq_n))
+    e_dqn = s_n (u |dq| + e_n max(1, ndq_n))          their velocities' error
+    e_ddq = s (u |ddq| + e_n (nddq_n + ndq_n^2) + 2 e_dqn max(1, ndq_n))
+(e_q as above). On lazy tongs the positions of the far bars are a hundred times more
+sensitive than the angles, which alone move Phi_q.
 c is the error of q the residual r leaves: max |Phi_q^-1 Phi|, the size of the Newton
 correction, where it was solved for (runtime.newton does so before it iterates on to avoid a
 flag), else the bound s r. The correction is the actual error where the bound is the worst

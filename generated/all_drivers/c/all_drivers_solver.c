@@ -98,8 +98,9 @@ static const all_drivers_real all_drivers_alternating[ALL_DRIVERS_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
+static all_drivers_real all_drivers_inverse_norm1_rows(const all_drivers_lu *lu, const all_drivers_real rows[])
 {
     all_drivers_real y[ALL_DRIVERS_NQ], z[ALL_DRIVERS_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -107,7 +108,7 @@ static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, all_drivers_alternating, sizeof z);
     all_drivers_lu_solve(lu, z);
-    for (i = 0; i < ALL_DRIVERS_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < ALL_DRIVERS_ESTIMATOR_STEPS; ++step) {
         all_drivers_real dot, best, finite = 0;
         int jmax = 0;
@@ -120,9 +121,11 @@ static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
         all_drivers_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (all_drivers_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -151,6 +154,11 @@ static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
     extra = 2 * extra / (3 * ALL_DRIVERS_NQ);
     if (extra - extra != 0) return (all_drivers_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static all_drivers_real all_drivers_inverse_norm1(const all_drivers_lu *lu)
+{
+    return all_drivers_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -482,6 +490,54 @@ static int all_drivers_flagged(const all_drivers_options *options,
         || ALL_DRIVERS_SAFETY * e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const all_drivers_real all_drivers_nonlinear[ALL_DRIVERS_NQ] = { 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static all_drivers_real all_drivers_nonlinear_max(const all_drivers_real v[])
+{
+    all_drivers_real largest = 0;
+    int i;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+        const all_drivers_real a = all_drivers_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int all_drivers_flagged_refined(const all_drivers_options *options,
+                                        const all_drivers_workspace *work,
+                                        const all_drivers_report *report, all_drivers_real nq,
+                                        all_drivers_real ndq, all_drivers_real nddq, const all_drivers_real dq[],
+                                        const all_drivers_real ddq[])
+{
+    const all_drivers_real u = ALL_DRIVERS_UNIT_ROUNDOFF;
+    const all_drivers_real root = sqrt((all_drivers_real)ALL_DRIVERS_NQ);
+    const all_drivers_real s = report->inv_norm / root;
+    const all_drivers_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    all_drivers_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!all_drivers_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = all_drivers_inverse_norm1_rows(&work->lu, all_drivers_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? all_drivers_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? all_drivers_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * all_drivers_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * all_drivers_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * all_drivers_at_least_1(ndq_n));
+    return ALL_DRIVERS_SAFETY * e_q > options->target_q * all_drivers_at_least_1(nq)
+        || ALL_DRIVERS_SAFETY * e_dq > options->target_dq * all_drivers_at_least_1(ndq)
+        || ALL_DRIVERS_SAFETY * e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int all_drivers_would_flag(const all_drivers_options *options,
@@ -638,8 +694,9 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
         report->status = ALL_DRIVERS_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = all_drivers_flagged(options, work, report,
-                                           sum_q != sum_q ? (all_drivers_real)NAN : nq, ndq, nddq);
+    report->flagged = all_drivers_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (all_drivers_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

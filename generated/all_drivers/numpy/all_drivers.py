@@ -69,6 +69,8 @@ PATTERN_ROWS = numpy.array([0, 1, 2, 2, 2, 3, 3, 3, 4, 4, 5, 5, 5, 5, 5, 6, 6, 7
     9, 9, 10, 10, 10, 10, 10, 11, 11, 12, 12, 13, 13, 14], dtype=numpy.intp)
 PATTERN_COLS = numpy.array([0, 1, 0, 2, 3, 1, 2, 4, 5, 8, 3, 4, 5, 6, 7, 3, 5, 4, 5, 3, 4, 6, 7, 8, 6, 7, 8,
     9, 10, 6, 7, 8, 9, 10, 8, 11, 9, 12, 10, 13, 14], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0], dtype=bool)
 POINTS = (
     ('arm1', 'elbow'),
     ('arm2', 'tip'),

@@ -110,8 +110,9 @@ static const andrews_squeezer_real andrews_squeezer_alternating[ANDREWS_SQUEEZER
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeezer_lu *lu)
+static andrews_squeezer_real andrews_squeezer_inverse_norm1_rows(const andrews_squeezer_lu *lu, const andrews_squeezer_real rows[])
 {
     andrews_squeezer_real y[ANDREWS_SQUEEZER_NQ], z[ANDREWS_SQUEEZER_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -119,7 +120,7 @@ static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeez
      * processor can overlap the two chains of dependent operations */
     memcpy(z, andrews_squeezer_alternating, sizeof z);
     andrews_squeezer_lu_solve(lu, z);
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < ANDREWS_SQUEEZER_ESTIMATOR_STEPS; ++step) {
         andrews_squeezer_real dot, best, finite = 0;
         int jmax = 0;
@@ -132,9 +133,11 @@ static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeez
         andrews_squeezer_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (andrews_squeezer_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -163,6 +166,11 @@ static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeez
     extra = 2 * extra / (3 * ANDREWS_SQUEEZER_NQ);
     if (extra - extra != 0) return (andrews_squeezer_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static andrews_squeezer_real andrews_squeezer_inverse_norm1(const andrews_squeezer_lu *lu)
+{
+    return andrews_squeezer_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -488,6 +496,54 @@ static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
         || ANDREWS_SQUEEZER_SAFETY * e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const andrews_squeezer_real andrews_squeezer_nonlinear[ANDREWS_SQUEEZER_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static andrews_squeezer_real andrews_squeezer_nonlinear_max(const andrews_squeezer_real v[])
+{
+    andrews_squeezer_real largest = 0;
+    int i;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        const andrews_squeezer_real a = andrews_squeezer_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int andrews_squeezer_flagged_refined(const andrews_squeezer_options *options,
+                                        const andrews_squeezer_workspace *work,
+                                        const andrews_squeezer_report *report, andrews_squeezer_real nq,
+                                        andrews_squeezer_real ndq, andrews_squeezer_real nddq, const andrews_squeezer_real dq[],
+                                        const andrews_squeezer_real ddq[])
+{
+    const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
+    const andrews_squeezer_real root = sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
+    const andrews_squeezer_real s = report->inv_norm / root;
+    const andrews_squeezer_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    andrews_squeezer_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!andrews_squeezer_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = andrews_squeezer_inverse_norm1_rows(&work->lu, andrews_squeezer_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? andrews_squeezer_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? andrews_squeezer_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * andrews_squeezer_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * andrews_squeezer_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * andrews_squeezer_at_least_1(ndq_n));
+    return ANDREWS_SQUEEZER_SAFETY * e_q > options->target_q * andrews_squeezer_at_least_1(nq)
+        || ANDREWS_SQUEEZER_SAFETY * e_dq > options->target_dq * andrews_squeezer_at_least_1(ndq)
+        || ANDREWS_SQUEEZER_SAFETY * e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int andrews_squeezer_would_flag(const andrews_squeezer_options *options,
@@ -644,8 +700,9 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
         report->status = ANDREWS_SQUEEZER_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = andrews_squeezer_flagged(options, work, report,
-                                           sum_q != sum_q ? (andrews_squeezer_real)NAN : nq, ndq, nddq);
+    report->flagged = andrews_squeezer_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (andrews_squeezer_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -91,6 +91,8 @@ PATTERN_ROWS = numpy.array([0, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 6, 6
 PATTERN_COLS = numpy.array([0, 1, 0, 2, 3, 1, 2, 4, 3, 5, 6, 8, 4, 5, 7, 8, 3, 5, 9, 4, 5, 10, 3, 5, 15, 4,
     5, 16, 6, 7, 9, 11, 12, 14, 10, 11, 13, 14, 12, 13, 15, 17, 18, 20, 16, 17, 19,
     20, 18, 19, 2], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1], dtype=bool)
 POINTS = (
     ('crank', 'O'),
     ('crank', 'F'),

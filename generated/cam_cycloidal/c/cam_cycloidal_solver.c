@@ -82,8 +82,9 @@ static const cam_cycloidal_real cam_cycloidal_alternating[CAM_CYCLOIDAL_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static cam_cycloidal_real cam_cycloidal_inverse_norm1(const cam_cycloidal_lu *lu)
+static cam_cycloidal_real cam_cycloidal_inverse_norm1_rows(const cam_cycloidal_lu *lu, const cam_cycloidal_real rows[])
 {
     cam_cycloidal_real y[CAM_CYCLOIDAL_NQ], z[CAM_CYCLOIDAL_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -91,7 +92,7 @@ static cam_cycloidal_real cam_cycloidal_inverse_norm1(const cam_cycloidal_lu *lu
      * processor can overlap the two chains of dependent operations */
     memcpy(z, cam_cycloidal_alternating, sizeof z);
     cam_cycloidal_lu_solve(lu, z);
-    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < CAM_CYCLOIDAL_ESTIMATOR_STEPS; ++step) {
         cam_cycloidal_real dot, best, finite = 0;
         int jmax = 0;
@@ -104,9 +105,11 @@ static cam_cycloidal_real cam_cycloidal_inverse_norm1(const cam_cycloidal_lu *lu
         cam_cycloidal_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (cam_cycloidal_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -135,6 +138,11 @@ static cam_cycloidal_real cam_cycloidal_inverse_norm1(const cam_cycloidal_lu *lu
     extra = 2 * extra / (3 * CAM_CYCLOIDAL_NQ);
     if (extra - extra != 0) return (cam_cycloidal_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static cam_cycloidal_real cam_cycloidal_inverse_norm1(const cam_cycloidal_lu *lu)
+{
+    return cam_cycloidal_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -255,6 +263,54 @@ static int cam_cycloidal_flagged(const cam_cycloidal_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * cam_cycloidal_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * cam_cycloidal_at_least_1(ndq));
+    return CAM_CYCLOIDAL_SAFETY * e_q > options->target_q * cam_cycloidal_at_least_1(nq)
+        || CAM_CYCLOIDAL_SAFETY * e_dq > options->target_dq * cam_cycloidal_at_least_1(ndq)
+        || CAM_CYCLOIDAL_SAFETY * e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const cam_cycloidal_real cam_cycloidal_nonlinear[CAM_CYCLOIDAL_NQ] = { 0, 0, 1, 0, 0, 0, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static cam_cycloidal_real cam_cycloidal_nonlinear_max(const cam_cycloidal_real v[])
+{
+    cam_cycloidal_real largest = 0;
+    int i;
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
+        const cam_cycloidal_real a = cam_cycloidal_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int cam_cycloidal_flagged_refined(const cam_cycloidal_options *options,
+                                        const cam_cycloidal_workspace *work,
+                                        const cam_cycloidal_report *report, cam_cycloidal_real nq,
+                                        cam_cycloidal_real ndq, cam_cycloidal_real nddq, const cam_cycloidal_real dq[],
+                                        const cam_cycloidal_real ddq[])
+{
+    const cam_cycloidal_real u = CAM_CYCLOIDAL_UNIT_ROUNDOFF;
+    const cam_cycloidal_real root = sqrt((cam_cycloidal_real)CAM_CYCLOIDAL_NQ);
+    const cam_cycloidal_real s = report->inv_norm / root;
+    const cam_cycloidal_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    cam_cycloidal_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!cam_cycloidal_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = cam_cycloidal_inverse_norm1_rows(&work->lu, cam_cycloidal_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? cam_cycloidal_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? cam_cycloidal_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * cam_cycloidal_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * cam_cycloidal_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * cam_cycloidal_at_least_1(ndq_n));
     return CAM_CYCLOIDAL_SAFETY * e_q > options->target_q * cam_cycloidal_at_least_1(nq)
         || CAM_CYCLOIDAL_SAFETY * e_dq > options->target_dq * cam_cycloidal_at_least_1(ndq)
         || CAM_CYCLOIDAL_SAFETY * e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq);
@@ -416,8 +472,9 @@ int cam_cycloidal_solve_step(const cam_cycloidal_options *options, const cam_cyc
         report->status = CAM_CYCLOIDAL_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = cam_cycloidal_flagged(options, work, report,
-                                           sum_q != sum_q ? (cam_cycloidal_real)NAN : nq, ndq, nddq);
+    report->flagged = cam_cycloidal_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (cam_cycloidal_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

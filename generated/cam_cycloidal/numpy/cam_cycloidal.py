@@ -49,6 +49,8 @@ ROWS = (
 )
 PATTERN_ROWS = numpy.array([0, 1, 2, 3, 4, 4, 4, 4, 5, 5, 5, 5, 6], dtype=numpy.intp)
 PATTERN_COLS = numpy.array([0, 1, 5, 4, 0, 2, 3, 6, 1, 2, 4, 6, 2], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 1, 0, 0, 0, 1], dtype=bool)
 POINTS = (
     ('follower', 'R'),
 )

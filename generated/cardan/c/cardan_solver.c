@@ -96,8 +96,9 @@ static const cardan_real cardan_alternating[CARDAN_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static cardan_real cardan_inverse_norm1(const cardan_lu *lu)
+static cardan_real cardan_inverse_norm1_rows(const cardan_lu *lu, const cardan_real rows[])
 {
     cardan_real y[CARDAN_NQ], z[CARDAN_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -105,7 +106,7 @@ static cardan_real cardan_inverse_norm1(const cardan_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, cardan_alternating, sizeof z);
     cardan_lu_solve(lu, z);
-    for (i = 0; i < CARDAN_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < CARDAN_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < CARDAN_ESTIMATOR_STEPS; ++step) {
         cardan_real dot, best, finite = 0;
         int jmax = 0;
@@ -118,9 +119,11 @@ static cardan_real cardan_inverse_norm1(const cardan_lu *lu)
         cardan_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < CARDAN_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (cardan_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -149,6 +152,11 @@ static cardan_real cardan_inverse_norm1(const cardan_lu *lu)
     extra = 2 * extra / (3 * CARDAN_NQ);
     if (extra - extra != 0) return (cardan_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static cardan_real cardan_inverse_norm1(const cardan_lu *lu)
+{
+    return cardan_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -249,6 +257,54 @@ static int cardan_flagged(const cardan_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * cardan_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * cardan_at_least_1(ndq));
+    return CARDAN_SAFETY * e_q > options->target_q * cardan_at_least_1(nq)
+        || CARDAN_SAFETY * e_dq > options->target_dq * cardan_at_least_1(ndq)
+        || CARDAN_SAFETY * e_ddq > options->target_ddq * cardan_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const cardan_real cardan_nonlinear[CARDAN_NQ] = { 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static cardan_real cardan_nonlinear_max(const cardan_real v[])
+{
+    cardan_real largest = 0;
+    int i;
+    for (i = 0; i < CARDAN_NQ; ++i) {
+        const cardan_real a = cardan_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int cardan_flagged_refined(const cardan_options *options,
+                                        const cardan_workspace *work,
+                                        const cardan_report *report, cardan_real nq,
+                                        cardan_real ndq, cardan_real nddq, const cardan_real dq[],
+                                        const cardan_real ddq[])
+{
+    const cardan_real u = CARDAN_UNIT_ROUNDOFF;
+    const cardan_real root = sqrt((cardan_real)CARDAN_NQ);
+    const cardan_real s = report->inv_norm / root;
+    const cardan_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    cardan_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!cardan_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = cardan_inverse_norm1_rows(&work->lu, cardan_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? cardan_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? cardan_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * cardan_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * cardan_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * cardan_at_least_1(ndq_n));
     return CARDAN_SAFETY * e_q > options->target_q * cardan_at_least_1(nq)
         || CARDAN_SAFETY * e_dq > options->target_dq * cardan_at_least_1(ndq)
         || CARDAN_SAFETY * e_ddq > options->target_ddq * cardan_at_least_1(nddq);
@@ -410,8 +466,9 @@ int cardan_solve_step(const cardan_options *options, const cardan_real p[], card
         report->status = CARDAN_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = cardan_flagged(options, work, report,
-                                           sum_q != sum_q ? (cardan_real)NAN : nq, ndq, nddq);
+    report->flagged = cardan_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (cardan_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -72,6 +72,8 @@ PATTERN_ROWS = numpy.array([0, 1, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 5, 5, 6
 PATTERN_COLS = numpy.array([0, 1, 2, 3, 4, 5, 6, 3, 4, 5, 6, 0, 3, 4, 5, 6, 7, 1, 3, 4, 5, 6, 8, 2, 3, 4, 5,
     6, 9, 3, 4, 5, 6, 10, 11, 12, 13, 7, 10, 11, 12, 13, 9, 10, 11, 12, 13, 3, 4, 5,
     6, 3, 4, 5, 6, 10, 11, 12, 13], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1], dtype=bool)
 POINTS = (
     ('shaft1', 'O1'),
     ('shaft1', 'C'),

@@ -86,8 +86,9 @@ static const crank_slider_drawn_real crank_slider_drawn_alternating[CRANK_SLIDER
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static crank_slider_drawn_real crank_slider_drawn_inverse_norm1(const crank_slider_drawn_lu *lu)
+static crank_slider_drawn_real crank_slider_drawn_inverse_norm1_rows(const crank_slider_drawn_lu *lu, const crank_slider_drawn_real rows[])
 {
     crank_slider_drawn_real y[CRANK_SLIDER_DRAWN_NQ], z[CRANK_SLIDER_DRAWN_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -95,7 +96,7 @@ static crank_slider_drawn_real crank_slider_drawn_inverse_norm1(const crank_slid
      * processor can overlap the two chains of dependent operations */
     memcpy(z, crank_slider_drawn_alternating, sizeof z);
     crank_slider_drawn_lu_solve(lu, z);
-    for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < CRANK_SLIDER_DRAWN_ESTIMATOR_STEPS; ++step) {
         crank_slider_drawn_real dot, best, finite = 0;
         int jmax = 0;
@@ -108,9 +109,11 @@ static crank_slider_drawn_real crank_slider_drawn_inverse_norm1(const crank_slid
         crank_slider_drawn_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (crank_slider_drawn_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -139,6 +142,11 @@ static crank_slider_drawn_real crank_slider_drawn_inverse_norm1(const crank_slid
     extra = 2 * extra / (3 * CRANK_SLIDER_DRAWN_NQ);
     if (extra - extra != 0) return (crank_slider_drawn_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static crank_slider_drawn_real crank_slider_drawn_inverse_norm1(const crank_slider_drawn_lu *lu)
+{
+    return crank_slider_drawn_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -262,6 +270,54 @@ static int crank_slider_drawn_flagged(const crank_slider_drawn_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * crank_slider_drawn_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * crank_slider_drawn_at_least_1(ndq));
+    return CRANK_SLIDER_DRAWN_SAFETY * e_q > options->target_q * crank_slider_drawn_at_least_1(nq)
+        || CRANK_SLIDER_DRAWN_SAFETY * e_dq > options->target_dq * crank_slider_drawn_at_least_1(ndq)
+        || CRANK_SLIDER_DRAWN_SAFETY * e_ddq > options->target_ddq * crank_slider_drawn_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const crank_slider_drawn_real crank_slider_drawn_nonlinear[CRANK_SLIDER_DRAWN_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 0 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static crank_slider_drawn_real crank_slider_drawn_nonlinear_max(const crank_slider_drawn_real v[])
+{
+    crank_slider_drawn_real largest = 0;
+    int i;
+    for (i = 0; i < CRANK_SLIDER_DRAWN_NQ; ++i) {
+        const crank_slider_drawn_real a = crank_slider_drawn_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int crank_slider_drawn_flagged_refined(const crank_slider_drawn_options *options,
+                                        const crank_slider_drawn_workspace *work,
+                                        const crank_slider_drawn_report *report, crank_slider_drawn_real nq,
+                                        crank_slider_drawn_real ndq, crank_slider_drawn_real nddq, const crank_slider_drawn_real dq[],
+                                        const crank_slider_drawn_real ddq[])
+{
+    const crank_slider_drawn_real u = CRANK_SLIDER_DRAWN_UNIT_ROUNDOFF;
+    const crank_slider_drawn_real root = sqrt((crank_slider_drawn_real)CRANK_SLIDER_DRAWN_NQ);
+    const crank_slider_drawn_real s = report->inv_norm / root;
+    const crank_slider_drawn_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    crank_slider_drawn_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!crank_slider_drawn_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = crank_slider_drawn_inverse_norm1_rows(&work->lu, crank_slider_drawn_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? crank_slider_drawn_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? crank_slider_drawn_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * crank_slider_drawn_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * crank_slider_drawn_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * crank_slider_drawn_at_least_1(ndq_n));
     return CRANK_SLIDER_DRAWN_SAFETY * e_q > options->target_q * crank_slider_drawn_at_least_1(nq)
         || CRANK_SLIDER_DRAWN_SAFETY * e_dq > options->target_dq * crank_slider_drawn_at_least_1(ndq)
         || CRANK_SLIDER_DRAWN_SAFETY * e_ddq > options->target_ddq * crank_slider_drawn_at_least_1(nddq);
@@ -423,8 +479,9 @@ int crank_slider_drawn_solve_step(const crank_slider_drawn_options *options, con
         report->status = CRANK_SLIDER_DRAWN_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = crank_slider_drawn_flagged(options, work, report,
-                                           sum_q != sum_q ? (crank_slider_drawn_real)NAN : nq, ndq, nddq);
+    report->flagged = crank_slider_drawn_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (crank_slider_drawn_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

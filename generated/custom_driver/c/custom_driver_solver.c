@@ -86,8 +86,9 @@ static const custom_driver_real custom_driver_alternating[CUSTOM_DRIVER_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu)
+static custom_driver_real custom_driver_inverse_norm1_rows(const custom_driver_lu *lu, const custom_driver_real rows[])
 {
     custom_driver_real y[CUSTOM_DRIVER_NQ], z[CUSTOM_DRIVER_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -95,7 +96,7 @@ static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu
      * processor can overlap the two chains of dependent operations */
     memcpy(z, custom_driver_alternating, sizeof z);
     custom_driver_lu_solve(lu, z);
-    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < CUSTOM_DRIVER_ESTIMATOR_STEPS; ++step) {
         custom_driver_real dot, best, finite = 0;
         int jmax = 0;
@@ -108,9 +109,11 @@ static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu
         custom_driver_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (custom_driver_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -139,6 +142,11 @@ static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu
     extra = 2 * extra / (3 * CUSTOM_DRIVER_NQ);
     if (extra - extra != 0) return (custom_driver_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static custom_driver_real custom_driver_inverse_norm1(const custom_driver_lu *lu)
+{
+    return custom_driver_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -285,6 +293,54 @@ static int custom_driver_flagged(const custom_driver_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * custom_driver_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * custom_driver_at_least_1(ndq));
+    return CUSTOM_DRIVER_SAFETY * e_q > options->target_q * custom_driver_at_least_1(nq)
+        || CUSTOM_DRIVER_SAFETY * e_dq > options->target_dq * custom_driver_at_least_1(ndq)
+        || CUSTOM_DRIVER_SAFETY * e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const custom_driver_real custom_driver_nonlinear[CUSTOM_DRIVER_NQ] = { 1, 1, 1, 0, 0, 1, 0, 0, 0 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static custom_driver_real custom_driver_nonlinear_max(const custom_driver_real v[])
+{
+    custom_driver_real largest = 0;
+    int i;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+        const custom_driver_real a = custom_driver_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int custom_driver_flagged_refined(const custom_driver_options *options,
+                                        const custom_driver_workspace *work,
+                                        const custom_driver_report *report, custom_driver_real nq,
+                                        custom_driver_real ndq, custom_driver_real nddq, const custom_driver_real dq[],
+                                        const custom_driver_real ddq[])
+{
+    const custom_driver_real u = CUSTOM_DRIVER_UNIT_ROUNDOFF;
+    const custom_driver_real root = sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
+    const custom_driver_real s = report->inv_norm / root;
+    const custom_driver_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    custom_driver_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!custom_driver_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = custom_driver_inverse_norm1_rows(&work->lu, custom_driver_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? custom_driver_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? custom_driver_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * custom_driver_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * custom_driver_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * custom_driver_at_least_1(ndq_n));
     return CUSTOM_DRIVER_SAFETY * e_q > options->target_q * custom_driver_at_least_1(nq)
         || CUSTOM_DRIVER_SAFETY * e_dq > options->target_dq * custom_driver_at_least_1(ndq)
         || CUSTOM_DRIVER_SAFETY * e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
@@ -446,8 +502,9 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
         report->status = CUSTOM_DRIVER_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = custom_driver_flagged(options, work, report,
-                                           sum_q != sum_q ? (custom_driver_real)NAN : nq, ndq, nddq);
+    report->flagged = custom_driver_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (custom_driver_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -52,6 +52,8 @@ ROWS = (
 )
 PATTERN_ROWS = numpy.array([0, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 5, 5, 5, 6, 7, 8, 8, 8], dtype=numpy.intp)
 PATTERN_COLS = numpy.array([0, 1, 0, 2, 3, 1, 2, 4, 3, 5, 6, 4, 5, 7, 8, 7, 0, 1, 2], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([1, 1, 1, 0, 0, 1, 0, 0, 0], dtype=bool)
 POINTS = (
     ('crank', 'A'),
     ('rod', 'B'),

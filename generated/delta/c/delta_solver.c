@@ -124,8 +124,9 @@ static const delta_real delta_alternating[DELTA_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static delta_real delta_inverse_norm1(const delta_lu *lu)
+static delta_real delta_inverse_norm1_rows(const delta_lu *lu, const delta_real rows[])
 {
     delta_real y[DELTA_NQ], z[DELTA_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -133,7 +134,7 @@ static delta_real delta_inverse_norm1(const delta_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, delta_alternating, sizeof z);
     delta_lu_solve(lu, z);
-    for (i = 0; i < DELTA_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < DELTA_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < DELTA_ESTIMATOR_STEPS; ++step) {
         delta_real dot, best, finite = 0;
         int jmax = 0;
@@ -146,9 +147,11 @@ static delta_real delta_inverse_norm1(const delta_lu *lu)
         delta_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < DELTA_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (delta_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -177,6 +180,11 @@ static delta_real delta_inverse_norm1(const delta_lu *lu)
     extra = 2 * extra / (3 * DELTA_NQ);
     if (extra - extra != 0) return (delta_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static delta_real delta_inverse_norm1(const delta_lu *lu)
+{
+    return delta_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -317,6 +325,54 @@ static int delta_flagged(const delta_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * delta_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * delta_at_least_1(ndq));
+    return DELTA_SAFETY * e_q > options->target_q * delta_at_least_1(nq)
+        || DELTA_SAFETY * e_dq > options->target_dq * delta_at_least_1(ndq)
+        || DELTA_SAFETY * e_ddq > options->target_ddq * delta_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const delta_real delta_nonlinear[DELTA_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static delta_real delta_nonlinear_max(const delta_real v[])
+{
+    delta_real largest = 0;
+    int i;
+    for (i = 0; i < DELTA_NQ; ++i) {
+        const delta_real a = delta_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int delta_flagged_refined(const delta_options *options,
+                                        const delta_workspace *work,
+                                        const delta_report *report, delta_real nq,
+                                        delta_real ndq, delta_real nddq, const delta_real dq[],
+                                        const delta_real ddq[])
+{
+    const delta_real u = DELTA_UNIT_ROUNDOFF;
+    const delta_real root = sqrt((delta_real)DELTA_NQ);
+    const delta_real s = report->inv_norm / root;
+    const delta_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    delta_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!delta_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = delta_inverse_norm1_rows(&work->lu, delta_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? delta_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? delta_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * delta_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * delta_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * delta_at_least_1(ndq_n));
     return DELTA_SAFETY * e_q > options->target_q * delta_at_least_1(nq)
         || DELTA_SAFETY * e_dq > options->target_dq * delta_at_least_1(ndq)
         || DELTA_SAFETY * e_ddq > options->target_ddq * delta_at_least_1(nddq);
@@ -478,8 +534,9 @@ int delta_solve_step(const delta_options *options, const delta_real p[], delta_r
         report->status = DELTA_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = delta_flagged(options, work, report,
-                                           sum_q != sum_q ? (delta_real)NAN : nq, ndq, nddq);
+    report->flagged = delta_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (delta_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

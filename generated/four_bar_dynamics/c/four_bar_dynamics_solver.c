@@ -86,8 +86,9 @@ static const four_bar_dynamics_real four_bar_dynamics_alternating[FOUR_BAR_DYNAM
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static four_bar_dynamics_real four_bar_dynamics_inverse_norm1(const four_bar_dynamics_lu *lu)
+static four_bar_dynamics_real four_bar_dynamics_inverse_norm1_rows(const four_bar_dynamics_lu *lu, const four_bar_dynamics_real rows[])
 {
     four_bar_dynamics_real y[FOUR_BAR_DYNAMICS_NQ], z[FOUR_BAR_DYNAMICS_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -95,7 +96,7 @@ static four_bar_dynamics_real four_bar_dynamics_inverse_norm1(const four_bar_dyn
      * processor can overlap the two chains of dependent operations */
     memcpy(z, four_bar_dynamics_alternating, sizeof z);
     four_bar_dynamics_lu_solve(lu, z);
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < FOUR_BAR_DYNAMICS_ESTIMATOR_STEPS; ++step) {
         four_bar_dynamics_real dot, best, finite = 0;
         int jmax = 0;
@@ -108,9 +109,11 @@ static four_bar_dynamics_real four_bar_dynamics_inverse_norm1(const four_bar_dyn
         four_bar_dynamics_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (four_bar_dynamics_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -139,6 +142,11 @@ static four_bar_dynamics_real four_bar_dynamics_inverse_norm1(const four_bar_dyn
     extra = 2 * extra / (3 * FOUR_BAR_DYNAMICS_NQ);
     if (extra - extra != 0) return (four_bar_dynamics_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static four_bar_dynamics_real four_bar_dynamics_inverse_norm1(const four_bar_dynamics_lu *lu)
+{
+    return four_bar_dynamics_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -277,6 +285,54 @@ static int four_bar_dynamics_flagged(const four_bar_dynamics_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * four_bar_dynamics_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * four_bar_dynamics_at_least_1(ndq));
+    return FOUR_BAR_DYNAMICS_SAFETY * e_q > options->target_q * four_bar_dynamics_at_least_1(nq)
+        || FOUR_BAR_DYNAMICS_SAFETY * e_dq > options->target_dq * four_bar_dynamics_at_least_1(ndq)
+        || FOUR_BAR_DYNAMICS_SAFETY * e_ddq > options->target_ddq * four_bar_dynamics_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const four_bar_dynamics_real four_bar_dynamics_nonlinear[FOUR_BAR_DYNAMICS_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static four_bar_dynamics_real four_bar_dynamics_nonlinear_max(const four_bar_dynamics_real v[])
+{
+    four_bar_dynamics_real largest = 0;
+    int i;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
+        const four_bar_dynamics_real a = four_bar_dynamics_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int four_bar_dynamics_flagged_refined(const four_bar_dynamics_options *options,
+                                        const four_bar_dynamics_workspace *work,
+                                        const four_bar_dynamics_report *report, four_bar_dynamics_real nq,
+                                        four_bar_dynamics_real ndq, four_bar_dynamics_real nddq, const four_bar_dynamics_real dq[],
+                                        const four_bar_dynamics_real ddq[])
+{
+    const four_bar_dynamics_real u = FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF;
+    const four_bar_dynamics_real root = sqrt((four_bar_dynamics_real)FOUR_BAR_DYNAMICS_NQ);
+    const four_bar_dynamics_real s = report->inv_norm / root;
+    const four_bar_dynamics_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    four_bar_dynamics_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!four_bar_dynamics_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = four_bar_dynamics_inverse_norm1_rows(&work->lu, four_bar_dynamics_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? four_bar_dynamics_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? four_bar_dynamics_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * four_bar_dynamics_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * four_bar_dynamics_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * four_bar_dynamics_at_least_1(ndq_n));
     return FOUR_BAR_DYNAMICS_SAFETY * e_q > options->target_q * four_bar_dynamics_at_least_1(nq)
         || FOUR_BAR_DYNAMICS_SAFETY * e_dq > options->target_dq * four_bar_dynamics_at_least_1(ndq)
         || FOUR_BAR_DYNAMICS_SAFETY * e_ddq > options->target_ddq * four_bar_dynamics_at_least_1(nddq);
@@ -438,8 +494,9 @@ int four_bar_dynamics_solve_step(const four_bar_dynamics_options *options, const
         report->status = FOUR_BAR_DYNAMICS_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = four_bar_dynamics_flagged(options, work, report,
-                                           sum_q != sum_q ? (four_bar_dynamics_real)NAN : nq, ndq, nddq);
+    report->flagged = four_bar_dynamics_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (four_bar_dynamics_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -92,8 +92,9 @@ static const parallelogram_extra_bar_real parallelogram_extra_bar_alternating[PA
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1(const parallelogram_extra_bar_lu *lu)
+static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1_rows(const parallelogram_extra_bar_lu *lu, const parallelogram_extra_bar_real rows[])
 {
     parallelogram_extra_bar_real y[PARALLELOGRAM_EXTRA_BAR_NQ], z[PARALLELOGRAM_EXTRA_BAR_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -101,7 +102,7 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1(const 
      * processor can overlap the two chains of dependent operations */
     memcpy(z, parallelogram_extra_bar_alternating, sizeof z);
     parallelogram_extra_bar_lu_solve(lu, z);
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < PARALLELOGRAM_EXTRA_BAR_ESTIMATOR_STEPS; ++step) {
         parallelogram_extra_bar_real dot, best, finite = 0;
         int jmax = 0;
@@ -114,9 +115,11 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1(const 
         parallelogram_extra_bar_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (parallelogram_extra_bar_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -145,6 +148,11 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1(const 
     extra = 2 * extra / (3 * PARALLELOGRAM_EXTRA_BAR_NQ);
     if (extra - extra != 0) return (parallelogram_extra_bar_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1(const parallelogram_extra_bar_lu *lu)
+{
+    return parallelogram_extra_bar_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -321,6 +329,54 @@ static int parallelogram_extra_bar_flagged(const parallelogram_extra_bar_options
         || PARALLELOGRAM_EXTRA_BAR_SAFETY * e_ddq > options->target_ddq * parallelogram_extra_bar_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const parallelogram_extra_bar_real parallelogram_extra_bar_nonlinear[PARALLELOGRAM_EXTRA_BAR_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static parallelogram_extra_bar_real parallelogram_extra_bar_nonlinear_max(const parallelogram_extra_bar_real v[])
+{
+    parallelogram_extra_bar_real largest = 0;
+    int i;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_NQ; ++i) {
+        const parallelogram_extra_bar_real a = parallelogram_extra_bar_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int parallelogram_extra_bar_flagged_refined(const parallelogram_extra_bar_options *options,
+                                        const parallelogram_extra_bar_workspace *work,
+                                        const parallelogram_extra_bar_report *report, parallelogram_extra_bar_real nq,
+                                        parallelogram_extra_bar_real ndq, parallelogram_extra_bar_real nddq, const parallelogram_extra_bar_real dq[],
+                                        const parallelogram_extra_bar_real ddq[])
+{
+    const parallelogram_extra_bar_real u = PARALLELOGRAM_EXTRA_BAR_UNIT_ROUNDOFF;
+    const parallelogram_extra_bar_real root = sqrt((parallelogram_extra_bar_real)PARALLELOGRAM_EXTRA_BAR_NQ);
+    const parallelogram_extra_bar_real s = report->inv_norm / root;
+    const parallelogram_extra_bar_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    parallelogram_extra_bar_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!parallelogram_extra_bar_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = parallelogram_extra_bar_inverse_norm1_rows(&work->lu, parallelogram_extra_bar_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? parallelogram_extra_bar_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? parallelogram_extra_bar_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * parallelogram_extra_bar_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * parallelogram_extra_bar_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * parallelogram_extra_bar_at_least_1(ndq_n));
+    return PARALLELOGRAM_EXTRA_BAR_SAFETY * e_q > options->target_q * parallelogram_extra_bar_at_least_1(nq)
+        || PARALLELOGRAM_EXTRA_BAR_SAFETY * e_dq > options->target_dq * parallelogram_extra_bar_at_least_1(ndq)
+        || PARALLELOGRAM_EXTRA_BAR_SAFETY * e_ddq > options->target_ddq * parallelogram_extra_bar_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int parallelogram_extra_bar_would_flag(const parallelogram_extra_bar_options *options,
@@ -477,8 +533,9 @@ int parallelogram_extra_bar_solve_step(const parallelogram_extra_bar_options *op
         report->status = PARALLELOGRAM_EXTRA_BAR_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = parallelogram_extra_bar_flagged(options, work, report,
-                                           sum_q != sum_q ? (parallelogram_extra_bar_real)NAN : nq, ndq, nddq);
+    report->flagged = parallelogram_extra_bar_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (parallelogram_extra_bar_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

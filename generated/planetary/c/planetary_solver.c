@@ -86,8 +86,9 @@ static const planetary_real planetary_alternating[PLANETARY_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static planetary_real planetary_inverse_norm1(const planetary_lu *lu)
+static planetary_real planetary_inverse_norm1_rows(const planetary_lu *lu, const planetary_real rows[])
 {
     planetary_real y[PLANETARY_NQ], z[PLANETARY_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -95,7 +96,7 @@ static planetary_real planetary_inverse_norm1(const planetary_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, planetary_alternating, sizeof z);
     planetary_lu_solve(lu, z);
-    for (i = 0; i < PLANETARY_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < PLANETARY_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < PLANETARY_ESTIMATOR_STEPS; ++step) {
         planetary_real dot, best, finite = 0;
         int jmax = 0;
@@ -108,9 +109,11 @@ static planetary_real planetary_inverse_norm1(const planetary_lu *lu)
         planetary_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < PLANETARY_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (planetary_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -139,6 +142,11 @@ static planetary_real planetary_inverse_norm1(const planetary_lu *lu)
     extra = 2 * extra / (3 * PLANETARY_NQ);
     if (extra - extra != 0) return (planetary_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static planetary_real planetary_inverse_norm1(const planetary_lu *lu)
+{
+    return planetary_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -270,6 +278,54 @@ static int planetary_flagged(const planetary_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * planetary_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * planetary_at_least_1(ndq));
+    return PLANETARY_SAFETY * e_q > options->target_q * planetary_at_least_1(nq)
+        || PLANETARY_SAFETY * e_dq > options->target_dq * planetary_at_least_1(ndq)
+        || PLANETARY_SAFETY * e_ddq > options->target_ddq * planetary_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const planetary_real planetary_nonlinear[PLANETARY_NQ] = { 0, 0, 0, 0, 0, 1, 0, 0, 0 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static planetary_real planetary_nonlinear_max(const planetary_real v[])
+{
+    planetary_real largest = 0;
+    int i;
+    for (i = 0; i < PLANETARY_NQ; ++i) {
+        const planetary_real a = planetary_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int planetary_flagged_refined(const planetary_options *options,
+                                        const planetary_workspace *work,
+                                        const planetary_report *report, planetary_real nq,
+                                        planetary_real ndq, planetary_real nddq, const planetary_real dq[],
+                                        const planetary_real ddq[])
+{
+    const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
+    const planetary_real root = sqrt((planetary_real)PLANETARY_NQ);
+    const planetary_real s = report->inv_norm / root;
+    const planetary_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    planetary_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!planetary_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = planetary_inverse_norm1_rows(&work->lu, planetary_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? planetary_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? planetary_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * planetary_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * planetary_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * planetary_at_least_1(ndq_n));
     return PLANETARY_SAFETY * e_q > options->target_q * planetary_at_least_1(nq)
         || PLANETARY_SAFETY * e_dq > options->target_dq * planetary_at_least_1(ndq)
         || PLANETARY_SAFETY * e_ddq > options->target_ddq * planetary_at_least_1(nddq);
@@ -431,8 +487,9 @@ int planetary_solve_step(const planetary_options *options, const planetary_real 
         report->status = PLANETARY_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = planetary_flagged(options, work, report,
-                                           sum_q != sum_q ? (planetary_real)NAN : nq, ndq, nddq);
+    report->flagged = planetary_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (planetary_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -50,6 +50,8 @@ ROWS = (
 )
 PATTERN_ROWS = numpy.array([0, 1, 2, 3, 4, 4, 4, 5, 5, 5, 6, 6, 6, 7, 7, 8], dtype=numpy.intp)
 PATTERN_COLS = numpy.array([0, 1, 3, 4, 3, 5, 6, 4, 5, 7, 2, 5, 8, 5, 8, 2], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 0, 0, 0, 1, 0, 0, 0], dtype=bool)
 POINTS = (
     ('arm', 'hub'),
 )

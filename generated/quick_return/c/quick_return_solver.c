@@ -92,8 +92,9 @@ static const quick_return_real quick_return_alternating[QUICK_RETURN_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
+static quick_return_real quick_return_inverse_norm1_rows(const quick_return_lu *lu, const quick_return_real rows[])
 {
     quick_return_real y[QUICK_RETURN_NQ], z[QUICK_RETURN_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -101,7 +102,7 @@ static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, quick_return_alternating, sizeof z);
     quick_return_lu_solve(lu, z);
-    for (i = 0; i < QUICK_RETURN_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < QUICK_RETURN_ESTIMATOR_STEPS; ++step) {
         quick_return_real dot, best, finite = 0;
         int jmax = 0;
@@ -114,9 +115,11 @@ static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
         quick_return_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (quick_return_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -145,6 +148,11 @@ static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
     extra = 2 * extra / (3 * QUICK_RETURN_NQ);
     if (extra - extra != 0) return (quick_return_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static quick_return_real quick_return_inverse_norm1(const quick_return_lu *lu)
+{
+    return quick_return_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -329,6 +337,54 @@ static int quick_return_flagged(const quick_return_options *options,
         || QUICK_RETURN_SAFETY * e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const quick_return_real quick_return_nonlinear[QUICK_RETURN_NQ] = { 1, 1, 1, 1, 1, 1, 0, 0, 1, 0, 0, 0 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static quick_return_real quick_return_nonlinear_max(const quick_return_real v[])
+{
+    quick_return_real largest = 0;
+    int i;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+        const quick_return_real a = quick_return_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int quick_return_flagged_refined(const quick_return_options *options,
+                                        const quick_return_workspace *work,
+                                        const quick_return_report *report, quick_return_real nq,
+                                        quick_return_real ndq, quick_return_real nddq, const quick_return_real dq[],
+                                        const quick_return_real ddq[])
+{
+    const quick_return_real u = QUICK_RETURN_UNIT_ROUNDOFF;
+    const quick_return_real root = sqrt((quick_return_real)QUICK_RETURN_NQ);
+    const quick_return_real s = report->inv_norm / root;
+    const quick_return_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    quick_return_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!quick_return_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = quick_return_inverse_norm1_rows(&work->lu, quick_return_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? quick_return_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? quick_return_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * quick_return_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * quick_return_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * quick_return_at_least_1(ndq_n));
+    return QUICK_RETURN_SAFETY * e_q > options->target_q * quick_return_at_least_1(nq)
+        || QUICK_RETURN_SAFETY * e_dq > options->target_dq * quick_return_at_least_1(ndq)
+        || QUICK_RETURN_SAFETY * e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int quick_return_would_flag(const quick_return_options *options,
@@ -485,8 +541,9 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
         report->status = QUICK_RETURN_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = quick_return_flagged(options, work, report,
-                                           sum_q != sum_q ? (quick_return_real)NAN : nq, ndq, nddq);
+    report->flagged = quick_return_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (quick_return_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -92,8 +92,9 @@ static const rack_linkage_real rack_linkage_alternating[RACK_LINKAGE_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static rack_linkage_real rack_linkage_inverse_norm1(const rack_linkage_lu *lu)
+static rack_linkage_real rack_linkage_inverse_norm1_rows(const rack_linkage_lu *lu, const rack_linkage_real rows[])
 {
     rack_linkage_real y[RACK_LINKAGE_NQ], z[RACK_LINKAGE_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -101,7 +102,7 @@ static rack_linkage_real rack_linkage_inverse_norm1(const rack_linkage_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, rack_linkage_alternating, sizeof z);
     rack_linkage_lu_solve(lu, z);
-    for (i = 0; i < RACK_LINKAGE_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < RACK_LINKAGE_ESTIMATOR_STEPS; ++step) {
         rack_linkage_real dot, best, finite = 0;
         int jmax = 0;
@@ -114,9 +115,11 @@ static rack_linkage_real rack_linkage_inverse_norm1(const rack_linkage_lu *lu)
         rack_linkage_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (rack_linkage_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -145,6 +148,11 @@ static rack_linkage_real rack_linkage_inverse_norm1(const rack_linkage_lu *lu)
     extra = 2 * extra / (3 * RACK_LINKAGE_NQ);
     if (extra - extra != 0) return (rack_linkage_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static rack_linkage_real rack_linkage_inverse_norm1(const rack_linkage_lu *lu)
+{
+    return rack_linkage_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -356,6 +364,54 @@ static int rack_linkage_flagged(const rack_linkage_options *options,
         || RACK_LINKAGE_SAFETY * e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const rack_linkage_real rack_linkage_nonlinear[RACK_LINKAGE_NQ] = { 1, 1, 0, 1, 1, 1, 0, 0, 1, 0, 0, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static rack_linkage_real rack_linkage_nonlinear_max(const rack_linkage_real v[])
+{
+    rack_linkage_real largest = 0;
+    int i;
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
+        const rack_linkage_real a = rack_linkage_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int rack_linkage_flagged_refined(const rack_linkage_options *options,
+                                        const rack_linkage_workspace *work,
+                                        const rack_linkage_report *report, rack_linkage_real nq,
+                                        rack_linkage_real ndq, rack_linkage_real nddq, const rack_linkage_real dq[],
+                                        const rack_linkage_real ddq[])
+{
+    const rack_linkage_real u = RACK_LINKAGE_UNIT_ROUNDOFF;
+    const rack_linkage_real root = sqrt((rack_linkage_real)RACK_LINKAGE_NQ);
+    const rack_linkage_real s = report->inv_norm / root;
+    const rack_linkage_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    rack_linkage_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!rack_linkage_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = rack_linkage_inverse_norm1_rows(&work->lu, rack_linkage_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? rack_linkage_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? rack_linkage_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * rack_linkage_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * rack_linkage_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * rack_linkage_at_least_1(ndq_n));
+    return RACK_LINKAGE_SAFETY * e_q > options->target_q * rack_linkage_at_least_1(nq)
+        || RACK_LINKAGE_SAFETY * e_dq > options->target_dq * rack_linkage_at_least_1(ndq)
+        || RACK_LINKAGE_SAFETY * e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int rack_linkage_would_flag(const rack_linkage_options *options,
@@ -512,8 +568,9 @@ int rack_linkage_solve_step(const rack_linkage_options *options, const rack_link
         report->status = RACK_LINKAGE_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = rack_linkage_flagged(options, work, report,
-                                           sum_q != sum_q ? (rack_linkage_real)NAN : nq, ndq, nddq);
+    report->flagged = rack_linkage_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (rack_linkage_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

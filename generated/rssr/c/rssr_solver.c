@@ -96,8 +96,9 @@ static const rssr_real rssr_alternating[RSSR_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static rssr_real rssr_inverse_norm1(const rssr_lu *lu)
+static rssr_real rssr_inverse_norm1_rows(const rssr_lu *lu, const rssr_real rows[])
 {
     rssr_real y[RSSR_NQ], z[RSSR_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -105,7 +106,7 @@ static rssr_real rssr_inverse_norm1(const rssr_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, rssr_alternating, sizeof z);
     rssr_lu_solve(lu, z);
-    for (i = 0; i < RSSR_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < RSSR_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < RSSR_ESTIMATOR_STEPS; ++step) {
         rssr_real dot, best, finite = 0;
         int jmax = 0;
@@ -118,9 +119,11 @@ static rssr_real rssr_inverse_norm1(const rssr_lu *lu)
         rssr_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < RSSR_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (rssr_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -149,6 +152,11 @@ static rssr_real rssr_inverse_norm1(const rssr_lu *lu)
     extra = 2 * extra / (3 * RSSR_NQ);
     if (extra - extra != 0) return (rssr_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static rssr_real rssr_inverse_norm1(const rssr_lu *lu)
+{
+    return rssr_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -611,6 +619,54 @@ static int rssr_flagged(const rssr_options *options,
         || RSSR_SAFETY * e_ddq > options->target_ddq * rssr_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const rssr_real rssr_nonlinear[RSSR_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static rssr_real rssr_nonlinear_max(const rssr_real v[])
+{
+    rssr_real largest = 0;
+    int i;
+    for (i = 0; i < RSSR_NQ; ++i) {
+        const rssr_real a = rssr_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int rssr_flagged_refined(const rssr_options *options,
+                                        const rssr_workspace *work,
+                                        const rssr_report *report, rssr_real nq,
+                                        rssr_real ndq, rssr_real nddq, const rssr_real dq[],
+                                        const rssr_real ddq[])
+{
+    const rssr_real u = RSSR_UNIT_ROUNDOFF;
+    const rssr_real root = sqrt((rssr_real)RSSR_NQ);
+    const rssr_real s = report->inv_norm / root;
+    const rssr_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    rssr_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!rssr_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = rssr_inverse_norm1_rows(&work->lu, rssr_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? rssr_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? rssr_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * rssr_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * rssr_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * rssr_at_least_1(ndq_n));
+    return RSSR_SAFETY * e_q > options->target_q * rssr_at_least_1(nq)
+        || RSSR_SAFETY * e_dq > options->target_dq * rssr_at_least_1(ndq)
+        || RSSR_SAFETY * e_ddq > options->target_ddq * rssr_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int rssr_would_flag(const rssr_options *options,
@@ -767,8 +823,9 @@ int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real 
         report->status = RSSR_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = rssr_flagged(options, work, report,
-                                           sum_q != sum_q ? (rssr_real)NAN : nq, ndq, nddq);
+    report->flagged = rssr_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (rssr_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -65,6 +65,8 @@ PATTERN_ROWS = numpy.array([0, 1, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 6, 7, 8, 8, 8, 8
     13, 13, 13], dtype=numpy.intp)
 PATTERN_COLS = numpy.array([0, 1, 2, 3, 4, 5, 6, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 10, 11, 12, 13, 0, 1,
     2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 3, 4, 5, 6, 3, 4, 5, 6, 10, 11, 12, 13], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1], dtype=bool)
 POINTS = (
     ('crank', 'A0'),
     ('crank', 'A'),

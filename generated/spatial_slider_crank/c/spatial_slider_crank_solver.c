@@ -110,8 +110,9 @@ static const spatial_slider_crank_real spatial_slider_crank_alternating[SPATIAL_
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static spatial_slider_crank_real spatial_slider_crank_inverse_norm1(const spatial_slider_crank_lu *lu)
+static spatial_slider_crank_real spatial_slider_crank_inverse_norm1_rows(const spatial_slider_crank_lu *lu, const spatial_slider_crank_real rows[])
 {
     spatial_slider_crank_real y[SPATIAL_SLIDER_CRANK_NQ], z[SPATIAL_SLIDER_CRANK_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -119,7 +120,7 @@ static spatial_slider_crank_real spatial_slider_crank_inverse_norm1(const spatia
      * processor can overlap the two chains of dependent operations */
     memcpy(z, spatial_slider_crank_alternating, sizeof z);
     spatial_slider_crank_lu_solve(lu, z);
-    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < SPATIAL_SLIDER_CRANK_ESTIMATOR_STEPS; ++step) {
         spatial_slider_crank_real dot, best, finite = 0;
         int jmax = 0;
@@ -132,9 +133,11 @@ static spatial_slider_crank_real spatial_slider_crank_inverse_norm1(const spatia
         spatial_slider_crank_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (spatial_slider_crank_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -163,6 +166,11 @@ static spatial_slider_crank_real spatial_slider_crank_inverse_norm1(const spatia
     extra = 2 * extra / (3 * SPATIAL_SLIDER_CRANK_NQ);
     if (extra - extra != 0) return (spatial_slider_crank_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static spatial_slider_crank_real spatial_slider_crank_inverse_norm1(const spatial_slider_crank_lu *lu)
+{
+    return spatial_slider_crank_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -271,6 +279,54 @@ static int spatial_slider_crank_flagged(const spatial_slider_crank_options *opti
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * spatial_slider_crank_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * spatial_slider_crank_at_least_1(ndq));
+    return SPATIAL_SLIDER_CRANK_SAFETY * e_q > options->target_q * spatial_slider_crank_at_least_1(nq)
+        || SPATIAL_SLIDER_CRANK_SAFETY * e_dq > options->target_dq * spatial_slider_crank_at_least_1(ndq)
+        || SPATIAL_SLIDER_CRANK_SAFETY * e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const spatial_slider_crank_real spatial_slider_crank_nonlinear[SPATIAL_SLIDER_CRANK_NQ] = { 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static spatial_slider_crank_real spatial_slider_crank_nonlinear_max(const spatial_slider_crank_real v[])
+{
+    spatial_slider_crank_real largest = 0;
+    int i;
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+        const spatial_slider_crank_real a = spatial_slider_crank_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int spatial_slider_crank_flagged_refined(const spatial_slider_crank_options *options,
+                                        const spatial_slider_crank_workspace *work,
+                                        const spatial_slider_crank_report *report, spatial_slider_crank_real nq,
+                                        spatial_slider_crank_real ndq, spatial_slider_crank_real nddq, const spatial_slider_crank_real dq[],
+                                        const spatial_slider_crank_real ddq[])
+{
+    const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
+    const spatial_slider_crank_real root = sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
+    const spatial_slider_crank_real s = report->inv_norm / root;
+    const spatial_slider_crank_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    spatial_slider_crank_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!spatial_slider_crank_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = spatial_slider_crank_inverse_norm1_rows(&work->lu, spatial_slider_crank_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? spatial_slider_crank_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? spatial_slider_crank_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * spatial_slider_crank_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * spatial_slider_crank_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * spatial_slider_crank_at_least_1(ndq_n));
     return SPATIAL_SLIDER_CRANK_SAFETY * e_q > options->target_q * spatial_slider_crank_at_least_1(nq)
         || SPATIAL_SLIDER_CRANK_SAFETY * e_dq > options->target_dq * spatial_slider_crank_at_least_1(ndq)
         || SPATIAL_SLIDER_CRANK_SAFETY * e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq);
@@ -432,8 +488,9 @@ int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options,
         report->status = SPATIAL_SLIDER_CRANK_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = spatial_slider_crank_flagged(options, work, report,
-                                           sum_q != sum_q ? (spatial_slider_crank_real)NAN : nq, ndq, nddq);
+    report->flagged = spatial_slider_crank_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (spatial_slider_crank_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

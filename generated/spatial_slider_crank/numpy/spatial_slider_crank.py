@@ -82,6 +82,8 @@ PATTERN_COLS = numpy.array([0, 1, 2, 3, 4, 5, 6, 3, 4, 5, 6, 0, 3, 4, 5, 6, 7, 1
     6, 9, 7, 10, 11, 12, 13, 14, 8, 10, 11, 12, 13, 15, 9, 10, 11, 12, 13, 16, 10,
     11, 12, 13, 17, 18, 19, 20, 17, 18, 19, 20, 17, 18, 19, 20, 16, 15, 17, 18, 19,
     20, 3, 4, 5, 6, 3, 4, 5, 6, 10, 11, 12, 13, 17, 18, 19, 20], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1], dtype=bool)
 POINTS = (
     ('crank', 'O'),
     ('crank', 'A'),

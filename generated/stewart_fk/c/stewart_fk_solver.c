@@ -82,8 +82,9 @@ static const stewart_fk_real stewart_fk_alternating[STEWART_FK_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static stewart_fk_real stewart_fk_inverse_norm1(const stewart_fk_lu *lu)
+static stewart_fk_real stewart_fk_inverse_norm1_rows(const stewart_fk_lu *lu, const stewart_fk_real rows[])
 {
     stewart_fk_real y[STEWART_FK_NQ], z[STEWART_FK_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -91,7 +92,7 @@ static stewart_fk_real stewart_fk_inverse_norm1(const stewart_fk_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, stewart_fk_alternating, sizeof z);
     stewart_fk_lu_solve(lu, z);
-    for (i = 0; i < STEWART_FK_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < STEWART_FK_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < STEWART_FK_ESTIMATOR_STEPS; ++step) {
         stewart_fk_real dot, best, finite = 0;
         int jmax = 0;
@@ -104,9 +105,11 @@ static stewart_fk_real stewart_fk_inverse_norm1(const stewart_fk_lu *lu)
         stewart_fk_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < STEWART_FK_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (stewart_fk_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -135,6 +138,11 @@ static stewart_fk_real stewart_fk_inverse_norm1(const stewart_fk_lu *lu)
     extra = 2 * extra / (3 * STEWART_FK_NQ);
     if (extra - extra != 0) return (stewart_fk_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static stewart_fk_real stewart_fk_inverse_norm1(const stewart_fk_lu *lu)
+{
+    return stewart_fk_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -623,6 +631,54 @@ static int stewart_fk_flagged(const stewart_fk_options *options,
         || STEWART_FK_SAFETY * e_ddq > options->target_ddq * stewart_fk_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const stewart_fk_real stewart_fk_nonlinear[STEWART_FK_NQ] = { 1, 1, 1, 1, 1, 1, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static stewart_fk_real stewart_fk_nonlinear_max(const stewart_fk_real v[])
+{
+    stewart_fk_real largest = 0;
+    int i;
+    for (i = 0; i < STEWART_FK_NQ; ++i) {
+        const stewart_fk_real a = stewart_fk_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int stewart_fk_flagged_refined(const stewart_fk_options *options,
+                                        const stewart_fk_workspace *work,
+                                        const stewart_fk_report *report, stewart_fk_real nq,
+                                        stewart_fk_real ndq, stewart_fk_real nddq, const stewart_fk_real dq[],
+                                        const stewart_fk_real ddq[])
+{
+    const stewart_fk_real u = STEWART_FK_UNIT_ROUNDOFF;
+    const stewart_fk_real root = sqrt((stewart_fk_real)STEWART_FK_NQ);
+    const stewart_fk_real s = report->inv_norm / root;
+    const stewart_fk_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    stewart_fk_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!stewart_fk_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = stewart_fk_inverse_norm1_rows(&work->lu, stewart_fk_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? stewart_fk_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? stewart_fk_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * stewart_fk_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * stewart_fk_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * stewart_fk_at_least_1(ndq_n));
+    return STEWART_FK_SAFETY * e_q > options->target_q * stewart_fk_at_least_1(nq)
+        || STEWART_FK_SAFETY * e_dq > options->target_dq * stewart_fk_at_least_1(ndq)
+        || STEWART_FK_SAFETY * e_ddq > options->target_ddq * stewart_fk_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int stewart_fk_would_flag(const stewart_fk_options *options,
@@ -779,8 +835,9 @@ int stewart_fk_solve_step(const stewart_fk_options *options, const stewart_fk_re
         report->status = STEWART_FK_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = stewart_fk_flagged(options, work, report,
-                                           sum_q != sum_q ? (stewart_fk_real)NAN : nq, ndq, nddq);
+    report->flagged = stewart_fk_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (stewart_fk_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -855,7 +912,9 @@ int stewart_fk_solve_inputs(const stewart_fk_options *options, const stewart_fk_
         if (!rates) state->dq[i] = (stewart_fk_real)NAN;
         if (!accelerations) state->ddq[i] = (stewart_fk_real)NAN;
     }
-    report->flagged = stewart_fk_flagged(options, work, report, nq, ndq, nddq);
+    report->flagged = stewart_fk_flagged_refined(options, work, report, nq, ndq, nddq,
+                                                   rates ? state->dq : NULL,
+                                                   accelerations ? state->ddq : NULL);
     work->norms[0] = nq;
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -92,8 +92,9 @@ static const whitworth_drawn_real whitworth_drawn_alternating[WHITWORTH_DRAWN_NQ
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static whitworth_drawn_real whitworth_drawn_inverse_norm1(const whitworth_drawn_lu *lu)
+static whitworth_drawn_real whitworth_drawn_inverse_norm1_rows(const whitworth_drawn_lu *lu, const whitworth_drawn_real rows[])
 {
     whitworth_drawn_real y[WHITWORTH_DRAWN_NQ], z[WHITWORTH_DRAWN_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -101,7 +102,7 @@ static whitworth_drawn_real whitworth_drawn_inverse_norm1(const whitworth_drawn_
      * processor can overlap the two chains of dependent operations */
     memcpy(z, whitworth_drawn_alternating, sizeof z);
     whitworth_drawn_lu_solve(lu, z);
-    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < WHITWORTH_DRAWN_ESTIMATOR_STEPS; ++step) {
         whitworth_drawn_real dot, best, finite = 0;
         int jmax = 0;
@@ -114,9 +115,11 @@ static whitworth_drawn_real whitworth_drawn_inverse_norm1(const whitworth_drawn_
         whitworth_drawn_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (whitworth_drawn_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -145,6 +148,11 @@ static whitworth_drawn_real whitworth_drawn_inverse_norm1(const whitworth_drawn_
     extra = 2 * extra / (3 * WHITWORTH_DRAWN_NQ);
     if (extra - extra != 0) return (whitworth_drawn_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static whitworth_drawn_real whitworth_drawn_inverse_norm1(const whitworth_drawn_lu *lu)
+{
+    return whitworth_drawn_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -329,6 +337,54 @@ static int whitworth_drawn_flagged(const whitworth_drawn_options *options,
         || WHITWORTH_DRAWN_SAFETY * e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq);
 }
 
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const whitworth_drawn_real whitworth_drawn_nonlinear[WHITWORTH_DRAWN_NQ] = { 1, 1, 1, 1, 1, 1, 0, 0, 1, 0, 0, 0 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static whitworth_drawn_real whitworth_drawn_nonlinear_max(const whitworth_drawn_real v[])
+{
+    whitworth_drawn_real largest = 0;
+    int i;
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
+        const whitworth_drawn_real a = whitworth_drawn_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int whitworth_drawn_flagged_refined(const whitworth_drawn_options *options,
+                                        const whitworth_drawn_workspace *work,
+                                        const whitworth_drawn_report *report, whitworth_drawn_real nq,
+                                        whitworth_drawn_real ndq, whitworth_drawn_real nddq, const whitworth_drawn_real dq[],
+                                        const whitworth_drawn_real ddq[])
+{
+    const whitworth_drawn_real u = WHITWORTH_DRAWN_UNIT_ROUNDOFF;
+    const whitworth_drawn_real root = sqrt((whitworth_drawn_real)WHITWORTH_DRAWN_NQ);
+    const whitworth_drawn_real s = report->inv_norm / root;
+    const whitworth_drawn_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    whitworth_drawn_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!whitworth_drawn_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = whitworth_drawn_inverse_norm1_rows(&work->lu, whitworth_drawn_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? whitworth_drawn_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? whitworth_drawn_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * whitworth_drawn_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * whitworth_drawn_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * whitworth_drawn_at_least_1(ndq_n));
+    return WHITWORTH_DRAWN_SAFETY * e_q > options->target_q * whitworth_drawn_at_least_1(nq)
+        || WHITWORTH_DRAWN_SAFETY * e_dq > options->target_dq * whitworth_drawn_at_least_1(ndq)
+        || WHITWORTH_DRAWN_SAFETY * e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq);
+}
+
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
 static int whitworth_drawn_would_flag(const whitworth_drawn_options *options,
@@ -485,8 +541,9 @@ int whitworth_drawn_solve_step(const whitworth_drawn_options *options, const whi
         report->status = WHITWORTH_DRAWN_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = whitworth_drawn_flagged(options, work, report,
-                                           sum_q != sum_q ? (whitworth_drawn_real)NAN : nq, ndq, nddq);
+    report->flagged = whitworth_drawn_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (whitworth_drawn_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
