@@ -23,9 +23,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 import symkin
 from symkin import cli
+from symkin.spec.validate import from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 MECHANISM = ROOT / "examples" / "parallelogram_extra_bar_loads.yaml"
@@ -215,3 +217,29 @@ def test_cli_writes_the_flags_and_names_the_indeterminate_reactions(
         assert data["reaction_determinate"].dtype == bool
         np.testing.assert_array_equal(data["effort_determinate"], [True, True])
         assert data["reaction"].shape == (data["t"].size, 7, 3)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_repeated_joint_and_driver_share_the_load_equally(backend: str) -> None:
+    """four_bar_dynamics with its rocker pivot and its motor written twice: every row of the
+    copies is removed (a joint with no kept row still has its reaction). Any split of the
+    load between a joint and its copy solves the equations; the minimum-norm one is half
+    each, and the halves add up to the four-bar's own (checked by Newton-Euler elsewhere)."""
+    data = yaml.safe_load((ROOT / "examples" / "four_bar_dynamics.yaml").read_text())
+    data["joints"].append(dict(data["joints"][3], name="O4bis"))
+    data["drivers"].append(dict(data["drivers"][0], name="drive2"))
+    twice = symkin.solve(symkin.compile(symkin.derive(from_dict(data)), backend=backend))
+    once = symkin.solve(symkin.compile(
+        symkin.derive(ROOT / "examples" / "four_bar_dynamics.yaml"), backend=backend))
+    assert len(twice.removed) == 3
+    scale = max(np.abs(once.reaction).max(), np.abs(once.effort).max())
+    for k in (0, 1):
+        np.testing.assert_allclose(twice.effort[:, k], once.effort[:, 0] / 2, rtol=0,
+                                   atol=1e-9 * scale)
+    for k in (3, 4):
+        np.testing.assert_allclose(twice.reaction[:, k], once.reaction[:, 3] / 2, rtol=0,
+                                   atol=1e-9 * scale)
+    np.testing.assert_allclose(twice.reaction[:, :3], once.reaction[:, :3], rtol=0,
+                               atol=1e-9 * scale)
+    assert twice.forces.indeterminate() == ["crank_drive.effort", "drive2.effort", "O4.Fx",
+                                            "O4.Fy", "O4bis.Fx", "O4bis.Fy"]
