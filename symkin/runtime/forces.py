@@ -81,6 +81,21 @@ def allocate(kernel: Any, size: int) -> tuple[Array, Array] | None:
     return np.full((size, len(kernel.coordinates)), np.nan), np.full((size, n_loads), np.nan)
 
 
+def grid(kernel: Any) -> Any:
+    """The kernel's ``multipliers_grid`` (t, q, dq, d2q, p) -> (lam, loads); where rows were
+    removed as redundant, the minimum-norm ones (as :func:`compute` gives a run)."""
+    if not getattr(kernel, "removed", ()):
+        return kernel.multipliers_grid
+
+    def minimum_norm(t: Array, q: Array, dq: Array, d2q: Array, p: Array
+                     ) -> tuple[Array, Array]:
+        found = compute(kernel, t, q, dq, d2q, p)
+        if found is None:  # a kernel without dynamics: there is nothing to complete
+            return kernel.multipliers_grid(t, q, dq, d2q, p)
+        return found.multipliers, found.table()
+    return minimum_norm
+
+
 def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
             given: tuple[Array, ...] | None = None) -> Forces | None:
     """The efforts and reactions of solved rows; None for a kernel without dynamics.

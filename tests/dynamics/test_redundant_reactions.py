@@ -243,3 +243,18 @@ def test_a_repeated_joint_and_driver_share_the_load_equally(backend: str) -> Non
                                atol=1e-9 * scale)
     assert twice.forces.indeterminate() == ["crank_drive.effort", "drive2.effort", "O4.Fx",
                                             "O4.Fy", "O4bis.Fx", "O4bis.Fy"]
+
+
+def test_a_sweep_reports_the_minimum_norm_reactions_too() -> None:
+    """symkin.sweep over two lamp masses: each set's reactions are those symkin.solve gives
+    that set (the minimum-norm ones), so its envelope is of the reported values."""
+    kernel = symkin.compile(symkin.derive(MECHANISM), backend="numpy")
+    result = symkin.sweep(kernel, {"ml": [2.0, 3.0]})
+    effort, reaction = result.forces
+    for j, mass in enumerate((2.0, 3.0)):
+        p = kernel.p_values.copy()
+        p[kernel.parameter_names.index("ml")] = mass
+        alone = symkin.solve(kernel, params=p)
+        scale = np.abs(alone.reaction).max()
+        np.testing.assert_allclose(reaction[j], alone.reaction, rtol=0, atol=1e-9 * scale)
+        np.testing.assert_allclose(effort[j], alone.effort, rtol=0, atol=1e-9 * scale)
