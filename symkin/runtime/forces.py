@@ -91,7 +91,7 @@ def grid(kernel: Any) -> Any:
                      ) -> tuple[Array, Array]:
         found = compute(kernel, t, q, dq, d2q, p)
         if found is None:  # a kernel without dynamics: there is nothing to complete
-            return kernel.multipliers_grid(t, q, dq, d2q, p)
+            raise ValueError(f"{kernel.name} has no masses or forces")
         return found.multipliers, found.table()
     return minimum_norm
 
