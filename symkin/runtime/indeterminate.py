@@ -63,36 +63,52 @@ def complete(kernel: Any, t: Array, q: Array, p: Array, lam: Array, loads: Array
     whole = np.full((t.size, n + count), np.nan)
     out = np.full(loads.shape, np.nan)
     varies = np.zeros(loads.shape[1], dtype=bool)
-    for k in range(t.size):
-        if not np.isfinite(lam[k]).all():
+    rows = np.flatnonzero(np.isfinite(lam).all(axis=1))
+    null = _null_spaces(kernel, t[rows], q[rows], p)
+    for k, basis in zip(rows, null):
+        if basis is None:  # the kept rows' Phi_q is singular here: no unique completion
             continue
-        null = _null_space(kernel, q[k], float(t[k]), p)
-        if null is None:
-            continue
+        # the loads of each null vector: linear in lam, so the solution's loads follow too
+        change = np.array([kernel.loads_full(q[k], basis[:, r], t[k], p)
+                           for r in range(count)])
         start = np.concatenate([lam[k], np.zeros(count)])
-        whole[k] = start - null @ (null.T @ start)
-        out[k] = kernel.loads_full(q[k], whole[k], t[k], p)
-        varies |= _varying(kernel, q[k], float(t[k]), p, null)
+        along = basis.T @ start
+        whole[k] = start - basis @ along
+        out[k] = loads[k] - along @ change
+        varies |= _varying(change)
     return Completion(whole[:, :n], whole[:, n:], out, ~varies)
 
 
-def _null_space(kernel: Any, q: Array, t: float, p: Array) -> Array | None:
-    """An orthonormal basis (N + R, R) of the null space of Phi_full_q^T; None where the kept
-    rows' Phi_q is singular."""
-    kept = kernel.phi_q(q, t, p)
-    removed = kernel.removed_q(q, t, p)
+def _null_spaces(kernel: Any, t: Array, q: Array, p: Array) -> list[Array | None]:
+    """Per row, an orthonormal basis (N + R, R) of the null space of Phi_full_q^T, all rows
+    in one batched solve and QR; None where the kept rows' Phi_q is singular."""
+    kept = np.array([kernel.phi_q(q[k], t[k], p).T for k in range(t.size)])
+    removed = np.array([kernel.removed_q(q[k], t[k], p).T for k in range(t.size)])
+    if t.size == 0:
+        return []
     try:
-        combination = np.linalg.solve(kept.T, removed.T)
+        combination = np.linalg.solve(kept, removed)
+    except np.linalg.LinAlgError:  # some row is singular: those alone go without
+        return [_null_space(a, b) for a, b in zip(kept, removed)]
+    count = removed.shape[2]
+    identity = np.broadcast_to(np.eye(count), (t.size, count, count))
+    orthonormal, _ = np.linalg.qr(np.concatenate([-combination, identity], axis=1))
+    return list(orthonormal)
+
+
+def _null_space(kept_t: Array, removed_t: Array) -> Array | None:
+    """One row's basis (:func:`_null_spaces`) from Phi_q^T and the removed rows' Jacobian^T."""
+    try:
+        combination = np.linalg.solve(kept_t, removed_t)
     except np.linalg.LinAlgError:
         return None
-    basis = np.vstack([-combination, np.eye(removed.shape[0])])
-    orthonormal, _ = np.linalg.qr(basis)
+    orthonormal, _ = np.linalg.qr(np.vstack([-combination, np.eye(removed_t.shape[1])]))
     return np.asarray(orthonormal, dtype=float)
 
 
-def _varying(kernel: Any, q: Array, t: float, p: Array, null: Array) -> NDArray[np.bool_]:
-    """(NLOADS,) the loads that change along the null space at this point."""
-    change = np.abs(np.array([kernel.loads_full(q, null[:, r], t, p)
-                              for r in range(null.shape[1])]))
-    largest = float(change.max(initial=0.0))
-    return np.asarray((change > DETERMINATE_TOLERANCE * largest).any(axis=0))
+def _varying(change: Array) -> NDArray[np.bool_]:
+    """(NLOADS,) the loads that change along the null space at a point, from the loads of
+    its orthonormal null vectors (R, NLOADS)."""
+    size = np.abs(change)
+    largest = float(size.max(initial=0.0))
+    return np.asarray((size > DETERMINATE_TOLERANCE * largest).any(axis=0))
