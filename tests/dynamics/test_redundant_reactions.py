@@ -258,3 +258,71 @@ def test_a_sweep_reports_the_minimum_norm_reactions_too() -> None:
         scale = np.abs(alone.reaction).max()
         np.testing.assert_allclose(reaction[j], alone.reaction, rtol=0, atol=1e-9 * scale)
         np.testing.assert_allclose(effort[j], alone.effort, rtol=0, atol=1e-9 * scale)
+
+
+class _StubKernel:
+    """A kernel whose loads are its multipliers (loads_full(lam) = lam), with a random Phi_q
+    and one removed row: the completion's algebra alone, against numpy.linalg.lstsq."""
+
+    removed = ("extra",)
+
+    def __init__(self, rng: np.random.Generator, singular_at: int) -> None:
+        self.kept = rng.normal(size=(5, 4, 4))
+        self.kept[singular_at, 3] = self.kept[singular_at, 0]  # two equal rows: singular
+        self.extra = rng.normal(size=(5, 1, 4))
+
+    def phi_q(self, q, t, p):
+        return self.kept[int(t)]
+
+    def removed_q(self, q, t, p):
+        return self.extra[int(t)]
+
+    def loads_full(self, q, lam, t, p):
+        return np.asarray(lam, dtype=float)
+
+
+def test_completion_is_lstsq_and_a_singular_row_stays_nan() -> None:
+    """Rows with finite multipliers: the minimum-norm solution of [Phi_q; removed]^T lam =
+    rhs, as lstsq finds it; the singular row (NaN multipliers) stays NaN."""
+    from symkin.runtime import indeterminate
+
+    rng = np.random.default_rng(7)
+    kernel = _StubKernel(rng, singular_at=2)
+    t = np.arange(5.0)
+    q = np.zeros((5, 4))
+    rhs = rng.normal(size=(5, 4))
+    lam = np.array([np.linalg.lstsq(kernel.kept[k].T, rhs[k], rcond=None)[0]
+                    for k in range(5)])
+    lam[2] = np.nan  # as the kernel's multipliers_grid leaves a singular row
+    loads = np.column_stack([lam, np.zeros(5)])  # the kept rows' solution, removed lam 0
+    found = indeterminate.complete(kernel, t, q, np.zeros(0), lam, loads)
+    for k in (0, 1, 3, 4):
+        full = np.vstack([kernel.kept[k], kernel.extra[k]])
+        reference = np.linalg.lstsq(full.T, rhs[k], rcond=None)[0]
+        np.testing.assert_allclose(found.loads[k], reference, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(np.concatenate([found.multipliers[k],
+                                                   found.removed_multipliers[k]]),
+                                   reference, rtol=0, atol=1e-12)
+    assert np.isnan(found.loads[2]).all() and np.isnan(found.multipliers[2]).all()
+    assert not found.determinate.any()  # a generic Phi_q: every multiplier can change
+
+
+def test_an_exactly_singular_row_is_nan_and_the_others_still_complete() -> None:
+    """A Phi_q with a zero row (exactly singular) in the batch: that row has no unique
+    completion and stays NaN, the others are completed one by one."""
+    from symkin.runtime import indeterminate
+
+    rng = np.random.default_rng(3)
+    kernel = _StubKernel(rng, singular_at=1)
+    kernel.kept[1, 3] = 0.0
+    rhs = rng.normal(size=(5, 4))
+    lam = rng.normal(size=(5, 4))  # finite everywhere: the batch meets the singular row
+    for k in (0, 2, 3, 4):
+        lam[k] = np.linalg.solve(kernel.kept[k].T, rhs[k])
+    found = indeterminate.complete(kernel, np.arange(5.0), np.zeros((5, 4)), np.zeros(0),
+                                   lam, np.column_stack([lam, np.zeros(5)]))
+    for k in (0, 2, 3, 4):
+        full = np.vstack([kernel.kept[k], kernel.extra[k]])
+        reference = np.linalg.lstsq(full.T, rhs[k], rcond=None)[0]
+        np.testing.assert_allclose(found.loads[k], reference, rtol=0, atol=1e-12)
+    assert np.isnan(found.loads[1]).all()
