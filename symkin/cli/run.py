@@ -291,6 +291,8 @@ def _warn_flagged(trajectory: Any) -> None:
     after the note naming the rows removed as redundant, if any."""
     if getattr(trajectory, "removed", ()):
         messages.note(run_outputs.removed_note(trajectory))
+        if run_outputs.indeterminate_note(trajectory):
+            messages.note(run_outputs.indeterminate_note(trajectory))
     for line in run_outputs.flag_warnings(trajectory):
         messages.note(line)
 

@@ -243,6 +243,18 @@ def removed_note(trajectory: Any) -> str:
             + "; ".join(trajectory.removed))
 
 
+def indeterminate_note(trajectory: Any) -> str:
+    """The note naming the efforts and reactions that the removed rows leave indeterminate
+    (empty when there is none, or no forces)."""
+    forces = getattr(trajectory, "forces", None)
+    names = forces.indeterminate() if forces is not None else []
+    if not names:
+        return ""
+    return ("with equations removed as redundant these reactions are not unique (the rows "
+            "can share the load in any proportion); their values are the minimum-norm "
+            "solution (NPZ effort_determinate, reaction_determinate): " + ", ".join(names))
+
+
 def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
     """The removed rows that miss the target between points k and end, with their largest
     |Phi| there ('' when none does)."""

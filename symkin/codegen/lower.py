@@ -56,6 +56,10 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     # the same from the fused routine's sines and cosines, at the q of the last step
     "dynamics_rhs_shared": ("q", "dq", "ddq", "t", "p", "shared"),
     "loads_shared": ("q", "lam", "t", "p", "shared"),
+    # Dynamics with removed rows: their Jacobian (dense) and the loads of lam of every row
+    # (kept, then removed), for the runtime's minimum-norm loads (runtime.indeterminate).
+    "removed_q": ("q", "t", "p"),
+    "loads_full": ("q", "lam", "t", "p"),
 }
 DYNAMICS = ("dynamics_rhs", "loads")
 FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
@@ -288,6 +292,10 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
         **({"removed": [removed.phi for removed in system.removed]} if system.removed else {}),
         **({"dynamics_rhs": list(system.dynamics.rhs), "loads": list(system.dynamics.loads)}
            if system.dynamics is not None else {}),
+        **({"removed_q": list(system.dynamics.removed_q),
+            "loads_full": list(system.dynamics.loads_full)}
+           if system.dynamics is not None and system.dynamics.removed_q is not None
+           and system.dynamics.loads_full is not None else {}),
     }
 
 

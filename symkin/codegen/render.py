@@ -31,7 +31,7 @@ from symkin.symbolic.derivation import System
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
              "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out", "removed": "out",
              "dynamics_rhs": "out", "loads": "out", "dynamics_rhs_shared": "out",
-             "loads_shared": "out"}
+             "loads_shared": "out", "removed_q": "out", "loads_full": "out"}
 # The output arrays of a routine with several (Routine.sizes), in order.
 _C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
@@ -52,6 +52,8 @@ _PYTHON_DOC = {
     "loads": "The efforts (DRIVER_NAMES) then Fx, Fy, M of each joint (JOINT_NAMES) from lam.",
     "dynamics_rhs_shared": "dynamics_rhs from the shared values of phi_phi_q_nz at the same q.",
     "loads_shared": "loads from the shared values of phi_phi_q_nz at the same q, t, p.",
+    "removed_q": "The removed rows' Jacobian, row-major, shape (NREMOVED * NQ,).",
+    "loads_full": "loads from lam of every row: the kept rows' (NQ), then the removed rows'.",
 }
 
 
@@ -358,7 +360,10 @@ def _labels(code: Code, routine: str) -> list[str]:
         return _labels(code, routine[:-len("_shared")])
     if routine == "dynamics_rhs":
         return [lower.comment(name) for name in code.coordinates]
-    if routine == "loads":
+    if routine == "removed_q":
+        return [lower.comment(f"({row}, {name})") for row in code.removed
+                for name in code.coordinates]
+    if routine in ("loads", "loads_full"):
         return [lower.comment(f"{name}.effort") for name in code.driver_names] + [
             lower.comment(f"{name}.{part}") for name in code.joint_names
             for part in ("Fx", "Fy", "M")]

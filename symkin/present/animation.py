@@ -4,6 +4,8 @@ Bodies are drawn as polygons through the local vectors of their joints and point
 (``outlines``, from :func:`symkin.symbolic.drawing.outlines`), so what moves on screen is what
 the constraints hold together. Ground pivots are drawn as hatched triangles, slide axes as
 dash-dotted lines through the whole picture; the legend stands to the right of the mechanism.
+With masses or forces, each joint's reaction (body i on body j) is an arrow at its point on
+body i, the largest of the run VECTOR_SHARE of the picture long, as in the HTML report.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ MAX_FRAMES = 200
 DEFAULT_SIZE = (900, 600)  # pixels
 DPI = 100
 GROUND = "ground"
+VECTOR_SHARE = 0.15  # the longest reaction of the run drawn this long, relative to the picture
+REACTION = "#c2008f"  # the joint reactions' arrows: a magenta no body is drawn in
 
 
 def body_shapes(trajectory: Trajectory, outlines: Outlines) -> dict[str, Array]:
@@ -205,6 +209,7 @@ class _Scene:
                                    label=label if first[label] == k else None)[0]
                            for k, (label, _) in enumerate(self.marks)]
         _pivots(ax, _ground(outlines), span)
+        self.reactions, self.arrows = _reaction_arrows(ax, trajectory, outlines, span)
         colours = series.palette(len(self.shapes))
         self.lines = {body: ax.plot([], [], "o-", linewidth=3, markersize=4, color=colour,
                                     alpha=0.85, label=body)[0]
@@ -219,7 +224,8 @@ class _Scene:
         # background and draws only the moving artists (an order of magnitude faster than
         # drawing the whole figure per frame).
         self.moving = [*self.lines.values(), *(line for _, line in self.traces),
-                       *self.slide_lines, *self.rod_lines, *self.mark_lines, self.title]
+                       *self.slide_lines, *self.rod_lines, *self.mark_lines, self.title,
+                       *([self.arrows] if self.arrows is not None else [])]
         for artist in self.moving:
             artist.set_animated(True)
         canvas = self.figure.canvas
@@ -248,7 +254,31 @@ class _Scene:
             line.set_data([a[k, 0], b[k, 0]], [a[k, 1], b[k, 1]])
         for (_, polyline), line in zip(self.marks, self.mark_lines):
             line.set_data(polyline[k, :, 0], polyline[k, :, 1])
+        if self.arrows is not None:
+            points, vectors = self.reactions
+            self.arrows.set_offsets(points[k])
+            self.arrows.set_UVC(vectors[k, :, 0], vectors[k, :, 1])
         self.title.set_text(f"t = {self.trajectory.t[k]:.4g}")
+
+
+def _reaction_arrows(ax: Any, trajectory: Trajectory, outlines: Outlines, span: float
+                     ) -> tuple[tuple[Array, Array], Any]:
+    """The joints' points (T, J, 2) and their reactions scaled to picture lengths (T, J, 2)
+    (NaN rows drawn as nothing), and the arrows' artist; (empty, None) without forces."""
+    forces = trajectory.forces
+    where = joint_points(trajectory, outlines) if forces is not None else {}
+    shown = [k for k, name in enumerate(forces.joint_names) if name in where] if forces else []
+    if forces is None or not shown:
+        return (np.zeros((0, 0, 2)), np.zeros((0, 0, 2))), None
+    points = np.stack([where[forces.joint_names[k]] for k in shown], axis=1)
+    vectors = np.nan_to_num(forces.reaction[:, shown, :2])
+    largest = float(np.hypot(vectors[..., 0], vectors[..., 1]).max(initial=0.0))
+    vectors = vectors * (VECTOR_SHARE * span / largest if largest > 0 else 0.0)
+    arrows = ax.quiver(points[0, :, 0], points[0, :, 1], vectors[0, :, 0], vectors[0, :, 1],
+                       angles="xy", scale_units="xy", scale=1.0, color=REACTION,
+                       width=0.004, zorder=4)
+    ax.plot([], [], "-", color=REACTION, linewidth=2, label="joint reactions (i on j)")
+    return (points, vectors), arrows
 
 
 def _moving_point(trajectory: Trajectory, body: str, point: str) -> bool:

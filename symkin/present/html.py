@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import UsageError
-from symkin.present import series
+from symkin.present import html_forces, series
 from symkin.present.animation import (
     MAX_FRAMES,
     Outlines,
@@ -86,18 +86,23 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
         if select is not None else series.default_selection(trajectory)
     curves = series.curves(trajectory, chosen, units)
     columns = series.kinds(curves)
-    panel: list[dict[str, Any] | None] = [{} for _ in columns]
+    # with masses or forces, one more column: efforts and reactions (present.html_forces)
+    forces = [] if trajectory.forces is None else [2 + len(columns)]
+    panel: list[dict[str, Any] | None] = [{} for _ in [*columns, *forces]]
     specs: list[list[dict[str, Any] | None]] = [[{"rowspan": 3}, *panel]]
     specs += [[None, *panel] for _ in range(2)]
     figure = make_subplots(
-        rows=3, cols=1 + len(columns), specs=specs, shared_xaxes=True,
-        column_widths=[0.5] + [0.5 / len(columns)] * len(columns),
+        rows=3, cols=1 + len(panel), specs=specs, shared_xaxes=True,
+        column_widths=[0.5] + [0.5 / len(panel)] * len(panel),
         horizontal_spacing=0.07, vertical_spacing=0.06)
     frames = np.unique(np.linspace(0, trajectory.t.size - 1, MAX_FRAMES).astype(int))
     scene = _Scene(trajectory, outlines, [c.name for c in curves if c.kind == LENGTH
                                           and len(c.components) == 2], units)
     moving = scene.static(go, figure)
     cursors = _plots(go, figure, trajectory, curves, columns, units)
+    for column in forces:
+        cursors += html_forces.plot(go, figure, trajectory, column)
+        html_forces.label(figure, column, units)
     _animate(go, figure, trajectory, frames, scene, moving, cursors)
     _layout(figure, trajectory, frames, scene, columns, units, title)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -6,6 +6,9 @@ applies along the driver's function (an ``angle`` driver: the torque on body i, 
 j; a ``slide``: the force on body j along u). ``reaction`` (T, n_joints, 3): [Fx, Fy]
 (global) and M that body i exerts on body j, M about the joint's point on body i (0 for a
 revolute; a prismatic pair: about A, carried by i). Rows where Φ_q is exactly singular are NaN.
+
+Where rows were removed as redundant, the loads are those of the minimum-norm multipliers of
+every row the file writes, and ``determinate`` says which are unique (runtime.indeterminate).
 """
 
 from __future__ import annotations
@@ -15,6 +18,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from symkin.runtime import indeterminate
 
 Array = NDArray[np.float64]
 REACTION_PARTS = ("Fx", "Fy", "M")
@@ -29,6 +34,32 @@ class Forces:
     reaction: Array  # (T, n_joints, 3): Fx, Fy, M
     driver_names: tuple[str, ...]
     joint_names: tuple[str, ...]
+    determinate: NDArray[np.bool_] | None = None
+    """(NLOADS,) where rows were removed as redundant: True for an effort or reaction
+    component that is the same whatever the split among the redundant rows; the others are
+    the minimum-norm solution's. None for every other file (all determinate)."""
+    removed_multipliers: Array | None = None
+    """(T, R) the removed rows' multipliers of the minimum-norm solution, or None."""
+
+    @property
+    def effort_determinate(self) -> NDArray[np.bool_] | None:
+        """(n_driver_equations,) bool, or None where no row was removed."""
+        if self.determinate is None:
+            return None
+        return self.determinate[:len(self.driver_names)]
+
+    @property
+    def reaction_determinate(self) -> NDArray[np.bool_] | None:
+        """(n_joints, 3) bool (Fx, Fy, M), or None where no row was removed."""
+        if self.determinate is None:
+            return None
+        return self.determinate[len(self.driver_names):].reshape(len(self.joint_names), 3)
+
+    def indeterminate(self) -> list[str]:
+        """The :meth:`columns` names of the loads that are not determinate."""
+        if self.determinate is None:
+            return []
+        return [name for name, fixed in zip(self.columns(), self.determinate) if not fixed]
 
     def columns(self) -> list[str]:
         """The CSV columns: ``DRIVER.effort``, then ``JOINT.Fx``, ``JOINT.Fy``, ``JOINT.M``."""
@@ -50,6 +81,21 @@ def allocate(kernel: Any, size: int) -> tuple[Array, Array] | None:
     return np.full((size, len(kernel.coordinates)), np.nan), np.full((size, n_loads), np.nan)
 
 
+def grid(kernel: Any) -> Any:
+    """The kernel's ``multipliers_grid`` (t, q, dq, d2q, p) -> (lam, loads); where rows were
+    removed as redundant, the minimum-norm ones (as :func:`compute` gives a run)."""
+    if not getattr(kernel, "removed", ()):
+        return kernel.multipliers_grid
+
+    def minimum_norm(t: Array, q: Array, dq: Array, d2q: Array, p: Array
+                     ) -> tuple[Array, Array]:
+        found = compute(kernel, t, q, dq, d2q, p)
+        if found is None:  # a kernel without dynamics: there is nothing to complete
+            raise ValueError(f"{kernel.name} has no masses or forces")
+        return found.multipliers, found.table()
+    return minimum_norm
+
+
 def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
             given: tuple[Array, ...] | None = None) -> Forces | None:
     """The efforts and reactions of solved rows; None for a kernel without dynamics.
@@ -68,6 +114,13 @@ def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
             if missing.size:
                 lam[missing], loads[missing] = kernel.multipliers_grid(
                     t[missing], q[missing], dq[missing], d2q[missing], p)
+    determinate, removed = None, None
+    if getattr(kernel, "removed", ()):  # rows removed as redundant: not unique
+        with np.errstate(all="ignore"):
+            found = indeterminate.complete(kernel, t, q, p, lam, loads)
+        lam, loads = found.multipliers, found.loads
+        determinate, removed = found.determinate, found.removed_multipliers
     n_efforts, n_joints = len(kernel.driver_names), len(kernel.joint_names)
     return Forces(lam, loads[:, :n_efforts], loads[:, n_efforts:].reshape(t.size, n_joints, 3),
-                  tuple(kernel.driver_names), tuple(kernel.joint_names))
+                  tuple(kernel.driver_names), tuple(kernel.joint_names), determinate,
+                  removed)

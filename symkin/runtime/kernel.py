@@ -43,6 +43,9 @@ class _Functions(Protocol):
     # inverse dynamics (kernels of mechanisms with masses or forces only)
     def dynamics_rhs(self, q: Array, dq: Array, ddq: Array, t: float, p: Array) -> Array: ...
     def loads(self, q: Array, lam: Array, t: float, p: Array) -> Array: ...
+    # ... with rows removed as redundant too (runtime.indeterminate)
+    def removed_q(self, q: Array, t: float, p: Array) -> Array: ...
+    def loads_full(self, q: Array, lam: Array, t: float, p: Array) -> Array: ...
 
 
 class Kernel:
@@ -181,6 +184,23 @@ class Kernel:
         """The efforts (one per driver row) then Fx, Fy, M of each joint, from lam."""
         self._require_dynamics()
         return self._functions.loads(self._q(q), self._q(lam, "lam"), float(t), self._p(p))
+
+    def removed_q(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """The removed rows' Jacobian, (NREMOVED, N) (dynamics and removed rows only)."""
+        self._require_dynamics()
+        flat = self._functions.removed_q(self._q(q), float(t), self._p(p))
+        return np.asarray(flat, dtype=float).reshape(len(self.removed), self.nq)
+
+    def loads_full(self, q: ArrayLike, lam: ArrayLike, t: float,
+                   p: ArrayLike | None = None) -> Array:
+        """The loads of the multipliers of every row: lam (N + NREMOVED,), the kept rows'
+        then the removed rows' (dynamics and removed rows only)."""
+        self._require_dynamics()
+        whole = np.ascontiguousarray(lam, dtype=float)
+        if whole.shape != (self.nq + len(self.removed),):
+            raise ValueError(f"lam must have shape ({self.nq + len(self.removed)},) for "
+                             f"{self.name}, got {whole.shape}")
+        return self._functions.loads_full(self._q(q), whole, float(t), self._p(p))
 
     def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array,
                          p: Array) -> tuple[Array, Array]:

@@ -242,8 +242,13 @@ class Trajectory:
         if self.forces is None:
             return {}
         f = self.forces
-        return {"effort": f.effort, "driver_names": np.array(f.driver_names, dtype=str),
-                "reaction": f.reaction, "joint_names": np.array(f.joint_names, dtype=str)}
+        arrays = {"effort": f.effort, "driver_names": np.array(f.driver_names, dtype=str),
+                  "reaction": f.reaction, "joint_names": np.array(f.joint_names, dtype=str)}
+        # Only where rows were removed as redundant (every other file's NPZ as before).
+        efforts, reactions = f.effort_determinate, f.reaction_determinate
+        if efforts is not None and reactions is not None:
+            arrays.update(effort_determinate=efforts, reaction_determinate=reactions)
+        return arrays
 
     def _save_csv(self, path: Path) -> None:
         header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin import limits
 from symkin.contract.options import Options
 from symkin.errors import SolveError
-from symkin.runtime import driver, redundant
+from symkin.runtime import driver, forces, redundant
 from symkin.runtime.inputs import refuse_inputs
 from symkin.runtime.kernel import Kernel
 from symkin.sweeps import parallel
@@ -184,7 +184,7 @@ def _result(kernel: Kernel, times: Array, values: Array, chunk: Chunk) -> SweepR
         t_reached=chunk.t_reached, solved=chunk.solved, iterations=chunk.iterations,
         points_named=tuple(kernel.points), local_vectors=kernel.point_vectors,
         removed=kernel.removed, removed_broken=_removed_broken(kernel, times, values, chunk),
-        multipliers_grid=kernel.multipliers_grid if kernel.has_dynamics else None,
+        multipliers_grid=forces.grid(kernel) if kernel.has_dynamics else None,
         driver_names=kernel.driver_names, joint_names=kernel.joint_names,
         space=getattr(kernel, "space", "2d"))
 

@@ -207,7 +207,8 @@ def derive(mech: Mechanism | str | Path) -> System:
                      for body, spec in mech.bodies.items() for name in spec.points),
         placed=placed, time_grid=time_grid,
         phi_p=_parameter_jacobian(phi, symbols.p), removed=removed, mobility=mobility,
-        dynamics=(dynamics.derive(mech, ctx, phi_q, rows, placed)
+        dynamics=(dynamics.derive(mech, ctx, phi_q, rows, placed,
+                                  _removed_jacobians(removed, column, symbols))
                   if has_dynamics(mech) else None),
         inputs=symbols.inputs,
         input_values=_input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
@@ -249,6 +250,18 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
                     for k, d in zip(found.removed, found.dependency))
     return ([phi[k] for k in found.kept], tuple(rows[k] for k in found.kept), removed,
             found.mobility)
+
+
+def _removed_jacobians(removed: tuple[Removed, ...], column: dict[sp.Symbol, int],
+                       symbols: Symbols) -> tuple[tuple[Row, sp.Matrix], ...]:
+    """Each removed row's label and 1 x N Jacobian (for its share of the reactions)."""
+    found = []
+    for item in removed:
+        jacobian = sp.zeros(1, len(symbols.q))
+        for k, value in _row_jacobian(item.phi, column, symbols.q).items():
+            jacobian[0, k] = value
+        found.append((item.row, jacobian))
+    return tuple(found)
 
 
 def _at_tau(expr: sp.Expr, symbols: Symbols) -> sp.Expr:

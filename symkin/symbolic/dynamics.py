@@ -21,6 +21,13 @@ M = n - (P - r_j) x F. When j is the ground the same is taken from body i and ne
 (action and reaction). A driver row's effort is -λ: the generalized force its actuator
 applies along the driven function (work = effort · δf) — for an ``angle`` driver the torque
 on body i, for ``slide`` the force on body j along u (unit u).
+
+Where rows were removed as redundant (symbolic.redundancy) the loads are derived from the
+multipliers of every row the file writes: lam holds the kept rows' then the removed rows',
+``loads`` reads the kept ones only (the removed rows' multipliers taken as zero, one of the
+many solutions) and ``loads_full`` all of them, with ``removed_q`` the removed rows' Jacobian:
+the runtime (runtime.indeterminate) finds from these which loads are determinate and the
+minimum-norm multipliers.
 """
 
 from __future__ import annotations
@@ -44,7 +51,7 @@ class Dynamics:
 
     Attributes:
         ddq: the acceleration symbols (``body.x_tt``...), same order as q.
-        lam: the multiplier symbols, one per row of Φ.
+        lam: the multiplier symbols, one per row of Φ, then one per removed row.
         mass_matrix: M(q), N x N.
         applied: Q(q, dq, t), N x 1.
         velocity_terms: h(q, dq), N x 1 (zero when every frame is at its centre of mass).
@@ -53,6 +60,9 @@ class Dynamics:
         loads: the efforts (one per driver row) then 3 values per joint (Fx, Fy, M), as
             functions of q, λ, t and p.
         driver_names, joint_names: labels of the efforts and of the joints' reactions.
+        loads_full: the loads from the multipliers of the kept and the removed rows (lam
+            whole); None when no row was removed.
+        removed_q: the removed rows' Jacobian, R x N; None when no row was removed.
     """
 
     ddq: tuple[sp.Symbol, ...]
@@ -65,15 +75,18 @@ class Dynamics:
     loads: sp.ImmutableMatrix
     driver_names: tuple[str, ...]
     joint_names: tuple[str, ...]
+    loads_full: sp.ImmutableMatrix | None = None
+    removed_q: sp.ImmutableMatrix | None = None
 
 
 def derive(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any,
-           placed: Any) -> Dynamics:
-    """The dynamics of ``mech`` whose Jacobian is ``phi_q`` (rows labelled by ``rows``)."""
+           placed: Any, removed: tuple[tuple[Any, sp.Matrix], ...] = ()) -> Dynamics:
+    """The dynamics of ``mech`` whose Jacobian is ``phi_q`` (rows labelled by ``rows``);
+    ``removed``: the rows removed as redundant, each (its label, its 1 x N Jacobian)."""
     symbols = ctx.symbols
     ddq = tuple(sp.Symbol(name + "_tt", real=True) for name in symbols.coordinates)
-    lam = tuple(sp.Symbol(f"lambda{k}", real=True) for k in range(len(symbols.q)))
     n = len(symbols.q)
+    lam = tuple(sp.Symbol(f"lambda{k}", real=True) for k in range(n + len(removed)))
     kinetic, applied = sp.Integer(0), sp.zeros(n, 1)
     mass, velocity_terms = sp.zeros(n, n), sp.zeros(n, 1)
     for body, spec in mech.bodies.items():
@@ -86,13 +99,20 @@ def derive(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any,
     for load in mech.forces:
         applied += _generalized_force(mech, ctx, load)
     rhs = applied - mass * sp.Matrix(ddq) - velocity_terms
-    efforts, reactions, driver_names, joint_names = _loads(mech, ctx, phi_q, rows, placed, lam)
+    removed_q = sp.Matrix.vstack(sp.zeros(0, n), *(jacobian for _, jacobian in removed))
+    every_row = sp.Matrix.vstack(sp.Matrix(phi_q), removed_q)
+    every_label = (*rows, *(label for label, _ in removed))
+    efforts, reactions, driver_names, joint_names = _loads(mech, ctx, every_row, every_label,
+                                                           placed, lam)
+    full = sp.ImmutableMatrix([*efforts, *reactions])
+    kept = full.xreplace({symbol: 0 for symbol in lam[n:]})
     return Dynamics(
         ddq=ddq, lam=lam, mass_matrix=sp.ImmutableMatrix(mass),
         applied=sp.ImmutableMatrix(applied), velocity_terms=sp.ImmutableMatrix(velocity_terms),
         rhs=sp.ImmutableMatrix(rhs), kinetic=kinetic,
-        loads=sp.ImmutableMatrix([*efforts, *reactions]),
-        driver_names=driver_names, joint_names=joint_names)
+        loads=kept, driver_names=driver_names, joint_names=joint_names,
+        loads_full=full if removed else None,
+        removed_q=sp.ImmutableMatrix(removed_q) if removed else None)
 
 
 def _columns(symbols: Any, body: str) -> list[int]:

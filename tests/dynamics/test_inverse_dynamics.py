@@ -191,7 +191,23 @@ def _power_crank_slider(traj):
     return drive + applied, _kinetic_rate(bodies, masses)
 
 
-POWER = {"four_bar_dynamics": _power_four_bar, "crank_slider_load": _power_crank_slider}
+def _power_parallelogram(traj):
+    """The parallelogram with an extra bar and a swung lamp (drawn layout: each frame at the
+    body's first point, global axes as drawn); its reactions are partly indeterminate, its
+    efforts are not (tests/dynamics/test_redundant_reactions.py)."""
+    a, th0, w, arm, mb, mc, ml, g = 1.0, np.pi / 3, np.pi / 2, 0.4, 1.0, 3.0, 2.0, -9.81
+    half = [a * np.cos(th0) / 2, a * np.sin(th0) / 2]
+    bodies = {n: Body(traj, n) for n in ("crank", "rocker", "extra", "coupler", "lamp")}
+    masses = {"crank": (mb, mb * a * a / 12, half), "rocker": (mb, mb * a * a / 12, half),
+              "extra": (mb, mb * a * a / 12, half), "coupler": (mc, 0.25, [0.5, 0]),
+              "lamp": (ml, 0.02, [0, -arm])}
+    applied = sum(masses[n][0] * g * bodies[n].point(masses[n][2])[1][:, 1] for n in bodies)
+    swing = traj.effort[:, 1] * (bodies["lamp"].w - bodies["coupler"].w)
+    return traj.effort[:, 0] * w + swing + applied, _kinetic_rate(bodies, masses)
+
+
+POWER = {"four_bar_dynamics": _power_four_bar, "crank_slider_load": _power_crank_slider,
+         "parallelogram_extra_bar_loads": _power_parallelogram}
 
 
 def test_every_example_with_forces_has_a_power_balance() -> None:

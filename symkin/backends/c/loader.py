@@ -88,7 +88,8 @@ class _CFunctions:
         self._ctype = f"{real}[]"
         self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq,
                        "points": point_components, "phi_p": nnz_p, "removed": nremoved,
-                       "dynamics_rhs": nq, "loads": n_loads}
+                       "dynamics_rhs": nq, "loads": n_loads, "removed_q": nremoved * nq,
+                       "loads_full": n_loads}
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}
@@ -134,6 +135,12 @@ class _CFunctions:
 
     def loads(self, q: Array, lam: Array, t: float, p: Array) -> Array:
         return self._call("loads", self._in(q), self._in(lam), t, self._in(p))
+
+    def removed_q(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("removed_q", self._in(q), t, self._in(p))
+
+    def loads_full(self, q: Array, lam: Array, t: float, p: Array) -> Array:
+        return self._call("loads_full", self._in(q), self._in(lam), t, self._in(p))
 
 
 def load(folder: Path, meta: Mapping[str, Any]) -> CKernel:
