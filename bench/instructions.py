@@ -1,15 +1,19 @@
 """Instructions per time step of the generated C solver, counted by callgrind (valgrind).
 
-    python3 bench/instructions.py [--tighten-cond C] crank_slider chain:100 tongs:1000 ...
+    python3 bench/instructions.py [--tighten-cond C] [--linalg dense] crank_slider chain:100 ...
 
-Each argument is an example's name (examples/<name>.yaml, started from its q0) or FAMILY:BODIES
-of bench/scaling_limit.py (started from the closed form). The generated folder is compiled as
-a plain C program (gcc -O2) whose main calls ``<prefix>_solve_grid`` over t = k * dt; the count
-is (instructions of 121 steps - instructions of 21 steps) / 100, so set-up and the first
-assembly cancel. Instruction counts do not depend on the load of a shared machine, unlike
-times. dt is 1.5/20000 for an example (the textbook grid), 0.001 for a family.
+Each argument is an example's name (examples/<name>.yaml, started from its q0), FAMILY:BODIES
+of bench/scaling_limit.py (started from the closed form), or ``handwritten``: the hand-written
+dense C crank-slider of bench/baselines/crank_slider.c on the textbook grid, for the ratio.
+The generated folder is compiled as a plain C program (gcc -O2) whose main calls
+``<prefix>_solve_grid`` over t = k * dt; the count is (instructions of 121 steps -
+instructions of 21 steps) / 100, so set-up and the first assembly cancel. Instruction
+counts do not depend on the load of a shared machine, unlike times. dt is 1.5/20000 for an
+example (the textbook grid), 0.001 for a family.
 ``--tighten-cond C`` replaces the solver's default ``tighten_cond`` (``inf``: no extra Newton
-iterations at all, so every step does the same work at every size).
+iterations at all, so every step does the same work at every size). ``--linalg dense``
+generates the dense LU with partial pivoting instead of the sparse one (the path of the
+sparse LU's fall-back too).
 """
 
 from __future__ import annotations
@@ -50,6 +54,35 @@ int main(int argc, char **argv)
 """
 
 
+HANDWRITTEN_MAIN = r"""
+#include <stdio.h>
+#include <stdlib.h>
+long cs_solve_grid(long steps, double dt, double *Q, double *DQ, double *D2Q,
+                   long *newton_iterations, unsigned long *fallbacks);
+int main(int argc, char **argv)
+{
+    long n = atol(argv[1]), iterations = 0;
+    unsigned long fallbacks = 0;
+    double *rows = malloc(sizeof(double) * 27 * (n + 1));
+    long done = cs_solve_grid(n, 1.5 / 20000, rows, rows + 9 * (n + 1), rows + 18 * (n + 1),
+                              &iterations, &fallbacks);
+    printf("%ld %ld\n", done, iterations);
+    return 0;
+}
+"""
+
+
+def handwritten_per_step() -> tuple[str, int, float]:
+    """The hand-written dense C crank-slider's instructions per step, counted alike."""
+    with tempfile.TemporaryDirectory() as folder:
+        build = Path(folder)
+        (build / "main.c").write_text(HANDWRITTEN_MAIN)
+        program = build / "main"
+        subprocess.run(["gcc", "-std=c99", "-O2", "-o", str(program), str(build / "main.c"),
+                        str(ROOT / "bench" / "baselines" / "crank_slider.c"), "-lm"], check=True)
+        return "handwritten", 9, (_total(program, 121) - _total(program, 21)) / 100
+
+
 def _total(program: Path, steps: int) -> int:
     out = program.parent / f"callgrind.{steps}"
     subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
@@ -61,7 +94,8 @@ def _total(program: Path, steps: int) -> int:
     return int(match.group(1).replace(",", ""))
 
 
-def per_step(spec: str, tighten_cond: str | None = None) -> tuple[str, int, float]:
+def per_step(spec: str, tighten_cond: str | None = None, linalg: str = "sparse"
+             ) -> tuple[str, int, float]:
     import symkin
     from symkin.spec import validate as model
 
@@ -75,7 +109,7 @@ def per_step(spec: str, tighten_cond: str | None = None) -> tuple[str, int, floa
         system, dt = symkin.derive(ROOT / "examples" / f"{spec}.yaml"), "(1.5 / 20000)"
     with tempfile.TemporaryDirectory() as folder:
         build = Path(folder)
-        symkin.generate(system, backend="c", out_dir=build / "c")
+        symkin.generate(system, backend="c", out_dir=build / "c", linalg=linalg)
         prefix = system.name
         tighten = "" if tighten_cond is None else f"o.tighten_cond = {tighten_cond};"
         (build / "main.c").write_text(
@@ -95,8 +129,13 @@ def main() -> int:
         value = float(args[1])  # a C literal: INFINITY for inf (any spelling)
         tighten_cond = "INFINITY" if math.isinf(value) else repr(value)
         args = args[2:]
+    linalg = "sparse"
+    if args[:1] == ["--linalg"]:
+        linalg = args[1]
+        args = args[2:]
     for spec in args or ["crank_slider"]:
-        name, nq, count = per_step(spec, tighten_cond)
+        name, nq, count = (handwritten_per_step() if spec == "handwritten"
+                           else per_step(spec, tighten_cond, linalg))
         print(f"{name:20s} N = {nq:5d}  {count:10.0f} instructions/step", flush=True)
     return 0
 

@@ -16,7 +16,9 @@
 
 typedef struct {
     all_drivers_real a[ALL_DRIVERS_NQ * ALL_DRIVERS_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    all_drivers_real inv[ALL_DRIVERS_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[ALL_DRIVERS_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    all_drivers_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } all_drivers_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

@@ -67,6 +67,7 @@ typedef struct {
     all_drivers_real phi[ALL_DRIVERS_NQ]; /* Phi, then the Newton step */
     all_drivers_real shared[9]; /* sin, cos of the last iterate (all_drivers_phi_phi_q) */
     all_drivers_real nz_estimated[ALL_DRIVERS_NNZ]; /* Phi_q where the condition was estimated */
+    all_drivers_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     all_drivers_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     all_drivers_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } all_drivers_workspace;

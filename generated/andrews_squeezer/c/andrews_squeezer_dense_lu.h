@@ -16,7 +16,9 @@
 
 typedef struct {
     andrews_squeezer_real a[ANDREWS_SQUEEZER_NQ * ANDREWS_SQUEEZER_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    andrews_squeezer_real inv[ANDREWS_SQUEEZER_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[ANDREWS_SQUEEZER_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    andrews_squeezer_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } andrews_squeezer_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

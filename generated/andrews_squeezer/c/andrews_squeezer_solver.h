@@ -67,6 +67,7 @@ typedef struct {
     andrews_squeezer_real phi[ANDREWS_SQUEEZER_NQ]; /* Phi, then the Newton step */
     andrews_squeezer_real shared[14]; /* sin, cos of the last iterate (andrews_squeezer_phi_phi_q) */
     andrews_squeezer_real nz_estimated[ANDREWS_SQUEEZER_NNZ]; /* Phi_q where the condition was estimated */
+    andrews_squeezer_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     andrews_squeezer_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     andrews_squeezer_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } andrews_squeezer_workspace;

@@ -16,7 +16,9 @@
 
 typedef struct {
     cam_cycloidal_real a[CAM_CYCLOIDAL_NQ * CAM_CYCLOIDAL_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    cam_cycloidal_real inv[CAM_CYCLOIDAL_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[CAM_CYCLOIDAL_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    cam_cycloidal_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } cam_cycloidal_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

@@ -67,6 +67,7 @@ typedef struct {
     cam_cycloidal_real phi[CAM_CYCLOIDAL_NQ]; /* Phi, then the Newton step */
     cam_cycloidal_real shared[8]; /* sin, cos of the last iterate (cam_cycloidal_phi_phi_q) */
     cam_cycloidal_real nz_estimated[CAM_CYCLOIDAL_NNZ]; /* Phi_q where the condition was estimated */
+    cam_cycloidal_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     cam_cycloidal_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     cam_cycloidal_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } cam_cycloidal_workspace;

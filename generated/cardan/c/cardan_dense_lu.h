@@ -16,7 +16,9 @@
 
 typedef struct {
     cardan_real a[CARDAN_NQ * CARDAN_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    cardan_real inv[CARDAN_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[CARDAN_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    cardan_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } cardan_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

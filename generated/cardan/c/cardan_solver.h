@@ -67,6 +67,7 @@ typedef struct {
     cardan_real phi[CARDAN_NQ]; /* Phi, then the Newton step */
     cardan_real shared[4]; /* sin, cos of the last iterate (cardan_phi_phi_q) */
     cardan_real nz_estimated[CARDAN_NNZ]; /* Phi_q where the condition was estimated */
+    cardan_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     cardan_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     cardan_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } cardan_workspace;

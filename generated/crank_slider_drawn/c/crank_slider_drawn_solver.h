@@ -67,6 +67,7 @@ typedef struct {
     crank_slider_drawn_real phi[CRANK_SLIDER_DRAWN_NQ]; /* Phi, then the Newton step */
     crank_slider_drawn_real shared[4]; /* sin, cos of the last iterate (crank_slider_drawn_phi_phi_q) */
     crank_slider_drawn_real nz_estimated[CRANK_SLIDER_DRAWN_NNZ]; /* Phi_q where the condition was estimated */
+    crank_slider_drawn_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     crank_slider_drawn_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_drawn_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } crank_slider_drawn_workspace;

@@ -16,7 +16,9 @@
 
 typedef struct {
     crank_slider_load_real a[CRANK_SLIDER_LOAD_NQ * CRANK_SLIDER_LOAD_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    crank_slider_load_real inv[CRANK_SLIDER_LOAD_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[CRANK_SLIDER_LOAD_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    crank_slider_load_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } crank_slider_load_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

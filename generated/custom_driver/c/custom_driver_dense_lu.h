@@ -16,7 +16,9 @@
 
 typedef struct {
     custom_driver_real a[CUSTOM_DRIVER_NQ * CUSTOM_DRIVER_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    custom_driver_real inv[CUSTOM_DRIVER_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[CUSTOM_DRIVER_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    custom_driver_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } custom_driver_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

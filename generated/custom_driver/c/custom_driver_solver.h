@@ -67,6 +67,7 @@ typedef struct {
     custom_driver_real phi[CUSTOM_DRIVER_NQ]; /* Phi, then the Newton step */
     custom_driver_real shared[7]; /* sin, cos of the last iterate (custom_driver_phi_phi_q) */
     custom_driver_real nz_estimated[CUSTOM_DRIVER_NNZ]; /* Phi_q where the condition was estimated */
+    custom_driver_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     custom_driver_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     custom_driver_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } custom_driver_workspace;

@@ -67,6 +67,7 @@ typedef struct {
     delta_real phi[DELTA_NQ]; /* Phi, then the Newton step */
     delta_real shared[9]; /* sin, cos of the last iterate (delta_phi_phi_q) */
     delta_real nz_estimated[DELTA_NNZ]; /* Phi_q where the condition was estimated */
+    delta_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     delta_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     delta_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } delta_workspace;

@@ -67,6 +67,7 @@ typedef struct {
     four_bar_real phi[FOUR_BAR_NQ]; /* Phi, then the Newton step */
     four_bar_real shared[6]; /* sin, cos of the last iterate (four_bar_phi_phi_q) */
     four_bar_real nz_estimated[FOUR_BAR_NNZ]; /* Phi_q where the condition was estimated */
+    four_bar_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     four_bar_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     four_bar_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } four_bar_workspace;

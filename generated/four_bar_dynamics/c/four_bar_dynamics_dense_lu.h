@@ -16,7 +16,9 @@
 
 typedef struct {
     four_bar_dynamics_real a[FOUR_BAR_DYNAMICS_NQ * FOUR_BAR_DYNAMICS_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    four_bar_dynamics_real inv[FOUR_BAR_DYNAMICS_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[FOUR_BAR_DYNAMICS_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    four_bar_dynamics_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } four_bar_dynamics_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

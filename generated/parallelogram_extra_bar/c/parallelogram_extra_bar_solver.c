@@ -263,43 +263,43 @@ static int parallelogram_extra_bar_exact_estimate(const parallelogram_extra_bar_
     return !work->lu.dense;
 }
 
+/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
+ * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
+static parallelogram_extra_bar_real parallelogram_extra_bar_difference_bound1(const parallelogram_extra_bar_real a[], const parallelogram_extra_bar_real b[])
+{
+    parallelogram_extra_bar_real sum = 0;
+    int e;
+    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_NNZ; ++e) sum += fabs(a[e] - b[e]);
+    return sum;
+}
+
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
+ * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
+ * or where the exact code would be long) is a chain of four or more solves, most of a dense
+ * step: it is made afresh only when Phi_q has moved too far from where the last one was made
+ * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one (it errs towards flagging), for one pass over the
+ * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
 static void parallelogram_extra_bar_estimate(parallelogram_extra_bar_workspace *work, parallelogram_extra_bar_report *report)
 {
-    /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = parallelogram_extra_bar_exact_estimate(work)
-        ? parallelogram_extra_bar_inverse_norm1_exact(work->lu.v, work->lu.inv)
-        : parallelogram_extra_bar_inverse_norm1(&work->lu);
-    report->cond = report->inv_norm * parallelogram_extra_bar_norm1(work->nz);
-}
-
-/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
-static parallelogram_extra_bar_real parallelogram_extra_bar_difference_norm1(const parallelogram_extra_bar_real a[], const parallelogram_extra_bar_real b[])
-{
-    parallelogram_extra_bar_real sums[PARALLELOGRAM_EXTRA_BAR_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < PARALLELOGRAM_EXTRA_BAR_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_NNZ; ++e) sums[parallelogram_extra_bar_phi_q_col[e]] += fabs(a[e] - b[e]);
-    for (j = 0; j < PARALLELOGRAM_EXTRA_BAR_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
-    return largest;
-}
-
-/* The estimate again after Newton moved q from where it was made (Phi_q then was in
- * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
- * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
- * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
- * a few per cent above the old one, for the price of one pass over the non-zeros. */
-static void parallelogram_extra_bar_estimate_again(parallelogram_extra_bar_workspace *work, parallelogram_extra_bar_report *report)
-{
     parallelogram_extra_bar_real theta;
-    if (!parallelogram_extra_bar_exact_estimate(work)) {
-        theta = report->inv_norm * parallelogram_extra_bar_difference_norm1(work->nz, work->nz_estimated);
-        if (theta <= PARALLELOGRAM_EXTRA_BAR_REESTIMATE_SHIFT) {
-            report->inv_norm /= 1 - theta;
-            report->cond = report->inv_norm * parallelogram_extra_bar_norm1(work->nz);
-            return;
-        }
+    if (parallelogram_extra_bar_exact_estimate(work)) {
+        report->inv_norm = parallelogram_extra_bar_inverse_norm1_exact(work->lu.v, work->lu.inv);
+        report->cond = report->inv_norm * parallelogram_extra_bar_norm1(work->nz);
+        return;
     }
-    parallelogram_extra_bar_estimate(work, report);
+    /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
+    theta = work->estimated_inv_norm * parallelogram_extra_bar_difference_bound1(work->nz, work->nz_estimated);
+    if (work->estimated_inv_norm >= 0 && theta <= PARALLELOGRAM_EXTRA_BAR_REESTIMATE_SHIFT) {
+        report->inv_norm = work->estimated_inv_norm / (1 - theta);
+    } else {
+        report->inv_norm = parallelogram_extra_bar_inverse_norm1(&work->lu);
+        work->estimated_inv_norm = report->inv_norm;
+        memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+    }
+    report->cond = report->inv_norm * parallelogram_extra_bar_norm1(work->nz);
 }
 
 static parallelogram_extra_bar_real parallelogram_extra_bar_at_least_1(parallelogram_extra_bar_real x)
@@ -417,9 +417,6 @@ static int parallelogram_extra_bar_converged(const parallelogram_extra_bar_optio
             if (!ill && !parallelogram_extra_bar_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_NQ; ++i) q[i] += work->phi[i];
-            if (!moved) { /* Phi_q where the estimate was made */
-                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
-            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             parallelogram_extra_bar_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = parallelogram_extra_bar_max_abs(work->phi);
@@ -432,7 +429,7 @@ static int parallelogram_extra_bar_converged(const parallelogram_extra_bar_optio
             if (!ill && !parallelogram_extra_bar_would_flag(options, work, report)) break;
         }
         if (moved) {
-            parallelogram_extra_bar_estimate_again(work, report);
+            parallelogram_extra_bar_estimate(work, report);
         }
     }
     return report->cond <= options->max_cond ? PARALLELOGRAM_EXTRA_BAR_OK : PARALLELOGRAM_EXTRA_BAR_SINGULAR;
@@ -501,6 +498,7 @@ int parallelogram_extra_bar_solve_step(const parallelogram_extra_bar_options *op
     } else {
         parallelogram_extra_bar_lu_init(&work->lu); /* the caller's workspace may hold anything */
         work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        work->estimated_inv_norm = -1; /* no condition estimate to start from */
     }
     report->status = parallelogram_extra_bar_newton(options, p, t, state->q, work, report);
     report->fallbacks = parallelogram_extra_bar_lu_fallbacks(&work->lu);

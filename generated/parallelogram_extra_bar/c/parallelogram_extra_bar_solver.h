@@ -67,6 +67,7 @@ typedef struct {
     parallelogram_extra_bar_real phi[PARALLELOGRAM_EXTRA_BAR_NQ]; /* Phi, then the Newton step */
     parallelogram_extra_bar_real shared[10]; /* sin, cos of the last iterate (parallelogram_extra_bar_phi_phi_q) */
     parallelogram_extra_bar_real nz_estimated[PARALLELOGRAM_EXTRA_BAR_NNZ]; /* Phi_q where the condition was estimated */
+    parallelogram_extra_bar_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     parallelogram_extra_bar_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     parallelogram_extra_bar_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } parallelogram_extra_bar_workspace;

@@ -16,7 +16,9 @@
 
 typedef struct {
     planetary_real a[PLANETARY_NQ * PLANETARY_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    planetary_real inv[PLANETARY_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[PLANETARY_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    planetary_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } planetary_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

@@ -67,6 +67,7 @@ typedef struct {
     planetary_real phi[PLANETARY_NQ]; /* Phi, then the Newton step */
     planetary_real shared[2]; /* sin, cos of the last iterate (planetary_phi_phi_q) */
     planetary_real nz_estimated[PLANETARY_NNZ]; /* Phi_q where the condition was estimated */
+    planetary_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     planetary_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     planetary_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } planetary_workspace;

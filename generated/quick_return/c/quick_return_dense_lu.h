@@ -16,7 +16,9 @@
 
 typedef struct {
     quick_return_real a[QUICK_RETURN_NQ * QUICK_RETURN_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    quick_return_real inv[QUICK_RETURN_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[QUICK_RETURN_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    quick_return_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } quick_return_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

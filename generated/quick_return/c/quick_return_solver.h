@@ -67,6 +67,7 @@ typedef struct {
     quick_return_real phi[QUICK_RETURN_NQ]; /* Phi, then the Newton step */
     quick_return_real shared[6]; /* sin, cos of the last iterate (quick_return_phi_phi_q) */
     quick_return_real nz_estimated[QUICK_RETURN_NNZ]; /* Phi_q where the condition was estimated */
+    quick_return_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     quick_return_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     quick_return_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } quick_return_workspace;

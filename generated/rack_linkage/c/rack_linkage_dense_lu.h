@@ -16,7 +16,9 @@
 
 typedef struct {
     rack_linkage_real a[RACK_LINKAGE_NQ * RACK_LINKAGE_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    rack_linkage_real inv[RACK_LINKAGE_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[RACK_LINKAGE_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    rack_linkage_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } rack_linkage_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

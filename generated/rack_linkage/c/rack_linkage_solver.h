@@ -67,6 +67,7 @@ typedef struct {
     rack_linkage_real phi[RACK_LINKAGE_NQ]; /* Phi, then the Newton step */
     rack_linkage_real shared[7]; /* sin, cos of the last iterate (rack_linkage_phi_phi_q) */
     rack_linkage_real nz_estimated[RACK_LINKAGE_NNZ]; /* Phi_q where the condition was estimated */
+    rack_linkage_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     rack_linkage_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     rack_linkage_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } rack_linkage_workspace;

@@ -16,7 +16,9 @@
 
 typedef struct {
     rssr_real a[RSSR_NQ * RSSR_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    rssr_real inv[RSSR_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[RSSR_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    rssr_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } rssr_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

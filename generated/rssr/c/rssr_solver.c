@@ -553,43 +553,43 @@ static int rssr_exact_estimate(const rssr_workspace *work)
     return !work->lu.dense;
 }
 
+/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
+ * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
+static rssr_real rssr_difference_bound1(const rssr_real a[], const rssr_real b[])
+{
+    rssr_real sum = 0;
+    int e;
+    for (e = 0; e < RSSR_NNZ; ++e) sum += fabs(a[e] - b[e]);
+    return sum;
+}
+
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
+ * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
+ * or where the exact code would be long) is a chain of four or more solves, most of a dense
+ * step: it is made afresh only when Phi_q has moved too far from where the last one was made
+ * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one (it errs towards flagging), for one pass over the
+ * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
 static void rssr_estimate(rssr_workspace *work, rssr_report *report)
 {
-    /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = rssr_exact_estimate(work)
-        ? rssr_inverse_norm1_exact(work->lu.v, work->lu.inv)
-        : rssr_inverse_norm1(&work->lu);
-    report->cond = report->inv_norm * rssr_norm1(work->nz);
-}
-
-/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
-static rssr_real rssr_difference_norm1(const rssr_real a[], const rssr_real b[])
-{
-    rssr_real sums[RSSR_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < RSSR_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < RSSR_NNZ; ++e) sums[rssr_phi_q_col[e]] += fabs(a[e] - b[e]);
-    for (j = 0; j < RSSR_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
-    return largest;
-}
-
-/* The estimate again after Newton moved q from where it was made (Phi_q then was in
- * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
- * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
- * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
- * a few per cent above the old one, for the price of one pass over the non-zeros. */
-static void rssr_estimate_again(rssr_workspace *work, rssr_report *report)
-{
     rssr_real theta;
-    if (!rssr_exact_estimate(work)) {
-        theta = report->inv_norm * rssr_difference_norm1(work->nz, work->nz_estimated);
-        if (theta <= RSSR_REESTIMATE_SHIFT) {
-            report->inv_norm /= 1 - theta;
-            report->cond = report->inv_norm * rssr_norm1(work->nz);
-            return;
-        }
+    if (rssr_exact_estimate(work)) {
+        report->inv_norm = rssr_inverse_norm1_exact(work->lu.v, work->lu.inv);
+        report->cond = report->inv_norm * rssr_norm1(work->nz);
+        return;
     }
-    rssr_estimate(work, report);
+    /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
+    theta = work->estimated_inv_norm * rssr_difference_bound1(work->nz, work->nz_estimated);
+    if (work->estimated_inv_norm >= 0 && theta <= RSSR_REESTIMATE_SHIFT) {
+        report->inv_norm = work->estimated_inv_norm / (1 - theta);
+    } else {
+        report->inv_norm = rssr_inverse_norm1(&work->lu);
+        work->estimated_inv_norm = report->inv_norm;
+        memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+    }
+    report->cond = report->inv_norm * rssr_norm1(work->nz);
 }
 
 static rssr_real rssr_at_least_1(rssr_real x)
@@ -707,9 +707,6 @@ static int rssr_converged(const rssr_options *options, const rssr_real p[],
             if (!ill && !rssr_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < RSSR_NQ; ++i) q[i] += work->phi[i];
-            if (!moved) { /* Phi_q where the estimate was made */
-                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
-            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             rssr_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = rssr_max_abs(work->phi);
@@ -722,7 +719,7 @@ static int rssr_converged(const rssr_options *options, const rssr_real p[],
             if (!ill && !rssr_would_flag(options, work, report)) break;
         }
         if (moved) {
-            rssr_estimate_again(work, report);
+            rssr_estimate(work, report);
         }
     }
     return report->cond <= options->max_cond ? RSSR_OK : RSSR_SINGULAR;
@@ -791,6 +788,7 @@ int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real 
     } else {
         rssr_lu_init(&work->lu); /* the caller's workspace may hold anything */
         work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        work->estimated_inv_norm = -1; /* no condition estimate to start from */
     }
     report->status = rssr_newton(options, p, t, state->q, work, report);
     report->fallbacks = rssr_lu_fallbacks(&work->lu);

@@ -67,6 +67,7 @@ typedef struct {
     rssr_real phi[RSSR_NQ]; /* Phi, then the Newton step */
     rssr_real shared[2]; /* sin, cos of the last iterate (rssr_phi_phi_q) */
     rssr_real nz_estimated[RSSR_NNZ]; /* Phi_q where the condition was estimated */
+    rssr_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     rssr_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     rssr_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } rssr_workspace;

@@ -16,7 +16,9 @@
 
 typedef struct {
     spatial_slider_crank_real a[SPATIAL_SLIDER_CRANK_NQ * SPATIAL_SLIDER_CRANK_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    spatial_slider_crank_real inv[SPATIAL_SLIDER_CRANK_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[SPATIAL_SLIDER_CRANK_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    spatial_slider_crank_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } spatial_slider_crank_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

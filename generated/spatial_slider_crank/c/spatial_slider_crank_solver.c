@@ -214,47 +214,39 @@ static spatial_slider_crank_real spatial_slider_crank_norm1(const spatial_slider
     return largest;
 }
 
-/* Where the estimate is exact (the sparse factors of a mechanism with a short exact code). */
-static int spatial_slider_crank_exact_estimate(const spatial_slider_crank_workspace *work)
+
+/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
+ * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
+static spatial_slider_crank_real spatial_slider_crank_difference_bound1(const spatial_slider_crank_real a[], const spatial_slider_crank_real b[])
 {
-    (void)work;
-    return 0;
+    spatial_slider_crank_real sum = 0;
+    int e;
+    for (e = 0; e < SPATIAL_SLIDER_CRANK_NNZ; ++e) sum += fabs(a[e] - b[e]);
+    return sum;
 }
 
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
+ * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
+ * or where the exact code would be long) is a chain of four or more solves, most of a dense
+ * step: it is made afresh only when Phi_q has moved too far from where the last one was made
+ * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one (it errs towards flagging), for one pass over the
+ * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
 static void spatial_slider_crank_estimate(spatial_slider_crank_workspace *work, spatial_slider_crank_report *report)
 {
-    report->inv_norm = spatial_slider_crank_inverse_norm1(&work->lu);
-    report->cond = report->inv_norm * spatial_slider_crank_norm1(work->nz);
-}
-
-/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
-static spatial_slider_crank_real spatial_slider_crank_difference_norm1(const spatial_slider_crank_real a[], const spatial_slider_crank_real b[])
-{
-    spatial_slider_crank_real sums[SPATIAL_SLIDER_CRANK_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < SPATIAL_SLIDER_CRANK_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < SPATIAL_SLIDER_CRANK_NNZ; ++e) sums[spatial_slider_crank_phi_q_col[e]] += fabs(a[e] - b[e]);
-    for (j = 0; j < SPATIAL_SLIDER_CRANK_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
-    return largest;
-}
-
-/* The estimate again after Newton moved q from where it was made (Phi_q then was in
- * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
- * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
- * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
- * a few per cent above the old one, for the price of one pass over the non-zeros. */
-static void spatial_slider_crank_estimate_again(spatial_slider_crank_workspace *work, spatial_slider_crank_report *report)
-{
     spatial_slider_crank_real theta;
-    if (!spatial_slider_crank_exact_estimate(work)) {
-        theta = report->inv_norm * spatial_slider_crank_difference_norm1(work->nz, work->nz_estimated);
-        if (theta <= SPATIAL_SLIDER_CRANK_REESTIMATE_SHIFT) {
-            report->inv_norm /= 1 - theta;
-            report->cond = report->inv_norm * spatial_slider_crank_norm1(work->nz);
-            return;
-        }
+    /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
+    theta = work->estimated_inv_norm * spatial_slider_crank_difference_bound1(work->nz, work->nz_estimated);
+    if (work->estimated_inv_norm >= 0 && theta <= SPATIAL_SLIDER_CRANK_REESTIMATE_SHIFT) {
+        report->inv_norm = work->estimated_inv_norm / (1 - theta);
+    } else {
+        report->inv_norm = spatial_slider_crank_inverse_norm1(&work->lu);
+        work->estimated_inv_norm = report->inv_norm;
+        memcpy(work->nz_estimated, work->nz, sizeof work->nz);
     }
-    spatial_slider_crank_estimate(work, report);
+    report->cond = report->inv_norm * spatial_slider_crank_norm1(work->nz);
 }
 
 static spatial_slider_crank_real spatial_slider_crank_at_least_1(spatial_slider_crank_real x)
@@ -372,9 +364,6 @@ static int spatial_slider_crank_converged(const spatial_slider_crank_options *op
             if (!ill && !spatial_slider_crank_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) q[i] += work->phi[i];
-            if (!moved) { /* Phi_q where the estimate was made */
-                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
-            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             spatial_slider_crank_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = spatial_slider_crank_max_abs(work->phi);
@@ -387,7 +376,7 @@ static int spatial_slider_crank_converged(const spatial_slider_crank_options *op
             if (!ill && !spatial_slider_crank_would_flag(options, work, report)) break;
         }
         if (moved) {
-            spatial_slider_crank_estimate_again(work, report);
+            spatial_slider_crank_estimate(work, report);
         }
     }
     return report->cond <= options->max_cond ? SPATIAL_SLIDER_CRANK_OK : SPATIAL_SLIDER_CRANK_SINGULAR;
@@ -456,6 +445,7 @@ int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options,
     } else {
         spatial_slider_crank_lu_init(&work->lu); /* the caller's workspace may hold anything */
         work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        work->estimated_inv_norm = -1; /* no condition estimate to start from */
     }
     report->status = spatial_slider_crank_newton(options, p, t, state->q, work, report);
     report->fallbacks = spatial_slider_crank_lu_fallbacks(&work->lu);

@@ -67,6 +67,7 @@ typedef struct {
     spatial_slider_crank_real phi[SPATIAL_SLIDER_CRANK_NQ]; /* Phi, then the Newton step */
     spatial_slider_crank_real shared[2]; /* sin, cos of the last iterate (spatial_slider_crank_phi_phi_q) */
     spatial_slider_crank_real nz_estimated[SPATIAL_SLIDER_CRANK_NNZ]; /* Phi_q where the condition was estimated */
+    spatial_slider_crank_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     spatial_slider_crank_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     spatial_slider_crank_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } spatial_slider_crank_workspace;

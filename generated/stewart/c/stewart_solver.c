@@ -565,43 +565,43 @@ static int stewart_exact_estimate(const stewart_workspace *work)
     return !work->lu.dense;
 }
 
+/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
+ * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
+static stewart_real stewart_difference_bound1(const stewart_real a[], const stewart_real b[])
+{
+    stewart_real sum = 0;
+    int e;
+    for (e = 0; e < STEWART_NNZ; ++e) sum += fabs(a[e] - b[e]);
+    return sum;
+}
+
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
+ * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
+ * or where the exact code would be long) is a chain of four or more solves, most of a dense
+ * step: it is made afresh only when Phi_q has moved too far from where the last one was made
+ * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one (it errs towards flagging), for one pass over the
+ * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
 static void stewart_estimate(stewart_workspace *work, stewart_report *report)
 {
-    /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = stewart_exact_estimate(work)
-        ? stewart_inverse_norm1_exact(work->lu.v, work->lu.inv)
-        : stewart_inverse_norm1(&work->lu);
-    report->cond = report->inv_norm * stewart_norm1(work->nz);
-}
-
-/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
-static stewart_real stewart_difference_norm1(const stewart_real a[], const stewart_real b[])
-{
-    stewart_real sums[STEWART_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < STEWART_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < STEWART_NNZ; ++e) sums[stewart_phi_q_col[e]] += fabs(a[e] - b[e]);
-    for (j = 0; j < STEWART_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
-    return largest;
-}
-
-/* The estimate again after Newton moved q from where it was made (Phi_q then was in
- * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
- * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
- * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
- * a few per cent above the old one, for the price of one pass over the non-zeros. */
-static void stewart_estimate_again(stewart_workspace *work, stewart_report *report)
-{
     stewart_real theta;
-    if (!stewart_exact_estimate(work)) {
-        theta = report->inv_norm * stewart_difference_norm1(work->nz, work->nz_estimated);
-        if (theta <= STEWART_REESTIMATE_SHIFT) {
-            report->inv_norm /= 1 - theta;
-            report->cond = report->inv_norm * stewart_norm1(work->nz);
-            return;
-        }
+    if (stewart_exact_estimate(work)) {
+        report->inv_norm = stewart_inverse_norm1_exact(work->lu.v, work->lu.inv);
+        report->cond = report->inv_norm * stewart_norm1(work->nz);
+        return;
     }
-    stewart_estimate(work, report);
+    /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
+    theta = work->estimated_inv_norm * stewart_difference_bound1(work->nz, work->nz_estimated);
+    if (work->estimated_inv_norm >= 0 && theta <= STEWART_REESTIMATE_SHIFT) {
+        report->inv_norm = work->estimated_inv_norm / (1 - theta);
+    } else {
+        report->inv_norm = stewart_inverse_norm1(&work->lu);
+        work->estimated_inv_norm = report->inv_norm;
+        memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+    }
+    report->cond = report->inv_norm * stewart_norm1(work->nz);
 }
 
 static stewart_real stewart_at_least_1(stewart_real x)
@@ -719,9 +719,6 @@ static int stewart_converged(const stewart_options *options, const stewart_real 
             if (!ill && !stewart_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
             for (i = 0; i < STEWART_NQ; ++i) q[i] += work->phi[i];
-            if (!moved) { /* Phi_q where the estimate was made */
-                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
-            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             stewart_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
             report->residual = stewart_max_abs(work->phi);
@@ -734,7 +731,7 @@ static int stewart_converged(const stewart_options *options, const stewart_real 
             if (!ill && !stewart_would_flag(options, work, report)) break;
         }
         if (moved) {
-            stewart_estimate_again(work, report);
+            stewart_estimate(work, report);
         }
     }
     return report->cond <= options->max_cond ? STEWART_OK : STEWART_SINGULAR;
@@ -803,6 +800,7 @@ int stewart_solve_step(const stewart_options *options, const stewart_real p[], s
     } else {
         stewart_lu_init(&work->lu); /* the caller's workspace may hold anything */
         work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        work->estimated_inv_norm = -1; /* no condition estimate to start from */
     }
     report->status = stewart_newton(options, p, t, state->q, work, report);
     report->fallbacks = stewart_lu_fallbacks(&work->lu);

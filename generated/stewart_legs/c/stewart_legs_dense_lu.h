@@ -16,7 +16,9 @@
 
 typedef struct {
     stewart_legs_real a[STEWART_LEGS_NQ * STEWART_LEGS_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    stewart_legs_real inv[STEWART_LEGS_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[STEWART_LEGS_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    stewart_legs_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } stewart_legs_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

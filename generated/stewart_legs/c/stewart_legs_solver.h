@@ -67,6 +67,7 @@ typedef struct {
     stewart_legs_real phi[STEWART_LEGS_NQ]; /* Phi, then the Newton step */
     stewart_legs_real shared[7]; /* sin, cos of the last iterate (stewart_legs_phi_phi_q) */
     stewart_legs_real nz_estimated[STEWART_LEGS_NNZ]; /* Phi_q where the condition was estimated */
+    stewart_legs_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     stewart_legs_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_legs_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } stewart_legs_workspace;

@@ -67,6 +67,7 @@ typedef struct {
     whitworth_drawn_real phi[WHITWORTH_DRAWN_NQ]; /* Phi, then the Newton step */
     whitworth_drawn_real shared[6]; /* sin, cos of the last iterate (whitworth_drawn_phi_phi_q) */
     whitworth_drawn_real nz_estimated[WHITWORTH_DRAWN_NNZ]; /* Phi_q where the condition was estimated */
+    whitworth_drawn_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     whitworth_drawn_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     whitworth_drawn_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
 } whitworth_drawn_workspace;

@@ -3,7 +3,8 @@ straight-line column sums, Phi_q's numbers folded in) equals the largest column 
 ||Phi_q^-1||_1 is exact where the generated code computes the inverse's columns
 (backends.c.inverse_code: every example here) and equals the largest column sum of
 numpy.linalg.inv; where that code would be too long, the solver runs the Hager-Higham estimate
-of runtime.accuracy instead, a lower bound that is usually exact."""
+of runtime.accuracy instead, a lower bound that is usually exact (carried from point to point
+by the Banach lemma while Phi_q moves little)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import pytest
 import symkin
 from symkin import backends
 from symkin.backends.c import inverse_code
+from symkin.contract import tuning
 from symkin.runtime import accuracy, driver, linalg
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[3] / "examples"
@@ -64,7 +66,11 @@ def test_hager_estimate_where_the_exact_code_would_be_long(
         expected = accuracy.inverse_norm1(lambda b: np.linalg.solve(a, b),
                                           lambda b: np.linalg.solve(a.T, b), len(a))
         exact = np.abs(np.linalg.inv(a)).sum(axis=0).max()
-        assert exact / 3 <= report.inv_norm <= exact * (1 + 1e-9)
+        # Hager's lower bound, or the Banach-lemma bound from the last fresh estimate,
+        # which may exceed the exact norm by 1 / (1 - REESTIMATE_SHIFT)^2 at most
+        # (tests/backends/c/test_dense_condition.py)
+        carried = exact / (1 - tuning.REESTIMATE_SHIFT) ** 2
+        assert exact / 3 <= report.inv_norm <= carried * (1 + 1e-9)
         points += 1
         same += report.inv_norm == pytest.approx(expected, rel=1e-9)
     # both are the same estimator on LUs that round differently: near a tie of two columns
