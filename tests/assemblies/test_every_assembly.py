@@ -1,0 +1,160 @@
+"""Every assembly at given inputs (symkin.scan(kernel, inputs=...)): the number found equals
+the number counted here, independently of symkin, and each assembly closes the loops.
+
+The counts: a planar 3-RRR at fixed actuated angles is a 3-RPR (elbows fixed, distal links of
+fixed length). Sweeping the platform angle phi, legs 1 and 2 place the platform in closed form
+(two circles meet, two branches); the sign changes of leg 3's residual along both branches
+count the assemblies (the branches join where the circles touch, with equal residuals, so no
+root is lost there), and bisection gives each pose. A 3-3 (octahedral) Stewart platform: each
+platform vertex lies on a circle about a base edge; sweeping vertex 1's angle, vertices 2 and 3
+follow in closed form (two roots each), and the sign changes of the third side's residual over
+the four branch pairs count the assemblies. The four-bar: two (circle intersections).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import symkin
+from symkin.runtime.scan import scan
+
+SWEEP = 200_000
+
+
+def _sign_changes(f: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """Indices k where f changes sign from sample k to k + 1 (periodic), both valid."""
+    both = valid & np.roll(valid, -1)
+    return np.flatnonzero(both & (np.sign(f) != np.sign(np.roll(f, -1))))
+
+
+def _bisect(f: Callable[[float], float], a: float, b: float) -> float:
+    fa = f(a)
+    for _ in range(80):
+        m = 0.5 * (a + b)
+        fm = f(m)
+        if (fm > 0) == (fa > 0):
+            a, fa = m, fm
+        else:
+            b = m
+    return 0.5 * (a + b)
+
+
+def _rotation2(phi: float) -> np.ndarray:
+    return np.array([[math.cos(phi), -math.sin(phi)], [math.sin(phi), math.cos(phi)]])
+
+
+# --- the planar 3-RRR, counted as a 3-RPR -------------------------------------------------
+
+ELBOWS = np.array([[-0.02, 0.11], [-0.79, 0.73], [-0.44, -0.11]])
+PLATFORM = np.array([[-0.53, -0.6], [-0.37, -0.19], [0.51, 0.47]])  # in its own frame
+DISTAL = np.array([0.88, 0.85, 1.1])
+PROXIMAL = 0.4  # the actuated link: its angle fixes the elbow
+
+
+def _rpr_place(phi: np.ndarray, sign: int) -> tuple[np.ndarray, np.ndarray]:
+    """The platform origin where legs 1 and 2 close at platform angles phi (branch sign), and
+    where they can (the two circles meet)."""
+    c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    k1, k2 = (ELBOWS[k] - np.hstack([c * PLATFORM[k][0] - s * PLATFORM[k][1],
+                                     s * PLATFORM[k][0] + c * PLATFORM[k][1]]) for k in (0, 1))
+    d = k2 - k1
+    length = np.linalg.norm(d, axis=1)
+    along = (DISTAL[0]**2 - DISTAL[1]**2 + length**2) / (2 * length)
+    h2 = DISTAL[0]**2 - along**2
+    u = d / length[:, None]
+    normal = np.stack([-u[:, 1], u[:, 0]], axis=1)
+    return (k1 + along[:, None] * u + sign * np.sqrt(np.maximum(h2, 0.0))[:, None] * normal,
+            h2 > 0)
+
+
+def _rpr_residual(phi: np.ndarray, sign: int) -> np.ndarray:
+    origin, _ = _rpr_place(phi, sign)
+    c, s = np.cos(phi), np.sin(phi)
+    joint = origin + np.stack([c * PLATFORM[2][0] - s * PLATFORM[2][1],
+                               s * PLATFORM[2][0] + c * PLATFORM[2][1]], axis=1)
+    return np.sum((joint - ELBOWS[2])**2, axis=1) - DISTAL[2]**2
+
+
+def rpr_poses() -> list[np.ndarray]:
+    """Every (x, y, phi) of the platform, by the sweep of the module docstring."""
+    phis = np.linspace(-math.pi, math.pi, SWEEP, endpoint=False)
+    step = 2 * math.pi / SWEEP
+    poses = []
+    for sign in (1, -1):
+        _, valid = _rpr_place(phis, sign)
+        for k in _sign_changes(_rpr_residual(phis, sign), valid):
+            phi = _bisect(lambda v: float(_rpr_residual(np.array([v]), sign)[0]), phis[k],
+                          phis[k] + step)
+            origin = _rpr_place(np.array([phi]), sign)[0][0]
+            poses.append(np.array([*origin, math.remainder(phi, 2 * math.pi)]))
+    return poses
+
+
+def _point(values: np.ndarray) -> str:
+    return "[" + ", ".join(repr(float(v)) for v in values) + "]"
+
+
+def _rrr_file(tmp_path: Path, pose: np.ndarray) -> Path:
+    """A 3-RRR drawn in the assembly ``pose``: ground pivot A_k at PROXIMAL from the elbow."""
+    lines = ["name: rrr_six", "layout: drawn", "bodies:"]
+    pivots = ELBOWS + PROXIMAL * np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+    joints = [_rotation2(pose[2]) @ PLATFORM[k] + pose[:2] for k in range(3)]
+    lines.append("  ground: {points: {%s}}" % ", ".join(
+        f"A{k + 1}: {_point(pivots[k])}" for k in range(3)))
+    for k in range(3):
+        n = k + 1
+        lines.append(f"  prox{n}: {{points: {{A{n}: {_point(pivots[k])}, "
+                     f"E{n}: {_point(ELBOWS[k])}}}}}")
+        lines.append(f"  dist{n}: {{points: {{E{n}: {_point(ELBOWS[k])}, "
+                     f"C{n}: {_point(joints[k])}}}}}")
+    lines.append(f"  platform: {{frame: {{origin: {_point(pose[:2])}, angle: {float(pose[2])!r}}}, "
+                 "points: {%s}}" % ", ".join(f"C{k + 1}: {_point(joints[k])}" for k in range(3)))
+    lines.append("joints:")
+    for n in (1, 2, 3):
+        lines += [f"  - {{type: revolute, i: ground, j: prox{n}, at: A{n}}}",
+                  f"  - {{type: revolute, i: prox{n}, j: dist{n}, at: E{n}}}",
+                  f"  - {{type: revolute, i: dist{n}, j: platform, at: C{n}}}"]
+    lines.append("drivers:")
+    lines += [f"  - {{type: angle, name: theta{n}, i: prox{n}, j: ground, theta: input}}"
+              for n in (1, 2, 3)]
+    lines.append("time: {t0: 0, t1: 1, dt: 0.1}")
+    path = tmp_path / "rrr_six.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_the_3rpr_sweep_counts_six() -> None:
+    """The independent count itself: six poses, each closing all three legs."""
+    poses = rpr_poses()
+    assert len(poses) == 6
+    for x, y, phi in poses:
+        for k in range(3):
+            gap = np.array([x, y]) + _rotation2(phi) @ PLATFORM[k] - ELBOWS[k]
+            assert abs(np.linalg.norm(gap) - DISTAL[k]) < 1e-10
+
+
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_3rrr_has_the_six_assemblies_counted_by_the_sweep(tmp_path: Path, backend: str) -> None:
+    expected = rpr_poses()
+    kernel = symkin.compile(symkin.derive(_rrr_file(tmp_path, expected[0])), backend=backend)
+    report = scan(kernel, inputs={"theta1": 0.0, "theta2": 0.0, "theta3": 0.0})
+    assert report.motions == () and dict(report.inputs) == {f"theta{n}": 0.0 for n in (1, 2, 3)}
+    names = kernel.coordinates
+    at = [names.index(f"platform.{c}") for c in ("x", "y", "phi")]
+    found = [b.q[at] for b in report.branches]
+    assert len(found) == len(expected) == 6
+    for pose in expected:
+        matches = [f for f in found if max(abs(f[0] - pose[0]), abs(f[1] - pose[1]),
+                                           abs(math.remainder(f[2] - pose[2], 2 * math.pi)))
+                   < 1e-8]
+        assert len(matches) == 1, (pose, found)
+    for branch in report.branches:  # the loops close: each distal link spans elbow to joint
+        x, y, phi = branch.q[at]
+        for k in range(3):
+            joint = np.array([x, y]) + _rotation2(phi) @ PLATFORM[k]
+            assert abs(np.linalg.norm(joint - ELBOWS[k]) - DISTAL[k]) < 1e-10
