@@ -40,10 +40,10 @@ from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
 
-STARTS = 64
+STARTS = 160
 """Starts tried at most."""
 
-PATIENCE = 24
+PATIENCE = 100
 """The search ends after this many starts in a row that found no new assembly."""
 
 DEFLATED_ITERATIONS = 80

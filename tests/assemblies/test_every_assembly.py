@@ -158,3 +158,119 @@ def test_3rrr_has_the_six_assemblies_counted_by_the_sweep(tmp_path: Path, backen
         for k in range(3):
             joint = np.array([x, y]) + _rotation2(phi) @ PLATFORM[k]
             assert abs(np.linalg.norm(joint - ELBOWS[k]) - DISTAL[k]) < 1e-10
+
+
+# --- the 3-3 (octahedral) Stewart platform -------------------------------------------------
+
+BASE = np.array([[1.0, 0.0, 0.0], [-0.5, math.sqrt(3) / 2, 0.0], [-0.5, -math.sqrt(3) / 2, 0.0]])
+LEGS = np.array([1.363, 0.996, 1.373, 1.018, 0.802, 1.306])  # B1P1 B2P1 B2P2 B3P2 B3P3 B1P3
+SIDES = np.array([1.057, 1.203, 0.662])  # |P1P2|, |P1P3|, |P2P3|
+ENDS = ((0, 1), (1, 2), (2, 0))  # the base vertices of platform vertex k's two legs
+
+
+def _circle(k: int) -> tuple[np.ndarray, float, np.ndarray, np.ndarray]:
+    """Centre, radius and in-plane axes of the circle platform vertex k moves on: about the
+    base edge of its two legs, at their lengths."""
+    b1, b2 = BASE[ENDS[k][0]], BASE[ENDS[k][1]]
+    r1, r2 = LEGS[2 * k], LEGS[2 * k + 1]
+    edge = b2 - b1
+    span = float(np.linalg.norm(edge))
+    w = edge / span
+    along = (r1**2 - r2**2 + span**2) / (2 * span)
+    u = np.cross(w, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    return b1 + along * w, math.sqrt(r1**2 - along**2), u, np.cross(w, u)
+
+
+def _on(k: int, angle: np.ndarray) -> np.ndarray:
+    centre, radius, u, v = _circle(k)
+    return centre + radius * (np.cos(angle)[:, None] * u + np.sin(angle)[:, None] * v)
+
+
+def _follow(k: int, vertex: np.ndarray, side: float, sign: int) -> tuple[np.ndarray, np.ndarray]:
+    """Vertex k's angles at distance ``side`` from vertex 1 (branch sign): a cos + b sin = c."""
+    centre, radius, u, v = _circle(k)
+    m = centre - vertex
+    a, b = 2 * radius * (m @ u), 2 * radius * (m @ v)
+    c = side**2 - np.sum(m * m, axis=1) - radius**2
+    reach = np.hypot(a, b)
+    return (np.arctan2(b, a) + sign * np.arccos(np.clip(c / reach, -1, 1)),
+            np.abs(c) < reach)
+
+
+def _third_side(theta: np.ndarray, s2: int, s3: int) -> tuple[np.ndarray, np.ndarray]:
+    vertex = _on(0, theta)
+    a2, ok2 = _follow(1, vertex, SIDES[0], s2)
+    a3, ok3 = _follow(2, vertex, SIDES[1], s3)
+    return np.sum((_on(1, a2) - _on(2, a3))**2, axis=1) - SIDES[2]**2, ok2 & ok3
+
+
+def stewart_vertices() -> list[np.ndarray]:
+    """The platform's vertices (3, 3) in every assembly, by the sweep of the docstring."""
+    thetas = np.linspace(-math.pi, math.pi, SWEEP, endpoint=False)
+    step = 2 * math.pi / SWEEP
+    found = []
+    for s2 in (1, -1):
+        for s3 in (1, -1):
+            f, valid = _third_side(thetas, s2, s3)
+            for k in _sign_changes(f, valid):
+                theta = np.array([_bisect(lambda v: float(_third_side(np.array([v]), s2, s3)[0][0]),
+                                          thetas[k], thetas[k] + step)])
+                vertex = _on(0, theta)
+                found.append(np.vstack([vertex, _on(1, _follow(1, vertex, SIDES[0], s2)[0]),
+                                        _on(2, _follow(2, vertex, SIDES[1], s3)[0])]))
+    return found
+
+
+def _stewart_file(tmp_path: Path, vertices: np.ndarray) -> Path:
+    """The 3-3 platform drawn at ``vertices``, its six legs distance drivers with input f."""
+    ground = ", ".join(f"B{k + 1}: {_point(BASE[k])}" for k in range(3))
+    top = ", ".join(f"P{k + 1}: {_point(vertices[k])}" for k in range(3))
+    legs = [f"  - {{type: distance, name: leg{2 * k + n + 1}, i: ground, j: platform, "
+            f"A: B{ENDS[k][n] + 1}, B: P{k + 1}, f: input}}" for k in range(3) for n in (0, 1)]
+    path = tmp_path / "octahedral.yaml"
+    path.write_text("\n".join(["name: octahedral", "space: 3d", "layout: drawn", "bodies:",
+                               f"  ground: {{points: {{{ground}}}}}",
+                               f"  platform: {{points: {{{top}}}}}", "joints: []", "drivers:",
+                               *legs, "time: {t0: 0, t1: 1, dt: 0.1}"]) + "\n")
+    return path
+
+
+def _rotation(e: np.ndarray) -> np.ndarray:
+    """A(e) of unit Euler parameters, written out here."""
+    e0, e1, e2, e3 = e
+    return 2 * np.array([
+        [e0 * e0 + e1 * e1 - 0.5, e1 * e2 - e0 * e3, e1 * e3 + e0 * e2],
+        [e1 * e2 + e0 * e3, e0 * e0 + e2 * e2 - 0.5, e2 * e3 - e0 * e1],
+        [e1 * e3 - e0 * e2, e2 * e3 + e0 * e1, e0 * e0 + e3 * e3 - 0.5]])
+
+
+def test_the_octahedral_sweep_counts_twelve() -> None:
+    found = stewart_vertices()
+    assert len(found) == 12
+    for vertices in found:
+        for k, (i, j) in enumerate(ENDS):
+            assert abs(np.linalg.norm(vertices[k] - BASE[i]) - LEGS[2 * k]) < 1e-10
+            assert abs(np.linalg.norm(vertices[k] - BASE[j]) - LEGS[2 * k + 1]) < 1e-10
+        sides = [np.linalg.norm(vertices[a] - vertices[b]) for a, b in ((0, 1), (0, 2), (1, 2))]
+        assert np.max(np.abs(np.array(sides) - SIDES)) < 1e-10
+
+
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_stewart_3_3_has_the_twelve_assemblies_counted_by_the_sweep(tmp_path: Path,
+                                                                     backend: str) -> None:
+    expected = stewart_vertices()
+    kernel = symkin.compile(symkin.derive(_stewart_file(tmp_path, expected[0])), backend=backend)
+    report = scan(kernel, inputs=LEGS)
+    names = kernel.coordinates
+    r = [names.index(f"platform.{c}") for c in ("x", "y", "z")]
+    e = [names.index(f"platform.e{k}") for k in range(4)]
+    local = expected[0] - expected[0][0]  # the frame: at P1, axes as drawn
+    found = [branch.q[r] + local @ _rotation(branch.q[e]).T for branch in report.branches]
+    assert len(found) == len(expected) == 12
+    for vertices in expected:
+        assert sum(np.max(np.abs(f - vertices)) < 1e-8 for f in found) == 1
+    for vertices in found:  # every leg closes
+        for k, (i, j) in enumerate(ENDS):
+            assert abs(np.linalg.norm(vertices[k] - BASE[i]) - LEGS[2 * k]) < 1e-10
+            assert abs(np.linalg.norm(vertices[k] - BASE[j]) - LEGS[2 * k + 1]) < 1e-10
