@@ -16,10 +16,10 @@ Phi_q at points) does not give; deflation needs only what Newton needs.
 The starts are seeded (the same every time): those of the damped assembly (runtime.assembly:
 q0, the bodies placed along their joints, q0 perturbed, random angles), each after q0 with
 random Euler parameters (uniform on the unit sphere). The search stops after STARTS starts
-or after PATIENCE starts in a row that found nothing new. Each root of the deflated Newton is polished by the
-runtime's Newton (the same test as a run), which gives its condition; two roots are one
-assembly when they agree to SAME (angles modulo 2 pi, Euler parameters up to their sign).
-Imports NumPy only: part of the runtime.
+or after PATIENCE starts in a row that found nothing new. Each root of the deflated Newton is
+polished by the runtime's Newton (the same test as a run), which gives its condition; two
+roots are one assembly when they agree to SAME (angles modulo 2 pi, Euler parameters up to
+their sign). Imports NumPy only: part of the runtime.
 """
 
 from __future__ import annotations
