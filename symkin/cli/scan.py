@@ -68,12 +68,12 @@ def handle(args: argparse.Namespace) -> int:
         return messages.error(f"{args.mechanism}: {inputs}", EXIT_BAD_INPUT)
     try:
         report = scan(kernel, t=times, all_branches=args.all_branches, inputs=inputs)
+    except driver.SolveInterrupted:  # a SolveError too: first
+        messages.note("interrupted")
+        return EXIT_INTERRUPTED
     except SolveError as error:
         return messages.error(f"{args.mechanism}: {error} (give --input NAME=VALUE for each "
                               "input driver)", EXIT_BAD_INPUT)
-    except driver.SolveInterrupted:
-        messages.note("interrupted")
-        return EXIT_INTERRUPTED
     print(text(report, kernel.name, f"t = {t0:g} to {t1:g} by {dt:g}, {kernel.backend} backend"),
           end="")
     return EXIT_OK

@@ -8,8 +8,9 @@ Birkisson and Funke 2015) repels Newton from the assemblies already found: it so
 M(q) Phi(q) = 0 with M(q) = prod_k (1 / |q - q_k|^2 + 1), which has the same roots as Phi
 except the known q_k, so a start that led to a known assembly now leads on to a new one. The
 deflated Newton step is the plain step scaled by 1 / (1 - grad(log M) . step) (Sherman-
-Morrison), so it costs one Phi_q solve like Newton. Each start is deflated again and again
-until it finds nothing new, then the next start is taken. Homotopy continuation would find
+Morrison), so it costs one Phi_q solve like Newton; it is cut to STEP_CAP. From each start,
+plain Newton first, then deflated Newton again and again until it finds nothing new, then the
+next start is taken. Homotopy continuation would find
 every complex root too, but it needs the equations as polynomials, which the kernel (Phi and
 Phi_q at points) does not give; deflation needs only what Newton needs.
 
@@ -46,8 +47,12 @@ STARTS = 160
 PATIENCE = 100
 """The search ends after this many starts in a row that found no new assembly."""
 
-DEFLATED_ITERATIONS = 80
+DEFLATED_ITERATIONS = 50
 """Deflated Newton iterations per attempt (steps far from a root are not quadratic)."""
+
+STEP_CAP = 0.5
+"""The longest deflated Newton step (max-norm: radians, Euler parameters, and lengths in the
+unit near the mechanism's size that a scan solves in, runtime.units)."""
 
 FOUND = 1e-8
 """The deflated Newton stops at max |Phi| below this; the runtime's Newton then polishes."""
@@ -65,8 +70,11 @@ class Shape:
 
     def __init__(self, coordinates: tuple[str, ...]) -> None:
         self.angles = np.array([name.endswith(".phi") for name in coordinates])
-        self.euler = [np.array([coordinates.index(f"{name[:-3]}.e{k}") for k in range(4)])
-                      for name in coordinates if name.endswith(".e0")]
+        bodies = [name[:-3] for name in coordinates if name.endswith(".e0")]
+        self.euler = [np.array([coordinates.index(f"{body}.e{k}") for k in range(4)])
+                      for body in bodies]
+        self.origins = [np.array([coordinates.index(f"{body}.{c}") for c in "xyz"])
+                        for body in bodies]
         orientation = self.angles.copy()
         for block in self.euler:
             orientation[block] = True
@@ -120,28 +128,32 @@ def search(kernel: KinematicsKernel, q0: Array, t0: float, p: Array, options: Op
 
 def _from_start(kernel: KinematicsKernel, shape: Shape, start: Array, t0: float, p: Array,
                 options: Options, roots: list[Array]) -> list[Newton]:
-    """Deflated Newton from one start, again after each new assembly, until nothing new."""
+    """Plain Newton from one start first (its own basin may hold an assembly not yet known),
+    then deflated Newton from it again after each new assembly, until nothing new."""
     new: list[Newton] = []
+    deflate: list[Array] = []
     while True:
-        q = _deflated_newton(kernel, shape, start, t0, p, roots)
-        if q is None and not roots and not new:
+        q = _deflated_newton(kernel, shape, start, t0, p, deflate)
+        if q is None and not roots:
             # No assembly known yet, and plain Newton fails from here: damp first.
             q = levenberg_marquardt(kernel, start, t0, p, options)[0]
-        if q is None:
+        result = None if q is None else newton(kernel, q, t0, p, options)
+        if (result is not None and result.status == OK
+                and redundant.holds(kernel, result.q, t0, p, options.target_q)
+                and not any(shape.same(result.q, root) for root in roots)):
+            roots.append(result.q)
+            new.append(result)
+        elif deflate is roots:
             return new
-        result = newton(kernel, q, t0, p, options)
-        if result.status != OK or not redundant.holds(kernel, result.q, t0, p,
-                                                       options.target_q):
-            return new
-        if any(shape.same(result.q, root) for root in roots):
-            return new
-        roots.append(result.q)
-        new.append(result)
+        deflate = roots
 
 
 def _deflated_newton(kernel: KinematicsKernel, shape: Shape, q: Array, t0: float, p: Array,
                      roots: list[Array]) -> Array | None:
-    """Newton on M(q) Phi(q) from q: a point with max |Phi| <= FOUND, or None."""
+    """Newton on M(q) Phi(q) from q: a point with max |Phi| <= FOUND, or None. Each step is
+    cut to STEP_CAP: the deflated step grows without bound where 1 - grad(log M) . step
+    nears zero, and a long step lands far outside every basin (uncut, almost every deflated
+    attempt on a Stewart platform left the mechanism's size)."""
     q = np.array(q, dtype=float)
     size = 10.0 * (1.0 + float(np.abs(q[shape.positions]).max(initial=0.0)))
     with np.errstate(all="ignore"):
@@ -159,7 +171,9 @@ def _deflated_newton(kernel: KinematicsKernel, shape: Shape, q: Array, t0: float
             denominator = 1.0 - float(_log_gradient(shape, q, roots) @ step)
             if not (math.isfinite(denominator) and abs(denominator) > 1e-12):
                 return None
-            q = q + step / denominator
+            step = step / denominator
+            longest = float(np.abs(step).max(initial=0.0))
+            q = q + (step if longest <= STEP_CAP else step * (STEP_CAP / longest))
             if not np.abs(q[shape.positions]).max(initial=0.0) <= 100.0 * size:
                 return None  # gone far beyond the mechanism: deflation pushed it away
     return None
@@ -180,11 +194,15 @@ def _log_gradient(shape: Shape, q: Array, roots: list[Array]) -> Array:
 def _starts(kernel: KinematicsKernel, shape: Shape, q0: Array, t0: float, p: Array
             ) -> Iterator[Array]:
     """The damped assembly's starts (q0, the bodies placed along their joints, q0 perturbed,
-    random angles with the positions placed), with random Euler parameters after q0."""
+    random angles with the positions placed); after q0, each spatial body at a random
+    orientation and a random origin about q0's (within half the mechanism's size: a body
+    turned about a far point lands far from its origin as drawn)."""
     rng = np.random.default_rng(SEED)
+    size = max(1.0, float(np.abs(q0[shape.positions]).max(initial=0.0)))
     for index, q in enumerate(assembly_starts(kernel, q0, t0, p, random_angles=STARTS)):
         if index:
-            for block in shape.euler:
+            for block, origin in zip(shape.euler, shape.origins):
                 e = rng.standard_normal(4)
                 q[block] = e / np.linalg.norm(e)
+                q[origin] = q0[origin] + 0.5 * size * rng.standard_normal(3)
         yield q

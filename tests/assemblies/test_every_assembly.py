@@ -261,9 +261,6 @@ def test_the_octahedral_sweep_counts_twelve() -> None:
         assert np.max(np.abs(np.array(sides) - SIDES)) < 1e-10
 
 
-@pytest.mark.xfail(strict=True, reason="open: the deflated multi-start search finds 7 of the "
-                   "12 assemblies (all 12 are well conditioned: Newton from each converges at "
-                   "once); more starts do not help, the spatial starts need better positions")
 @pytest.mark.parametrize("backend", ["numpy", "c"])
 def test_stewart_3_3_has_the_twelve_assemblies_counted_by_the_sweep(tmp_path: Path,
                                                                      backend: str) -> None:
