@@ -1,5 +1,6 @@
 """``symkin scan``: the assembly branches at t0, then the singular configurations, limit
-positions and flagged stretches over the driver range (symkin.runtime.scan), as a short report.
+positions and flagged stretches over the driver range (symkin.runtime.scan), as a short report;
+with ``--input NAME=VALUE`` (a mechanism with input drivers) every assembly at those inputs.
 
 Exit status 0 when the scan ran, whatever it found (a limit position is a finding, not a
 failure); 2 for bad input; 1 when the kernel cannot be built or cached; 130 on Ctrl-C.
