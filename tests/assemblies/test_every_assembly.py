@@ -14,6 +14,7 @@ the four branch pairs count the assemblies. The four-bar: two (circle intersecti
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 from collections.abc import Callable
@@ -23,6 +24,7 @@ import numpy as np
 import pytest
 
 import symkin
+from symkin.errors import SolveError
 from symkin.runtime.scan import scan
 
 SWEEP = 200_000
@@ -298,3 +300,34 @@ def test_cli_scan_at_inputs_lists_the_six_and_locates_bad_inputs(tmp_path: Path)
         result = _cli(path, "--backend", "numpy", *bad)
         assert result.returncode == 2 and said in result.stderr and path in result.stderr
         assert "Traceback" not in result.stderr
+
+
+def test_scan_refuses_bad_inputs_with_what_is_wrong() -> None:
+    with_inputs = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider_input.yaml"),
+                                 backend="numpy")
+    without = symkin.compile(symkin.derive(ROOT / "tests" / "mechanisms" / "non_grashof.yaml"),
+                             backend="numpy")
+    for kernel, inputs, said in (
+            (with_inputs, [1.0, 2.0], "give 1 values (crank_angle), got 2"),
+            (with_inputs, {"crank_angle": math.inf}, "crank_angle is inf"),
+            (with_inputs, {"crank": 1.0}, "no input driver named 'crank'; missing 'crank_angle'"),
+            (without, [1.0], "has no input drivers")):
+        with pytest.raises(SolveError, match=re.escape(said)):
+            scan(kernel, inputs=inputs)
+
+
+def test_crank_slider_at_an_input_angle_has_its_two_assemblies() -> None:
+    """The textbook crank-slider with the crank angle an input: the slider slides on y = c = 4,
+    the rod (b = 5) joins the crank tip A = (cos theta, sin theta) (a = 1) to it, so its x is
+    cos(theta) +- sqrt(b^2 - (c - sin(theta))^2): two assemblies."""
+    kernel = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider_input.yaml"),
+                            backend="c")
+    theta = 1.2
+    report = scan(kernel, inputs={"crank_angle": theta})
+    reach = math.sqrt(25.0 - (4.0 - math.sin(theta))**2)
+    expected = [math.cos(theta) - reach, math.cos(theta) + reach]
+    names = kernel.coordinates
+    found = sorted(float(b.q[names.index("slider.x")]) for b in report.branches)
+    assert len(found) == 2 and np.allclose(found, expected, atol=1e-9, rtol=0)
+    for branch in report.branches:
+        assert branch.q[names.index("slider.y")] == pytest.approx(4.0, abs=1e-9)
