@@ -1,5 +1,6 @@
 """``symkin scan``: the assembly branches at t0, then the singular configurations, limit
-positions and flagged stretches over the driver range (symkin.runtime.scan), as a short report.
+positions and flagged stretches over the driver range (symkin.runtime.scan), as a short report;
+with ``--input NAME=VALUE`` (a mechanism with input drivers) every assembly at those inputs.
 
 Exit status 0 when the scan ran, whatever it found (a limit position is a finding, not a
 failure); 2 for bad input; 1 when the kernel cannot be built or cached; 130 on Ctrl-C.
@@ -31,6 +32,9 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
     scan.add_argument("--all-branches", action="store_true",
                       help="follow the motion from every branch found at t0, not only from "
                            "the one a run takes (reached from q0)")
+    scan.add_argument("--input", action="append", default=[], metavar="NAME=VALUE",
+                      dest="inputs", help="the value of input driver NAME (repeat for each): "
+                      "the branches are then the assemblies at these inputs")
     overrides.add_argument(scan)
     scan.set_defaults(handler=handle)
 
@@ -60,14 +64,39 @@ def handle(args: argparse.Namespace) -> int:
     except SolveError as error:
         return messages.error(f"{args.mechanism}: {error}; change --t0, --t1 or --dt",
                               EXIT_BAD_INPUT)
+    inputs = _inputs(args.inputs)
+    if isinstance(inputs, str):
+        return messages.error(f"{args.mechanism}: {inputs}", EXIT_BAD_INPUT)
     try:
-        report = scan(kernel, t=times, all_branches=args.all_branches)
-    except driver.SolveInterrupted:
+        report = scan(kernel, t=times, all_branches=args.all_branches, inputs=inputs)
+    except driver.SolveInterrupted:  # a SolveError too: first
         messages.note("interrupted")
         return EXIT_INTERRUPTED
+    except SolveError as error:
+        return messages.error(f"{args.mechanism}: {error} (give --input NAME=VALUE for each "
+                              "input driver)", EXIT_BAD_INPUT)
     print(text(report, kernel.name, f"t = {t0:g} to {t1:g} by {dt:g}, {kernel.backend} backend"),
           end="")
     return EXIT_OK
+
+
+def _inputs(pairs: list[str]) -> dict[str, float] | str | None:
+    """The --input NAME=VALUE pairs as a dict (None when none given), or what is wrong."""
+    if not pairs:
+        return None
+    values: dict[str, float] = {}
+    for pair in pairs:
+        name, equals, value = pair.partition("=")
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not equals or not name.strip() or not math.isfinite(number):
+            return f"--input {pair}: write NAME=VALUE with a finite number"
+        if name.strip() in values:
+            return f"--input {pair}: {name.strip()} is given twice"
+        values[name.strip()] = number
+    return values
 
 
 def text(report: Any, name: str, grid: str) -> str:
@@ -78,7 +107,8 @@ def text(report: Any, name: str, grid: str) -> str:
     shown = distinguishing(report)
     count = len(report.branches)
     near = sum(1 for branch in report.branches if branch.near_singular)
-    lines.append(f"assembly branches at t = {report.t0:g}: {count}"
+    at = "".join(f", {name} = {value:g}" for name, value in report.inputs.items())
+    lines.append(f"assembly branches at t = {report.t0:g}{at}: {count}"
                  + ("" if count else " (none found: the mechanism cannot be assembled there)")
                  + (f" ({near} of them at or near a singular configuration, where branches "
                     "meet: those are approximate and their count is not exact)" if near else ""))

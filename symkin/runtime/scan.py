@@ -1,9 +1,9 @@
 """A first look at a mechanism over its driver range: what a designer asks before anything else.
 
-At t0, the assembly branches: the damped assembly (runtime.assembly) is run from all its starts
-and from more sets of random angles (a fixed seed, so scans repeat); the converged solutions
-are clustered (angles compared modulo 2 pi) into distinct branches. The branch a run takes is
-the one reached from q0.
+At t0 (and at given values of the input drivers), the assembly branches: the damped assembly
+(runtime.assembly) from q0, then the deflated multi-start search (runtime.assemblies: seeded,
+so scans repeat) for the others, each distinct (angles modulo 2 pi, Euler parameters up to
+their sign). The branch a run takes is the one reached from q0.
 
 Over the time grid, the motion on that branch (and, on request, on every other): the singular
 configurations passed, the stretches of flagged points, and where the motion stops, a limit
@@ -21,23 +21,18 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.status import OK
+from symkin.errors import SolveError
 from symkin.runtime import driver, redundant, units
-from symkin.runtime.assembly import RANDOM_ANGLES, assemble, starts
+from symkin.runtime.assemblies import SAME, Shape, search
+from symkin.runtime.assembly import assemble
 from symkin.runtime.edges import LIMIT_COND
-from symkin.runtime.inputs import refuse_inputs
-from symkin.runtime.newton import newton
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
 
-EXTRA_RANDOM_ANGLES = 24
-"""Sets of random angles tried besides the assembly's own starts (more branches found)."""
-
-SAME = 1e-6
-"""Two assemblies closer than this (radians; lengths relative to the mechanism's size) are
-one branch."""
+InputPoint = Mapping[str, float] | ArrayLike
+"""The input drivers' values at which a scan looks for assemblies."""
 
 
 @dataclass(frozen=True)
@@ -99,21 +94,30 @@ class ScanReport:
     t1: float
     branches: tuple[Branch, ...]
     motions: tuple[Motion, ...]
+    inputs: Mapping[str, float] = dataclasses.field(default_factory=dict)
+    """The input drivers' values of the assemblies (empty without input drivers)."""
 
 
 def scan(kernel: KinematicsKernel, t: ArrayLike | None = None,
          params: Mapping[str, float] | ArrayLike | None = None, *,
-         all_branches: bool = False) -> ScanReport:
+         all_branches: bool = False, inputs: InputPoint | None = None) -> ScanReport:
     """Branches at t[0] and the motion over t from the branch reached from q0 (and from every
     branch with ``all_branches``). t defaults to the file's grid.
 
+    A mechanism with input drivers needs ``inputs``: their values (a dict by driver name, or
+    NU values in the order of kernel.input_names); the branches are then the assemblies at
+    those inputs, and no motion is followed (the inputs are one set of values, not a path).
+
     Raises:
-        SolveError: bad t or params (the caller's input), never for what the motion meets.
+        SolveError: bad t, params or inputs (the caller's input), never for what the motion
+            meets.
         SolveInterrupted: on Ctrl-C during a motion.
     """
-    refuse_inputs(kernel, "a scan")
     times = driver.time_points(kernel, t)
     p = driver.parameter_values(kernel, params)
+    values = input_point(kernel, inputs)
+    if values:
+        p = kernel.with_inputs(p, list(values.values()))  # type: ignore[attr-defined]
     t0 = float(times[0])
     with np.errstate(all="ignore"):
         # In the unit that brings the mechanism near unit size (runtime.units), as solve does;
@@ -127,49 +131,70 @@ def scan(kernel: KinematicsKernel, t: ArrayLike | None = None,
                         for branch in _branches(scaled, t0, p)]
     motions = []
     for index, branch in enumerate(branches):
-        if branch.taken or all_branches:
+        if not values and (branch.taken or all_branches):
             motions.append(_motion(kernel, times, p, index, branch))
     return ScanReport(tuple(kernel.coordinates), t0, float(times[-1]), tuple(branches),
-                      tuple(motions))
+                      tuple(motions), values)
+
+
+def input_point(kernel: KinematicsKernel, inputs: InputPoint | None) -> dict[str, float]:
+    """The input drivers' values by name, checked (empty for a mechanism without inputs).
+
+    Raises:
+        SolveError: inputs missing, unknown, of the wrong count or not finite.
+    """
+    names = tuple(getattr(kernel, "input_names", ()))
+    if not names:
+        if inputs is not None:
+            raise SolveError("this mechanism has no input drivers (a driver function written "
+                             "`input`): leave out inputs=")
+        return {}
+    if inputs is None:
+        raise SolveError(f"this mechanism's drivers {', '.join(names)} are inputs: a scan "
+                         "needs their values, inputs= (a dict by driver name or "
+                         f"{len(names)} numbers)")
+    if isinstance(inputs, Mapping):
+        unknown = sorted(set(inputs) - set(names))
+        missing = [name for name in names if name not in inputs]
+        if unknown or missing:
+            raise SolveError("inputs: " + "; ".join(
+                [f"no input driver named {', '.join(map(repr, unknown))}"] * bool(unknown)
+                + [f"missing {', '.join(map(repr, missing))}"] * bool(missing))
+                + f" (the input drivers are {', '.join(names)})")
+        listed = [inputs[name] for name in names]
+    else:
+        listed = list(np.ravel(np.asarray(inputs, dtype=object)))
+        if len(listed) != len(names):
+            raise SolveError(f"inputs: give {len(names)} values ({', '.join(names)}), got "
+                             f"{len(listed)}")
+    values = {}
+    for name, value in zip(names, listed):
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            number = math.nan
+        if not math.isfinite(number):
+            raise SolveError(f"inputs: {name} is {value!r}; every input must be a finite "
+                             "number")
+        values[name] = number
+    return values
 
 
 def _branches(kernel: KinematicsKernel, t0: float, p: Array) -> list[Branch]:
-    """The distinct assemblies at t0, the one reached from q0 first (when there is one)."""
+    """The distinct assemblies at t0, the one reached from q0 first (when there is one): the
+    deflated multi-start search of runtime.assemblies."""
     options = driver.default_options(kernel)
-    angles = np.array([name.endswith(".phi") for name in kernel.coordinates])
+    shape = Shape(tuple(kernel.coordinates))
     q0 = np.array(kernel.q0, dtype=float)
     found: list[Branch] = []
     first = assemble(kernel, q0, t0, p, options).result
-    if first.status == OK:
-        found.append(Branch(_wrapped(first.q, angles), first.cond, True))
-    for start in starts(kernel, q0, t0, p, random_angles=RANDOM_ANGLES + EXTRA_RANDOM_ANGLES):
-        q, _ = levenberg_marquardt(kernel, start, t0, p, options)
-        result = newton(kernel, q, t0, p, options)
-        if result.status != OK:
-            continue
-        q = _wrapped(result.q, angles)
-        # An over-constrained file's rows removed at t0 must hold too: elsewhere the kept rows
-        # alone are assembled, which is no assembly of the file (runtime.redundant).
-        if not redundant.holds(kernel, result.q, t0, p, options.target_q):
-            continue
-        if not any(_same(q, b.q, angles) for b in found):
-            found.append(Branch(q, result.cond, False))
+    # An over-constrained file's rows removed at t0 must hold too: elsewhere the kept rows
+    # alone are assembled, which is no assembly of the file (runtime.redundant).
+    if first.status == OK and redundant.holds(kernel, first.q, t0, p, options.target_q):
+        found.append(Branch(shape.canonical(first.q), first.cond, True))
+    for result in search(kernel, q0, t0, p, options, [b.q for b in found]):
+        found.append(Branch(shape.canonical(result.q), result.cond, False))
     return found
-
-
-def _wrapped(q: Array, angles: NDArray[np.bool_]) -> Array:
-    """q with its angles in (-pi, pi]."""
-    q = np.array(q, dtype=float)
-    q[angles] = math.pi - np.mod(math.pi - q[angles], 2 * math.pi)
-    return q
-
-
-def _same(a: Array, b: Array, angles: NDArray[np.bool_]) -> bool:
-    difference = np.abs(a - b)
-    difference[angles] = np.minimum(difference[angles], 2 * math.pi - difference[angles])
-    size = 1.0 + float(np.abs(a[~angles]).max(initial=0.0))
-    return bool(difference[angles].max(initial=0.0) <= SAME
-                and difference[~angles].max(initial=0.0) <= SAME * size)
 
 
 def _motion(kernel: KinematicsKernel, times: Array, p: Array, index: int,

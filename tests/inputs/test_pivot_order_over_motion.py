@@ -28,7 +28,9 @@ EXPECTED = {"parallelogram": 1, "parallelogram_chain": 1, "crank_slider_general"
 # Motions that end at a limit position (half_circle_end: the end of its curve, where the
 # edge treatment's bisection factors Phi_q as it turns singular).
 LIMITED = {"dead_centre", "non_grashof", "half_circle_end"}
-INPUT_DRIVEN = {"stewart_fk", "stewart_legs_fk"}  # no motion in t: the caller gives the legs
+# No motion in t: the caller gives the legs (arm angles); their fall-backs are checked along
+# prescribed paths in tests/inputs/test_parallel_fk_examples.py (delta_fk, three_rrr_fk).
+INPUT_DRIVEN = {"stewart_fk", "stewart_legs_fk", "delta_fk", "three_rrr_fk"}
 # Open (issue 26): a body that turns half a turn or more in Euler parameters. Its driver and
 # normalisation rows meet its columns e0, e3 in the block 2 [[s, -c], [c, s]] (c, s the cosine
 # and sine of half its angle), and its two axis rows meet e1, e2 in another rotation: every
