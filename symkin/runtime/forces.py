@@ -5,7 +5,9 @@ generated ``multipliers``: Φ_qᵀ λ = Q - M q̈ - h at every solved row.
 applies along the driver's function (an ``angle`` driver: the torque on body i, -effort on
 j; a ``slide``: the force on body j along u). ``reaction`` (T, n_joints, 3): [Fx, Fy]
 (global) and M that body i exerts on body j, M about the joint's point on body i (0 for a
-revolute; a prismatic pair: about A, carried by i). Rows where Φ_q is exactly singular are NaN.
+revolute; a prismatic pair: about A, carried by i). A spatial mechanism's ``reaction`` is
+(T, n_joints, 6): [Fx, Fy, Fz, Mx, My, Mz], the same, in global components
+(:mod:`symkin.contract.loads`). Rows where Φ_q is exactly singular are NaN.
 """
 
 from __future__ import annotations
@@ -16,8 +18,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.loads import load_count, reaction_parts
+
 Array = NDArray[np.float64]
-REACTION_PARTS = ("Fx", "Fy", "M")
+REACTION_PARTS = reaction_parts("2d")
 
 
 @dataclass(frozen=True)
@@ -26,14 +30,17 @@ class Forces:
 
     multipliers: Array  # (T, N): lambda
     effort: Array  # (T, n_driver_equations)
-    reaction: Array  # (T, n_joints, 3): Fx, Fy, M
+    reaction: Array  # (T, n_joints, 3): Fx, Fy, M (spatial: 6, Fx ... Mz)
     driver_names: tuple[str, ...]
     joint_names: tuple[str, ...]
+    parts: tuple[str, ...] = REACTION_PARTS
+    """The components of a reaction (contract.loads)."""
 
     def columns(self) -> list[str]:
-        """The CSV columns: ``DRIVER.effort``, then ``JOINT.Fx``, ``JOINT.Fy``, ``JOINT.M``."""
+        """The CSV columns: ``DRIVER.effort``, then ``JOINT.Fx``, ``JOINT.Fy``, ``JOINT.M``
+        (spatial: ``JOINT.Fx`` ... ``JOINT.Mz``)."""
         return [f"{name}.effort" for name in self.driver_names] + [
-            f"{name}.{part}" for name in self.joint_names for part in REACTION_PARTS]
+            f"{name}.{part}" for name in self.joint_names for part in self.parts]
 
     def table(self) -> Array:
         """The values of :meth:`columns`, (T, n_driver_equations + 3 n_joints)."""
@@ -46,7 +53,7 @@ def allocate(kernel: Any, size: int) -> tuple[Array, Array] | None:
     generated C solver); None for a kernel without dynamics."""
     if not getattr(kernel, "has_dynamics", False):
         return None
-    n_loads = len(kernel.driver_names) + 3 * len(kernel.joint_names)
+    n_loads = load_count(len(kernel.driver_names), len(kernel.joint_names), kernel.space)
     return np.full((size, len(kernel.coordinates)), np.nan), np.full((size, n_loads), np.nan)
 
 
@@ -69,5 +76,7 @@ def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
                 lam[missing], loads[missing] = kernel.multipliers_grid(
                     t[missing], q[missing], dq[missing], d2q[missing], p)
     n_efforts, n_joints = len(kernel.driver_names), len(kernel.joint_names)
-    return Forces(lam, loads[:, :n_efforts], loads[:, n_efforts:].reshape(t.size, n_joints, 3),
-                  tuple(kernel.driver_names), tuple(kernel.joint_names))
+    parts = reaction_parts(kernel.space)
+    return Forces(lam, loads[:, :n_efforts],
+                  loads[:, n_efforts:].reshape(t.size, n_joints, len(parts)),
+                  tuple(kernel.driver_names), tuple(kernel.joint_names), parts)
