@@ -276,3 +276,27 @@ def test_backends_agree_and_the_csv_has_six_components(tmp_path: Path) -> None:
                            "shaft.My", "shaft.Mz"]
     npz = np.load(runs["numpy"].save(tmp_path / "rotor.npz"))
     assert npz["reaction"].shape == (runs["numpy"].t.size, 1, 6)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_local_layout_inertia_and_com_are_in_the_body_frame(backend: str) -> None:
+    """The rotor in the local layout, its frame turned by θ = ωt + π/2 about z: the centre
+    and the tensor written in that frame (c' = Rᵀ c, J' = Rᵀ J R with R = Rz(π/2)) give the
+    loads of the drawn rotor, whose frame is turned by ωt alone."""
+    turn = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]])
+    drawn_inertia = np.array([[0.1, 0, 0.02], [0, 0.2, 0], [0.02, 0, 0.15]])
+    data = {
+        "name": "rotor_local", "space": "3d", "parameters": ROTOR["parameters"],
+        "bodies": {"arm": {"q0": [0, 0, 0, float(np.cos(np.pi / 4)), 0, 0,
+                                  float(np.sin(np.pi / 4))],
+                           "mass": "m", "com": (turn.T @ [0.3, 0, 0.2]).tolist(),
+                           "inertia": (turn.T @ drawn_inertia @ turn).tolist()}},
+        "joints": [{"type": "revolute", "name": "shaft", "i": "ground", "j": "arm",
+                    "sA": [0, 0, 0], "sB": [0, 0, 0], "axis": [0, 0, 1]}],
+        "drivers": [{"type": "angle", "name": "motor", "i": "ground", "j": "arm",
+                     "axis": [0, 0, 1], "theta": "w*t + pi/2"}],
+        "forces": ROTOR["forces"], "time": ROTOR["time"],
+    }
+    local, drawn = _solve(data, backend), _solve(ROTOR, backend)
+    np.testing.assert_allclose(local.reaction, drawn.reaction, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(local.effort, drawn.effort, rtol=0, atol=1e-9)
