@@ -62,13 +62,14 @@ def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
     """The efforts and reactions of solved rows; None for a kernel without dynamics.
 
     ``given``: (lam, loads) the grid loop already wrote; only the rows it did not (NaN: points
-    the runtime's edge treatment solved) are computed here.
+    the runtime's edge treatment solved) are computed here. ``p``: the kernel's p[] of every
+    row, or (T, NP + 3 NU) each row's own (a run driven by inputs).
     """
     if not getattr(kernel, "has_dynamics", False):
         return None
     with np.errstate(all="ignore"):  # a singular row is NaN, said in the docstring
         if given is None:
-            lam, loads = kernel.multipliers_grid(t, q, dq, d2q, p)
+            lam, loads = _grid(kernel, t, q, dq, d2q, p)
         else:
             lam, loads = given[0].copy(), given[1].copy()
             missing = np.flatnonzero(np.isnan(lam).any(axis=1))
@@ -80,3 +81,13 @@ def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
     return Forces(lam, loads[:, :n_efforts],
                   loads[:, n_efforts:].reshape(t.size, n_joints, len(parts)),
                   tuple(kernel.driver_names), tuple(kernel.joint_names), parts)
+
+
+def _grid(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array,
+          p: Array) -> tuple[Array, Array]:
+    """The kernel's multipliers_grid, row by row where each row has its own p[]."""
+    if p.ndim == 1 or t.size == 0:
+        return kernel.multipliers_grid(t, q, dq, d2q, p if p.ndim == 1 else kernel.p_values)
+    rows = [kernel.multipliers_grid(t[k:k + 1], q[k:k + 1], dq[k:k + 1], d2q[k:k + 1], p[k])
+            for k in range(t.size)]
+    return np.concatenate([lam for lam, _ in rows]), np.concatenate([out for _, out in rows])

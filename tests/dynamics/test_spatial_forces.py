@@ -300,3 +300,25 @@ def test_local_layout_inertia_and_com_are_in_the_body_frame(backend: str) -> Non
     local, drawn = _solve(data, backend), _solve(ROTOR, backend)
     np.testing.assert_allclose(local.reaction, drawn.reaction, rtol=0, atol=1e-9)
     np.testing.assert_allclose(local.effort, drawn.effort, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_input_legs_hold_the_platform(backend: str) -> None:
+    """The forward-kinematics Stewart file (leg lengths are inputs) with a platform mass, the
+    inputs held at the drawn lengths: the efforts are J^-T w again (an input's effort is
+    conjugate to the input, as a formula's is)."""
+    data = yaml.safe_load((EXAMPLES / "stewart_fk.yaml").read_text())
+    base = np.array([data["bodies"]["ground"]["points"][f"B{k}"] for k in range(1, 7)], float)
+    top = np.array([data["bodies"]["platform"]["points"][f"P{k}"] for k in range(1, 7)], float)
+    data["bodies"]["platform"].update(mass=30, inertia=[1, 1, 1.5], com=[0.02, 0.03, 1.05])
+    data["forces"] = [{"type": "gravity", "g": G.tolist()}]
+    kernel = symkin.compile(symkin.derive(from_dict(data)), backend=backend)
+    t = np.linspace(0.0, 0.2, 3)
+    lengths = np.tile(np.linalg.norm(top - base, axis=1), (t.size, 1))
+    still = np.zeros_like(lengths)  # at rest: without rates dq and d2q are NaN
+    traj = symkin.solve(kernel, t=t, inputs=lengths, input_rates=still, input_accels=still)
+    u = (top - base) / lengths[0][:, None]
+    jacobian = np.hstack([u, np.cross(top - np.array([0.02, 0.03, 1.05]), u)])
+    legs = np.linalg.solve(jacobian.T, np.concatenate([-30 * G, np.zeros(3)]))
+    for row in traj.effort:
+        np.testing.assert_allclose(row, legs, rtol=0, atol=1e-9 * np.abs(legs).max())
