@@ -322,3 +322,18 @@ def test_input_legs_hold_the_platform(backend: str) -> None:
     legs = np.linalg.solve(jacobian.T, np.concatenate([-30 * G, np.zeros(3)]))
     for row in traj.effort:
         np.testing.assert_allclose(row, legs, rtol=0, atol=1e-9 * np.abs(legs).max())
+
+
+def test_sweep_envelope_has_the_six_components() -> None:
+    """A sweep over the rotor's speed: the bearing's radial force peaks at the largest ω,
+    m ω² a (closed form), and the envelope names JOINT.Fx ... JOINT.Mz."""
+    kernel = symkin.compile(symkin.derive(from_dict(ROTOR)), backend="c")
+    speeds = np.array([1.0, 2.0, 4.0])
+    result = symkin.sweep(kernel, {"w": speeds}, workers=1)
+    _, reaction = result.forces
+    assert reaction.shape == (3, result.t.size, 1, 6)
+    radial = np.hypot(reaction[..., 0, 0], reaction[..., 0, 1])
+    np.testing.assert_allclose(radial.max(axis=1), 2.0 * speeds**2 * 0.3, rtol=1e-9)
+    names = [row[0] for row in result.force_envelope()]
+    assert names == ["motor.effort"] + [f"shaft.{part}" for part in
+                                        ("Fx", "Fy", "Fz", "Mx", "My", "Mz")]
