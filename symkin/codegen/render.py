@@ -282,8 +282,10 @@ def template_context(code: Code) -> dict[str, Any]:
         "n_joints": len(code.joint_names),
         "n_loads": load_count(len(code.driver_names), len(code.joint_names), code.space),
         "reaction_size": len(reaction_parts(code.space)),
-        "reaction_text": ("Fx, Fy, Fz (global) and Mx, My, Mz" if code.space == "3d"
+        "reaction_text": ("Fx, Fy, Fz and Mx, My, Mz (global)" if code.space == "3d"
                           else "Fx, Fy (global) and M"),
+        # a spatial driver's effort is conjugate to its function (symbolic.dynamics3d)
+        "effort_text": "lam dPhi/df" if code.space == "3d" else "-lam",
         "driver_literals": [repr(n) for n in code.driver_names],
         "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
