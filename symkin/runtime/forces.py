@@ -87,7 +87,8 @@ def _grid(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array,
           p: Array) -> tuple[Array, Array]:
     """The kernel's multipliers_grid, row by row where each row has its own p[]."""
     if p.ndim == 1 or t.size == 0:
-        return kernel.multipliers_grid(t, q, dq, d2q, p if p.ndim == 1 else kernel.p_values)
+        lam, loads = kernel.multipliers_grid(t, q, dq, d2q, p if p.ndim == 1 else kernel.p_values)
+        return lam, loads
     rows = [kernel.multipliers_grid(t[k:k + 1], q[k:k + 1], dq[k:k + 1], d2q[k:k + 1], p[k])
             for k in range(t.size)]
     return np.concatenate([lam for lam, _ in rows]), np.concatenate([out for _, out in rows])
