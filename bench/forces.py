@@ -3,9 +3,10 @@ in the same run.
 
     python3 bench/forces.py [--steps 20000] [--repeat 15]
 
-For each example with forces (C kernels, symkin.compile's build, nominal parameters, the
-file's q0, a grid of --steps + 1 points over the file's interval), in interleaved rounds,
-best of --repeat, CPU time of this process:
+For each example with forces and the spatial slider-crank with forces of this folder (C
+kernels, symkin.compile's build, nominal parameters, the file's q0, a grid of --steps + 1
+points over the file's interval), in interleaved rounds, best of --repeat, CPU time of this
+process:
 
 - ``kinematic``: the generated grid loop (``<prefix>_solve_grid_checked`` through the
   GridSolver the driver uses) with NULL multiplier outputs: predictor, Newton, condition
@@ -32,13 +33,20 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import symkin  # noqa: E402
+from symkin.contract.loads import load_count  # noqa: E402
 from symkin.runtime.driver import default_options  # noqa: E402
 
 EXAMPLES = ("crank_slider_load", "four_bar_dynamics")
+SPATIAL = ("spatial_slider_crank_forces",)  # files in bench/ (their names are the mechanisms')
+
+
+def _path(name: str) -> Path:
+    folder = "bench" if name in SPATIAL else "examples"
+    return ROOT / folder / f"{name}.yaml"
 
 
 def measure(name: str, steps: int, repeat: int) -> tuple[float, float, float]:
-    kernel = symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"), backend="c")
+    kernel = symkin.compile(symkin.derive(_path(name)), backend="c")
     t0, t1, _ = kernel.time_grid
     t = np.linspace(t0, t1, steps + 1)
     n = kernel.nq
@@ -47,7 +55,8 @@ def measure(name: str, steps: int, repeat: int) -> tuple[float, float, float]:
     p = kernel.p_values
     solver = kernel.grid_solver(default_options(kernel), kernel.q0, p)
     lam = np.empty((t.size, n))
-    loads = np.empty((t.size, len(kernel.driver_names) + 3 * len(kernel.joint_names)))
+    loads = np.empty((t.size, load_count(len(kernel.driver_names), len(kernel.joint_names),
+                                         kernel.space)))
     best = [float("inf")] * 3
     for _ in range(repeat):
         for k, forces_out in enumerate((None, (lam, loads))):
@@ -69,11 +78,11 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=20000)
     parser.add_argument("--repeat", type=int, default=15)
     args = parser.parse_args()
-    print(f"{'mechanism':<20} {'kinematic':>10} {'with forces':>12} {'extra':>6} "
+    print(f"{'mechanism':<28} {'kinematic':>10} {'with forces':>12} {'extra':>6} "
           f"{'post-pass':>10} {'extra':>6}   (us/step; extra: x the kinematic step)")
-    for name in EXAMPLES:
+    for name in EXAMPLES + SPATIAL:
         kinematic, with_forces, post = measure(name, args.steps, args.repeat)
-        print(f"{name:<20} {kinematic * 1e6:>10.3f} {with_forces * 1e6:>12.3f} "
+        print(f"{name:<28} {kinematic * 1e6:>10.3f} {with_forces * 1e6:>12.3f} "
               f"{(with_forces - kinematic) / kinematic:>6.2f} {post * 1e6:>10.3f} "
               f"{post / kinematic:>6.2f}")
 

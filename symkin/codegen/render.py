@@ -24,6 +24,7 @@ from symkin.codegen import lower
 from symkin.codegen.lower import Code, Routine
 from symkin.codegen.target import Target
 from symkin.contract import options, status, tuning
+from symkin.contract.loads import load_count, reaction_parts
 from symkin.contract.manifest import GENERATOR, MANIFEST_SUFFIX, Manifest, Metadata, manifest_name
 from symkin.errors import BuildError, UsageError
 from symkin.symbolic.derivation import System
@@ -282,6 +283,12 @@ def template_context(code: Code) -> dict[str, Any]:
         # Inverse dynamics (only when the file has masses or forces).
         "dynamics": code.dynamics, "n_efforts": len(code.driver_names),
         "n_joints": len(code.joint_names),
+        "n_loads": load_count(len(code.driver_names), len(code.joint_names), code.space),
+        "reaction_size": len(reaction_parts(code.space)),
+        "reaction_text": ("Fx, Fy, Fz and Mx, My, Mz (global)" if code.space == "3d"
+                          else "Fx, Fy (global) and M"),
+        # a spatial driver's effort is conjugate to its function (symbolic.dynamics3d)
+        "effort_text": "lam dPhi/df" if code.space == "3d" else "-lam",
         "driver_literals": [repr(n) for n in code.driver_names],
         "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
@@ -339,9 +346,12 @@ def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
 
 
 def _doc(code: Code, routine: str) -> str:
-    """The generated function's docstring; a spatial mechanism's points are triples."""
+    """The generated function's docstring; a spatial mechanism's points are triples, its
+    reactions six components."""
     doc = _PYTHON_DOC[routine]
-    return doc.replace("(x, y) pairs", "(x, y, z) triples") if code.space == "3d" else doc
+    if code.space != "3d":
+        return doc
+    return doc.replace("(x, y) pairs", "(x, y, z) triples").replace("Fx, Fy, M", "Fx ... Mz")
 
 
 def _labels(code: Code, routine: str) -> list[str]:
@@ -366,7 +376,7 @@ def _labels(code: Code, routine: str) -> list[str]:
     if routine in ("loads", "loads_full"):
         return [lower.comment(f"{name}.effort") for name in code.driver_names] + [
             lower.comment(f"{name}.{part}") for name in code.joint_names
-            for part in ("Fx", "Fy", "M")]
+            for part in reaction_parts(code.space)]
     if routine == "points":
         return [lower.comment(f"{body}.{point}.{axis}") for body, point in code.points
                 for axis in code.point_axes]

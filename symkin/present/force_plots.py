@@ -33,8 +33,13 @@ def plot_forces(trajectory: Trajectory, path: str | Path, title: str | None = No
     for k, name in enumerate(forces.driver_names):
         axes[0].plot(t, forces.effort[:, k], label=name, linewidth=1.4)
     axes[0].set_ylabel("effort (torque or force)")
-    magnitude = np.hypot(forces.reaction[..., 0], forces.reaction[..., 1])
-    moments = forces.reaction[..., 2]
+    # the force's components are Fx, Fy (spatial: Fz too); the moment is M, or Mx, My, Mz
+    # of a spatial joint, shown by its magnitude
+    n_force = sum(part.startswith("F") for part in forces.parts)
+    magnitude = np.linalg.norm(forces.reaction[..., :n_force], axis=-1)
+    moment_parts = forces.reaction[..., n_force:]
+    spatial = moment_parts.shape[-1] > 1
+    moments = np.linalg.norm(moment_parts, axis=-1) if spatial else moment_parts[..., 0]
     for k, name in enumerate(forces.joint_names):
         axes[1].plot(t, magnitude[:, k], label=name, linewidth=1.4)
         if np.nanmax(np.abs(moments[:, k]), initial=0.0) > 1e-9 * max(
@@ -44,7 +49,7 @@ def plot_forces(trajectory: Trajectory, path: str | Path, title: str | None = No
         axes[2].text(0.5, 0.5, "no joint carries a moment (revolute pairs only)",
                      transform=axes[2].transAxes, ha="center", va="center")
     axes[1].set_ylabel("joint force |F|")
-    axes[2].set_ylabel("joint moment M")
+    axes[2].set_ylabel("joint moment |M|" if spatial else "joint moment M")
     axes[2].set_xlabel("t")
     for ax in axes:
         ax.grid(True, linewidth=0.4, alpha=0.5)

@@ -283,7 +283,9 @@ def _solve_inputs(kernel: Any, t: ArrayLike | None, q0: ArrayLike | None,
             at = float(times[run.done])
             _fail(kernel, run, pu, result, at, assembling=run.done == 0, assembly=assembly
                   if run.done == 0 else None, params=p)
-    return _trajectory(kernel, run, p)
+    # each row's efforts and reactions at its own inputs (an actuator's depend on them)
+    rows = np.array([table.row(kernel, p, k) for k in range(run.done)]).reshape(run.done, -1)
+    return _trajectory(kernel, run, p, loads_p=rows)
 
 
 def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,
@@ -332,8 +334,10 @@ def _resume(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: A
 
 
 def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
-                point_vectors: Array | None = None) -> Trajectory:
-    """The Trajectory of the rows done, over the run's own arrays (p: owned by the run)."""
+                point_vectors: Array | None = None, loads_p: Array | None = None) -> Trajectory:
+    """The Trajectory of the rows done, over the run's own arrays (p: owned by the run).
+    A run of a kernel with input drivers has efforts and reactions only given ``loads_p``,
+    each row's p[] with its inputs (T, NP + 3 NU); elsewhere they are not computed."""
     done = run.done
     arrays: tuple[NDArray[Any], ...] = (run.t, run.q, run.dq, run.d2q, run.flagged, run.cond)
     if done < run.t.size:  # a partial result: the caller's rows viewed, the run's copied
@@ -349,7 +353,11 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
                                    flagged, cond, singular, space=_space(kernel))
     # inverse dynamics (a kernel with masses or forces): efforts and reactions of the rows
     given = None if run.forces_out is None else tuple(a[:done] for a in run.forces_out)
-    trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
+    if getattr(kernel, "nu", 0):
+        trajectory.__dict__["forces"] = (None if loads_p is None else
+                                         forces.compute(kernel, t, q, dq, d2q, loads_p))
+    else:
+        trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
     return trajectory
 
 

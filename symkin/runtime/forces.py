@@ -5,7 +5,9 @@ generated ``multipliers``: Φ_qᵀ λ = Q - M q̈ - h at every solved row.
 applies along the driver's function (an ``angle`` driver: the torque on body i, -effort on
 j; a ``slide``: the force on body j along u). ``reaction`` (T, n_joints, 3): [Fx, Fy]
 (global) and M that body i exerts on body j, M about the joint's point on body i (0 for a
-revolute; a prismatic pair: about A, carried by i). Rows where Φ_q is exactly singular are NaN.
+revolute; a prismatic pair: about A, carried by i). A spatial mechanism's ``reaction`` is
+(T, n_joints, 6): [Fx, Fy, Fz, Mx, My, Mz], the same, in global components
+(:mod:`symkin.contract.loads`). Rows where Φ_q is exactly singular are NaN.
 
 Where rows were removed as redundant, the loads are those of the minimum-norm multipliers of
 every row the file writes, and ``determinate`` says which are unique (runtime.indeterminate).
@@ -19,10 +21,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.loads import load_count, reaction_parts
 from symkin.runtime import indeterminate
 
 Array = NDArray[np.float64]
-REACTION_PARTS = ("Fx", "Fy", "M")
+REACTION_PARTS = reaction_parts("2d")
 
 
 @dataclass(frozen=True)
@@ -31,9 +34,11 @@ class Forces:
 
     multipliers: Array  # (T, N): lambda
     effort: Array  # (T, n_driver_equations)
-    reaction: Array  # (T, n_joints, 3): Fx, Fy, M
+    reaction: Array  # (T, n_joints, 3): Fx, Fy, M (spatial: 6, Fx ... Mz)
     driver_names: tuple[str, ...]
     joint_names: tuple[str, ...]
+    parts: tuple[str, ...] = REACTION_PARTS
+    """The components of a reaction (contract.loads)."""
     determinate: NDArray[np.bool_] | None = None
     """(NLOADS,) where rows were removed as redundant: True for an effort or reaction
     component that is the same whatever the split among the redundant rows; the others are
@@ -50,10 +55,12 @@ class Forces:
 
     @property
     def reaction_determinate(self) -> NDArray[np.bool_] | None:
-        """(n_joints, 3) bool (Fx, Fy, M), or None where no row was removed."""
+        """(n_joints, 3) bool (Fx, Fy, M; spatial: 6, Fx ... Mz), or None where no row was
+        removed."""
         if self.determinate is None:
             return None
-        return self.determinate[len(self.driver_names):].reshape(len(self.joint_names), 3)
+        return self.determinate[len(self.driver_names):].reshape(len(self.joint_names),
+                                                                  len(self.parts))
 
     def indeterminate(self) -> list[str]:
         """The :meth:`columns` names of the loads that are not determinate."""
@@ -62,9 +69,10 @@ class Forces:
         return [name for name, fixed in zip(self.columns(), self.determinate) if not fixed]
 
     def columns(self) -> list[str]:
-        """The CSV columns: ``DRIVER.effort``, then ``JOINT.Fx``, ``JOINT.Fy``, ``JOINT.M``."""
+        """The CSV columns: ``DRIVER.effort``, then ``JOINT.Fx``, ``JOINT.Fy``, ``JOINT.M``
+        (spatial: ``JOINT.Fx`` ... ``JOINT.Mz``)."""
         return [f"{name}.effort" for name in self.driver_names] + [
-            f"{name}.{part}" for name in self.joint_names for part in REACTION_PARTS]
+            f"{name}.{part}" for name in self.joint_names for part in self.parts]
 
     def table(self) -> Array:
         """The values of :meth:`columns`, (T, n_driver_equations + 3 n_joints)."""
@@ -77,7 +85,7 @@ def allocate(kernel: Any, size: int) -> tuple[Array, Array] | None:
     generated C solver); None for a kernel without dynamics."""
     if not getattr(kernel, "has_dynamics", False):
         return None
-    n_loads = len(kernel.driver_names) + 3 * len(kernel.joint_names)
+    n_loads = load_count(len(kernel.driver_names), len(kernel.joint_names), kernel.space)
     return np.full((size, len(kernel.coordinates)), np.nan), np.full((size, n_loads), np.nan)
 
 
@@ -101,13 +109,14 @@ def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
     """The efforts and reactions of solved rows; None for a kernel without dynamics.
 
     ``given``: (lam, loads) the grid loop already wrote; only the rows it did not (NaN: points
-    the runtime's edge treatment solved) are computed here.
+    the runtime's edge treatment solved) are computed here. ``p``: the kernel's p[] of every
+    row, or (T, NP + 3 NU) each row's own (a run driven by inputs).
     """
     if not getattr(kernel, "has_dynamics", False):
         return None
     with np.errstate(all="ignore"):  # a singular row is NaN, said in the docstring
         if given is None:
-            lam, loads = kernel.multipliers_grid(t, q, dq, d2q, p)
+            lam, loads = _grid(kernel, t, q, dq, d2q, p)
         else:
             lam, loads = given[0].copy(), given[1].copy()
             missing = np.flatnonzero(np.isnan(lam).any(axis=1))
@@ -121,6 +130,19 @@ def compute(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array, p: Array,
         lam, loads = found.multipliers, found.loads
         determinate, removed = found.determinate, found.removed_multipliers
     n_efforts, n_joints = len(kernel.driver_names), len(kernel.joint_names)
-    return Forces(lam, loads[:, :n_efforts], loads[:, n_efforts:].reshape(t.size, n_joints, 3),
-                  tuple(kernel.driver_names), tuple(kernel.joint_names), determinate,
+    parts = reaction_parts(kernel.space)
+    return Forces(lam, loads[:, :n_efforts],
+                  loads[:, n_efforts:].reshape(t.size, n_joints, len(parts)),
+                  tuple(kernel.driver_names), tuple(kernel.joint_names), parts, determinate,
                   removed)
+
+
+def _grid(kernel: Any, t: Array, q: Array, dq: Array, d2q: Array,
+          p: Array) -> tuple[Array, Array]:
+    """The kernel's multipliers_grid, row by row where each row has its own p[]."""
+    if p.ndim == 1 or t.size == 0:
+        lam, loads = kernel.multipliers_grid(t, q, dq, d2q, p if p.ndim == 1 else kernel.p_values)
+        return lam, loads
+    rows = [kernel.multipliers_grid(t[k:k + 1], q[k:k + 1], dq[k:k + 1], d2q[k:k + 1], p[k])
+            for k in range(t.size)]
+    return np.concatenate([lam for lam, _ in rows]), np.concatenate([out for _, out in rows])

@@ -22,6 +22,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin.contract.loads import load_count
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.contract.options import Options
 from symkin.runtime.protocol import BatchSolver, GridSolver
@@ -181,7 +182,8 @@ class Kernel:
 
     def loads(self, q: ArrayLike, lam: ArrayLike, t: float,
               p: ArrayLike | None = None) -> Array:
-        """The efforts (one per driver row) then Fx, Fy, M of each joint, from lam."""
+        """The efforts (one per driver row) then Fx, Fy, M of each joint (spatial: Fx, Fy, Fz,
+        Mx, My, Mz), from lam."""
         self._require_dynamics()
         return self._functions.loads(self._q(q), self._q(lam, "lam"), float(t), self._p(p))
 
@@ -206,7 +208,7 @@ class Kernel:
                          p: Array) -> tuple[Array, Array]:
         """lam (T, N) and the loads (T, NLOADS) of solved rows; NaN where Phi_q is singular.
         A backend whose generated code does it in one call overrides this loop."""
-        n_loads = len(self.driver_names) + 3 * len(self.joint_names)
+        n_loads = load_count(len(self.driver_names), len(self.joint_names), self.space)
         lam = np.full(q.shape, np.nan)
         loads = np.full((t.size, n_loads), np.nan)
         for k in range(t.size):

@@ -145,7 +145,8 @@ class Trajectory:
 
     @property
     def reaction(self) -> NDArray[np.float64] | None:
-        """(T, n_joints, 3): Fx, Fy, M body i exerts on body j (None without dynamics)."""
+        """(T, n_joints, 3): Fx, Fy, M body i exerts on body j (spatial: (T, n_joints, 6),
+        Fx, Fy, Fz, Mx, My, Mz; None without dynamics)."""
         return None if self.forces is None else self.forces.reaction
 
     @property

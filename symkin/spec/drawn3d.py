@@ -17,7 +17,8 @@ from typing import Any
 from symkin import pairs
 from symkin.errors import MechanismError
 from symkin.pairs.fields import GROUND
-from symkin.spec.drawn import layout_of
+from symkin.spec import forces
+from symkin.spec.drawn import DYNAMICS_KEYS, layout_of
 from symkin.spec.drawn_quantities import Q, _Context, _sub
 
 SPACES = ("2d", "3d")
@@ -58,7 +59,7 @@ class Drawing3d:
         path: Path_ = ("bodies", body)
         if not isinstance(spec, Mapping):
             raise MechanismError("expected a mapping with points (and frame)", path)
-        allowed = {"points"} if body == GROUND else {"points", "frame"}
+        allowed = {"points"} if body == GROUND else {"points", "frame", *DYNAMICS_KEYS}
         for key in spec:
             if key not in allowed:
                 raise MechanismError(f"unknown key {key!r} in the drawn layout", path + (key,),
@@ -194,8 +195,12 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
     drawing = Drawing3d(data)
     local["bodies"] = {body: {"q0": drawing.q0(body),
                               "points": {name: drawing.local(body, point)
-                                         for name, point in drawing.points[body].items()}}
+                                         for name, point in drawing.points[body].items()},
+                              **_dynamics(drawing, body, data["bodies"][body])}
                        for body in drawing.origins if body != GROUND}
+    if "forces" in data:
+        local["forces"] = [_load(drawing, item, ("forces", index))
+                           for index, item in enumerate(_items(data, "forces"))]
     for section in pairs.SECTIONS:
         items = data.get(section) or []
         if not isinstance(items, list):
@@ -203,6 +208,35 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
         local[section] = [_constraint(drawing, item, (section, k))
                           for k, item in enumerate(items)]
     return local
+
+
+def _dynamics(drawing: Drawing3d, body: str, spec: Mapping[str, Any]) -> dict[str, Any]:
+    """A body's mass and inertia as written (its frame is parallel to the global axes, so
+    the tensor as drawn is the one in its frame); its centre of mass in its own frame."""
+    found = {key: spec[key] for key in DYNAMICS_KEYS if key in spec}
+    if "com" in found:
+        found["com"] = drawing.point(body, found["com"], ("bodies", body, "com"))
+    return found
+
+
+def _load(drawing: Drawing3d, item: Any, path: Path_) -> Any:
+    """A load with its points (drawn globally) in the frames of their bodies; unknown
+    bodies and shapes go on to validation, which names them."""
+    if not isinstance(item, Mapping):
+        return item
+    local = dict(item)
+    for key, body_key in forces.POINT_KEYS.get(item.get("type"), ()):  # type: ignore[arg-type]
+        body = item.get(body_key)
+        if key in item and isinstance(body, str) and body in drawing.origins:
+            local[key] = drawing.point(body, item[key], path + (key,))
+    return local
+
+
+def _items(data: Mapping[str, Any], section: str) -> list[Any]:
+    items = data.get(section) or []
+    if not isinstance(items, list):
+        raise MechanismError(f"expected a list of {section}", (section,))
+    return items
 
 
 def _constraint(drawing: Drawing3d, item: Any, path: Path_) -> Any:

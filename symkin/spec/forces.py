@@ -81,14 +81,16 @@ EXPRESSION_KEYS = {"gravity": ("g",), "force": ("f",), "torque": ("m",),
                    "spring": ("k", "length0", "damping")}
 
 
-def coordinate_names(bodies: Mapping[str, Any],
-                     symbol: Any = None) -> dict[tuple[str, str], sp.Symbol]:
+def coordinate_names(bodies: Mapping[str, Any], symbol: Any = None,
+                     parts: tuple[str, ...] = COORDINATE_PARTS
+                     ) -> dict[tuple[str, str], sp.Symbol]:
     """``(body, "x"|"y"|"phi"|"x_t"|...) -> Symbol`` named ``body.x`` / ``body.x_t``, the
-    coordinates and rates an expression in ``forces`` may use (the symbolic stage's names)."""
+    coordinates and rates an expression in ``forces`` may use (the symbolic stage's names);
+    ``parts``: a body's coordinates (a spatial file's in :mod:`symkin.spec.forces3d`)."""
     make = symbol or (lambda name: sp.Symbol(name, real=True))
     found = {}
     for body in bodies:
-        for part in COORDINATE_PARTS:
+        for part in parts:
             found[(body, part)] = make(f"{body}.{part}")
             found[(body, part + RATE_SUFFIX)] = make(f"{body}.{part}{RATE_SUFFIX}")
     return found

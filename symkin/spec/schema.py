@@ -16,8 +16,8 @@ from typing import Annotated, Any, Literal
 from pydantic import Field
 
 from symkin import pairs
-from symkin.pairs.fields import Expr, PointRef, Strict, Vec2, Vec3, Vec7
-from symkin.spec import expressions
+from symkin.pairs.fields import Expr, PointRef, PointRef3, Strict, Vec2, Vec3, Vec7
+from symkin.spec import expressions, forces3d
 from symkin.spec.forces import Load
 
 DYNAMICS_BODY_KEYS = ("mass", "inertia", "com")
@@ -37,10 +37,15 @@ class Body(Strict):
 
 class SpatialBody(Strict):
     """A moving body of a ``space: 3d`` file: first guess q0 = [x, y, z, e0, e1, e2, e3]
-    (position of its frame and Euler parameters, e0 the scalar part) and named 3-vectors."""
+    (position of its frame and Euler parameters, e0 the scalar part) and named 3-vectors; for
+    inverse dynamics its mass, its inertia tensor about the centre of mass in the body frame
+    (:mod:`symkin.spec.forces3d`) and that centre (a point name or a local 3-vector)."""
 
     q0: Vec7 = Field(default_factory=lambda: [0, 0, 0, 1, 0, 0, 0])
     points: dict[str, Vec3] = Field(default_factory=dict)
+    mass: Expr | None = None
+    inertia: forces3d.Inertia3 | None = None
+    com: PointRef3 | None = None
 
 
 # The coordinates of one body, by space: planar x, y, phi; spatial x, y, z and the Euler
@@ -143,6 +148,7 @@ class SpatialMechanismSpec(MechanismSpec):
     bodies: dict[str, SpatialBody] = Field(min_length=1)  # type: ignore[assignment]
     joints: list[SpatialJoint] = Field(default_factory=list)
     drivers: list[SpatialDriver] = Field(default_factory=list)
+    forces: list[forces3d.Load] = Field(default_factory=list)  # type: ignore[assignment]
 
     @property
     def is_spatial(self) -> bool:

@@ -19,6 +19,8 @@ from symkin.errors import ExpressionError, MechanismError, UsageError, format_pa
 from symkin.limits import MAX_GRID_POINTS, grid_points
 from symkin.pairs.fields import GROUND, is_input
 from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, forces, loader
+from symkin.spec.forces3d import coordinate_names as spatial_coordinate_names
+from symkin.spec.forces3d import entries, magnitude_problem
 from symkin.spec.messages import translate
 from symkin.spec.mobility import check_degrees_of_freedom
 from symkin.spec.mobility import degrees_of_freedom as degrees_of_freedom
@@ -394,26 +396,21 @@ def _check_dynamics(mech: Mechanism, symbols: _Names,
                     nominal: Mapping[sp.Symbol, float]) -> None:
     """Masses and inertias are constants >= 0; a load names known bodies and points, and its
     expressions use only t, parameters, coordinates and their rates."""
-    if mech.is_spatial:
-        # a spatial body has no mass keys (its schema refuses them); forces are planar so far
-        if mech.forces:
-            raise MechanismError("forces are not available in a space: 3d file yet",
-                                 ("forces",), "Remove the forces section: inverse dynamics "
-                                 "is planar for now.")
-        return
     for name, body in mech.bodies.items():
         for key in ("mass", "inertia"):
             raw = getattr(body, key)
             if raw is None:
                 continue
             path = ("bodies", name, key)
-            value = _numeric(_expression(raw, symbols, path), nominal, path)
-            if value < 0:
-                raise MechanismError(f"the {key} {value:g} is negative", path,
-                                     f"A {key} is zero or positive.")
+            values = {at: _numeric(_expression(item, symbols, path + at), nominal, path + at)
+                      for at, item in entries(raw)}
+            problem = magnitude_problem(key, values)
+            if problem is not None:
+                raise MechanismError(problem[0], path, problem[1])
         if body.com is not None:
             _point(mech, name, body.com, symbols, nominal, ("bodies", name, "com"))
-    moving = _Names(symbols.parameters, symbols.t, forces.coordinate_names(mech.bodies))
+    names = spatial_coordinate_names if mech.is_spatial else forces.coordinate_names
+    moving = _Names(symbols.parameters, symbols.t, names(mech.bodies))
     for index, load in enumerate(mech.forces):
         where: tuple[str | int, ...] = ("forces", index)
         for key in forces.BODY_KEYS[load.type]:

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.loads import reaction_parts
 from symkin.errors import SymkinError
 from symkin.runtime import spatial
 
@@ -68,20 +69,21 @@ class SweepResult:
 
     @functools.cached_property
     def forces(self) -> tuple[Array, Array] | None:
-        """(effort (M, T, n_driver_equations), reaction (M, T, n_joints, 3)) of every set's
-        solved rows (NaN beyond them); None for a mechanism without masses or forces."""
+        """(effort (M, T, n_driver_equations), reaction (M, T, n_joints, 3; spatial 6)) of every
+        set's solved rows (NaN beyond them); None for a mechanism without masses or forces."""
         if self.multipliers_grid is None:
             return None
         m, size = self.q.shape[:2]
         n_efforts, n_joints = len(self.driver_names), len(self.joint_names)
         effort = np.full((m, size, n_efforts), np.nan)
-        reaction = np.full((m, size, n_joints, 3), np.nan)
+        parts = len(reaction_parts(self.space))
+        reaction = np.full((m, size, n_joints, parts), np.nan)
         for j in range(m):
             done = int(self.solved[j])
             _, loads = self.multipliers_grid(self.t[:done], self.q[j, :done], self.dq[j, :done],
                                              self.d2q[j, :done], self.params[j])
             effort[j, :done] = loads[:, :n_efforts]
-            reaction[j, :done] = loads[:, n_efforts:].reshape(done, n_joints, 3)
+            reaction[j, :done] = loads[:, n_efforts:].reshape(done, n_joints, parts)
         return effort, reaction
 
     def force_envelope(self) -> list[tuple[str, float, float, float, int]]:
@@ -92,8 +94,9 @@ class SweepResult:
         effort, reaction = self.forces
         sets = np.flatnonzero(self.ok)
         columns = [(f"{n}.effort", effort[sets, :, k]) for k, n in enumerate(self.driver_names)]
+        parts = reaction_parts(self.space)
         columns += [(f"{n}.{part}", reaction[sets, :, k, c]) for k, n in
-                    enumerate(self.joint_names) for c, part in enumerate(("Fx", "Fy", "M"))]
+                    enumerate(self.joint_names) for c, part in enumerate(parts)]
         found = []
         for name, values in columns:
             j, k = np.unravel_index(int(np.nanargmax(np.abs(values))), values.shape)

@@ -23,7 +23,7 @@ from symkin.errors import MechanismError
 from symkin.spec import validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
-from symkin.symbolic import dynamics, redundancy, spatial
+from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
 from symkin.symbolic.planar import TAU, Context, input_slot
 from symkin.symbolic.symbols import Input, Symbols, extra_coordinates, make_symbols
 
@@ -207,13 +207,25 @@ def derive(mech: Mechanism | str | Path) -> System:
                      for body, spec in mech.bodies.items() for name in spec.points),
         placed=placed, time_grid=time_grid,
         phi_p=_parameter_jacobian(phi, symbols.p), removed=removed, mobility=mobility,
-        dynamics=(dynamics.derive(mech, ctx, phi_q, rows, placed,
-                                  _removed_jacobians(removed, column, symbols))
+        dynamics=(_dynamics(mech, ctx, phi_q, rows, placed,
+                            _removed_jacobians(removed, column, symbols))
                   if has_dynamics(mech) else None),
         inputs=symbols.inputs,
         input_values=_input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
                                                   symbols.t: time_grid[0]}),
     )
+
+
+def _dynamics(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: tuple[Row, ...],
+              placed: tuple[Placed, ...],
+              removed: tuple[tuple[Row, sp.Matrix], ...]) -> dynamics.Dynamics:
+    """Inverse dynamics, planar or spatial (the latter given the drivers as their rows were
+    written, to find each row's driven function)."""
+    if not mech.is_spatial:
+        return dynamics.derive(mech, ctx, phi_q, rows, placed, removed)
+    drivers = [_with_inputs(c, ctx.symbols, k) for k, c in enumerate(mech.drivers)]
+    return dynamics3d.derive(mech, ctx, phi_q, rows, placed, drivers,  # type: ignore[arg-type]
+                             removed)
 
 
 def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbols,

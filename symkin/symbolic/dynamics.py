@@ -97,20 +97,31 @@ def derive(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any,
         kinetic += energy
         _lagrange_terms(energy, columns, symbols, mass, velocity_terms)
     for load in mech.forces:
-        applied += _generalized_force(mech, ctx, load)
+        applied += generalized_force(mech, ctx, load)
     rhs = applied - mass * sp.Matrix(ddq) - velocity_terms
+    return assemble(mech, ctx, phi_q, rows, placed, removed, lam, _reaction, {},
+                    ddq=ddq, mass_matrix=sp.ImmutableMatrix(mass),
+                    applied=sp.ImmutableMatrix(applied),
+                    velocity_terms=sp.ImmutableMatrix(velocity_terms),
+                    rhs=sp.ImmutableMatrix(rhs), kinetic=kinetic)
+
+
+def assemble(mech: Mechanism, ctx: Any, phi_q: sp.SparseMatrix, rows: Any, placed: Any,
+             removed: tuple[tuple[Any, sp.Matrix], ...], lam: tuple[sp.Symbol, ...],
+             reaction: Any, scale: dict[int, sp.Expr], **terms: Any) -> Dynamics:
+    """The Dynamics of the equations of motion ``terms``, with the loads of the multipliers
+    ``lam`` of every row the file writes: the kept rows' (``phi_q``) then the ``removed``
+    rows' (planar and spatial alike; ``reaction`` and ``scale`` as for :func:`loads`)."""
+    n = phi_q.shape[1]
     removed_q = sp.Matrix.vstack(sp.zeros(0, n), *(jacobian for _, jacobian in removed))
     every_row = sp.Matrix.vstack(sp.Matrix(phi_q), removed_q)
     every_label = (*rows, *(label for label, _ in removed))
-    efforts, reactions, driver_names, joint_names = _loads(mech, ctx, every_row, every_label,
-                                                           placed, lam)
+    efforts, reactions, driver_names, joint_names = loads(mech, ctx, every_row, every_label,
+                                                         placed, lam, reaction, scale)
     full = sp.ImmutableMatrix([*efforts, *reactions])
     kept = full.xreplace({symbol: 0 for symbol in lam[n:]})
     return Dynamics(
-        ddq=ddq, lam=lam, mass_matrix=sp.ImmutableMatrix(mass),
-        applied=sp.ImmutableMatrix(applied), velocity_terms=sp.ImmutableMatrix(velocity_terms),
-        rhs=sp.ImmutableMatrix(rhs), kinetic=kinetic,
-        loads=kept, driver_names=driver_names, joint_names=joint_names,
+        lam=lam, loads=kept, driver_names=driver_names, joint_names=joint_names, **terms,
         loads_full=full if removed else None,
         removed_q=sp.ImmutableMatrix(removed_q) if removed else None)
 
@@ -120,7 +131,7 @@ def _columns(symbols: Any, body: str) -> list[int]:
     return [start, start + 1, start + 2]
 
 
-def _velocity(expr: sp.Matrix, symbols: Any) -> sp.Matrix:
+def velocity(expr: sp.Matrix, symbols: Any) -> sp.Matrix:
     """d/dt of an expression of q (no explicit t): Σ ∂expr/∂q_k dq_k."""
     used = [k for k, q in enumerate(symbols.q) if expr.has(q)]
     return sum((expr.diff(symbols.q[k]) * symbols.dq[k] for k in used),
@@ -130,7 +141,7 @@ def _velocity(expr: sp.Matrix, symbols: Any) -> sp.Matrix:
 def _body_energy(ctx: Context, body: str, columns: list[int], m: sp.Expr, inertia: sp.Expr,
                  com: sp.Matrix) -> sp.Expr:
     """T = ½ m |ṙ_c|² + ½ J φ̇² with r_c = r + R c."""
-    speed = _velocity(ctx.pose(body).point(com), ctx.symbols)
+    speed = velocity(ctx.pose(body).point(com), ctx.symbols)
     rate = ctx.symbols.dq[columns[2]]
     return sp.expand(m * (speed.T * speed)[0, 0] / 2 + inertia * rate ** 2 / 2)
 
@@ -151,11 +162,13 @@ def _names(ctx: Context) -> tuple[dict[str, sp.Symbol], dict[tuple[str, str], sp
     symbols = ctx.symbols
     mapping = dict(zip(symbols.coordinates, symbols.q)) | dict(
         zip((c + loads_spec.RATE_SUFFIX for c in symbols.coordinates), symbols.dq))
-    coordinates = loads_spec.coordinate_names(ctx.mech.bodies, mapping.__getitem__)
+    coordinates = loads_spec.coordinate_names(ctx.mech.bodies, mapping.__getitem__,
+                                              ctx.mech.body_coordinates)
     return {**symbols.parameters, "t": symbols.t}, coordinates
 
 
-def _expr(ctx: Context, raw: Any) -> sp.Expr:
+def load_expr(ctx: Context, raw: Any) -> sp.Expr:
+    """An expression of a load: t, parameters, coordinates and their rates."""
     names, coordinates = _names(ctx)
     return expressions.parse(raw, names, coordinates)
 
@@ -165,31 +178,33 @@ def _point_force(ctx: Context, position: sp.Matrix, force: sp.Matrix) -> sp.Matr
     return sp.Matrix([(force.T * position.diff(q))[0, 0] for q in ctx.symbols.q])
 
 
-def _generalized_force(mech: Mechanism, ctx: Context, load: Any) -> sp.Matrix:
+def generalized_force(mech: Mechanism, ctx: Context, load: Any) -> sp.Matrix:
+    """Q of one load by virtual work (a planar torque; symbolic.dynamics3d: a spatial one)."""
     symbols, n = ctx.symbols, len(ctx.symbols.q)
     if load.type == "gravity":
-        g = sp.Matrix([_expr(ctx, raw) for raw in load.g])
+        g = sp.Matrix([load_expr(ctx, raw) for raw in load.g])
         total = sp.zeros(n, 1)
         for body, spec in mech.bodies.items():
             if spec.mass is not None:
-                com = ctx.local(body, spec.com) if spec.com is not None else sp.zeros(2, 1)
+                com = (ctx.local(body, spec.com) if spec.com is not None
+                       else sp.zeros(len(ctx.pose(body).r), 1))
                 total += _point_force(ctx, ctx.pose(body).point(com), ctx.expr(spec.mass) * g)
         return total
     if load.type == "force":
         position = ctx.pose(load.body).point(ctx.local(load.body, load.at))
-        return _point_force(ctx, position, sp.Matrix([_expr(ctx, raw) for raw in load.f]))
+        return _point_force(ctx, position, sp.Matrix([load_expr(ctx, raw) for raw in load.f]))
     if load.type == "torque":
         total = sp.zeros(n, 1)
-        total[_columns(symbols, load.body)[2]] = _expr(ctx, load.m)
+        total[_columns(symbols, load.body)[2]] = load_expr(ctx, load.m)
         return total
     # a spring-damper: Q = -tension dL/dq
     a = _end(ctx, load.i, load.A)
     b = _end(ctx, load.j, load.B)
     d = b - a
     length = sp.sqrt((d.T * d)[0, 0])
-    rate = _velocity(sp.Matrix([length]), symbols)[0, 0]
-    tension = (_expr(ctx, load.k) * (length - _expr(ctx, load.length0))
-               + _expr(ctx, load.damping) * rate)
+    rate = velocity(sp.Matrix([length]), symbols)[0, 0]
+    tension = (load_expr(ctx, load.k) * (length - load_expr(ctx, load.length0))
+               + load_expr(ctx, load.damping) * rate)
     return sp.Matrix([-tension * length.diff(q) for q in symbols.q])
 
 
@@ -203,10 +218,12 @@ def _cross(a: sp.Matrix, b: sp.Matrix) -> sp.Expr:
     return a[0] * b[1] - a[1] * b[0]
 
 
-def _loads(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any, placed: Any,
-           lam: tuple[sp.Symbol, ...]) -> tuple[list[sp.Expr], list[sp.Expr],
-                                                tuple[str, ...], tuple[str, ...]]:
-    """Efforts (-λ of each driver row) and each joint's [Fx, Fy, M] from its rows' λ."""
+def loads(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any, placed: Any,
+          lam: tuple[sp.Symbol, ...], reaction: Any,
+          scale: dict[int, sp.Expr]) -> tuple[list[sp.Expr], list[sp.Expr],
+                                              tuple[str, ...], tuple[str, ...]]:
+    """Efforts (``scale`` λ of each driver row, -λ where it has none) and each joint's
+    reaction (``reaction``, called like :func:`_reaction`) from its rows' λ."""
     efforts: list[sp.Expr] = []
     reactions: list[sp.Expr] = []
     driver_names: list[str] = []
@@ -219,13 +236,13 @@ def _loads(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: Any, pla
             own = by_owner.get((section, index), [])
             name = constraint.name or f"{section[:-1]}{index}"
             if section == "drivers":
-                efforts += [-lam[r] for r in own]
+                efforts += [scale.get(r, sp.Integer(-1)) * lam[r] for r in own]
                 parts = [rows[r].part for r in own]
                 driver_names += [name] if len(own) == 1 else [f"{name}.{p}" for p in parts]
                 continue
             joint_names.append(name)
-            reactions += _reaction(ctx, phi_q, own, rows[own[0]].bodies, lam,
-                                   _point_on_i(placed, index))
+            reactions += reaction(ctx, phi_q, own, rows[own[0]].bodies, lam,
+                                  _point_on_i(placed, index))
     return efforts, reactions, tuple(driver_names), tuple(joint_names)
 
 

@@ -113,6 +113,16 @@ EXPECTED: dict[str, tuple[int, str]] = {
                                           "column 4: unknown coordinate 'rocker.phi_t'"),
     "force_unknown_point.yaml": (4, "at bodies.crank.com: body 'crank' has no point named "
                                     "'middle'"),
+    # inverse dynamics of a spatial file: masses, inertia tensors, 3-vectors
+    "spatial_negative_mass.yaml": (5, "at bodies.crank.mass: the mass -2 is negative"),
+    "spatial_inertia_not_symmetric.yaml": (5, "at bodies.crank.inertia: the inertia tensor is "
+                                              "not symmetric: [0][2] = 0 but [2][0] = 0.5"),
+    "spatial_inertia_negative.yaml": (5, "at bodies.crank.inertia: the inertia tensor has a "
+                                         "negative principal moment -2"),
+    "spatial_inertia_impossible.yaml": (5, "the principal moments 1, 1, 3 break the triangle "
+                                           "inequality"),
+    "spatial_force_two_components.yaml": (10, "at forces[0].f: expected a vector of 3 numbers, "
+                                              "got 2 items"),
 }
 
 

@@ -17,6 +17,7 @@ from symkin import resources
 from symkin.backends.c import batch, multipliers
 from symkin.backends.c.cinputs import InputStepper
 from symkin.backends.c.csolver import GridSolver, SolverPool
+from symkin.contract.loads import load_count
 from symkin.contract.options import Options
 from symkin.runtime.kernel import Array, Kernel, import_file
 from symkin.runtime.protocol import BatchStatus
@@ -31,7 +32,8 @@ class CKernel(Kernel):
 
     def __init__(self, ffi: Any, lib: Any, meta: Mapping[str, Any],
                  folder: Path | None = None) -> None:
-        n_loads = len(meta.get("driver_names", ())) + 3 * len(meta.get("joint_names", ()))
+        n_loads = load_count(len(meta.get("driver_names", ())), len(meta.get("joint_names", ())),
+                             meta.get("space", "2d"))
         functions = _CFunctions(ffi, lib, meta["name"], meta["real"], len(meta["coordinates"]),
                                 len(meta["pattern_rows"]),
                                 len(meta["points"]) * (3 if meta.get("space") == "3d" else 2),
@@ -63,7 +65,8 @@ class CKernel(Kernel):
                          p: Array) -> tuple[Array, Array]:
         """lam and the loads of solved rows in one call of the generated C."""
         return multipliers.grid(self.ffi, self.lib, self.name, self.real, t, q, dq, d2q, p,
-                                len(self.driver_names) + 3 * len(self.joint_names))
+                                load_count(len(self.driver_names), len(self.joint_names),
+                                           self.space))
 
     def input_stepper(self) -> InputStepper | None:
         """The generated solve_inputs, for a mechanism with input drivers (else None)."""
