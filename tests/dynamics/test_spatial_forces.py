@@ -337,3 +337,22 @@ def test_sweep_envelope_has_the_six_components() -> None:
     names = [row[0] for row in result.force_envelope()]
     assert names == ["motor.effort"] + [f"shaft.{part}" for part in
                                         ("Fx", "Fy", "Fz", "Mx", "My", "Mz")]
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_cardan_torque_through_its_removed_rows(backend: str) -> None:
+    """The Cardan shaft has three rows removed as redundant, so its bearing forces are not
+    unique; the drive torque is. Massless shafts and a brake torque B on the output: by power,
+    T1 = B ω2/ω1 = B cos β / (1 - sin²β cos²θ1) (tan θ2 = tan θ1 / cos β, differentiated)."""
+    data = yaml.safe_load((EXAMPLES / "cardan.yaml").read_text(encoding="utf-8"))
+    data["forces"] = [{"type": "torque", "name": "brake", "body": "shaft2",
+                       "m": ["-3*cos(beta)", "-3*sin(beta)", 0]}]
+    traj = _solve(data, backend)
+    beta, theta = np.pi / 6, 2 * np.pi * traj.t
+    torque = 3 * np.cos(beta) / (1 - np.sin(beta) ** 2 * np.cos(theta) ** 2)
+    forces = traj.forces
+    assert np.max(np.abs(forces.effort[:, 0] - torque)) < 1e-9
+    assert forces.effort_determinate.all()
+    assert forces.reaction.shape == (traj.t.size, 3, 6)
+    # the cross's forces along the shafts are shared among the removed rows: min-norm, marked
+    assert "cross.Fx" in forces.indeterminate()
