@@ -209,8 +209,8 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
     p_pattern = parameter_pattern(system)
     expressions = _routine_expressions(system, pattern, p_pattern)
     printer: CodePrinter = backend.printer(real)
-    prepared = {name: [symbol_printing.prepare(e, internal) for e in exprs]
-                for name, exprs in expressions.items()}
+    prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
+    prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
     fused, shared = _fused_expressions(prepared)
     sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}
     orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
@@ -304,11 +304,13 @@ def _fused_expressions(prepared: dict[str, list[sp.Expr]]
     dynamics = tuple(name for name in DYNAMICS if name in prepared)
     shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma", *dynamics)),
                     key=sp.default_sort_key)
-    mapping = {f: sp.Symbol(f"_shared{k}", real=True) for k, f in enumerate(shared)}
+    # one memory of rebuilt subtrees: Gamma repeats Phi_t's piecewise parts
+    mapped = symbol_printing.Substitution({f: sp.Symbol(f"_shared{k}", real=True)
+                                           for k, f in enumerate(shared)})
     return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
-            "phi_t_shared": [e.xreplace(mapping) for e in prepared["phi_t"]],
-            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]],
-            **{f"{name}_shared": [e.xreplace(mapping) for e in prepared[name]]
+            "phi_t_shared": [mapped(e) for e in prepared["phi_t"]],
+            "gamma_shared": [mapped(e) for e in prepared["gamma"]],
+            **{f"{name}_shared": [mapped(e) for e in prepared[name]]
                for name in dynamics}}, shared
 
 
