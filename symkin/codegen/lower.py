@@ -25,6 +25,7 @@ from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.target import Target
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
+from symkin.symbolic.ranges import Range, coordinate_ranges
 
 REAL_TYPES = ("double", "float")
 # The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
@@ -142,6 +143,8 @@ class Code:
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
     removed: tuple[str, ...] = ()
     """The labels of the rows removed as dependent at t0 (the ``removed`` routine's outputs)."""
+    ranges: tuple[Range, ...] = ()
+    """The ranges the file gives the pairs' own coordinates (symbolic.ranges)."""
     space: str = "2d"
     """``3d`` for a spatial mechanism (its points have three components)."""
 
@@ -243,6 +246,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         removed=tuple(str(removed) for removed in system.removed),
+        ranges=coordinate_ranges(system),
         driver_names=system.dynamics.driver_names if system.dynamics else (),
         joint_names=system.dynamics.joint_names if system.dynamics else (),
         input_names=system.input_names, input_values=system.input_values,

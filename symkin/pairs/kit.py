@@ -154,6 +154,8 @@ class PairType:
         coordinate: the key of the first guess of the coordinate ``NAME.s`` the pair adds
             (a contact or curve parameter, solved like the bodies' coordinates); None: the
             pair adds no coordinate.
+        coordinate_range: the key of that coordinate's range [a, b] (optional in the file):
+            the motion stops, naming the pair, where ``NAME.s`` leaves it.
     """
 
     name: str
@@ -179,12 +181,18 @@ class PairType:
     coordinate: str | None = None
     outputs: Callable[[Any, Geometry], dict[str, tuple[sp.Expr, sp.Expr | None]]] | None = None
     marks: Callable[[Any, Geometry], list[Mark]] | None = None
+    coordinate_range: str | None = None
 
     def extra_coordinates(self, constraint: Any) -> tuple[tuple[str, Any], ...]:
         """The coordinates ``constraint`` adds, as (name, first guess): ``NAME.s``."""
         if self.coordinate is None:
             return ()
         return ((f"{constraint.name}.s", getattr(constraint, self.coordinate)),)
+
+    def range_of(self, constraint: Any) -> list[Any] | None:
+        """The range [a, b] the file gives ``NAME.s`` (raw expressions), or None."""
+        return None if self.coordinate_range is None else getattr(constraint,
+                                                                  self.coordinate_range)
 
     def equation_count(self, constraint: Any) -> int:
         """How many rows of Phi ``constraint`` owns."""

@@ -31,6 +31,7 @@ import sympy as sp
 from symkin.errors import MechanismError
 from symkin.pairs import kit
 from symkin.pairs.fields import Expr, PointRef, Strict, Vec2
+from symkin.pairs.planar.point_on_curve import check_range
 
 SAMPLES = 2048  # points of s checked over one turn of the profile
 
@@ -66,6 +67,7 @@ class Cam(Strict):
     profile: Vec2 | Polar
     follower: Roller | Flat
     s0: Expr = 0
+    range: Vec2 | None = None  # where the profile is meant to be followed: [a, b] of s
 
 
 def profile_texts(profile: list[Any] | Polar) -> list[Any]:
@@ -136,6 +138,7 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
 def check(c: Cam, checks: kit.Checks, path: kit.Path) -> None:
     """The follower's point and sizes; the profile smooth, and followable over one turn."""
     s0 = checks.value(checks.expression(c.s0, path + ("s0",)), path + ("s0",))
+    check_range(c.range, s0, checks, path)
     checks.point(c.j, c.follower.at, path + ("follower", "at"))
     key = ("profile", "polar") if isinstance(c.profile, Polar) else ("profile",)
     texts = profile_texts(c.profile)
@@ -246,4 +249,4 @@ def marks(c: Cam, geometry: kit.Geometry) -> list[kit.Mark]:
 TYPE = kit.PairType(
     name="cam", model=Cam, sections=("joints",), equations=equations,
     rows=("contact 1", "contact 2"), check=check, to_local=to_local, coordinate="s0",
-    outputs=outputs, marks=marks)
+    outputs=outputs, marks=marks, coordinate_range="range")
