@@ -123,3 +123,51 @@ def test_cli_exits_1_naming_the_pair_with_the_rows_before(tmp_path: Path) -> Non
     assert "c1.s = 1.55 left its range [0, 1.5] (joints[0] c1 point_on_curve)" in result.stderr
     saved = np.load(tmp_path / "out.npz")
     assert saved["t"][-1] == pytest.approx(1.3)
+
+
+# ----- the checks and the follower's side over the profile's own range ----------------------
+
+def test_undercut_is_checked_over_the_profiles_range_only() -> None:
+    """rho = 2 + 0.4 cos 3s has hollows (at s = pi/3, pi, 5 pi/3) tighter than a roller of 1.5:
+    refused over a whole turn. Near s = pi/2 its curvature (rho^2 + 2 rho'^2 - rho rho'') /
+    (rho^2 + rho'^2)^(3/2) = 6.88 / 5.44^1.5 > 0: a profile meant only for s in pi/2 +- 0.05
+    is convex there and accepted."""
+    lobed = _cam()
+    lobed["joints"][2].update(profile={"polar": "2 + 0.4*cos(3*s)"},
+                              follower={"roller": 1.5, "at": "R"})
+    with pytest.raises(MechanismError, match="undercutting"):
+        symkin.from_dict(lobed)
+    lobed["joints"][2]["range"] = ["pi/2 - 0.05", "pi/2 + 0.05"]
+    symkin.from_dict(lobed)
+
+
+def _wedge(follower_y: float) -> dict:
+    """An open profile: the straight flank y = x / 2 (s in [-2, 4], through the cam's frame
+    origin, so it has no turning sense about it), on a cam pushed left (x = -t) under a roller
+    of radius 0.3 on a vertical guide at x = 0, above or below the flank by q0."""
+    return {"name": "wedge", "parameters": {},
+            "bodies": {"cam": {"q0": [0, 0, 0]},
+                       "follower": {"q0": [0, follower_y, 0], "points": {"R": [0, 0]}}},
+            "joints": [{"type": "prismatic", "i": "cam", "j": "ground", "sA": [0, 0],
+                        "sB": [0, 0], "v": [0, 1]},  # v: the slide's normal
+                       {"type": "prismatic", "i": "follower", "j": "ground", "sA": [0, 0],
+                        "sB": [0, 0], "v": [1, 0]},
+                       {"type": "cam", "name": "k1", "i": "cam", "j": "follower",
+                        "profile": ["s", "s/2"], "follower": {"roller": 0.3, "at": "R"},
+                        "s0": 0, "range": [-2, 4]}],
+            "drivers": [{"type": "custom", "name": "push", "equations": ["cam.x + t"]}],
+            "time": {"t0": 0, "t1": 2, "dt": 0.1}}
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("side", [1, -1])
+def test_an_open_profiles_roller_stays_on_its_side_at_q0(side: int, backend: str) -> None:
+    """The roller's centre is 0.3 from the flank on the side it starts: y = t / 2 +- 0.3
+    sqrt(1 + 1/4) (the flank at x = 0 is at height t / 2 when the cam has moved by -t)."""
+    system = symkin.derive(symkin.from_dict(_wedge(0.5 * side)))
+    run = symkin.solve(kernel_for(system, backend))
+    y = run.q[:, system.coordinates.index("follower.y")]
+    expected = run.t / 2 + side * 0.3 * math.sqrt(1.25)
+    assert np.abs(y - expected).max() < 1e-9
+    assert np.abs(run.dq[:, system.coordinates.index("follower.y")] - 0.5).max() < 1e-8
+    assert run.t[-1] == pytest.approx(2.0)
