@@ -270,8 +270,8 @@ def _with_pair_outputs(trajectory: Any, args: argparse.Namespace, system: Any = 
     come from the validated file and the pairs' own expressions: the System of a cold run
     (``system``), else the file read again — never a second derivation (a warm run of a cam
     stays seconds long, and one of other mechanisms free of it)."""
-    if not args.output or trajectory.t.size == 0:
-        return trajectory
+    if not (args.output or args.animate or args.html) or trajectory.t.size == 0:
+        return trajectory  # written to the results file; contact points marked in pictures
     # Only a pair with its own coordinate NAME.s (a curve or a cam) reports outputs: any other
     # mechanism's warm run must not import the file's schema or SymPy.
     if not any(name.endswith(".s") for name in trajectory.coordinates):

@@ -135,7 +135,9 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
       undefined (NaN) where that point is at rest (a dwell), which has no direction;
     - ``curvature_radius``: the profile's radius of curvature |c'|^3 / (c' x c''), positive
       where the profile is convex, negative where it is hollow (a roller needs a radius
-      smaller than the hollow's)."""
+      smaller than the hollow's);
+    - ``contact_x``, ``contact_y``: the contact point c(s) in the global frame (marked in the
+      pictures)."""
     s = geometry.coordinate(f"{c.name}.s")
     curve = _profile(c, s, geometry)
     cam, follower = geometry.pose(c.i), geometry.pose(c.j)
@@ -151,7 +153,8 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     along = (normal.T * velocity)[0]
     return {"pressure_angle": (sp.atan2(sp.Abs(across), sp.Abs(along)),
                                sp.sqrt((velocity.T * velocity)[0])),
-            "curvature_radius": (sense * speed**3 / (t[0] * t2[1] - t[1] * t2[0]), None)}
+            "curvature_radius": (sense * speed**3 / (t[0] * t2[1] - t[1] * t2[0]), None),
+            **kit.contact_outputs(cam.point(curve))}
 
 
 def check(c: Cam, checks: kit.Checks, path: kit.Path) -> None:

@@ -133,6 +133,13 @@ def marks(c: Gear, geometry: kit.Geometry) -> list[kit.Mark]:
     return found
 
 
+def pitch(c: Gear, geometry: kit.Geometry) -> tuple[str, str, sp.Expr, sp.Expr]:
+    """Where the pitch circles touch: r_i from i's centre towards j's (away from a ring's)."""
+    ri, rj = (geometry.expr(raw) for raw in c.radii)
+    return c.i, c.j, ri, -rj if c.internal else rj
+
+
 TYPE = kit.PairType(
     name="gear", model=Gear, sections=("joints",), equations=equations, rows=("rolling",),
-    bodies=("i", "j", "carrier"), constants=("offset",), check=check, marks=marks)
+    bodies=("i", "j", "carrier"), constants=("offset",), check=check, marks=marks,
+    pitch=pitch)

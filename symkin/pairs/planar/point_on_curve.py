@@ -98,6 +98,13 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
     return local, float(((px - cx) ** 2 + (py - cy) ** 2) ** 0.5)
 
 
+def outputs(c: PointOnCurve, geometry: kit.Geometry
+            ) -> dict[str, tuple[sp.Expr, sp.Expr | None]]:
+    """The contact point c(s) in the global frame, ``contact_x`` and ``contact_y``."""
+    s = geometry.coordinate(f"{c.name}.{S}")
+    return kit.contact_outputs(geometry.pose(c.i).point(curve_of(c.curve, s, geometry)))
+
+
 def marks(c: PointOnCurve, geometry: kit.Geometry) -> list[kit.Mark]:
     """The curve, over s0 - pi to s0 + pi (where it is real)."""
     s0 = geometry.expr(c.s0)
@@ -107,4 +114,4 @@ def marks(c: PointOnCurve, geometry: kit.Geometry) -> list[kit.Mark]:
 TYPE = kit.PairType(
     name="point_on_curve", model=PointOnCurve, sections=("joints",), equations=equations,
     rows=("x", "y"), points=(("point", "j"),), check=check, to_local=to_local,
-    coordinate="s0", marks=marks, coordinate_range="range")
+    coordinate="s0", marks=marks, coordinate_range="range", outputs=outputs)
