@@ -171,3 +171,12 @@ def test_an_open_profiles_roller_stays_on_its_side_at_q0(side: int, backend: str
     assert np.abs(y - expected).max() < 1e-9
     assert np.abs(run.dq[:, system.coordinates.index("follower.y")] - 0.5).max() < 1e-8
     assert run.t[-1] == pytest.approx(2.0)
+
+
+def test_a_profile_with_a_range_is_drawn_over_it() -> None:
+    """The flank's mark runs from s = -2 to 4: (-2, -1) to (4, 2) in the cam's frame."""
+    from symkin.symbolic import drawing
+
+    outlines = drawing.outlines(symkin.derive(symkin.from_dict(_wedge(0.5))))
+    (profile,) = [v for k, v in outlines.items() if k.startswith("curve:cam:cam profile:")]
+    assert np.allclose(profile[0], [-2, -1]) and np.allclose(profile[-1], [4, 2])

@@ -286,9 +286,11 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
 
 
 def marks(c: Cam, geometry: kit.Geometry) -> list[kit.Mark]:
-    """The profile, over one turn of s from s0."""
+    """The profile over its range, else one turn of s from s0."""
     s0 = geometry.expr(c.s0)
-    return [(c.i, "cam profile", _profile(c, kit.S_MARK, geometry), (s0, s0 + 2 * sp.pi))]
+    span = ((s0, s0 + 2 * sp.pi) if c.range is None
+            else tuple(geometry.expr(end) for end in c.range))
+    return [(c.i, "cam profile", _profile(c, kit.S_MARK, geometry), span)]
 
 
 TYPE = kit.PairType(

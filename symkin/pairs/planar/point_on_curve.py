@@ -106,9 +106,11 @@ def outputs(c: PointOnCurve, geometry: kit.Geometry
 
 
 def marks(c: PointOnCurve, geometry: kit.Geometry) -> list[kit.Mark]:
-    """The curve, over s0 - pi to s0 + pi (where it is real)."""
+    """The curve over its range, else s0 - pi to s0 + pi (where it is real)."""
     s0 = geometry.expr(c.s0)
-    return [(c.i, "curve", curve_of(c.curve, kit.S_MARK, geometry), (s0 - sp.pi, s0 + sp.pi))]
+    span = ((s0 - sp.pi, s0 + sp.pi) if c.range is None
+            else tuple(geometry.expr(end) for end in c.range))
+    return [(c.i, "curve", curve_of(c.curve, kit.S_MARK, geometry), span)]
 
 
 TYPE = kit.PairType(
