@@ -59,7 +59,9 @@ def _outputs_of(mech: Mechanism, symbols: Symbols) -> tuple[Output, ...]:
 
 def _numeric(symbols: Symbols, expr: sp.Expr) -> Callable[..., NDArray[np.float64]]:
     arguments = [*symbols.q, *symbols.dq, symbols.t, *symbols.p]
-    return sp.lambdify(arguments, expr, "numpy")  # type: ignore[no-any-return]
+    # CSE first: a cam's pressure angle repeats the piecewise profile's derivatives, and
+    # printing the expanded tree took a minute for the cam example (5 s with CSE)
+    return sp.lambdify(arguments, expr, "numpy", cse=True)  # type: ignore[no-any-return]
 
 
 def evaluate(system: System, trajectory: Any) -> tuple[tuple[str, NDArray[np.float64]],
