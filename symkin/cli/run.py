@@ -212,7 +212,7 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     if progress:
         progress.finish()
     _warn_flagged(trajectory)
-    trajectory = _with_pair_outputs(trajectory, args)
+    trajectory = _with_pair_outputs(trajectory, args, prepared.system)
     written = _write(trajectory, args, prepared.outlines, picture)
     origin = ", cached kernel" if prepared.hit else ""
     if args.at is not None:
@@ -240,7 +240,7 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
         message += f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     try:
-        trajectory = _with_pair_outputs(stop.trajectory, args)
+        trajectory = _with_pair_outputs(stop.trajectory, args, prepared.system)
         with run_outputs.interrupts_held():  # a second Ctrl-C must not cut the file short
             written = _write(trajectory, args, prepared.outlines,
                              run_outputs.Pictures.of(args, prepared.kernel))
@@ -264,12 +264,14 @@ def _note_far_start(kernel: Any, trajectory: Any) -> None:
         messages.note(run_outputs.far_start_note(moved, scale))
 
 
-def _with_pair_outputs(trajectory: Any, args: argparse.Namespace) -> Any:
+def _with_pair_outputs(trajectory: Any, args: argparse.Namespace, system: Any = None) -> Any:
     """The trajectory with what its pairs report (a cam's pressure angle and radius of
-    curvature) when a results file is written and the mechanism has such pairs: only then
-    is the file read and derived again (a warm run of other mechanisms stays free of it)."""
-    if not args.output or trajectory.t.size == 0:
-        return trajectory
+    curvature) when a results file is written and the mechanism has such pairs. The outputs
+    come from the validated file and the pairs' own expressions: the System of a cold run
+    (``system``), else the file read again — never a second derivation (a warm run of a cam
+    stays seconds long, and one of other mechanisms free of it)."""
+    if not (args.output or args.animate or args.html) or trajectory.t.size == 0:
+        return trajectory  # written to the results file; contact points marked in pictures
     # Only a pair with its own coordinate NAME.s (a curve or a cam) reports outputs: any other
     # mechanism's warm run must not import the file's schema or SymPy.
     if not any(name.endswith(".s") for name in trajectory.coordinates):
@@ -277,13 +279,14 @@ def _with_pair_outputs(trajectory: Any, args: argparse.Namespace) -> Any:
     from symkin import pairs
     from symkin.spec import validate
 
-    mech = validate.load(args.mechanism, overrides.parse(args.overrides))
+    mech = (system.mechanism if system is not None
+            else validate.load(args.mechanism, overrides.parse(args.overrides)))
     if not any(pairs.of(c).outputs for section in pairs.SECTIONS
                for c in getattr(mech, section)):
         return trajectory
-    from symkin.symbolic import derivation, outputs
+    from symkin.symbolic import outputs
 
-    return outputs.with_outputs(derivation.derive(mech), trajectory)
+    return outputs.with_mechanism_outputs(mech, trajectory)
 
 
 def _warn_flagged(trajectory: Any) -> None:

@@ -25,6 +25,7 @@ from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.target import Target
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
+from symkin.symbolic.ranges import Range, coordinate_ranges
 
 REAL_TYPES = ("double", "float")
 # The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
@@ -146,6 +147,8 @@ class Code:
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
     removed: tuple[str, ...] = ()
     """The labels of the rows removed as dependent at t0 (the ``removed`` routine's outputs)."""
+    ranges: tuple[Range, ...] = ()
+    """The ranges the file gives the pairs' own coordinates (symbolic.ranges)."""
     space: str = "2d"
     """``3d`` for a spatial mechanism (its points have three components)."""
 
@@ -216,8 +219,8 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
     p_pattern = parameter_pattern(system)
     expressions = _routine_expressions(system, pattern, p_pattern)
     printer: CodePrinter = backend.printer(real)
-    prepared = {name: [symbol_printing.prepare(e, internal) for e in exprs]
-                for name, exprs in expressions.items()}
+    prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
+    prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
     fused, shared = _fused_expressions(prepared)
     sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}
     orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
@@ -250,6 +253,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         removed=tuple(str(removed) for removed in system.removed),
+        ranges=coordinate_ranges(system),
         driver_names=system.dynamics.driver_names if system.dynamics else (),
         joint_names=system.dynamics.joint_names if system.dynamics else (),
         input_names=system.input_names, input_values=system.input_values,
@@ -321,11 +325,13 @@ def _fused_expressions(prepared: dict[str, list[sp.Expr]]
     dynamics = tuple(name for name in DYNAMICS if name in prepared)
     shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma", *dynamics)),
                     key=sp.default_sort_key)
-    mapping = {f: sp.Symbol(f"_shared{k}", real=True) for k, f in enumerate(shared)}
+    # one memory of rebuilt subtrees: Gamma repeats Phi_t's piecewise parts
+    mapped = symbol_printing.Substitution({f: sp.Symbol(f"_shared{k}", real=True)
+                                           for k, f in enumerate(shared)})
     return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
-            "phi_t_shared": [e.xreplace(mapping) for e in prepared["phi_t"]],
-            "gamma_shared": [e.xreplace(mapping) for e in prepared["gamma"]],
-            **{f"{name}_shared": [e.xreplace(mapping) for e in prepared[name]]
+            "phi_t_shared": [mapped(e) for e in prepared["phi_t"]],
+            "gamma_shared": [mapped(e) for e in prepared["gamma"]],
+            **{f"{name}_shared": [mapped(e) for e in prepared[name]]
                for name in dynamics}}, shared
 
 

@@ -232,6 +232,8 @@ def metadata(code: Code) -> Metadata:
         data["joint_names"] = list(code.joint_names)
     if code.input_names:  # only then: the other mechanisms' manifests stay the same
         data["input_names"] = list(code.input_names)
+    if code.ranges:  # likewise
+        data["ranges"] = [list(entry) for entry in code.ranges]
     return data
 
 
@@ -276,6 +278,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "nremoved": len(code.removed),
         "removed_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.removed)],
         "removed_literals": [repr(r) for r in code.removed],
+        "range_literals": [repr(tuple(entry)) for entry in code.ranges],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "point_size": len(code.point_axes),
         "point_tuples": "(x, y, z) triples" if code.space == "3d" else "(x, y) pairs",

@@ -118,10 +118,10 @@ class _SampleKernel:
         self.coordinates = system.coordinates
         self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
         self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
-        phi = [symbol_printing.prepare(e, internal) for e in system.phi]
-        self._phi = sp.lambdify(arguments, phi, modules="numpy")
-        self._nz = sp.lambdify(arguments, [symbol_printing.prepare(system.phi_q[r, c], internal)
-                                           for r, c in pattern], modules="numpy")
+        prepare = symbol_printing.Preparer(internal)
+        self._phi = sp.lambdify(arguments, [prepare(e) for e in system.phi], modules="numpy")
+        self._nz = sp.lambdify(arguments, [prepare(system.phi_q[r, c]) for r, c in pattern],
+                               modules="numpy")
         self._p = np.array(system.code_p_values, dtype=float)
 
     # t as a NumPy float: IEEE semantics as in the generated code (inf, NaN), never a Python

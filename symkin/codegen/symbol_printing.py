@@ -50,21 +50,82 @@ def internal_symbols(system: System) -> dict[sp.Symbol, sp.Symbol]:
 
 
 def prepare(expr: sp.Expr, internal: dict[sp.Symbol, sp.Symbol]) -> sp.Expr:
-    """Internal symbols, no DiracDelta, and every constant part a plain number.
+    """Internal symbols, no DiracDelta, and every constant part a plain number (one
+    expression; :class:`Preparer` for many)."""
+    return Preparer(internal)(expr)
 
-    Constants are folded to correctly rounded doubles (:func:`constants.fold`), so no printer
-    ever meets ``sqrt(2)`` (C99 would print the POSIX macro ``M_SQRT2``) or an integer wider
-    than a C integer constant.
 
-    Raises:
-        BuildError: a constant part has no finite real value.
+class Preparer:
+    """Prepares expressions for printing: internal symbols, no DiracDelta, and every constant
+    part a plain number.
+
+    Constants are folded to correctly rounded doubles (:func:`constants.fold`'s rule: each
+    largest constant part that is not a plain number becomes its value), so no printer ever
+    meets ``sqrt(2)`` (C99 would print the POSIX macro ``M_SQRT2``) or an integer wider than a
+    C integer constant.
+
+    One pass rebuilds each distinct subtree once, remembered across every expression it is
+    given: a piecewise cam profile's derivatives recur in many rows of Phi_q and Gamma, and
+    rebuilding a Piecewise re-evaluates its conditions, which dominated the lowering when each
+    row was substituted and then folded on its own (two full rebuilds per row).
     """
-    expr = sp.sympify(expr).xreplace(internal)
-    # d/dx Heaviside is DiracDelta, which is zero wherever it can be evaluated in floats.
-    if expr.has(sp.DiracDelta):
-        expr = expr.replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: sp.Integer(0))
-    try:
-        return constants.fold(expr)
-    except ExpressionError as error:
-        raise BuildError(f"cannot generate code for {sp.sstr(expr)[:200]}: "
-                         f"{error.message}") from None
+
+    def __init__(self, internal: dict[sp.Symbol, sp.Symbol]) -> None:
+        self._rebuild = Substitution(internal, fold=True)
+
+    def __call__(self, expr: sp.Expr) -> sp.Expr:
+        """Raises:
+            BuildError: a constant part has no finite real value.
+        """
+        expr = sp.sympify(expr)
+        # d/dx Heaviside is DiracDelta, which is zero wherever it can be evaluated in floats.
+        if expr.has(sp.DiracDelta):
+            expr = expr.replace(lambda e: isinstance(e, sp.DiracDelta),
+                                lambda e: sp.Integer(0))
+        try:
+            return self._rebuild(expr)
+        except ExpressionError as error:
+            raise BuildError(f"cannot generate code for {sp.sstr(expr)[:200]}: "
+                             f"{error.message}") from None
+
+
+class Substitution:
+    """``expr.xreplace(mapping)`` for many expressions with one memory of the subtrees
+    rebuilt; with ``fold``, also each largest constant part that is not a plain number
+    replaced by its correctly rounded value (as :func:`constants.fold`)."""
+
+    def __init__(self, mapping: dict[sp.Basic, sp.Basic], fold: bool = False) -> None:
+        self._mapping = mapping
+        self._fold = fold
+        self._done: dict[sp.Basic, sp.Basic] = {}
+        self._constant: dict[sp.Basic, bool] = {}
+
+    def __call__(self, expr: sp.Basic) -> sp.Basic:
+        return self._visit(expr)
+
+    def _visit(self, node: sp.Basic) -> sp.Basic:
+        done = self._done.get(node)
+        if done is not None:
+            return done
+        if node in self._mapping:
+            result = self._mapping[node]
+        elif self._fold and isinstance(node, sp.Expr) and self._is_constant(node):
+            result = (node if constants.is_plain_number(node)
+                      else sp.Float(constants.value(node), 17))
+        elif not node.args:
+            result = node
+        else:
+            args = [self._visit(arg) for arg in node.args]
+            changed = any(new is not old for new, old in zip(args, node.args))
+            result = node.func(*args) if changed else node
+        self._done[node] = result
+        return result
+
+    def _is_constant(self, node: sp.Basic) -> bool:
+        """No free symbols (remembered, so a deep tree is walked once)."""
+        known = self._constant.get(node)
+        if known is None:
+            known = (not isinstance(node, sp.Symbol) if not node.args
+                     else all(self._is_constant(arg) for arg in node.args))
+            self._constant[node] = known
+        return known

@@ -55,6 +55,9 @@ class Metadata(_Dynamics):
     absent for a planar one."""
     input_names: NotRequired[list[str]]
     """The input drivers, in the order of u[] (only a mechanism that has them)."""
+    ranges: NotRequired[list[list[str | float]]]
+    """[coordinate, a, b, owner] for each range a file gives a pair's own coordinate (only a
+    mechanism that has one), at the nominal parameter values."""
 
 
 class Manifest(Metadata):
@@ -78,7 +81,7 @@ KEYS = frozenset(Manifest.__annotations__)
 DYNAMICS_KEYS = frozenset(_Dynamics.__annotations__)
 """The keys only a mechanism with masses or forces has."""
 
-OPTIONAL_KEYS = frozenset({"removed", "space", "input_names"}) | DYNAMICS_KEYS
+OPTIONAL_KEYS = frozenset({"removed", "space", "input_names", "ranges"}) | DYNAMICS_KEYS
 """The keys only some manifests have (``removed``: an over-constrained file's; ``space``: a
 spatial one's; ``input_names``: one with input drivers; the dynamics keys). Written out:
 with postponed annotations the TypedDict cannot see NotRequired in Python 3.11."""

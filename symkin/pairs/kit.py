@@ -74,6 +74,7 @@ class Checks(Protocol):
     def body_names(self) -> tuple[str, ...]: ...
     def point(self, body: str, ref: Any, path: Path) -> None: ...
     def at_nominal(self, expr: sp.Expr) -> sp.Expr: ...
+    def pins(self, a: str, b: str) -> list[tuple[tuple[float, ...], tuple[float, ...]]]: ...
 
 
 class Drawing(Protocol):
@@ -153,6 +154,11 @@ class PairType:
         coordinate: the key of the first guess of the coordinate ``NAME.s`` the pair adds
             (a contact or curve parameter, solved like the bodies' coordinates); None: the
             pair adds no coordinate.
+        coordinate_range: the key of that coordinate's range [a, b] (optional in the file):
+            the motion stops, naming the pair, where ``NAME.s`` leaves it.
+        pitch: a meshing's pitch point, drawn where the pitch circles touch: (body i, body
+            j, r_i, r_j), r_j negative for a ring (internal) gear j; the point lies on the
+            line of the two frame origins (the pitch circles' centres), r_i from i's.
     """
 
     name: str
@@ -178,12 +184,19 @@ class PairType:
     coordinate: str | None = None
     outputs: Callable[[Any, Geometry], dict[str, tuple[sp.Expr, sp.Expr | None]]] | None = None
     marks: Callable[[Any, Geometry], list[Mark]] | None = None
+    coordinate_range: str | None = None
+    pitch: Callable[[Any, Geometry], tuple[str, str, sp.Expr, sp.Expr]] | None = None
 
     def extra_coordinates(self, constraint: Any) -> tuple[tuple[str, Any], ...]:
         """The coordinates ``constraint`` adds, as (name, first guess): ``NAME.s``."""
         if self.coordinate is None:
             return ()
         return ((f"{constraint.name}.s", getattr(constraint, self.coordinate)),)
+
+    def range_of(self, constraint: Any) -> list[Any] | None:
+        """The range [a, b] the file gives ``NAME.s`` (raw expressions), or None."""
+        return None if self.coordinate_range is None else getattr(constraint,
+                                                                  self.coordinate_range)
 
     def equation_count(self, constraint: Any) -> int:
         """How many rows of Phi ``constraint`` owns."""
@@ -232,6 +245,11 @@ def relative(c: Any, geometry: Geometry) -> tuple[Pose, Pose, sp.Matrix, sp.Matr
 def perpendicular(bi: Pose, bj: Pose, sA: sp.Matrix, sB: sp.Matrix, v: sp.Matrix) -> sp.Expr:
     """(R_j v)^T (r_j + R_j s_B - r_i - R_i s_A)  (2.22)."""
     return ((bj.R * v).T * (bj.point(sB) - bi.point(sA)))[0]
+
+
+def contact_outputs(point: sp.Matrix) -> dict[str, tuple[sp.Expr, sp.Expr | None]]:
+    """A contact point in the global frame as the outputs ``contact_x``, ``contact_y``."""
+    return {"contact_x": (point[0], None), "contact_y": (point[1], None)}
 
 
 def components(raw: list[Any], geometry: Geometry) -> sp.Matrix:

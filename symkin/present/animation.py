@@ -10,6 +10,7 @@ body i, the largest of the run VECTOR_SHARE of the picture long, as in the HTML 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -117,6 +118,33 @@ def marks(trajectory: Trajectory, outlines: Outlines) -> list[tuple[str, Array]]
     return found
 
 
+def contacts(trajectory: Trajectory, outlines: Outlines) -> list[tuple[str, Array]]:
+    """The contact points to mark, as (label, (T, 2) global): each gear pair's pitch point
+    (outlines ``pitch:<i>:<j>:<k>``: r_i from i's frame origin along the line to j's, away
+    from it for a ring, r_j < 0), then each pair's reported ``NAME.contact_x`` and
+    ``NAME.contact_y`` (a cam's contact, a point on its curve)."""
+    found = []
+    for key, rows in outlines.items():
+        if not key.startswith("pitch:"):
+            continue
+        i, j = key.split(":")[1:3]
+        if not all(body == GROUND or body in trajectory.bodies for body in (i, j)):
+            continue
+        ri, rj = np.asarray(rows, dtype=float).reshape(-1, 2)[0]
+        centre_i, centre_j = (_global(trajectory, body, np.zeros((1, 2)))[:, 0]
+                              for body in (i, j))
+        line = centre_j - centre_i
+        with np.errstate(all="ignore"):
+            towards = line / np.hypot(*line.T)[:, None] * math.copysign(1.0, rj)
+        found.append(("pitch point", centre_i + ri * towards))
+    reported = dict(trajectory.outputs)
+    for name, x in reported.items():
+        if name.endswith(".contact_x") and name[:-1] + "y" in reported:
+            found.append((f"contact {name[:-len('.contact_x')]}",
+                          np.column_stack([x, reported[name[:-1] + "y"]])))
+    return found
+
+
 def parse_size(text: str) -> tuple[int, int]:
     """``"900x600"`` -> (900, 600), pixels; UsageError for anything else."""
     width, _, height = text.lower().partition("x")
@@ -190,6 +218,7 @@ class _Scene:
         self.slides = slide_axes(trajectory, outlines)
         self.rods = rods(trajectory, outlines)
         self.marks = marks(trajectory, outlines)
+        self.contacts = contacts(trajectory, outlines)
         x0, x1, y0, y1 = _limits([*self.shapes.values(), _ground(outlines)[None],
                                   *(polyline for _, polyline in self.marks)])
         ax.set_xlim(x0, x1)
@@ -208,6 +237,13 @@ class _Scene:
         self.mark_lines = [ax.plot([], [], "-", color="0.35", linewidth=0.9,
                                    label=label if first[label] == k else None)[0]
                            for k, (label, _) in enumerate(self.marks)]
+        seen: set[str] = set()
+        self.contact_dots = []
+        for label, _ in self.contacts:
+            self.contact_dots.append(ax.plot([], [], "x", color="crimson", markersize=7,
+                                             markeredgewidth=1.6, label=None if label in seen
+                                             else label)[0])
+            seen.add(label)
         _pivots(ax, _ground(outlines), span)
         self.reactions, self.arrows = _reaction_arrows(ax, trajectory, outlines, span)
         colours = series.palette(len(self.shapes))
@@ -224,7 +260,8 @@ class _Scene:
         # background and draws only the moving artists (an order of magnitude faster than
         # drawing the whole figure per frame).
         self.moving = [*self.lines.values(), *(line for _, line in self.traces),
-                       *self.slide_lines, *self.rod_lines, *self.mark_lines, self.title,
+                       *self.slide_lines, *self.rod_lines, *self.mark_lines,
+                       *self.contact_dots, self.title,
                        *([self.arrows] if self.arrows is not None else [])]
         for artist in self.moving:
             artist.set_animated(True)
@@ -258,6 +295,8 @@ class _Scene:
             points, vectors = self.reactions
             self.arrows.set_offsets(points[k])
             self.arrows.set_UVC(vectors[k, :, 0], vectors[k, :, 1])
+        for (_, point), dot in zip(self.contacts, self.contact_dots):
+            dot.set_data(point[k, :1], point[k, 1:])
         self.title.set_text(f"t = {self.trajectory.t[k]:.4g}")
 
 

@@ -25,6 +25,7 @@ from symkin.present.animation import (
     MAX_FRAMES,
     Outlines,
     body_shapes,
+    contacts,
     joint_points,
     marks,
     rods,
@@ -122,6 +123,7 @@ class _Scene:
         self.slides = slide_axes(trajectory, outlines)
         self.rods = rods(trajectory, outlines)
         self.marks = marks(trajectory, outlines)
+        self.contacts = contacts(trajectory, outlines)
         self.ground = np.asarray(outlines.get("ground", np.zeros((0, 2))), float).reshape(-1, 2)
         self.points = list(points)
         every = np.concatenate([s.reshape(-1, 2) for s in self.shapes.values()]
@@ -186,6 +188,11 @@ class _Scene:
                 mode="lines", name=label, showlegend=label not in shown, legendgroup=label,
                 line={"width": 1, "color": "#555"}, hoverinfo="skip")))
             shown.add(label)
+        for label, _ in self.contacts:
+            moving.append(self._add(figure, go.Scatter(
+                mode="markers", name=label, showlegend=label not in shown, legendgroup=label,
+                marker={"symbol": "x", "size": 10, "color": "crimson"})))
+            shown.add(label)
         for order, colour, word in ((1, VELOCITY, "velocity"), (2, ACCELERATION,
                                                                 "acceleration")):
             unit = self.units.unit(LENGTH, order)
@@ -222,6 +229,8 @@ class _Scene:
             data.append(go.Scatter(x=[a[k, 0], b[k, 0]], y=[a[k, 1], b[k, 1]]))
         for _, polyline in self.marks:
             data.append(go.Scatter(x=polyline[k, :, 0], y=polyline[k, :, 1]))
+        for _, point in self.contacts:
+            data.append(go.Scatter(x=point[k, :1], y=point[k, 1:]))
         for order in (1, 2):
             for name in self.points:
                 r, tip = self.kinematics[name][0][k], self.kinematics[name][order][k]

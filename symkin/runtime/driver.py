@@ -36,7 +36,7 @@ from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime import failures, forces, redundant, units
+from symkin.runtime import failures, forces, ranges, redundant, units
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
@@ -179,24 +179,47 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     options = options or default_options(kernel)
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
-    if getattr(kernel, "input_names", ()) or inputs is not None:
-        if sensitivities:
-            raise SolveError("sensitivities= is not supported for a mechanism with input "
-                             "drivers (q_p would need the inputs at every point)")
-        trajectory = _solve_inputs(kernel, t, q0, params, options, out,
-                                   (inputs, input_rates, input_accels))
-    elif input_rates is not None or input_accels is not None:
-        raise SolveError("input_rates= and input_accels= need inputs= (and a mechanism with "
-                         "input drivers)")
-    else:
-        trajectory = _solve_in_unit(kernel, t, q0, params, options, progress, use_c_solver,
-                                    out)
+    try:
+        trajectory = _solved(kernel, t, q0, params, options, progress, use_c_solver, out,
+                             (inputs, input_rates, input_accels), sensitivities)
+    except SolveFailure as failure:  # past a curve's range first: that is the cause to name
+        _stop_outside_range(kernel, failure.trajectory)
+        raise
+    _stop_outside_range(kernel, trajectory)
     trajectory = redundant.check(kernel, trajectory, options)
     if sensitivities:
         from symkin.runtime.sensitivity import with_sensitivities
 
         return with_sensitivities(kernel, trajectory)
     return trajectory
+
+
+def _stop_outside_range(kernel: KinematicsKernel, trajectory: Trajectory) -> None:
+    """A SolveFailure at the first point where a pair's coordinate left its range (the rows
+    before it kept); nothing when every point is inside."""
+    found = ranges.first_outside(kernel, trajectory)
+    if found is not None:
+        k, message = found
+        raise SolveFailure(message, ranges.head(trajectory, k), float(trajectory.t[k]),
+                           math.nan, 0, reason="out of range")
+
+
+def _solved(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
+            params: Mapping[str, float] | ArrayLike | None, options: Options,
+            progress: Progress | None, use_c_solver: bool, out: Out | None,
+            given: tuple[Any, Any, Any], sensitivities: bool) -> Trajectory:
+    """The trajectory of the grid loop that fits: with input values, or the general one."""
+    inputs, input_rates, input_accels = given
+    if getattr(kernel, "input_names", ()) or inputs is not None:
+        if sensitivities:
+            raise SolveError("sensitivities= is not supported for a mechanism with input "
+                             "drivers (q_p would need the inputs at every point)")
+        return _solve_inputs(kernel, t, q0, params, options, out,
+                             (inputs, input_rates, input_accels))
+    if input_rates is not None or input_accels is not None:
+        raise SolveError("input_rates= and input_accels= need inputs= (and a mechanism with "
+                         "input drivers)")
+    return _solve_in_unit(kernel, t, q0, params, options, progress, use_c_solver, out)
 
 
 def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,

@@ -89,6 +89,9 @@ class Kernel:
         # The rows of an over-constrained file removed as dependent at t0 (not in Phi); the
         # driver checks them along the motion with removed_phi.
         self.removed: tuple[str, ...] = tuple(meta.get("removed", ()))
+        # A pair's coordinate and the range its file gives it, (name, a, b, owner): the
+        # driver stops the motion where it is left (runtime.ranges).
+        self.ranges = tuple(tuple(entry) for entry in meta.get("ranges", ()))
         # Inverse dynamics: present when the file has masses or forces.
         self.has_dynamics = "joint_names" in meta
         self.driver_names: tuple[str, ...] = tuple(meta.get("driver_names", ()))

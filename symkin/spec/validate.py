@@ -5,6 +5,7 @@ degree-of-freedom count. Every mistake is a :class:`MechanismError` with the fie
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -303,20 +304,38 @@ class _Checks:
         """A point of ``body`` by name, or a vector of constant expressions."""
         _point(self.mech, body, ref, self.symbols, self.nominal, path)
 
+    def pins(self, a: str, b: str) -> list[tuple[tuple[float, ...], tuple[float, ...]]]:
+        """Where a pivot pair (a revolute) pins bodies ``a`` and ``b`` together: each such
+        joint's local points (nominal values) as (point on a, point on b), in file order."""
+        found = []
+        for constraint in self.mech.joints:
+            kind = pairs.of(constraint)
+            if not kind.pivot:
+                continue
+            at = {getattr(constraint, body): getattr(constraint, key)
+                  for key, body in kind.points}
+            if set(at) == {a, b}:
+                with contextlib.suppress(KeyError, ExpressionError):  # its own check says
+                    found.append((self._local(a, at[a]), self._local(b, at[b])))
+        return found
+
+    def _local(self, body: str, ref: Any) -> tuple[float, ...]:
+        """A point's local vector (or any list of constants) at the nominal values."""
+        local = self.mech.bodies[body].points[ref] if isinstance(ref, str) else ref
+        return tuple(constants.value(expressions.parse(raw, self.symbols.parameters),
+                                     self.nominal) for raw in local)
+
     def point_at_q0(self, body: str, ref: Any) -> tuple[float, ...]:
         """The global position of a (checked) point of ``body`` at its first guess q0."""
-        def nominal(raw: Any) -> float:  # checked already: parses and has a value
-            return constants.value(expressions.parse(raw, self.symbols.parameters), self.nominal)
-
-        local = self.mech.bodies[body].points[ref] if isinstance(ref, str) else ref
+        local = self._local(body, ref)  # checked already: parses and has a value
         if self.mech.is_spatial:
-            return _spatial_point(list(map(nominal, local)), body,
-                                  list(map(nominal, self.mech.bodies[body].q0))
+            return _spatial_point(list(local), body,
+                                  list(self._local(body, self.mech.bodies[body].q0))
                                   if body != GROUND else None)
-        sx, sy = map(nominal, local)
+        sx, sy = local
         if body == GROUND:
             return sx, sy
-        x, y, phi = map(nominal, self.mech.bodies[body].q0)
+        x, y, phi = self._local(body, self.mech.bodies[body].q0)
         return (x + math.cos(phi) * sx - math.sin(phi) * sy,
                 y + math.sin(phi) * sx + math.cos(phi) * sy)
 

@@ -71,6 +71,7 @@ def outlines(system: System) -> dict[str, NDArray[np.float64]]:
             rods.setdefault(f"rod:{first.body}:{second.body}", []).extend(
                 [at(first.vector), at(second.vector)])
     drawn.update(_marks(system, values))
+    drawn.update(_pitches(system, values))
     if pivots:
         drawn[GROUND] = np.array(sorted(pivots), dtype=float)
     drawn.update({f"slide:{body}": np.array(rows, dtype=float) for body, rows in slides.items()})
@@ -120,6 +121,24 @@ def _marks(system: System, values: dict[sp.Symbol, float]) -> dict[str, NDArray[
                 xy = xy[np.isfinite(xy).all(axis=1)]
                 if len(xy) > 1:
                     found[f"curve:{body}:{label}:{len(found)}"] = xy
+    return found
+
+
+def _pitches(system: System, values: dict[sp.Symbol, float]) -> dict[str, NDArray[np.float64]]:
+    """Each meshing's pitch point as ``pitch:<body i>:<body j>:<k>``: one row (r_i, r_j), r_j
+    negative for a ring gear j (see :attr:`symkin.pairs.kit.PairType.pitch`)."""
+    from symkin.symbolic.planar import Context
+    from symkin.symbolic.symbols import make_symbols
+
+    mech = system.mechanism
+    ctx = Context(mech, make_symbols(mech))
+    found: dict[str, NDArray[np.float64]] = {}
+    for constraint in mech.joints:
+        pitch = pairs.of(constraint).pitch
+        if pitch is not None:
+            i, j, ri, rj = pitch(constraint, ctx)
+            found[f"pitch:{i}:{j}:{len(found)}"] = np.array(
+                [[float(ri.subs(values)), float(rj.subs(values))]], dtype=float)
     return found
 
 

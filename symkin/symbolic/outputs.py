@@ -12,16 +12,19 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import sympy as sp
 from numpy.typing import NDArray
 
 from symkin import pairs
-from symkin.symbolic.derivation import System
+from symkin.spec.validate import Mechanism
 from symkin.symbolic.planar import Context
-from symkin.symbolic.symbols import make_symbols
+from symkin.symbolic.symbols import Symbols, make_symbols
+
+if TYPE_CHECKING:  # a warm run that writes the outputs does not load the derivation
+    from symkin.symbolic.derivation import System
 
 UNDEFINED_BELOW = 1e-9
 """An output is NaN where its guard is below this fraction of the guard's largest value."""
@@ -38,8 +41,11 @@ class Output:
 
 def pair_outputs(system: System) -> tuple[Output, ...]:
     """Every pair's outputs, joints then drivers in file order."""
-    mech = system.mechanism
-    ctx = Context(mech, make_symbols(mech))
+    return _outputs_of(system.mechanism, make_symbols(system.mechanism))
+
+
+def _outputs_of(mech: Mechanism, symbols: Symbols) -> tuple[Output, ...]:
+    ctx = Context(mech, symbols)
     found = []
     for section in pairs.SECTIONS:
         for constraint in getattr(mech, section):
@@ -51,24 +57,31 @@ def pair_outputs(system: System) -> tuple[Output, ...]:
     return tuple(found)
 
 
-def _numeric(system: System, expr: sp.Expr) -> Callable[..., NDArray[np.float64]]:
-    arguments = [*system.q, *system.dq, system.t, *system.p]
-    return sp.lambdify(arguments, expr, "numpy")  # type: ignore[no-any-return]
+def _numeric(symbols: Symbols, expr: sp.Expr) -> Callable[..., NDArray[np.float64]]:
+    arguments = [*symbols.q, *symbols.dq, symbols.t, *symbols.p]
+    # CSE first: a cam's pressure angle repeats the piecewise profile's derivatives, and
+    # printing the expanded tree took a minute for the cam example (5 s with CSE)
+    return sp.lambdify(arguments, expr, "numpy", cse=True)  # type: ignore[no-any-return]
 
 
 def evaluate(system: System, trajectory: Any) -> tuple[tuple[str, NDArray[np.float64]],
                                                              ...]:
     """The outputs' values at every solved point of a Trajectory (its t, q, dq and params),
     shape (T,) each."""
+    return _evaluate(system.mechanism, trajectory)
+
+
+def _evaluate(mech: Mechanism, trajectory: Any) -> tuple[tuple[str, NDArray[np.float64]], ...]:
+    symbols = make_symbols(mech)
     columns = [*trajectory.q.T, *trajectory.dq.T, trajectory.t, *trajectory.params]
     values = []
-    for output in pair_outputs(system):
+    for output in _outputs_of(mech, symbols):
         with np.errstate(all="ignore"):
-            value = np.broadcast_to(np.asarray(_numeric(system, output.expr)(*columns),
+            value = np.broadcast_to(np.asarray(_numeric(symbols, output.expr)(*columns),
                                                dtype=float), trajectory.t.shape).copy()
             if output.guard is not None and trajectory.t.size:
                 guard = np.abs(np.broadcast_to(np.asarray(
-                    _numeric(system, output.guard)(*columns), dtype=float),
+                    _numeric(symbols, output.guard)(*columns), dtype=float),
                     trajectory.t.shape))
                 value[guard <= UNDEFINED_BELOW * np.max(guard)] = np.nan
         values.append((output.name, value))
@@ -77,5 +90,12 @@ def evaluate(system: System, trajectory: Any) -> tuple[tuple[str, NDArray[np.flo
 
 def with_outputs(system: System, trajectory: Any) -> Any:
     """A Trajectory carrying the pairs' outputs (the same Trajectory if there are none)."""
-    values = evaluate(system, trajectory)
+    return with_mechanism_outputs(system.mechanism, trajectory)
+
+
+def with_mechanism_outputs(mech: Mechanism, trajectory: Any) -> Any:
+    """As :func:`with_outputs`, from the validated Mechanism alone: the outputs need its
+    symbols and the pairs' expressions, not Phi_q or Gamma, so a warm run that writes them
+    does not derive the file again."""
+    values = _evaluate(mech, trajectory)
     return dataclasses.replace(trajectory, outputs=values) if values else trajectory

@@ -112,6 +112,42 @@ def test_warm_run_is_identical_and_skips_sympy(snapshot: Path, tmp_path: Path,
         assert (tmp_path / "a.gif").read_bytes()[:6] == b"GIF89a"
 
 
+DISK_CAM = """name: disk
+parameters: {}
+bodies:
+  cam: {q0: [0, 0, 0]}
+  follower: {q0: [0, 3, 0], points: {R: [0, 0]}}
+joints:
+  - {type: revolute, i: ground, j: cam, sA: [0, 0], sB: [0, 0]}
+  - {type: prismatic, i: follower, j: ground, sA: [0, 0], sB: [0, 0], v: [1, 0]}
+  - {type: cam, name: k1, i: cam, j: follower, profile: {polar: "2 + 0.4*cos(s)"},
+     follower: {roller: 0.5, at: R}, s0: pi/2}
+drivers:
+  - {type: angle, i: cam, j: ground, theta: t}
+time: {t0: 0, t1: 3, dt: 0.1}
+"""
+
+
+def test_warm_cam_run_writes_its_outputs_without_deriving_again(snapshot: Path,
+                                                                tmp_path: Path) -> None:
+    """A cam's pressure angle and radius of curvature come from the file and the pair's own
+    expressions: the warm run that writes them never loads the derivation (it used to derive
+    the whole file again, Gamma included), and writes the cold run's numbers."""
+    mechanism = tmp_path / "disk.yaml"
+    mechanism.write_text(DISK_CAM)
+    cache = tmp_path / "cache"
+    cold = symkin_run(snapshot, cache, mechanism, "--backend", "numpy", "-o", "cold.npz",
+                      cwd=tmp_path)
+    assert cold.returncode == 0 and not cold.hit, cold.stderr
+    warm = symkin_run(snapshot, cache, mechanism, "--backend", "numpy", "-o", "warm.npz",
+                      cwd=tmp_path)
+    assert warm.returncode == 0 and warm.hit, warm.stderr
+    assert "symkin.symbolic.derivation" not in warm.heavy
+    first, second = (dict(np.load(tmp_path / f"{run}.npz")) for run in ("cold", "warm"))
+    assert {"k1.pressure_angle", "k1.curvature_radius"} <= first.keys()
+    assert same_results(first, second)
+
+
 def test_editing_the_file_misses(snapshot: Path, tmp_path: Path) -> None:
     mechanism = tmp_path / "mechanism.yaml"
     text = TEXTBOOK.read_text()

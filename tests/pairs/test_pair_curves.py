@@ -322,8 +322,16 @@ def test_cam_pressure_angle_and_curvature_radius_follow_the_law(cam, tmp_path: P
     R = R0 + y
     pitch = (R**2 + dy**2) ** 1.5 / (R**2 + 2 * dy**2 - R * d2y)
     assert np.abs(outputs["k1.curvature_radius"] - (pitch - 0.5)).max() < 1e-9
+    # the contact: the roller's radius 0.5 from its centre (R0 + y, 0), along the normal that
+    # makes the pressure angle with the follower's axis
+    contact = np.stack([outputs["k1.contact_x"], outputs["k1.contact_y"]], axis=1)
+    gap = np.stack([R0 + y, 0 * y], axis=1) - contact
+    assert np.abs(np.hypot(*gap.T) - 0.5).max() < 1e-9
+    tilt = np.abs(np.arctan2(gap[:, 1], gap[:, 0]))
+    assert np.abs(tilt[moving] - np.arctan(np.abs(dy[moving]) / (R0 + y[moving]))).max() < 1e-9
     header = next(csv.reader(run.save(tmp_path / "cam.csv").open()))
-    assert header[-3:] == ["k1.pressure_angle", "k1.curvature_radius", "flagged"]
+    assert header[-5:] == ["k1.pressure_angle", "k1.curvature_radius", "k1.contact_x",
+                           "k1.contact_y", "flagged"]
     saved = np.load(run.save(tmp_path / "cam.npz"))
     assert np.array_equal(saved["k1.curvature_radius"], outputs["k1.curvature_radius"])
 

@@ -73,6 +73,7 @@ EVERY_CONSTRAINT = {
 # The higher pairs (gear, rack, point on a curve, cam with a roller and with a flat face),
 # with their bodies otherwise free and held by one custom driver: Phi only has to be
 # differentiable, not solvable, for the differences below.
+_PINNED = ("sun", "planet", "arm")  # their x and y held by the revolutes
 _FREE = ("sun", "planet", "arm", "pinion", "rack", "cam", "roller", "flat", "plate", "pin")
 HIGHER_PAIRS = {
     "name": "higher_pairs",
@@ -81,6 +82,10 @@ HIGHER_PAIRS = {
                "pinion": {"q0": [0, 1, 0], "points": {"C": [0.1, -0.05]}},
                "roller": {"points": {"R": [0.2, 0.4]}}},
     "joints": [
+        # the gears' centres on their carrier, as a gear pair requires (ring: the ground)
+        {"type": "revolute", "i": "arm", "j": "sun", "sA": [0, 0], "sB": [0, 0]},
+        {"type": "revolute", "i": "arm", "j": "planet", "sA": ["rs + rp", 0], "sB": [0, 0]},
+        {"type": "revolute", "i": "ground", "j": "arm", "sA": [0, 0], "sB": [0, 0]},
         {"type": "gear", "name": "g1", "i": "sun", "j": "planet", "radii": ["rs", "rp"],
          "carrier": "arm"},
         {"type": "gear", "name": "g2", "i": "planet", "j": "ground", "radii": ["rp", "rs + 2*rp"],
@@ -98,7 +103,8 @@ HIGHER_PAIRS = {
     ],
     "drivers": [{"type": "custom", "name": "hold", "equations": [
         f"{body}.{part} - {0.1 * k}*t" for k, (body, part) in enumerate(
-            (body, part) for body in _FREE for part in ("x", "y", "phi"))][:24]}],
+            (body, part) for body in _FREE for part in ("x", "y", "phi")
+            if body not in _PINNED or part == "phi")][:18]}],
     "time": {"t0": 0, "t1": 1, "dt": 0.1},
 }
 

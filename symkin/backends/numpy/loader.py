@@ -54,6 +54,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
            if hasattr(module, "PHI_P_ROWS") else {}),
         **({"removed": module.REMOVED} if hasattr(module, "REMOVED") else {}),
+        **({"ranges": module.RANGES} if hasattr(module, "RANGES") else {}),
         **({"driver_names": module.DRIVER_NAMES, "joint_names": module.JOINT_NAMES}
            if hasattr(module, "JOINT_NAMES") else {}),
         "input_names": getattr(module, "INPUT_NAMES", ()),

@@ -7,16 +7,19 @@ guess ``s0``). With t = c'(s) and the outward unit normal n(s) = sigma [t_y, -t_
     flat:    m^T R_j^T (r_i + R_i c(s) - r_j - R_j s_F) / |m| = 0   (the face through c(s))
              m^T R_j^T R_i t(s) / |m| = 0                           (tangent to it there)
 
-sigma = +1 when the profile runs counter-clockwise about the cam's frame origin at s0
-(c x t > 0), -1 otherwise, so a roller lies outside the profile whatever its orientation (a
-disk cam turns about its frame origin, which lies inside its profile). A profile is
-[x(s), y(s)] or {polar: rho(s)}, x = rho cos s, y = rho sin s. A flat face touches at the
-tangent point nearest s0.
+For a closed profile (no ``range``, or one whose ends meet) sigma = +1 when the profile runs
+counter-clockwise about the cam's frame origin at s0 (c x t > 0), -1 otherwise, so a roller
+lies outside the profile whatever its orientation (a disk cam turns about its frame origin,
+which lies inside its profile). For an open one (a ``range: [a, b]`` whose ends differ: a
+wedge, a plate cam's flank) sigma puts the normal on the side of the follower's point at q0
+(as drawn, in the drawn layout). A profile is [x(s), y(s)] or {polar: rho(s)},
+x = rho cos s, y = rho sin s. A flat face touches at the tangent point nearest s0.
 
-Checked over one turn of s from s0 (2 pi, the period of a closed profile): a cusp (t = 0), a
-roller larger than the radius of curvature of a concave part (undercutting: the roller
-cannot follow the profile there), a flat face on a concave part (it would bridge the hollow
-and lose contact) are refused with the value of s where they occur.
+Checked over the profile's own parameter range (``range``; else one turn of s from s0, 2 pi,
+the period of a closed profile): a cusp (t = 0), a roller larger than the radius of
+curvature of a part hollow on the follower's side (undercutting: the roller cannot follow
+the profile there), a flat face on such a part (it would bridge the hollow and lose contact)
+are refused with the value of s where they occur.
 """
 
 from __future__ import annotations
@@ -31,8 +34,10 @@ import sympy as sp
 from symkin.errors import MechanismError
 from symkin.pairs import kit
 from symkin.pairs.fields import Expr, PointRef, Strict, Vec2
+from symkin.pairs.planar.point_on_curve import check_range
 
-SAMPLES = 2048  # points of s checked over one turn of the profile
+SAMPLES = 2048  # points of s checked over the profile's range (or one turn)
+OPEN_GAP = 1e-9  # relative: a range whose ends are farther apart than this is open
 
 
 class Polar(Strict):
@@ -66,6 +71,7 @@ class Cam(Strict):
     profile: Vec2 | Polar
     follower: Roller | Flat
     s0: Expr = 0
+    range: Vec2 | None = None  # where the profile is meant to be followed: [a, b] of s
 
 
 def profile_texts(profile: list[Any] | Polar) -> list[Any]:
@@ -80,14 +86,30 @@ def _profile(c: Cam, s: sp.Symbol, geometry: kit.Geometry) -> sp.Matrix:
     return sp.Matrix([geometry.curve(item, s) for item in profile_texts(c.profile)])
 
 
-def outward_normal(curve: sp.Matrix, s: sp.Symbol, s0: sp.Expr,
-                   geometry: kit.Geometry) -> sp.Matrix:
-    """sigma [t_y, -t_x] / |t|, with sigma the profile's turning sense about its origin at
-    s0 (nominal parameter values)."""
+def outward_normal(c: Cam, curve: sp.Matrix, s: sp.Symbol, geometry: kit.Geometry
+                   ) -> sp.Matrix:
+    """sigma [t_y, -t_x] / |t| (sigma: :func:`follower_side`)."""
     t = curve.diff(s)
-    turning = (curve[0] * t[1] - curve[1] * t[0]).subs(s, s0)
-    sense = geometry.sign_at_nominal(turning)
-    return sense * sp.Matrix([t[1], -t[0]]) / sp.sqrt((t.T * t)[0])
+    return follower_side(c, curve, s, geometry) * sp.Matrix([t[1], -t[0]]) / sp.sqrt((t.T * t)[0])
+
+
+def follower_side(c: Cam, curve: sp.Matrix, s: sp.Symbol, geometry: kit.Geometry) -> int:
+    """sigma, at the nominal parameter values: an open profile's follower side at q0, else
+    (or when q0 puts the follower's point on the profile) the turning sense about the cam's
+    frame origin at s0."""
+    s0 = geometry.expr(c.s0)
+    t = curve.diff(s).subs(s, s0)
+    if c.range is not None:
+        a, b = (curve.subs(s, geometry.expr(end)) for end in c.range)
+        gap, size = a - b, 1 + (a.T * a)[0]
+        if geometry.sign_at_nominal((gap.T * gap)[0] - OPEN_GAP**2 * size) > 0:
+            cam, follower = geometry.initial_pose(c.i), geometry.initial_pose(c.j)
+            away = follower.point(geometry.local(c.j, c.follower.at)) - cam.point(
+                curve.subs(s, s0))
+            side = geometry.sign_at_nominal((away.T * cam.R * sp.Matrix([t[1], -t[0]]))[0])
+            if side:
+                return side
+    return geometry.sign_at_nominal(curve[0].subs(s, s0) * t[1] - curve[1].subs(s, s0) * t[0])
 
 
 def equations(c: Cam, geometry: kit.Geometry) -> list[sp.Expr]:
@@ -97,7 +119,7 @@ def equations(c: Cam, geometry: kit.Geometry) -> list[sp.Expr]:
     cam, follower = geometry.pose(c.i), geometry.pose(c.j)
     at = follower.point(geometry.local(c.j, c.follower.at))
     if isinstance(c.follower, Roller):
-        normal = outward_normal(curve, s, geometry.expr(c.s0), geometry)
+        normal = outward_normal(c, curve, s, geometry)
         centre = cam.point(curve + geometry.expr(c.follower.roller) * normal)
         return list(at - centre)
     m = geometry.vector(c.follower.normal)
@@ -113,13 +135,14 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
       undefined (NaN) where that point is at rest (a dwell), which has no direction;
     - ``curvature_radius``: the profile's radius of curvature |c'|^3 / (c' x c''), positive
       where the profile is convex, negative where it is hollow (a roller needs a radius
-      smaller than the hollow's)."""
+      smaller than the hollow's);
+    - ``contact_x``, ``contact_y``: the contact point c(s) in the global frame (marked in the
+      pictures)."""
     s = geometry.coordinate(f"{c.name}.s")
     curve = _profile(c, s, geometry)
     cam, follower = geometry.pose(c.i), geometry.pose(c.j)
     t, t2 = curve.diff(s), curve.diff(s, 2)
-    turning = (curve[0] * t[1] - curve[1] * t[0]).subs(s, geometry.expr(c.s0))
-    sense = geometry.sign_at_nominal(turning)
+    sense = follower_side(c, curve, s, geometry)
     speed = sp.sqrt((t.T * t)[0])
     if isinstance(c.follower, Roller):
         normal = cam.R * sp.Matrix([t[1], -t[0]])
@@ -130,12 +153,14 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     along = (normal.T * velocity)[0]
     return {"pressure_angle": (sp.atan2(sp.Abs(across), sp.Abs(along)),
                                sp.sqrt((velocity.T * velocity)[0])),
-            "curvature_radius": (sense * speed**3 / (t[0] * t2[1] - t[1] * t2[0]), None)}
+            "curvature_radius": (sense * speed**3 / (t[0] * t2[1] - t[1] * t2[0]), None),
+            **kit.contact_outputs(cam.point(curve))}
 
 
 def check(c: Cam, checks: kit.Checks, path: kit.Path) -> None:
     """The follower's point and sizes; the profile smooth, and followable over one turn."""
     s0 = checks.value(checks.expression(c.s0, path + ("s0",)), path + ("s0",))
+    check_range(c.range, s0, checks, path)
     checks.point(c.j, c.follower.at, path + ("follower", "at"))
     key = ("profile", "polar") if isinstance(c.profile, Polar) else ("profile",)
     texts = profile_texts(c.profile)
@@ -162,13 +187,39 @@ def check(c: Cam, checks: kit.Checks, path: kit.Path) -> None:
     _check_followable(c, exprs, checks, s0, size, path + key)
 
 
-def _curvature_along(exprs: list[sp.Expr], checks: kit.Checks, s0: float,
+def _samples(c: Cam, checks: kit.Checks, s0: float, path: kit.Path) -> np.ndarray:
+    """The values of s checked: the profile's range, else one turn from s0."""
+    if c.range is None:
+        return s0 + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
+    low, high = (checks.value(checks.expression(raw, path + ("range", k)),
+                              path + ("range", k)) for k, raw in enumerate(c.range))
+    return np.linspace(low, high, SAMPLES)
+
+
+def _side(c: Cam, exprs: list[sp.Expr], checks: kit.Checks, s0: float,
+          grid: np.ndarray) -> float:
+    """:func:`follower_side` in numbers (nominal values, q0)."""
+    s = sp.Symbol("s", real=True)
+    at = [sp.lambdify(s, checks.at_nominal(e), "math") for e in exprs]
+    slope = [sp.lambdify(s, sp.diff(checks.at_nominal(e), s), "math") for e in exprs]
+    (x0, y0), (x1, y1) = ([float(f(s0)) for f in fs] for fs in (at, slope))
+    if c.range is not None:
+        ends = [np.array([float(f(end)) for f in at]) for end in (grid[0], grid[-1])]
+        if np.linalg.norm(ends[0] - ends[1]) > OPEN_GAP * math.sqrt(1 + ends[0] @ ends[0]):
+            contact = np.array(checks.point_at_q0(c.i, [x0, y0]))
+            normal = np.array(checks.point_at_q0(c.i, [x0 + y1, y0 - x1])) - contact
+            away = np.array(checks.point_at_q0(c.j, c.follower.at)) - contact
+            if away @ normal:
+                return 1.0 if away @ normal > 0 else -1.0
+    return 1.0 if x0 * y1 - y0 * x1 > 0 else -1.0
+
+
+def _curvature_along(exprs: list[sp.Expr], checks: kit.Checks, grid: np.ndarray,
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """s over one turn from s0, |c'(s)| and the signed curvature there (nominal values)."""
+    """s over the grid, |c'(s)| and the signed curvature there (nominal values)."""
     s = sp.Symbol("s", real=True)
     values = [checks.at_nominal(expr) for expr in exprs]
     derivatives = [sp.diff(v, s, k) for k in (1, 2) for v in values]
-    grid = s0 + np.linspace(0.0, 2 * math.pi, SAMPLES, endpoint=False)
     with np.errstate(all="ignore"):
         x1, y1, x2, y2 = (np.broadcast_to(np.asarray(sp.lambdify(s, e, "numpy")(grid),
                                                      dtype=float), grid.shape)
@@ -181,7 +232,7 @@ def _curvature_along(exprs: list[sp.Expr], checks: kit.Checks, s0: float,
 def _check_followable(c: Cam, exprs: list[sp.Expr], checks: kit.Checks, s0: float,
                       roller: float, path: kit.Path) -> None:
     """No cusp; no concave part tighter than the roller; no concave part under a face."""
-    grid, speed, curvature = _curvature_along(exprs, checks, s0)
+    grid, speed, curvature = _curvature_along(exprs, checks, _samples(c, checks, s0, path))
     finite = np.isfinite(speed) & np.isfinite(curvature)
     scale = float(np.max(speed[finite])) if finite.any() else 1.0
     cusp = finite & (speed <= 1e-9 * scale)
@@ -189,11 +240,8 @@ def _check_followable(c: Cam, exprs: list[sp.Expr], checks: kit.Checks, s0: floa
         raise MechanismError(f"the profile has a cusp (c'(s) = 0) at s = "
                              f"{grid[cusp][0]:.6g}", path, "Smooth the profile there: a "
                              "follower cannot keep a defined contact at a cusp.")
-    s = sp.Symbol("s", real=True)
-    x1, y1 = (sp.lambdify(s, sp.diff(checks.at_nominal(e), s), "math")(s0) for e in exprs)
-    x0, y0 = (float(sp.lambdify(s, checks.at_nominal(e), "math")(s0)) for e in exprs)
-    sense = 1.0 if x0 * y1 - y0 * x1 > 0 else -1.0
-    # with the outward normal, a convex part has sense * curvature > 0
+    sense = _side(c, exprs, checks, s0, grid)
+    # with the normal on the follower's side, a part convex towards it has sense * curvature > 0
     concave = finite & (sense * curvature < 0)
     if not concave.any():
         return
@@ -238,12 +286,14 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
 
 
 def marks(c: Cam, geometry: kit.Geometry) -> list[kit.Mark]:
-    """The profile, over one turn of s from s0."""
+    """The profile over its range, else one turn of s from s0."""
     s0 = geometry.expr(c.s0)
-    return [(c.i, "cam profile", _profile(c, kit.S_MARK, geometry), (s0, s0 + 2 * sp.pi))]
+    span = ((s0, s0 + 2 * sp.pi) if c.range is None
+            else tuple(geometry.expr(end) for end in c.range))
+    return [(c.i, "cam profile", _profile(c, kit.S_MARK, geometry), span)]
 
 
 TYPE = kit.PairType(
     name="cam", model=Cam, sections=("joints",), equations=equations,
     rows=("contact 1", "contact 2"), check=check, to_local=to_local, coordinate="s0",
-    outputs=outputs, marks=marks)
+    outputs=outputs, marks=marks, coordinate_range="range")

@@ -6,11 +6,17 @@ roll on their pitch circles without slipping. Relative to the carrier (Willis):
 
 One row, a length (the arc rolled). ``offset`` defaults to its value at q0 (the drawing in
 the drawn layout, whose q0 is the drawing). The pair holds only the rolling: the centres are
-held by the joints the file gives (revolute joints of both gears to the carrier).
+held by the joints the file gives, revolute joints of both gears to the carrier. Refused, as
+they would make the rolling equation describe gears that do not mesh: a gear not pinned to
+the carrier (nothing holds its centre distance), and pivots on the carrier whose distance is
+not r_i + r_j (external) or r_j - r_i (internal) at the nominal parameters (the pitch circles
+would not touch). A carrier at rest (the ground, or an arm held still) or driven needs
+nothing more: Willis' relation holds relative to it either way.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Literal
 
@@ -19,6 +25,9 @@ import sympy as sp
 from symkin.errors import MechanismError
 from symkin.pairs import kit
 from symkin.pairs.fields import GROUND, Expr, Strict, Vec2
+
+MESH_TOLERANCE = 1e-6
+"""Relative: the drawing tolerance, so a drawn centre distance read to six digits passes."""
 
 
 class Gear(Strict):
@@ -70,6 +79,47 @@ def check(c: Gear, checks: kit.Checks, path: kit.Path) -> None:
                              f"larger than the pinion i (radius {values[0]:g})",
                              path + ("radii", 1), "Give the ring gear as j, or set "
                              "internal: false.")
+    _check_carrier(c, checks, path, values)
+
+
+def _centre_on_carrier(gear: str, carrier: str, checks: kit.Checks,
+                       ) -> tuple[float, ...] | None:
+    """The gear's centre as a point of the carrier: where a revolute pins the gear to the
+    carrier, or to a third body at the very point where the carrier is pinned to it too (a
+    sun and an arm on one ground pivot). None when nothing holds it there."""
+    direct = checks.pins(carrier, gear)
+    if direct:
+        return direct[0][0]
+    for other in (GROUND, *checks.body_names()):
+        for on_other, _ in checks.pins(other, gear):
+            for shared, on_carrier in checks.pins(other, carrier):
+                if math.dist(on_other, shared) <= MESH_TOLERANCE * (1 + math.hypot(*shared)):
+                    return on_carrier
+    return None
+
+
+def _check_carrier(c: Gear, checks: kit.Checks, path: kit.Path, radii: list[float]) -> None:
+    """Both gears pinned to the carrier, their pivots there as far apart as the radii say."""
+    pivots = []
+    for key, gear in (("i", c.i), ("j", c.j)):
+        pivot = _centre_on_carrier(gear, c.carrier, checks)
+        if pivot is None:
+            raise MechanismError(
+                f"the gear {gear!r} is not pinned to the carrier {c.carrier!r} by a revolute "
+                "joint: nothing holds its centre at the meshing distance, so the rolling "
+                "equation would turn gears that do not touch", path + (key,),
+                f"Add a revolute joint between {c.carrier!r} and {gear!r} at the gear's "
+                "centre, or name as carrier the body that holds both gears' centres.")
+        pivots.append(pivot)
+    distance = math.dist(pivots[0][:2], pivots[1][:2])
+    expected = radii[1] - radii[0] if c.internal else radii[0] + radii[1]
+    if abs(distance - expected) > MESH_TOLERANCE * max(expected, distance):
+        rule = "r_j - r_i" if c.internal else "r_i + r_j"
+        raise MechanismError(
+            f"the gears' pivots on the carrier {c.carrier!r} are {distance:.6g} apart, not "
+            f"{rule} = {expected:.6g}: the pitch circles would not touch", path + ("radii",),
+            f"Make the pitch radii fit the centre distance ({rule}), or move the revolute "
+            "joints that hold the gears on the carrier.")
 
 
 def marks(c: Gear, geometry: kit.Geometry) -> list[kit.Mark]:
@@ -83,6 +133,13 @@ def marks(c: Gear, geometry: kit.Geometry) -> list[kit.Mark]:
     return found
 
 
+def pitch(c: Gear, geometry: kit.Geometry) -> tuple[str, str, sp.Expr, sp.Expr]:
+    """Where the pitch circles touch: r_i from i's centre towards j's (away from a ring's)."""
+    ri, rj = (geometry.expr(raw) for raw in c.radii)
+    return c.i, c.j, ri, -rj if c.internal else rj
+
+
 TYPE = kit.PairType(
     name="gear", model=Gear, sections=("joints",), equations=equations, rows=("rolling",),
-    bodies=("i", "j", "carrier"), constants=("offset",), check=check, marks=marks)
+    bodies=("i", "j", "carrier"), constants=("offset",), check=check, marks=marks,
+    pitch=pitch)

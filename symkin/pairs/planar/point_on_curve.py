@@ -32,6 +32,7 @@ class PointOnCurve(Strict):
     point: PointRef
     curve: Vec2
     s0: Expr = 0
+    range: Vec2 | None = None  # where the curve is meant to be followed: [a, b] of s
 
 
 def curve_of(raw: list[Any], s: sp.Symbol, geometry: kit.Geometry) -> sp.Matrix:
@@ -50,9 +51,25 @@ def equations(c: PointOnCurve, geometry: kit.Geometry) -> list[sp.Expr]:
 def check(c: PointOnCurve, checks: kit.Checks, path: kit.Path) -> None:
     """Each component an expression of s (its derivatives printable), real at s0."""
     s0 = checks.value(checks.expression(c.s0, path + ("s0",)), path + ("s0",))
+    check_range(c.range, s0, checks, path)
     for k, raw in enumerate(c.curve):
         expr = checks.curve(raw, path + ("curve", k))
         checks.curve_value(expr, s0, path + ("curve", k))
+
+
+def check_range(raw: list[Any] | None, s0: float, checks: kit.Checks, path: kit.Path) -> None:
+    """A range [a, b] of constants with a < b that holds s0."""
+    if raw is None:
+        return
+    low, high = (checks.value(checks.expression(item, path + ("range", k)),
+                              path + ("range", k)) for k, item in enumerate(raw))
+    if not low < high:
+        raise MechanismError(f"the range [{low:g}, {high:g}] is empty", path + ("range",),
+                             "Give [a, b] with a < b: the values of s the curve is meant "
+                             "for.")
+    if not low <= s0 <= high:
+        raise MechanismError(f"s0 = {s0:g} is outside the range [{low:g}, {high:g}]",
+                             path + ("s0",), "Start the contact inside the curve's range.")
 
 
 def drawn_curve(drawing: kit.Drawing, data: Mapping[str, Any], raw: Any, path: kit.Path,
@@ -81,13 +98,22 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
     return local, float(((px - cx) ** 2 + (py - cy) ** 2) ** 0.5)
 
 
+def outputs(c: PointOnCurve, geometry: kit.Geometry
+            ) -> dict[str, tuple[sp.Expr, sp.Expr | None]]:
+    """The contact point c(s) in the global frame, ``contact_x`` and ``contact_y``."""
+    s = geometry.coordinate(f"{c.name}.{S}")
+    return kit.contact_outputs(geometry.pose(c.i).point(curve_of(c.curve, s, geometry)))
+
+
 def marks(c: PointOnCurve, geometry: kit.Geometry) -> list[kit.Mark]:
-    """The curve, over s0 - pi to s0 + pi (where it is real)."""
+    """The curve over its range, else s0 - pi to s0 + pi (where it is real)."""
     s0 = geometry.expr(c.s0)
-    return [(c.i, "curve", curve_of(c.curve, kit.S_MARK, geometry), (s0 - sp.pi, s0 + sp.pi))]
+    span = ((s0 - sp.pi, s0 + sp.pi) if c.range is None
+            else tuple(geometry.expr(end) for end in c.range))
+    return [(c.i, "curve", curve_of(c.curve, kit.S_MARK, geometry), span)]
 
 
 TYPE = kit.PairType(
     name="point_on_curve", model=PointOnCurve, sections=("joints",), equations=equations,
     rows=("x", "y"), points=(("point", "j"),), check=check, to_local=to_local,
-    coordinate="s0", marks=marks)
+    coordinate="s0", marks=marks, coordinate_range="range", outputs=outputs)
