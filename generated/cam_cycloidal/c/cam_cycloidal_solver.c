@@ -21,6 +21,7 @@ void cam_cycloidal_default_options(cam_cycloidal_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define CAM_CYCLOIDAL_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,55 @@ static int cam_cycloidal_factor_jacobian(const cam_cycloidal_options *options, c
         return CAM_CYCLOIDAL_SINGULAR;
     }
     return CAM_CYCLOIDAL_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char cam_cycloidal_length_column[CAM_CYCLOIDAL_NQ] = { 1, 1, 0, 1, 1, 0, 0 };
+static const unsigned char cam_cycloidal_length_row[CAM_CYCLOIDAL_NQ] = { 1, 1, 0, 1, 1, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void cam_cycloidal_prepare(cam_cycloidal_real unit, cam_cycloidal_workspace *work)
+{
+    int i, e;
+    cam_cycloidal_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->scaled = unit != 1 && CAM_CYCLOIDAL_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
+        work->column[i] = cam_cycloidal_length_column[i] ? unit : 1;
+        work->row[i] = cam_cycloidal_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < CAM_CYCLOIDAL_NNZ; ++e) {
+        work->nz_factor[e] = work->column[cam_cycloidal_phi_q_col[e]] / work->row[cam_cycloidal_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void cam_cycloidal_in_unit(cam_cycloidal_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < CAM_CYCLOIDAL_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void cam_cycloidal_rows_in_unit(const cam_cycloidal_workspace *work, cam_cycloidal_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void cam_cycloidal_from_unit(const cam_cycloidal_workspace *work, cam_cycloidal_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -299,12 +349,14 @@ static int cam_cycloidal_converged(const cam_cycloidal_options *options, const c
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !cam_cycloidal_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            cam_cycloidal_from_unit(work, work->phi);
             for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) q[i] += work->phi[i];
             if (!moved) { /* Phi_q where the estimate was made */
                 memcpy(work->nz_estimated, work->nz, sizeof work->nz);
             }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             cam_cycloidal_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            cam_cycloidal_in_unit(work);
             report->residual = cam_cycloidal_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -334,6 +386,7 @@ static int cam_cycloidal_newton(const cam_cycloidal_options *options, const cam_
         cam_cycloidal_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         cam_cycloidal_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        cam_cycloidal_in_unit(work);
         residual = cam_cycloidal_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -354,10 +407,11 @@ static int cam_cycloidal_newton(const cam_cycloidal_options *options, const cam_
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         cam_cycloidal_lu_solve(&work->lu, work->phi);
+        step = cam_cycloidal_max_abs(work->phi); /* in the run's unit */
+        cam_cycloidal_from_unit(work, work->phi);
         for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = cam_cycloidal_max_abs(work->phi);
     }
     return CAM_CYCLOIDAL_NO_CONVERGENCE;
 }
@@ -382,8 +436,7 @@ int cam_cycloidal_solve_step(const cam_cycloidal_options *options, const cam_cyc
     if (state->started) {
         cam_cycloidal_predict(t, state);
     } else {
-        cam_cycloidal_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        cam_cycloidal_prepare(options->unit, work);
     }
     report->status = cam_cycloidal_newton(options, p, t, state->q, work, report);
     report->fallbacks = cam_cycloidal_lu_fallbacks(&work->lu);
@@ -396,15 +449,20 @@ int cam_cycloidal_solve_step(const cam_cycloidal_options *options, const cam_cyc
     for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    cam_cycloidal_rows_in_unit(work, state->dq);
     cam_cycloidal_lu_solve(&work->lu, state->dq); /* (2.73) */
+    cam_cycloidal_from_unit(work, state->dq);
     cam_cycloidal_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    cam_cycloidal_rows_in_unit(work, state->ddq);
     cam_cycloidal_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    cam_cycloidal_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
-        const cam_cycloidal_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const cam_cycloidal_real c = fabs(state->ddq[i]);
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) { /* in the run's unit: q / column */
+        const cam_cycloidal_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const cam_cycloidal_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const cam_cycloidal_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -498,11 +556,13 @@ int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, int m, const
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (cam_cycloidal_real)NAN;
         for (k = 0; k < n; ++k) {
             if (cam_cycloidal_solve_step(options, p_set, t[k], state, work, &report) != CAM_CYCLOIDAL_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             cam_cycloidal_store(q_set, k, state->q);
             cam_cycloidal_store(dq_set, k, state->dq);
             cam_cycloidal_store(ddq_set, k, state->ddq);
@@ -517,4 +577,66 @@ int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, int m, const
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static cam_cycloidal_real cam_cycloidal_march(const cam_cycloidal_options *options, const cam_cycloidal_real p[],
+                                 cam_cycloidal_real target, cam_cycloidal_real h0, cam_cycloidal_real h_min,
+                                 cam_cycloidal_state *state, cam_cycloidal_workspace *work,
+                                 cam_cycloidal_report *report, cam_cycloidal_real *cond)
+{
+    cam_cycloidal_real h = h0;
+    while (state->t < target) {
+        const cam_cycloidal_real rest = target - state->t;
+        const cam_cycloidal_real step = h < rest ? h : rest;
+        const cam_cycloidal_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (cam_cycloidal_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == CAM_CYCLOIDAL_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int cam_cycloidal_solve_edge(const cam_cycloidal_options *options, const cam_cycloidal_real p[],
+                            cam_cycloidal_real t, cam_cycloidal_real h_min, cam_cycloidal_real delta,
+                            cam_cycloidal_real cond, cam_cycloidal_state *state,
+                            cam_cycloidal_workspace *work, cam_cycloidal_report *report,
+                            cam_cycloidal_edge_report *edge)
+{
+    const cam_cycloidal_state previous = *state;
+    const cam_cycloidal_real h0 = t - previous.t;
+    cam_cycloidal_state before = previous, after;
+    cam_cycloidal_real blocked, reach, early = 0, before_cond = cond;
+    cam_cycloidal_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = cam_cycloidal_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = CAM_CYCLOIDAL_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = cam_cycloidal_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = CAM_CYCLOIDAL_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (cam_cycloidal_solve_step(options, p, blocked + reach, &after, work, report) == CAM_CYCLOIDAL_OK) {
+            edge->outcome = CAM_CYCLOIDAL_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }
