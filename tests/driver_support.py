@@ -84,3 +84,22 @@ def derive(name: str):
     """The System of tests/mechanisms/<name>.yaml."""
     return symkin.derive(MECHANISMS / f"{name}.yaml")
 
+
+
+def _condition_apart(message: str) -> tuple[str, float]:
+    """A failure message with its condition figure taken out, and that figure."""
+    import re
+
+    found = re.search(r"condition ([0-9.e+-]+)\)", message)
+    if found is None:
+        return message, 0.0
+    return message.replace(found.group(1), "C"), float(found.group(1))
+
+
+def same_condition(result_message: str, solve_message: str) -> None:
+    """Equal messages but for the condition figure, which agrees to 1 %: a sweep's limit is
+    bisected in C (sweeps.stops), whose condition estimate there may differ from the
+    runtime's in the last of the 3 digits printed."""
+    mine, theirs = _condition_apart(result_message), _condition_apart(solve_message)
+    assert mine[0] == theirs[0]
+    assert mine[1] == pytest.approx(theirs[1], rel=0.01)

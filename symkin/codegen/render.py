@@ -296,7 +296,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
-        "option_fields": list(options.SOLVER_FIELDS),
+        "option_fields": list(options.C_FIELDS),
         "status": dict(status.CODES),
         "shared_constants": {name: _c_number(value) for name, value in tuning.SHARED.items()},
         **code.backend.template_context(code),
@@ -388,9 +388,8 @@ def _labels(code: Code, routine: str) -> list[str]:
 
 def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
     """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
-    defaults = options.defaults(code.real)
     return {name: str(value) if isinstance(value, (int, bool)) else literal(value)
-            for name, value in vars(defaults).items()}
+            for name, value in options.c_defaults(code.real).items()}
 
 
 def _c_number(value: float) -> str:

@@ -62,3 +62,18 @@ SOLVER_FIELDS = tuple(f.name for f in fields(Options) if f.name != "stop_at_sing
 """The options the generated C solver reads too, in the order of its ``<prefix>_options``
 struct; ``stop_at_singular`` is the Python driver's alone (it decides what happens after the C
 grid loop stops)."""
+
+LENGTH_UNIT = "unit"
+"""The C solver's option beyond :data:`SOLVER_FIELDS`: the length unit its decisions are made
+in (runtime.units chooses it from the mechanism's length scale; 1, the default, is the
+mechanism's own unit). The Python loop applies the same unit by solving a scaled view of the
+kernel (runtime.units.ScaledKernel), so it is no field of :class:`Options`."""
+
+C_FIELDS = (*SOLVER_FIELDS, LENGTH_UNIT)
+"""The fields of the generated ``<prefix>_options`` struct, in order."""
+
+
+def c_defaults(real: str) -> dict[str, float]:
+    """``<prefix>_default_options`` for a real type: the Options defaults and unit 1."""
+    chosen = defaults(real)
+    return {**{name: getattr(chosen, name) for name in SOLVER_FIELDS}, LENGTH_UNIT: 1.0}

@@ -237,7 +237,8 @@ def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike 
         return _solve(kernel, times, q, p, options, progress, use_c_solver, out)
     scaled = units.ScaledKernel(kernel, unit)
     try:
-        trajectory = _solve(scaled, times, q / scaled.column, p, options, progress, False, out)
+        trajectory = _solve(scaled, times, q / scaled.column, p, options, progress,
+                            use_c_solver, out)
     except (SolveFailure, SolveInterrupted) as stop:
         units.to_kernel_unit(scaled, stop.trajectory.q, stop.trajectory.dq, stop.trajectory.d2q)
         raise

@@ -157,16 +157,22 @@ def _minimum_norm_correction(jacobian: Array, phi: Array) -> Array:
         return np.zeros_like(phi)
 
 
+def substeps(previous: float, t: float) -> tuple[float, float, float]:
+    """The first substep h0 from the last time solved to the failing grid point t, the least
+    substep h_min (about 1e-9 of h0: the bisection's resolution) and the half-width delta of
+    the step over a blocked time (also used by the generated C's ``<prefix>_solve_edge``)."""
+    h0 = t - previous
+    return h0, max(1e-9 * h0, 1e-13 * (1.0 + abs(t))), DELTA_FRACTION * h0
+
+
 def resolve(kernel: KinematicsKernel, p: Array, options: Options, previous: State,
             t: float) -> Resolution:
     """Solve the grid point t that the plain step from ``previous`` could not."""
-    h0 = t - previous.t
-    h_min = max(1e-9 * h0, 1e-13 * (1.0 + abs(t)))
+    h0, h_min, delta = substeps(previous.t, t)
     state, failed = march(kernel, p, options, previous, t, h0, h_min)
     if not failed:
         return Resolution(state.point)
     blocked = state.t + failed
-    delta = DELTA_FRACTION * h0
     before, early = march(kernel, p, options, previous, blocked - delta, h0, h_min) \
         if blocked - delta > previous.t else (previous, 0.0)
     after = None if early else _over(kernel, p, options, before, blocked, delta, h0)
@@ -218,14 +224,31 @@ def _stopped(kernel: KinematicsKernel, p: Array, options: Options, state: State,
              failed: float, start: State) -> Resolution:
     """The motion cannot go on past state.t (reached by substeps from start): a limit
     position, or no convergence."""
-    threshold = min(LIMIT_COND, options.max_cond / 10)
-    limit = state.point.cond > threshold or state.point.cond > LIMIT_GROWTH * start.point.cond
-    stop = Resolution(None, limit=limit, reached=state, failed_at=state.t + failed)
-    if limit:
+    stop = stopped_at(kernel, p, options, state, failed, start.point.cond)
+    if stop.limit:
         jacobian = kernel.phi_q(state.point.q, state.t, p)
+        threshold = limit_threshold(options)
         _, found = dependencies(jacobian, list(kernel.rows), rcond=1.0 / threshold)
         stop.groups = tuple(tuple(group) for group in found)
-        stop.aligned, stop.drivers = limit_motion(kernel, jacobian)
+    return stop
+
+
+def limit_threshold(options: Options) -> float:
+    """The condition above which a stop is a limit position (LIMIT_COND)."""
+    return min(LIMIT_COND, options.max_cond / 10)
+
+
+def stopped_at(kernel: KinematicsKernel, p: Array, options: Options, state: State,
+               failed: float, start_cond: float) -> Resolution:
+    """The stop at state.t (a step of ``failed`` from it failed; start_cond: the condition at
+    the grid point the substeps began from), told a limit position or no convergence, with
+    the aligned joints and held drivers of a limit (not its dependent rows: ``_stopped``)."""
+    cond = state.point.cond
+    limit = cond > limit_threshold(options) or cond > LIMIT_GROWTH * start_cond
+    stop = Resolution(None, limit=limit, reached=state, failed_at=state.t + failed)
+    if limit:
+        stop.aligned, stop.drivers = limit_motion(kernel, kernel.phi_q(state.point.q, state.t,
+                                                                        p))
     return stop
 
 

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.loads import load_count
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.contract.options import Options
-from symkin.runtime.protocol import BatchSolver, GridSolver
+from symkin.runtime.protocol import BatchSolver, EdgeSolver, GridSolver
 
 Array = NDArray[np.float64]
 
@@ -57,6 +57,10 @@ class Kernel:
 
     # A backend's solve of many parameter sets in one call (None: a sweep solves set by set).
     batch_solver: BatchSolver | None = None
+
+    def edge_solver(self) -> EdgeSolver | None:
+        """A backend's substeps towards a point its batch stopped at (None: none)."""
+        return None
 
     def __init__(self, backend: str, meta: Mapping[str, Any], functions: _Functions,
                  folder: Path | None = None) -> None:
@@ -105,9 +109,11 @@ class Kernel:
         """True for a kernel whose generated code runs whole grids (the C solver)."""
         return False
 
-    def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
-        """A fresh run of the generated grid loop from q, or None without one."""
-        del options, q, p
+    def grid_solver(self, options: Options, q: Array, p: Array, unit: float = 1.0
+                    ) -> GridSolver | None:
+        """A fresh run of the generated grid loop from q (its decisions made in the length
+        unit ``unit``, runtime.units), or None without one."""
+        del options, q, p, unit
         return None
 
     def input_stepper(self) -> Any:

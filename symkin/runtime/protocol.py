@@ -38,8 +38,8 @@ class GridSolver(Protocol):
     between calls, so a grid runs in chunks exactly as in one call. A kernel hands one out
     per run (``Kernel.grid_solver``); the driver releases it after the run."""
 
-    def start(self, options: Options, q: Array, p: Array) -> GridSolver:
-        """Begin a new run from q with parameters p."""
+    def start(self, options: Options, q: Array, p: Array, unit: float = 1.0) -> GridSolver:
+        """Begin a new run from q with parameters p (decisions in the length unit ``unit``)."""
         ...
 
     def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
@@ -84,9 +84,10 @@ class GridSolver(Protocol):
         ...
 
 
-BatchStatus = tuple[NDArray[np.int32], NDArray[np.int32], NDArray[np.int32]]
-"""(status, iterations, solved) per parameter set of a batch solve; solved: the rows written
-(a failed set stopped at the grid point t[solved])."""
+BatchStatus = tuple[NDArray[np.int32], NDArray[np.int32], NDArray[np.int32], Array]
+"""(status, iterations, solved, cond) per parameter set of a batch solve; solved: the rows
+written (a failed set stopped at the grid point t[solved]); cond: the condition estimate at
+the last row solved (NaN: none)."""
 
 
 class BatchSolver(Protocol):
@@ -96,6 +97,33 @@ class BatchSolver(Protocol):
     def __call__(self, params: Array, t: Array, q0: Array, options: Options,
                  q: Array, dq: Array, d2q: Array) -> BatchStatus: ...
 
+
+
+EDGE_REACHED, EDGE_PASSABLE, EDGE_STOPPED = 0, 1, 2
+"""The outcomes of an EdgeSolver (the generated ``<PREFIX>_EDGE_*``)."""
+
+
+@dataclass(frozen=True)
+class EdgeFound:
+    """What a backend's edge treatment found (runtime.edges.resolve up to its decision):
+    outcome (EDGE_*), the step that failed from the last point reached, that point's condition
+    estimate, time, q, dq and ddq."""
+
+    outcome: int
+    failed: float
+    cond: float
+    t: float
+    q: Array
+    dq: Array
+    ddq: Array
+
+
+class EdgeSolver(Protocol):
+    """A backend's substeps from a solved point towards a grid point it could not reach (the
+    generated ``<prefix>_solve_edge``): start = (t, q, dq, ddq) with its condition ``cond``."""
+
+    def __call__(self, options: Options, p: Array, start: tuple[float, Array, Array, Array],
+                 cond: float, t: float, h_min: float, delta: float) -> EdgeFound: ...
 
 
 class KinematicsKernel(Protocol):
@@ -125,4 +153,5 @@ class KinematicsKernel(Protocol):
     def gamma(self, q: ArrayLike, dq: ArrayLike, t: float,
               p: ArrayLike | None = None) -> Array: ...
     def point_vectors(self, p: ArrayLike | None = None) -> Array: ...
-    def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None: ...
+    def grid_solver(self, options: Options, q: Array, p: Array,
+                    unit: float = 1.0) -> GridSolver | None: ...

@@ -22,12 +22,14 @@ Imports NumPy only: part of the runtime.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract.lengths import POSITION_SUFFIXES
 from symkin.contract.options import Options
 from symkin.runtime import accuracy
 from symkin.runtime.edges import LIMIT_COND, limit_motion
@@ -36,8 +38,6 @@ from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
 
-POSITION_SUFFIXES = (".x", ".y", ".z")
-"""Coordinates that are lengths; every other coordinate (an angle) is dimensionless."""
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,13 @@ def start_threshold(options: Options) -> float:
 
 def positions(kernel: KinematicsKernel) -> NDArray[np.bool_]:
     """Which columns of Phi_q are lengths (x, y, z of a body)."""
-    return np.array([name.endswith(POSITION_SUFFIXES) for name in kernel.coordinates])
+    return _positions(tuple(kernel.coordinates)).copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _positions(coordinates: tuple[str, ...]) -> NDArray[np.bool_]:
+    """positions, once per mechanism (a sweep asks for every failed set)."""
+    return np.array([name.endswith(POSITION_SUFFIXES) for name in coordinates], dtype=bool)
 
 
 def length_rows(kernel: KinematicsKernel) -> NDArray[np.bool_]:

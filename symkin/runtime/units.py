@@ -12,10 +12,14 @@ and the results are converted back. Inside NATURAL nothing changes (u = 1). The 
 mechanism at 10^-9, 10^-3, 1, 10^3 or 10^6 times its size is then solved on numbers that
 differ only by the rounding of that one conversion: the same flags, the motion scaled.
 
-A kernel solved in a unit other than 1 runs the general grid loop in Python over the
-kernel's functions (its generated C evaluates Phi, Phi_q, Phi_t and Gamma; its C grid loop is
-not used, as its options are absolute): both backends then take the same path. Imports NumPy
-only: part of the runtime.
+A C kernel runs its generated grid loop in that unit too (the C options' ``unit``: the
+generated solver scales Phi, Phi_q and the solutions as ScaledKernel does, while its q, dq and
+ddq stay in the kernel's own unit); ScaledGridSolver shows that loop to the driver in the unit
+u, so the driver's treatment of the points it stops at is the same whichever backend solved
+the rest. Both backends take the same decisions at C speed on C. A kernel whose generated C
+cannot rescale (``CKernel.scale_free`` false: a literal lever arm folded into the code, or a
+kernel built before the option) runs the general loop in Python over its functions instead.
+Imports NumPy only: part of the runtime.
 """
 
 from __future__ import annotations
@@ -26,7 +30,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from symkin.runtime.protocol import KinematicsKernel
+from symkin.contract.options import Options
+from symkin.runtime.protocol import ChunkResult, GridSolver, KinematicsKernel
 from symkin.runtime.start import length_rows, length_scale, positions
 
 Array = NDArray[np.float64]
@@ -40,7 +45,7 @@ def unit_for(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> float:
     L)."""
     with np.errstate(all="ignore"):
         nz = np.asarray(kernel.phi_q_nz(q0, t0, p), dtype=np.float64)
-    if not np.all(np.isfinite(nz)):
+    if not np.isfinite(nz).all():
         return 1.0
     scale = length_scale(kernel, nz)
     if NATURAL[0] <= scale <= NATURAL[1]:
@@ -68,10 +73,23 @@ class ScaledKernel:
 
     @property
     def has_grid_solver(self) -> bool:
-        return False  # the generated C loop's options are absolute: see the module docstring
+        return bool(self.kernel.has_grid_solver)
 
-    def grid_solver(self, *args: Any) -> None:
-        return None
+    def grid_solver(self, options: Options, q: Array, p: Array, unit: float = 1.0
+                    ) -> ScaledGridSolver | None:
+        """The kernel's grid loop deciding in this unit, seen in it (None where the kernel has
+        none, or one that cannot rescale: the driver then loops in Python)."""
+        del unit  # q is in this view's unit already
+        inner = self.kernel.grid_solver(options, self.to_length(q), p, self.unit)
+        return None if inner is None else ScaledGridSolver(inner, self)
+
+    def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array, p: Array
+                         ) -> tuple[Array, Array]:
+        """The kernel's multipliers and loads of rows given in this unit (in its own unit)."""
+        kernel: Any = self.kernel  # a kernel with dynamics (runtime.forces asks only those)
+        result: tuple[Array, Array] = kernel.multipliers_grid(
+            t, self.to_length(q), self.to_length(dq), self.to_length(d2q), p)
+        return result
 
     def to_length(self, q: ArrayLike) -> Array:
         """q~ -> q in the kernel's own unit."""
@@ -101,3 +119,57 @@ def to_kernel_unit(scaled: ScaledKernel, q: Array, dq: Array, d2q: Array) -> Non
     """Convert solved rows from the unit u back to the kernel's own, in place."""
     for values in (q, dq, d2q):
         values *= scaled.column
+
+
+class ScaledGridSolver:
+    """A kernel's grid solver run in the unit u (its options' ``unit``), shown to the driver in
+    that unit like ScaledKernel: the rows it writes in the kernel's unit are divided by the
+    column scales as they come, and a state handed to it is multiplied back."""
+
+    def __init__(self, solver: GridSolver, scaled: ScaledKernel) -> None:
+        self.solver = solver
+        self.scaled = scaled
+        self.rows: tuple[Array, ...] = ()
+
+    def start(self, options: Options, q: Array, p: Array, unit: float = 1.0
+              ) -> ScaledGridSolver:
+        del unit
+        self.solver.start(options, self.scaled.to_length(q), p, self.scaled.unit)
+        return self
+
+    def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
+             cond_out: Array, flagged_out: NDArray[np.bool_],
+             forces_out: tuple[Array, Array] | None = None) -> None:
+        self.rows = (q_out, dq_out, d2q_out)
+        self.solver.bind(times, q_out, dq_out, d2q_out, cond_out, flagged_out, forces_out)
+
+    def advance(self, start: int, stop: int) -> int:
+        solved = self.solver.advance(start, stop)
+        for values in self.rows:
+            values[start:start + solved] /= self.scaled.column
+        return solved
+
+    @property
+    def status(self) -> int:
+        return self.solver.status
+
+    @property
+    def fallbacks(self) -> int:
+        return self.solver.fallbacks
+
+    def outcome(self, solved: int) -> ChunkResult:
+        return self.solver.outcome(solved)
+
+    def point_vectors(self, count: int, size: int = 2) -> Array:
+        return self.solver.point_vectors(count, size)
+
+    def set_state(self, t: float, q: Array, dq: Array, ddq: Array) -> None:
+        length = self.scaled.to_length
+        self.solver.set_state(t, length(q), length(dq), length(ddq))
+
+    def last_q(self) -> Array:
+        return np.asarray(self.solver.last_q(), dtype=float) / self.scaled.column
+
+    def release(self) -> None:
+        self.rows = ()
+        self.solver.release()

@@ -2,12 +2,13 @@
 ``<prefix>_solve_batch`` of a C kernel), or the driver set by set for a kernel without one.
 
 The batch runs plain Newton from q0 at t[0], like the first attempt of ``symkin.solve``. A set
-it stops on at a limit position is finished from its rows (sweeps.stops: two SVDs, no re-run);
-any other set it cannot solve is handed to ``symkin.solve`` itself, which adds the damped
-assembly, the passage through singular configurations, and names the reason (no assembly,
-singular, no convergence, not finite) — so every set of a sweep is what a per-set ``solve``
-gives, failures included (same reason, stop time and rows; a limit's message gives the grid
-interval, not the bisected time), and a failed set costs at most its own re-run.
+it stops on along the grid goes on from its last row in the generated edge treatment
+(sweeps.stops: the substeps and the bisection to a limit position in C, no re-run); any other
+set it cannot solve is handed to ``symkin.solve`` itself, which adds the damped assembly, the
+passage through singular configurations, and names the reason (no assembly, singular, no
+convergence, not finite) — so every set of a sweep is what a per-set ``solve`` gives, failures
+included (same reason, stop time, bisected time in the message, and rows), and a failed set
+costs at most its own re-run.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ from symkin.contract.options import Options
 from symkin.contract.status import OK
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
-from symkin.sweeps.stops import limit_stop
+from symkin.runtime.protocol import EdgeSolver
+from symkin.sweeps.stops import Stopped, edge_stop
 
 Array = NDArray[np.float64]
 
@@ -76,12 +78,17 @@ def solve_chunk(kernel: Kernel, params: Array, t: Array, q0: Array,
     chunk = empty_chunk(m, t, size) if into is None else into
     starts = np.broadcast_to(q0, (m, size))
     if kernel.batch_solver is not None:
-        status, iterations, solved = kernel.batch_solver(params, t, q0, options, chunk.q,
-                                                         chunk.dq, chunk.d2q)
+        status, iterations, solved, cond = kernel.batch_solver(params, t, q0, options, chunk.q,
+                                                               chunk.dq, chunk.d2q)
         chunk.iterations[:] = iterations
-        pending = [int(j) for j in np.flatnonzero(status != OK)
-                   if not _limit(kernel, params[j], t, starts[j], options, chunk, int(j),
-                                 int(solved[j]))]
+        failed = np.flatnonzero(status != OK)
+        edge = kernel.edge_solver() if failed.size else None
+        pending = [int(j) for j in failed
+                   if edge is None or not _edge(kernel, edge, params[j], t, starts[j], options,
+                                                chunk, int(j), Stopped(
+                                                    (chunk.q[j], chunk.dq[j], chunk.d2q[j]),
+                                                    int(solved[j]), int(status[j]),
+                                                    float(cond[j])))]
     else:
         pending = list(range(m))
     for j in pending:
@@ -89,14 +96,14 @@ def solve_chunk(kernel: Kernel, params: Array, t: Array, q0: Array,
     return chunk
 
 
-def _limit(kernel: Kernel, p: Array, t: Array, q0: Array, options: Options, chunk: Chunk,
-           j: int, solved: int) -> bool:
-    """Set j, stopped by the batch after ``solved`` rows, ended here when those rows show a
-    limit position (as symkin.solve would end it); False: it must be re-run."""
-    stop = limit_stop(kernel, p, t, (chunk.q[j], chunk.dq[j], chunk.d2q[j]), solved, q0,
-                      options)
+def _edge(kernel: Kernel, edge: EdgeSolver, p: Array, t: Array, q0: Array, options: Options,
+          chunk: Chunk, j: int, stopped: Stopped) -> bool:
+    """Set j, stopped by the batch, ended here when the edge treatment stops it (as
+    symkin.solve would end it); False: it must be re-run."""
+    stop = edge_stop(kernel, edge, p, t, q0, stopped, options)
     if stop is None:
         return False
+    solved = stopped.solved
     chunk.status[j] = REASON_CODES.get(stop.reason, max(REASON_CODES.values()) + 1)
     chunk.reasons[j], chunk.messages[j] = stop.reason, stop.message
     chunk.t_reached[j], chunk.solved[j] = stop.t, solved

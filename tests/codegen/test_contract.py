@@ -64,18 +64,20 @@ def test_default_options_are_the_contracts(rendered: tuple[str, dict[str, str]])
     real, files = rendered
     body = files["crank_slider_solver.c"].split("_default_options(", 1)[1].split("}", 1)[0]
     assigned = re.findall(r"options->(\w+) = (.*?);", body)
-    assert [field for field, _ in assigned] == list(options.SOLVER_FIELDS)
-    defaults = options.defaults(real)
+    assert [field for field, _ in assigned] == list(options.C_FIELDS)
+    defaults = options.c_defaults(real)
+    assert defaults[options.LENGTH_UNIT] == 1.0  # the mechanism's own unit
     for field, literal in assigned:
-        assert _c_value(literal) == pytest.approx(getattr(defaults, field), rel=1e-6), field
+        assert _c_value(literal) == pytest.approx(defaults[field], rel=1e-6), field
 
 
 def test_options_struct_has_the_solver_fields(rendered: tuple[str, dict[str, str]]) -> None:
-    """The C struct and the contract's fields, in order (backends.c.csolver copies them by name)."""
+    """The C struct and the contract's fields, in order (backends.c.csolver copies them by name):
+    the Options, then the length unit."""
     _, files = rendered
     struct = files["crank_slider_solver.h"].split("typedef struct {", 1)[1].split("}", 1)[0]
     fields = re.findall(r"^\s+\w+ (\w+);", struct, re.M)
-    assert fields == list(options.SOLVER_FIELDS)
+    assert fields == [*options.SOLVER_FIELDS, options.LENGTH_UNIT] == list(options.C_FIELDS)
 
 
 def test_no_template_spells_a_contract_value() -> None:

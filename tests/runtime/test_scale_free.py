@@ -169,3 +169,58 @@ def test_scan_finds_the_same_branches_at_any_scale(tmp_path, s):
     rod = sorted(float(b.q[kernel.coordinates.index("rod.phi")]) for b in report.branches)
     np.testing.assert_allclose(rod, [math.atan(0.75), math.pi - math.atan(0.75)], atol=1e-9)
     assert report.motions[0].stop is None and not report.branches[0].near_singular
+
+
+@pytest.mark.parametrize("s", (1e-6, 1e-3, 1e3, 1e6))
+def test_c_solves_any_scale_in_its_generated_loop_with_the_decisions_of_numpy(
+        tmp_path, monkeypatch, s):
+    """A C run in another unit runs the generated grid loop deciding in that unit (the C
+    options' ``unit``), never the Python loop, and takes NumPy's decisions: the same flags and
+    condition estimates, the motion equal to rounding (the closed form is checked above)."""
+    text = CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s)
+    c_kernel, numpy_kernel = (_kernel(tmp_path, text, b) for b in ("c", "numpy"))
+    assert c_kernel.scale_free
+
+    def refuse(*args):
+        raise AssertionError("the Python grid loop ran")
+
+    advanced = []
+    advance = units.ScaledGridSolver.advance
+    monkeypatch.setattr(driver, "_python_loop", refuse)
+    monkeypatch.setattr(units.ScaledGridSolver, "advance",
+                        lambda self, a, b: advanced.append((a, b)) or advance(self, a, b))
+    in_c = symkin.solve(c_kernel)
+    assert advanced == [(0, 31)]  # one call of the generated loop, in the unit
+    monkeypatch.undo()
+    in_numpy = symkin.solve(numpy_kernel)
+    assert np.array_equal(in_c.flagged, in_numpy.flagged) and not in_c.flagged.any()
+    np.testing.assert_allclose(in_c.cond, in_numpy.cond, rtol=1e-6)
+    positions = np.array([name.endswith((".x", ".y")) for name in c_kernel.coordinates])
+    scale = np.where(positions, s, 1.0)
+    np.testing.assert_allclose(in_c.q / scale, in_numpy.q / scale, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(in_c.d2q / scale, in_numpy.d2q / scale, rtol=0, atol=1e-10)
+
+
+def test_the_c_option_unit_decides_a_millimetre_drawing_as_one_in_metres(tmp_path):
+    """The generated loop itself, called with unit 1 and unit 1000 on the crank-slider drawn
+    in millimetres: in its own unit the Jacobian's condition is a million times that in
+    metres, and the point is counted singular; in unit 1000 the 31 points solve, with the
+    condition estimates of the drawing in metres."""
+    metres = _kernel(tmp_path, CRANK_SLIDER.format(a=1.0, b=5.0, c=4.0), "c")
+    millimetres = _kernel(tmp_path, CRANK_SLIDER.format(a=1e3, b=5e3, c=4e3), "c")
+    options = driver.default_options(millimetres)
+    t = np.linspace(0.0, 1.5, 31)
+    reference = symkin.solve(metres, t=t)
+    conds = {}
+    for unit in (1.0, 1e3):
+        q0 = np.asarray(millimetres.q0, dtype=float)
+        solver = millimetres.grid_solver(options, q0, millimetres.p_values, unit)
+        rows = [np.zeros((31, 9)) for _ in range(3)]
+        cond, flagged = np.zeros(31), np.zeros(31, dtype=bool)
+        solver.bind(t, *rows, cond, flagged)
+        solved = solver.advance(0, 31)
+        solver.release()
+        conds[unit] = (solved, cond[:solved])
+    assert conds[1.0][0] < 31  # stopped: counted singular in the drawing's own unit
+    assert conds[1e3][0] == 31
+    np.testing.assert_allclose(conds[1e3][1], reference.cond, rtol=1e-6)

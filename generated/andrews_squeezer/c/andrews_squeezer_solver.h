@@ -35,7 +35,19 @@ typedef struct {
     andrews_squeezer_real target_q;        /* flagged when the estimated error of q, dq or    */
     andrews_squeezer_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     andrews_squeezer_real target_ddq;
+    andrews_squeezer_real unit;            /* the length unit the decisions are made in: the     */
+                                       /* tolerances, the singularity test and the flags   */
+                                       /* see lengths (q's x, y, z and Phi's length rows)  */
+                                       /* divided by it, angles as they are. q, dq, ddq in  */
+                                       /* and out stay in the mechanism's own unit. 1 (the */
+                                       /* default): that unit. A mechanism drawn in mm is  */
+                                       /* decided alike with unit 1000. Ignored where      */
+                                       /* ANDREWS_SQUEEZER_SCALE_FREE is 0. */
 } andrews_squeezer_options;
+
+/* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
+ * written as a number (folded into the generated code, it cannot be rescaled at run time). */
+#define ANDREWS_SQUEEZER_SCALE_FREE 1
 
 typedef struct {
     int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -70,6 +82,11 @@ typedef struct {
     andrews_squeezer_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     andrews_squeezer_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     andrews_squeezer_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    andrews_squeezer_real column[ANDREWS_SQUEEZER_NQ]; /* options->unit where q_i is a length, else 1 */
+    andrews_squeezer_real inverse_column[ANDREWS_SQUEEZER_NQ]; /* 1 / column */
+    andrews_squeezer_real row[ANDREWS_SQUEEZER_NQ]; /* options->unit where Phi_i is a length, else 1 */
+    andrews_squeezer_real nz_factor[ANDREWS_SQUEEZER_NNZ]; /* column / row of each non-zero */
+    int scaled; /* the decisions are made in a unit other than 1 */
 } andrews_squeezer_workspace;
 
 /* Tolerances suited to the real type. */
@@ -108,6 +125,7 @@ typedef struct {
     andrews_squeezer_real t;         /* the time of the last step attempted (t[n-1] when OK)    */
     int iterations;              /* Newton iterations summed over the set's steps           */
     andrews_squeezer_real residual;  /* max|Phi| of the last iterate                            */
+    andrews_squeezer_real cond;      /* the condition estimate at the last point solved (NaN: none) */
 } andrews_squeezer_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
@@ -123,5 +141,33 @@ int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, int m,
                              andrews_squeezer_real dq_out[], andrews_squeezer_real ddq_out[],
                              andrews_squeezer_state *state, andrews_squeezer_workspace *work,
                              andrews_squeezer_batch_report reports[]);
+
+#define ANDREWS_SQUEEZER_EDGE_REACHED 0  /* the substeps reached t                                */
+#define ANDREWS_SQUEEZER_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */
+#define ANDREWS_SQUEEZER_EDGE_STOPPED 2  /* blocked, and no step over it converges                */
+
+/* What andrews_squeezer_solve_edge found. */
+typedef struct {
+    int outcome;                 /* ANDREWS_SQUEEZER_EDGE_REACHED, _PASSABLE or _STOPPED          */
+    andrews_squeezer_real failed;    /* the step that failed from the last point reached (0: none) */
+    andrews_squeezer_real cond;      /* the condition estimate at the last point reached          */
+} andrews_squeezer_edge_report;
+
+/* A time t that the plain step from a solved state could not reach (the point where
+ * andrews_squeezer_solve_grid stopped), treated as symkin's runtime does before it decides (its
+ * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
+ * blocked time b; then, from the last point reached substepping towards b - delta, steps to
+ * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the
+ * position passable. Each substep is a andrews_squeezer_solve_step with no last point for the error
+ * model. On return state is the last point reached (t itself when reached) and
+ * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
+ * bisection to a limit position: the motion stops between state->t and state->t +
+ * edge->failed. The workspace is set up here. Returns edge->outcome. */
+int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
+                            andrews_squeezer_real t, andrews_squeezer_real h_min, andrews_squeezer_real delta,
+                            andrews_squeezer_real cond, andrews_squeezer_state *state,
+                            andrews_squeezer_workspace *work, andrews_squeezer_report *report,
+                            andrews_squeezer_edge_report *edge);
 
 #endif /* ANDREWS_SQUEEZER_SOLVER_H */

@@ -35,7 +35,19 @@ typedef struct {
     cardan_real target_q;        /* flagged when the estimated error of q, dq or    */
     cardan_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     cardan_real target_ddq;
+    cardan_real unit;            /* the length unit the decisions are made in: the     */
+                                       /* tolerances, the singularity test and the flags   */
+                                       /* see lengths (q's x, y, z and Phi's length rows)  */
+                                       /* divided by it, angles as they are. q, dq, ddq in  */
+                                       /* and out stay in the mechanism's own unit. 1 (the */
+                                       /* default): that unit. A mechanism drawn in mm is  */
+                                       /* decided alike with unit 1000. Ignored where      */
+                                       /* CARDAN_SCALE_FREE is 0. */
 } cardan_options;
+
+/* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
+ * written as a number (folded into the generated code, it cannot be rescaled at run time). */
+#define CARDAN_SCALE_FREE 1
 
 typedef struct {
     int status;                  /* CARDAN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -70,6 +82,11 @@ typedef struct {
     cardan_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     cardan_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     cardan_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    cardan_real column[CARDAN_NQ]; /* options->unit where q_i is a length, else 1 */
+    cardan_real inverse_column[CARDAN_NQ]; /* 1 / column */
+    cardan_real row[CARDAN_NQ]; /* options->unit where Phi_i is a length, else 1 */
+    cardan_real nz_factor[CARDAN_NNZ]; /* column / row of each non-zero */
+    int scaled; /* the decisions are made in a unit other than 1 */
 } cardan_workspace;
 
 /* Tolerances suited to the real type. */
@@ -108,6 +125,7 @@ typedef struct {
     cardan_real t;         /* the time of the last step attempted (t[n-1] when OK)    */
     int iterations;              /* Newton iterations summed over the set's steps           */
     cardan_real residual;  /* max|Phi| of the last iterate                            */
+    cardan_real cond;      /* the condition estimate at the last point solved (NaN: none) */
 } cardan_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
@@ -123,5 +141,33 @@ int cardan_solve_batch(const cardan_options *options, int m, const cardan_real p
                              cardan_real dq_out[], cardan_real ddq_out[],
                              cardan_state *state, cardan_workspace *work,
                              cardan_batch_report reports[]);
+
+#define CARDAN_EDGE_REACHED 0  /* the substeps reached t                                */
+#define CARDAN_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */
+#define CARDAN_EDGE_STOPPED 2  /* blocked, and no step over it converges                */
+
+/* What cardan_solve_edge found. */
+typedef struct {
+    int outcome;                 /* CARDAN_EDGE_REACHED, _PASSABLE or _STOPPED          */
+    cardan_real failed;    /* the step that failed from the last point reached (0: none) */
+    cardan_real cond;      /* the condition estimate at the last point reached          */
+} cardan_edge_report;
+
+/* A time t that the plain step from a solved state could not reach (the point where
+ * cardan_solve_grid stopped), treated as symkin's runtime does before it decides (its
+ * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
+ * blocked time b; then, from the last point reached substepping towards b - delta, steps to
+ * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the
+ * position passable. Each substep is a cardan_solve_step with no last point for the error
+ * model. On return state is the last point reached (t itself when reached) and
+ * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
+ * bisection to a limit position: the motion stops between state->t and state->t +
+ * edge->failed. The workspace is set up here. Returns edge->outcome. */
+int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
+                            cardan_real t, cardan_real h_min, cardan_real delta,
+                            cardan_real cond, cardan_state *state,
+                            cardan_workspace *work, cardan_report *report,
+                            cardan_edge_report *edge);
 
 #endif /* CARDAN_SOLVER_H */

@@ -35,7 +35,19 @@ typedef struct {
     crank_slider_drawn_real target_q;        /* flagged when the estimated error of q, dq or    */
     crank_slider_drawn_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     crank_slider_drawn_real target_ddq;
+    crank_slider_drawn_real unit;            /* the length unit the decisions are made in: the     */
+                                       /* tolerances, the singularity test and the flags   */
+                                       /* see lengths (q's x, y, z and Phi's length rows)  */
+                                       /* divided by it, angles as they are. q, dq, ddq in  */
+                                       /* and out stay in the mechanism's own unit. 1 (the */
+                                       /* default): that unit. A mechanism drawn in mm is  */
+                                       /* decided alike with unit 1000. Ignored where      */
+                                       /* CRANK_SLIDER_DRAWN_SCALE_FREE is 0. */
 } crank_slider_drawn_options;
+
+/* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
+ * written as a number (folded into the generated code, it cannot be rescaled at run time). */
+#define CRANK_SLIDER_DRAWN_SCALE_FREE 1
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -70,6 +82,11 @@ typedef struct {
     crank_slider_drawn_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     crank_slider_drawn_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_drawn_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    crank_slider_drawn_real column[CRANK_SLIDER_DRAWN_NQ]; /* options->unit where q_i is a length, else 1 */
+    crank_slider_drawn_real inverse_column[CRANK_SLIDER_DRAWN_NQ]; /* 1 / column */
+    crank_slider_drawn_real row[CRANK_SLIDER_DRAWN_NQ]; /* options->unit where Phi_i is a length, else 1 */
+    crank_slider_drawn_real nz_factor[CRANK_SLIDER_DRAWN_NNZ]; /* column / row of each non-zero */
+    int scaled; /* the decisions are made in a unit other than 1 */
 } crank_slider_drawn_workspace;
 
 /* Tolerances suited to the real type. */
@@ -108,6 +125,7 @@ typedef struct {
     crank_slider_drawn_real t;         /* the time of the last step attempted (t[n-1] when OK)    */
     int iterations;              /* Newton iterations summed over the set's steps           */
     crank_slider_drawn_real residual;  /* max|Phi| of the last iterate                            */
+    crank_slider_drawn_real cond;      /* the condition estimate at the last point solved (NaN: none) */
 } crank_slider_drawn_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
@@ -123,5 +141,33 @@ int crank_slider_drawn_solve_batch(const crank_slider_drawn_options *options, in
                              crank_slider_drawn_real dq_out[], crank_slider_drawn_real ddq_out[],
                              crank_slider_drawn_state *state, crank_slider_drawn_workspace *work,
                              crank_slider_drawn_batch_report reports[]);
+
+#define CRANK_SLIDER_DRAWN_EDGE_REACHED 0  /* the substeps reached t                                */
+#define CRANK_SLIDER_DRAWN_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */
+#define CRANK_SLIDER_DRAWN_EDGE_STOPPED 2  /* blocked, and no step over it converges                */
+
+/* What crank_slider_drawn_solve_edge found. */
+typedef struct {
+    int outcome;                 /* CRANK_SLIDER_DRAWN_EDGE_REACHED, _PASSABLE or _STOPPED          */
+    crank_slider_drawn_real failed;    /* the step that failed from the last point reached (0: none) */
+    crank_slider_drawn_real cond;      /* the condition estimate at the last point reached          */
+} crank_slider_drawn_edge_report;
+
+/* A time t that the plain step from a solved state could not reach (the point where
+ * crank_slider_drawn_solve_grid stopped), treated as symkin's runtime does before it decides (its
+ * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
+ * blocked time b; then, from the last point reached substepping towards b - delta, steps to
+ * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the
+ * position passable. Each substep is a crank_slider_drawn_solve_step with no last point for the error
+ * model. On return state is the last point reached (t itself when reached) and
+ * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
+ * bisection to a limit position: the motion stops between state->t and state->t +
+ * edge->failed. The workspace is set up here. Returns edge->outcome. */
+int crank_slider_drawn_solve_edge(const crank_slider_drawn_options *options, const crank_slider_drawn_real p[],
+                            crank_slider_drawn_real t, crank_slider_drawn_real h_min, crank_slider_drawn_real delta,
+                            crank_slider_drawn_real cond, crank_slider_drawn_state *state,
+                            crank_slider_drawn_workspace *work, crank_slider_drawn_report *report,
+                            crank_slider_drawn_edge_report *edge);
 
 #endif /* CRANK_SLIDER_DRAWN_SOLVER_H */

@@ -35,7 +35,19 @@ typedef struct {
     four_bar_real target_q;        /* flagged when the estimated error of q, dq or    */
     four_bar_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     four_bar_real target_ddq;
+    four_bar_real unit;            /* the length unit the decisions are made in: the     */
+                                       /* tolerances, the singularity test and the flags   */
+                                       /* see lengths (q's x, y, z and Phi's length rows)  */
+                                       /* divided by it, angles as they are. q, dq, ddq in  */
+                                       /* and out stay in the mechanism's own unit. 1 (the */
+                                       /* default): that unit. A mechanism drawn in mm is  */
+                                       /* decided alike with unit 1000. Ignored where      */
+                                       /* FOUR_BAR_SCALE_FREE is 0. */
 } four_bar_options;
+
+/* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
+ * written as a number (folded into the generated code, it cannot be rescaled at run time). */
+#define FOUR_BAR_SCALE_FREE 1
 
 typedef struct {
     int status;                  /* FOUR_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -70,6 +82,11 @@ typedef struct {
     four_bar_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     four_bar_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     four_bar_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    four_bar_real column[FOUR_BAR_NQ]; /* options->unit where q_i is a length, else 1 */
+    four_bar_real inverse_column[FOUR_BAR_NQ]; /* 1 / column */
+    four_bar_real row[FOUR_BAR_NQ]; /* options->unit where Phi_i is a length, else 1 */
+    four_bar_real nz_factor[FOUR_BAR_NNZ]; /* column / row of each non-zero */
+    int scaled; /* the decisions are made in a unit other than 1 */
 } four_bar_workspace;
 
 /* Tolerances suited to the real type. */
@@ -108,6 +125,7 @@ typedef struct {
     four_bar_real t;         /* the time of the last step attempted (t[n-1] when OK)    */
     int iterations;              /* Newton iterations summed over the set's steps           */
     four_bar_real residual;  /* max|Phi| of the last iterate                            */
+    four_bar_real cond;      /* the condition estimate at the last point solved (NaN: none) */
 } four_bar_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
@@ -123,5 +141,33 @@ int four_bar_solve_batch(const four_bar_options *options, int m, const four_bar_
                              four_bar_real dq_out[], four_bar_real ddq_out[],
                              four_bar_state *state, four_bar_workspace *work,
                              four_bar_batch_report reports[]);
+
+#define FOUR_BAR_EDGE_REACHED 0  /* the substeps reached t                                */
+#define FOUR_BAR_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */
+#define FOUR_BAR_EDGE_STOPPED 2  /* blocked, and no step over it converges                */
+
+/* What four_bar_solve_edge found. */
+typedef struct {
+    int outcome;                 /* FOUR_BAR_EDGE_REACHED, _PASSABLE or _STOPPED          */
+    four_bar_real failed;    /* the step that failed from the last point reached (0: none) */
+    four_bar_real cond;      /* the condition estimate at the last point reached          */
+} four_bar_edge_report;
+
+/* A time t that the plain step from a solved state could not reach (the point where
+ * four_bar_solve_grid stopped), treated as symkin's runtime does before it decides (its
+ * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
+ * blocked time b; then, from the last point reached substepping towards b - delta, steps to
+ * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the
+ * position passable. Each substep is a four_bar_solve_step with no last point for the error
+ * model. On return state is the last point reached (t itself when reached) and
+ * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
+ * bisection to a limit position: the motion stops between state->t and state->t +
+ * edge->failed. The workspace is set up here. Returns edge->outcome. */
+int four_bar_solve_edge(const four_bar_options *options, const four_bar_real p[],
+                            four_bar_real t, four_bar_real h_min, four_bar_real delta,
+                            four_bar_real cond, four_bar_state *state,
+                            four_bar_workspace *work, four_bar_report *report,
+                            four_bar_edge_report *edge);
 
 #endif /* FOUR_BAR_SOLVER_H */

@@ -35,7 +35,19 @@ typedef struct {
     rack_linkage_real target_q;        /* flagged when the estimated error of q, dq or    */
     rack_linkage_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     rack_linkage_real target_ddq;
+    rack_linkage_real unit;            /* the length unit the decisions are made in: the     */
+                                       /* tolerances, the singularity test and the flags   */
+                                       /* see lengths (q's x, y, z and Phi's length rows)  */
+                                       /* divided by it, angles as they are. q, dq, ddq in  */
+                                       /* and out stay in the mechanism's own unit. 1 (the */
+                                       /* default): that unit. A mechanism drawn in mm is  */
+                                       /* decided alike with unit 1000. Ignored where      */
+                                       /* RACK_LINKAGE_SCALE_FREE is 0. */
 } rack_linkage_options;
+
+/* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
+ * written as a number (folded into the generated code, it cannot be rescaled at run time). */
+#define RACK_LINKAGE_SCALE_FREE 1
 
 typedef struct {
     int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -70,6 +82,11 @@ typedef struct {
     rack_linkage_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     rack_linkage_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     rack_linkage_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    rack_linkage_real column[RACK_LINKAGE_NQ]; /* options->unit where q_i is a length, else 1 */
+    rack_linkage_real inverse_column[RACK_LINKAGE_NQ]; /* 1 / column */
+    rack_linkage_real row[RACK_LINKAGE_NQ]; /* options->unit where Phi_i is a length, else 1 */
+    rack_linkage_real nz_factor[RACK_LINKAGE_NNZ]; /* column / row of each non-zero */
+    int scaled; /* the decisions are made in a unit other than 1 */
 } rack_linkage_workspace;
 
 /* Tolerances suited to the real type. */
@@ -108,6 +125,7 @@ typedef struct {
     rack_linkage_real t;         /* the time of the last step attempted (t[n-1] when OK)    */
     int iterations;              /* Newton iterations summed over the set's steps           */
     rack_linkage_real residual;  /* max|Phi| of the last iterate                            */
+    rack_linkage_real cond;      /* the condition estimate at the last point solved (NaN: none) */
 } rack_linkage_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
@@ -123,5 +141,33 @@ int rack_linkage_solve_batch(const rack_linkage_options *options, int m, const r
                              rack_linkage_real dq_out[], rack_linkage_real ddq_out[],
                              rack_linkage_state *state, rack_linkage_workspace *work,
                              rack_linkage_batch_report reports[]);
+
+#define RACK_LINKAGE_EDGE_REACHED 0  /* the substeps reached t                                */
+#define RACK_LINKAGE_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */
+#define RACK_LINKAGE_EDGE_STOPPED 2  /* blocked, and no step over it converges                */
+
+/* What rack_linkage_solve_edge found. */
+typedef struct {
+    int outcome;                 /* RACK_LINKAGE_EDGE_REACHED, _PASSABLE or _STOPPED          */
+    rack_linkage_real failed;    /* the step that failed from the last point reached (0: none) */
+    rack_linkage_real cond;      /* the condition estimate at the last point reached          */
+} rack_linkage_edge_report;
+
+/* A time t that the plain step from a solved state could not reach (the point where
+ * rack_linkage_solve_grid stopped), treated as symkin's runtime does before it decides (its
+ * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
+ * blocked time b; then, from the last point reached substepping towards b - delta, steps to
+ * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the
+ * position passable. Each substep is a rack_linkage_solve_step with no last point for the error
+ * model. On return state is the last point reached (t itself when reached) and
+ * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
+ * bisection to a limit position: the motion stops between state->t and state->t +
+ * edge->failed. The workspace is set up here. Returns edge->outcome. */
+int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_linkage_real p[],
+                            rack_linkage_real t, rack_linkage_real h_min, rack_linkage_real delta,
+                            rack_linkage_real cond, rack_linkage_state *state,
+                            rack_linkage_workspace *work, rack_linkage_report *report,
+                            rack_linkage_edge_report *edge);
 
 #endif /* RACK_LINKAGE_SOLVER_H */

@@ -2,7 +2,8 @@
 call (the C backend's ``runtime.protocol.BatchSolver``, used by ``sweeps.batch``).
 
 The C batch runs plain Newton from q0 at t[0] per set, like the first attempt of
-``symkin.solve``; the sweep re-runs a set it reports as failed through ``symkin.solve``.
+``symkin.solve``; a set it reports as failed goes on in ``sweeps.stops`` (the generated
+``<prefix>_solve_edge``) or is re-run through ``symkin.solve``.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ def solve(ffi: Any, lib: Any, name: str, real: str, params: Array, t: Array, q0:
     status = np.frombuffer(ffi.buffer(reports, m * ffi.sizeof(f"{name}_batch_report")),
                            dtype=_report_dtype(ffi, name))
     found: BatchStatus = (status["status"].astype(np.int32), status["iterations"].astype(np.int32),
-                          status["solved"].astype(np.int32))
+                          status["solved"].astype(np.int32), status["cond"].astype(np.float64))
     return found
 
 
@@ -53,7 +54,7 @@ def _report_dtype(ffi: Any, name: str) -> np.dtype[Any]:
     struct = f"{name}_batch_report"
     real = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
     fields = {"status": np.int32, "solved": np.int32, "t": real, "iterations": np.int32,
-              "residual": real}
+              "residual": real, "cond": real}
     return np.dtype({"names": list(fields), "formats": list(fields.values()),
                      "offsets": [ffi.offsetof(struct, f) for f in fields],
                      "itemsize": ffi.sizeof(struct)})

@@ -9,6 +9,7 @@ from typing import Any
 from symkin.backends.c import lu_code, norm_code
 from symkin.backends.c.printer import literal
 from symkin.codegen.lower import Code
+from symkin.contract import lengths
 
 
 def template_context(code: Code) -> dict[str, Any]:
@@ -24,4 +25,10 @@ def template_context(code: Code) -> dict[str, Any]:
         "norm1": (norm_code.norm1_context(code.pattern_cols, code.nq, code.constant_nz,
                                           literal(code.real), code.real)
                   if not (lu and lu["style"] == "tables") else None),
+        # the scale-free solve (options->unit): which columns and rows are lengths
+        "length_columns": [int(c) for c in lengths.length_columns(code.coordinates)],
+        "length_rows": [int(r) for r in lengths.length_rows(
+            code.nq, code.pattern_rows, code.pattern_cols, code.coordinates)],
+        "scale_free": lengths.scale_free_constants(code.constant_nz, code.pattern_rows,
+                                                   code.pattern_cols, code.coordinates),
     }

@@ -24,8 +24,10 @@ from symkin.runtime.protocol import ChunkResult
 Array = NDArray[np.float64]
 
 
-def fill_options(lib: Any, name: str, target: Any, options: Options) -> None:
-    """The C options struct ``target`` set from the runtime's Options."""
+def fill_options(lib: Any, name: str, target: Any, options: Options, unit: float = 1.0
+                 ) -> None:
+    """The C options struct ``target`` set from the runtime's Options and the length unit the
+    decisions are made in (runtime.units)."""
     getattr(lib, f"{name}_default_options")(target)
     target.tol_phi, target.tol_dq = options.tol_phi, options.tol_dq
     target.max_iterations = options.max_iterations
@@ -34,6 +36,7 @@ def fill_options(lib: Any, name: str, target: Any, options: Options) -> None:
     target.tighten_cond = options.tighten_cond
     target.target_q, target.target_dq = options.target_q, options.target_dq
     target.target_ddq = options.target_ddq
+    target.unit = unit
 
 
 class GridSolver:
@@ -44,7 +47,7 @@ class GridSolver:
     """
 
     def __init__(self, ffi: Any, lib: Any, name: str, real: str, options: Options,
-                 q: Array, p: Array) -> None:
+                 q: Array, p: Array, unit: float = 1.0) -> None:
         self._ffi, self._lib, self._name = ffi, lib, name
         self._options = ffi.new(f"{name}_options *")
         self._state = ffi.new(f"{name}_state *")
@@ -63,19 +66,21 @@ class GridSolver:
         # The bytes of q and p in the real type: they are copied into the structs as they are.
         self._q_bytes = q.size * np.dtype(self.dtype).itemsize
         self._p_bytes = p.size * np.dtype(self.dtype).itemsize
-        self._set_options: Options | None = None
+        self._set_options: tuple[Options, float] | None = None
         self._pointers: tuple[Any, ...] | None = None  # of the run's arrays (bind)
         self._size = 0  # their time points
         # (float64 target, buffer of the real type) pairs, for a float kernel only.
         self._copies: list[tuple[NDArray[Any], NDArray[Any]]] | None = None
         self.pool: SolverPool | None = None
-        self.start(options, q, p)
+        self.start(options, q, p, unit)
 
-    def start(self, options: Options, q: Array, p: Array) -> GridSolver:
-        """Begin a new run from q with parameters p (the state is reset, not reallocated)."""
-        if options is not self._set_options:
-            fill_options(self._lib, self._name, self._options, options)
-            self._set_options = options
+    def start(self, options: Options, q: Array, p: Array, unit: float = 1.0) -> GridSolver:
+        """Begin a new run from q with parameters p, its decisions made in the length unit
+        ``unit`` (the state is reset, not reallocated)."""
+        if self._set_options is None or options is not self._set_options[0] \
+                or unit != self._set_options[1]:
+            fill_options(self._lib, self._name, self._options, options, unit)
+            self._set_options = (options, unit)
         if p.size != self._np or q.size != self._n:
             raise ValueError(f"expected {self._n} coordinates and {self._np} parameters, got "
                              f"{q.size} and {p.size}")
@@ -201,14 +206,14 @@ class SolverPool:
         self._arguments = (ffi, lib, name, real)
         self._idle: list[GridSolver] = []
 
-    def take(self, options: Options, q: Array, p: Array) -> GridSolver:
+    def take(self, options: Options, q: Array, p: Array, unit: float = 1.0) -> GridSolver:
         try:
             solver = self._idle.pop()  # atomic under the GIL
         except IndexError:
-            solver = GridSolver(*self._arguments, options, q, p)
+            solver = GridSolver(*self._arguments, options, q, p, unit)
             solver.pool = self
             return solver
-        return solver.start(options, q, p)
+        return solver.start(options, q, p, unit)
 
     def put(self, solver: GridSolver) -> None:
         if len(self._idle) < 8:

@@ -20,7 +20,7 @@ from symkin.backends.c.csolver import GridSolver, SolverPool
 from symkin.contract.loads import load_count
 from symkin.contract.options import Options
 from symkin.runtime.kernel import Array, Kernel, import_file
-from symkin.runtime.protocol import BatchStatus
+from symkin.runtime.protocol import BatchStatus, EdgeSolver
 
 
 class CKernel(Kernel):
@@ -45,6 +45,8 @@ class CKernel(Kernel):
         self._solvers: SolverPool | None = None  # GridSolvers reused from run to run
         # Looked up once: solve asks on every call.
         self._has_grid_solver = hasattr(lib, f"{self.name}_solve_grid")
+        # options.unit honoured (a kernel built before it, or with a literal lever arm: not)
+        self.scale_free = bool(getattr(lib, f"{self.name.upper()}_SCALE_FREE", 0))
         if hasattr(lib, f"{self.name}_solve_batch"):
             self.batch_solver = self._solve_batch
 
@@ -53,13 +55,18 @@ class CKernel(Kernel):
         """True when the generated solver runs whole grids (``solve_grid``)."""
         return self._has_grid_solver
 
-    def grid_solver(self, options: Options, q: Array, p: Array) -> GridSolver | None:
-        """A fresh run of the generated C grid loop from q, or None without a C solver."""
+    def grid_solver(self, options: Options, q: Array, p: Array, unit: float = 1.0
+                    ) -> GridSolver | None:
+        """A fresh run of the generated C grid loop from q, its decisions made in the length
+        unit ``unit`` (runtime.units), or None without a C solver (or, for a unit other than
+        1, one that cannot honour it)."""
+        if unit != 1.0 and not self.scale_free:
+            return None
         if self._solvers is None:
             if not self.has_grid_solver:
                 return None
             self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
-        return self._solvers.take(options, q, p)
+        return self._solvers.take(options, q, p, unit)
 
     def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array,
                          p: Array) -> tuple[Array, Array]:
@@ -67,6 +74,14 @@ class CKernel(Kernel):
         return multipliers.grid(self.ffi, self.lib, self.name, self.real, t, q, dq, d2q, p,
                                 load_count(len(self.driver_names), len(self.joint_names),
                                            self.space))
+
+    def edge_solver(self) -> EdgeSolver | None:
+        """The generated solve_edge (None in a kernel built before it)."""
+        if not hasattr(self.lib, f"{self.name}_solve_edge"):
+            return None
+        from symkin.backends.c.edge import EdgeSolver as CEdgeSolver
+
+        return CEdgeSolver(self.ffi, self.lib, self.name, self.nq)
 
     def input_stepper(self) -> InputStepper | None:
         """The generated solve_inputs, for a mechanism with input drivers (else None)."""
