@@ -22,6 +22,12 @@ from symkin.codegen import sample, symbol_printing
 from symkin.codegen.cse_tidy import _count_ops, _inline_trivial, _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
+from symkin.codegen.system_facts import (
+    nonlinear_coordinates,
+    parameter_pattern,
+    point_names,
+    point_vectors,
+)
 from symkin.codegen.target import Target
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
@@ -261,12 +267,6 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
     )
 
 
-def nonlinear_coordinates(system: System) -> tuple[int, ...]:
-    """The indices of the coordinates Phi_q or Phi_t depends on."""
-    entered = system.phi_q.free_symbols | system.phi_t.free_symbols
-    return tuple(k for k, symbol in enumerate(system.q) if symbol in entered)
-
-
 def _check_options(backend: Target, real: str, linalg: str) -> None:
     if linalg not in LINALG:
         raise BuildError(f"unknown linear algebra {linalg!r}; choose 'dense' or 'sparse'")
@@ -276,11 +276,6 @@ def _check_options(backend: Target, real: str, linalg: str) -> None:
         raise BuildError(f"the {backend.title} backend computes in "
                          f"{' or '.join(backend.real_types)} precision; use "
                          f"real={backend.real_types[0]!r}")
-
-
-def parameter_pattern(system: System) -> list[tuple[int, int]]:
-    """Structural non-zeros of Phi_p as (row, parameter), row-major."""
-    return [] if system.phi_p is None else sorted(system.phi_p.todok())
 
 
 def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
@@ -333,16 +328,6 @@ def _fused_expressions(prepared: dict[str, list[sp.Expr]]
             "gamma_shared": [mapped(e) for e in prepared["gamma"]],
             **{f"{name}_shared": [mapped(e) for e in prepared[name]]
                for name in dynamics}}, shared
-
-
-def point_names(system: System) -> tuple[tuple[str, str], ...]:
-    """Every named point as (body, point), bodies and points in file order."""
-    return tuple((body, name) for body, name, _ in system.points)
-
-
-def point_vectors(system: System) -> list[tuple[sp.Expr, sp.Expr]]:
-    """The local vector s of every named point, as expressions of the parameters."""
-    return [tuple(vector) for _, _, vector in system.points]
 
 
 def _fused_order(prepared: dict[str, list[sp.Expr]], pattern: Sequence[tuple[int, int]],
