@@ -21,6 +21,7 @@ void all_drivers_default_options(all_drivers_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define ALL_DRIVERS_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int all_drivers_factor_jacobian(const all_drivers_options *options, all_d
         return ALL_DRIVERS_SINGULAR;
     }
     return ALL_DRIVERS_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char all_drivers_length_column[ALL_DRIVERS_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char all_drivers_length_row[ALL_DRIVERS_NQ] = { 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 1, 0, 1, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void all_drivers_prepare(all_drivers_real unit, all_drivers_workspace *work)
+{
+    int i, e;
+    all_drivers_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && ALL_DRIVERS_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+        work->column[i] = all_drivers_length_column[i] ? unit : 1;
+        work->row[i] = all_drivers_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) {
+        work->nz_factor[e] = work->column[all_drivers_phi_q_col[e]] / work->row[all_drivers_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void all_drivers_in_unit(all_drivers_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void all_drivers_rows_in_unit(const all_drivers_workspace *work, all_drivers_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void all_drivers_from_unit(const all_drivers_workspace *work, all_drivers_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -577,9 +628,11 @@ static int all_drivers_converged(const all_drivers_options *options, const all_d
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !all_drivers_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            all_drivers_from_unit(work, work->phi);
             for (i = 0; i < ALL_DRIVERS_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             all_drivers_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            all_drivers_in_unit(work);
             report->residual = all_drivers_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -609,6 +662,7 @@ static int all_drivers_newton(const all_drivers_options *options, const all_driv
         all_drivers_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         all_drivers_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        all_drivers_in_unit(work);
         residual = all_drivers_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -629,10 +683,11 @@ static int all_drivers_newton(const all_drivers_options *options, const all_driv
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         all_drivers_lu_solve(&work->lu, work->phi);
+        step = all_drivers_max_abs(work->phi); /* in the run's unit */
+        all_drivers_from_unit(work, work->phi);
         for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = all_drivers_max_abs(work->phi);
     }
     return ALL_DRIVERS_NO_CONVERGENCE;
 }
@@ -657,9 +712,7 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
     if (state->started) {
         all_drivers_predict(t, state);
     } else {
-        all_drivers_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        all_drivers_prepare(options->unit, work);
     }
     report->status = all_drivers_newton(options, p, t, state->q, work, report);
     report->fallbacks = all_drivers_lu_fallbacks(&work->lu);
@@ -672,15 +725,20 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
     for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    all_drivers_rows_in_unit(work, state->dq);
     all_drivers_lu_solve(&work->lu, state->dq); /* (2.73) */
+    all_drivers_from_unit(work, state->dq);
     all_drivers_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    all_drivers_rows_in_unit(work, state->ddq);
     all_drivers_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    all_drivers_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
-        const all_drivers_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const all_drivers_real c = fabs(state->ddq[i]);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) { /* in the run's unit: q / column */
+        const all_drivers_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const all_drivers_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const all_drivers_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -775,11 +833,13 @@ int all_drivers_solve_batch(const all_drivers_options *options, int m, const all
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (all_drivers_real)NAN;
         for (k = 0; k < n; ++k) {
             if (all_drivers_solve_step(options, p_set, t[k], state, work, &report) != ALL_DRIVERS_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             all_drivers_store(q_set, k, state->q);
             all_drivers_store(dq_set, k, state->dq);
             all_drivers_store(ddq_set, k, state->ddq);
@@ -794,4 +854,66 @@ int all_drivers_solve_batch(const all_drivers_options *options, int m, const all
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static all_drivers_real all_drivers_march(const all_drivers_options *options, const all_drivers_real p[],
+                                 all_drivers_real target, all_drivers_real h0, all_drivers_real h_min,
+                                 all_drivers_state *state, all_drivers_workspace *work,
+                                 all_drivers_report *report, all_drivers_real *cond)
+{
+    all_drivers_real h = h0;
+    while (state->t < target) {
+        const all_drivers_real rest = target - state->t;
+        const all_drivers_real step = h < rest ? h : rest;
+        const all_drivers_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (all_drivers_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == ALL_DRIVERS_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int all_drivers_solve_edge(const all_drivers_options *options, const all_drivers_real p[],
+                            all_drivers_real t, all_drivers_real h_min, all_drivers_real delta,
+                            all_drivers_real cond, all_drivers_state *state,
+                            all_drivers_workspace *work, all_drivers_report *report,
+                            all_drivers_edge_report *edge)
+{
+    const all_drivers_state previous = *state;
+    const all_drivers_real h0 = t - previous.t;
+    all_drivers_state before = previous, after;
+    all_drivers_real blocked, reach, early = 0, before_cond = cond;
+    all_drivers_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = all_drivers_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = ALL_DRIVERS_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = all_drivers_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = ALL_DRIVERS_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (all_drivers_solve_step(options, p, blocked + reach, &after, work, report) == ALL_DRIVERS_OK) {
+            edge->outcome = ALL_DRIVERS_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

@@ -21,6 +21,7 @@ void andrews_squeezer_default_options(andrews_squeezer_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define ANDREWS_SQUEEZER_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int andrews_squeezer_factor_jacobian(const andrews_squeezer_options *opti
         return ANDREWS_SQUEEZER_SINGULAR;
     }
     return ANDREWS_SQUEEZER_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char andrews_squeezer_length_column[ANDREWS_SQUEEZER_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char andrews_squeezer_length_row[ANDREWS_SQUEEZER_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void andrews_squeezer_prepare(andrews_squeezer_real unit, andrews_squeezer_workspace *work)
+{
+    int i, e;
+    andrews_squeezer_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && ANDREWS_SQUEEZER_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        work->column[i] = andrews_squeezer_length_column[i] ? unit : 1;
+        work->row[i] = andrews_squeezer_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < ANDREWS_SQUEEZER_NNZ; ++e) {
+        work->nz_factor[e] = work->column[andrews_squeezer_phi_q_col[e]] / work->row[andrews_squeezer_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void andrews_squeezer_in_unit(andrews_squeezer_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < ANDREWS_SQUEEZER_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void andrews_squeezer_rows_in_unit(const andrews_squeezer_workspace *work, andrews_squeezer_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void andrews_squeezer_from_unit(const andrews_squeezer_workspace *work, andrews_squeezer_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -583,9 +634,11 @@ static int andrews_squeezer_converged(const andrews_squeezer_options *options, c
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !andrews_squeezer_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            andrews_squeezer_from_unit(work, work->phi);
             for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             andrews_squeezer_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            andrews_squeezer_in_unit(work);
             report->residual = andrews_squeezer_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -615,6 +668,7 @@ static int andrews_squeezer_newton(const andrews_squeezer_options *options, cons
         andrews_squeezer_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         andrews_squeezer_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        andrews_squeezer_in_unit(work);
         residual = andrews_squeezer_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -635,10 +689,11 @@ static int andrews_squeezer_newton(const andrews_squeezer_options *options, cons
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         andrews_squeezer_lu_solve(&work->lu, work->phi);
+        step = andrews_squeezer_max_abs(work->phi); /* in the run's unit */
+        andrews_squeezer_from_unit(work, work->phi);
         for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = andrews_squeezer_max_abs(work->phi);
     }
     return ANDREWS_SQUEEZER_NO_CONVERGENCE;
 }
@@ -663,9 +718,7 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
     if (state->started) {
         andrews_squeezer_predict(t, state);
     } else {
-        andrews_squeezer_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        andrews_squeezer_prepare(options->unit, work);
     }
     report->status = andrews_squeezer_newton(options, p, t, state->q, work, report);
     report->fallbacks = andrews_squeezer_lu_fallbacks(&work->lu);
@@ -678,15 +731,20 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
     for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    andrews_squeezer_rows_in_unit(work, state->dq);
     andrews_squeezer_lu_solve(&work->lu, state->dq); /* (2.73) */
+    andrews_squeezer_from_unit(work, state->dq);
     andrews_squeezer_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    andrews_squeezer_rows_in_unit(work, state->ddq);
     andrews_squeezer_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    andrews_squeezer_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        const andrews_squeezer_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const andrews_squeezer_real c = fabs(state->ddq[i]);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) { /* in the run's unit: q / column */
+        const andrews_squeezer_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const andrews_squeezer_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const andrews_squeezer_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -781,11 +839,13 @@ int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, int m,
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (andrews_squeezer_real)NAN;
         for (k = 0; k < n; ++k) {
             if (andrews_squeezer_solve_step(options, p_set, t[k], state, work, &report) != ANDREWS_SQUEEZER_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             andrews_squeezer_store(q_set, k, state->q);
             andrews_squeezer_store(dq_set, k, state->dq);
             andrews_squeezer_store(ddq_set, k, state->ddq);
@@ -800,4 +860,66 @@ int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, int m,
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static andrews_squeezer_real andrews_squeezer_march(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
+                                 andrews_squeezer_real target, andrews_squeezer_real h0, andrews_squeezer_real h_min,
+                                 andrews_squeezer_state *state, andrews_squeezer_workspace *work,
+                                 andrews_squeezer_report *report, andrews_squeezer_real *cond)
+{
+    andrews_squeezer_real h = h0;
+    while (state->t < target) {
+        const andrews_squeezer_real rest = target - state->t;
+        const andrews_squeezer_real step = h < rest ? h : rest;
+        const andrews_squeezer_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (andrews_squeezer_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == ANDREWS_SQUEEZER_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
+                            andrews_squeezer_real t, andrews_squeezer_real h_min, andrews_squeezer_real delta,
+                            andrews_squeezer_real cond, andrews_squeezer_state *state,
+                            andrews_squeezer_workspace *work, andrews_squeezer_report *report,
+                            andrews_squeezer_edge_report *edge)
+{
+    const andrews_squeezer_state previous = *state;
+    const andrews_squeezer_real h0 = t - previous.t;
+    andrews_squeezer_state before = previous, after;
+    andrews_squeezer_real blocked, reach, early = 0, before_cond = cond;
+    andrews_squeezer_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = andrews_squeezer_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = ANDREWS_SQUEEZER_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = andrews_squeezer_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = ANDREWS_SQUEEZER_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (andrews_squeezer_solve_step(options, p, blocked + reach, &after, work, report) == ANDREWS_SQUEEZER_OK) {
+            edge->outcome = ANDREWS_SQUEEZER_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

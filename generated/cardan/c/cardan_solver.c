@@ -21,6 +21,7 @@ void cardan_default_options(cardan_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define CARDAN_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int cardan_factor_jacobian(const cardan_options *options, cardan_workspac
         return CARDAN_SINGULAR;
     }
     return CARDAN_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char cardan_length_column[CARDAN_NQ] = { 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0 };
+static const unsigned char cardan_length_row[CARDAN_NQ] = { 1, 1, 1, 0, 0, 1, 1, 1, 0, 1, 1, 0, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void cardan_prepare(cardan_real unit, cardan_workspace *work)
+{
+    int i, e;
+    cardan_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && CARDAN_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < CARDAN_NQ; ++i) {
+        work->column[i] = cardan_length_column[i] ? unit : 1;
+        work->row[i] = cardan_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < CARDAN_NNZ; ++e) {
+        work->nz_factor[e] = work->column[cardan_phi_q_col[e]] / work->row[cardan_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void cardan_in_unit(cardan_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < CARDAN_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < CARDAN_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void cardan_rows_in_unit(const cardan_workspace *work, cardan_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CARDAN_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void cardan_from_unit(const cardan_workspace *work, cardan_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CARDAN_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -341,9 +392,11 @@ static int cardan_converged(const cardan_options *options, const cardan_real p[]
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !cardan_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            cardan_from_unit(work, work->phi);
             for (i = 0; i < CARDAN_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             cardan_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            cardan_in_unit(work);
             report->residual = cardan_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -373,6 +426,7 @@ static int cardan_newton(const cardan_options *options, const cardan_real p[], c
         cardan_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         cardan_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        cardan_in_unit(work);
         residual = cardan_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -393,10 +447,11 @@ static int cardan_newton(const cardan_options *options, const cardan_real p[], c
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         cardan_lu_solve(&work->lu, work->phi);
+        step = cardan_max_abs(work->phi); /* in the run's unit */
+        cardan_from_unit(work, work->phi);
         for (i = 0; i < CARDAN_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = cardan_max_abs(work->phi);
     }
     return CARDAN_NO_CONVERGENCE;
 }
@@ -421,9 +476,7 @@ int cardan_solve_step(const cardan_options *options, const cardan_real p[], card
     if (state->started) {
         cardan_predict(t, state);
     } else {
-        cardan_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        cardan_prepare(options->unit, work);
     }
     report->status = cardan_newton(options, p, t, state->q, work, report);
     report->fallbacks = cardan_lu_fallbacks(&work->lu);
@@ -436,15 +489,20 @@ int cardan_solve_step(const cardan_options *options, const cardan_real p[], card
     for (i = 0; i < CARDAN_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    cardan_rows_in_unit(work, state->dq);
     cardan_lu_solve(&work->lu, state->dq); /* (2.73) */
+    cardan_from_unit(work, state->dq);
     cardan_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    cardan_rows_in_unit(work, state->ddq);
     cardan_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    cardan_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < CARDAN_NQ; ++i) {
-        const cardan_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const cardan_real c = fabs(state->ddq[i]);
+    for (i = 0; i < CARDAN_NQ; ++i) { /* in the run's unit: q / column */
+        const cardan_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const cardan_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const cardan_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -539,11 +597,13 @@ int cardan_solve_batch(const cardan_options *options, int m, const cardan_real p
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (cardan_real)NAN;
         for (k = 0; k < n; ++k) {
             if (cardan_solve_step(options, p_set, t[k], state, work, &report) != CARDAN_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             cardan_store(q_set, k, state->q);
             cardan_store(dq_set, k, state->dq);
             cardan_store(ddq_set, k, state->ddq);
@@ -558,4 +618,66 @@ int cardan_solve_batch(const cardan_options *options, int m, const cardan_real p
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static cardan_real cardan_march(const cardan_options *options, const cardan_real p[],
+                                 cardan_real target, cardan_real h0, cardan_real h_min,
+                                 cardan_state *state, cardan_workspace *work,
+                                 cardan_report *report, cardan_real *cond)
+{
+    cardan_real h = h0;
+    while (state->t < target) {
+        const cardan_real rest = target - state->t;
+        const cardan_real step = h < rest ? h : rest;
+        const cardan_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (cardan_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == CARDAN_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
+                            cardan_real t, cardan_real h_min, cardan_real delta,
+                            cardan_real cond, cardan_state *state,
+                            cardan_workspace *work, cardan_report *report,
+                            cardan_edge_report *edge)
+{
+    const cardan_state previous = *state;
+    const cardan_real h0 = t - previous.t;
+    cardan_state before = previous, after;
+    cardan_real blocked, reach, early = 0, before_cond = cond;
+    cardan_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = cardan_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = CARDAN_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = cardan_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = CARDAN_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (cardan_solve_step(options, p, blocked + reach, &after, work, report) == CARDAN_OK) {
+            edge->outcome = CARDAN_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

@@ -21,6 +21,7 @@ void crank_slider_load_default_options(crank_slider_load_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define CRANK_SLIDER_LOAD_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int crank_slider_load_factor_jacobian(const crank_slider_load_options *op
         return CRANK_SLIDER_LOAD_SINGULAR;
     }
     return CRANK_SLIDER_LOAD_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char crank_slider_load_length_column[CRANK_SLIDER_LOAD_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char crank_slider_load_length_row[CRANK_SLIDER_LOAD_NQ] = { 1, 1, 1, 1, 1, 1, 0, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void crank_slider_load_prepare(crank_slider_load_real unit, crank_slider_load_workspace *work)
+{
+    int i, e;
+    crank_slider_load_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && CRANK_SLIDER_LOAD_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) {
+        work->column[i] = crank_slider_load_length_column[i] ? unit : 1;
+        work->row[i] = crank_slider_load_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < CRANK_SLIDER_LOAD_NNZ; ++e) {
+        work->nz_factor[e] = work->column[crank_slider_load_phi_q_col[e]] / work->row[crank_slider_load_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void crank_slider_load_in_unit(crank_slider_load_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < CRANK_SLIDER_LOAD_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void crank_slider_load_rows_in_unit(const crank_slider_load_workspace *work, crank_slider_load_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void crank_slider_load_from_unit(const crank_slider_load_workspace *work, crank_slider_load_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -362,9 +413,11 @@ static int crank_slider_load_converged(const crank_slider_load_options *options,
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !crank_slider_load_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            crank_slider_load_from_unit(work, work->phi);
             for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             crank_slider_load_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            crank_slider_load_in_unit(work);
             report->residual = crank_slider_load_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -394,6 +447,7 @@ static int crank_slider_load_newton(const crank_slider_load_options *options, co
         crank_slider_load_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         crank_slider_load_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        crank_slider_load_in_unit(work);
         residual = crank_slider_load_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -414,10 +468,11 @@ static int crank_slider_load_newton(const crank_slider_load_options *options, co
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         crank_slider_load_lu_solve(&work->lu, work->phi);
+        step = crank_slider_load_max_abs(work->phi); /* in the run's unit */
+        crank_slider_load_from_unit(work, work->phi);
         for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = crank_slider_load_max_abs(work->phi);
     }
     return CRANK_SLIDER_LOAD_NO_CONVERGENCE;
 }
@@ -442,9 +497,7 @@ int crank_slider_load_solve_step(const crank_slider_load_options *options, const
     if (state->started) {
         crank_slider_load_predict(t, state);
     } else {
-        crank_slider_load_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        crank_slider_load_prepare(options->unit, work);
     }
     report->status = crank_slider_load_newton(options, p, t, state->q, work, report);
     report->fallbacks = crank_slider_load_lu_fallbacks(&work->lu);
@@ -457,15 +510,20 @@ int crank_slider_load_solve_step(const crank_slider_load_options *options, const
     for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    crank_slider_load_rows_in_unit(work, state->dq);
     crank_slider_load_lu_solve(&work->lu, state->dq); /* (2.73) */
+    crank_slider_load_from_unit(work, state->dq);
     crank_slider_load_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    crank_slider_load_rows_in_unit(work, state->ddq);
     crank_slider_load_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    crank_slider_load_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) {
-        const crank_slider_load_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const crank_slider_load_real c = fabs(state->ddq[i]);
+    for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) { /* in the run's unit: q / column */
+        const crank_slider_load_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const crank_slider_load_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const crank_slider_load_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -492,8 +550,12 @@ void crank_slider_load_multipliers(const crank_slider_load_real p[], const crank
                               const crank_slider_load_workspace *work, crank_slider_load_real lam[])
 {
     /* the step's last fused call was at state->q: its sines and cosines serve here too */
+    int i;
     crank_slider_load_dynamics_rhs_shared(state->q, state->dq, state->ddq, state->t, p, work->shared, lam);
+    /* the factors are of Phi~_q = Phi_q column / row: Phi_q^-T = row^-1 Phi~_q^-T column */
+    if (work->scaled) for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) lam[i] *= work->column[i];
     crank_slider_load_lu_solve_transposed(&work->lu, lam); /* Phi_q^T lam = Q - M ddq - h */
+    if (work->scaled) for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) lam[i] /= work->row[i];
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
@@ -578,11 +640,13 @@ int crank_slider_load_solve_batch(const crank_slider_load_options *options, int 
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (crank_slider_load_real)NAN;
         for (k = 0; k < n; ++k) {
             if (crank_slider_load_solve_step(options, p_set, t[k], state, work, &report) != CRANK_SLIDER_LOAD_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             crank_slider_load_store(q_set, k, state->q);
             crank_slider_load_store(dq_set, k, state->dq);
             crank_slider_load_store(ddq_set, k, state->ddq);
@@ -597,6 +661,68 @@ int crank_slider_load_solve_batch(const crank_slider_load_options *options, int 
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static crank_slider_load_real crank_slider_load_march(const crank_slider_load_options *options, const crank_slider_load_real p[],
+                                 crank_slider_load_real target, crank_slider_load_real h0, crank_slider_load_real h_min,
+                                 crank_slider_load_state *state, crank_slider_load_workspace *work,
+                                 crank_slider_load_report *report, crank_slider_load_real *cond)
+{
+    crank_slider_load_real h = h0;
+    while (state->t < target) {
+        const crank_slider_load_real rest = target - state->t;
+        const crank_slider_load_real step = h < rest ? h : rest;
+        const crank_slider_load_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (crank_slider_load_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == CRANK_SLIDER_LOAD_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int crank_slider_load_solve_edge(const crank_slider_load_options *options, const crank_slider_load_real p[],
+                            crank_slider_load_real t, crank_slider_load_real h_min, crank_slider_load_real delta,
+                            crank_slider_load_real cond, crank_slider_load_state *state,
+                            crank_slider_load_workspace *work, crank_slider_load_report *report,
+                            crank_slider_load_edge_report *edge)
+{
+    const crank_slider_load_state previous = *state;
+    const crank_slider_load_real h0 = t - previous.t;
+    crank_slider_load_state before = previous, after;
+    crank_slider_load_real blocked, reach, early = 0, before_cond = cond;
+    crank_slider_load_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = crank_slider_load_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = CRANK_SLIDER_LOAD_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = crank_slider_load_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = CRANK_SLIDER_LOAD_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (crank_slider_load_solve_step(options, p, blocked + reach, &after, work, report) == CRANK_SLIDER_LOAD_OK) {
+            edge->outcome = CRANK_SLIDER_LOAD_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }
 
 int crank_slider_load_multipliers_grid(const crank_slider_load_real p[], int n, const crank_slider_load_real t[],

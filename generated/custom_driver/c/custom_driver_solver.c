@@ -21,6 +21,7 @@ void custom_driver_default_options(custom_driver_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define CUSTOM_DRIVER_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int custom_driver_factor_jacobian(const custom_driver_options *options, c
         return CUSTOM_DRIVER_SINGULAR;
     }
     return CUSTOM_DRIVER_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char custom_driver_length_column[CUSTOM_DRIVER_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char custom_driver_length_row[CUSTOM_DRIVER_NQ] = { 1, 1, 1, 1, 1, 1, 0, 1, 1 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void custom_driver_prepare(custom_driver_real unit, custom_driver_workspace *work)
+{
+    int i, e;
+    custom_driver_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && CUSTOM_DRIVER_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+        work->column[i] = custom_driver_length_column[i] ? unit : 1;
+        work->row[i] = custom_driver_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e) {
+        work->nz_factor[e] = work->column[custom_driver_phi_q_col[e]] / work->row[custom_driver_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void custom_driver_in_unit(custom_driver_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void custom_driver_rows_in_unit(const custom_driver_workspace *work, custom_driver_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void custom_driver_from_unit(const custom_driver_workspace *work, custom_driver_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -385,9 +436,11 @@ static int custom_driver_converged(const custom_driver_options *options, const c
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !custom_driver_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            custom_driver_from_unit(work, work->phi);
             for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             custom_driver_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            custom_driver_in_unit(work);
             report->residual = custom_driver_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -417,6 +470,7 @@ static int custom_driver_newton(const custom_driver_options *options, const cust
         custom_driver_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         custom_driver_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        custom_driver_in_unit(work);
         residual = custom_driver_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -437,10 +491,11 @@ static int custom_driver_newton(const custom_driver_options *options, const cust
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         custom_driver_lu_solve(&work->lu, work->phi);
+        step = custom_driver_max_abs(work->phi); /* in the run's unit */
+        custom_driver_from_unit(work, work->phi);
         for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = custom_driver_max_abs(work->phi);
     }
     return CUSTOM_DRIVER_NO_CONVERGENCE;
 }
@@ -465,9 +520,7 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
     if (state->started) {
         custom_driver_predict(t, state);
     } else {
-        custom_driver_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        custom_driver_prepare(options->unit, work);
     }
     report->status = custom_driver_newton(options, p, t, state->q, work, report);
     report->fallbacks = custom_driver_lu_fallbacks(&work->lu);
@@ -480,15 +533,20 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
     for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    custom_driver_rows_in_unit(work, state->dq);
     custom_driver_lu_solve(&work->lu, state->dq); /* (2.73) */
+    custom_driver_from_unit(work, state->dq);
     custom_driver_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    custom_driver_rows_in_unit(work, state->ddq);
     custom_driver_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    custom_driver_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
-        const custom_driver_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const custom_driver_real c = fabs(state->ddq[i]);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) { /* in the run's unit: q / column */
+        const custom_driver_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const custom_driver_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const custom_driver_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -583,11 +641,13 @@ int custom_driver_solve_batch(const custom_driver_options *options, int m, const
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (custom_driver_real)NAN;
         for (k = 0; k < n; ++k) {
             if (custom_driver_solve_step(options, p_set, t[k], state, work, &report) != CUSTOM_DRIVER_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             custom_driver_store(q_set, k, state->q);
             custom_driver_store(dq_set, k, state->dq);
             custom_driver_store(ddq_set, k, state->ddq);
@@ -602,4 +662,66 @@ int custom_driver_solve_batch(const custom_driver_options *options, int m, const
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static custom_driver_real custom_driver_march(const custom_driver_options *options, const custom_driver_real p[],
+                                 custom_driver_real target, custom_driver_real h0, custom_driver_real h_min,
+                                 custom_driver_state *state, custom_driver_workspace *work,
+                                 custom_driver_report *report, custom_driver_real *cond)
+{
+    custom_driver_real h = h0;
+    while (state->t < target) {
+        const custom_driver_real rest = target - state->t;
+        const custom_driver_real step = h < rest ? h : rest;
+        const custom_driver_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (custom_driver_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == CUSTOM_DRIVER_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int custom_driver_solve_edge(const custom_driver_options *options, const custom_driver_real p[],
+                            custom_driver_real t, custom_driver_real h_min, custom_driver_real delta,
+                            custom_driver_real cond, custom_driver_state *state,
+                            custom_driver_workspace *work, custom_driver_report *report,
+                            custom_driver_edge_report *edge)
+{
+    const custom_driver_state previous = *state;
+    const custom_driver_real h0 = t - previous.t;
+    custom_driver_state before = previous, after;
+    custom_driver_real blocked, reach, early = 0, before_cond = cond;
+    custom_driver_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = custom_driver_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = CUSTOM_DRIVER_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = custom_driver_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = CUSTOM_DRIVER_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (custom_driver_solve_step(options, p, blocked + reach, &after, work, report) == CUSTOM_DRIVER_OK) {
+            edge->outcome = CUSTOM_DRIVER_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

@@ -21,6 +21,7 @@ void delta_default_options(delta_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define DELTA_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int delta_factor_jacobian(const delta_options *options, delta_workspace *
         return DELTA_SINGULAR;
     }
     return DELTA_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char delta_length_column[DELTA_NQ] = { 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0 };
+static const unsigned char delta_length_row[DELTA_NQ] = { 1, 1, 1, 0, 0, 1, 1, 1, 1, 1, 0, 0, 1, 1, 1, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void delta_prepare(delta_real unit, delta_workspace *work)
+{
+    int i, e;
+    delta_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && DELTA_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < DELTA_NQ; ++i) {
+        work->column[i] = delta_length_column[i] ? unit : 1;
+        work->row[i] = delta_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < DELTA_NNZ; ++e) {
+        work->nz_factor[e] = work->column[delta_phi_q_col[e]] / work->row[delta_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void delta_in_unit(delta_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < DELTA_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < DELTA_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void delta_rows_in_unit(const delta_workspace *work, delta_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < DELTA_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void delta_from_unit(const delta_workspace *work, delta_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < DELTA_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -409,9 +460,11 @@ static int delta_converged(const delta_options *options, const delta_real p[],
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !delta_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            delta_from_unit(work, work->phi);
             for (i = 0; i < DELTA_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             delta_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            delta_in_unit(work);
             report->residual = delta_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -441,6 +494,7 @@ static int delta_newton(const delta_options *options, const delta_real p[], delt
         delta_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         delta_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        delta_in_unit(work);
         residual = delta_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -461,10 +515,11 @@ static int delta_newton(const delta_options *options, const delta_real p[], delt
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         delta_lu_solve(&work->lu, work->phi);
+        step = delta_max_abs(work->phi); /* in the run's unit */
+        delta_from_unit(work, work->phi);
         for (i = 0; i < DELTA_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = delta_max_abs(work->phi);
     }
     return DELTA_NO_CONVERGENCE;
 }
@@ -489,9 +544,7 @@ int delta_solve_step(const delta_options *options, const delta_real p[], delta_r
     if (state->started) {
         delta_predict(t, state);
     } else {
-        delta_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        delta_prepare(options->unit, work);
     }
     report->status = delta_newton(options, p, t, state->q, work, report);
     report->fallbacks = delta_lu_fallbacks(&work->lu);
@@ -504,15 +557,20 @@ int delta_solve_step(const delta_options *options, const delta_real p[], delta_r
     for (i = 0; i < DELTA_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    delta_rows_in_unit(work, state->dq);
     delta_lu_solve(&work->lu, state->dq); /* (2.73) */
+    delta_from_unit(work, state->dq);
     delta_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    delta_rows_in_unit(work, state->ddq);
     delta_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    delta_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < DELTA_NQ; ++i) {
-        const delta_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const delta_real c = fabs(state->ddq[i]);
+    for (i = 0; i < DELTA_NQ; ++i) { /* in the run's unit: q / column */
+        const delta_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const delta_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const delta_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -607,11 +665,13 @@ int delta_solve_batch(const delta_options *options, int m, const delta_real p[],
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (delta_real)NAN;
         for (k = 0; k < n; ++k) {
             if (delta_solve_step(options, p_set, t[k], state, work, &report) != DELTA_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             delta_store(q_set, k, state->q);
             delta_store(dq_set, k, state->dq);
             delta_store(ddq_set, k, state->ddq);
@@ -626,4 +686,66 @@ int delta_solve_batch(const delta_options *options, int m, const delta_real p[],
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static delta_real delta_march(const delta_options *options, const delta_real p[],
+                                 delta_real target, delta_real h0, delta_real h_min,
+                                 delta_state *state, delta_workspace *work,
+                                 delta_report *report, delta_real *cond)
+{
+    delta_real h = h0;
+    while (state->t < target) {
+        const delta_real rest = target - state->t;
+        const delta_real step = h < rest ? h : rest;
+        const delta_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (delta_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == DELTA_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int delta_solve_edge(const delta_options *options, const delta_real p[],
+                            delta_real t, delta_real h_min, delta_real delta,
+                            delta_real cond, delta_state *state,
+                            delta_workspace *work, delta_report *report,
+                            delta_edge_report *edge)
+{
+    const delta_state previous = *state;
+    const delta_real h0 = t - previous.t;
+    delta_state before = previous, after;
+    delta_real blocked, reach, early = 0, before_cond = cond;
+    delta_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = delta_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = DELTA_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = delta_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = DELTA_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (delta_solve_step(options, p, blocked + reach, &after, work, report) == DELTA_OK) {
+            edge->outcome = DELTA_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

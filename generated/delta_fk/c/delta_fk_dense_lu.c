@@ -22,12 +22,15 @@ delta_fk_real delta_fk_dense_lu_tiny(const delta_fk_real nz[])
 int delta_fk_dense_lu_factor(const delta_fk_real nz[], delta_fk_dense_lu *lu)
 {
     const int n = DELTA_FK_NQ;
-    const delta_fk_real tiny = delta_fk_dense_lu_tiny(nz);
+    delta_fk_real tiny, amax = 0, low = 0, high = 0;
     delta_fk_real *a = lu->a;
-    int i, j, k, e;
+    int i, j, k, e, count, used[DELTA_FK_NQ];
     for (e = 0; e < n * n; ++e) a[e] = 0;
-    for (e = 0; e < DELTA_FK_NNZ; ++e)
+    for (e = 0; e < DELTA_FK_NNZ; ++e) { /* scatter, and delta_fk_dense_lu_tiny in the same pass */
         a[delta_fk_phi_q_row[e] * n + delta_fk_phi_q_col[e]] = nz[e];
+        if (!(fabs(nz[e]) <= amax)) amax = fabs(nz[e]); /* NaN propagates */
+    }
+    tiny = DELTA_FK_NQ * DBL_EPSILON * amax;
     for (i = 0; i < n; ++i) lu->perm[i] = i;
     for (k = 0; k < n; ++k) {
         int p = k; /* the first row of largest |a_ik| */
@@ -36,6 +39,8 @@ int delta_fk_dense_lu_factor(const delta_fk_real nz[], delta_fk_dense_lu *lu)
             if (fabs(a[i * n + k]) > best) { best = fabs(a[i * n + k]); p = i; }
         }
         if (!(best > tiny)) return k + 1; /* also when best is NaN */
+        low = k == 0 || best < low ? best : low; /* the spread of |u_kk|, for pivot_ratio */
+        high = best > high ? best : high;
         if (p != k) {
             int swap = lu->perm[k];
             lu->perm[k] = lu->perm[p];
@@ -46,27 +51,30 @@ int delta_fk_dense_lu_factor(const delta_fk_real nz[], delta_fk_dense_lu *lu)
                 a[p * n + j] = tmp;
             }
         }
+        /* one division a pivot, multiplications after it (as LAPACK's dgetf2 scales by the
+         * reciprocal); the solves reuse the reciprocals */
+        const delta_fk_real inv = lu->inv[k] = 1 / a[k * n + k];
+        /* Phi_q is sparse, and so mostly are the pivot rows: the updates skip their zeros
+         * (a - m * 0 is a, bit for bit, for the finite m that reach them) */
+        for (count = 0, j = k + 1; j < n; ++j) {
+            used[count] = j;
+            count += a[k * n + j] != 0;
+        }
         for (i = k + 1; i < n; ++i) {
-            delta_fk_real m = a[i * n + k] / a[k * n + k];
+            delta_fk_real m = a[i * n + k] * inv;
             a[i * n + k] = m;
             if (m != 0) {
-                for (j = k + 1; j < n; ++j) a[i * n + j] -= m * a[k * n + j];
+                for (e = 0; e < count; ++e) a[i * n + used[e]] -= m * a[k * n + used[e]];
             }
         }
     }
+    lu->pivot_ratio = high > 0 ? low / high : 0;
     return 0;
 }
 
 delta_fk_real delta_fk_dense_lu_pivot_ratio(const delta_fk_dense_lu *lu)
 {
-    delta_fk_real low = fabs(lu->a[0]), high = low;
-    int k;
-    for (k = 1; k < DELTA_FK_NQ; ++k) {
-        const delta_fk_real u = fabs(lu->a[k * DELTA_FK_NQ + k]);
-        low = u < low ? u : low;
-        high = u > high ? u : high;
-    }
-    return high > 0 ? low / high : 0;
+    return lu->pivot_ratio; /* kept by the factorization */
 }
 
 void delta_fk_dense_lu_solve(const delta_fk_dense_lu *lu, delta_fk_real b[])
@@ -83,7 +91,7 @@ void delta_fk_dense_lu_solve(const delta_fk_dense_lu *lu, delta_fk_real b[])
     for (i = n - 1; i >= 0; --i) { /* U x = y */
         delta_fk_real sum = x[i];
         for (j = i + 1; j < n; ++j) sum -= a[i * n + j] * x[j];
-        x[i] = sum / a[i * n + i];
+        x[i] = sum * lu->inv[i];
     }
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
@@ -98,7 +106,7 @@ void delta_fk_dense_lu_solve_transposed(const delta_fk_dense_lu *lu, delta_fk_re
     for (i = 0; i < n; ++i) { /* U^T w = b, U^T lower triangular */
         delta_fk_real sum = b[i];
         for (j = 0; j < i; ++j) sum -= a[j * n + i] * x[j];
-        x[i] = sum / a[i * n + i];
+        x[i] = sum * lu->inv[i];
     }
     for (i = n - 1; i >= 0; --i) { /* L^T v = w, unit diagonal */
         delta_fk_real sum = x[i];

@@ -16,7 +16,9 @@
 
 typedef struct {
     delta_fk_real a[DELTA_FK_NQ * DELTA_FK_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    delta_fk_real inv[DELTA_FK_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[DELTA_FK_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    delta_fk_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } delta_fk_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

@@ -21,6 +21,7 @@ void delta_fk_default_options(delta_fk_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define DELTA_FK_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int delta_fk_factor_jacobian(const delta_fk_options *options, delta_fk_wo
         return DELTA_FK_SINGULAR;
     }
     return DELTA_FK_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char delta_fk_length_column[DELTA_FK_NQ] = { 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0 };
+static const unsigned char delta_fk_length_row[DELTA_FK_NQ] = { 1, 1, 1, 0, 0, 1, 1, 1, 1, 1, 0, 0, 1, 1, 1, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void delta_fk_prepare(delta_fk_real unit, delta_fk_workspace *work)
+{
+    int i, e;
+    delta_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && DELTA_FK_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < DELTA_FK_NQ; ++i) {
+        work->column[i] = delta_fk_length_column[i] ? unit : 1;
+        work->row[i] = delta_fk_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < DELTA_FK_NNZ; ++e) {
+        work->nz_factor[e] = work->column[delta_fk_phi_q_col[e]] / work->row[delta_fk_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void delta_fk_in_unit(delta_fk_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < DELTA_FK_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < DELTA_FK_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void delta_fk_rows_in_unit(const delta_fk_workspace *work, delta_fk_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < DELTA_FK_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void delta_fk_from_unit(const delta_fk_workspace *work, delta_fk_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < DELTA_FK_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -124,8 +175,9 @@ static const delta_fk_real delta_fk_alternating[DELTA_FK_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static delta_fk_real delta_fk_inverse_norm1(const delta_fk_lu *lu)
+static delta_fk_real delta_fk_inverse_norm1_rows(const delta_fk_lu *lu, const delta_fk_real rows[])
 {
     delta_fk_real y[DELTA_FK_NQ], z[DELTA_FK_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -133,7 +185,7 @@ static delta_fk_real delta_fk_inverse_norm1(const delta_fk_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, delta_fk_alternating, sizeof z);
     delta_fk_lu_solve(lu, z);
-    for (i = 0; i < DELTA_FK_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < DELTA_FK_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < DELTA_FK_ESTIMATOR_STEPS; ++step) {
         delta_fk_real dot, best, finite = 0;
         int jmax = 0;
@@ -146,9 +198,11 @@ static delta_fk_real delta_fk_inverse_norm1(const delta_fk_lu *lu)
         delta_fk_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < DELTA_FK_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (delta_fk_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -177,6 +231,11 @@ static delta_fk_real delta_fk_inverse_norm1(const delta_fk_lu *lu)
     extra = 2 * extra / (3 * DELTA_FK_NQ);
     if (extra - extra != 0) return (delta_fk_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static delta_fk_real delta_fk_inverse_norm1(const delta_fk_lu *lu)
+{
+    return delta_fk_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -252,47 +311,39 @@ static delta_fk_real delta_fk_norm1(const delta_fk_real nz[])
     return largest;
 }
 
-/* Where the estimate is exact (the sparse factors of a mechanism with a short exact code). */
-static int delta_fk_exact_estimate(const delta_fk_workspace *work)
+
+/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
+ * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
+static delta_fk_real delta_fk_difference_bound1(const delta_fk_real a[], const delta_fk_real b[])
 {
-    (void)work;
-    return 0;
+    delta_fk_real sum = 0;
+    int e;
+    for (e = 0; e < DELTA_FK_NNZ; ++e) sum += fabs(a[e] - b[e]);
+    return sum;
 }
 
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
+ * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
+ * or where the exact code would be long) is a chain of four or more solves, most of a dense
+ * step: it is made afresh only when Phi_q has moved too far from where the last one was made
+ * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one (it errs towards flagging), for one pass over the
+ * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
 static void delta_fk_estimate(delta_fk_workspace *work, delta_fk_report *report)
 {
-    report->inv_norm = delta_fk_inverse_norm1(&work->lu);
-    report->cond = report->inv_norm * delta_fk_norm1(work->nz);
-}
-
-/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
-static delta_fk_real delta_fk_difference_norm1(const delta_fk_real a[], const delta_fk_real b[])
-{
-    delta_fk_real sums[DELTA_FK_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < DELTA_FK_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < DELTA_FK_NNZ; ++e) sums[delta_fk_phi_q_col[e]] += fabs(a[e] - b[e]);
-    for (j = 0; j < DELTA_FK_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
-    return largest;
-}
-
-/* The estimate again after Newton moved q from where it was made (Phi_q then was in
- * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
- * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
- * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
- * a few per cent above the old one, for the price of one pass over the non-zeros. */
-static void delta_fk_estimate_again(delta_fk_workspace *work, delta_fk_report *report)
-{
     delta_fk_real theta;
-    if (!delta_fk_exact_estimate(work)) {
-        theta = report->inv_norm * delta_fk_difference_norm1(work->nz, work->nz_estimated);
-        if (theta <= DELTA_FK_REESTIMATE_SHIFT) {
-            report->inv_norm /= 1 - theta;
-            report->cond = report->inv_norm * delta_fk_norm1(work->nz);
-            return;
-        }
+    /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
+    theta = work->estimated_inv_norm * delta_fk_difference_bound1(work->nz, work->nz_estimated);
+    if (work->estimated_inv_norm >= 0 && theta <= DELTA_FK_REESTIMATE_SHIFT) {
+        report->inv_norm = work->estimated_inv_norm / (1 - theta);
+    } else {
+        report->inv_norm = delta_fk_inverse_norm1(&work->lu);
+        work->estimated_inv_norm = report->inv_norm;
+        memcpy(work->nz_estimated, work->nz, sizeof work->nz);
     }
-    delta_fk_estimate(work, report);
+    report->cond = report->inv_norm * delta_fk_norm1(work->nz);
 }
 
 static delta_fk_real delta_fk_at_least_1(delta_fk_real x)
@@ -317,6 +368,54 @@ static int delta_fk_flagged(const delta_fk_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * delta_fk_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * delta_fk_at_least_1(ndq));
+    return DELTA_FK_SAFETY * e_q > options->target_q * delta_fk_at_least_1(nq)
+        || DELTA_FK_SAFETY * e_dq > options->target_dq * delta_fk_at_least_1(ndq)
+        || DELTA_FK_SAFETY * e_ddq > options->target_ddq * delta_fk_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const delta_fk_real delta_fk_nonlinear[DELTA_FK_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static delta_fk_real delta_fk_nonlinear_max(const delta_fk_real v[])
+{
+    delta_fk_real largest = 0;
+    int i;
+    for (i = 0; i < DELTA_FK_NQ; ++i) {
+        const delta_fk_real a = delta_fk_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int delta_fk_flagged_refined(const delta_fk_options *options,
+                                        const delta_fk_workspace *work,
+                                        const delta_fk_report *report, delta_fk_real nq,
+                                        delta_fk_real ndq, delta_fk_real nddq, const delta_fk_real dq[],
+                                        const delta_fk_real ddq[])
+{
+    const delta_fk_real u = DELTA_FK_UNIT_ROUNDOFF;
+    const delta_fk_real root = sqrt((delta_fk_real)DELTA_FK_NQ);
+    const delta_fk_real s = report->inv_norm / root;
+    const delta_fk_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    delta_fk_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!delta_fk_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = delta_fk_inverse_norm1_rows(&work->lu, delta_fk_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? delta_fk_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? delta_fk_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * delta_fk_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * delta_fk_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * delta_fk_at_least_1(ndq_n));
     return DELTA_FK_SAFETY * e_q > options->target_q * delta_fk_at_least_1(nq)
         || DELTA_FK_SAFETY * e_dq > options->target_dq * delta_fk_at_least_1(ndq)
         || DELTA_FK_SAFETY * e_ddq > options->target_ddq * delta_fk_at_least_1(nddq);
@@ -361,12 +460,11 @@ static int delta_fk_converged(const delta_fk_options *options, const delta_fk_re
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !delta_fk_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            delta_fk_from_unit(work, work->phi);
             for (i = 0; i < DELTA_FK_NQ; ++i) q[i] += work->phi[i];
-            if (!moved) { /* Phi_q where the estimate was made */
-                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
-            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             delta_fk_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            delta_fk_in_unit(work);
             report->residual = delta_fk_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -377,7 +475,7 @@ static int delta_fk_converged(const delta_fk_options *options, const delta_fk_re
             if (!ill && !delta_fk_would_flag(options, work, report)) break;
         }
         if (moved) {
-            delta_fk_estimate_again(work, report);
+            delta_fk_estimate(work, report);
         }
     }
     return report->cond <= options->max_cond ? DELTA_FK_OK : DELTA_FK_SINGULAR;
@@ -396,6 +494,7 @@ static int delta_fk_newton(const delta_fk_options *options, const delta_fk_real 
         delta_fk_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         delta_fk_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        delta_fk_in_unit(work);
         residual = delta_fk_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -416,10 +515,11 @@ static int delta_fk_newton(const delta_fk_options *options, const delta_fk_real 
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         delta_fk_lu_solve(&work->lu, work->phi);
+        step = delta_fk_max_abs(work->phi); /* in the run's unit */
+        delta_fk_from_unit(work, work->phi);
         for (i = 0; i < DELTA_FK_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = delta_fk_max_abs(work->phi);
     }
     return DELTA_FK_NO_CONVERGENCE;
 }
@@ -444,8 +544,7 @@ int delta_fk_solve_step(const delta_fk_options *options, const delta_fk_real p[]
     if (state->started) {
         delta_fk_predict(t, state);
     } else {
-        delta_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        delta_fk_prepare(options->unit, work);
     }
     report->status = delta_fk_newton(options, p, t, state->q, work, report);
     report->fallbacks = delta_fk_lu_fallbacks(&work->lu);
@@ -458,15 +557,20 @@ int delta_fk_solve_step(const delta_fk_options *options, const delta_fk_real p[]
     for (i = 0; i < DELTA_FK_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    delta_fk_rows_in_unit(work, state->dq);
     delta_fk_lu_solve(&work->lu, state->dq); /* (2.73) */
+    delta_fk_from_unit(work, state->dq);
     delta_fk_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    delta_fk_rows_in_unit(work, state->ddq);
     delta_fk_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    delta_fk_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < DELTA_FK_NQ; ++i) {
-        const delta_fk_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const delta_fk_real c = fabs(state->ddq[i]);
+    for (i = 0; i < DELTA_FK_NQ; ++i) { /* in the run's unit: q / column */
+        const delta_fk_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const delta_fk_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const delta_fk_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -478,8 +582,9 @@ int delta_fk_solve_step(const delta_fk_options *options, const delta_fk_real p[]
         report->status = DELTA_FK_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = delta_fk_flagged(options, work, report,
-                                           sum_q != sum_q ? (delta_fk_real)NAN : nq, ndq, nddq);
+    report->flagged = delta_fk_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (delta_fk_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -523,8 +628,7 @@ int delta_fk_solve_inputs(const delta_fk_options *options, const delta_fk_real p
     report->flagged = 0;
     report->cond = (delta_fk_real)NAN;
     if (!state->started) {
-        delta_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        delta_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess. */
     report->status = delta_fk_newton(options, pu, state->t, state->q, work, report);
@@ -554,7 +658,9 @@ int delta_fk_solve_inputs(const delta_fk_options *options, const delta_fk_real p
         if (!rates) state->dq[i] = (delta_fk_real)NAN;
         if (!accelerations) state->ddq[i] = (delta_fk_real)NAN;
     }
-    report->flagged = delta_fk_flagged(options, work, report, nq, ndq, nddq);
+    report->flagged = delta_fk_flagged_refined(options, work, report, nq, ndq, nddq,
+                                                   rates ? state->dq : NULL,
+                                                   accelerations ? state->ddq : NULL);
     work->norms[0] = nq;
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -634,11 +740,13 @@ int delta_fk_solve_batch(const delta_fk_options *options, int m, const delta_fk_
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (delta_fk_real)NAN;
         for (k = 0; k < n; ++k) {
             if (delta_fk_solve_step(options, p_set, t[k], state, work, &report) != DELTA_FK_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             delta_fk_store(q_set, k, state->q);
             delta_fk_store(dq_set, k, state->dq);
             delta_fk_store(ddq_set, k, state->ddq);
@@ -653,4 +761,66 @@ int delta_fk_solve_batch(const delta_fk_options *options, int m, const delta_fk_
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static delta_fk_real delta_fk_march(const delta_fk_options *options, const delta_fk_real p[],
+                                 delta_fk_real target, delta_fk_real h0, delta_fk_real h_min,
+                                 delta_fk_state *state, delta_fk_workspace *work,
+                                 delta_fk_report *report, delta_fk_real *cond)
+{
+    delta_fk_real h = h0;
+    while (state->t < target) {
+        const delta_fk_real rest = target - state->t;
+        const delta_fk_real step = h < rest ? h : rest;
+        const delta_fk_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (delta_fk_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == DELTA_FK_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int delta_fk_solve_edge(const delta_fk_options *options, const delta_fk_real p[],
+                            delta_fk_real t, delta_fk_real h_min, delta_fk_real delta,
+                            delta_fk_real cond, delta_fk_state *state,
+                            delta_fk_workspace *work, delta_fk_report *report,
+                            delta_fk_edge_report *edge)
+{
+    const delta_fk_state previous = *state;
+    const delta_fk_real h0 = t - previous.t;
+    delta_fk_state before = previous, after;
+    delta_fk_real blocked, reach, early = 0, before_cond = cond;
+    delta_fk_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = delta_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = DELTA_FK_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = delta_fk_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = DELTA_FK_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (delta_fk_solve_step(options, p, blocked + reach, &after, work, report) == DELTA_FK_OK) {
+            edge->outcome = DELTA_FK_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

@@ -106,6 +106,9 @@ PATTERN_COLS = numpy.array([0, 1, 2, 3, 4, 5, 6, 3, 4, 5, 6, 0, 1, 2, 3, 4, 5, 6
     19, 20, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 14, 15, 16, 17,
     18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 3, 4, 5, 6, 10, 11, 12, 13, 17, 18, 19,
     20, 3, 4, 5, 6, 10, 11, 12, 13, 17, 18, 19, 20, 24, 25, 26, 27], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1,
+    1], dtype=bool)
 POINTS = (
     ('arm1', 'S1'),
     ('arm1', 'E1a'),

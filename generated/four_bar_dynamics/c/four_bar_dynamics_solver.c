@@ -21,6 +21,7 @@ void four_bar_dynamics_default_options(four_bar_dynamics_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int four_bar_dynamics_factor_jacobian(const four_bar_dynamics_options *op
         return FOUR_BAR_DYNAMICS_SINGULAR;
     }
     return FOUR_BAR_DYNAMICS_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char four_bar_dynamics_length_column[FOUR_BAR_DYNAMICS_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char four_bar_dynamics_length_row[FOUR_BAR_DYNAMICS_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void four_bar_dynamics_prepare(four_bar_dynamics_real unit, four_bar_dynamics_workspace *work)
+{
+    int i, e;
+    four_bar_dynamics_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && FOUR_BAR_DYNAMICS_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
+        work->column[i] = four_bar_dynamics_length_column[i] ? unit : 1;
+        work->row[i] = four_bar_dynamics_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < FOUR_BAR_DYNAMICS_NNZ; ++e) {
+        work->nz_factor[e] = work->column[four_bar_dynamics_phi_q_col[e]] / work->row[four_bar_dynamics_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void four_bar_dynamics_in_unit(four_bar_dynamics_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < FOUR_BAR_DYNAMICS_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void four_bar_dynamics_rows_in_unit(const four_bar_dynamics_workspace *work, four_bar_dynamics_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void four_bar_dynamics_from_unit(const four_bar_dynamics_workspace *work, four_bar_dynamics_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -377,9 +428,11 @@ static int four_bar_dynamics_converged(const four_bar_dynamics_options *options,
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !four_bar_dynamics_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            four_bar_dynamics_from_unit(work, work->phi);
             for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             four_bar_dynamics_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            four_bar_dynamics_in_unit(work);
             report->residual = four_bar_dynamics_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -409,6 +462,7 @@ static int four_bar_dynamics_newton(const four_bar_dynamics_options *options, co
         four_bar_dynamics_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         four_bar_dynamics_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        four_bar_dynamics_in_unit(work);
         residual = four_bar_dynamics_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -429,10 +483,11 @@ static int four_bar_dynamics_newton(const four_bar_dynamics_options *options, co
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         four_bar_dynamics_lu_solve(&work->lu, work->phi);
+        step = four_bar_dynamics_max_abs(work->phi); /* in the run's unit */
+        four_bar_dynamics_from_unit(work, work->phi);
         for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = four_bar_dynamics_max_abs(work->phi);
     }
     return FOUR_BAR_DYNAMICS_NO_CONVERGENCE;
 }
@@ -457,9 +512,7 @@ int four_bar_dynamics_solve_step(const four_bar_dynamics_options *options, const
     if (state->started) {
         four_bar_dynamics_predict(t, state);
     } else {
-        four_bar_dynamics_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        four_bar_dynamics_prepare(options->unit, work);
     }
     report->status = four_bar_dynamics_newton(options, p, t, state->q, work, report);
     report->fallbacks = four_bar_dynamics_lu_fallbacks(&work->lu);
@@ -472,15 +525,20 @@ int four_bar_dynamics_solve_step(const four_bar_dynamics_options *options, const
     for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    four_bar_dynamics_rows_in_unit(work, state->dq);
     four_bar_dynamics_lu_solve(&work->lu, state->dq); /* (2.73) */
+    four_bar_dynamics_from_unit(work, state->dq);
     four_bar_dynamics_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    four_bar_dynamics_rows_in_unit(work, state->ddq);
     four_bar_dynamics_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    four_bar_dynamics_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        const four_bar_dynamics_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const four_bar_dynamics_real c = fabs(state->ddq[i]);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) { /* in the run's unit: q / column */
+        const four_bar_dynamics_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const four_bar_dynamics_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const four_bar_dynamics_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -507,8 +565,12 @@ void four_bar_dynamics_multipliers(const four_bar_dynamics_real p[], const four_
                               const four_bar_dynamics_workspace *work, four_bar_dynamics_real lam[])
 {
     /* the step's last fused call was at state->q: its sines and cosines serve here too */
+    int i;
     four_bar_dynamics_dynamics_rhs_shared(state->q, state->dq, state->ddq, state->t, p, work->shared, lam);
+    /* the factors are of Phi~_q = Phi_q column / row: Phi_q^-T = row^-1 Phi~_q^-T column */
+    if (work->scaled) for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) lam[i] *= work->column[i];
     four_bar_dynamics_lu_solve_transposed(&work->lu, lam); /* Phi_q^T lam = Q - M ddq - h */
+    if (work->scaled) for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) lam[i] /= work->row[i];
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
@@ -593,11 +655,13 @@ int four_bar_dynamics_solve_batch(const four_bar_dynamics_options *options, int 
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (four_bar_dynamics_real)NAN;
         for (k = 0; k < n; ++k) {
             if (four_bar_dynamics_solve_step(options, p_set, t[k], state, work, &report) != FOUR_BAR_DYNAMICS_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             four_bar_dynamics_store(q_set, k, state->q);
             four_bar_dynamics_store(dq_set, k, state->dq);
             four_bar_dynamics_store(ddq_set, k, state->ddq);
@@ -612,6 +676,68 @@ int four_bar_dynamics_solve_batch(const four_bar_dynamics_options *options, int 
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static four_bar_dynamics_real four_bar_dynamics_march(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[],
+                                 four_bar_dynamics_real target, four_bar_dynamics_real h0, four_bar_dynamics_real h_min,
+                                 four_bar_dynamics_state *state, four_bar_dynamics_workspace *work,
+                                 four_bar_dynamics_report *report, four_bar_dynamics_real *cond)
+{
+    four_bar_dynamics_real h = h0;
+    while (state->t < target) {
+        const four_bar_dynamics_real rest = target - state->t;
+        const four_bar_dynamics_real step = h < rest ? h : rest;
+        const four_bar_dynamics_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (four_bar_dynamics_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == FOUR_BAR_DYNAMICS_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int four_bar_dynamics_solve_edge(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[],
+                            four_bar_dynamics_real t, four_bar_dynamics_real h_min, four_bar_dynamics_real delta,
+                            four_bar_dynamics_real cond, four_bar_dynamics_state *state,
+                            four_bar_dynamics_workspace *work, four_bar_dynamics_report *report,
+                            four_bar_dynamics_edge_report *edge)
+{
+    const four_bar_dynamics_state previous = *state;
+    const four_bar_dynamics_real h0 = t - previous.t;
+    four_bar_dynamics_state before = previous, after;
+    four_bar_dynamics_real blocked, reach, early = 0, before_cond = cond;
+    four_bar_dynamics_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = four_bar_dynamics_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = FOUR_BAR_DYNAMICS_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = four_bar_dynamics_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = FOUR_BAR_DYNAMICS_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (four_bar_dynamics_solve_step(options, p, blocked + reach, &after, work, report) == FOUR_BAR_DYNAMICS_OK) {
+            edge->outcome = FOUR_BAR_DYNAMICS_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }
 
 int four_bar_dynamics_multipliers_grid(const four_bar_dynamics_real p[], int n, const four_bar_dynamics_real t[],

@@ -16,7 +16,9 @@
 
 typedef struct {
     parallelogram_extra_bar_loads_real a[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ * PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    parallelogram_extra_bar_loads_real inv[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    parallelogram_extra_bar_loads_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } parallelogram_extra_bar_loads_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

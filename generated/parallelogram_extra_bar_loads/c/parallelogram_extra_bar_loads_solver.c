@@ -21,6 +21,7 @@ void parallelogram_extra_bar_loads_default_options(parallelogram_extra_bar_loads
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int parallelogram_extra_bar_loads_factor_jacobian(const parallelogram_ext
         return PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR;
     }
     return PARALLELOGRAM_EXTRA_BAR_LOADS_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char parallelogram_extra_bar_loads_length_column[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char parallelogram_extra_bar_loads_length_row[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void parallelogram_extra_bar_loads_prepare(parallelogram_extra_bar_loads_real unit, parallelogram_extra_bar_loads_workspace *work)
+{
+    int i, e;
+    parallelogram_extra_bar_loads_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && PARALLELOGRAM_EXTRA_BAR_LOADS_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
+        work->column[i] = parallelogram_extra_bar_loads_length_column[i] ? unit : 1;
+        work->row[i] = parallelogram_extra_bar_loads_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e) {
+        work->nz_factor[e] = work->column[parallelogram_extra_bar_loads_phi_q_col[e]] / work->row[parallelogram_extra_bar_loads_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void parallelogram_extra_bar_loads_in_unit(parallelogram_extra_bar_loads_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void parallelogram_extra_bar_loads_rows_in_unit(const parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void parallelogram_extra_bar_loads_from_unit(const parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -98,8 +149,9 @@ static const parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_al
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_norm1(const parallelogram_extra_bar_loads_lu *lu)
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_norm1_rows(const parallelogram_extra_bar_loads_lu *lu, const parallelogram_extra_bar_loads_real rows[])
 {
     parallelogram_extra_bar_loads_real y[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], z[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -107,7 +159,7 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_
      * processor can overlap the two chains of dependent operations */
     memcpy(z, parallelogram_extra_bar_loads_alternating, sizeof z);
     parallelogram_extra_bar_loads_lu_solve(lu, z);
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < PARALLELOGRAM_EXTRA_BAR_LOADS_ESTIMATOR_STEPS; ++step) {
         parallelogram_extra_bar_loads_real dot, best, finite = 0;
         int jmax = 0;
@@ -120,9 +172,11 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_
         parallelogram_extra_bar_loads_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (parallelogram_extra_bar_loads_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -151,6 +205,11 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_
     extra = 2 * extra / (3 * PARALLELOGRAM_EXTRA_BAR_LOADS_NQ);
     if (extra - extra != 0) return (parallelogram_extra_bar_loads_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_norm1(const parallelogram_extra_bar_loads_lu *lu)
+{
+    return parallelogram_extra_bar_loads_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -275,43 +334,43 @@ static int parallelogram_extra_bar_loads_exact_estimate(const parallelogram_extr
     return !work->lu.dense;
 }
 
+/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
+ * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_difference_bound1(const parallelogram_extra_bar_loads_real a[], const parallelogram_extra_bar_loads_real b[])
+{
+    parallelogram_extra_bar_loads_real sum = 0;
+    int e;
+    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e) sum += fabs(a[e] - b[e]);
+    return sum;
+}
+
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
+ * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
+ * or where the exact code would be long) is a chain of four or more solves, most of a dense
+ * step: it is made afresh only when Phi_q has moved too far from where the last one was made
+ * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one (it errs towards flagging), for one pass over the
+ * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
 static void parallelogram_extra_bar_loads_estimate(parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_report *report)
 {
-    /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = parallelogram_extra_bar_loads_exact_estimate(work)
-        ? parallelogram_extra_bar_loads_inverse_norm1_exact(work->lu.v, work->lu.inv)
-        : parallelogram_extra_bar_loads_inverse_norm1(&work->lu);
-    report->cond = report->inv_norm * parallelogram_extra_bar_loads_norm1(work->nz);
-}
-
-/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
-static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_difference_norm1(const parallelogram_extra_bar_loads_real a[], const parallelogram_extra_bar_loads_real b[])
-{
-    parallelogram_extra_bar_loads_real sums[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e) sums[parallelogram_extra_bar_loads_phi_q_col[e]] += fabs(a[e] - b[e]);
-    for (j = 0; j < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
-    return largest;
-}
-
-/* The estimate again after Newton moved q from where it was made (Phi_q then was in
- * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
- * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
- * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
- * a few per cent above the old one, for the price of one pass over the non-zeros. */
-static void parallelogram_extra_bar_loads_estimate_again(parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_report *report)
-{
     parallelogram_extra_bar_loads_real theta;
-    if (!parallelogram_extra_bar_loads_exact_estimate(work)) {
-        theta = report->inv_norm * parallelogram_extra_bar_loads_difference_norm1(work->nz, work->nz_estimated);
-        if (theta <= PARALLELOGRAM_EXTRA_BAR_LOADS_REESTIMATE_SHIFT) {
-            report->inv_norm /= 1 - theta;
-            report->cond = report->inv_norm * parallelogram_extra_bar_loads_norm1(work->nz);
-            return;
-        }
+    if (parallelogram_extra_bar_loads_exact_estimate(work)) {
+        report->inv_norm = parallelogram_extra_bar_loads_inverse_norm1_exact(work->lu.v, work->lu.inv);
+        report->cond = report->inv_norm * parallelogram_extra_bar_loads_norm1(work->nz);
+        return;
     }
-    parallelogram_extra_bar_loads_estimate(work, report);
+    /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
+    theta = work->estimated_inv_norm * parallelogram_extra_bar_loads_difference_bound1(work->nz, work->nz_estimated);
+    if (work->estimated_inv_norm >= 0 && theta <= PARALLELOGRAM_EXTRA_BAR_LOADS_REESTIMATE_SHIFT) {
+        report->inv_norm = work->estimated_inv_norm / (1 - theta);
+    } else {
+        report->inv_norm = parallelogram_extra_bar_loads_inverse_norm1(&work->lu);
+        work->estimated_inv_norm = report->inv_norm;
+        memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+    }
+    report->cond = report->inv_norm * parallelogram_extra_bar_loads_norm1(work->nz);
 }
 
 static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_at_least_1(parallelogram_extra_bar_loads_real x)
@@ -336,6 +395,54 @@ static int parallelogram_extra_bar_loads_flagged(const parallelogram_extra_bar_l
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * parallelogram_extra_bar_loads_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * parallelogram_extra_bar_loads_at_least_1(ndq));
+    return PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_q > options->target_q * parallelogram_extra_bar_loads_at_least_1(nq)
+        || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_dq > options->target_dq * parallelogram_extra_bar_loads_at_least_1(ndq)
+        || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_nonlinear[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 0 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_nonlinear_max(const parallelogram_extra_bar_loads_real v[])
+{
+    parallelogram_extra_bar_loads_real largest = 0;
+    int i;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
+        const parallelogram_extra_bar_loads_real a = parallelogram_extra_bar_loads_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int parallelogram_extra_bar_loads_flagged_refined(const parallelogram_extra_bar_loads_options *options,
+                                        const parallelogram_extra_bar_loads_workspace *work,
+                                        const parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real nq,
+                                        parallelogram_extra_bar_loads_real ndq, parallelogram_extra_bar_loads_real nddq, const parallelogram_extra_bar_loads_real dq[],
+                                        const parallelogram_extra_bar_loads_real ddq[])
+{
+    const parallelogram_extra_bar_loads_real u = PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF;
+    const parallelogram_extra_bar_loads_real root = sqrt((parallelogram_extra_bar_loads_real)PARALLELOGRAM_EXTRA_BAR_LOADS_NQ);
+    const parallelogram_extra_bar_loads_real s = report->inv_norm / root;
+    const parallelogram_extra_bar_loads_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    parallelogram_extra_bar_loads_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!parallelogram_extra_bar_loads_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = parallelogram_extra_bar_loads_inverse_norm1_rows(&work->lu, parallelogram_extra_bar_loads_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? parallelogram_extra_bar_loads_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? parallelogram_extra_bar_loads_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * parallelogram_extra_bar_loads_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * parallelogram_extra_bar_loads_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * parallelogram_extra_bar_loads_at_least_1(ndq_n));
     return PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_q > options->target_q * parallelogram_extra_bar_loads_at_least_1(nq)
         || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_dq > options->target_dq * parallelogram_extra_bar_loads_at_least_1(ndq)
         || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq);
@@ -380,12 +487,11 @@ static int parallelogram_extra_bar_loads_converged(const parallelogram_extra_bar
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !parallelogram_extra_bar_loads_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            parallelogram_extra_bar_loads_from_unit(work, work->phi);
             for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) q[i] += work->phi[i];
-            if (!moved) { /* Phi_q where the estimate was made */
-                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
-            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             parallelogram_extra_bar_loads_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            parallelogram_extra_bar_loads_in_unit(work);
             report->residual = parallelogram_extra_bar_loads_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -396,7 +502,7 @@ static int parallelogram_extra_bar_loads_converged(const parallelogram_extra_bar
             if (!ill && !parallelogram_extra_bar_loads_would_flag(options, work, report)) break;
         }
         if (moved) {
-            parallelogram_extra_bar_loads_estimate_again(work, report);
+            parallelogram_extra_bar_loads_estimate(work, report);
         }
     }
     return report->cond <= options->max_cond ? PARALLELOGRAM_EXTRA_BAR_LOADS_OK : PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR;
@@ -415,6 +521,7 @@ static int parallelogram_extra_bar_loads_newton(const parallelogram_extra_bar_lo
         parallelogram_extra_bar_loads_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         parallelogram_extra_bar_loads_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        parallelogram_extra_bar_loads_in_unit(work);
         residual = parallelogram_extra_bar_loads_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -435,10 +542,11 @@ static int parallelogram_extra_bar_loads_newton(const parallelogram_extra_bar_lo
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         parallelogram_extra_bar_loads_lu_solve(&work->lu, work->phi);
+        step = parallelogram_extra_bar_loads_max_abs(work->phi); /* in the run's unit */
+        parallelogram_extra_bar_loads_from_unit(work, work->phi);
         for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = parallelogram_extra_bar_loads_max_abs(work->phi);
     }
     return PARALLELOGRAM_EXTRA_BAR_LOADS_NO_CONVERGENCE;
 }
@@ -463,8 +571,7 @@ int parallelogram_extra_bar_loads_solve_step(const parallelogram_extra_bar_loads
     if (state->started) {
         parallelogram_extra_bar_loads_predict(t, state);
     } else {
-        parallelogram_extra_bar_loads_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        parallelogram_extra_bar_loads_prepare(options->unit, work);
     }
     report->status = parallelogram_extra_bar_loads_newton(options, p, t, state->q, work, report);
     report->fallbacks = parallelogram_extra_bar_loads_lu_fallbacks(&work->lu);
@@ -477,15 +584,20 @@ int parallelogram_extra_bar_loads_solve_step(const parallelogram_extra_bar_loads
     for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    parallelogram_extra_bar_loads_rows_in_unit(work, state->dq);
     parallelogram_extra_bar_loads_lu_solve(&work->lu, state->dq); /* (2.73) */
+    parallelogram_extra_bar_loads_from_unit(work, state->dq);
     parallelogram_extra_bar_loads_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    parallelogram_extra_bar_loads_rows_in_unit(work, state->ddq);
     parallelogram_extra_bar_loads_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    parallelogram_extra_bar_loads_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
-        const parallelogram_extra_bar_loads_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const parallelogram_extra_bar_loads_real c = fabs(state->ddq[i]);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) { /* in the run's unit: q / column */
+        const parallelogram_extra_bar_loads_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const parallelogram_extra_bar_loads_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const parallelogram_extra_bar_loads_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -497,8 +609,9 @@ int parallelogram_extra_bar_loads_solve_step(const parallelogram_extra_bar_loads
         report->status = PARALLELOGRAM_EXTRA_BAR_LOADS_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = parallelogram_extra_bar_loads_flagged(options, work, report,
-                                           sum_q != sum_q ? (parallelogram_extra_bar_loads_real)NAN : nq, ndq, nddq);
+    report->flagged = parallelogram_extra_bar_loads_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (parallelogram_extra_bar_loads_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -511,8 +624,12 @@ void parallelogram_extra_bar_loads_multipliers(const parallelogram_extra_bar_loa
                               const parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_real lam[])
 {
     /* the step's last fused call was at state->q: its sines and cosines serve here too */
+    int i;
     parallelogram_extra_bar_loads_dynamics_rhs_shared(state->q, state->dq, state->ddq, state->t, p, work->shared, lam);
+    /* the factors are of Phi~_q = Phi_q column / row: Phi_q^-T = row^-1 Phi~_q^-T column */
+    if (work->scaled) for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) lam[i] *= work->column[i];
     parallelogram_extra_bar_loads_lu_solve_transposed(&work->lu, lam); /* Phi_q^T lam = Q - M ddq - h */
+    if (work->scaled) for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) lam[i] /= work->row[i];
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */
@@ -597,11 +714,13 @@ int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_load
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (parallelogram_extra_bar_loads_real)NAN;
         for (k = 0; k < n; ++k) {
             if (parallelogram_extra_bar_loads_solve_step(options, p_set, t[k], state, work, &report) != PARALLELOGRAM_EXTRA_BAR_LOADS_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             parallelogram_extra_bar_loads_store(q_set, k, state->q);
             parallelogram_extra_bar_loads_store(dq_set, k, state->dq);
             parallelogram_extra_bar_loads_store(ddq_set, k, state->ddq);
@@ -616,6 +735,68 @@ int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_load
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_march(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
+                                 parallelogram_extra_bar_loads_real target, parallelogram_extra_bar_loads_real h0, parallelogram_extra_bar_loads_real h_min,
+                                 parallelogram_extra_bar_loads_state *state, parallelogram_extra_bar_loads_workspace *work,
+                                 parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real *cond)
+{
+    parallelogram_extra_bar_loads_real h = h0;
+    while (state->t < target) {
+        const parallelogram_extra_bar_loads_real rest = target - state->t;
+        const parallelogram_extra_bar_loads_real step = h < rest ? h : rest;
+        const parallelogram_extra_bar_loads_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (parallelogram_extra_bar_loads_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == PARALLELOGRAM_EXTRA_BAR_LOADS_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int parallelogram_extra_bar_loads_solve_edge(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
+                            parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_real h_min, parallelogram_extra_bar_loads_real delta,
+                            parallelogram_extra_bar_loads_real cond, parallelogram_extra_bar_loads_state *state,
+                            parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_report *report,
+                            parallelogram_extra_bar_loads_edge_report *edge)
+{
+    const parallelogram_extra_bar_loads_state previous = *state;
+    const parallelogram_extra_bar_loads_real h0 = t - previous.t;
+    parallelogram_extra_bar_loads_state before = previous, after;
+    parallelogram_extra_bar_loads_real blocked, reach, early = 0, before_cond = cond;
+    parallelogram_extra_bar_loads_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = parallelogram_extra_bar_loads_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = parallelogram_extra_bar_loads_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (parallelogram_extra_bar_loads_solve_step(options, p, blocked + reach, &after, work, report) == PARALLELOGRAM_EXTRA_BAR_LOADS_OK) {
+            edge->outcome = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }
 
 int parallelogram_extra_bar_loads_multipliers_grid(const parallelogram_extra_bar_loads_real p[], int n, const parallelogram_extra_bar_loads_real t[],

@@ -35,7 +35,19 @@ typedef struct {
     parallelogram_extra_bar_loads_real target_q;        /* flagged when the estimated error of q, dq or    */
     parallelogram_extra_bar_loads_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     parallelogram_extra_bar_loads_real target_ddq;
+    parallelogram_extra_bar_loads_real unit;            /* the length unit the decisions are made in: the     */
+                                       /* tolerances, the singularity test and the flags   */
+                                       /* see lengths (q's x, y, z and Phi's length rows)  */
+                                       /* divided by it, angles as they are. q, dq, ddq in  */
+                                       /* and out stay in the mechanism's own unit. 1 (the */
+                                       /* default): that unit. A mechanism drawn in mm is  */
+                                       /* decided alike with unit 1000. Ignored where      */
+                                       /* PARALLELOGRAM_EXTRA_BAR_LOADS_SCALE_FREE is 0. */
 } parallelogram_extra_bar_loads_options;
+
+/* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
+ * written as a number (folded into the generated code, it cannot be rescaled at run time). */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_SCALE_FREE 1
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_LOADS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -67,8 +79,14 @@ typedef struct {
     parallelogram_extra_bar_loads_real phi[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* Phi, then the Newton step */
     parallelogram_extra_bar_loads_real shared[11]; /* sin, cos of the last iterate (parallelogram_extra_bar_loads_phi_phi_q) */
     parallelogram_extra_bar_loads_real nz_estimated[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ]; /* Phi_q where the condition was estimated */
+    parallelogram_extra_bar_loads_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     parallelogram_extra_bar_loads_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     parallelogram_extra_bar_loads_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    parallelogram_extra_bar_loads_real column[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* options->unit where q_i is a length, else 1 */
+    parallelogram_extra_bar_loads_real inverse_column[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* 1 / column */
+    parallelogram_extra_bar_loads_real row[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* options->unit where Phi_i is a length, else 1 */
+    parallelogram_extra_bar_loads_real nz_factor[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ]; /* column / row of each non-zero */
+    int scaled; /* the decisions are made in a unit other than 1 */
 } parallelogram_extra_bar_loads_workspace;
 
 /* Tolerances suited to the real type. */
@@ -113,6 +131,7 @@ typedef struct {
     parallelogram_extra_bar_loads_real t;         /* the time of the last step attempted (t[n-1] when OK)    */
     int iterations;              /* Newton iterations summed over the set's steps           */
     parallelogram_extra_bar_loads_real residual;  /* max|Phi| of the last iterate                            */
+    parallelogram_extra_bar_loads_real cond;      /* the condition estimate at the last point solved (NaN: none) */
 } parallelogram_extra_bar_loads_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
@@ -128,6 +147,34 @@ int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_load
                              parallelogram_extra_bar_loads_real dq_out[], parallelogram_extra_bar_loads_real ddq_out[],
                              parallelogram_extra_bar_loads_state *state, parallelogram_extra_bar_loads_workspace *work,
                              parallelogram_extra_bar_loads_batch_report reports[]);
+
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_REACHED 0  /* the substeps reached t                                */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_STOPPED 2  /* blocked, and no step over it converges                */
+
+/* What parallelogram_extra_bar_loads_solve_edge found. */
+typedef struct {
+    int outcome;                 /* PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_REACHED, _PASSABLE or _STOPPED          */
+    parallelogram_extra_bar_loads_real failed;    /* the step that failed from the last point reached (0: none) */
+    parallelogram_extra_bar_loads_real cond;      /* the condition estimate at the last point reached          */
+} parallelogram_extra_bar_loads_edge_report;
+
+/* A time t that the plain step from a solved state could not reach (the point where
+ * parallelogram_extra_bar_loads_solve_grid stopped), treated as symkin's runtime does before it decides (its
+ * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
+ * blocked time b; then, from the last point reached substepping towards b - delta, steps to
+ * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the
+ * position passable. Each substep is a parallelogram_extra_bar_loads_solve_step with no last point for the error
+ * model. On return state is the last point reached (t itself when reached) and
+ * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
+ * bisection to a limit position: the motion stops between state->t and state->t +
+ * edge->failed. The workspace is set up here. Returns edge->outcome. */
+int parallelogram_extra_bar_loads_solve_edge(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
+                            parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_real h_min, parallelogram_extra_bar_loads_real delta,
+                            parallelogram_extra_bar_loads_real cond, parallelogram_extra_bar_loads_state *state,
+                            parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_report *report,
+                            parallelogram_extra_bar_loads_edge_report *edge);
 
 /* Inverse dynamics after a successful parallelogram_extra_bar_loads_solve_step: the multipliers lam[NQ] of
  * Phi_q^T lam = Q - M ddq - h at the state's q, dq, ddq and t, with the factors of Phi_q the

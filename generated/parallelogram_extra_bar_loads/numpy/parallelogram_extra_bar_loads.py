@@ -77,6 +77,8 @@ PATTERN_ROWS = numpy.array([0, 1, 2, 3, 4, 4, 4, 5, 5, 5, 6, 6, 6, 6, 7, 7, 7, 7
     11, 11, 12, 12, 12, 13, 14, 14], dtype=numpy.intp)
 PATTERN_COLS = numpy.array([0, 1, 3, 4, 0, 2, 9, 1, 2, 10, 3, 5, 9, 11, 4, 5, 10, 11, 6, 7, 6, 8, 9, 11, 9,
     11, 12, 10, 11, 13, 2, 11, 14], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 0], dtype=bool)
 POINTS = (
     ('crank', 'O0'),
     ('crank', 'A'),

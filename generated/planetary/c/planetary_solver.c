@@ -21,6 +21,7 @@ void planetary_default_options(planetary_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define PLANETARY_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int planetary_factor_jacobian(const planetary_options *options, planetary
         return PLANETARY_SINGULAR;
     }
     return PLANETARY_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char planetary_length_column[PLANETARY_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char planetary_length_row[PLANETARY_NQ] = { 1, 1, 1, 1, 1, 1, 0, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void planetary_prepare(planetary_real unit, planetary_workspace *work)
+{
+    int i, e;
+    planetary_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && PLANETARY_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < PLANETARY_NQ; ++i) {
+        work->column[i] = planetary_length_column[i] ? unit : 1;
+        work->row[i] = planetary_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < PLANETARY_NNZ; ++e) {
+        work->nz_factor[e] = work->column[planetary_phi_q_col[e]] / work->row[planetary_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void planetary_in_unit(planetary_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < PLANETARY_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < PLANETARY_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void planetary_rows_in_unit(const planetary_workspace *work, planetary_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < PLANETARY_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void planetary_from_unit(const planetary_workspace *work, planetary_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < PLANETARY_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -370,9 +421,11 @@ static int planetary_converged(const planetary_options *options, const planetary
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !planetary_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            planetary_from_unit(work, work->phi);
             for (i = 0; i < PLANETARY_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             planetary_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            planetary_in_unit(work);
             report->residual = planetary_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -402,6 +455,7 @@ static int planetary_newton(const planetary_options *options, const planetary_re
         planetary_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         planetary_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        planetary_in_unit(work);
         residual = planetary_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -422,10 +476,11 @@ static int planetary_newton(const planetary_options *options, const planetary_re
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         planetary_lu_solve(&work->lu, work->phi);
+        step = planetary_max_abs(work->phi); /* in the run's unit */
+        planetary_from_unit(work, work->phi);
         for (i = 0; i < PLANETARY_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = planetary_max_abs(work->phi);
     }
     return PLANETARY_NO_CONVERGENCE;
 }
@@ -450,9 +505,7 @@ int planetary_solve_step(const planetary_options *options, const planetary_real 
     if (state->started) {
         planetary_predict(t, state);
     } else {
-        planetary_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        planetary_prepare(options->unit, work);
     }
     report->status = planetary_newton(options, p, t, state->q, work, report);
     report->fallbacks = planetary_lu_fallbacks(&work->lu);
@@ -465,15 +518,20 @@ int planetary_solve_step(const planetary_options *options, const planetary_real 
     for (i = 0; i < PLANETARY_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    planetary_rows_in_unit(work, state->dq);
     planetary_lu_solve(&work->lu, state->dq); /* (2.73) */
+    planetary_from_unit(work, state->dq);
     planetary_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    planetary_rows_in_unit(work, state->ddq);
     planetary_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    planetary_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < PLANETARY_NQ; ++i) {
-        const planetary_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const planetary_real c = fabs(state->ddq[i]);
+    for (i = 0; i < PLANETARY_NQ; ++i) { /* in the run's unit: q / column */
+        const planetary_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const planetary_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const planetary_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -568,11 +626,13 @@ int planetary_solve_batch(const planetary_options *options, int m, const planeta
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (planetary_real)NAN;
         for (k = 0; k < n; ++k) {
             if (planetary_solve_step(options, p_set, t[k], state, work, &report) != PLANETARY_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             planetary_store(q_set, k, state->q);
             planetary_store(dq_set, k, state->dq);
             planetary_store(ddq_set, k, state->ddq);
@@ -587,4 +647,66 @@ int planetary_solve_batch(const planetary_options *options, int m, const planeta
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static planetary_real planetary_march(const planetary_options *options, const planetary_real p[],
+                                 planetary_real target, planetary_real h0, planetary_real h_min,
+                                 planetary_state *state, planetary_workspace *work,
+                                 planetary_report *report, planetary_real *cond)
+{
+    planetary_real h = h0;
+    while (state->t < target) {
+        const planetary_real rest = target - state->t;
+        const planetary_real step = h < rest ? h : rest;
+        const planetary_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (planetary_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == PLANETARY_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int planetary_solve_edge(const planetary_options *options, const planetary_real p[],
+                            planetary_real t, planetary_real h_min, planetary_real delta,
+                            planetary_real cond, planetary_state *state,
+                            planetary_workspace *work, planetary_report *report,
+                            planetary_edge_report *edge)
+{
+    const planetary_state previous = *state;
+    const planetary_real h0 = t - previous.t;
+    planetary_state before = previous, after;
+    planetary_real blocked, reach, early = 0, before_cond = cond;
+    planetary_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = planetary_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = PLANETARY_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = planetary_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = PLANETARY_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (planetary_solve_step(options, p, blocked + reach, &after, work, report) == PLANETARY_OK) {
+            edge->outcome = PLANETARY_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

@@ -21,6 +21,7 @@ void quick_return_default_options(quick_return_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define QUICK_RETURN_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int quick_return_factor_jacobian(const quick_return_options *options, qui
         return QUICK_RETURN_SINGULAR;
     }
     return QUICK_RETURN_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char quick_return_length_column[QUICK_RETURN_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char quick_return_length_row[QUICK_RETURN_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void quick_return_prepare(quick_return_real unit, quick_return_workspace *work)
+{
+    int i, e;
+    quick_return_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && QUICK_RETURN_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+        work->column[i] = quick_return_length_column[i] ? unit : 1;
+        work->row[i] = quick_return_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < QUICK_RETURN_NNZ; ++e) {
+        work->nz_factor[e] = work->column[quick_return_phi_q_col[e]] / work->row[quick_return_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void quick_return_in_unit(quick_return_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < QUICK_RETURN_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void quick_return_rows_in_unit(const quick_return_workspace *work, quick_return_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void quick_return_from_unit(const quick_return_workspace *work, quick_return_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -424,9 +475,11 @@ static int quick_return_converged(const quick_return_options *options, const qui
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !quick_return_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            quick_return_from_unit(work, work->phi);
             for (i = 0; i < QUICK_RETURN_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             quick_return_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            quick_return_in_unit(work);
             report->residual = quick_return_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -456,6 +509,7 @@ static int quick_return_newton(const quick_return_options *options, const quick_
         quick_return_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         quick_return_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        quick_return_in_unit(work);
         residual = quick_return_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -476,10 +530,11 @@ static int quick_return_newton(const quick_return_options *options, const quick_
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         quick_return_lu_solve(&work->lu, work->phi);
+        step = quick_return_max_abs(work->phi); /* in the run's unit */
+        quick_return_from_unit(work, work->phi);
         for (i = 0; i < QUICK_RETURN_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = quick_return_max_abs(work->phi);
     }
     return QUICK_RETURN_NO_CONVERGENCE;
 }
@@ -504,9 +559,7 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
     if (state->started) {
         quick_return_predict(t, state);
     } else {
-        quick_return_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        quick_return_prepare(options->unit, work);
     }
     report->status = quick_return_newton(options, p, t, state->q, work, report);
     report->fallbacks = quick_return_lu_fallbacks(&work->lu);
@@ -519,15 +572,20 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
     for (i = 0; i < QUICK_RETURN_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    quick_return_rows_in_unit(work, state->dq);
     quick_return_lu_solve(&work->lu, state->dq); /* (2.73) */
+    quick_return_from_unit(work, state->dq);
     quick_return_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    quick_return_rows_in_unit(work, state->ddq);
     quick_return_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    quick_return_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
-        const quick_return_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const quick_return_real c = fabs(state->ddq[i]);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) { /* in the run's unit: q / column */
+        const quick_return_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const quick_return_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const quick_return_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -622,11 +680,13 @@ int quick_return_solve_batch(const quick_return_options *options, int m, const q
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (quick_return_real)NAN;
         for (k = 0; k < n; ++k) {
             if (quick_return_solve_step(options, p_set, t[k], state, work, &report) != QUICK_RETURN_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             quick_return_store(q_set, k, state->q);
             quick_return_store(dq_set, k, state->dq);
             quick_return_store(ddq_set, k, state->ddq);
@@ -641,4 +701,66 @@ int quick_return_solve_batch(const quick_return_options *options, int m, const q
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static quick_return_real quick_return_march(const quick_return_options *options, const quick_return_real p[],
+                                 quick_return_real target, quick_return_real h0, quick_return_real h_min,
+                                 quick_return_state *state, quick_return_workspace *work,
+                                 quick_return_report *report, quick_return_real *cond)
+{
+    quick_return_real h = h0;
+    while (state->t < target) {
+        const quick_return_real rest = target - state->t;
+        const quick_return_real step = h < rest ? h : rest;
+        const quick_return_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (quick_return_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == QUICK_RETURN_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int quick_return_solve_edge(const quick_return_options *options, const quick_return_real p[],
+                            quick_return_real t, quick_return_real h_min, quick_return_real delta,
+                            quick_return_real cond, quick_return_state *state,
+                            quick_return_workspace *work, quick_return_report *report,
+                            quick_return_edge_report *edge)
+{
+    const quick_return_state previous = *state;
+    const quick_return_real h0 = t - previous.t;
+    quick_return_state before = previous, after;
+    quick_return_real blocked, reach, early = 0, before_cond = cond;
+    quick_return_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = quick_return_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = QUICK_RETURN_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = quick_return_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = QUICK_RETURN_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (quick_return_solve_step(options, p, blocked + reach, &after, work, report) == QUICK_RETURN_OK) {
+            edge->outcome = QUICK_RETURN_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

@@ -21,6 +21,7 @@ void rack_linkage_default_options(rack_linkage_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define RACK_LINKAGE_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int rack_linkage_factor_jacobian(const rack_linkage_options *options, rac
         return RACK_LINKAGE_SINGULAR;
     }
     return RACK_LINKAGE_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char rack_linkage_length_column[RACK_LINKAGE_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char rack_linkage_length_row[RACK_LINKAGE_NQ] = { 1, 1, 0, 1, 1, 1, 1, 1, 1, 1, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void rack_linkage_prepare(rack_linkage_real unit, rack_linkage_workspace *work)
+{
+    int i, e;
+    rack_linkage_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && RACK_LINKAGE_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
+        work->column[i] = rack_linkage_length_column[i] ? unit : 1;
+        work->row[i] = rack_linkage_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < RACK_LINKAGE_NNZ; ++e) {
+        work->nz_factor[e] = work->column[rack_linkage_phi_q_col[e]] / work->row[rack_linkage_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void rack_linkage_in_unit(rack_linkage_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < RACK_LINKAGE_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void rack_linkage_rows_in_unit(const rack_linkage_workspace *work, rack_linkage_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void rack_linkage_from_unit(const rack_linkage_workspace *work, rack_linkage_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -451,9 +502,11 @@ static int rack_linkage_converged(const rack_linkage_options *options, const rac
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !rack_linkage_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            rack_linkage_from_unit(work, work->phi);
             for (i = 0; i < RACK_LINKAGE_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             rack_linkage_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            rack_linkage_in_unit(work);
             report->residual = rack_linkage_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -483,6 +536,7 @@ static int rack_linkage_newton(const rack_linkage_options *options, const rack_l
         rack_linkage_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         rack_linkage_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        rack_linkage_in_unit(work);
         residual = rack_linkage_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -503,10 +557,11 @@ static int rack_linkage_newton(const rack_linkage_options *options, const rack_l
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         rack_linkage_lu_solve(&work->lu, work->phi);
+        step = rack_linkage_max_abs(work->phi); /* in the run's unit */
+        rack_linkage_from_unit(work, work->phi);
         for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = rack_linkage_max_abs(work->phi);
     }
     return RACK_LINKAGE_NO_CONVERGENCE;
 }
@@ -531,9 +586,7 @@ int rack_linkage_solve_step(const rack_linkage_options *options, const rack_link
     if (state->started) {
         rack_linkage_predict(t, state);
     } else {
-        rack_linkage_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        rack_linkage_prepare(options->unit, work);
     }
     report->status = rack_linkage_newton(options, p, t, state->q, work, report);
     report->fallbacks = rack_linkage_lu_fallbacks(&work->lu);
@@ -546,15 +599,20 @@ int rack_linkage_solve_step(const rack_linkage_options *options, const rack_link
     for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    rack_linkage_rows_in_unit(work, state->dq);
     rack_linkage_lu_solve(&work->lu, state->dq); /* (2.73) */
+    rack_linkage_from_unit(work, state->dq);
     rack_linkage_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    rack_linkage_rows_in_unit(work, state->ddq);
     rack_linkage_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    rack_linkage_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
-        const rack_linkage_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const rack_linkage_real c = fabs(state->ddq[i]);
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) { /* in the run's unit: q / column */
+        const rack_linkage_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const rack_linkage_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const rack_linkage_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -649,11 +707,13 @@ int rack_linkage_solve_batch(const rack_linkage_options *options, int m, const r
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (rack_linkage_real)NAN;
         for (k = 0; k < n; ++k) {
             if (rack_linkage_solve_step(options, p_set, t[k], state, work, &report) != RACK_LINKAGE_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             rack_linkage_store(q_set, k, state->q);
             rack_linkage_store(dq_set, k, state->dq);
             rack_linkage_store(ddq_set, k, state->ddq);
@@ -668,4 +728,66 @@ int rack_linkage_solve_batch(const rack_linkage_options *options, int m, const r
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static rack_linkage_real rack_linkage_march(const rack_linkage_options *options, const rack_linkage_real p[],
+                                 rack_linkage_real target, rack_linkage_real h0, rack_linkage_real h_min,
+                                 rack_linkage_state *state, rack_linkage_workspace *work,
+                                 rack_linkage_report *report, rack_linkage_real *cond)
+{
+    rack_linkage_real h = h0;
+    while (state->t < target) {
+        const rack_linkage_real rest = target - state->t;
+        const rack_linkage_real step = h < rest ? h : rest;
+        const rack_linkage_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (rack_linkage_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == RACK_LINKAGE_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_linkage_real p[],
+                            rack_linkage_real t, rack_linkage_real h_min, rack_linkage_real delta,
+                            rack_linkage_real cond, rack_linkage_state *state,
+                            rack_linkage_workspace *work, rack_linkage_report *report,
+                            rack_linkage_edge_report *edge)
+{
+    const rack_linkage_state previous = *state;
+    const rack_linkage_real h0 = t - previous.t;
+    rack_linkage_state before = previous, after;
+    rack_linkage_real blocked, reach, early = 0, before_cond = cond;
+    rack_linkage_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = rack_linkage_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = RACK_LINKAGE_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = rack_linkage_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = RACK_LINKAGE_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (rack_linkage_solve_step(options, p, blocked + reach, &after, work, report) == RACK_LINKAGE_OK) {
+            edge->outcome = RACK_LINKAGE_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

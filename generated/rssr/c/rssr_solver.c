@@ -21,6 +21,7 @@ void rssr_default_options(rssr_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define RSSR_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int rssr_factor_jacobian(const rssr_options *options, rssr_workspace *wor
         return RSSR_SINGULAR;
     }
     return RSSR_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char rssr_length_column[RSSR_NQ] = { 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0 };
+static const unsigned char rssr_length_row[RSSR_NQ] = { 1, 1, 1, 0, 0, 1, 1, 1, 0, 0, 1, 0, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void rssr_prepare(rssr_real unit, rssr_workspace *work)
+{
+    int i, e;
+    rssr_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && RSSR_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < RSSR_NQ; ++i) {
+        work->column[i] = rssr_length_column[i] ? unit : 1;
+        work->row[i] = rssr_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < RSSR_NNZ; ++e) {
+        work->nz_factor[e] = work->column[rssr_phi_q_col[e]] / work->row[rssr_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void rssr_in_unit(rssr_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < RSSR_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < RSSR_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void rssr_rows_in_unit(const rssr_workspace *work, rssr_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < RSSR_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void rssr_from_unit(const rssr_workspace *work, rssr_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < RSSR_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -706,9 +757,11 @@ static int rssr_converged(const rssr_options *options, const rssr_real p[],
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !rssr_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            rssr_from_unit(work, work->phi);
             for (i = 0; i < RSSR_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             rssr_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            rssr_in_unit(work);
             report->residual = rssr_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -738,6 +791,7 @@ static int rssr_newton(const rssr_options *options, const rssr_real p[], rssr_re
         rssr_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         rssr_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        rssr_in_unit(work);
         residual = rssr_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -758,10 +812,11 @@ static int rssr_newton(const rssr_options *options, const rssr_real p[], rssr_re
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         rssr_lu_solve(&work->lu, work->phi);
+        step = rssr_max_abs(work->phi); /* in the run's unit */
+        rssr_from_unit(work, work->phi);
         for (i = 0; i < RSSR_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = rssr_max_abs(work->phi);
     }
     return RSSR_NO_CONVERGENCE;
 }
@@ -786,9 +841,7 @@ int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real 
     if (state->started) {
         rssr_predict(t, state);
     } else {
-        rssr_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        rssr_prepare(options->unit, work);
     }
     report->status = rssr_newton(options, p, t, state->q, work, report);
     report->fallbacks = rssr_lu_fallbacks(&work->lu);
@@ -801,15 +854,20 @@ int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real 
     for (i = 0; i < RSSR_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    rssr_rows_in_unit(work, state->dq);
     rssr_lu_solve(&work->lu, state->dq); /* (2.73) */
+    rssr_from_unit(work, state->dq);
     rssr_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    rssr_rows_in_unit(work, state->ddq);
     rssr_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    rssr_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < RSSR_NQ; ++i) {
-        const rssr_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const rssr_real c = fabs(state->ddq[i]);
+    for (i = 0; i < RSSR_NQ; ++i) { /* in the run's unit: q / column */
+        const rssr_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const rssr_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const rssr_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -904,11 +962,13 @@ int rssr_solve_batch(const rssr_options *options, int m, const rssr_real p[],
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (rssr_real)NAN;
         for (k = 0; k < n; ++k) {
             if (rssr_solve_step(options, p_set, t[k], state, work, &report) != RSSR_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             rssr_store(q_set, k, state->q);
             rssr_store(dq_set, k, state->dq);
             rssr_store(ddq_set, k, state->ddq);
@@ -923,4 +983,66 @@ int rssr_solve_batch(const rssr_options *options, int m, const rssr_real p[],
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static rssr_real rssr_march(const rssr_options *options, const rssr_real p[],
+                                 rssr_real target, rssr_real h0, rssr_real h_min,
+                                 rssr_state *state, rssr_workspace *work,
+                                 rssr_report *report, rssr_real *cond)
+{
+    rssr_real h = h0;
+    while (state->t < target) {
+        const rssr_real rest = target - state->t;
+        const rssr_real step = h < rest ? h : rest;
+        const rssr_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (rssr_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == RSSR_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int rssr_solve_edge(const rssr_options *options, const rssr_real p[],
+                            rssr_real t, rssr_real h_min, rssr_real delta,
+                            rssr_real cond, rssr_state *state,
+                            rssr_workspace *work, rssr_report *report,
+                            rssr_edge_report *edge)
+{
+    const rssr_state previous = *state;
+    const rssr_real h0 = t - previous.t;
+    rssr_state before = previous, after;
+    rssr_real blocked, reach, early = 0, before_cond = cond;
+    rssr_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = rssr_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = RSSR_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = rssr_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = RSSR_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (rssr_solve_step(options, p, blocked + reach, &after, work, report) == RSSR_OK) {
+            edge->outcome = RSSR_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

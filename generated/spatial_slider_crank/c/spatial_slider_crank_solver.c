@@ -21,6 +21,7 @@ void spatial_slider_crank_default_options(spatial_slider_crank_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int spatial_slider_crank_factor_jacobian(const spatial_slider_crank_optio
         return SPATIAL_SLIDER_CRANK_SINGULAR;
     }
     return SPATIAL_SLIDER_CRANK_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char spatial_slider_crank_length_column[SPATIAL_SLIDER_CRANK_NQ] = { 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0 };
+static const unsigned char spatial_slider_crank_length_row[SPATIAL_SLIDER_CRANK_NQ] = { 1, 1, 1, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void spatial_slider_crank_prepare(spatial_slider_crank_real unit, spatial_slider_crank_workspace *work)
+{
+    int i, e;
+    spatial_slider_crank_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && SPATIAL_SLIDER_CRANK_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+        work->column[i] = spatial_slider_crank_length_column[i] ? unit : 1;
+        work->row[i] = spatial_slider_crank_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < SPATIAL_SLIDER_CRANK_NNZ; ++e) {
+        work->nz_factor[e] = work->column[spatial_slider_crank_phi_q_col[e]] / work->row[spatial_slider_crank_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void spatial_slider_crank_in_unit(spatial_slider_crank_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < SPATIAL_SLIDER_CRANK_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void spatial_slider_crank_rows_in_unit(const spatial_slider_crank_workspace *work, spatial_slider_crank_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void spatial_slider_crank_from_unit(const spatial_slider_crank_workspace *work, spatial_slider_crank_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -363,9 +414,11 @@ static int spatial_slider_crank_converged(const spatial_slider_crank_options *op
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !spatial_slider_crank_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            spatial_slider_crank_from_unit(work, work->phi);
             for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             spatial_slider_crank_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            spatial_slider_crank_in_unit(work);
             report->residual = spatial_slider_crank_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -395,6 +448,7 @@ static int spatial_slider_crank_newton(const spatial_slider_crank_options *optio
         spatial_slider_crank_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         spatial_slider_crank_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        spatial_slider_crank_in_unit(work);
         residual = spatial_slider_crank_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -415,10 +469,11 @@ static int spatial_slider_crank_newton(const spatial_slider_crank_options *optio
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         spatial_slider_crank_lu_solve(&work->lu, work->phi);
+        step = spatial_slider_crank_max_abs(work->phi); /* in the run's unit */
+        spatial_slider_crank_from_unit(work, work->phi);
         for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = spatial_slider_crank_max_abs(work->phi);
     }
     return SPATIAL_SLIDER_CRANK_NO_CONVERGENCE;
 }
@@ -443,9 +498,7 @@ int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options,
     if (state->started) {
         spatial_slider_crank_predict(t, state);
     } else {
-        spatial_slider_crank_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        spatial_slider_crank_prepare(options->unit, work);
     }
     report->status = spatial_slider_crank_newton(options, p, t, state->q, work, report);
     report->fallbacks = spatial_slider_crank_lu_fallbacks(&work->lu);
@@ -458,15 +511,20 @@ int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options,
     for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    spatial_slider_crank_rows_in_unit(work, state->dq);
     spatial_slider_crank_lu_solve(&work->lu, state->dq); /* (2.73) */
+    spatial_slider_crank_from_unit(work, state->dq);
     spatial_slider_crank_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    spatial_slider_crank_rows_in_unit(work, state->ddq);
     spatial_slider_crank_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    spatial_slider_crank_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        const spatial_slider_crank_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const spatial_slider_crank_real c = fabs(state->ddq[i]);
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) { /* in the run's unit: q / column */
+        const spatial_slider_crank_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const spatial_slider_crank_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const spatial_slider_crank_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -561,11 +619,13 @@ int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (spatial_slider_crank_real)NAN;
         for (k = 0; k < n; ++k) {
             if (spatial_slider_crank_solve_step(options, p_set, t[k], state, work, &report) != SPATIAL_SLIDER_CRANK_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             spatial_slider_crank_store(q_set, k, state->q);
             spatial_slider_crank_store(dq_set, k, state->dq);
             spatial_slider_crank_store(ddq_set, k, state->ddq);
@@ -580,4 +640,66 @@ int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static spatial_slider_crank_real spatial_slider_crank_march(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[],
+                                 spatial_slider_crank_real target, spatial_slider_crank_real h0, spatial_slider_crank_real h_min,
+                                 spatial_slider_crank_state *state, spatial_slider_crank_workspace *work,
+                                 spatial_slider_crank_report *report, spatial_slider_crank_real *cond)
+{
+    spatial_slider_crank_real h = h0;
+    while (state->t < target) {
+        const spatial_slider_crank_real rest = target - state->t;
+        const spatial_slider_crank_real step = h < rest ? h : rest;
+        const spatial_slider_crank_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (spatial_slider_crank_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == SPATIAL_SLIDER_CRANK_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int spatial_slider_crank_solve_edge(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[],
+                            spatial_slider_crank_real t, spatial_slider_crank_real h_min, spatial_slider_crank_real delta,
+                            spatial_slider_crank_real cond, spatial_slider_crank_state *state,
+                            spatial_slider_crank_workspace *work, spatial_slider_crank_report *report,
+                            spatial_slider_crank_edge_report *edge)
+{
+    const spatial_slider_crank_state previous = *state;
+    const spatial_slider_crank_real h0 = t - previous.t;
+    spatial_slider_crank_state before = previous, after;
+    spatial_slider_crank_real blocked, reach, early = 0, before_cond = cond;
+    spatial_slider_crank_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = spatial_slider_crank_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = spatial_slider_crank_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (spatial_slider_crank_solve_step(options, p, blocked + reach, &after, work, report) == SPATIAL_SLIDER_CRANK_OK) {
+            edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

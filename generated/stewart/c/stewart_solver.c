@@ -21,6 +21,7 @@ void stewart_default_options(stewart_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define STEWART_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int stewart_factor_jacobian(const stewart_options *options, stewart_works
         return STEWART_SINGULAR;
     }
     return STEWART_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char stewart_length_column[STEWART_NQ] = { 1, 1, 1, 0, 0, 0, 0 };
+static const unsigned char stewart_length_row[STEWART_NQ] = { 1, 1, 1, 1, 1, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void stewart_prepare(stewart_real unit, stewart_workspace *work)
+{
+    int i, e;
+    stewart_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && STEWART_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < STEWART_NQ; ++i) {
+        work->column[i] = stewart_length_column[i] ? unit : 1;
+        work->row[i] = stewart_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < STEWART_NNZ; ++e) {
+        work->nz_factor[e] = work->column[stewart_phi_q_col[e]] / work->row[stewart_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void stewart_in_unit(stewart_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < STEWART_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < STEWART_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void stewart_rows_in_unit(const stewart_workspace *work, stewart_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < STEWART_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void stewart_from_unit(const stewart_workspace *work, stewart_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < STEWART_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -718,9 +769,11 @@ static int stewart_converged(const stewart_options *options, const stewart_real 
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !stewart_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            stewart_from_unit(work, work->phi);
             for (i = 0; i < STEWART_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             stewart_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            stewart_in_unit(work);
             report->residual = stewart_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -750,6 +803,7 @@ static int stewart_newton(const stewart_options *options, const stewart_real p[]
         stewart_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         stewart_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        stewart_in_unit(work);
         residual = stewart_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -770,10 +824,11 @@ static int stewart_newton(const stewart_options *options, const stewart_real p[]
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         stewart_lu_solve(&work->lu, work->phi);
+        step = stewart_max_abs(work->phi); /* in the run's unit */
+        stewart_from_unit(work, work->phi);
         for (i = 0; i < STEWART_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = stewart_max_abs(work->phi);
     }
     return STEWART_NO_CONVERGENCE;
 }
@@ -798,9 +853,7 @@ int stewart_solve_step(const stewart_options *options, const stewart_real p[], s
     if (state->started) {
         stewart_predict(t, state);
     } else {
-        stewart_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        stewart_prepare(options->unit, work);
     }
     report->status = stewart_newton(options, p, t, state->q, work, report);
     report->fallbacks = stewart_lu_fallbacks(&work->lu);
@@ -813,15 +866,20 @@ int stewart_solve_step(const stewart_options *options, const stewart_real p[], s
     for (i = 0; i < STEWART_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    stewart_rows_in_unit(work, state->dq);
     stewart_lu_solve(&work->lu, state->dq); /* (2.73) */
+    stewart_from_unit(work, state->dq);
     stewart_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    stewart_rows_in_unit(work, state->ddq);
     stewart_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    stewart_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < STEWART_NQ; ++i) {
-        const stewart_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const stewart_real c = fabs(state->ddq[i]);
+    for (i = 0; i < STEWART_NQ; ++i) { /* in the run's unit: q / column */
+        const stewart_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const stewart_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const stewart_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -916,11 +974,13 @@ int stewart_solve_batch(const stewart_options *options, int m, const stewart_rea
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (stewart_real)NAN;
         for (k = 0; k < n; ++k) {
             if (stewart_solve_step(options, p_set, t[k], state, work, &report) != STEWART_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             stewart_store(q_set, k, state->q);
             stewart_store(dq_set, k, state->dq);
             stewart_store(ddq_set, k, state->ddq);
@@ -935,4 +995,66 @@ int stewart_solve_batch(const stewart_options *options, int m, const stewart_rea
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static stewart_real stewart_march(const stewart_options *options, const stewart_real p[],
+                                 stewart_real target, stewart_real h0, stewart_real h_min,
+                                 stewart_state *state, stewart_workspace *work,
+                                 stewart_report *report, stewart_real *cond)
+{
+    stewart_real h = h0;
+    while (state->t < target) {
+        const stewart_real rest = target - state->t;
+        const stewart_real step = h < rest ? h : rest;
+        const stewart_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (stewart_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == STEWART_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int stewart_solve_edge(const stewart_options *options, const stewart_real p[],
+                            stewart_real t, stewart_real h_min, stewart_real delta,
+                            stewart_real cond, stewart_state *state,
+                            stewart_workspace *work, stewart_report *report,
+                            stewart_edge_report *edge)
+{
+    const stewart_state previous = *state;
+    const stewart_real h0 = t - previous.t;
+    stewart_state before = previous, after;
+    stewart_real blocked, reach, early = 0, before_cond = cond;
+    stewart_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = stewart_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = STEWART_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = stewart_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = STEWART_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (stewart_solve_step(options, p, blocked + reach, &after, work, report) == STEWART_OK) {
+            edge->outcome = STEWART_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

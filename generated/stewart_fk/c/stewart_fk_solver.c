@@ -21,6 +21,7 @@ void stewart_fk_default_options(stewart_fk_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define STEWART_FK_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int stewart_fk_factor_jacobian(const stewart_fk_options *options, stewart
         return STEWART_FK_SINGULAR;
     }
     return STEWART_FK_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char stewart_fk_length_column[STEWART_FK_NQ] = { 1, 1, 1, 0, 0, 0, 0 };
+static const unsigned char stewart_fk_length_row[STEWART_FK_NQ] = { 1, 1, 1, 1, 1, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void stewart_fk_prepare(stewart_fk_real unit, stewart_fk_workspace *work)
+{
+    int i, e;
+    stewart_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && STEWART_FK_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < STEWART_FK_NQ; ++i) {
+        work->column[i] = stewart_fk_length_column[i] ? unit : 1;
+        work->row[i] = stewart_fk_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < STEWART_FK_NNZ; ++e) {
+        work->nz_factor[e] = work->column[stewart_fk_phi_q_col[e]] / work->row[stewart_fk_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void stewart_fk_in_unit(stewart_fk_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < STEWART_FK_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < STEWART_FK_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void stewart_fk_rows_in_unit(const stewart_fk_workspace *work, stewart_fk_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < STEWART_FK_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void stewart_fk_from_unit(const stewart_fk_workspace *work, stewart_fk_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < STEWART_FK_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -718,9 +769,11 @@ static int stewart_fk_converged(const stewart_fk_options *options, const stewart
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !stewart_fk_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            stewart_fk_from_unit(work, work->phi);
             for (i = 0; i < STEWART_FK_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             stewart_fk_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            stewart_fk_in_unit(work);
             report->residual = stewart_fk_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -750,6 +803,7 @@ static int stewart_fk_newton(const stewart_fk_options *options, const stewart_fk
         stewart_fk_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         stewart_fk_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        stewart_fk_in_unit(work);
         residual = stewart_fk_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -770,10 +824,11 @@ static int stewart_fk_newton(const stewart_fk_options *options, const stewart_fk
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         stewart_fk_lu_solve(&work->lu, work->phi);
+        step = stewart_fk_max_abs(work->phi); /* in the run's unit */
+        stewart_fk_from_unit(work, work->phi);
         for (i = 0; i < STEWART_FK_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = stewart_fk_max_abs(work->phi);
     }
     return STEWART_FK_NO_CONVERGENCE;
 }
@@ -798,9 +853,7 @@ int stewart_fk_solve_step(const stewart_fk_options *options, const stewart_fk_re
     if (state->started) {
         stewart_fk_predict(t, state);
     } else {
-        stewart_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        stewart_fk_prepare(options->unit, work);
     }
     report->status = stewart_fk_newton(options, p, t, state->q, work, report);
     report->fallbacks = stewart_fk_lu_fallbacks(&work->lu);
@@ -813,15 +866,20 @@ int stewart_fk_solve_step(const stewart_fk_options *options, const stewart_fk_re
     for (i = 0; i < STEWART_FK_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    stewart_fk_rows_in_unit(work, state->dq);
     stewart_fk_lu_solve(&work->lu, state->dq); /* (2.73) */
+    stewart_fk_from_unit(work, state->dq);
     stewart_fk_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    stewart_fk_rows_in_unit(work, state->ddq);
     stewart_fk_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    stewart_fk_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < STEWART_FK_NQ; ++i) {
-        const stewart_fk_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const stewart_fk_real c = fabs(state->ddq[i]);
+    for (i = 0; i < STEWART_FK_NQ; ++i) { /* in the run's unit: q / column */
+        const stewart_fk_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const stewart_fk_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const stewart_fk_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -879,9 +937,7 @@ int stewart_fk_solve_inputs(const stewart_fk_options *options, const stewart_fk_
     report->flagged = 0;
     report->cond = (stewart_fk_real)NAN;
     if (!state->started) {
-        stewart_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        stewart_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess. */
     report->status = stewart_fk_newton(options, pu, state->t, state->q, work, report);
@@ -993,11 +1049,13 @@ int stewart_fk_solve_batch(const stewart_fk_options *options, int m, const stewa
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (stewart_fk_real)NAN;
         for (k = 0; k < n; ++k) {
             if (stewart_fk_solve_step(options, p_set, t[k], state, work, &report) != STEWART_FK_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             stewart_fk_store(q_set, k, state->q);
             stewart_fk_store(dq_set, k, state->dq);
             stewart_fk_store(ddq_set, k, state->ddq);
@@ -1012,4 +1070,66 @@ int stewart_fk_solve_batch(const stewart_fk_options *options, int m, const stewa
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static stewart_fk_real stewart_fk_march(const stewart_fk_options *options, const stewart_fk_real p[],
+                                 stewart_fk_real target, stewart_fk_real h0, stewart_fk_real h_min,
+                                 stewart_fk_state *state, stewart_fk_workspace *work,
+                                 stewart_fk_report *report, stewart_fk_real *cond)
+{
+    stewart_fk_real h = h0;
+    while (state->t < target) {
+        const stewart_fk_real rest = target - state->t;
+        const stewart_fk_real step = h < rest ? h : rest;
+        const stewart_fk_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (stewart_fk_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == STEWART_FK_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int stewart_fk_solve_edge(const stewart_fk_options *options, const stewart_fk_real p[],
+                            stewart_fk_real t, stewart_fk_real h_min, stewart_fk_real delta,
+                            stewart_fk_real cond, stewart_fk_state *state,
+                            stewart_fk_workspace *work, stewart_fk_report *report,
+                            stewart_fk_edge_report *edge)
+{
+    const stewart_fk_state previous = *state;
+    const stewart_fk_real h0 = t - previous.t;
+    stewart_fk_state before = previous, after;
+    stewart_fk_real blocked, reach, early = 0, before_cond = cond;
+    stewart_fk_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = stewart_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = STEWART_FK_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = stewart_fk_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = STEWART_FK_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (stewart_fk_solve_step(options, p, blocked + reach, &after, work, report) == STEWART_FK_OK) {
+            edge->outcome = STEWART_FK_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

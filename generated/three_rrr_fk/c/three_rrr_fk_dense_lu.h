@@ -16,7 +16,9 @@
 
 typedef struct {
     three_rrr_fk_real a[THREE_RRR_FK_NQ * THREE_RRR_FK_NQ]; /* unit L below the diagonal, U on and above; row-major */
+    three_rrr_fk_real inv[THREE_RRR_FK_NQ]; /* 1 / u_kk, the reciprocals of the pivots */
     int perm[THREE_RRR_FK_NQ];           /* row k of the factors is row perm[k] of Phi_q */
+    three_rrr_fk_real pivot_ratio;       /* min |u_kk| / max |u_kk| of the last complete factorization */
 } three_rrr_fk_dense_lu;
 
 /* NQ * epsilon * max |nz|: a pivot at or below it is numerically zero (NaN when nz has one). */

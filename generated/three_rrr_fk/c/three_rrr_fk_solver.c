@@ -21,6 +21,7 @@ void three_rrr_fk_default_options(three_rrr_fk_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define THREE_RRR_FK_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int three_rrr_fk_factor_jacobian(const three_rrr_fk_options *options, thr
         return THREE_RRR_FK_SINGULAR;
     }
     return THREE_RRR_FK_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char three_rrr_fk_length_column[THREE_RRR_FK_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char three_rrr_fk_length_row[THREE_RRR_FK_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void three_rrr_fk_prepare(three_rrr_fk_real unit, three_rrr_fk_workspace *work)
+{
+    int i, e;
+    three_rrr_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && THREE_RRR_FK_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+        work->column[i] = three_rrr_fk_length_column[i] ? unit : 1;
+        work->row[i] = three_rrr_fk_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) {
+        work->nz_factor[e] = work->column[three_rrr_fk_phi_q_col[e]] / work->row[three_rrr_fk_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void three_rrr_fk_in_unit(three_rrr_fk_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void three_rrr_fk_rows_in_unit(const three_rrr_fk_workspace *work, three_rrr_fk_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void three_rrr_fk_from_unit(const three_rrr_fk_workspace *work, three_rrr_fk_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -110,8 +161,9 @@ static const three_rrr_fk_real three_rrr_fk_alternating[THREE_RRR_FK_NQ] = {
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
  * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
-static three_rrr_fk_real three_rrr_fk_inverse_norm1(const three_rrr_fk_lu *lu)
+static three_rrr_fk_real three_rrr_fk_inverse_norm1_rows(const three_rrr_fk_lu *lu, const three_rrr_fk_real rows[])
 {
     three_rrr_fk_real y[THREE_RRR_FK_NQ], z[THREE_RRR_FK_NQ], estimate = 0, norm, extra = 0;
     int i, j = -1, step;
@@ -119,7 +171,7 @@ static three_rrr_fk_real three_rrr_fk_inverse_norm1(const three_rrr_fk_lu *lu)
      * processor can overlap the two chains of dependent operations */
     memcpy(z, three_rrr_fk_alternating, sizeof z);
     three_rrr_fk_lu_solve(lu, z);
-    for (i = 0; i < THREE_RRR_FK_NQ; ++i) extra += fabs(z[i]);
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) extra += fabs(rows ? z[i] * rows[i] : z[i]);
     for (step = 0; step < THREE_RRR_FK_ESTIMATOR_STEPS; ++step) {
         three_rrr_fk_real dot, best, finite = 0;
         int jmax = 0;
@@ -132,9 +184,11 @@ static three_rrr_fk_real three_rrr_fk_inverse_norm1(const three_rrr_fk_lu *lu)
         three_rrr_fk_lu_solve(lu, y);
         norm = 0;
         for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+            if (rows) y[i] *= rows[i]; /* 0 * inf is NaN: still not finite */
             norm += fabs(y[i]);
             /* sign(y_i), +1 at 0 (also -0: -0 + 0 is +0), branch-free; unused on a break */
             y[i] = copysign(1, y[i] + 0);
+            if (rows) y[i] *= rows[i];
         }
         if (norm - norm != 0) return (three_rrr_fk_real)INFINITY;
         if (step > 0 && norm <= estimate) break;
@@ -163,6 +217,11 @@ static three_rrr_fk_real three_rrr_fk_inverse_norm1(const three_rrr_fk_lu *lu)
     extra = 2 * extra / (3 * THREE_RRR_FK_NQ);
     if (extra - extra != 0) return (three_rrr_fk_real)INFINITY;
     return extra > estimate ? extra : estimate;
+}
+
+static three_rrr_fk_real three_rrr_fk_inverse_norm1(const three_rrr_fk_lu *lu)
+{
+    return three_rrr_fk_inverse_norm1_rows(lu, NULL);
 }
 
 /* Column sums of |Phi_q| (entries known at generation time folded in, the order of the
@@ -445,43 +504,43 @@ static int three_rrr_fk_exact_estimate(const three_rrr_fk_workspace *work)
     return !work->lu.dense;
 }
 
+/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
+ * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
+static three_rrr_fk_real three_rrr_fk_difference_bound1(const three_rrr_fk_real a[], const three_rrr_fk_real b[])
+{
+    three_rrr_fk_real sum = 0;
+    int e;
+    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) sum += fabs(a[e] - b[e]);
+    return sum;
+}
+
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
+ * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
+ * or where the exact code would be long) is a chain of four or more solves, most of a dense
+ * step: it is made afresh only when Phi_q has moved too far from where the last one was made
+ * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
+ * a few per cent above the old one (it errs towards flagging), for one pass over the
+ * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
 static void three_rrr_fk_estimate(three_rrr_fk_workspace *work, three_rrr_fk_report *report)
 {
-    /* exact on the sparse factors, Hager's estimate on the dense fall-back's */
-    report->inv_norm = three_rrr_fk_exact_estimate(work)
-        ? three_rrr_fk_inverse_norm1_exact(work->lu.v, work->lu.inv)
-        : three_rrr_fk_inverse_norm1(&work->lu);
-    report->cond = report->inv_norm * three_rrr_fk_norm1(work->nz);
-}
-
-/* ||A - B||_1 of two sets of non-zeros of Phi_q (same pattern). */
-static three_rrr_fk_real three_rrr_fk_difference_norm1(const three_rrr_fk_real a[], const three_rrr_fk_real b[])
-{
-    three_rrr_fk_real sums[THREE_RRR_FK_NQ], largest = 0;
-    int e, j;
-    for (j = 0; j < THREE_RRR_FK_NQ; ++j) sums[j] = 0;
-    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) sums[three_rrr_fk_phi_q_col[e]] += fabs(a[e] - b[e]);
-    for (j = 0; j < THREE_RRR_FK_NQ; ++j) largest = sums[j] > largest ? sums[j] : largest;
-    return largest;
-}
-
-/* The estimate again after Newton moved q from where it was made (Phi_q then was in
- * work->nz_estimated). The exact norm is recomputed. Hager's estimate is not: with
- * theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
- * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
- * a few per cent above the old one, for the price of one pass over the non-zeros. */
-static void three_rrr_fk_estimate_again(three_rrr_fk_workspace *work, three_rrr_fk_report *report)
-{
     three_rrr_fk_real theta;
-    if (!three_rrr_fk_exact_estimate(work)) {
-        theta = report->inv_norm * three_rrr_fk_difference_norm1(work->nz, work->nz_estimated);
-        if (theta <= THREE_RRR_FK_REESTIMATE_SHIFT) {
-            report->inv_norm /= 1 - theta;
-            report->cond = report->inv_norm * three_rrr_fk_norm1(work->nz);
-            return;
-        }
+    if (three_rrr_fk_exact_estimate(work)) {
+        report->inv_norm = three_rrr_fk_inverse_norm1_exact(work->lu.v, work->lu.inv);
+        report->cond = report->inv_norm * three_rrr_fk_norm1(work->nz);
+        return;
     }
-    three_rrr_fk_estimate(work, report);
+    /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
+    theta = work->estimated_inv_norm * three_rrr_fk_difference_bound1(work->nz, work->nz_estimated);
+    if (work->estimated_inv_norm >= 0 && theta <= THREE_RRR_FK_REESTIMATE_SHIFT) {
+        report->inv_norm = work->estimated_inv_norm / (1 - theta);
+    } else {
+        report->inv_norm = three_rrr_fk_inverse_norm1(&work->lu);
+        work->estimated_inv_norm = report->inv_norm;
+        memcpy(work->nz_estimated, work->nz, sizeof work->nz);
+    }
+    report->cond = report->inv_norm * three_rrr_fk_norm1(work->nz);
 }
 
 static three_rrr_fk_real three_rrr_fk_at_least_1(three_rrr_fk_real x)
@@ -506,6 +565,54 @@ static int three_rrr_fk_flagged(const three_rrr_fk_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * three_rrr_fk_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * three_rrr_fk_at_least_1(ndq));
+    return THREE_RRR_FK_SAFETY * e_q > options->target_q * three_rrr_fk_at_least_1(nq)
+        || THREE_RRR_FK_SAFETY * e_dq > options->target_dq * three_rrr_fk_at_least_1(ndq)
+        || THREE_RRR_FK_SAFETY * e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq);
+}
+
+/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
+static const three_rrr_fk_real three_rrr_fk_nonlinear[THREE_RRR_FK_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
+
+/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
+static three_rrr_fk_real three_rrr_fk_nonlinear_max(const three_rrr_fk_real v[])
+{
+    three_rrr_fk_real largest = 0;
+    int i;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+        const three_rrr_fk_real a = three_rrr_fk_nonlinear[i] != 0 ? fabs(v[i]) : 0;
+        largest = a > largest ? a : largest;
+    }
+    return largest;
+}
+
+/* The refined model of runtime.accuracy: where the model of every coordinate flags the
+ * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
+ * P their rows) and their velocities and accelerations carry the error of q into dq and
+ * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
+ * for (their norms over every coordinate stand in). */
+static int three_rrr_fk_flagged_refined(const three_rrr_fk_options *options,
+                                        const three_rrr_fk_workspace *work,
+                                        const three_rrr_fk_report *report, three_rrr_fk_real nq,
+                                        three_rrr_fk_real ndq, three_rrr_fk_real nddq, const three_rrr_fk_real dq[],
+                                        const three_rrr_fk_real ddq[])
+{
+    const three_rrr_fk_real u = THREE_RRR_FK_UNIT_ROUNDOFF;
+    const three_rrr_fk_real root = sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
+    const three_rrr_fk_real s = report->inv_norm / root;
+    const three_rrr_fk_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    three_rrr_fk_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    if (!three_rrr_fk_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    s_n = three_rrr_fk_inverse_norm1_rows(&work->lu, three_rrr_fk_nonlinear) / root;
+    if (s_n - s_n != 0) return 1;
+    ndq_n = dq ? three_rrr_fk_nonlinear_max(dq) : ndq;
+    nddq_n = ddq ? three_rrr_fk_nonlinear_max(ddq) : nddq;
+    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
+    bound = left < s_n * report->residual ? left : s_n * report->residual;
+    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
+    e_dq = s * (u * ndq + e_n * three_rrr_fk_at_least_1(ndq_n));
+    e_dq_n = s_n * (u * ndq + e_n * three_rrr_fk_at_least_1(ndq_n));
+    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
+                 + 2 * e_dq_n * three_rrr_fk_at_least_1(ndq_n));
     return THREE_RRR_FK_SAFETY * e_q > options->target_q * three_rrr_fk_at_least_1(nq)
         || THREE_RRR_FK_SAFETY * e_dq > options->target_dq * three_rrr_fk_at_least_1(ndq)
         || THREE_RRR_FK_SAFETY * e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq);
@@ -550,12 +657,11 @@ static int three_rrr_fk_converged(const three_rrr_fk_options *options, const thr
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !three_rrr_fk_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            three_rrr_fk_from_unit(work, work->phi);
             for (i = 0; i < THREE_RRR_FK_NQ; ++i) q[i] += work->phi[i];
-            if (!moved) { /* Phi_q where the estimate was made */
-                memcpy(work->nz_estimated, work->nz, sizeof work->nz);
-            }
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             three_rrr_fk_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            three_rrr_fk_in_unit(work);
             report->residual = three_rrr_fk_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -566,7 +672,7 @@ static int three_rrr_fk_converged(const three_rrr_fk_options *options, const thr
             if (!ill && !three_rrr_fk_would_flag(options, work, report)) break;
         }
         if (moved) {
-            three_rrr_fk_estimate_again(work, report);
+            three_rrr_fk_estimate(work, report);
         }
     }
     return report->cond <= options->max_cond ? THREE_RRR_FK_OK : THREE_RRR_FK_SINGULAR;
@@ -585,6 +691,7 @@ static int three_rrr_fk_newton(const three_rrr_fk_options *options, const three_
         three_rrr_fk_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         three_rrr_fk_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        three_rrr_fk_in_unit(work);
         residual = three_rrr_fk_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -605,10 +712,11 @@ static int three_rrr_fk_newton(const three_rrr_fk_options *options, const three_
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         three_rrr_fk_lu_solve(&work->lu, work->phi);
+        step = three_rrr_fk_max_abs(work->phi); /* in the run's unit */
+        three_rrr_fk_from_unit(work, work->phi);
         for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = three_rrr_fk_max_abs(work->phi);
     }
     return THREE_RRR_FK_NO_CONVERGENCE;
 }
@@ -633,8 +741,7 @@ int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr
     if (state->started) {
         three_rrr_fk_predict(t, state);
     } else {
-        three_rrr_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        three_rrr_fk_prepare(options->unit, work);
     }
     report->status = three_rrr_fk_newton(options, p, t, state->q, work, report);
     report->fallbacks = three_rrr_fk_lu_fallbacks(&work->lu);
@@ -647,15 +754,20 @@ int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr
     for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    three_rrr_fk_rows_in_unit(work, state->dq);
     three_rrr_fk_lu_solve(&work->lu, state->dq); /* (2.73) */
+    three_rrr_fk_from_unit(work, state->dq);
     three_rrr_fk_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    three_rrr_fk_rows_in_unit(work, state->ddq);
     three_rrr_fk_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    three_rrr_fk_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
-        const three_rrr_fk_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const three_rrr_fk_real c = fabs(state->ddq[i]);
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) { /* in the run's unit: q / column */
+        const three_rrr_fk_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const three_rrr_fk_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const three_rrr_fk_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -667,8 +779,9 @@ int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr
         report->status = THREE_RRR_FK_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = three_rrr_fk_flagged(options, work, report,
-                                           sum_q != sum_q ? (three_rrr_fk_real)NAN : nq, ndq, nddq);
+    report->flagged = three_rrr_fk_flagged_refined(options, work, report,
+                                                   sum_q != sum_q ? (three_rrr_fk_real)NAN : nq, ndq,
+                                                   nddq, state->dq, state->ddq);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -712,8 +825,7 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
     report->flagged = 0;
     report->cond = (three_rrr_fk_real)NAN;
     if (!state->started) {
-        three_rrr_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        three_rrr_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess. */
     report->status = three_rrr_fk_newton(options, pu, state->t, state->q, work, report);
@@ -743,7 +855,9 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
         if (!rates) state->dq[i] = (three_rrr_fk_real)NAN;
         if (!accelerations) state->ddq[i] = (three_rrr_fk_real)NAN;
     }
-    report->flagged = three_rrr_fk_flagged(options, work, report, nq, ndq, nddq);
+    report->flagged = three_rrr_fk_flagged_refined(options, work, report, nq, ndq, nddq,
+                                                   rates ? state->dq : NULL,
+                                                   accelerations ? state->ddq : NULL);
     work->norms[0] = nq;
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -823,11 +937,13 @@ int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, int m, const t
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (three_rrr_fk_real)NAN;
         for (k = 0; k < n; ++k) {
             if (three_rrr_fk_solve_step(options, p_set, t[k], state, work, &report) != THREE_RRR_FK_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             three_rrr_fk_store(q_set, k, state->q);
             three_rrr_fk_store(dq_set, k, state->dq);
             three_rrr_fk_store(ddq_set, k, state->ddq);
@@ -842,4 +958,66 @@ int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, int m, const t
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static three_rrr_fk_real three_rrr_fk_march(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
+                                 three_rrr_fk_real target, three_rrr_fk_real h0, three_rrr_fk_real h_min,
+                                 three_rrr_fk_state *state, three_rrr_fk_workspace *work,
+                                 three_rrr_fk_report *report, three_rrr_fk_real *cond)
+{
+    three_rrr_fk_real h = h0;
+    while (state->t < target) {
+        const three_rrr_fk_real rest = target - state->t;
+        const three_rrr_fk_real step = h < rest ? h : rest;
+        const three_rrr_fk_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (three_rrr_fk_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == THREE_RRR_FK_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int three_rrr_fk_solve_edge(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
+                            three_rrr_fk_real t, three_rrr_fk_real h_min, three_rrr_fk_real delta,
+                            three_rrr_fk_real cond, three_rrr_fk_state *state,
+                            three_rrr_fk_workspace *work, three_rrr_fk_report *report,
+                            three_rrr_fk_edge_report *edge)
+{
+    const three_rrr_fk_state previous = *state;
+    const three_rrr_fk_real h0 = t - previous.t;
+    three_rrr_fk_state before = previous, after;
+    three_rrr_fk_real blocked, reach, early = 0, before_cond = cond;
+    three_rrr_fk_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = three_rrr_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = THREE_RRR_FK_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = three_rrr_fk_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = THREE_RRR_FK_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (three_rrr_fk_solve_step(options, p, blocked + reach, &after, work, report) == THREE_RRR_FK_OK) {
+            edge->outcome = THREE_RRR_FK_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }

@@ -35,7 +35,19 @@ typedef struct {
     three_rrr_fk_real target_q;        /* flagged when the estimated error of q, dq or    */
     three_rrr_fk_real target_dq;       /* ddq exceeds its target times max(1, max|x|)     */
     three_rrr_fk_real target_ddq;
+    three_rrr_fk_real unit;            /* the length unit the decisions are made in: the     */
+                                       /* tolerances, the singularity test and the flags   */
+                                       /* see lengths (q's x, y, z and Phi's length rows)  */
+                                       /* divided by it, angles as they are. q, dq, ddq in  */
+                                       /* and out stay in the mechanism's own unit. 1 (the */
+                                       /* default): that unit. A mechanism drawn in mm is  */
+                                       /* decided alike with unit 1000. Ignored where      */
+                                       /* THREE_RRR_FK_SCALE_FREE is 0 and by three_rrr_fk_solve_inputs. */
 } three_rrr_fk_options;
+
+/* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
+ * written as a number (folded into the generated code, it cannot be rescaled at run time). */
+#define THREE_RRR_FK_SCALE_FREE 1
 
 typedef struct {
     int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -67,8 +79,14 @@ typedef struct {
     three_rrr_fk_real phi[THREE_RRR_FK_NQ]; /* Phi, then the Newton step */
     three_rrr_fk_real shared[14]; /* sin, cos of the last iterate (three_rrr_fk_phi_phi_q) */
     three_rrr_fk_real nz_estimated[THREE_RRR_FK_NNZ]; /* Phi_q where the condition was estimated */
+    three_rrr_fk_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     three_rrr_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     three_rrr_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    three_rrr_fk_real column[THREE_RRR_FK_NQ]; /* options->unit where q_i is a length, else 1 */
+    three_rrr_fk_real inverse_column[THREE_RRR_FK_NQ]; /* 1 / column */
+    three_rrr_fk_real row[THREE_RRR_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */
+    three_rrr_fk_real nz_factor[THREE_RRR_FK_NNZ]; /* column / row of each non-zero */
+    int scaled; /* the decisions are made in a unit other than 1 */
 } three_rrr_fk_workspace;
 
 /* Tolerances suited to the real type. */
@@ -119,6 +137,7 @@ typedef struct {
     three_rrr_fk_real t;         /* the time of the last step attempted (t[n-1] when OK)    */
     int iterations;              /* Newton iterations summed over the set's steps           */
     three_rrr_fk_real residual;  /* max|Phi| of the last iterate                            */
+    three_rrr_fk_real cond;      /* the condition estimate at the last point solved (NaN: none) */
 } three_rrr_fk_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
@@ -134,5 +153,33 @@ int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, int m, const t
                              three_rrr_fk_real dq_out[], three_rrr_fk_real ddq_out[],
                              three_rrr_fk_state *state, three_rrr_fk_workspace *work,
                              three_rrr_fk_batch_report reports[]);
+
+#define THREE_RRR_FK_EDGE_REACHED 0  /* the substeps reached t                                */
+#define THREE_RRR_FK_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */
+#define THREE_RRR_FK_EDGE_STOPPED 2  /* blocked, and no step over it converges                */
+
+/* What three_rrr_fk_solve_edge found. */
+typedef struct {
+    int outcome;                 /* THREE_RRR_FK_EDGE_REACHED, _PASSABLE or _STOPPED          */
+    three_rrr_fk_real failed;    /* the step that failed from the last point reached (0: none) */
+    three_rrr_fk_real cond;      /* the condition estimate at the last point reached          */
+} three_rrr_fk_edge_report;
+
+/* A time t that the plain step from a solved state could not reach (the point where
+ * three_rrr_fk_solve_grid stopped), treated as symkin's runtime does before it decides (its
+ * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
+ * blocked time b; then, from the last point reached substepping towards b - delta, steps to
+ * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the
+ * position passable. Each substep is a three_rrr_fk_solve_step with no last point for the error
+ * model. On return state is the last point reached (t itself when reached) and
+ * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
+ * bisection to a limit position: the motion stops between state->t and state->t +
+ * edge->failed. The workspace is set up here. Returns edge->outcome. */
+int three_rrr_fk_solve_edge(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
+                            three_rrr_fk_real t, three_rrr_fk_real h_min, three_rrr_fk_real delta,
+                            three_rrr_fk_real cond, three_rrr_fk_state *state,
+                            three_rrr_fk_workspace *work, three_rrr_fk_report *report,
+                            three_rrr_fk_edge_report *edge);
 
 #endif /* THREE_RRR_FK_SOLVER_H */

@@ -83,6 +83,8 @@ PATTERN_ROWS = numpy.array([0, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 6, 7
 PATTERN_COLS = numpy.array([0, 1, 0, 2, 9, 1, 2, 10, 9, 11, 18, 20, 10, 11, 19, 20, 3, 4, 3, 5, 12, 4, 5,
     13, 12, 14, 18, 20, 13, 14, 19, 20, 6, 7, 6, 8, 15, 7, 8, 16, 15, 17, 18, 20,
     16, 17, 19, 20, 2, 5, 8], dtype=numpy.intp)
+# The coordinates that enter Phi_q or Phi_t: only their errors move Phi_q (the error model).
+NONLINEAR = numpy.array([0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1], dtype=bool)
 POINTS = (
     ('prox1', 'A1'),
     ('prox1', 'E1'),

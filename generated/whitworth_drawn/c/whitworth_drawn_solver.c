@@ -21,6 +21,7 @@ void whitworth_drawn_default_options(whitworth_drawn_options *options)
     options->target_q = 1e-08;
     options->target_dq = 1e-07;
     options->target_ddq = 1e-06;
+    options->unit = 1.0;
 }
 
 #define WHITWORTH_DRAWN_UNIT_ROUNDOFF DBL_EPSILON
@@ -56,6 +57,56 @@ static int whitworth_drawn_factor_jacobian(const whitworth_drawn_options *option
         return WHITWORTH_DRAWN_SINGULAR;
     }
     return WHITWORTH_DRAWN_OK;
+}
+
+/* Which coordinates and which rows of Phi are lengths (symkin.contract.lengths). */
+static const unsigned char whitworth_drawn_length_column[WHITWORTH_DRAWN_NQ] = { 1, 1, 0, 1, 1, 0, 1, 1, 0, 1, 1, 0 };
+static const unsigned char whitworth_drawn_length_row[WHITWORTH_DRAWN_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 1, 0 };
+
+/* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
+ * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
+ * runtime.units), so Phi~_q = Phi_q column / row. */
+static void whitworth_drawn_prepare(whitworth_drawn_real unit, whitworth_drawn_workspace *work)
+{
+    int i, e;
+    whitworth_drawn_lu_init(&work->lu); /* the caller's workspace may hold anything */
+    work->norms[0] = work->norms[1] = work->norms[2] = 0;
+    work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->scaled = unit != 1 && WHITWORTH_DRAWN_SCALE_FREE;
+    if (!work->scaled) unit = 1;
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
+        work->column[i] = whitworth_drawn_length_column[i] ? unit : 1;
+        work->row[i] = whitworth_drawn_length_row[i] ? unit : 1;
+        work->inverse_column[i] = 1 / work->column[i];
+    }
+    for (e = 0; e < WHITWORTH_DRAWN_NNZ; ++e) {
+        work->nz_factor[e] = work->column[whitworth_drawn_phi_q_col[e]] / work->row[whitworth_drawn_phi_q_row[e]];
+    }
+}
+
+/* Phi and the non-zeros of Phi_q just evaluated, seen in the run's unit. */
+static void whitworth_drawn_in_unit(whitworth_drawn_workspace *work)
+{
+    int i, e;
+    if (!work->scaled) return;
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) work->phi[i] /= work->row[i];
+    for (e = 0; e < WHITWORTH_DRAWN_NNZ; ++e) work->nz[e] *= work->nz_factor[e];
+}
+
+/* A right-hand side of Phi's rows (v[NQ]) seen in the run's unit. */
+static void whitworth_drawn_rows_in_unit(const whitworth_drawn_workspace *work, whitworth_drawn_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) v[i] /= work->row[i];
+}
+
+/* A solution in the run's unit (v[NQ]) back in the mechanism's own. */
+static void whitworth_drawn_from_unit(const whitworth_drawn_workspace *work, whitworth_drawn_real v[])
+{
+    int i;
+    if (!work->scaled) return;
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) v[i] *= work->column[i];
 }
 
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -424,9 +475,11 @@ static int whitworth_drawn_converged(const whitworth_drawn_options *options, con
             work->correction = size - size == 0 ? size : -1;
             if (!ill && !whitworth_drawn_would_flag(options, work, report)) break;
             if (!(size > 0 && size <= step / 2)) break;
+            whitworth_drawn_from_unit(work, work->phi);
             for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) q[i] += work->phi[i];
             /* the fused call also refreshes the sines and cosines Phi_t and Gamma read */
             whitworth_drawn_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+            whitworth_drawn_in_unit(work);
             report->residual = whitworth_drawn_max_abs(work->phi);
             work->correction = -1;
             step = size;
@@ -456,6 +509,7 @@ static int whitworth_drawn_newton(const whitworth_drawn_options *options, const 
         whitworth_drawn_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         whitworth_drawn_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
+        whitworth_drawn_in_unit(work);
         residual = whitworth_drawn_max_abs(work->phi);
         report->residual = residual;
         report->iterations = iteration;
@@ -476,10 +530,11 @@ static int whitworth_drawn_newton(const whitworth_drawn_options *options, const 
             work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
         }
         whitworth_drawn_lu_solve(&work->lu, work->phi);
+        step = whitworth_drawn_max_abs(work->phi); /* in the run's unit */
+        whitworth_drawn_from_unit(work, work->phi);
         for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
             q[i] += work->phi[i];
         }
-        step = whitworth_drawn_max_abs(work->phi);
     }
     return WHITWORTH_DRAWN_NO_CONVERGENCE;
 }
@@ -504,9 +559,7 @@ int whitworth_drawn_solve_step(const whitworth_drawn_options *options, const whi
     if (state->started) {
         whitworth_drawn_predict(t, state);
     } else {
-        whitworth_drawn_lu_init(&work->lu); /* the caller's workspace may hold anything */
-        work->norms[0] = work->norms[1] = work->norms[2] = 0;
-        work->estimated_inv_norm = -1; /* no condition estimate to start from */
+        whitworth_drawn_prepare(options->unit, work);
     }
     report->status = whitworth_drawn_newton(options, p, t, state->q, work, report);
     report->fallbacks = whitworth_drawn_lu_fallbacks(&work->lu);
@@ -519,15 +572,20 @@ int whitworth_drawn_solve_step(const whitworth_drawn_options *options, const whi
     for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
         state->dq[i] = -state->dq[i];
     }
+    whitworth_drawn_rows_in_unit(work, state->dq);
     whitworth_drawn_lu_solve(&work->lu, state->dq); /* (2.73) */
+    whitworth_drawn_from_unit(work, state->dq);
     whitworth_drawn_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
+    whitworth_drawn_rows_in_unit(work, state->ddq);
     whitworth_drawn_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
+    whitworth_drawn_from_unit(work, state->ddq);
     /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
      * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
     nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
-        const whitworth_drawn_real a = fabs(state->q[i]), b = fabs(state->dq[i]);
-        const whitworth_drawn_real c = fabs(state->ddq[i]);
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) { /* in the run's unit: q / column */
+        const whitworth_drawn_real a = fabs(state->q[i]) * work->inverse_column[i];
+        const whitworth_drawn_real b = fabs(state->dq[i]) * work->inverse_column[i];
+        const whitworth_drawn_real c = fabs(state->ddq[i]) * work->inverse_column[i];
         nq = a > nq ? a : nq;
         ndq = b > ndq ? b : ndq;
         nddq = c > nddq ? c : nddq;
@@ -622,11 +680,13 @@ int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, int m, c
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
+        out->cond = (whitworth_drawn_real)NAN;
         for (k = 0; k < n; ++k) {
             if (whitworth_drawn_solve_step(options, p_set, t[k], state, work, &report) != WHITWORTH_DRAWN_OK) {
                 break;
             }
             out->iterations += report.iterations;
+            out->cond = report.cond;
             whitworth_drawn_store(q_set, k, state->q);
             whitworth_drawn_store(dq_set, k, state->dq);
             whitworth_drawn_store(ddq_set, k, state->ddq);
@@ -641,4 +701,66 @@ int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, int m, c
         solved_sets += k == n;
     }
     return solved_sets;
+}
+
+/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+ * success up to h0. Returns the step that failed from the last point reached (state), 0 when
+ * target was reached; *cond: the condition estimate at that point. */
+static whitworth_drawn_real whitworth_drawn_march(const whitworth_drawn_options *options, const whitworth_drawn_real p[],
+                                 whitworth_drawn_real target, whitworth_drawn_real h0, whitworth_drawn_real h_min,
+                                 whitworth_drawn_state *state, whitworth_drawn_workspace *work,
+                                 whitworth_drawn_report *report, whitworth_drawn_real *cond)
+{
+    whitworth_drawn_real h = h0;
+    while (state->t < target) {
+        const whitworth_drawn_real rest = target - state->t;
+        const whitworth_drawn_real step = h < rest ? h : rest;
+        const whitworth_drawn_state saved = *state;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
+        if (whitworth_drawn_solve_step(options, p, step == rest ? target : state->t + step, state,
+                                   work, report) == WHITWORTH_DRAWN_OK) {
+            *cond = report->cond;
+            h = 2 * step < h0 ? 2 * step : h0;
+        } else {
+            *state = saved; /* a failed step leaves its last iterate there */
+            if (step <= h_min) return step;
+            h = step / 2;
+        }
+    }
+    return 0;
+}
+
+int whitworth_drawn_solve_edge(const whitworth_drawn_options *options, const whitworth_drawn_real p[],
+                            whitworth_drawn_real t, whitworth_drawn_real h_min, whitworth_drawn_real delta,
+                            whitworth_drawn_real cond, whitworth_drawn_state *state,
+                            whitworth_drawn_workspace *work, whitworth_drawn_report *report,
+                            whitworth_drawn_edge_report *edge)
+{
+    const whitworth_drawn_state previous = *state;
+    const whitworth_drawn_real h0 = t - previous.t;
+    whitworth_drawn_state before = previous, after;
+    whitworth_drawn_real blocked, reach, early = 0, before_cond = cond;
+    whitworth_drawn_prepare(options->unit, work);
+    state->started = before.started = 1;
+    edge->cond = cond;
+    edge->failed = whitworth_drawn_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    if (edge->failed == 0) {
+        edge->outcome = WHITWORTH_DRAWN_EDGE_REACHED;
+        return edge->outcome;
+    }
+    blocked = state->t + edge->failed;
+    if (blocked - delta > previous.t) {
+        early = whitworth_drawn_march(options, p, blocked - delta, h0, h_min, &before, work, report,
+                                  &before_cond);
+    }
+    edge->outcome = WHITWORTH_DRAWN_EDGE_STOPPED;
+    for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
+        after = before;
+        work->norms[0] = work->norms[1] = work->norms[2] = 0;
+        if (whitworth_drawn_solve_step(options, p, blocked + reach, &after, work, report) == WHITWORTH_DRAWN_OK) {
+            edge->outcome = WHITWORTH_DRAWN_EDGE_PASSABLE;
+            break;
+        }
+    }
+    return edge->outcome;
 }
