@@ -17,7 +17,7 @@ a plain number stays a number, so a numeric drawing gives a numeric local form.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -252,13 +252,16 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
     if layout_of(data) != "drawn":
         return local
     drawing = Drawing(data)
+
+    def place(body: str, point: Any, path: Path_) -> Any:
+        return drawing.point(body, point, path)[0]
     local["bodies"] = {body: {"q0": drawing.q0(body),
                               "points": {name: drawing.texts(drawing.local(body, point))
                                          for name, point in drawing.points[body].items()},
-                              **_dynamics(drawing, body, data["bodies"][body])}
+                              **body_dynamics(data["bodies"][body], body, place)}
                        for body in drawing.frames if body != GROUND}
     if "forces" in data:
-        local["forces"] = [_load(drawing, item, ("forces", index))
+        local["forces"] = [drawn_load(item, ("forces", index), drawing.frames, place)
                            for index, item in enumerate(_items(data, "forces"))]
     residuals = []
     for section in pairs.SECTIONS:
@@ -274,15 +277,20 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
     return local
 
 
-def _dynamics(drawing: Drawing, body: str, spec: Mapping[str, Any]) -> dict[str, Any]:
-    """A body's mass and inertia as written; its centre of mass in its own frame."""
+Place = Callable[[str, Any, Path_], Any]
+"""(body, a point as drawn, its path) -> the point in the body's frame, as the file writes it."""
+
+
+def body_dynamics(spec: Mapping[str, Any], body: str, place: Place) -> dict[str, Any]:
+    """A drawn body's mass and inertia as written (its frame is parallel to the global axes,
+    so a tensor as drawn is the one in its frame); its centre of mass in its own frame."""
     found = {key: spec[key] for key in DYNAMICS_KEYS if key in spec}
     if "com" in found:
-        found["com"] = drawing.point(body, found["com"], ("bodies", body, "com"))[0]
+        found["com"] = place(body, found["com"], ("bodies", body, "com"))
     return found
 
 
-def _load(drawing: Drawing, item: Any, path: Path_) -> Any:
+def drawn_load(item: Any, path: Path_, bodies: Collection[str], place: Place) -> Any:
     """A load with its points (drawn globally) in the frames of their bodies; unknown
     bodies and shapes go on to validation, which names them."""
     if not isinstance(item, Mapping):
@@ -290,8 +298,8 @@ def _load(drawing: Drawing, item: Any, path: Path_) -> Any:
     local = dict(item)
     for key, body_key in forces.POINT_KEYS.get(item.get("type"), ()):  # type: ignore[arg-type]
         body = item.get(body_key)
-        if key in item and isinstance(body, str) and body in drawing.frames:
-            local[key] = drawing.point(body, item[key], path + (key,))[0]
+        if key in item and isinstance(body, str) and body in bodies:
+            local[key] = place(body, item[key], path + (key,))
     return local
 
 

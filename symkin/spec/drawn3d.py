@@ -17,8 +17,7 @@ from typing import Any
 from symkin import pairs
 from symkin.errors import MechanismError
 from symkin.pairs.fields import GROUND
-from symkin.spec import forces
-from symkin.spec.drawn import DYNAMICS_KEYS, layout_of
+from symkin.spec.drawn import DYNAMICS_KEYS, body_dynamics, drawn_load, layout_of
 from symkin.spec.drawn_quantities import Q, _Context, _sub
 
 SPACES = ("2d", "3d")
@@ -196,10 +195,10 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
     local["bodies"] = {body: {"q0": drawing.q0(body),
                               "points": {name: drawing.local(body, point)
                                          for name, point in drawing.points[body].items()},
-                              **_dynamics(drawing, body, data["bodies"][body])}
+                              **body_dynamics(data["bodies"][body], body, drawing.point)}
                        for body in drawing.origins if body != GROUND}
     if "forces" in data:
-        local["forces"] = [_load(drawing, item, ("forces", index))
+        local["forces"] = [drawn_load(item, ("forces", index), drawing.origins, drawing.point)
                            for index, item in enumerate(_items(data, "forces"))]
     for section in pairs.SECTIONS:
         items = data.get(section) or []
@@ -207,28 +206,6 @@ def to_local(data: Mapping[str, Any]) -> dict[str, Any]:
             raise MechanismError(f"expected a list of {section}", (section,))
         local[section] = [_constraint(drawing, item, (section, k))
                           for k, item in enumerate(items)]
-    return local
-
-
-def _dynamics(drawing: Drawing3d, body: str, spec: Mapping[str, Any]) -> dict[str, Any]:
-    """A body's mass and inertia as written (its frame is parallel to the global axes, so
-    the tensor as drawn is the one in its frame); its centre of mass in its own frame."""
-    found = {key: spec[key] for key in DYNAMICS_KEYS if key in spec}
-    if "com" in found:
-        found["com"] = drawing.point(body, found["com"], ("bodies", body, "com"))
-    return found
-
-
-def _load(drawing: Drawing3d, item: Any, path: Path_) -> Any:
-    """A load with its points (drawn globally) in the frames of their bodies; unknown
-    bodies and shapes go on to validation, which names them."""
-    if not isinstance(item, Mapping):
-        return item
-    local = dict(item)
-    for key, body_key in forces.POINT_KEYS.get(item.get("type"), ()):  # type: ignore[arg-type]
-        body = item.get(body_key)
-        if key in item and isinstance(body, str) and body in drawing.origins:
-            local[key] = drawing.point(body, item[key], path + (key,))
     return local
 
 
