@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from symkin.errors import SymkinError, UsageError
 from symkin.present import series
+from symkin.runtime import spatial
 from symkin.runtime.results import Trajectory, rotation
 
 Array = NDArray[np.float64]
@@ -73,17 +74,27 @@ def slide_axes(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, 
 
 
 def joint_points(trajectory: Trajectory, outlines: Outlines) -> dict[str, Array]:
-    """Where each joint's reaction acts (its point on body i), (T, 2) in the global frame,
-    by joint name: the keys ``joint:<name>:<body i>`` (files with masses or forces)."""
+    """Where each joint's reaction acts (its point on body i), (T, 2) in the global frame
+    (spatial: (T, 3)), by joint name: the keys ``joint:<name>:<body i>`` (files with masses
+    or forces; :func:`symkin.symbolic.drawing.spatial_outlines` for a spatial one)."""
     found = {}
     for key, rows in outlines.items():
         if not key.startswith("joint:"):
             continue
         name, body = key.split(":")[1:3]
         if body == GROUND or body in trajectory.bodies:
-            local = np.asarray(rows, dtype=float).reshape(-1, 2)[:1]
-            found[name] = _global(trajectory, body, local)[:, 0]
+            local = np.asarray(rows, dtype=float).reshape(-1, trajectory.point_size)[:1]
+            found[name] = _placed(trajectory, body, local)[:, 0]
     return found
+
+
+def _placed(trajectory: Trajectory, body: str, local: Array) -> Array:
+    """:func:`_global` for a planar or a spatial run: (K, 2 or 3) local vectors, (T, K, d)."""
+    if not trajectory.spatial or body == GROUND:
+        return _global(trajectory, body, local)
+    q, dq, d2q = trajectory.body(body)
+    r, _, _ = spatial.point_kinematics(q[:, None], dq[:, None], d2q[:, None], local)
+    return r
 
 
 def rods(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]]:
@@ -175,7 +186,7 @@ def animate(trajectory: Trajectory, path: str | Path, outlines: Outlines, fps: i
     if trajectory.spatial:  # no planar outlines: an isometric view of the points
         from symkin.present import view3d
 
-        return view3d.animate(trajectory, path, fps, size, progress)
+        return view3d.animate(trajectory, path, fps, size, progress, outlines)
     if trajectory.t.size == 0:
         raise SymkinError("nothing to animate: no time point was solved")
     if not 1 <= fps <= 100:

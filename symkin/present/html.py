@@ -74,7 +74,7 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
     if trajectory.spatial:  # no planar outlines: the 3D view draws from the points alone
         from symkin.present import view3d
 
-        return view3d.report(trajectory, path, units, title)
+        return view3d.report(trajectory, path, units, title, outlines)
     path = Path(path)
     if path.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"cannot write a report to {path.name}: use a file ending in .html")
