@@ -1,0 +1,125 @@
+"""The reaction arrows of a spatial run (issue 27, item 2): the 3D report and the isometric GIF.
+
+The run is bench/spatial_slider_crank_forces.yaml (the spatial slider-crank with masses,
+gravity, a torque, a damper and a spring) solved by the CLI. The arrows are checked against
+the run's own NPZ and the file's geometry: each starts at its joint's point on body i (a
+ground point of the file, or a named point the NPZ holds) and is the NPZ reaction force
+times one scale, the largest of the run VECTOR_SHARE of the scene's cube.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from symkin.present import view3d
+from tests.present.test_view3d import RSSR, _cli, _figure, _numbers
+
+ROOT = Path(__file__).resolve().parents[2]
+FORCES = ROOT / "bench" / "spatial_slider_crank_forces.yaml"
+H, R, K, L = 0.1, 0.08, 0.12, 0.4  # the file's parameters h, r, k, L
+B0 = np.sqrt(L**2 - (H + R) ** 2 - K**2)  # where the slider's B starts, on the x axis
+ARROWS = "joint reactions (i on j)"
+MAGENTA = np.array([0xC2, 0x00, 0x8F])  # animation.REACTION
+
+
+@pytest.fixture(scope="module")
+def forces_run(tmp_path_factory) -> tuple[Path, Path, Path]:
+    """The loaded spatial slider-crank solved by the CLI (NumPy backend): npz, html, gif."""
+    folder = tmp_path_factory.mktemp("spatial_forces")
+    result = _cli(str(FORCES), "--backend", "numpy", "-o", "f.npz", "--html", "f.html",
+                  "--animate", "f.gif", cwd=folder)
+    assert result.returncode == 0, result.stderr
+    return folder / "f.npz", folder / "f.html", folder / "f.gif"
+
+
+def _tails_and_heads(frame: dict, first: int) -> tuple[np.ndarray, np.ndarray]:
+    """The arrows of one frame, the figure's traces from ``first`` on: tails and heads, each
+    (J, 3)."""
+    own = frame["traces"].index(first)  # a frame lists the traces it updates, in its order
+    ends = np.array([np.stack([_numbers(trace[axis]) for axis in "xyz"], axis=1)
+                     for trace in frame["data"][own:]])
+    return ends[:, 0], ends[:, 1]
+
+
+def test_report_arrows_are_the_npz_reactions_at_the_joints_points(forces_run) -> None:
+    npz, page, _ = forces_run
+    saved = np.load(npz)
+    names = [str(n) for n in saved["points"]]
+    joints = [str(n) for n in saved["joint_names"]]
+    assert joints == ["crank_bearing", "pin", "cross", "guide"]
+    data, frames, layout = _figure(page)
+    arrows = [k for k, trace in enumerate(data) if trace.get("name") == ARROWS]
+    assert len(arrows) == 4 and sum(data[k]["showlegend"] for k in arrows) == 1
+    first = arrows[0]
+    assert len(frames) == saved["t"].size == 101
+    # the file's geometry: the bearing and the guide on the ground, the pin on the crank (its
+    # point A), the cross on the slider (its point B)
+    ground = np.array([[0.0, H, K], [B0, 0.0, 0.0]])
+    span = (np.diff(layout["scene"]["xaxis"]["range"])[0]) / 1.1  # the cube is 1.1 spans
+    largest = np.linalg.norm(saved["reaction"][..., :3], axis=-1).max()
+    scale = 0.15 * span / largest
+    for k, frame in enumerate(frames):
+        tails, heads = _tails_and_heads(frame, first)
+        np.testing.assert_allclose(tails[[0, 3]], ground, atol=1e-12)
+        np.testing.assert_allclose(tails[1], saved["r"][k, names.index("crank.A")], atol=1e-12)
+        np.testing.assert_allclose(tails[2], saved["r"][k, names.index("slider.B")],
+                                   atol=1e-12)
+        force = saved["reaction"][k, :, :3]
+        np.testing.assert_allclose(heads - tails, scale * force, rtol=1e-9,
+                                   atol=1e-12 * span)
+        for j, trace in enumerate(frame["data"][frame["traces"].index(first):]):
+            np.testing.assert_allclose(np.reshape(_numbers(trace["customdata"]), (2, 3)),
+                                       [force[j], force[j]], rtol=1e-12)
+    # every time point is a frame, so the run's largest force is among them: VECTOR_SHARE long
+    lengths = [np.linalg.norm(heads - tails, axis=1)
+               for tails, heads in (_tails_and_heads(f, first) for f in frames)]
+    assert np.max(lengths) == pytest.approx(0.15 * span, rel=1e-9)
+    # the crank pin on its circle about the bearing's axis x, turned by the driver 2πt:
+    # the arrows' tails are where the mechanism is, not only where the code put them
+    t = saved["t"]
+    pin = np.array([_tails_and_heads(f, first)[0][1] for f in frames])
+    circle = np.stack([0 * t, H + R * np.cos(2 * np.pi * t), K + R * np.sin(2 * np.pi * t)], 1)
+    assert np.abs(pin - circle).max() < 1e-9
+
+
+def test_no_arrows_without_forces_or_without_the_joints_points(forces_run,
+                                                               tmp_path: Path) -> None:
+    import symkin
+
+    rssr = symkin.solve(symkin.compile(symkin.derive(symkin.load(RSSR)), backend="numpy"))
+    assert rssr.forces is None
+    data, frames, _ = _figure(view3d.report(rssr, tmp_path / "rssr.html", outlines={}))
+    assert not [trace for trace in data if trace.get("name") == ARROWS]
+    assert len(frames[0]["data"]) == len(view3d.body_lines(rssr))
+
+
+def _frame(gif: Path, k: int) -> np.ndarray:
+    from PIL import Image
+
+    image = Image.open(gif)
+    image.seek(k)
+    return np.asarray(image.convert("RGB"), dtype=int)
+
+
+def _magenta(pixels: np.ndarray) -> int:
+    return int((np.abs(pixels - MAGENTA).sum(axis=2) < 40).sum())
+
+
+def test_gif_draws_the_arrows_and_only_with_them(forces_run, tmp_path: Path) -> None:
+    import symkin
+    from symkin.symbolic import drawing
+
+    _, _, gif = forces_run
+    system = symkin.derive(symkin.load(FORCES))
+    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    bare = view3d.animate(trajectory, tmp_path / "bare.gif")
+    drawn = view3d.animate(trajectory, tmp_path / "drawn.gif",
+                           outlines=drawing.spatial_outlines(system))
+    for k in (0, 25, 60):
+        with_arrows, without = _frame(drawn, k), _frame(bare, k)
+        assert _magenta(with_arrows) > 50 and _magenta(without) == 0
+        assert (np.abs(with_arrows - without).sum(axis=2) > 0).sum() > 50
+        np.testing.assert_array_equal(_frame(gif, k), with_arrows)  # the CLI draws them too
