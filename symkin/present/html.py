@@ -270,7 +270,7 @@ def _plots(go: Any, figure: Any, trajectory: Trajectory, curves: Sequence[series
 def _animate(go: Any, figure: Any, trajectory: Trajectory, frames: Array, scene: _Scene,
              moving: list[int], cursors: list[tuple[int, int, int]]) -> None:
     """One plotly frame per shown time: the moving traces and the time cursors."""
-    bounds = {index: _bounds(figure, index) for index, _, _ in cursors}
+    bounds = {index: panel_range(figure, index) for index, _, _ in cursors}
     built = []
     for k in frames:
         t = float(trajectory.t[k])
@@ -284,11 +284,11 @@ def _animate(go: Any, figure: Any, trajectory: Trajectory, frames: Array, scene:
         figure.data[index].x, figure.data[index].y = trace.x, trace.y
 
 
-def _bounds(figure: Any, cursor: int) -> tuple[float, float]:
+def panel_range(figure: Any, cursor: int) -> tuple[float, float]:
     """The y range of a panel's curves (the traces just before its cursor on that axis)."""
     axis = figure.data[cursor].yaxis
     values = [np.asarray(trace.y, dtype=float) for trace in figure.data[:cursor]
-              if trace.yaxis == axis and trace.y is not None and len(trace.y)]
+              if getattr(trace, "yaxis", None) == axis and trace.y is not None and len(trace.y)]
     if not values:
         return (0.0, 1.0)
     joined = np.concatenate(values)

@@ -126,7 +126,7 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
     go = graph_objects()
     lines = _drawable(trajectory)
     frames = frame_indices(trajectory)
-    figure = go.Figure()
+    figure = _figure(go, trajectory)
     for body, points in lines.items():
         for k, (_, name) in enumerate(p for p in trajectory.points if p[0] == body):
             track = points[:, k, :]
@@ -152,20 +152,51 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
             line={"width": 6, "color": REACTION},
             marker={"size": [0, 4], "color": REACTION, "symbol": "diamond"}))
         moving.append(len(figure.data) - 1)
-    built = [go.Frame(name=f"{float(trajectory.t[k]):.6g}", traces=moving,
+    cursors = _force_column(go, figure, trajectory, units)
+    built = [go.Frame(name=f"{float(trajectory.t[k]):.6g}", traces=moving + list(cursors),
                       data=[*(_at(go, shape[k]) for shape in lines.values()),
-                            *_arrows(go, points[k], forces[k], scale)])
+                            *_arrows(go, points[k], forces[k], scale),
+                            *(go.Scatter(x=[trajectory.t[k]] * 2, y=list(extent))
+                              for extent in cursors.values())])
              for k in frames]
     figure.frames = built
-    for index, trace in zip(moving, built[0].data):
-        figure.data[index].x, figure.data[index].y, figure.data[index].z = \
-            trace.x, trace.y, trace.z
+    for index, trace in zip(built[0].traces, built[0].data):
+        figure.data[index].x, figure.data[index].y = trace.x, trace.y
+        if index in moving:
+            figure.data[index].z = trace.z
     _layout(figure, trajectory, frames, lines, units, title)
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
                       config={"displaylogo": False, "responsive": True},
                       div_id="symkin-report")
     return path
+
+
+def _figure(go: Any, trajectory: Trajectory) -> Any:
+    """The empty figure: the scene alone, or with masses or forces the scene beside the
+    column of efforts and reactions (:mod:`symkin.present.html_forces`)."""
+    if trajectory.forces is None:
+        return go.Figure()
+    from plotly.subplots import make_subplots
+
+    specs = [[{"type": "scene", "rowspan": 3}, {}], [None, {}], [None, {}]]
+    return make_subplots(rows=3, cols=2, specs=specs, shared_xaxes=True,
+                         column_widths=[0.62, 0.38], horizontal_spacing=0.08,
+                         vertical_spacing=0.06)
+
+
+def _force_column(go: Any, figure: Any, trajectory: Trajectory, units: Units
+                  ) -> dict[int, tuple[float, float]]:
+    """The efforts' and reactions' curves in column 2; returns each time cursor's trace
+    index and the y range it spans (none without forces)."""
+    if trajectory.forces is None:
+        return {}
+    from symkin.present import html_forces
+    from symkin.present.html import panel_range
+
+    cursors = html_forces.plot(go, figure, trajectory, column=2)
+    html_forces.label(figure, 2, units, spatial=True)
+    return {index: panel_range(figure, index) for index, _, _ in cursors}
 
 
 def _span(lines: dict[str, Array]) -> float:

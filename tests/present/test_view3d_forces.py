@@ -35,12 +35,12 @@ def forces_run(tmp_path_factory) -> tuple[Path, Path, Path]:
     return folder / "f.npz", folder / "f.html", folder / "f.gif"
 
 
-def _tails_and_heads(frame: dict, first: int) -> tuple[np.ndarray, np.ndarray]:
-    """The arrows of one frame, the figure's traces from ``first`` on: tails and heads, each
-    (J, 3)."""
+def _tails_and_heads(frame: dict, first: int, count: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """The arrows of one frame, the figure's ``count`` traces from ``first`` on: tails and
+    heads, each (J, 3)."""
     own = frame["traces"].index(first)  # a frame lists the traces it updates, in its order
     ends = np.array([np.stack([_numbers(trace[axis]) for axis in "xyz"], axis=1)
-                     for trace in frame["data"][own:]])
+                     for trace in frame["data"][own:own + count]])
     return ends[:, 0], ends[:, 1]
 
 
@@ -70,7 +70,8 @@ def test_report_arrows_are_the_npz_reactions_at_the_joints_points(forces_run) ->
         force = saved["reaction"][k, :, :3]
         np.testing.assert_allclose(heads - tails, scale * force, rtol=1e-9,
                                    atol=1e-12 * span)
-        for j, trace in enumerate(frame["data"][frame["traces"].index(first):]):
+        own = frame["traces"].index(first)
+        for j, trace in enumerate(frame["data"][own:own + 4]):
             np.testing.assert_allclose(np.reshape(_numbers(trace["customdata"]), (2, 3)),
                                        [force[j], force[j]], rtol=1e-12)
     # every time point is a frame, so the run's largest force is among them: VECTOR_SHARE long
@@ -123,3 +124,26 @@ def test_gif_draws_the_arrows_and_only_with_them(forces_run, tmp_path: Path) -> 
         assert _magenta(with_arrows) > 50 and _magenta(without) == 0
         assert (np.abs(with_arrows - without).sum(axis=2) > 0).sum() > 50
         np.testing.assert_array_equal(_frame(gif, k), with_arrows)  # the CLI draws them too
+
+
+def test_report_force_column_is_the_npz_magnitudes(forces_run) -> None:
+    """Beside the scene: each driver's effort, each joint's |F| and |M| (the norms of the
+    NPZ's [Fx, Fy, Fz] and [Mx, My, Mz]) against t, and a time cursor per panel."""
+    npz, page, _ = forces_run
+    saved = np.load(npz)
+    data, frames, layout = _figure(page)
+    curves = {(trace["yaxis"], trace["name"]): _numbers(trace["y"]) for trace in data
+              if trace["type"] == "scatter" and trace.get("name")}
+    np.testing.assert_allclose(curves[("y", "driver0")], saved["effort"][:, 0], rtol=1e-12)
+    force = np.sqrt((saved["reaction"][..., :3] ** 2).sum(axis=-1))
+    moment = np.sqrt((saved["reaction"][..., 3:] ** 2).sum(axis=-1))
+    for j, name in enumerate(str(n) for n in saved["joint_names"]):
+        np.testing.assert_allclose(curves[("y2", name)], force[:, j], rtol=1e-12)
+        if moment[:, j].max() > 1e-9 * force.max():  # the spherical pin carries none
+            np.testing.assert_allclose(curves[("y3", name)], moment[:, j], rtol=1e-12)
+    assert ("y3", "pin") not in curves and layout["yaxis3"]["title"]["text"] == "joint moment |M|"
+    cursors = [k for k, trace in enumerate(data) if trace["type"] == "scatter"
+               and not trace.get("name")]
+    assert len(cursors) == 3 and set(cursors) <= set(frames[0]["traces"])
+    own = frames[40]["traces"].index(cursors[0])
+    assert _numbers(frames[40]["data"][own]["x"]) == pytest.approx([saved["t"][40]] * 2)
