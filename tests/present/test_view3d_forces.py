@@ -9,6 +9,9 @@ times one scale, the largest of the run VECTOR_SHARE of the scene's cube.
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -147,3 +150,23 @@ def test_report_force_column_is_the_npz_magnitudes(forces_run) -> None:
     assert len(cursors) == 3 and set(cursors) <= set(frames[0]["traces"])
     own = frames[40]["traces"].index(cursors[0])
     assert _numbers(frames[40]["data"][own]["x"]) == pytest.approx([saved["t"][40]] * 2)
+
+
+def test_a_warm_run_draws_the_same_arrows(tmp_path: Path) -> None:
+    """The joints' points travel in the index with the kernel (3-component rows): the run
+    that reuses the cached kernel draws the arrows the deriving run drew."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(tmp_path / "cache")}
+    pages = []
+    for run in ("cold", "warm"):
+        result = subprocess.run(
+            [sys.executable, "-m", "symkin", "run", str(FORCES), "--backend", "numpy",
+             "--html", f"{run}.html"], cwd=tmp_path, env=env, capture_output=True, text=True,
+            timeout=600, check=False)
+        assert result.returncode == 0, result.stderr
+        assert ("cached kernel" in result.stdout) == (run == "warm"), result.stdout
+        pages.append(_figure(tmp_path / f"{run}.html"))
+    (cold, cold_frames, _), (warm, warm_frames, _) = pages
+    assert [t.get("name") for t in warm] == [t.get("name") for t in cold]
+    first = next(k for k, trace in enumerate(cold) if trace.get("name") == ARROWS)
+    for a, b in zip(cold_frames, warm_frames):
+        np.testing.assert_array_equal(_tails_and_heads(a, first), _tails_and_heads(b, first))
