@@ -98,3 +98,15 @@ def label(figure: Any, column: int, units: Units, spatial: bool = False) -> None
     for panel, title in enumerate(titles):
         figure.update_yaxes(title_text=title, row=panel + 1, col=column)
     figure.update_xaxes(title_text=units.time_label(), row=3, col=column)
+
+
+def panel_range(figure: Any, cursor: int) -> tuple[float, float]:
+    """The y range of a panel's curves (the traces just before its cursor on that axis)."""
+    axis = figure.data[cursor].yaxis
+    values = [np.asarray(trace.y, dtype=float) for trace in figure.data[:cursor]
+              if getattr(trace, "yaxis", None) == axis and trace.y is not None and len(trace.y)]
+    if not values:
+        return (0.0, 1.0)
+    joined = np.concatenate(values)
+    joined = joined[np.isfinite(joined)]
+    return (float(joined.min()), float(joined.max())) if joined.size else (0.0, 1.0)

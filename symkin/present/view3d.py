@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from symkin.errors import SymkinError, UsageError
 from symkin.present import series
-from symkin.present.animation import REACTION, VECTOR_SHARE, Outlines, joint_points
+from symkin.present.placement import REACTION, VECTOR_SHARE, Outlines, joint_points
 from symkin.present.series import DEFAULT_UNITS, Units
 from symkin.runtime.results import Trajectory
 
@@ -192,11 +192,10 @@ def _force_column(go: Any, figure: Any, trajectory: Trajectory, units: Units
     if trajectory.forces is None:
         return {}
     from symkin.present import html_forces
-    from symkin.present.html import panel_range
 
     cursors = html_forces.plot(go, figure, trajectory, column=2)
     html_forces.label(figure, 2, units, spatial=True)
-    return {index: panel_range(figure, index) for index, _, _ in cursors}
+    return {index: html_forces.panel_range(figure, index) for index, _, _ in cursors}
 
 
 def _span(lines: dict[str, Array]) -> float:
