@@ -71,7 +71,8 @@ def _drawable(trajectory: Trajectory) -> dict[str, Array]:
 def reactions(trajectory: Trajectory, outlines: Outlines | None
               ) -> tuple[list[str], Array, Array]:
     """The joints drawn with an arrow, their points on body i (T, J, 3) and their reaction
-    forces [Fx, Fy, Fz] (T, J, 3, unscaled, NaN rows as zero); none without forces."""
+    forces [Fx, Fy, Fz] (T, J, 3, unscaled); none without forces. An unsolved row's force
+    is zero and its point NaN (a ground point too), so that no arrow is drawn there."""
     forces = trajectory.forces
     where = joint_points(trajectory, outlines or {}) if forces is not None else {}
     shown = [k for k, name in enumerate(forces.joint_names) if name in where] if forces else []
@@ -79,7 +80,9 @@ def reactions(trajectory: Trajectory, outlines: Outlines | None
         return [], np.zeros((trajectory.t.size, 0, 3)), np.zeros((trajectory.t.size, 0, 3))
     names = [forces.joint_names[k] for k in shown]
     points = np.stack([where[name] for name in names], axis=1)
-    return names, points, np.nan_to_num(forces.reaction[:, shown, :3])
+    force = forces.reaction[:, shown, :3]
+    points = np.where(np.isfinite(force).all(axis=-1, keepdims=True), points, np.nan)
+    return names, points, np.nan_to_num(force)
 
 
 def force_scale(forces: Array, span: float) -> float:

@@ -109,7 +109,9 @@ def _frame(gif: Path, k: int) -> np.ndarray:
 
 
 def _magenta(pixels: np.ndarray) -> int:
-    return int((np.abs(pixels - MAGENTA).sum(axis=2) < 40).sum())
+    """Arrow-coloured pixels in the mechanism's axes (the legend, right of x = 700, has a
+    magenta line of its own)."""
+    return int((np.abs(pixels[:, :700] - MAGENTA).sum(axis=2) < 40).sum())
 
 
 def test_gif_draws_the_arrows_and_only_with_them(forces_run, tmp_path: Path) -> None:
@@ -170,3 +172,30 @@ def test_a_warm_run_draws_the_same_arrows(tmp_path: Path) -> None:
     first = next(k for k, trace in enumerate(cold) if trace.get("name") == ARROWS)
     for a, b in zip(cold_frames, warm_frames):
         np.testing.assert_array_equal(_tails_and_heads(a, first), _tails_and_heads(b, first))
+
+
+def test_a_partial_run_with_forces_draws_without_warnings(tmp_path: Path) -> None:
+    """Rows a run did not solve (NaN positions and loads) draw no arrow and warn nothing."""
+    import dataclasses
+    import warnings
+
+    import symkin
+    from symkin.symbolic import drawing
+
+    system = symkin.derive(symkin.load(FORCES))
+    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    q, reaction = trajectory.q.copy(), trajectory.forces.reaction.copy()
+    q[50:], reaction[50:] = np.nan, np.nan
+    partial = dataclasses.replace(trajectory, q=q, forces=dataclasses.replace(
+        trajectory.forces, reaction=reaction))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        outlines = drawing.spatial_outlines(system)
+        page = view3d.report(partial, tmp_path / "p.html", outlines=outlines)
+        view3d.animate(partial, tmp_path / "p.gif", outlines=outlines)
+    data, frames, _ = _figure(page)
+    first = next(k for k, trace in enumerate(data) if trace.get("name") == ARROWS)
+    tails, heads = _tails_and_heads(frames[20], first)
+    assert np.isfinite(tails).all() and (np.linalg.norm(heads - tails, axis=1) > 0).all()
+    assert _magenta(_frame(tmp_path / "p.gif", 20)) > 50
+    assert _magenta(_frame(tmp_path / "p.gif", 80)) == 0  # nothing solved, nothing drawn
