@@ -6,7 +6,8 @@ every named point is marked (the examples name a point at each joint), and the d
 every moving point stays in the view. The HTML report is a rotatable plotly scene with one
 frame per shown time and a slider; the GIF is an isometric projection of the same lines.
 With masses or forces, each joint's reaction force (body i on body j) is an arrow at its point
-on body i, the largest of the run VECTOR_SHARE of the scene long, as in the planar pictures.
+on body i, the largest of the run VECTOR_SHARE of the scene long, as in the planar pictures,
+and the HTML report has the planar report's column of efforts and reactions beside its scene.
 
 Names in the figure come from a validated file and reach the browser as JSON data only.
 """
