@@ -199,3 +199,22 @@ def test_a_partial_run_with_forces_draws_without_warnings(tmp_path: Path) -> Non
     assert np.isfinite(tails).all() and (np.linalg.norm(heads - tails, axis=1) > 0).all()
     assert _magenta(_frame(tmp_path / "p.gif", 20)) > 50
     assert _magenta(_frame(tmp_path / "p.gif", 80)) == 0  # nothing solved, nothing drawn
+
+
+def test_report_with_forces_in_headless_chromium(forces_run, tmp_path: Path) -> None:
+    """The page with its arrows and forces column loads without a console message and shows
+    the arrows' magenta in the scene (software WebGL)."""
+    from PIL import Image
+
+    from tests.present.test_present import _browse, _console_lines
+
+    _, page, _ = forces_run
+    webgl = ("--enable-unsafe-swiftshader", "--use-angle=swiftshader")
+    shot = tmp_path / "forces.png"
+    taken = _browse(page, *webgl, f"--screenshot={shot}")
+    assert taken.returncode == 0 and shot.exists(), taken.stderr
+    benign = ("willReadFrequently", "GL Driver Message (OpenGL, Performance")
+    assert [line for line in _console_lines(taken.stderr)
+            if not any(remark in line for remark in benign)] == [], taken.stderr
+    scene = np.asarray(Image.open(shot).convert("RGB"), dtype=int)[60:650, :700]
+    assert (np.abs(scene - MAGENTA).sum(axis=2) < 60).sum() > 20
