@@ -121,9 +121,9 @@ def _full_pipeline(mechanism: Path, options: Options, cache: Path,
     system = derivation.derive(validate.load(mechanism, dict(options.parameters)))
     kernel = compile_system(system, backend=options.backend, real=options.real,
                            cse=options.cse, linalg=options.linalg, cache_dir=cache)
-    # the pictures of a spatial mechanism are not drawn (the run refuses to make them)
-    drawn = drawing.outlines(system) if want_outlines and not system.mechanism.is_spatial \
-        else None
+    # a spatial mechanism is drawn from its points; only its joints' points come from here
+    outline = drawing.spatial_outlines if system.mechanism.is_spatial else drawing.outlines
+    drawn = outline(system) if want_outlines else None
     return Prepared(kernel, hit=False, outlines=drawn, system=system)
 
 
@@ -245,10 +245,15 @@ def _outlines(data: Any) -> Outlines | None:
     if not isinstance(data, dict):
         return None
     try:
-        drawn = {str(body): np.array(v, dtype=float).reshape(-1, 2) for body, v in data.items()}
+        drawn = {str(body): _rows(np.array(v, dtype=float)) for body, v in data.items()}
     except (TypeError, ValueError):
         return None
     return drawn
+
+
+def _rows(array: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Rows of 2 components, or of 3 as a spatial joint's point is recorded."""
+    return array.reshape(-1, 3 if array.ndim == 2 and array.shape[1] == 3 else 2)
 
 
 def record(cache: Path, key: str, built: Kernel, backend: Backend,

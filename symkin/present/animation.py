@@ -11,7 +11,7 @@ body i, the largest of the run VECTOR_SHARE of the picture long, as in the HTML 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -20,18 +20,22 @@ from numpy.typing import NDArray
 
 from symkin.errors import SymkinError, UsageError
 from symkin.present import series
-from symkin.runtime.results import Trajectory, rotation
+from symkin.present.placement import (
+    GROUND,
+    REACTION,
+    VECTOR_SHARE,
+    Outlines,
+    global_vectors,
+    joint_points,
+)
+from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
-Outlines = Mapping[str, Array]
 Progress = Callable[[int, int], None]
 
 MAX_FRAMES = 200
 DEFAULT_SIZE = (900, 600)  # pixels
 DPI = 100
-GROUND = "ground"
-VECTOR_SHARE = 0.15  # the longest reaction of the run drawn this long, relative to the picture
-REACTION = "#c2008f"  # the joint reactions' arrows: a magenta no body is drawn in
 
 
 def body_shapes(trajectory: Trajectory, outlines: Outlines) -> dict[str, Array]:
@@ -39,17 +43,8 @@ def body_shapes(trajectory: Trajectory, outlines: Outlines) -> dict[str, Array]:
     shapes = {}
     for body in trajectory.bodies:
         local = np.asarray(outlines.get(body, np.zeros((1, 2))), dtype=float).reshape(-1, 2)
-        shapes[body] = _global(trajectory, body, local)
+        shapes[body] = global_vectors(trajectory, body, local)
     return shapes
-
-
-def _global(trajectory: Trajectory, body: str, local: Array) -> Array:
-    """Local vectors of ``body`` (K, 2) in the global frame at every time: (T, K, 2)."""
-    if body == GROUND:
-        return np.broadcast_to(local, (trajectory.t.size, *local.shape))
-    q, _, _ = trajectory.body(body)
-    turned: Array = np.einsum("tij,kj->tki", rotation(q[:, 2]), local)
-    return q[:, None, :2] + turned
 
 
 def slide_axes(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]]:
@@ -66,24 +61,10 @@ def slide_axes(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, 
             norm = float(np.hypot(*direction))
             if norm == 0:
                 continue
-            at = _global(trajectory, body, point[None])[:, 0]
-            turned = _global(trajectory, body, np.array([point + direction / norm]))[:, 0]
+            at = global_vectors(trajectory, body, point[None])[:, 0]
+            turned = global_vectors(trajectory, body, np.array([point + direction / norm]))[:, 0]
             axes.append((at, turned - at))
     return axes
-
-
-def joint_points(trajectory: Trajectory, outlines: Outlines) -> dict[str, Array]:
-    """Where each joint's reaction acts (its point on body i), (T, 2) in the global frame,
-    by joint name: the keys ``joint:<name>:<body i>`` (files with masses or forces)."""
-    found = {}
-    for key, rows in outlines.items():
-        if not key.startswith("joint:"):
-            continue
-        name, body = key.split(":")[1:3]
-        if body == GROUND or body in trajectory.bodies:
-            local = np.asarray(rows, dtype=float).reshape(-1, 2)[:1]
-            found[name] = _global(trajectory, body, local)[:, 0]
-    return found
 
 
 def rods(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]]:
@@ -98,8 +79,8 @@ def rods(trajectory: Trajectory, outlines: Outlines) -> list[tuple[Array, Array]
             continue
         rows = np.asarray(rows, dtype=float).reshape(-1, 2)
         for a, b in zip(rows[0::2], rows[1::2]):
-            found.append((_global(trajectory, first, a[None])[:, 0],
-                          _global(trajectory, second, b[None])[:, 0]))
+            found.append((global_vectors(trajectory, first, a[None])[:, 0],
+                          global_vectors(trajectory, second, b[None])[:, 0]))
     return found
 
 
@@ -114,7 +95,7 @@ def marks(trajectory: Trajectory, outlines: Outlines) -> list[tuple[str, Array]]
         if body != GROUND and body not in trajectory.bodies:
             continue
         local = np.asarray(rows, dtype=float).reshape(-1, 2)
-        found.append((label, _global(trajectory, body, local)))
+        found.append((label, global_vectors(trajectory, body, local)))
     return found
 
 
@@ -131,7 +112,7 @@ def contacts(trajectory: Trajectory, outlines: Outlines) -> list[tuple[str, Arra
         if not all(body == GROUND or body in trajectory.bodies for body in (i, j)):
             continue
         ri, rj = np.asarray(rows, dtype=float).reshape(-1, 2)[0]
-        centre_i, centre_j = (_global(trajectory, body, np.zeros((1, 2)))[:, 0]
+        centre_i, centre_j = (global_vectors(trajectory, body, np.zeros((1, 2)))[:, 0]
                               for body in (i, j))
         line = centre_j - centre_i
         with np.errstate(all="ignore"):
@@ -175,7 +156,7 @@ def animate(trajectory: Trajectory, path: str | Path, outlines: Outlines, fps: i
     if trajectory.spatial:  # no planar outlines: an isometric view of the points
         from symkin.present import view3d
 
-        return view3d.animate(trajectory, path, fps, size, progress)
+        return view3d.animate(trajectory, path, fps, size, progress, outlines)
     if trajectory.t.size == 0:
         raise SymkinError("nothing to animate: no time point was solved")
     if not 1 <= fps <= 100:

@@ -23,14 +23,13 @@ from symkin.errors import UsageError
 from symkin.present import html_forces, series
 from symkin.present.animation import (
     MAX_FRAMES,
-    Outlines,
     body_shapes,
     contacts,
-    joint_points,
     marks,
     rods,
     slide_axes,
 )
+from symkin.present.placement import Outlines, joint_points
 from symkin.present.series import DEFAULT_UNITS, LENGTH, Units
 from symkin.runtime.results import Trajectory
 
@@ -74,7 +73,7 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
     if trajectory.spatial:  # no planar outlines: the 3D view draws from the points alone
         from symkin.present import view3d
 
-        return view3d.report(trajectory, path, units, title)
+        return view3d.report(trajectory, path, units, title, outlines)
     path = Path(path)
     if path.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"cannot write a report to {path.name}: use a file ending in .html")
@@ -270,7 +269,7 @@ def _plots(go: Any, figure: Any, trajectory: Trajectory, curves: Sequence[series
 def _animate(go: Any, figure: Any, trajectory: Trajectory, frames: Array, scene: _Scene,
              moving: list[int], cursors: list[tuple[int, int, int]]) -> None:
     """One plotly frame per shown time: the moving traces and the time cursors."""
-    bounds = {index: _bounds(figure, index) for index, _, _ in cursors}
+    bounds = {index: html_forces.panel_range(figure, index) for index, _, _ in cursors}
     built = []
     for k in frames:
         t = float(trajectory.t[k])
@@ -282,18 +281,6 @@ def _animate(go: Any, figure: Any, trajectory: Trajectory, frames: Array, scene:
     first = built[0]
     for index, trace in zip(first.traces, first.data):
         figure.data[index].x, figure.data[index].y = trace.x, trace.y
-
-
-def _bounds(figure: Any, cursor: int) -> tuple[float, float]:
-    """The y range of a panel's curves (the traces just before its cursor on that axis)."""
-    axis = figure.data[cursor].yaxis
-    values = [np.asarray(trace.y, dtype=float) for trace in figure.data[:cursor]
-              if trace.yaxis == axis and trace.y is not None and len(trace.y)]
-    if not values:
-        return (0.0, 1.0)
-    joined = np.concatenate(values)
-    joined = joined[np.isfinite(joined)]
-    return (float(joined.min()), float(joined.max())) if joined.size else (0.0, 1.0)
 
 
 def _layout(figure: Any, trajectory: Trajectory, frames: Array, scene: _Scene,

@@ -1,7 +1,8 @@
 """Stage 7 — the HTML report's efforts and reactions against time (a file with masses or
 forces): one more column of three panels beside the kinematics', as ``run_forces.png`` has
 them: each driver's effort, each joint's force magnitude |F| = sqrt(Fx² + Fy²), and the
-moments of the joints that carry one. Where rows were removed as redundant, a curve that is
+moments of the joints that carry one (a spatial run: |F| of [Fx, Fy, Fz] and the moment's
+magnitude |M| of [Mx, My, Mz]). Where rows were removed as redundant, a curve that is
 not unique (the minimum-norm solution's) is dotted and its name says ``min-norm``.
 """
 
@@ -44,15 +45,26 @@ def force_curves(trajectory: Trajectory) -> list[ForceCurve]:
     efforts = len(forces.driver_names)
     found = [ForceCurve(0, name, forces.effort[:, k], bool(fixed[k]))
              for k, name in enumerate(forces.driver_names)]
-    magnitude = np.hypot(forces.reaction[..., 0], forces.reaction[..., 1])
-    floor = MOMENT_FLOOR * max(float(np.nanmax(magnitude, initial=0.0)), 1.0)
+    width = len(forces.parts)
+    force, moments = _magnitudes(forces.reaction)
+    floor = MOMENT_FLOOR * max(float(np.nanmax(force, initial=0.0)), 1.0)
     for k, name in enumerate(forces.joint_names):
-        parts = fixed[efforts + 3 * k:efforts + 3 * k + 3]
-        found.append(ForceCurve(1, name, magnitude[:, k], bool(parts[:2].all())))
-        moment = forces.reaction[:, k, 2]
+        parts = fixed[efforts + width * k:efforts + width * (k + 1)]
+        split = 3 if width == 6 else 2  # the force components, then the moment
+        found.append(ForceCurve(1, name, force[:, k], bool(parts[:split].all())))
+        moment = moments[:, k]
         if float(np.nanmax(np.abs(moment), initial=0.0)) > floor:
-            found.append(ForceCurve(2, name, moment, bool(parts[2])))
+            found.append(ForceCurve(2, name, moment, bool(parts[split:].all())))
     return found
+
+
+def _magnitudes(reaction: Array) -> tuple[Array, Array]:
+    """(T, J) |F| and the moment: M itself in a planar run (T, J, 3), |M| in a spatial one
+    (T, J, 6)."""
+    if reaction.shape[-1] == 6:
+        return (np.linalg.norm(reaction[..., :3], axis=-1),
+                np.linalg.norm(reaction[..., 3:], axis=-1))
+    return np.hypot(reaction[..., 0], reaction[..., 1]), reaction[..., 2]
 
 
 def plot(go: Any, figure: Any, trajectory: Trajectory, column: int
@@ -80,8 +92,21 @@ def plot(go: Any, figure: Any, trajectory: Trajectory, column: int
     return cursors
 
 
-def label(figure: Any, column: int, units: Units) -> None:
-    """The column's axis titles."""
-    for panel, title in enumerate(TITLES):
+def label(figure: Any, column: int, units: Units, spatial: bool = False) -> None:
+    """The column's axis titles (a spatial run's moments are magnitudes |M|)."""
+    titles = (*TITLES[:2], "joint moment |M|") if spatial else TITLES
+    for panel, title in enumerate(titles):
         figure.update_yaxes(title_text=title, row=panel + 1, col=column)
     figure.update_xaxes(title_text=units.time_label(), row=3, col=column)
+
+
+def panel_range(figure: Any, cursor: int) -> tuple[float, float]:
+    """The y range of a panel's curves (the traces just before its cursor on that axis)."""
+    axis = figure.data[cursor].yaxis
+    values = [np.asarray(trace.y, dtype=float) for trace in figure.data[:cursor]
+              if getattr(trace, "yaxis", None) == axis and trace.y is not None and len(trace.y)]
+    if not values:
+        return (0.0, 1.0)
+    joined = np.concatenate(values)
+    joined = joined[np.isfinite(joined)]
+    return (float(joined.min()), float(joined.max())) if joined.size else (0.0, 1.0)

@@ -5,6 +5,9 @@ from the trajectory alone: each moving body is a line through its named points i
 every named point is marked (the examples name a point at each joint), and the dotted path of
 every moving point stays in the view. The HTML report is a rotatable plotly scene with one
 frame per shown time and a slider; the GIF is an isometric projection of the same lines.
+With masses or forces, each joint's reaction force (body i on body j) is an arrow at its point
+on body i, the largest of the run VECTOR_SHARE of the scene long, as in the planar pictures,
+and the HTML report has the planar report's column of efforts and reactions beside its scene.
 
 Names in the figure come from a validated file and reach the browser as JSON data only.
 """
@@ -20,6 +23,7 @@ from numpy.typing import NDArray
 
 from symkin.errors import SymkinError, UsageError
 from symkin.present import series
+from symkin.present.placement import REACTION, VECTOR_SHARE, Outlines, joint_points
 from symkin.present.series import DEFAULT_UNITS, Units
 from symkin.runtime.results import Trajectory
 
@@ -65,6 +69,29 @@ def _drawable(trajectory: Trajectory) -> dict[str, Array]:
     return lines
 
 
+def reactions(trajectory: Trajectory, outlines: Outlines | None
+              ) -> tuple[list[str], Array, Array]:
+    """The joints drawn with an arrow, their points on body i (T, J, 3) and their reaction
+    forces [Fx, Fy, Fz] (T, J, 3, unscaled); none without forces. An unsolved row's force
+    is zero and its point NaN (a ground point too), so that no arrow is drawn there."""
+    forces = trajectory.forces
+    where = joint_points(trajectory, outlines or {}) if forces is not None else {}
+    shown = [k for k, name in enumerate(forces.joint_names) if name in where] if forces else []
+    if forces is None or not shown:
+        return [], np.zeros((trajectory.t.size, 0, 3)), np.zeros((trajectory.t.size, 0, 3))
+    names = [forces.joint_names[k] for k in shown]
+    points = np.stack([where[name] for name in names], axis=1)
+    force = forces.reaction[:, shown, :3]
+    points = np.where(np.isfinite(force).all(axis=-1, keepdims=True), points, np.nan)
+    return names, points, np.nan_to_num(force)
+
+
+def force_scale(forces: Array, span: float) -> float:
+    """Scene length per unit of force: the largest force of the run VECTOR_SHARE of span."""
+    largest = float(np.linalg.norm(forces, axis=-1).max(initial=0.0))
+    return VECTOR_SHARE * span / largest if largest > 0 else 0.0
+
+
 def _bounds(lines: dict[str, Array]) -> tuple[Array, Array]:
     """Low and high corners of everything drawn (NaN rows of a partial run ignored)."""
     every = np.concatenate([a.reshape(-1, 3) for a in lines.values()] + [np.zeros((1, 3))])
@@ -86,7 +113,7 @@ def graph_objects() -> Any:
 
 
 def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNITS,
-           title: str = "symkin") -> Path:
+           title: str = "symkin", outlines: Outlines | None = None) -> Path:
     """Write the self-contained 3D report: bodies moving under a time slider (play / pause).
 
     Args:
@@ -94,6 +121,8 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
         path: the .html file to write.
         units: labels from the file's ``units`` key.
         title: the page's title, e.g. the mechanism's name.
+        outlines: the joints' points (:func:`symkin.symbolic.drawing.spatial_outlines`),
+            where the reaction arrows are drawn; none drawn without.
     """
     path = Path(path)
     if path.suffix.lower() not in (".html", ".htm"):
@@ -101,7 +130,7 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
     go = graph_objects()
     lines = _drawable(trajectory)
     frames = frame_indices(trajectory)
-    figure = go.Figure()
+    figure = _figure(go, trajectory)
     for body, points in lines.items():
         for k, (_, name) in enumerate(p for p in trajectory.points if p[0] == body):
             track = points[:, k, :]
@@ -118,19 +147,75 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
             line={"width": 8, "color": colour},
             marker={"size": 5, "color": "black", "symbol": "circle"}))
         moving.append(len(figure.data) - 1)
-    built = [go.Frame(name=f"{float(trajectory.t[k]):.6g}", traces=moving,
-                      data=[_at(go, points[k]) for points in lines.values()])
+    names, points, forces = reactions(trajectory, outlines)
+    scale = force_scale(forces, _span(lines))
+    for name in names:
+        figure.add_trace(go.Scatter3d(
+            mode="lines+markers", name="joint reactions (i on j)", legendgroup="reactions",
+            showlegend=name == names[0], hovertemplate=f"{name} reaction<extra></extra>",
+            line={"width": 6, "color": REACTION},
+            marker={"size": [0, 4], "color": REACTION, "symbol": "diamond"}))
+        moving.append(len(figure.data) - 1)
+    cursors = _force_column(go, figure, trajectory, units)
+    built = [go.Frame(name=f"{float(trajectory.t[k]):.6g}", traces=moving + list(cursors),
+                      data=[*(_at(go, shape[k]) for shape in lines.values()),
+                            *_arrows(go, points[k], forces[k], scale),
+                            *(go.Scatter(x=[trajectory.t[k]] * 2, y=list(extent))
+                              for extent in cursors.values())])
              for k in frames]
     figure.frames = built
-    for index, trace in zip(moving, built[0].data):
-        figure.data[index].x, figure.data[index].y, figure.data[index].z = \
-            trace.x, trace.y, trace.z
+    for index, trace in zip(built[0].traces, built[0].data):
+        figure.data[index].x, figure.data[index].y = trace.x, trace.y
+        if index in moving:
+            figure.data[index].z = trace.z
     _layout(figure, trajectory, frames, lines, units, title)
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
                       config={"displaylogo": False, "responsive": True},
                       div_id="symkin-report")
     return path
+
+
+def _figure(go: Any, trajectory: Trajectory) -> Any:
+    """The empty figure: the scene alone, or with masses or forces the scene beside the
+    column of efforts and reactions (:mod:`symkin.present.html_forces`)."""
+    if trajectory.forces is None:
+        return go.Figure()
+    from plotly.subplots import make_subplots
+
+    specs = [[{"type": "scene", "rowspan": 3}, {}], [None, {}], [None, {}]]
+    return make_subplots(rows=3, cols=2, specs=specs, shared_xaxes=True,
+                         column_widths=[0.62, 0.38], horizontal_spacing=0.08,
+                         vertical_spacing=0.06)
+
+
+def _force_column(go: Any, figure: Any, trajectory: Trajectory, units: Units
+                  ) -> dict[int, tuple[float, float]]:
+    """The efforts' and reactions' curves in column 2; returns each time cursor's trace
+    index and the y range it spans (none without forces)."""
+    if trajectory.forces is None:
+        return {}
+    from symkin.present import html_forces
+
+    cursors = html_forces.plot(go, figure, trajectory, column=2)
+    html_forces.label(figure, 2, units, spatial=True)
+    return {index: html_forces.panel_range(figure, index) for index, _, _ in cursors}
+
+
+def _span(lines: dict[str, Array]) -> float:
+    low, high = _bounds(lines)
+    return max(float(np.max(high - low)), 1e-9)
+
+
+def _arrows(go: Any, points: Array, forces: Array, scale: float) -> list[Any]:
+    """Each joint's arrow at one time: from its point along its force (J, 3), scaled; the
+    unscaled force rides along as customdata."""
+    found = []
+    for point, force in zip(points, forces):
+        ends = np.stack([point, point + scale * force])
+        found.append(go.Scatter3d(x=ends[:, 0], y=ends[:, 1], z=ends[:, 2],
+                                  customdata=[force, force]))
+    return found
 
 
 def _moves(track: Array) -> bool:
@@ -196,7 +281,8 @@ def _layout(figure: Any, trajectory: Trajectory, frames: Array, lines: dict[str,
 
 
 def animate(trajectory: Trajectory, path: str | Path, fps: int = 20,
-            size: tuple[int, int] = DEFAULT_SIZE, progress: Progress | None = None) -> Path:
+            size: tuple[int, int] = DEFAULT_SIZE, progress: Progress | None = None,
+            outlines: Outlines | None = None) -> Path:
     """Write a GIF of the spatial mechanism moving, in isometric projection (z up).
 
     Args:
@@ -205,6 +291,8 @@ def animate(trajectory: Trajectory, path: str | Path, fps: int = 20,
         fps: frames per second; at most MAX_FRAMES frames are drawn, evenly spaced.
         size: width and height in pixels.
         progress: called as progress(frames done, frames) while frames are drawn.
+        outlines: the joints' points, where the reaction arrows are drawn (see
+            :func:`report`).
     """
     if trajectory.t.size == 0:
         raise SymkinError("nothing to animate: no time point was solved")
@@ -214,18 +302,26 @@ def animate(trajectory: Trajectory, path: str | Path, fps: int = 20,
 
     from symkin.present.plots import _pyplot
 
-    lines = {body: isometric(points) for body, points in _drawable(trajectory).items()}
+    spatial_lines = _drawable(trajectory)
+    lines = {body: isometric(points) for body, points in spatial_lines.items()}
+    _, points, forces = reactions(trajectory, outlines)
+    # the arrows scaled in space, then projected (the projection is linear)
+    tails, heads = isometric(points), isometric(force_scale(forces, _span(spatial_lines)) * forces)
     plt = _pyplot()
     figure, ax = plt.subplots(figsize=(size[0] / DPI, size[1] / DPI), dpi=DPI,
                               layout="constrained")
     try:
         drawn = _projected_scene(ax, trajectory, lines)
+        arrows = _projected_arrows(ax, tails, heads)
         ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize="small")
         frames = frame_indices(trajectory)
         images = []
         for done, k in enumerate(frames, start=1):
             for body, line in drawn.items():
                 line.set_data(*closed(lines[body][k]).T)
+            if arrows is not None:
+                arrows.set_offsets(tails[k])
+                arrows.set_UVC(heads[k, :, 0], heads[k, :, 1])
             ax.set_title(f"t = {trajectory.t[k]:.4g} (isometric view, z up)")
             figure.canvas.draw()
             rgb = Image.fromarray(np.asarray(figure.canvas.buffer_rgba())).convert("RGB")
@@ -266,3 +362,14 @@ def _projected_scene(ax: Any, trajectory: Trajectory, lines: dict[str, Array]) -
     return {body: ax.plot([], [], "o-", linewidth=3, markersize=5, color=colour,
                           markerfacecolor="black", label=body)[0]
             for body, colour in zip(lines, series.palette(len(lines)))}
+
+
+def _projected_arrows(ax: Any, tails: Array, heads: Array) -> Any:
+    """The reaction arrows' artist at the first frame (tails and projected forces, each
+    (T, J, 2)), and their legend entry; None without forces."""
+    if tails.shape[1] == 0:
+        return None
+    ax.plot([], [], "-", color=REACTION, linewidth=2, label="joint reactions (i on j)")
+    return ax.quiver(tails[0, :, 0], tails[0, :, 1], heads[0, :, 0], heads[0, :, 1],
+                     angles="xy", scale_units="xy", scale=1.0, color=REACTION,
+                     width=0.004, zorder=4)

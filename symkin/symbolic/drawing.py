@@ -80,6 +80,18 @@ def outlines(system: System) -> dict[str, NDArray[np.float64]]:
     return drawn
 
 
+def spatial_outlines(system: System) -> dict[str, NDArray[np.float64]]:
+    """What the 3D view needs besides the trajectory's named points: with inverse dynamics,
+    each joint's point on body i (``joint:<name>:<body i>``, one row x, y, z in the frame of
+    body i, global for the ground), where its reaction arrow is drawn; else nothing."""
+    values = dict(zip(system.p, system.p_values))
+
+    def at(vector: sp.ImmutableMatrix) -> tuple[float, ...]:
+        return tuple(float(v.subs(values)) for v in vector)
+
+    return _joint_points(system, at)
+
+
 def _joint_points(system: System, at: Any) -> dict[str, NDArray[np.float64]]:
     """With inverse dynamics, where each joint's reaction acts: ``joint:<name>:<body i>``
     holds the joint's point on body i (its local vector), the point its moment is about."""

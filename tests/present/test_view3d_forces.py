@@ -1,0 +1,220 @@
+"""The reaction arrows of a spatial run (issue 27, item 2): the 3D report and the isometric GIF.
+
+The run is bench/spatial_slider_crank_forces.yaml (the spatial slider-crank with masses,
+gravity, a torque, a damper and a spring) solved by the CLI. The arrows are checked against
+the run's own NPZ and the file's geometry: each starts at its joint's point on body i (a
+ground point of the file, or a named point the NPZ holds) and is the NPZ reaction force
+times one scale, the largest of the run VECTOR_SHARE of the scene's cube.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from symkin.present import view3d
+from tests.present.test_view3d import RSSR, _cli, _figure, _numbers
+
+ROOT = Path(__file__).resolve().parents[2]
+FORCES = ROOT / "bench" / "spatial_slider_crank_forces.yaml"
+H, R, K, L = 0.1, 0.08, 0.12, 0.4  # the file's parameters h, r, k, L
+B0 = np.sqrt(L**2 - (H + R) ** 2 - K**2)  # where the slider's B starts, on the x axis
+ARROWS = "joint reactions (i on j)"
+MAGENTA = np.array([0xC2, 0x00, 0x8F])  # animation.REACTION
+
+
+@pytest.fixture(scope="module")
+def forces_run(tmp_path_factory) -> tuple[Path, Path, Path]:
+    """The loaded spatial slider-crank solved by the CLI (NumPy backend): npz, html, gif."""
+    folder = tmp_path_factory.mktemp("spatial_forces")
+    result = _cli(str(FORCES), "--backend", "numpy", "-o", "f.npz", "--html", "f.html",
+                  "--animate", "f.gif", cwd=folder)
+    assert result.returncode == 0, result.stderr
+    return folder / "f.npz", folder / "f.html", folder / "f.gif"
+
+
+def _tails_and_heads(frame: dict, first: int, count: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """The arrows of one frame, the figure's ``count`` traces from ``first`` on: tails and
+    heads, each (J, 3)."""
+    own = frame["traces"].index(first)  # a frame lists the traces it updates, in its order
+    ends = np.array([np.stack([_numbers(trace[axis]) for axis in "xyz"], axis=1)
+                     for trace in frame["data"][own:own + count]])
+    return ends[:, 0], ends[:, 1]
+
+
+def test_report_arrows_are_the_npz_reactions_at_the_joints_points(forces_run) -> None:
+    npz, page, _ = forces_run
+    saved = np.load(npz)
+    names = [str(n) for n in saved["points"]]
+    joints = [str(n) for n in saved["joint_names"]]
+    assert joints == ["crank_bearing", "pin", "cross", "guide"]
+    data, frames, layout = _figure(page)
+    arrows = [k for k, trace in enumerate(data) if trace.get("name") == ARROWS]
+    assert len(arrows) == 4 and sum(data[k]["showlegend"] for k in arrows) == 1
+    first = arrows[0]
+    assert len(frames) == saved["t"].size == 101
+    # the file's geometry: the bearing and the guide on the ground, the pin on the crank (its
+    # point A), the cross on the slider (its point B)
+    ground = np.array([[0.0, H, K], [B0, 0.0, 0.0]])
+    span = (np.diff(layout["scene"]["xaxis"]["range"])[0]) / 1.1  # the cube is 1.1 spans
+    largest = np.linalg.norm(saved["reaction"][..., :3], axis=-1).max()
+    scale = 0.15 * span / largest
+    for k, frame in enumerate(frames):
+        tails, heads = _tails_and_heads(frame, first)
+        np.testing.assert_allclose(tails[[0, 3]], ground, atol=1e-12)
+        np.testing.assert_allclose(tails[1], saved["r"][k, names.index("crank.A")], atol=1e-12)
+        np.testing.assert_allclose(tails[2], saved["r"][k, names.index("slider.B")],
+                                   atol=1e-12)
+        force = saved["reaction"][k, :, :3]
+        np.testing.assert_allclose(heads - tails, scale * force, rtol=1e-9,
+                                   atol=1e-12 * span)
+        own = frame["traces"].index(first)
+        for j, trace in enumerate(frame["data"][own:own + 4]):
+            np.testing.assert_allclose(np.reshape(_numbers(trace["customdata"]), (2, 3)),
+                                       [force[j], force[j]], rtol=1e-12)
+    # every time point is a frame, so the run's largest force is among them: VECTOR_SHARE long
+    lengths = [np.linalg.norm(heads - tails, axis=1)
+               for tails, heads in (_tails_and_heads(f, first) for f in frames)]
+    assert np.max(lengths) == pytest.approx(0.15 * span, rel=1e-9)
+    # the crank pin on its circle about the bearing's axis x, turned by the driver 2πt:
+    # the arrows' tails are where the mechanism is, not only where the code put them
+    t = saved["t"]
+    pin = np.array([_tails_and_heads(f, first)[0][1] for f in frames])
+    circle = np.stack([0 * t, H + R * np.cos(2 * np.pi * t), K + R * np.sin(2 * np.pi * t)], 1)
+    assert np.abs(pin - circle).max() < 1e-9
+
+
+def test_no_arrows_without_forces_or_without_the_joints_points(forces_run,
+                                                               tmp_path: Path) -> None:
+    import symkin
+
+    rssr = symkin.solve(symkin.compile(symkin.derive(symkin.load(RSSR)), backend="numpy"))
+    assert rssr.forces is None
+    data, frames, _ = _figure(view3d.report(rssr, tmp_path / "rssr.html", outlines={}))
+    assert not [trace for trace in data if trace.get("name") == ARROWS]
+    assert len(frames[0]["data"]) == len(view3d.body_lines(rssr))
+
+
+def _frame(gif: Path, k: int) -> np.ndarray:
+    from PIL import Image
+
+    image = Image.open(gif)
+    image.seek(k)
+    return np.asarray(image.convert("RGB"), dtype=int)
+
+
+def _magenta(pixels: np.ndarray) -> int:
+    """Arrow-coloured pixels in the mechanism's axes (the legend, right of x = 700, has a
+    magenta line of its own)."""
+    return int((np.abs(pixels[:, :700] - MAGENTA).sum(axis=2) < 40).sum())
+
+
+def test_gif_draws_the_arrows_and_only_with_them(forces_run, tmp_path: Path) -> None:
+    import symkin
+    from symkin.symbolic import drawing
+
+    _, _, gif = forces_run
+    system = symkin.derive(symkin.load(FORCES))
+    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    bare = view3d.animate(trajectory, tmp_path / "bare.gif")
+    drawn = view3d.animate(trajectory, tmp_path / "drawn.gif",
+                           outlines=drawing.spatial_outlines(system))
+    for k in (0, 25, 60):
+        with_arrows, without = _frame(drawn, k), _frame(bare, k)
+        assert _magenta(with_arrows) > 50 and _magenta(without) == 0
+        assert (np.abs(with_arrows - without).sum(axis=2) > 0).sum() > 50
+        np.testing.assert_array_equal(_frame(gif, k), with_arrows)  # the CLI draws them too
+
+
+def test_report_force_column_is_the_npz_magnitudes(forces_run) -> None:
+    """Beside the scene: each driver's effort, each joint's |F| and |M| (the norms of the
+    NPZ's [Fx, Fy, Fz] and [Mx, My, Mz]) against t, and a time cursor per panel."""
+    npz, page, _ = forces_run
+    saved = np.load(npz)
+    data, frames, layout = _figure(page)
+    curves = {(trace["yaxis"], trace["name"]): _numbers(trace["y"]) for trace in data
+              if trace["type"] == "scatter" and trace.get("name")}
+    np.testing.assert_allclose(curves[("y", "driver0")], saved["effort"][:, 0], rtol=1e-12)
+    force = np.sqrt((saved["reaction"][..., :3] ** 2).sum(axis=-1))
+    moment = np.sqrt((saved["reaction"][..., 3:] ** 2).sum(axis=-1))
+    for j, name in enumerate(str(n) for n in saved["joint_names"]):
+        np.testing.assert_allclose(curves[("y2", name)], force[:, j], rtol=1e-12)
+        if moment[:, j].max() > 1e-9 * force.max():  # the spherical pin carries none
+            np.testing.assert_allclose(curves[("y3", name)], moment[:, j], rtol=1e-12)
+    assert ("y3", "pin") not in curves and layout["yaxis3"]["title"]["text"] == "joint moment |M|"
+    cursors = [k for k, trace in enumerate(data) if trace["type"] == "scatter"
+               and not trace.get("name")]
+    assert len(cursors) == 3 and set(cursors) <= set(frames[0]["traces"])
+    own = frames[40]["traces"].index(cursors[0])
+    assert _numbers(frames[40]["data"][own]["x"]) == pytest.approx([saved["t"][40]] * 2)
+
+
+def test_a_warm_run_draws_the_same_arrows(tmp_path: Path) -> None:
+    """The joints' points travel in the index with the kernel (3-component rows): the run
+    that reuses the cached kernel draws the arrows the deriving run drew."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(tmp_path / "cache")}
+    pages = []
+    for run in ("cold", "warm"):
+        result = subprocess.run(
+            [sys.executable, "-m", "symkin", "run", str(FORCES), "--backend", "numpy",
+             "--html", f"{run}.html"], cwd=tmp_path, env=env, capture_output=True, text=True,
+            timeout=600, check=False)
+        assert result.returncode == 0, result.stderr
+        assert ("cached kernel" in result.stdout) == (run == "warm"), result.stdout
+        pages.append(_figure(tmp_path / f"{run}.html"))
+    (cold, cold_frames, _), (warm, warm_frames, _) = pages
+    assert [t.get("name") for t in warm] == [t.get("name") for t in cold]
+    first = next(k for k, trace in enumerate(cold) if trace.get("name") == ARROWS)
+    for a, b in zip(cold_frames, warm_frames):
+        np.testing.assert_array_equal(_tails_and_heads(a, first), _tails_and_heads(b, first))
+
+
+def test_a_partial_run_with_forces_draws_without_warnings(tmp_path: Path) -> None:
+    """Rows a run did not solve (NaN positions and loads) draw no arrow and warn nothing."""
+    import dataclasses
+    import warnings
+
+    import symkin
+    from symkin.symbolic import drawing
+
+    system = symkin.derive(symkin.load(FORCES))
+    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    q, reaction = trajectory.q.copy(), trajectory.forces.reaction.copy()
+    q[50:], reaction[50:] = np.nan, np.nan
+    partial = dataclasses.replace(trajectory, q=q, forces=dataclasses.replace(
+        trajectory.forces, reaction=reaction))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        outlines = drawing.spatial_outlines(system)
+        page = view3d.report(partial, tmp_path / "p.html", outlines=outlines)
+        view3d.animate(partial, tmp_path / "p.gif", outlines=outlines)
+    data, frames, _ = _figure(page)
+    first = next(k for k, trace in enumerate(data) if trace.get("name") == ARROWS)
+    tails, heads = _tails_and_heads(frames[20], first)
+    assert np.isfinite(tails).all() and (np.linalg.norm(heads - tails, axis=1) > 0).all()
+    assert _magenta(_frame(tmp_path / "p.gif", 20)) > 50
+    assert _magenta(_frame(tmp_path / "p.gif", 80)) == 0  # nothing solved, nothing drawn
+
+
+def test_report_with_forces_in_headless_chromium(forces_run, tmp_path: Path) -> None:
+    """The page with its arrows and forces column loads without a console message and shows
+    the arrows' magenta in the scene (software WebGL)."""
+    from PIL import Image
+
+    from tests.present.test_present import _browse, _console_lines
+
+    _, page, _ = forces_run
+    webgl = ("--enable-unsafe-swiftshader", "--use-angle=swiftshader")
+    shot = tmp_path / "forces.png"
+    taken = _browse(page, *webgl, f"--screenshot={shot}")
+    assert taken.returncode == 0 and shot.exists(), taken.stderr
+    benign = ("willReadFrequently", "GL Driver Message (OpenGL, Performance")
+    assert [line for line in _console_lines(taken.stderr)
+            if not any(remark in line for remark in benign)] == [], taken.stderr
+    scene = np.asarray(Image.open(shot).convert("RGB"), dtype=int)[60:650, :700]
+    assert (np.abs(scene - MAGENTA).sum(axis=2) < 60).sum() > 20
