@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import UsageError
-from symkin.present import html_forces, series
+from symkin.present import html_forces, page, series
 from symkin.present.animation import (
     MAX_FRAMES,
     body_shapes,
@@ -105,11 +105,7 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
         html_forces.label(figure, column, units)
     _animate(go, figure, trajectory, frames, scene, moving, cursors)
     _layout(figure, trajectory, frames, scene, columns, units, title)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
-                      config={"displaylogo": False, "responsive": True},
-                      div_id="symkin-report")
-    return path
+    return page.write(figure, path)
 
 
 class _Scene:
@@ -296,12 +292,6 @@ def _layout(figure: Any, trajectory: Trajectory, frames: Array, scene: _Scene,
             figure.update_yaxes(title_text=units.axis_label(kind, order), row=order + 1,
                                 col=column)
         figure.update_xaxes(title_text=units.time_label(), row=3, col=column)
-    steps = [{"method": "animate", "label": f"{float(trajectory.t[k]):.4g}",
-              "args": [[f"{float(trajectory.t[k]):.6g}"],
-                       {"mode": "immediate", "frame": {"duration": 0, "redraw": False},
-                        "transition": {"duration": 0}}]} for k in frames]
-    play = {"frame": {"duration": 50, "redraw": False}, "fromcurrent": True,
-            "transition": {"duration": 0}}
     figure.update_layout(
         title={"text": f"{title}: {trajectory.t.size} time points, t = "
                        f"{trajectory.t[0]:.4g} to {trajectory.t[-1]:.4g}"
@@ -310,20 +300,7 @@ def _layout(figure: Any, trajectory: Trajectory, frames: Array, scene: _Scene,
         legend={"x": 1.02, "y": 1.0, "xanchor": "left", "yanchor": "top",
                 "font": {"size": 11}, "groupclick": "togglegroup"},
         margin={"t": 60, "b": 110, "r": 40},
-        # The slider's own tick labels (one per frame) would crowd: the current time is shown
-        # above it instead.
-        sliders=[{"active": 0, "steps": steps, "y": -0.02, "x": 0.08, "len": 0.9,
-                  "font": {"color": "rgba(0,0,0,0)"}, "ticklen": 0, "minorticklen": 0,
-                  "currentvalue": {"prefix": f"{units.time_label()} = ",
-                                   "font": {"color": "#222"}},
-                  "pad": {"t": 40}}],
-        updatemenus=[{"type": "buttons", "direction": "left", "x": 0.0, "y": -0.02,
-                      "xanchor": "left", "yanchor": "top", "pad": {"t": 40, "r": 10},
-                      "buttons": [
-                          {"label": "▶", "method": "animate", "args": [None, play]},
-                          {"label": "❚❚", "method": "animate",
-                           "args": [[None], {"mode": "immediate",
-                                             "frame": {"duration": 0, "redraw": False}}]}]}])
+        **page.time_controls(trajectory, frames, units, redraw=False, y=-0.02))
 
 
 def _translucent(colour: str) -> str:

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import SymkinError, UsageError
-from symkin.present import series
+from symkin.present import page, series
 from symkin.present.placement import REACTION, VECTOR_SHARE, Outlines, joint_points
 from symkin.present.series import DEFAULT_UNITS, Units
 from symkin.runtime.results import Trajectory
@@ -169,11 +169,7 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
         if index in moving:
             figure.data[index].z = trace.z
     _layout(figure, trajectory, frames, lines, units, title)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
-                      config={"displaylogo": False, "responsive": True},
-                      div_id="symkin-report")
-    return path
+    return page.write(figure, path)
 
 
 def _figure(go: Any, trajectory: Trajectory) -> Any:
@@ -246,13 +242,6 @@ def _layout(figure: Any, trajectory: Trajectory, frames: Array, lines: dict[str,
     axes = {f"{axis}axis": {"range": [centre[k] - half, centre[k] + half],
                             "title": {"text": f"{axis}{unit}"}}
             for k, axis in enumerate("xyz")}
-    # 3D frames need a redraw (a scene cannot be updated in place the way a 2D plot can).
-    step = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
-            "transition": {"duration": 0}}
-    steps = [{"method": "animate", "label": f"{float(trajectory.t[k]):.4g}",
-              "args": [[f"{float(trajectory.t[k]):.6g}"], step]} for k in frames]
-    play = {"frame": {"duration": 50, "redraw": True}, "fromcurrent": True,
-            "transition": {"duration": 0}}
     figure.update_layout(
         title={"text": f"{title}: {trajectory.t.size} time points, t = "
                        f"{trajectory.t[0]:.4g} to {trajectory.t[-1]:.4g} "
@@ -263,18 +252,7 @@ def _layout(figure: Any, trajectory: Trajectory, frames: Array, lines: dict[str,
                           "eye": {"x": 1.5, "y": -1.5, "z": 1.0}}},
         legend={"x": 1.0, "y": 1.0, "xanchor": "left", "yanchor": "top"},
         margin={"t": 60, "b": 110},
-        sliders=[{"active": 0, "steps": steps, "y": 0.0, "x": 0.08, "len": 0.9,
-                  "font": {"color": "rgba(0,0,0,0)"}, "ticklen": 0, "minorticklen": 0,
-                  "currentvalue": {"prefix": f"{units.time_label()} = ",
-                                   "font": {"color": "#222"}},
-                  "pad": {"t": 40}}],
-        updatemenus=[{"type": "buttons", "direction": "left", "x": 0.0, "y": 0.0,
-                      "xanchor": "left", "yanchor": "top", "pad": {"t": 40, "r": 10},
-                      "buttons": [
-                          {"label": "▶", "method": "animate", "args": [None, play]},
-                          {"label": "❚❚", "method": "animate",
-                           "args": [[None], {"mode": "immediate",
-                                             "frame": {"duration": 0, "redraw": False}}]}]}])
+        **page.time_controls(trajectory, frames, units, redraw=True, y=0.0))
 
 
 # --- the GIF ---------------------------------------------------------------------------------
