@@ -17,7 +17,9 @@ solves, with the row and column permutations baked in. The C template ``sparse_l
 renders that data, as straight-line code or, for very large systems, as index tables walked
 by loops. At run time each pivot is checked again (|pivot| >= tau times the largest entry of
 its active column, and above NQ eps max |Phi_q|); a failure sends the factorization to a
-counted dense partial-pivoting fall-back, never to a wrong answer.
+counted dense partial-pivoting fall-back, never to a wrong answer. Where no fixed order holds
+over the samples, ``lu_interchange`` adds run-time interchanges of rows of one pattern
+(``LUPlan.swaps``) and executes a plan in Python (its reference for the generated code).
 
 Storage: slot ``e < nnz`` holds the ``e``-th structural non-zero of Phi_q (pattern order), slots
 ``nnz .. n_lu-1`` hold fill-in. After factorization each slot holds its entry of L (strictly
@@ -61,6 +63,19 @@ class Step:
 
 
 @dataclass(frozen=True)
+class Swap:
+    """A run-time interchange at step k of rows k and p (pivot positions), which have the same
+    pattern after fill: when |entry of row p in column k| > |entry of row k|, every slot of row
+    k trades its value with row p's slot of the same column (L part too, as LAPACK swaps whole
+    rows), and the solves exchange x[k] and x[p]. The operations stay those of the plan."""
+
+    k: int
+    p: int
+    pivots: tuple[int, int]  # slots of (k, k) and (p, k): the two magnitudes compared
+    pairs: tuple[tuple[int, int], ...]  # (slot in row k, slot in row p), column by column
+
+
+@dataclass(frozen=True)
 class LUPlan:
     """The fixed sequence of operations of a sparse LU factorization and solve."""
 
@@ -74,6 +89,8 @@ class LUPlan:
     tau: float
     # steps whose pivot passed no threshold test on the sample (a singular sample)
     unchecked: tuple[int, ...] = field(default=())
+    # run-time interchanges, in the order they are decided (lu_interchange)
+    swaps: tuple[Swap, ...] = field(default=())
 
     @property
     def flops(self) -> int:
@@ -246,6 +263,22 @@ def pivot_ratio(plan: LUPlan, rows: Sequence[int], cols: Sequence[int],
     return worst
 
 
+def padded(plan: LUPlan, rows: Sequence[int], cols: Sequence[int],
+           padding: Sequence[tuple[int, int]]) -> LUPlan:
+    """``plan``'s pivot order on the pattern with ``padding``'s (row, column) entries added as
+    zeros (fill slots before any elimination), so that rows can share a pattern
+    (lu_interchange); the sample ratios are not recomputed."""
+    rows, cols = [int(i) for i in rows], [int(j) for j in cols]
+    active = _Active(plan.n, rows, cols, np.zeros((len(rows), 1)))
+    fill: list[tuple[int, int]] = []
+    for i, j in padding:
+        active.add(i, j, np.zeros(1), len(rows) + len(fill))
+        fill.append((i, j))
+    steps = [_eliminate(active, k, i, j, old.sample_ratio, fill, len(rows))
+             for k, (i, j, old) in enumerate(zip(plan.row_perm, plan.col_perm, plan.steps))]
+    return _permute(plan.n, len(rows), steps, fill, plan.tau, plan.unchecked)
+
+
 def _order(n: int, rows: list[int], cols: list[int], values: np.ndarray,
            threshold: float | None, tau: float) -> LUPlan:
     """Eliminate pivot by pivot; ``threshold`` None chooses on structure alone, else only
@@ -408,35 +441,3 @@ def _structural_message(active: _Active) -> str:
             f"eliminated, column(s) {empty_cols[:10]} and row(s) {empty_rows[:10]} have no "
             "entry left. Some coordinates are not constrained (or some equations repeat); "
             "check the joints and drivers, and that drivers match the degrees of freedom")
-
-
-def solve_with_plan(plan: LUPlan, nz: Sequence[float], b: Sequence[float]) -> np.ndarray:
-    """Execute the plan in Python: a slow reference of what the generated C does.
-
-    Raises:
-        SolveError: a pivot fails the run-time relative test (the C code's fall-back case).
-    """
-    v = np.zeros(plan.n_lu)
-    v[: plan.nnz] = np.asarray(nz, dtype=float)
-    tiny = plan.n * np.finfo(float).eps * np.abs(v).max()
-    inv = np.zeros(plan.n)
-    for s in plan.steps:
-        column = [abs(v[s.pivot])] + [abs(v[slot]) for _, slot in s.lower]
-        if not (abs(v[s.pivot]) >= plan.tau * max(column) and abs(v[s.pivot]) > tiny):
-            raise SolveError(f"pivot {s.k} failed the relative pivot test")
-        inv[s.k] = 1.0 / v[s.pivot]
-        for _, slot in s.lower:
-            v[slot] *= inv[s.k]
-        for target, lslot, uslot in s.updates:
-            v[target] -= v[lslot] * v[uslot]
-    x = np.asarray(b, dtype=float)[list(plan.row_perm)].copy()
-    for s in plan.steps:
-        for i, slot in s.lower:
-            x[i] -= v[slot] * x[s.k]
-    for s in reversed(plan.steps):
-        for j, slot in s.upper:
-            x[s.k] -= v[slot] * x[j]
-        x[s.k] *= inv[s.k]
-    out = np.empty(plan.n)
-    out[list(plan.col_perm)] = x
-    return out

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from symkin.codegen import lu_plan, symbol_printing
+from symkin.codegen import lu_interchange, lu_plan, symbol_printing
 from symkin.contract import dense_solvers
 from symkin.contract.options import defaults
 from symkin.errors import BuildError, SolveError
@@ -38,7 +38,8 @@ SINGULAR_COND = 1e10
 
 def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_plan.LUPlan:
     """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration and
-    checked over the motion (lu_plan.analyse_over), so that a step's cost is predictable."""
+    checked over the motion (lu_plan.analyse_over), with run-time interchanges of rows of one
+    pattern where no fixed order holds (lu_interchange), so that a step's cost is predictable."""
     kernel = _SampleKernel(system, pattern)
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         # A singular first guess (SciPy's LinAlgWarning) is expected here and handled.
@@ -47,7 +48,7 @@ def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_pla
         samples = [kernel.phi_q_nz(q, t) for q, t in motion_configurations(system, kernel,
                                                                            start)]
     try:
-        plan = lu_plan.analyse_over(len(system.q), [r for r, _ in pattern],
+        plan = lu_interchange.analyse_over(len(system.q), [r for r, _ in pattern],
                                     [c for _, c in pattern],
                                     [[float(v) for v in sample] for sample in samples])
     except SolveError as error:

@@ -17,7 +17,7 @@ import pytest
 from codegen_support import HEAVY
 
 import symkin
-from symkin.codegen import lu_plan
+from symkin.codegen import lu_interchange, lu_plan
 
 ROOT = Path(__file__).resolve().parents[2]
 # Where a fall-back cannot be avoided, and why: the parallelograms pass through a singular
@@ -75,7 +75,7 @@ def test_an_order_failing_later_is_replaced_by_one_that_holds() -> None:
         a = np.zeros((2, 2))
         a[rows, cols] = sample
         b = np.array([1.0, 2.0])
-        assert np.allclose(lu_plan.solve_with_plan(plan, sample, b), np.linalg.solve(a, b),
+        assert np.allclose(lu_interchange.solve_with_plan(plan, sample, b), np.linalg.solve(a, b),
                            rtol=1e-12, atol=0)
 
 
@@ -89,7 +89,7 @@ def _solves(plan, rows, cols, sample) -> bool:
     a = np.zeros((plan.n, plan.n))
     a[rows, cols] = sample
     b = np.arange(1.0, plan.n + 1)
-    return bool(np.allclose(lu_plan.solve_with_plan(plan, sample, b), np.linalg.solve(a, b),
+    return bool(np.allclose(lu_interchange.solve_with_plan(plan, sample, b), np.linalg.solve(a, b),
                             rtol=1e-12, atol=0))
 
 

@@ -19,6 +19,11 @@ The tests that remain at run time still catch every near-singular pivot: a
 constant pivot c can only fail the tiny-pivot bound (NQ eps max |Phi_q| >= |c|, also true when
 an entry is inf or NaN), tested once for the smallest constant pivot; the threshold test of a
 constant pivot with unknown entries below it stays a run-time test; an unknown pivot keeps both.
+
+A plan's run-time row interchanges (``LUPlan.swaps``, codegen.lu_interchange) become a compare
+and an exchange of the two rows' slots at their step, the outcome kept in ``lu->swapped`` for
+the solves. The slots of both rows are unknown from there on: the ones known until then are
+stored first (an earlier exchange may have moved another value into their place).
 """
 
 from __future__ import annotations
@@ -55,6 +60,7 @@ class Statements:
     inv_high: str = "0.0"
     constant_pivots: int = 0
     values: list[Value] = field(default_factory=list)  # per slot, its final number if known
+    swap_lines: int = 0  # statements of the run-time interchanges
     inverses: dict[int, float] = field(default_factory=dict)  # constant pivots' 1/c
 
 
@@ -88,6 +94,7 @@ class _Emitter:
 
     def step(self, s: Step) -> None:
         lines: list[str] = []
+        self._interchanges(s.k, lines)
         pivot = self.val[s.pivot]
         uses_cmax = False
         if pivot is not None and pivot != 0.0:
@@ -99,6 +106,26 @@ class _Emitter:
             self._update(target, l_slot, u_slot, lines)
         self.out.factor.append(lines)
         self.out.uses_cmax.append(uses_cmax)
+
+    def _interchanges(self, k: int, lines: list[str]) -> None:
+        """Step k's interchanges: row p's slots trade with row k's when p's entry in column k
+        is larger in magnitude (the comparison codegen.lu_interchange.factor makes)."""
+        start = len(lines)
+        for index, swap in enumerate(self.plan.swaps):
+            if swap.k != k:
+                continue
+            for slot in (slot for pair in swap.pairs for slot in pair):
+                value = self.val[slot]
+                if value is not None:
+                    lines.append(f"v[{slot}] = {self.lit(value)};")
+                    self.val[slot] = None
+            mine, theirs = swap.pivots
+            lines.append(f"swapped[{index}] = {self.fabs}(v[{theirs}]) > {self.fabs}(v[{mine}]);")
+            lines.append(f"if (swapped[{index}]) {{ /* rows {k} and {swap.p} trade places */")
+            lines += [f"    const {self.prefix}_real w{n} = v[{a}]; v[{a}] = v[{b}]; v[{b}] = w{n};"
+                      for n, (a, b) in enumerate(swap.pairs)]
+            lines.append("}")
+        self.out.swap_lines += len(lines) - start
 
     def _constant_pivot(self, s: Step, pivot: float, lines: list[str]) -> bool:
         self.out.constant_pivots += 1
@@ -296,9 +323,14 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
         prefix: the C prefix of the generated functions.
     """
     if style is None:
-        style = "straight" if plan.flops + plan.solve_flops <= TABLE_FLOPS else "tables"
+        style = ("straight" if plan.flops + plan.solve_flops <= TABLE_FLOPS or plan.swaps
+                 else "tables")
     if style not in ("straight", "tables"):
         raise ValueError(f"unknown sparse LU style {style!r}: use 'straight' or 'tables'")
+    if style == "tables" and plan.swaps:
+        # interchanges are planned only on sampled mechanisms, far below TABLE_FLOPS
+        raise ValueError("the table-driven sparse LU has no run-time row interchanges: use "
+                         "the straight-line style for a plan with swaps")
     fabs = "fabsf" if real == "float" else "fabs"
     code = statements(plan, constants if real == "double" else None, literal(real), prefix, fabs)
     steps = [{"k": s.k, "row": s.row, "col": s.col, "pivot": s.pivot,
@@ -318,6 +350,10 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
         "col_perm": list(plan.col_perm),
         "fill_slots": list(range(plan.nnz, plan.n_lu)),
         "unchecked": list(plan.unchecked),
+        # run-time interchanges (k, p) in plan order: each a compare, then an exchange of
+        # len(pairs) slot values when it is taken (and of x[k], x[p] in every solve)
+        "swaps": [[s.k, s.p] for s in plan.swaps],
+        "swap_pairs": [len(s.pairs) for s in plan.swaps],
         "ratio_tests": (code.ratio_tests if style == "straight"
                         else sum(1 for s in plan.steps if s.lower)),
         "tiny_check": code.tiny_check if style == "straight" else None,
