@@ -1,13 +1,15 @@
 """A sample configuration of a mechanism, for choices made at generation time.
 
 The pivot order of the generated sparse LU is checked on Phi_q at the mechanism assembled at
-t0. That configuration is found here with plain NumPy (SymPy's lambdify of Phi and Phi_q) and
-the dense Newton and Levenberg-Marquardt of symkin.contract.dense_solvers, so code generation
-never depends on the runtime.
+t0, then along its motion. Those configurations are found here with plain NumPy (SymPy's
+lambdify of Phi and Phi_q) and the dense Newton and Levenberg-Marquardt of
+symkin.contract.dense_solvers, so code generation never depends on the runtime. A mechanism
+driven by inputs has no motion in t: its inputs are walked instead (``input_walks``).
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -34,6 +36,16 @@ MAX_SAMPLED_NQ = 150
 # A sample this ill-conditioned is a singular configuration: no pivot order survives it, so
 # it does not vote (the run-time test and the edge treatment handle the passage).
 SINGULAR_COND = 1e10
+# Inputs are walked from their values at the assembled start, each alone both ways, then in
+# INPUT_DIRECTIONS directions drawn once from a seeded generator (together they move the
+# mechanism where no single input can), out to INPUT_SPAN times the larger of |value| and 1
+# (radians for an angle, the file's unit for a length) in the largest component;
+# INPUT_SAMPLES samples a walk, each reached in CONTINUATION_STEPS steps; a walk ends where
+# Newton fails (the edge of the workspace).
+INPUT_SPAN = 0.5
+INPUT_SAMPLES = 4
+INPUT_DIRECTIONS = 16
+INPUT_SEED = 26
 
 
 def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_plan.LUPlan:
@@ -45,8 +57,8 @@ def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_pla
         # A singular first guess (SciPy's LinAlgWarning) is expected here and handled.
         warnings.simplefilter("ignore")
         start = sample_configuration(system, kernel)
-        samples = [kernel.phi_q_nz(q, t) for q, t in motion_configurations(system, kernel,
-                                                                           start)]
+        samples = [kernel.phi_q_nz(q, t, p)
+                   for q, t, p in motion_configurations(system, kernel, start)]
     try:
         plan = lu_interchange.analyse_over(len(system.q), [r for r, _ in pattern],
                                     [c for _, c in pattern],
@@ -57,27 +69,99 @@ def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_pla
 
 
 def motion_configurations(system: System, kernel: Any, start: Sequence[float]
-                          ) -> list[tuple[np.ndarray, float]]:
-    """(q, t) at the assembled start, then at up to MOTION_SAMPLES times of the file's grid,
-    each followed from the last by dense Newton; the walk stops where Newton fails (a limit
-    position or a singular passage), and ill-conditioned samples are left out."""
+                          ) -> list[tuple[np.ndarray, float, np.ndarray]]:
+    """(q, t, p) at the assembled start, then at up to MOTION_SAMPLES times of the file's grid
+    (or along the input walks), each followed from the last by dense Newton; a walk stops
+    where Newton fails (a limit position or a singular passage), and ill-conditioned samples
+    are left out."""
     t0, t1, _ = system.time_grid
-    q = np.array(start, dtype=float)
-    found = [(q, float(t0))]
-    if len(system.q) > MAX_SAMPLED_NQ or system.inputs or not t1 > t0:
-        return found
     p = np.array(system.code_p_values, dtype=float)
+    q = np.array(start, dtype=float)
+    if len(system.q) > MAX_SAMPLED_NQ:
+        return [(q, float(t0), p)]
+    if system.inputs:
+        return input_walks(system, kernel, q)
+    if not t1 > t0:
+        return [(q, float(t0), p)]
     times = np.linspace(t0, t1, MOTION_SAMPLES * CONTINUATION_STEPS + 1)[1:]
-    for k, t in enumerate(times, start=1):
+    return [(q, float(t0), p), *_follow(kernel, q, [(float(t), p) for t in times])]
+
+
+def input_walks(system: System, kernel: Any, start: np.ndarray
+                ) -> list[tuple[np.ndarray, float, np.ndarray]]:
+    """(q, t0, p) at the start with its inputs' values there, then along straight walks of the
+    inputs from there (INPUT_SPAN, INPUT_DIRECTIONS)."""
+    t0 = float(system.time_grid[0])
+    p = start_inputs(system, kernel, start)
+    at = len(system.p) + np.arange(len(system.inputs))  # where u sits in the code's p
+    span = INPUT_SPAN * np.maximum(np.abs(p[at]), 1.0)
+    drawn = np.random.default_rng(INPUT_SEED).standard_normal((INPUT_DIRECTIONS, len(at)))
+    directions = [*np.eye(len(at)), *-np.eye(len(at)),
+                  *(drawn / np.abs(drawn).max(axis=1, keepdims=True))]
+    found = [(start, t0, p)]
+    fractions = np.linspace(0.0, 1.0, INPUT_SAMPLES * CONTINUATION_STEPS + 1)[1:]
+    for direction in directions:
+        path = []
+        for fraction in fractions:
+            walked = p.copy()
+            walked[at] += fraction * span * direction
+            path.append((t0, walked))
+        found += _follow(kernel, start, path)
+    return found
+
+
+def start_inputs(system: System, kernel: Any, q: np.ndarray) -> np.ndarray:
+    """The code's p with each input at its value in configuration q: the root of its row in u
+    by Newton (numerical slope), from its nominal value, else from 1 (a length's row may be
+    flat at 0); the nominal value where neither converges."""
+    t0 = float(system.time_grid[0])
+    p = np.array(system.code_p_values, dtype=float)
+    for index, item in enumerate(system.inputs):
+        row = next(r for r, expression in enumerate(system.phi)
+                   if item.u in expression.free_symbols)
+        at = len(system.p) + index
+
+        def residual(u: float, row: int = row, at: int = at) -> float:
+            trial = p.copy()
+            trial[at] = u
+            return float(kernel.phi(q, t0, trial)[row])
+
+        for guess in (p[at], 1.0):
+            root = _scalar_root(residual, float(guess))
+            if root is not None:
+                p[at] = root
+                break
+    return p
+
+
+def _scalar_root(f: Any, u: float) -> float | None:
+    """Newton on a scalar f with a central-difference slope; None when it does not converge."""
+    for _ in range(NEWTON.max_iterations):
+        h = 1e-7 * max(1.0, abs(u))
+        value, slope = f(u), (f(u + h) - f(u - h)) / (2 * h)
+        if abs(value) <= NEWTON.tol_phi:
+            return u
+        if not (math.isfinite(value) and math.isfinite(slope)) or slope == 0.0:
+            return None
+        u -= value / slope
+    return None
+
+
+def _follow(kernel: Any, q: np.ndarray, path: Sequence[tuple[float, np.ndarray]]
+            ) -> list[tuple[np.ndarray, float, np.ndarray]]:
+    """Dense Newton from q along the path's (t, p), each point from the last; every
+    CONTINUATION_STEPS-th solution that is not singular is kept. Stops where Newton fails."""
+    found = []
+    for k, (t, p) in enumerate(path, start=1):
         try:
-            next_q = dense_solvers.newton(kernel, q, float(t), p, NEWTON)
+            next_q = dense_solvers.newton(kernel, q, t, p, NEWTON)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError):
             next_q = None
         if next_q is None or not np.all(np.isfinite(next_q)):
             break
         q = next_q
-        if k % CONTINUATION_STEPS == 0 and np.linalg.cond(kernel.phi_q(q, t)) < SINGULAR_COND:
-            found.append((q, float(t)))
+        if k % CONTINUATION_STEPS == 0 and np.linalg.cond(kernel.phi_q(q, t, p)) < SINGULAR_COND:
+            found.append((q, t, p))
     return found
 
 

@@ -4,7 +4,9 @@ test mechanisms never fall back to the dense LU along their motion: a step's cos
 straight-line code's, every time.
 
 Measured before this choice (order checked at t0 alone): all_drivers 36 of 101 points fell
-back, offset_crank_slider 9 of 101, slide_driven 6 of 101.
+back, offset_crank_slider 9 of 101, slide_driven 6 of 101. Where no fixed order holds (a body
+turning a full turn in Euler parameters), rows of one pattern trade places at run time
+(codegen.lu_interchange): cardan, rssr and spatial_slider_crank fell back 3 times each before.
 """
 
 from __future__ import annotations
@@ -31,23 +33,18 @@ LIMITED = {"dead_centre", "non_grashof", "half_circle_end"}
 # No motion in t: the caller gives the legs (arm angles); their fall-backs are checked along
 # prescribed paths in tests/inputs/test_parallel_fk_examples.py (delta_fk, three_rrr_fk).
 INPUT_DRIVEN = {"stewart_fk", "stewart_legs_fk", "delta_fk", "three_rrr_fk"}
-# Open (issue 26): a body that turns half a turn or more in Euler parameters. Its driver and
-# normalisation rows meet its columns e0, e3 in the block 2 [[s, -c], [c, s]] (c, s the cosine
-# and sine of half its angle), and its two axis rows meet e1, e2 in another rotation: every
-# entry of such a block is zero somewhere on the turn, so no fixed pivot order holds over it
-# (test_a_rotation_block_has_no_fixed_order below). What would: a run-time interchange of the
-# two rows, which have the same pattern (partial pivoting within the block, the operation
-# count unchanged). Reported as expected failures, so that a fix shows as XPASS.
-OPEN = {"cardan", "rssr", "spatial_slider_crank"}
+# A body that turns half a turn or more in Euler parameters (cardan, rssr,
+# spatial_slider_crank): its driver and normalisation rows meet its columns e0, e3 in the block
+# 2 [[s, -c], [c, s]] (c, s the cosine and sine of half its angle), and its two axis rows meet
+# e1, e2 in another rotation: every entry of such a block is zero somewhere on the turn, so no
+# fixed pivot order holds over it (test_a_rotation_block_has_no_fixed_order below). The plan
+# interchanges those rows at run time instead (test_interchanges_hold_over_the_turn).
 FILES = sorted(p for p in [*ROOT.glob("examples/*.yaml"), *ROOT.glob("tests/mechanisms/*.yaml")]
                if p.stem not in LIMITED | INPUT_DRIVEN and "input" not in p.stem
                and (p.stem not in HEAVY or os.environ.get("SYMKIN_SLOW") == "1"))
 
 
-@pytest.mark.parametrize("path", [
-    pytest.param(p, id=p.stem, marks=pytest.mark.xfail(
-        reason="dense fall-backs along this motion: open in issue 26") if p.stem in OPEN else ())
-    for p in FILES])
+@pytest.mark.parametrize("path", [pytest.param(p, id=p.stem) for p in FILES])
 def test_no_dense_fallback_along_the_motion(path: Path) -> None:
     kernel = symkin.compile(symkin.derive(path), backend="c")
     trajectory = symkin.solve(kernel)
@@ -110,12 +107,27 @@ def test_the_order_is_chosen_over_all_samples_at_once() -> None:
         assert _solves(plan, rows, cols, sample)
 
 
+ROTATION = ([0, 0, 1, 1], [0, 1, 0, 1],
+            [[2 * np.sin(a), -2 * np.cos(a), 2 * np.cos(a), 2 * np.sin(a)]
+             for a in np.linspace(0.0, np.pi / 2, 9)])
+
+
 def test_a_rotation_block_has_no_fixed_order() -> None:
-    """Why OPEN stays open: 2 [[s, -c], [c, s]] over half a turn (c, s from 1, 0 to 0, 1)
-    vanishes in every entry somewhere, so every one of the four first pivots fails the
-    run-time test at one end, whatever order is chosen."""
-    rows, cols = [0, 0, 1, 1], [0, 1, 0, 1]
-    angles = np.linspace(0.0, np.pi / 2, 9)
-    samples = [[2 * np.sin(a), -2 * np.cos(a), 2 * np.cos(a), 2 * np.sin(a)] for a in angles]
+    """2 [[s, -c], [c, s]] over half a turn (c, s from 1, 0 to 0, 1) vanishes in every entry
+    somewhere, so every one of the four first pivots fails the run-time test at one end,
+    whatever fixed order is chosen."""
+    rows, cols, samples = ROTATION
     plan = _plan_for(rows, cols, samples)
+    assert not plan.swaps
     assert min(lu_plan.pivot_ratio(plan, rows, cols, s) for s in samples) < plan.tau
+
+
+def test_interchanges_hold_over_the_turn() -> None:
+    """The same block with its two rows (one pattern) interchanged at run time: every sample
+    passes every pivot test, and the solutions are numpy's."""
+    rows, cols, samples = ROTATION
+    plan = lu_interchange.analyse_over(2, rows, cols, samples)
+    assert [(s.k, s.p) for s in plan.swaps] == [(0, 1)]
+    for sample in samples:
+        assert lu_interchange.factor(plan, sample).failed is None
+        assert _solves(plan, rows, cols, sample)
