@@ -28,6 +28,10 @@ from symkin.codegen import lu_plan
 from symkin.codegen.lu_plan import LUPlan, Swap
 from symkin.errors import SolveError
 
+MARGIN = lu_plan.GENERATION_THRESHOLD
+"""A pivot whose ratio on some sample is below this (while above the run-time test's tau)
+is close enough to failing between samples that an interchange is worth its compare."""
+
 
 @dataclass
 class Factors:
@@ -38,7 +42,7 @@ class Factors:
     inv: np.ndarray
     swapped: list[bool]
     failed: int | None = None  # the step k, or None when every pivot passed
-    worst_ratio: float = np.inf  # min |pivot| / max |active column| over the steps done
+    ratios: list[float] = dataclasses.field(default_factory=list)  # |pivot| / max |column|
 
 
 def analyse_over(n: int, rows: Sequence[int], cols: Sequence[int],
@@ -46,7 +50,8 @@ def analyse_over(n: int, rows: Sequence[int], cols: Sequence[int],
     """lu_plan.analyse_over's order, with the interchanges the samples need (none when the
     order holds on every sample, or when none helps)."""
     plan = lu_plan.analyse_over(n, rows, cols, samples)
-    return with_interchanges(plan, rows, cols, [_slots(plan, sample) for sample in samples])
+    values = [_slots(plan, sample) for sample in samples]
+    return with_margin(with_interchanges(plan, rows, cols, values), values)
 
 
 @dataclass(frozen=True)
@@ -76,6 +81,37 @@ def with_interchanges(plan: LUPlan, rows: Sequence[int], cols: Sequence[int],
             break
         trial = better
     return trial.plan if len(trial.failing) < len(_failing(plan, samples)) else plan
+
+
+def with_margin(plan: LUPlan, samples: Sequence[np.ndarray]) -> LUPlan:
+    """Interchanges where a pivot passes the run-time test on every sample but by less than
+    MARGIN on some: the samples are a few points of the motion, and a pivot that comes that
+    close to the limit at one of them may cross it between them. Taken, step by step, where
+    rows below share the pivot row's pattern, when they raise the step's smallest ratio over
+    the samples and make no sample fail."""
+    groups = same_pattern_rows(plan)
+    runs = [factor(plan, sample) for sample in samples]
+    for k in range(plan.n):
+        later = [q for q in groups.get(k, ()) if q > k]
+        if not later or any(s.k == k for s in plan.swaps) or _weakest(runs, k) >= MARGIN:
+            continue
+        pairs = sorted([(s.k, s.p) for s in plan.swaps] + [(k, q) for q in later],
+                       key=lambda pair: pair[0])
+        trial = _with_swaps(plan, pairs)
+        trial_runs = [factor(trial, sample) for sample in samples]
+        if (_fails(trial_runs) <= _fails(runs)
+                and _weakest(trial_runs, k) > _weakest(runs, k)):
+            plan, runs = trial, trial_runs
+    return plan
+
+
+def _weakest(runs: Sequence[Factors], k: int) -> float:
+    """The smallest ratio of step k over the runs that reached it."""
+    return min((run.ratios[k] for run in runs if len(run.ratios) > k), default=np.inf)
+
+
+def _fails(runs: Sequence[Factors]) -> int:
+    return sum(run.failed is not None for run in runs)
 
 
 def _past_step(base: LUPlan, rows: Sequence[int], cols: Sequence[int],
@@ -177,7 +213,7 @@ def factor(plan: LUPlan, nz: Sequence[float]) -> Factors:
         _interchange(plan, s.k, out)
         column = max([abs(v[s.pivot])] + [abs(v[slot]) for _, slot in s.lower])
         ratio = abs(v[s.pivot]) / column if column > 0 else 0.0
-        out.worst_ratio = min(out.worst_ratio, ratio)
+        out.ratios.append(ratio)
         if not (abs(v[s.pivot]) >= plan.tau * column and abs(v[s.pivot]) > tiny):
             out.failed = s.k
             return out

@@ -124,3 +124,19 @@ def test_float_build_with_interchanges_compiles_cleanly(tmp_path: Path) -> None:
                                "-O2", "-c", str(source), "-o", str(source.with_suffix(".o"))],
                               capture_output=True, text=True, check=False)
         assert done.returncode == 0, done.stderr
+
+
+def test_a_pivot_near_the_limit_gets_an_interchange() -> None:
+    """[[a, 1], [1, 2]] with a = 1, then 0.05: the first pivot's ratio a / 1 passes the
+    run-time test (0.01) at both samples, but by less than MARGIN at the second, where it
+    could fail between samples; the two rows (one pattern) are interchanged at run time, and
+    the larger entry, 1, then pivots: ratio 1 at both."""
+    rows, cols = [0, 0, 1, 1], [0, 1, 0, 1]
+    samples = [[1.0, 1.0, 1.0, 2.0], [0.05, 1.0, 1.0, 2.0]]
+    fixed = lu_plan.analyse_over(2, rows, cols, samples)
+    assert (fixed.row_perm, fixed.col_perm) == ((0, 1), (0, 1))
+    assert lu_plan.pivot_ratio(fixed, rows, cols, samples[1]) == pytest.approx(0.05)
+    plan = lu_interchange.analyse_over(2, rows, cols, samples)
+    assert [(s.k, s.p) for s in plan.swaps] == [(0, 1)]
+    for sample in samples:
+        assert lu_interchange.factor(plan, sample).ratios[0] == 1.0
