@@ -194,14 +194,14 @@ def _failing(plan: LUPlan, samples: Sequence[np.ndarray]) -> dict[int, int]:
     return {index: k for index, k in steps.items() if k is not None}
 
 
-def _slots(plan: LUPlan, sample: Sequence[float]) -> np.ndarray:
+def _slots(plan: LUPlan, sample: Sequence[float] | np.ndarray) -> np.ndarray:
     values = np.asarray(sample, dtype=float).ravel()
     if values.size != plan.nnz:
         raise ValueError(f"a sample has {values.size} values for {plan.nnz} non-zeros")
     return values
 
 
-def factor(plan: LUPlan, nz: Sequence[float]) -> Factors:
+def factor(plan: LUPlan, nz: Sequence[float] | np.ndarray) -> Factors:
     """Execute the factorization of ``plan`` on Phi_q's non-zeros (pattern order), with its
     interchanges and run-time pivot tests, as the generated C does; stops at a failing pivot
     (the C code's fall-back case)."""
@@ -236,7 +236,8 @@ def _interchange(plan: LUPlan, k: int, out: Factors) -> None:
             v[a], v[b] = v[b], v[a]
 
 
-def solve_with_plan(plan: LUPlan, nz: Sequence[float], b: Sequence[float]) -> np.ndarray:
+def solve_with_plan(plan: LUPlan, nz: Sequence[float] | np.ndarray,
+                    b: Sequence[float] | np.ndarray) -> np.ndarray:
     """Factor with the plan and solve Phi_q x = b in Python: a slow reference of what the
     generated C does.
 

@@ -4,7 +4,7 @@
  * Mechanism spec sha256: b71ddf7af64222d4f2be315ed6fa7e5ee2d5ecd055f46a9fd54a0449aabf6391
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 357, gamma_shared 352, phi 100, phi_p 55, phi_phi_q 192, phi_q 132, phi_t 20, phi_t_shared 17, points 4, removed 71
  */
-/* Factor: 78 flops, solve: 67 flops, fill-in: 8.
+/* Factor: 100 flops, solve: 73 flops, fill-in: 14.
  */
 #include <float.h>
 #include <math.h>
@@ -23,6 +23,7 @@ void cardan_lu_init(cardan_lu *lu)
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
+    for (e = 0; e < 6; ++e) lu->swapped[e] = 0;
     /* The slots and reciprocals known at generation time; the factorization never writes them. */
     lu->v[0] = -1.0;
     lu->v[1] = -1.0;
@@ -33,8 +34,6 @@ void cardan_lu_init(cardan_lu *lu)
     lu->v[22] = -1.0;
     lu->v[23] = -1.0;
     lu->v[28] = -1.0;
-    lu->v[37] = -1.0;
-    lu->v[42] = -1.0;
     lu->inv[0] = -1.0;
     lu->inv[1] = -1.0;
     lu->inv[2] = -1.0;
@@ -116,27 +115,43 @@ static cardan_real cardan_lu_load(const cardan_real nz[], cardan_real v[])
 
 /* Pivots 0..13: 0, or k + 1 when pivot k fails. */
 static int cardan_lu_factor_0(cardan_real *v, cardan_real *inv,
-        cardan_real tiny)
+        cardan_real tiny, int *swapped)
 {
     cardan_real cmax;
     (void)v;
     (void)inv;
     (void)tiny;
+    (void)swapped;
     /* pivot 0: row 6, column 8 */
     /* pivot 1: row 1, column 1 */
     /* pivot 2: row 0, column 0 */
     /* pivot 3: row 2, column 2 */
     /* pivot 4: row 5, column 7 */
-    v[59] = -((-1.0) * v[12]);
-    v[60] = -((-1.0) * v[13]);
-    v[61] = -((-1.0) * v[14]);
-    v[62] = -((-1.0) * v[15]);
+    v[65] = -((-1.0) * v[12]);
+    v[66] = -((-1.0) * v[13]);
+    v[67] = -((-1.0) * v[14]);
+    v[68] = -((-1.0) * v[15]);
     /* pivot 5: row 7, column 9 */
-    v[63] = -((-1.0) * v[24]);
-    v[64] = -((-1.0) * v[25]);
-    v[65] = -((-1.0) * v[26]);
-    v[66] = -((-1.0) * v[27]);
+    v[69] = -((-1.0) * v[24]);
+    v[70] = -((-1.0) * v[25]);
+    v[71] = -((-1.0) * v[26]);
+    v[72] = -((-1.0) * v[27]);
     /* pivot 6: row 13, column 10 */
+    v[59] = 0.0;
+    v[60] = 0.0;
+    v[61] = 0.0;
+    v[62] = 0.0;
+    swapped[0] = fabs(v[33]) > fabs(v[55]);
+    if (swapped[0]) { /* rows 6 and 7 trade places */
+        const cardan_real w0 = v[55]; v[55] = v[33]; v[33] = w0;
+        const cardan_real w1 = v[56]; v[56] = v[34]; v[34] = w1;
+        const cardan_real w2 = v[58]; v[58] = v[36]; v[36] = w2;
+        const cardan_real w3 = v[57]; v[57] = v[35]; v[35] = w3;
+        const cardan_real w4 = v[59]; v[59] = v[31]; v[31] = w4;
+        const cardan_real w5 = v[60]; v[60] = v[32]; v[32] = w5;
+        const cardan_real w6 = v[61]; v[61] = v[30]; v[30] = w6;
+        const cardan_real w7 = v[62]; v[62] = v[29]; v[29] = w7;
+    }
     cmax = fabs(v[55]);
     cmax = cardan_lu_amax(cmax, v[33]);
     cmax = cardan_lu_amax(cmax, v[38]);
@@ -146,12 +161,24 @@ static int cardan_lu_factor_0(cardan_real *v, cardan_real *inv,
     v[33] *= inv[6];
     v[38] *= inv[6];
     v[43] *= inv[6];
+    v[29] -= v[33] * v[62];
+    v[30] -= v[33] * v[61];
+    v[31] -= v[33] * v[59];
+    v[32] -= v[33] * v[60];
     v[34] -= v[33] * v[56];
     v[35] -= v[33] * v[57];
     v[36] -= v[33] * v[58];
+    v[65] -= v[38] * v[62];
+    v[66] -= v[38] * v[61];
+    v[67] -= v[38] * v[59];
+    v[68] -= v[38] * v[60];
     v[39] -= v[38] * v[56];
     v[40] -= v[38] * v[57];
     v[41] -= v[38] * v[58];
+    v[69] -= v[43] * v[62];
+    v[70] -= v[43] * v[61];
+    v[71] -= v[43] * v[59];
+    v[72] -= v[43] * v[60];
     v[44] -= v[43] * v[56];
     v[45] -= v[43] * v[57];
     v[46] -= v[43] * v[58];
@@ -163,33 +190,71 @@ static int cardan_lu_factor_0(cardan_real *v, cardan_real *inv,
     inv[7] = 1 / v[34];
     v[39] *= inv[7];
     v[44] *= inv[7];
-    v[59] -= v[39] * v[29];
-    v[60] -= v[39] * v[30];
-    v[61] -= v[39] * v[31];
-    v[62] -= v[39] * v[32];
+    v[65] -= v[39] * v[29];
+    v[66] -= v[39] * v[30];
+    v[67] -= v[39] * v[31];
+    v[68] -= v[39] * v[32];
     v[40] -= v[39] * v[35];
     v[41] -= v[39] * v[36];
-    v[63] -= v[44] * v[29];
-    v[64] -= v[44] * v[30];
-    v[65] -= v[44] * v[31];
-    v[66] -= v[44] * v[32];
+    v[69] -= v[44] * v[29];
+    v[70] -= v[44] * v[30];
+    v[71] -= v[44] * v[31];
+    v[72] -= v[44] * v[32];
     v[45] -= v[44] * v[35];
     v[46] -= v[44] * v[36];
     /* pivot 8: row 9, column 13 */
+    v[37] = -1.0;
+    v[64] = -0.0;
+    v[63] = -0.0;
+    v[42] = -1.0;
+    swapped[1] = fabs(v[46]) > fabs(v[41]);
+    if (swapped[1]) { /* rows 8 and 9 trade places */
+        const cardan_real w0 = v[37]; v[37] = v[64]; v[64] = w0;
+        const cardan_real w1 = v[63]; v[63] = v[42]; v[42] = w1;
+        const cardan_real w2 = v[38]; v[38] = v[43]; v[43] = w2;
+        const cardan_real w3 = v[39]; v[39] = v[44]; v[44] = w3;
+        const cardan_real w4 = v[41]; v[41] = v[46]; v[46] = w4;
+        const cardan_real w5 = v[40]; v[40] = v[45]; v[45] = w5;
+        const cardan_real w6 = v[67]; v[67] = v[71]; v[71] = w6;
+        const cardan_real w7 = v[68]; v[68] = v[72]; v[72] = w7;
+        const cardan_real w8 = v[66]; v[66] = v[70]; v[70] = w8;
+        const cardan_real w9 = v[65]; v[65] = v[69]; v[69] = w9;
+    }
     cmax = fabs(v[41]);
     cmax = cardan_lu_amax(cmax, v[46]);
     if (!cardan_lu_pivot_ok(v[41], cmax, tiny)) return 9;
     inv[8] = 1 / v[41];
     v[46] *= inv[8];
-    v[63] -= v[46] * v[59];
-    v[64] -= v[46] * v[60];
-    v[65] -= v[46] * v[61];
-    v[66] -= v[46] * v[62];
+    v[69] -= v[46] * v[65];
+    v[70] -= v[46] * v[66];
+    v[71] -= v[46] * v[67];
+    v[72] -= v[46] * v[68];
     v[45] -= v[46] * v[40];
     /* pivot 9: row 10, column 12 */
     if (!(fabs(v[45]) > tiny)) return 10;
     inv[9] = 1 / v[45];
     /* pivot 10: row 3, column 5 */
+    swapped[2] = fabs(v[9]) > fabs(v[5]);
+    if (swapped[2]) { /* rows 10 and 11 trade places */
+        const cardan_real w0 = v[5]; v[5] = v[9]; v[9] = w0;
+        const cardan_real w1 = v[6]; v[6] = v[10]; v[10] = w1;
+        const cardan_real w2 = v[4]; v[4] = v[8]; v[8] = w2;
+        const cardan_real w3 = v[3]; v[3] = v[7]; v[7] = w3;
+    }
+    swapped[3] = fabs(v[49]) > fabs(v[5]);
+    if (swapped[3]) { /* rows 10 and 12 trade places */
+        const cardan_real w0 = v[5]; v[5] = v[49]; v[49] = w0;
+        const cardan_real w1 = v[6]; v[6] = v[50]; v[50] = w1;
+        const cardan_real w2 = v[4]; v[4] = v[48]; v[48] = w2;
+        const cardan_real w3 = v[3]; v[3] = v[47]; v[47] = w3;
+    }
+    swapped[4] = fabs(v[53]) > fabs(v[5]);
+    if (swapped[4]) { /* rows 10 and 13 trade places */
+        const cardan_real w0 = v[5]; v[5] = v[53]; v[53] = w0;
+        const cardan_real w1 = v[6]; v[6] = v[54]; v[54] = w1;
+        const cardan_real w2 = v[4]; v[4] = v[52]; v[52] = w2;
+        const cardan_real w3 = v[3]; v[3] = v[51]; v[51] = w3;
+    }
     cmax = fabs(v[5]);
     cmax = cardan_lu_amax(cmax, v[9]);
     cmax = cardan_lu_amax(cmax, v[49]);
@@ -221,6 +286,13 @@ static int cardan_lu_factor_0(cardan_real *v, cardan_real *inv,
     v[51] -= v[54] * v[7];
     v[52] -= v[54] * v[8];
     /* pivot 12: row 11, column 4 */
+    swapped[5] = fabs(v[52]) > fabs(v[48]);
+    if (swapped[5]) { /* rows 12 and 13 trade places */
+        const cardan_real w0 = v[49]; v[49] = v[53]; v[53] = w0;
+        const cardan_real w1 = v[50]; v[50] = v[54]; v[54] = w1;
+        const cardan_real w2 = v[48]; v[48] = v[52]; v[52] = w2;
+        const cardan_real w3 = v[47]; v[47] = v[51]; v[51] = w3;
+    }
     cmax = fabs(v[48]);
     cmax = cardan_lu_amax(cmax, v[52]);
     if (!cardan_lu_pivot_ok(v[48], cmax, tiny)) return 13;
@@ -241,7 +313,7 @@ int cardan_lu_factor_sparse(const cardan_real nz[], cardan_lu *lu)
      * constants, unchanged by the elimination): no reciprocal, no test, except this one for the
      * smallest, which fails when max |Phi_q| is huge or not finite. */
     if (!(tiny < 1.0)) return 1;
-    status = cardan_lu_factor_0(lu->v, lu->inv, tiny);
+    status = cardan_lu_factor_0(lu->v, lu->inv, tiny, lu->swapped);
     if (status != 0) return status;
     return 0;
 }
@@ -303,8 +375,10 @@ static void cardan_lu_forward_0(const cardan_real *v, cardan_real *x)
     (void)v;
     x[4] += x[2];
     x[5] += x[3];
-    x[8] += x[4];
-    x[9] += x[5];
+    x[8] -= v[37] * x[4];
+    x[9] -= v[64] * x[4];
+    x[8] -= v[63] * x[5];
+    x[9] -= v[42] * x[5];
     x[7] -= v[33] * x[6];
     x[8] -= v[38] * x[6];
     x[9] -= v[43] * x[6];
@@ -335,16 +409,16 @@ static void cardan_lu_backward_0(const cardan_real *v,
     x[10] -= v[4] * x[12];
     x[10] -= v[3] * x[13];
     x[10] *= inv[10];
-    x[9] -= v[65] * x[10];
-    x[9] -= v[66] * x[11];
-    x[9] -= v[64] * x[12];
-    x[9] -= v[63] * x[13];
+    x[9] -= v[71] * x[10];
+    x[9] -= v[72] * x[11];
+    x[9] -= v[70] * x[12];
+    x[9] -= v[69] * x[13];
     x[9] *= inv[9];
     x[8] -= v[40] * x[9];
-    x[8] -= v[61] * x[10];
-    x[8] -= v[62] * x[11];
-    x[8] -= v[60] * x[12];
-    x[8] -= v[59] * x[13];
+    x[8] -= v[67] * x[10];
+    x[8] -= v[68] * x[11];
+    x[8] -= v[66] * x[12];
+    x[8] -= v[65] * x[13];
     x[8] *= inv[8];
     x[7] -= v[36] * x[8];
     x[7] -= v[35] * x[9];
@@ -356,6 +430,10 @@ static void cardan_lu_backward_0(const cardan_real *v,
     x[6] -= v[56] * x[7];
     x[6] -= v[58] * x[8];
     x[6] -= v[57] * x[9];
+    x[6] -= v[59] * x[10];
+    x[6] -= v[60] * x[11];
+    x[6] -= v[61] * x[12];
+    x[6] -= v[62] * x[13];
     x[6] *= inv[6];
     x[5] -= v[26] * x[10];
     x[5] -= v[27] * x[11];
@@ -400,6 +478,12 @@ void cardan_lu_solve(const cardan_lu *lu, cardan_real b[])
     x[11] = b[4];
     x[12] = b[11];
     x[13] = b[12];
+    if (lu->swapped[0]) { const cardan_real w = x[6]; x[6] = x[7]; x[7] = w; }
+    if (lu->swapped[1]) { const cardan_real w = x[8]; x[8] = x[9]; x[9] = w; }
+    if (lu->swapped[2]) { const cardan_real w = x[10]; x[10] = x[11]; x[11] = w; }
+    if (lu->swapped[3]) { const cardan_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[4]) { const cardan_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[5]) { const cardan_real w = x[12]; x[12] = x[13]; x[13] = w; }
     cardan_lu_forward_0(lu->v, x);
     cardan_lu_backward_0(lu->v, lu->inv, x);
     b[8] = x[0];
@@ -447,6 +531,10 @@ static void cardan_lu_upper_t_0(const cardan_real *v,
     x[7] -= v[56] * x[6];
     x[8] -= v[58] * x[6];
     x[9] -= v[57] * x[6];
+    x[10] -= v[59] * x[6];
+    x[11] -= v[60] * x[6];
+    x[12] -= v[61] * x[6];
+    x[13] -= v[62] * x[6];
     x[7] *= inv[7];
     x[8] -= v[36] * x[7];
     x[9] -= v[35] * x[7];
@@ -456,15 +544,15 @@ static void cardan_lu_upper_t_0(const cardan_real *v,
     x[13] -= v[29] * x[7];
     x[8] *= inv[8];
     x[9] -= v[40] * x[8];
-    x[10] -= v[61] * x[8];
-    x[11] -= v[62] * x[8];
-    x[12] -= v[60] * x[8];
-    x[13] -= v[59] * x[8];
+    x[10] -= v[67] * x[8];
+    x[11] -= v[68] * x[8];
+    x[12] -= v[66] * x[8];
+    x[13] -= v[65] * x[8];
     x[9] *= inv[9];
-    x[10] -= v[65] * x[9];
-    x[11] -= v[66] * x[9];
-    x[12] -= v[64] * x[9];
-    x[13] -= v[63] * x[9];
+    x[10] -= v[71] * x[9];
+    x[11] -= v[72] * x[9];
+    x[12] -= v[70] * x[9];
+    x[13] -= v[69] * x[9];
     x[10] *= inv[10];
     x[11] -= v[6] * x[10];
     x[12] -= v[4] * x[10];
@@ -493,8 +581,10 @@ static void cardan_lu_lower_t_0(const cardan_real *v, cardan_real *x)
     x[6] -= v[33] * x[7];
     x[6] -= v[38] * x[8];
     x[6] -= v[43] * x[9];
-    x[5] += x[9];
-    x[4] += x[8];
+    x[5] -= v[63] * x[8];
+    x[5] -= v[42] * x[9];
+    x[4] -= v[37] * x[8];
+    x[4] -= v[64] * x[9];
     x[3] += x[5];
     x[2] += x[4];
 }
@@ -524,6 +614,12 @@ void cardan_lu_solve_transposed(const cardan_lu *lu, cardan_real b[])
     x[13] = b[3];
     cardan_lu_upper_t_0(lu->v, lu->inv, x);
     cardan_lu_lower_t_0(lu->v, x);
+    if (lu->swapped[5]) { const cardan_real w = x[12]; x[12] = x[13]; x[13] = w; }
+    if (lu->swapped[4]) { const cardan_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[3]) { const cardan_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[2]) { const cardan_real w = x[10]; x[10] = x[11]; x[11] = w; }
+    if (lu->swapped[1]) { const cardan_real w = x[8]; x[8] = x[9]; x[9] = w; }
+    if (lu->swapped[0]) { const cardan_real w = x[6]; x[6] = x[7]; x[7] = w; }
     b[6] = x[0];
     b[1] = x[1];
     b[0] = x[2];

@@ -4,18 +4,21 @@
  * Mechanism spec sha256: b71ddf7af64222d4f2be315ed6fa7e5ee2d5ecd055f46a9fd54a0449aabf6391
  * Real type: double. Operations (SymPy count_ops, after CSE): gamma 357, gamma_shared 352, phi 100, phi_p 55, phi_phi_q 192, phi_q 132, phi_t 20, phi_t_shared 17, points 4, removed 71
  */
-/* Sparse LU of Phi_q for a fixed pattern (14 x 14, 59 non-zeros, 8 fill-in),
- * straight-line code; pivot order chosen at generation time, 78 flops to factor,
- * 67 to solve. Each pivot passes a relative test at run time
+/* Sparse LU of Phi_q for a fixed pattern (14 x 14, 59 non-zeros, 14 fill-in),
+ * straight-line code; pivot order chosen at generation time, 100 flops to factor,
+ * 73 to solve. Each pivot passes a relative test at run time
  * (|pivot| >= 0.01 * max |entry| of its active column); when one fails,
  * cardan_lu_factor falls back to dense LU with partial pivoting and counts it.
+ * Where no fixed order holds over the motion, rows of one pattern may trade places at run
+ * time: 6 interchange(s), each one comparison of two magnitudes and, when taken, an
+ * exchange of the two rows' values (the operations stay the same).
  */
 #ifndef CARDAN_SPARSE_LU_H
 #define CARDAN_SPARSE_LU_H
 
 #include "cardan_dense_lu.h"
 
-#define CARDAN_LU_NLU 67
+#define CARDAN_LU_NLU 73
 
 /* Caller-owned workspace of the factorization (no malloc, no statics). */
 typedef struct {
@@ -25,6 +28,7 @@ typedef struct {
     int dense;                 /* 1 when the last factorization used the fall-back path */
     int failed_pivot;          /* k + 1 when pivot k failed the run-time test last time, else 0 */
     unsigned long fallbacks;   /* factorizations that fell back since cardan_lu_init */
+    int swapped[6];           /* 1 when interchange i was taken (sparse path) */
 } cardan_lu;
 
 /* Reset the workspace, including the fall-back counter; call it once before the first

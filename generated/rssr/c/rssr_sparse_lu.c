@@ -23,6 +23,7 @@ void rssr_lu_init(rssr_lu *lu)
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
+    for (e = 0; e < 4; ++e) lu->swapped[e] = 0;
     /* The slots and reciprocals known at generation time; the factorization never writes them. */
     lu->v[0] = -1.0;
     lu->v[1] = -1.0;
@@ -105,12 +106,13 @@ static rssr_real rssr_lu_load(const rssr_real nz[], rssr_real v[])
 
 /* Pivots 0..13: 0, or k + 1 when pivot k fails. */
 static int rssr_lu_factor_0(rssr_real *v, rssr_real *inv,
-        rssr_real tiny)
+        rssr_real tiny, int *swapped)
 {
     rssr_real cmax;
     (void)v;
     (void)inv;
     (void)tiny;
+    (void)swapped;
     /* pivot 0: row 0, column 0 */
     cmax = 1.0;
     cmax = rssr_lu_amax(cmax, v[22]);
@@ -183,6 +185,27 @@ static int rssr_lu_factor_0(rssr_real *v, rssr_real *inv,
     if (!(fabs(v[33]) > tiny)) return 10;
     inv[9] = 1 / v[33];
     /* pivot 10: row 3, column 4 */
+    swapped[0] = fabs(v[8]) > fabs(v[4]);
+    if (swapped[0]) { /* rows 10 and 11 trade places */
+        const rssr_real w0 = v[4]; v[4] = v[8]; v[8] = w0;
+        const rssr_real w1 = v[5]; v[5] = v[9]; v[9] = w1;
+        const rssr_real w2 = v[6]; v[6] = v[10]; v[10] = w2;
+        const rssr_real w3 = v[3]; v[3] = v[7]; v[7] = w3;
+    }
+    swapped[1] = fabs(v[37]) > fabs(v[4]);
+    if (swapped[1]) { /* rows 10 and 12 trade places */
+        const rssr_real w0 = v[4]; v[4] = v[37]; v[37] = w0;
+        const rssr_real w1 = v[5]; v[5] = v[38]; v[38] = w1;
+        const rssr_real w2 = v[6]; v[6] = v[39]; v[39] = w2;
+        const rssr_real w3 = v[3]; v[3] = v[36]; v[36] = w3;
+    }
+    swapped[2] = fabs(v[41]) > fabs(v[4]);
+    if (swapped[2]) { /* rows 10 and 13 trade places */
+        const rssr_real w0 = v[4]; v[4] = v[41]; v[41] = w0;
+        const rssr_real w1 = v[5]; v[5] = v[42]; v[42] = w1;
+        const rssr_real w2 = v[6]; v[6] = v[43]; v[43] = w2;
+        const rssr_real w3 = v[3]; v[3] = v[40]; v[40] = w3;
+    }
     cmax = fabs(v[4]);
     cmax = rssr_lu_amax(cmax, v[8]);
     cmax = rssr_lu_amax(cmax, v[37]);
@@ -214,6 +237,13 @@ static int rssr_lu_factor_0(rssr_real *v, rssr_real *inv,
     v[40] -= v[42] * v[7];
     v[43] -= v[42] * v[10];
     /* pivot 12: row 11, column 6 */
+    swapped[3] = fabs(v[43]) > fabs(v[39]);
+    if (swapped[3]) { /* rows 12 and 13 trade places */
+        const rssr_real w0 = v[37]; v[37] = v[41]; v[41] = w0;
+        const rssr_real w1 = v[38]; v[38] = v[42]; v[42] = w1;
+        const rssr_real w2 = v[39]; v[39] = v[43]; v[43] = w2;
+        const rssr_real w3 = v[36]; v[36] = v[40]; v[40] = w3;
+    }
     cmax = fabs(v[39]);
     cmax = rssr_lu_amax(cmax, v[43]);
     if (!rssr_lu_pivot_ok(v[39], cmax, tiny)) return 13;
@@ -234,7 +264,7 @@ int rssr_lu_factor_sparse(const rssr_real nz[], rssr_lu *lu)
      * constants, unchanged by the elimination): no reciprocal, no test, except this one for the
      * smallest, which fails when max |Phi_q| is huge or not finite. */
     if (!(tiny < 1.0)) return 1;
-    status = rssr_lu_factor_0(lu->v, lu->inv, tiny);
+    status = rssr_lu_factor_0(lu->v, lu->inv, tiny, lu->swapped);
     if (status != 0) return status;
     return 0;
 }
@@ -374,6 +404,10 @@ void rssr_lu_solve(const rssr_lu *lu, rssr_real b[])
     x[11] = b[4];
     x[12] = b[11];
     x[13] = b[12];
+    if (lu->swapped[0]) { const rssr_real w = x[10]; x[10] = x[11]; x[11] = w; }
+    if (lu->swapped[1]) { const rssr_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[2]) { const rssr_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[3]) { const rssr_real w = x[12]; x[12] = x[13]; x[13] = w; }
     rssr_lu_forward_0(lu->v, x);
     rssr_lu_backward_0(lu->v, lu->inv, x);
     b[0] = x[0];
@@ -479,6 +513,10 @@ void rssr_lu_solve_transposed(const rssr_lu *lu, rssr_real b[])
     x[13] = b[3];
     rssr_lu_upper_t_0(lu->v, lu->inv, x);
     rssr_lu_lower_t_0(lu->v, x);
+    if (lu->swapped[3]) { const rssr_real w = x[12]; x[12] = x[13]; x[13] = w; }
+    if (lu->swapped[2]) { const rssr_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[1]) { const rssr_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[0]) { const rssr_real w = x[10]; x[10] = x[11]; x[11] = w; }
     b[0] = x[0];
     b[1] = x[1];
     b[2] = x[2];

@@ -23,6 +23,7 @@ void spatial_slider_crank_lu_init(spatial_slider_crank_lu *lu)
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
+    for (e = 0; e < 4; ++e) lu->swapped[e] = 0;
     /* The slots and reciprocals known at generation time; the factorization never writes them. */
     lu->v[0] = -1.0;
     lu->v[1] = -1.0;
@@ -145,12 +146,13 @@ static spatial_slider_crank_real spatial_slider_crank_lu_load(const spatial_slid
 
 /* Pivots 0..20: 0, or k + 1 when pivot k fails. */
 static int spatial_slider_crank_lu_factor_0(spatial_slider_crank_real *v, spatial_slider_crank_real *inv,
-        spatial_slider_crank_real tiny)
+        spatial_slider_crank_real tiny, int *swapped)
 {
     spatial_slider_crank_real cmax;
     (void)v;
     (void)inv;
     (void)tiny;
+    (void)swapped;
     /* pivot 0: row 8, column 14 */
     /* pivot 1: row 5, column 7 */
     /* pivot 2: row 0, column 0 */
@@ -222,6 +224,27 @@ static int spatial_slider_crank_lu_factor_0(spatial_slider_crank_real *v, spatia
     if (!(fabs(v[50]) > tiny)) return 13;
     inv[12] = 1 / v[50];
     /* pivot 13: row 3, column 5 */
+    swapped[0] = fabs(v[9]) > fabs(v[5]);
+    if (swapped[0]) { /* rows 13 and 14 trade places */
+        const spatial_slider_crank_real w0 = v[5]; v[5] = v[9]; v[9] = w0;
+        const spatial_slider_crank_real w1 = v[6]; v[6] = v[10]; v[10] = w1;
+        const spatial_slider_crank_real w2 = v[4]; v[4] = v[8]; v[8] = w2;
+        const spatial_slider_crank_real w3 = v[3]; v[3] = v[7]; v[7] = w3;
+    }
+    swapped[1] = fabs(v[71]) > fabs(v[5]);
+    if (swapped[1]) { /* rows 13 and 15 trade places */
+        const spatial_slider_crank_real w0 = v[5]; v[5] = v[71]; v[71] = w0;
+        const spatial_slider_crank_real w1 = v[6]; v[6] = v[72]; v[72] = w1;
+        const spatial_slider_crank_real w2 = v[4]; v[4] = v[70]; v[70] = w2;
+        const spatial_slider_crank_real w3 = v[3]; v[3] = v[69]; v[69] = w3;
+    }
+    swapped[2] = fabs(v[75]) > fabs(v[5]);
+    if (swapped[2]) { /* rows 13 and 16 trade places */
+        const spatial_slider_crank_real w0 = v[5]; v[5] = v[75]; v[75] = w0;
+        const spatial_slider_crank_real w1 = v[6]; v[6] = v[76]; v[76] = w1;
+        const spatial_slider_crank_real w2 = v[4]; v[4] = v[74]; v[74] = w2;
+        const spatial_slider_crank_real w3 = v[3]; v[3] = v[73]; v[73] = w3;
+    }
     cmax = fabs(v[5]);
     cmax = spatial_slider_crank_lu_amax(cmax, v[9]);
     cmax = spatial_slider_crank_lu_amax(cmax, v[71]);
@@ -253,6 +276,13 @@ static int spatial_slider_crank_lu_factor_0(spatial_slider_crank_real *v, spatia
     v[73] -= v[76] * v[7];
     v[74] -= v[76] * v[8];
     /* pivot 15: row 17, column 4 */
+    swapped[3] = fabs(v[74]) > fabs(v[70]);
+    if (swapped[3]) { /* rows 15 and 16 trade places */
+        const spatial_slider_crank_real w0 = v[71]; v[71] = v[75]; v[75] = w0;
+        const spatial_slider_crank_real w1 = v[72]; v[72] = v[76]; v[76] = w1;
+        const spatial_slider_crank_real w2 = v[70]; v[70] = v[74]; v[74] = w2;
+        const spatial_slider_crank_real w3 = v[69]; v[69] = v[73]; v[73] = w3;
+    }
     cmax = fabs(v[70]);
     cmax = spatial_slider_crank_lu_amax(cmax, v[74]);
     if (!spatial_slider_crank_lu_pivot_ok(v[70], cmax, tiny)) return 16;
@@ -314,7 +344,7 @@ int spatial_slider_crank_lu_factor_sparse(const spatial_slider_crank_real nz[], 
      * constants, unchanged by the elimination): no reciprocal, no test, except this one for the
      * smallest, which fails when max |Phi_q| is huge or not finite. */
     if (!(tiny < 1.0)) return 1;
-    status = spatial_slider_crank_lu_factor_0(lu->v, lu->inv, tiny);
+    status = spatial_slider_crank_lu_factor_0(lu->v, lu->inv, tiny, lu->swapped);
     if (status != 0) return status;
     return 0;
 }
@@ -516,6 +546,10 @@ void spatial_slider_crank_lu_solve(const spatial_slider_crank_lu *lu, spatial_sl
     x[18] = b[13];
     x[19] = b[16];
     x[20] = b[20];
+    if (lu->swapped[0]) { const spatial_slider_crank_real w = x[13]; x[13] = x[14]; x[14] = w; }
+    if (lu->swapped[1]) { const spatial_slider_crank_real w = x[13]; x[13] = x[15]; x[15] = w; }
+    if (lu->swapped[2]) { const spatial_slider_crank_real w = x[13]; x[13] = x[16]; x[16] = w; }
+    if (lu->swapped[3]) { const spatial_slider_crank_real w = x[15]; x[15] = x[16]; x[16] = w; }
     spatial_slider_crank_lu_forward_0(lu->v, x);
     spatial_slider_crank_lu_backward_0(lu->v, lu->inv, x);
     b[14] = x[0];
@@ -682,6 +716,10 @@ void spatial_slider_crank_lu_solve_transposed(const spatial_slider_crank_lu *lu,
     x[20] = b[17];
     spatial_slider_crank_lu_upper_t_0(lu->v, lu->inv, x);
     spatial_slider_crank_lu_lower_t_0(lu->v, x);
+    if (lu->swapped[3]) { const spatial_slider_crank_real w = x[15]; x[15] = x[16]; x[16] = w; }
+    if (lu->swapped[2]) { const spatial_slider_crank_real w = x[13]; x[13] = x[16]; x[16] = w; }
+    if (lu->swapped[1]) { const spatial_slider_crank_real w = x[13]; x[13] = x[15]; x[15] = w; }
+    if (lu->swapped[0]) { const spatial_slider_crank_real w = x[13]; x[13] = x[14]; x[14] = w; }
     b[8] = x[0];
     b[5] = x[1];
     b[0] = x[2];

@@ -9,6 +9,9 @@
  * 97 to solve. Each pivot passes a relative test at run time
  * (|pivot| >= 0.01 * max |entry| of its active column); when one fails,
  * spatial_slider_crank_lu_factor falls back to dense LU with partial pivoting and counts it.
+ * Where no fixed order holds over the motion, rows of one pattern may trade places at run
+ * time: 4 interchange(s), each one comparison of two magnitudes and, when taken, an
+ * exchange of the two rows' values (the operations stay the same).
  */
 #ifndef SPATIAL_SLIDER_CRANK_SPARSE_LU_H
 #define SPATIAL_SLIDER_CRANK_SPARSE_LU_H
@@ -25,6 +28,7 @@ typedef struct {
     int dense;                 /* 1 when the last factorization used the fall-back path */
     int failed_pivot;          /* k + 1 when pivot k failed the run-time test last time, else 0 */
     unsigned long fallbacks;   /* factorizations that fell back since spatial_slider_crank_lu_init */
+    int swapped[4];           /* 1 when interchange i was taken (sparse path) */
 } spatial_slider_crank_lu;
 
 /* Reset the workspace, including the fall-back counter; call it once before the first

@@ -23,6 +23,7 @@ void stewart_fk_lu_init(stewart_fk_lu *lu)
     lu->dense = 0;
     lu->failed_pivot = 0;
     lu->fallbacks = 0;
+    for (e = 0; e < 9; ++e) lu->swapped[e] = 0;
 }
 
 /* The pivot passes when it is above the tiny bound and at least tau times the largest entry of
@@ -96,12 +97,13 @@ static stewart_fk_real stewart_fk_lu_load(const stewart_fk_real nz[], stewart_fk
 
 /* Pivots 0..6: 0, or k + 1 when pivot k fails. */
 static int stewart_fk_lu_factor_0(stewart_fk_real *v, stewart_fk_real *inv,
-        stewart_fk_real tiny)
+        stewart_fk_real tiny, int *swapped)
 {
     stewart_fk_real cmax;
     (void)v;
     (void)inv;
     (void)tiny;
+    (void)swapped;
     /* pivot 0: row 6, column 3 */
     cmax = fabs(v[42]);
     cmax = stewart_fk_lu_amax(cmax, v[3]);
@@ -176,6 +178,46 @@ static int stewart_fk_lu_factor_0(stewart_fk_real *v, stewart_fk_real *inv,
     v[40] -= v[35] * v[5];
     v[41] -= v[35] * v[6];
     /* pivot 2: row 1, column 1 */
+    swapped[0] = fabs(v[15]) > fabs(v[8]);
+    if (swapped[0]) { /* rows 2 and 3 trade places */
+        const stewart_fk_real w0 = v[10]; v[10] = v[17]; v[17] = w0;
+        const stewart_fk_real w1 = v[7]; v[7] = v[14]; v[14] = w1;
+        const stewart_fk_real w2 = v[8]; v[8] = v[15]; v[15] = w2;
+        const stewart_fk_real w3 = v[9]; v[9] = v[16]; v[16] = w3;
+        const stewart_fk_real w4 = v[11]; v[11] = v[18]; v[18] = w4;
+        const stewart_fk_real w5 = v[12]; v[12] = v[19]; v[19] = w5;
+        const stewart_fk_real w6 = v[13]; v[13] = v[20]; v[20] = w6;
+    }
+    swapped[1] = fabs(v[22]) > fabs(v[8]);
+    if (swapped[1]) { /* rows 2 and 4 trade places */
+        const stewart_fk_real w0 = v[10]; v[10] = v[24]; v[24] = w0;
+        const stewart_fk_real w1 = v[7]; v[7] = v[21]; v[21] = w1;
+        const stewart_fk_real w2 = v[8]; v[8] = v[22]; v[22] = w2;
+        const stewart_fk_real w3 = v[9]; v[9] = v[23]; v[23] = w3;
+        const stewart_fk_real w4 = v[11]; v[11] = v[25]; v[25] = w4;
+        const stewart_fk_real w5 = v[12]; v[12] = v[26]; v[26] = w5;
+        const stewart_fk_real w6 = v[13]; v[13] = v[27]; v[27] = w6;
+    }
+    swapped[2] = fabs(v[29]) > fabs(v[8]);
+    if (swapped[2]) { /* rows 2 and 5 trade places */
+        const stewart_fk_real w0 = v[10]; v[10] = v[31]; v[31] = w0;
+        const stewart_fk_real w1 = v[7]; v[7] = v[28]; v[28] = w1;
+        const stewart_fk_real w2 = v[8]; v[8] = v[29]; v[29] = w2;
+        const stewart_fk_real w3 = v[9]; v[9] = v[30]; v[30] = w3;
+        const stewart_fk_real w4 = v[11]; v[11] = v[32]; v[32] = w4;
+        const stewart_fk_real w5 = v[12]; v[12] = v[33]; v[33] = w5;
+        const stewart_fk_real w6 = v[13]; v[13] = v[34]; v[34] = w6;
+    }
+    swapped[3] = fabs(v[36]) > fabs(v[8]);
+    if (swapped[3]) { /* rows 2 and 6 trade places */
+        const stewart_fk_real w0 = v[10]; v[10] = v[38]; v[38] = w0;
+        const stewart_fk_real w1 = v[7]; v[7] = v[35]; v[35] = w1;
+        const stewart_fk_real w2 = v[8]; v[8] = v[36]; v[36] = w2;
+        const stewart_fk_real w3 = v[9]; v[9] = v[37]; v[37] = w3;
+        const stewart_fk_real w4 = v[11]; v[11] = v[39]; v[39] = w4;
+        const stewart_fk_real w5 = v[12]; v[12] = v[40]; v[40] = w5;
+        const stewart_fk_real w6 = v[13]; v[13] = v[41]; v[41] = w6;
+    }
     cmax = fabs(v[8]);
     cmax = stewart_fk_lu_amax(cmax, v[15]);
     cmax = stewart_fk_lu_amax(cmax, v[22]);
@@ -204,6 +246,36 @@ static int stewart_fk_lu_factor_0(stewart_fk_real *v, stewart_fk_real *inv,
     v[40] -= v[36] * v[12];
     v[41] -= v[36] * v[13];
     /* pivot 3: row 2, column 2 */
+    swapped[4] = fabs(v[23]) > fabs(v[16]);
+    if (swapped[4]) { /* rows 3 and 4 trade places */
+        const stewart_fk_real w0 = v[17]; v[17] = v[24]; v[24] = w0;
+        const stewart_fk_real w1 = v[14]; v[14] = v[21]; v[21] = w1;
+        const stewart_fk_real w2 = v[15]; v[15] = v[22]; v[22] = w2;
+        const stewart_fk_real w3 = v[16]; v[16] = v[23]; v[23] = w3;
+        const stewart_fk_real w4 = v[18]; v[18] = v[25]; v[25] = w4;
+        const stewart_fk_real w5 = v[19]; v[19] = v[26]; v[26] = w5;
+        const stewart_fk_real w6 = v[20]; v[20] = v[27]; v[27] = w6;
+    }
+    swapped[5] = fabs(v[30]) > fabs(v[16]);
+    if (swapped[5]) { /* rows 3 and 5 trade places */
+        const stewart_fk_real w0 = v[17]; v[17] = v[31]; v[31] = w0;
+        const stewart_fk_real w1 = v[14]; v[14] = v[28]; v[28] = w1;
+        const stewart_fk_real w2 = v[15]; v[15] = v[29]; v[29] = w2;
+        const stewart_fk_real w3 = v[16]; v[16] = v[30]; v[30] = w3;
+        const stewart_fk_real w4 = v[18]; v[18] = v[32]; v[32] = w4;
+        const stewart_fk_real w5 = v[19]; v[19] = v[33]; v[33] = w5;
+        const stewart_fk_real w6 = v[20]; v[20] = v[34]; v[34] = w6;
+    }
+    swapped[6] = fabs(v[37]) > fabs(v[16]);
+    if (swapped[6]) { /* rows 3 and 6 trade places */
+        const stewart_fk_real w0 = v[17]; v[17] = v[38]; v[38] = w0;
+        const stewart_fk_real w1 = v[14]; v[14] = v[35]; v[35] = w1;
+        const stewart_fk_real w2 = v[15]; v[15] = v[36]; v[36] = w2;
+        const stewart_fk_real w3 = v[16]; v[16] = v[37]; v[37] = w3;
+        const stewart_fk_real w4 = v[18]; v[18] = v[39]; v[39] = w4;
+        const stewart_fk_real w5 = v[19]; v[19] = v[40]; v[40] = w5;
+        const stewart_fk_real w6 = v[20]; v[20] = v[41]; v[41] = w6;
+    }
     cmax = fabs(v[16]);
     cmax = stewart_fk_lu_amax(cmax, v[23]);
     cmax = stewart_fk_lu_amax(cmax, v[30]);
@@ -223,6 +295,26 @@ static int stewart_fk_lu_factor_0(stewart_fk_real *v, stewart_fk_real *inv,
     v[40] -= v[37] * v[19];
     v[41] -= v[37] * v[20];
     /* pivot 4: row 3, column 4 */
+    swapped[7] = fabs(v[32]) > fabs(v[25]);
+    if (swapped[7]) { /* rows 4 and 5 trade places */
+        const stewart_fk_real w0 = v[24]; v[24] = v[31]; v[31] = w0;
+        const stewart_fk_real w1 = v[21]; v[21] = v[28]; v[28] = w1;
+        const stewart_fk_real w2 = v[22]; v[22] = v[29]; v[29] = w2;
+        const stewart_fk_real w3 = v[23]; v[23] = v[30]; v[30] = w3;
+        const stewart_fk_real w4 = v[25]; v[25] = v[32]; v[32] = w4;
+        const stewart_fk_real w5 = v[26]; v[26] = v[33]; v[33] = w5;
+        const stewart_fk_real w6 = v[27]; v[27] = v[34]; v[34] = w6;
+    }
+    swapped[8] = fabs(v[39]) > fabs(v[25]);
+    if (swapped[8]) { /* rows 4 and 6 trade places */
+        const stewart_fk_real w0 = v[24]; v[24] = v[38]; v[38] = w0;
+        const stewart_fk_real w1 = v[21]; v[21] = v[35]; v[35] = w1;
+        const stewart_fk_real w2 = v[22]; v[22] = v[36]; v[36] = w2;
+        const stewart_fk_real w3 = v[23]; v[23] = v[37]; v[37] = w3;
+        const stewart_fk_real w4 = v[25]; v[25] = v[39]; v[39] = w4;
+        const stewart_fk_real w5 = v[26]; v[26] = v[40]; v[40] = w5;
+        const stewart_fk_real w6 = v[27]; v[27] = v[41]; v[41] = w6;
+    }
     cmax = fabs(v[25]);
     cmax = stewart_fk_lu_amax(cmax, v[32]);
     cmax = stewart_fk_lu_amax(cmax, v[39]);
@@ -251,7 +343,7 @@ int stewart_fk_lu_factor_sparse(const stewart_fk_real nz[], stewart_fk_lu *lu)
 {
     const stewart_fk_real tiny = stewart_fk_lu_load(nz, lu->v);
     int status;
-    status = stewart_fk_lu_factor_0(lu->v, lu->inv, tiny);
+    status = stewart_fk_lu_factor_0(lu->v, lu->inv, tiny, lu->swapped);
     if (status != 0) return status;
     return 0;
 }
@@ -368,6 +460,15 @@ void stewart_fk_lu_solve(const stewart_fk_lu *lu, stewart_fk_real b[])
     x[4] = b[3];
     x[5] = b[4];
     x[6] = b[5];
+    if (lu->swapped[0]) { const stewart_fk_real w = x[2]; x[2] = x[3]; x[3] = w; }
+    if (lu->swapped[1]) { const stewart_fk_real w = x[2]; x[2] = x[4]; x[4] = w; }
+    if (lu->swapped[2]) { const stewart_fk_real w = x[2]; x[2] = x[5]; x[5] = w; }
+    if (lu->swapped[3]) { const stewart_fk_real w = x[2]; x[2] = x[6]; x[6] = w; }
+    if (lu->swapped[4]) { const stewart_fk_real w = x[3]; x[3] = x[4]; x[4] = w; }
+    if (lu->swapped[5]) { const stewart_fk_real w = x[3]; x[3] = x[5]; x[5] = w; }
+    if (lu->swapped[6]) { const stewart_fk_real w = x[3]; x[3] = x[6]; x[6] = w; }
+    if (lu->swapped[7]) { const stewart_fk_real w = x[4]; x[4] = x[5]; x[5] = w; }
+    if (lu->swapped[8]) { const stewart_fk_real w = x[4]; x[4] = x[6]; x[6] = w; }
     stewart_fk_lu_forward_0(lu->v, x);
     stewart_fk_lu_backward_0(lu->v, lu->inv, x);
     b[3] = x[0];
@@ -457,6 +558,15 @@ void stewart_fk_lu_solve_transposed(const stewart_fk_lu *lu, stewart_fk_real b[]
     x[6] = b[6];
     stewart_fk_lu_upper_t_0(lu->v, lu->inv, x);
     stewart_fk_lu_lower_t_0(lu->v, x);
+    if (lu->swapped[8]) { const stewart_fk_real w = x[4]; x[4] = x[6]; x[6] = w; }
+    if (lu->swapped[7]) { const stewart_fk_real w = x[4]; x[4] = x[5]; x[5] = w; }
+    if (lu->swapped[6]) { const stewart_fk_real w = x[3]; x[3] = x[6]; x[6] = w; }
+    if (lu->swapped[5]) { const stewart_fk_real w = x[3]; x[3] = x[5]; x[5] = w; }
+    if (lu->swapped[4]) { const stewart_fk_real w = x[3]; x[3] = x[4]; x[4] = w; }
+    if (lu->swapped[3]) { const stewart_fk_real w = x[2]; x[2] = x[6]; x[6] = w; }
+    if (lu->swapped[2]) { const stewart_fk_real w = x[2]; x[2] = x[5]; x[5] = w; }
+    if (lu->swapped[1]) { const stewart_fk_real w = x[2]; x[2] = x[4]; x[4] = w; }
+    if (lu->swapped[0]) { const stewart_fk_real w = x[2]; x[2] = x[3]; x[3] = w; }
     b[6] = x[0];
     b[0] = x[1];
     b[1] = x[2];

@@ -43,6 +43,7 @@ void three_rrr_fk_lu_init(three_rrr_fk_lu *lu)
     lu->v[24] = -1.0;
     lu->v[26] = -1.0;
     lu->v[28] = -1.0;
+    lu->v[30] = 1.0;
     lu->v[32] = -1.0;
     lu->v[33] = -1.0;
     lu->v[34] = -1.0;
@@ -50,8 +51,8 @@ void three_rrr_fk_lu_init(three_rrr_fk_lu *lu)
     lu->v[37] = -1.0;
     lu->v[39] = -1.0;
     lu->v[40] = -1.0;
-    lu->v[42] = -1.0;
     lu->v[44] = -1.0;
+    lu->v[46] = -1.0;
     lu->v[48] = 1.0;
     lu->v[49] = 1.0;
     lu->v[50] = 1.0;
@@ -70,6 +71,7 @@ void three_rrr_fk_lu_init(three_rrr_fk_lu *lu)
     lu->inv[12] = 1.0;
     lu->inv[13] = -1.0;
     lu->inv[14] = -1.0;
+    lu->inv[18] = -1.0;
 }
 
 /* The pivot passes when it is above the tiny bound and at least tau times the largest entry of
@@ -164,36 +166,33 @@ static int three_rrr_fk_lu_factor_0(three_rrr_fk_real *v, three_rrr_fk_real *inv
     v[29] *= inv[16];
     v[52] = -(v[29] * (-1.0));
     v[31] -= v[29] * v[27];
-    /* pivot 17: row 16, column 17 */
-    cmax = fabs(v[41]);
-    cmax = three_rrr_fk_lu_amax(cmax, v[45]);
-    if (!three_rrr_fk_lu_pivot_ok(v[41], cmax, tiny)) return 18;
-    inv[17] = 1 / v[41];
-    v[45] *= inv[17];
-    v[53] = -(v[45] * (-1.0));
-    v[47] -= v[45] * v[43];
-    /* pivot 18: row 5, column 18 */
-    cmax = fabs(v[51]);
-    cmax = three_rrr_fk_lu_amax(cmax, v[52]);
+    /* pivot 17: row 17, column 17 */
+    cmax = fabs(v[45]);
+    cmax = three_rrr_fk_lu_amax(cmax, v[41]);
+    if (!three_rrr_fk_lu_pivot_ok(v[45], cmax, tiny)) return 18;
+    inv[17] = 1 / v[45];
+    v[41] *= inv[17];
+    v[53] = -(v[41] * (-1.0));
+    v[43] -= v[41] * v[47];
+    /* pivot 18: row 5, column 19 */
+    cmax = 1.0;
     cmax = three_rrr_fk_lu_amax(cmax, v[53]);
-    if (!three_rrr_fk_lu_pivot_ok(v[51], cmax, tiny)) return 19;
-    inv[18] = 1 / v[51];
-    v[52] *= inv[18];
-    v[53] *= inv[18];
-    v[30] = -1.0 - v[52] * (-1.0);
-    v[31] -= v[52] * v[15];
-    v[46] = -1.0 - v[53] * (-1.0);
-    v[47] -= v[53] * v[15];
-    /* pivot 19: row 11, column 19 */
-    cmax = fabs(v[30]);
-    cmax = three_rrr_fk_lu_amax(cmax, v[46]);
-    if (!three_rrr_fk_lu_pivot_ok(v[30], cmax, tiny)) return 20;
-    inv[19] = 1 / v[30];
-    v[46] *= inv[19];
-    v[47] -= v[46] * v[31];
-    /* pivot 20: row 17, column 20 */
-    if (!(fabs(v[47]) > tiny)) return 21;
-    inv[20] = 1 / v[47];
+    if (!(1.0 >= THREE_RRR_FK_LU_TAU * cmax)) return 19;
+    v[53] = -v[53];
+    v[52] -= v[51];
+    v[31] -= v[15];
+    v[42] = -1.0 - v[53] * v[51];
+    v[43] -= v[53] * v[15];
+    /* pivot 19: row 11, column 18 */
+    cmax = fabs(v[52]);
+    cmax = three_rrr_fk_lu_amax(cmax, v[42]);
+    if (!three_rrr_fk_lu_pivot_ok(v[52], cmax, tiny)) return 20;
+    inv[19] = 1 / v[52];
+    v[42] *= inv[19];
+    v[43] -= v[42] * v[31];
+    /* pivot 20: row 16, column 20 */
+    if (!(fabs(v[43]) > tiny)) return 21;
+    inv[20] = 1 / v[43];
     return 0;
 }
 
@@ -201,7 +200,7 @@ int three_rrr_fk_lu_factor_sparse(const three_rrr_fk_real nz[], three_rrr_fk_lu 
 {
     const three_rrr_fk_real tiny = three_rrr_fk_lu_load(nz, lu->v);
     int status;
-    /* 15 pivots are numbers known at generation time (their entries of Phi_q are
+    /* 16 pivots are numbers known at generation time (their entries of Phi_q are
      * constants, unchanged by the elimination): no reciprocal, no test, except this one for the
      * smallest, which fails when max |Phi_q| is huge or not finite. */
     if (!(tiny < 1.0)) return 1;
@@ -248,8 +247,6 @@ three_rrr_fk_real three_rrr_fk_lu_pivot_ratio(const three_rrr_fk_lu *lu)
     high = fabs(lu->inv[16]) > high ? fabs(lu->inv[16]) : high;
     low = fabs(lu->inv[17]) < low ? fabs(lu->inv[17]) : low;
     high = fabs(lu->inv[17]) > high ? fabs(lu->inv[17]) : high;
-    low = fabs(lu->inv[18]) < low ? fabs(lu->inv[18]) : low;
-    high = fabs(lu->inv[18]) > high ? fabs(lu->inv[18]) : high;
     low = fabs(lu->inv[19]) < low ? fabs(lu->inv[19]) : low;
     high = fabs(lu->inv[19]) > high ? fabs(lu->inv[19]) : high;
     low = fabs(lu->inv[20]) < low ? fabs(lu->inv[20]) : low;
@@ -277,14 +274,14 @@ static void three_rrr_fk_lu_forward_0(const three_rrr_fk_real *v, three_rrr_fk_r
     x[19] += x[11];
     x[13] -= v[35] * x[12];
     x[14] -= v[38] * x[12];
-    x[17] += x[13];
-    x[20] += x[14];
+    x[20] += x[13];
+    x[17] += x[14];
     x[18] -= v[13] * x[15];
     x[19] -= v[29] * x[16];
-    x[20] -= v[45] * x[17];
-    x[19] -= v[52] * x[18];
+    x[20] -= v[41] * x[17];
+    x[19] -= x[18];
     x[20] -= v[53] * x[18];
-    x[20] -= v[46] * x[19];
+    x[20] -= v[42] * x[19];
 }
 
 /* U z = y, rows 20..0 */
@@ -296,16 +293,16 @@ static void three_rrr_fk_lu_backward_0(const three_rrr_fk_real *v,
     x[20] *= inv[20];
     x[19] -= v[31] * x[20];
     x[19] *= inv[19];
-    x[18] += x[19];
+    x[18] -= v[51] * x[19];
     x[18] -= v[15] * x[20];
-    x[18] *= inv[18];
+    x[18] = -x[18];
     x[17] += x[18];
-    x[17] -= v[43] * x[20];
+    x[17] -= v[47] * x[20];
     x[17] *= inv[17];
-    x[16] += x[18];
+    x[16] += x[19];
     x[16] -= v[27] * x[20];
     x[16] *= inv[16];
-    x[15] += x[18];
+    x[15] += x[19];
     x[15] -= v[11] * x[20];
     x[15] *= inv[15];
     x[14] = -x[14];
@@ -347,10 +344,10 @@ void three_rrr_fk_lu_solve(const three_rrr_fk_lu *lu, three_rrr_fk_real b[])
     x[14] = b[15];
     x[15] = b[4];
     x[16] = b[10];
-    x[17] = b[16];
+    x[17] = b[17];
     x[18] = b[5];
     x[19] = b[11];
-    x[20] = b[17];
+    x[20] = b[16];
     three_rrr_fk_lu_forward_0(lu->v, x);
     three_rrr_fk_lu_backward_0(lu->v, lu->inv, x);
     b[0] = x[0];
@@ -371,8 +368,8 @@ void three_rrr_fk_lu_solve(const three_rrr_fk_lu *lu, three_rrr_fk_real b[])
     b[11] = x[15];
     b[14] = x[16];
     b[17] = x[17];
-    b[18] = x[18];
-    b[19] = x[19];
+    b[19] = x[18];
+    b[18] = x[19];
     b[20] = x[20];
 }
 
@@ -395,16 +392,16 @@ static void three_rrr_fk_lu_upper_t_0(const three_rrr_fk_real *v,
     x[13] = -x[13];
     x[14] = -x[14];
     x[15] *= inv[15];
-    x[18] += x[15];
+    x[19] += x[15];
     x[20] -= v[11] * x[15];
     x[16] *= inv[16];
-    x[18] += x[16];
+    x[19] += x[16];
     x[20] -= v[27] * x[16];
     x[17] *= inv[17];
     x[18] += x[17];
-    x[20] -= v[43] * x[17];
-    x[18] *= inv[18];
-    x[19] += x[18];
+    x[20] -= v[47] * x[17];
+    x[18] = -x[18];
+    x[19] -= v[51] * x[18];
     x[20] -= v[15] * x[18];
     x[19] *= inv[19];
     x[20] -= v[31] * x[19];
@@ -415,14 +412,14 @@ static void three_rrr_fk_lu_upper_t_0(const three_rrr_fk_real *v,
 static void three_rrr_fk_lu_lower_t_0(const three_rrr_fk_real *v, three_rrr_fk_real *x)
 {
     (void)v;
-    x[19] -= v[46] * x[20];
-    x[18] -= v[52] * x[19];
+    x[19] -= v[42] * x[20];
+    x[18] -= x[19];
     x[18] -= v[53] * x[20];
-    x[17] -= v[45] * x[20];
+    x[17] -= v[41] * x[20];
     x[16] -= v[29] * x[19];
     x[15] -= v[13] * x[18];
-    x[14] += x[20];
-    x[13] += x[17];
+    x[14] += x[17];
+    x[13] += x[20];
     x[12] -= v[35] * x[13];
     x[12] -= v[38] * x[14];
     x[11] += x[19];
@@ -468,8 +465,8 @@ void three_rrr_fk_lu_solve_transposed(const three_rrr_fk_lu *lu, three_rrr_fk_re
     x[15] = b[11];
     x[16] = b[14];
     x[17] = b[17];
-    x[18] = b[18];
-    x[19] = b[19];
+    x[18] = b[19];
+    x[19] = b[18];
     x[20] = b[20];
     three_rrr_fk_lu_upper_t_0(lu->v, lu->inv, x);
     three_rrr_fk_lu_lower_t_0(lu->v, x);
@@ -490,8 +487,8 @@ void three_rrr_fk_lu_solve_transposed(const three_rrr_fk_lu *lu, three_rrr_fk_re
     b[15] = x[14];
     b[4] = x[15];
     b[10] = x[16];
-    b[16] = x[17];
+    b[17] = x[17];
     b[5] = x[18];
     b[11] = x[19];
-    b[17] = x[20];
+    b[16] = x[20];
 }
