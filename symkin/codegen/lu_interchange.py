@@ -3,17 +3,20 @@
 A body that turns a full turn in Euler parameters meets its driver and normalisation rows in
 the block 2 [[s, -c], [c, s]] of its half angle: every entry of it is zero somewhere on the
 turn, so every fixed pivot order fails the run-time test somewhere and the factorization falls
-back to dense there. Such rows have the same pattern after fill (they form a dense trailing
-block), so exchanging two of them changes no slot and no operation of the plan: this is
-partial pivoting restricted to rows of one pattern, decided at run time by one comparison of
+back to dense there. Two rows with the same pattern after fill (as in a dense trailing block)
+can trade places without changing a slot or an operation of the plan: this is partial
+pivoting restricted to rows of one pattern, decided at run time by one comparison of
 magnitudes and paid for by exchanging the rows' few values.
 
 ``analyse_over`` keeps lu_plan's order and adds interchanges (``LUPlan.swaps``) only where the
-samples of the motion need them: at the first step whose pivot still fails on some sample, the
-rows below of its pattern are compared with it (a tournament: the larger entry of the pivot
-column takes the pivot row), then the samples are replayed. A plan that needs none keeps its
-bytes. ``factor`` and ``solve_with_plan`` execute a plan, interchanges included, in the order
-the generated C does: the reference both are tested against.
+samples of the motion ask for them. First where a pivot fails: at the first step whose pivot
+still fails on some sample, the rows below of its pattern are compared with it (a tournament:
+the larger entry of the pivot column takes the pivot row), then the samples are replayed;
+where no row below shares the pattern, the pivot row and a row with an entry in its column are
+padded with zeros to one (``lu_plan.padded``: more fill-in, the same order). Then, without
+padding, where a pivot passes by less than MARGIN (``with_margin``). A plan that needs none
+keeps its bytes. ``factor`` and ``solve_with_plan`` execute a plan, interchanges included, in
+the order the generated C does: the reference both are tested against.
 """
 
 from __future__ import annotations
