@@ -6,31 +6,37 @@ LAPACK's xLACN2): a few solves with the factors already made, never a new factor
 generated C solver (templates/c/solver.c.j2) runs the same steps and the same error model, so
 both backends flag the same points.
 
-The error model, with u the unit roundoff and s = ||Phi_q^-1||_1 / sqrt(N) (max norms of
-vectors; near a singularity the 1-norm sums the null vector over about N entries, where one
-coordinate's error sees only its share):
+The error model has two stages. The norm bound, with u the unit roundoff and
+s = ||Phi_q^-1||_1 / sqrt(N) (max norms of vectors; near a singularity the 1-norm sums the null
+vector over about N entries, where one coordinate's error sees only its share):
     e_q   = max(c, s u (1 + |q|))                  the residual's share, or the rounding of Phi
     e_dq  = s (u |dq| + e_q max(1, |dq|))          the solve's rounding, and Phi_q moved by e_q
     e_ddq = s (u |ddq| + e_q (|ddq| + |dq|^2) + 2 e_dq max(1, |dq|))
 each times SAFETY; a point is flagged when one of them exceeds its target times max(1, |x|).
+It multiplies three norm bounds, each above the actual amplification: near a singular
+configuration, where the actual error of ddq grows as cond^3, it stands a hundred times above
+it. Where it flags a point, the propagated model decides (flagged): the position error is
+e_q (without SAFETY) along the worst direction w, the column of Phi_q^-1 of largest 1-norm
+that Hager's ascent finds (worst_column; near a singularity every column lies along the null
+direction, where the rounding of Phi moves q), and the errors of dq and ddq are what that
+error causes, carried through the velocity and acceleration solves to first order
+(propagated):
+    e      = e_q w / max |w|
+    d_dq   = -Phi_q^-1 D(Phi_q dq + Phi_t)[e]
+    d_ddq  =  Phi_q^-1 (D Gamma[e, d_dq] - D(Phi_q)[e] ddq)
+    flagged where e_q, max |d_dq| + s u |dq| or max |d_ddq| + s u |ddq| misses its target,
+the directional derivatives D forward differences of length sqrt(u) (1 + |q|). The
+derivatives see only the coordinates that move Phi_q, Phi_t and Gamma (on lazy tongs the
+angles, not the far bars' positions, a hundred times more sensitive). On the chain of
+parallelogram four-bars crossing its singular configuration these estimates stand 3 to 11
+times above the actual errors (tests/runtime/test_flag_model.py), and the propagation of the
+actual position error gives the actual errors of dq and ddq: the errors there are the
+position error carried through the solves.
 SAFETY, u and the estimator's steps are symkin.contract.tuning's, which the C solver shares.
-Only the coordinates that enter Phi_q or Phi_t (kernel.nonlinear: angles, Euler parameters,
-a prismatic pair's positions) move Phi_q and Phi_t. Where the model above flags a point, a
-refined one decides: with s_n = ||P Phi_q^-1||_1 / sqrt(N), P the rows of those coordinates,
-and their max norms ndq_n, nddq_n,
-    e_n   = max(min(c, s_n r), s_n u (1 + |q|))       their error
-    e_dq  = s (u |dq| + e_n max(1, ndq_n))
-    e_dqn = s_n (u |dq| + e_n max(1, ndq_n))          their velocities' error
-    e_ddq = s (u |ddq| + e_n (nddq_n + ndq_n^2) + 2 e_dqn max(1, ndq_n))
-(e_q as above). On lazy tongs the positions of the far bars are a hundred times more
-sensitive than the angles, which alone move Phi_q.
 c is the error of q the residual r leaves: max |Phi_q^-1 Phi|, the size of the Newton
 correction, where it was solved for (runtime.newton does so before it iterates on to avoid a
 flag), else the bound s r. The correction is the actual error where the bound is the worst
 case: on the 301-body chain of loops of bench/scaling_limit.py it is a tenth of s r (median).
-The errors of a nearly singular Phi_q lie along its null direction and are amplified by s at
-each stage (position into velocity, velocity into acceleration), which is what the chain of
-parallelogram four-bars shows near its singular configuration (tests/runtime/test_edges_*.py).
 """
 
 from __future__ import annotations

@@ -140,13 +140,19 @@ def test_propagated_position_error_is_the_error_of_dq_and_ddq(chain_runs) -> Non
     near = np.flatnonzero(trajectory.cond > 2e4)
     assert near.size >= 5
     for i in near:
-        t, q, dq, ddq = (trajectory.t[i], trajectory.q[i], trajectory.dq[i], trajectory.d2q[i])
-        error = q - exact[0][i]
-        factors = linalg.factor(kernel.phi_q(q, t, p))
-        got = accuracy.propagated(
-            factors.solve, error, float(np.abs(error).max()), 1e-7,
-            lambda d: kernel.phi_q(q + d, t, p) @ dq + kernel.phi_t(q + d, t, p),
-            lambda d, v: kernel.gamma(q + d, dq + v, t, p) - kernel.phi_q(q + d, t, p) @ ddq)
+        solved = (trajectory.q[i], trajectory.dq[i], trajectory.d2q[i])
+        got = _propagate(kernel, p, trajectory.t[i], solved, solved[0] - exact[0][i])
         actual = [float(np.abs(x[i] - want[i]).max())
                   for x, want in ((trajectory.dq, exact[1]), (trajectory.d2q, exact[2]))]
         assert np.allclose(got, actual, rtol=0.1)
+
+
+def _propagate(kernel, p: np.ndarray, t: float, solved: tuple[np.ndarray, ...],
+               error: np.ndarray) -> tuple[float, float]:
+    """accuracy.propagated of this position error, with the dense Phi_q of the kernel."""
+    q, dq, ddq = solved
+    factors = linalg.factor(kernel.phi_q(q, t, p))
+    return accuracy.propagated(
+        factors.solve, error, float(np.abs(error).max()), 1e-7,
+        lambda d: kernel.phi_q(q + d, t, p) @ dq + kernel.phi_t(q + d, t, p),
+        lambda d, v: kernel.gamma(q + d, dq + v, t, p) - kernel.phi_q(q + d, t, p) @ ddq)
