@@ -163,10 +163,37 @@ def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
     if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(ddq))):
         return None
     unit = UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
-    flag = accuracy.flagged(
-        result.inv_norm, result.norm_a, result.residual, q, dq, ddq, options, unit,
-        result.correction, nonlinear=getattr(kernel, "nonlinear", None),
-        rows_inverse_norm=lambda rows: accuracy.inverse_norm1(
-            factors.solve, factors.solve_transposed, q.size, rows))
+    flag = accuracy.flagged(result.inv_norm, result.norm_a, result.residual, q, dq, ddq,
+                            options, unit, result.correction,
+                            _propagation(kernel, factors, (q, dq, ddq), t, p, unit))
     return Point(q, dq, ddq, result.cond, flag)
 
+
+
+def _propagation(kernel: KinematicsKernel, factors: Factors | SparseFactors,
+                 solved: tuple[Array, Array, Array], t: float, p: Array, unit: float
+                 ) -> accuracy.Propagate:
+    """The errors of dq and ddq that a position error of a given size causes at the solved
+    point, along the worst direction (runtime.accuracy.propagated, forward differences of
+    length sqrt(u) (1 + max |q|), as the generated C takes them)."""
+    q, dq, ddq = solved
+    rows, cols = (np.asarray(a, dtype=np.intp) for a in (kernel.pattern_rows, kernel.pattern_cols))
+
+    def jacobian_times(moved: Array, v: Array) -> Array:
+        nz = np.asarray(kernel.phi_q_nz(moved, t, p), dtype=float)
+        return np.bincount(rows, nz * v[cols], minlength=q.size)
+
+    def velocity_rows(d: Array) -> Array:
+        return jacobian_times(q + d, dq) + kernel.phi_t(q + d, t, p)
+
+    def acceleration_rows(d: Array, v: Array) -> Array:
+        return kernel.gamma(q + d, dq + v, t, p) - jacobian_times(q + d, ddq)
+
+    def propagate(size: float) -> tuple[float, float]:
+        direction = accuracy.worst_column(factors.solve, factors.solve_transposed, q.size)
+        step = math.sqrt(unit) * (1.0 + float(np.abs(q).max(initial=0.0)))
+        return accuracy.propagated(factors.solve, direction, step=step, size=size,
+                                   velocity_rows=velocity_rows,
+                                   acceleration_rows=acceleration_rows)
+
+    return propagate

@@ -541,52 +541,134 @@ static int all_drivers_flagged(const all_drivers_options *options,
         || ALL_DRIVERS_SAFETY * e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const all_drivers_real all_drivers_nonlinear[ALL_DRIVERS_NQ] = { 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0, 0, 0, 0 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static all_drivers_real all_drivers_nonlinear_max(const all_drivers_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static all_drivers_real all_drivers_position_error(const all_drivers_workspace *work,
+                                          const all_drivers_report *report, all_drivers_real nq)
 {
-    all_drivers_real largest = 0;
-    int i;
-    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
-        const all_drivers_real a = all_drivers_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const all_drivers_real s = report->inv_norm / sqrt((all_drivers_real)ALL_DRIVERS_NQ);
+    const all_drivers_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const all_drivers_real rounding = s * ALL_DRIVERS_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static all_drivers_real all_drivers_sum_abs(const all_drivers_real v[])
+{
+    all_drivers_real sum = 0;
+    int i;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void all_drivers_worst_column(const all_drivers_lu *lu, all_drivers_real y[])
+{
+    all_drivers_real z[ALL_DRIVERS_NQ], candidate[ALL_DRIVERS_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, all_drivers_uniform, sizeof z);
+    all_drivers_lu_solve(lu, y);
+    norm = all_drivers_sum_abs(y);
+    for (step = 0; step < ALL_DRIVERS_ESTIMATOR_STEPS - 1; ++step) {
+        all_drivers_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < ALL_DRIVERS_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        all_drivers_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < ALL_DRIVERS_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / ALL_DRIVERS_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        all_drivers_lu_solve(lu, candidate);
+        candidate_norm = all_drivers_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void all_drivers_jacobian_times(const all_drivers_real nz[], const all_drivers_real v[], all_drivers_real out[])
+{
+    int e;
+    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) {
+        out[all_drivers_phi_q_row[e]] += nz[e] * v[all_drivers_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void all_drivers_propagated(const all_drivers_workspace *work, all_drivers_real size, all_drivers_real nq,
+                                    const all_drivers_real q[], const all_drivers_real dq[], const all_drivers_real ddq[],
+                                    all_drivers_real t, const all_drivers_real p[], all_drivers_real errors[])
+{
+    all_drivers_real direction[ALL_DRIVERS_NQ], moved[ALL_DRIVERS_NQ], rows[ALL_DRIVERS_NQ];
+    all_drivers_real shifted[ALL_DRIVERS_NQ], nz[ALL_DRIVERS_NNZ > 0 ? ALL_DRIVERS_NNZ : 1];
+    const all_drivers_real step = sqrt(ALL_DRIVERS_UNIT_ROUNDOFF) * (1 + nq);
+    all_drivers_real largest;
+    int i;
+    all_drivers_worst_column(&work->lu, direction);
+    largest = all_drivers_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (all_drivers_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    all_drivers_from_unit(work, moved);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    all_drivers_phi_q(moved, t, p, nz);
+    all_drivers_phi_t(moved, t, p, rows);
+    all_drivers_jacobian_times(nz, dq, rows);
+    all_drivers_rows_in_unit(work, rows);
+    all_drivers_lu_solve(&work->lu, rows);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = all_drivers_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    all_drivers_from_unit(work, shifted);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) shifted[i] += dq[i];
+    all_drivers_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) shifted[i] = -ddq[i];
+    all_drivers_jacobian_times(nz, shifted, rows);
+    all_drivers_rows_in_unit(work, rows);
+    all_drivers_lu_solve(&work->lu, rows);
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) rows[i] *= size / step;
+    errors[1] = all_drivers_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int all_drivers_flagged_refined(const all_drivers_options *options,
                                         const all_drivers_workspace *work,
                                         const all_drivers_report *report, all_drivers_real nq,
-                                        all_drivers_real ndq, all_drivers_real nddq, const all_drivers_real dq[],
-                                        const all_drivers_real ddq[])
+                                        all_drivers_real ndq, all_drivers_real nddq, const all_drivers_real q[],
+                                        const all_drivers_real dq[], const all_drivers_real ddq[], all_drivers_real t,
+                                        const all_drivers_real p[])
 {
+    static const all_drivers_real zeros[ALL_DRIVERS_NQ];
+    const all_drivers_real s = report->inv_norm / sqrt((all_drivers_real)ALL_DRIVERS_NQ);
     const all_drivers_real u = ALL_DRIVERS_UNIT_ROUNDOFF;
-    const all_drivers_real root = sqrt((all_drivers_real)ALL_DRIVERS_NQ);
-    const all_drivers_real s = report->inv_norm / root;
-    const all_drivers_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    all_drivers_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    all_drivers_real e_q, errors[2], e_dq, e_ddq;
     if (!all_drivers_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = all_drivers_inverse_norm1_rows(&work->lu, all_drivers_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? all_drivers_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? all_drivers_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * all_drivers_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * all_drivers_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * all_drivers_at_least_1(ndq_n));
-    return ALL_DRIVERS_SAFETY * e_q > options->target_q * all_drivers_at_least_1(nq)
-        || ALL_DRIVERS_SAFETY * e_dq > options->target_dq * all_drivers_at_least_1(ndq)
-        || ALL_DRIVERS_SAFETY * e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
+    e_q = all_drivers_position_error(work, report, nq);
+    all_drivers_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * all_drivers_at_least_1(nq)
+        || e_dq > options->target_dq * all_drivers_at_least_1(ndq)
+        || e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -752,7 +834,8 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
     }
     report->flagged = all_drivers_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (all_drivers_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

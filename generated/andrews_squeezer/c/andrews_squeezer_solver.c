@@ -547,52 +547,134 @@ static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
         || ANDREWS_SQUEEZER_SAFETY * e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const andrews_squeezer_real andrews_squeezer_nonlinear[ANDREWS_SQUEEZER_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static andrews_squeezer_real andrews_squeezer_nonlinear_max(const andrews_squeezer_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static andrews_squeezer_real andrews_squeezer_position_error(const andrews_squeezer_workspace *work,
+                                          const andrews_squeezer_report *report, andrews_squeezer_real nq)
 {
-    andrews_squeezer_real largest = 0;
-    int i;
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        const andrews_squeezer_real a = andrews_squeezer_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
+    const andrews_squeezer_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const andrews_squeezer_real rounding = s * ANDREWS_SQUEEZER_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static andrews_squeezer_real andrews_squeezer_sum_abs(const andrews_squeezer_real v[])
+{
+    andrews_squeezer_real sum = 0;
+    int i;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void andrews_squeezer_worst_column(const andrews_squeezer_lu *lu, andrews_squeezer_real y[])
+{
+    andrews_squeezer_real z[ANDREWS_SQUEEZER_NQ], candidate[ANDREWS_SQUEEZER_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, andrews_squeezer_uniform, sizeof z);
+    andrews_squeezer_lu_solve(lu, y);
+    norm = andrews_squeezer_sum_abs(y);
+    for (step = 0; step < ANDREWS_SQUEEZER_ESTIMATOR_STEPS - 1; ++step) {
+        andrews_squeezer_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        andrews_squeezer_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < ANDREWS_SQUEEZER_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / ANDREWS_SQUEEZER_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        andrews_squeezer_lu_solve(lu, candidate);
+        candidate_norm = andrews_squeezer_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void andrews_squeezer_jacobian_times(const andrews_squeezer_real nz[], const andrews_squeezer_real v[], andrews_squeezer_real out[])
+{
+    int e;
+    for (e = 0; e < ANDREWS_SQUEEZER_NNZ; ++e) {
+        out[andrews_squeezer_phi_q_row[e]] += nz[e] * v[andrews_squeezer_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void andrews_squeezer_propagated(const andrews_squeezer_workspace *work, andrews_squeezer_real size, andrews_squeezer_real nq,
+                                    const andrews_squeezer_real q[], const andrews_squeezer_real dq[], const andrews_squeezer_real ddq[],
+                                    andrews_squeezer_real t, const andrews_squeezer_real p[], andrews_squeezer_real errors[])
+{
+    andrews_squeezer_real direction[ANDREWS_SQUEEZER_NQ], moved[ANDREWS_SQUEEZER_NQ], rows[ANDREWS_SQUEEZER_NQ];
+    andrews_squeezer_real shifted[ANDREWS_SQUEEZER_NQ], nz[ANDREWS_SQUEEZER_NNZ > 0 ? ANDREWS_SQUEEZER_NNZ : 1];
+    const andrews_squeezer_real step = sqrt(ANDREWS_SQUEEZER_UNIT_ROUNDOFF) * (1 + nq);
+    andrews_squeezer_real largest;
+    int i;
+    andrews_squeezer_worst_column(&work->lu, direction);
+    largest = andrews_squeezer_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (andrews_squeezer_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    andrews_squeezer_from_unit(work, moved);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    andrews_squeezer_phi_q(moved, t, p, nz);
+    andrews_squeezer_phi_t(moved, t, p, rows);
+    andrews_squeezer_jacobian_times(nz, dq, rows);
+    andrews_squeezer_rows_in_unit(work, rows);
+    andrews_squeezer_lu_solve(&work->lu, rows);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = andrews_squeezer_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    andrews_squeezer_from_unit(work, shifted);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) shifted[i] += dq[i];
+    andrews_squeezer_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) shifted[i] = -ddq[i];
+    andrews_squeezer_jacobian_times(nz, shifted, rows);
+    andrews_squeezer_rows_in_unit(work, rows);
+    andrews_squeezer_lu_solve(&work->lu, rows);
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) rows[i] *= size / step;
+    errors[1] = andrews_squeezer_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int andrews_squeezer_flagged_refined(const andrews_squeezer_options *options,
                                         const andrews_squeezer_workspace *work,
                                         const andrews_squeezer_report *report, andrews_squeezer_real nq,
-                                        andrews_squeezer_real ndq, andrews_squeezer_real nddq, const andrews_squeezer_real dq[],
-                                        const andrews_squeezer_real ddq[])
+                                        andrews_squeezer_real ndq, andrews_squeezer_real nddq, const andrews_squeezer_real q[],
+                                        const andrews_squeezer_real dq[], const andrews_squeezer_real ddq[], andrews_squeezer_real t,
+                                        const andrews_squeezer_real p[])
 {
+    static const andrews_squeezer_real zeros[ANDREWS_SQUEEZER_NQ];
+    const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
     const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
-    const andrews_squeezer_real root = sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
-    const andrews_squeezer_real s = report->inv_norm / root;
-    const andrews_squeezer_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    andrews_squeezer_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    andrews_squeezer_real e_q, errors[2], e_dq, e_ddq;
     if (!andrews_squeezer_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = andrews_squeezer_inverse_norm1_rows(&work->lu, andrews_squeezer_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? andrews_squeezer_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? andrews_squeezer_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * andrews_squeezer_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * andrews_squeezer_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * andrews_squeezer_at_least_1(ndq_n));
-    return ANDREWS_SQUEEZER_SAFETY * e_q > options->target_q * andrews_squeezer_at_least_1(nq)
-        || ANDREWS_SQUEEZER_SAFETY * e_dq > options->target_dq * andrews_squeezer_at_least_1(ndq)
-        || ANDREWS_SQUEEZER_SAFETY * e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
+    e_q = andrews_squeezer_position_error(work, report, nq);
+    andrews_squeezer_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * andrews_squeezer_at_least_1(nq)
+        || e_dq > options->target_dq * andrews_squeezer_at_least_1(ndq)
+        || e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -758,7 +840,8 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
     }
     report->flagged = andrews_squeezer_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (andrews_squeezer_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

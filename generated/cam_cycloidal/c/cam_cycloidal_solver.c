@@ -319,52 +319,134 @@ static int cam_cycloidal_flagged(const cam_cycloidal_options *options,
         || CAM_CYCLOIDAL_SAFETY * e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const cam_cycloidal_real cam_cycloidal_nonlinear[CAM_CYCLOIDAL_NQ] = { 0, 0, 1, 0, 0, 0, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static cam_cycloidal_real cam_cycloidal_nonlinear_max(const cam_cycloidal_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static cam_cycloidal_real cam_cycloidal_position_error(const cam_cycloidal_workspace *work,
+                                          const cam_cycloidal_report *report, cam_cycloidal_real nq)
 {
-    cam_cycloidal_real largest = 0;
-    int i;
-    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
-        const cam_cycloidal_real a = cam_cycloidal_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const cam_cycloidal_real s = report->inv_norm / sqrt((cam_cycloidal_real)CAM_CYCLOIDAL_NQ);
+    const cam_cycloidal_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const cam_cycloidal_real rounding = s * CAM_CYCLOIDAL_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static cam_cycloidal_real cam_cycloidal_sum_abs(const cam_cycloidal_real v[])
+{
+    cam_cycloidal_real sum = 0;
+    int i;
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void cam_cycloidal_worst_column(const cam_cycloidal_lu *lu, cam_cycloidal_real y[])
+{
+    cam_cycloidal_real z[CAM_CYCLOIDAL_NQ], candidate[CAM_CYCLOIDAL_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, cam_cycloidal_uniform, sizeof z);
+    cam_cycloidal_lu_solve(lu, y);
+    norm = cam_cycloidal_sum_abs(y);
+    for (step = 0; step < CAM_CYCLOIDAL_ESTIMATOR_STEPS - 1; ++step) {
+        cam_cycloidal_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        cam_cycloidal_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < CAM_CYCLOIDAL_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / CAM_CYCLOIDAL_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        cam_cycloidal_lu_solve(lu, candidate);
+        candidate_norm = cam_cycloidal_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void cam_cycloidal_jacobian_times(const cam_cycloidal_real nz[], const cam_cycloidal_real v[], cam_cycloidal_real out[])
+{
+    int e;
+    for (e = 0; e < CAM_CYCLOIDAL_NNZ; ++e) {
+        out[cam_cycloidal_phi_q_row[e]] += nz[e] * v[cam_cycloidal_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void cam_cycloidal_propagated(const cam_cycloidal_workspace *work, cam_cycloidal_real size, cam_cycloidal_real nq,
+                                    const cam_cycloidal_real q[], const cam_cycloidal_real dq[], const cam_cycloidal_real ddq[],
+                                    cam_cycloidal_real t, const cam_cycloidal_real p[], cam_cycloidal_real errors[])
+{
+    cam_cycloidal_real direction[CAM_CYCLOIDAL_NQ], moved[CAM_CYCLOIDAL_NQ], rows[CAM_CYCLOIDAL_NQ];
+    cam_cycloidal_real shifted[CAM_CYCLOIDAL_NQ], nz[CAM_CYCLOIDAL_NNZ > 0 ? CAM_CYCLOIDAL_NNZ : 1];
+    const cam_cycloidal_real step = sqrt(CAM_CYCLOIDAL_UNIT_ROUNDOFF) * (1 + nq);
+    cam_cycloidal_real largest;
+    int i;
+    cam_cycloidal_worst_column(&work->lu, direction);
+    largest = cam_cycloidal_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (cam_cycloidal_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    cam_cycloidal_from_unit(work, moved);
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    cam_cycloidal_phi_q(moved, t, p, nz);
+    cam_cycloidal_phi_t(moved, t, p, rows);
+    cam_cycloidal_jacobian_times(nz, dq, rows);
+    cam_cycloidal_rows_in_unit(work, rows);
+    cam_cycloidal_lu_solve(&work->lu, rows);
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = cam_cycloidal_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    cam_cycloidal_from_unit(work, shifted);
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) shifted[i] += dq[i];
+    cam_cycloidal_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) shifted[i] = -ddq[i];
+    cam_cycloidal_jacobian_times(nz, shifted, rows);
+    cam_cycloidal_rows_in_unit(work, rows);
+    cam_cycloidal_lu_solve(&work->lu, rows);
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) rows[i] *= size / step;
+    errors[1] = cam_cycloidal_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int cam_cycloidal_flagged_refined(const cam_cycloidal_options *options,
                                         const cam_cycloidal_workspace *work,
                                         const cam_cycloidal_report *report, cam_cycloidal_real nq,
-                                        cam_cycloidal_real ndq, cam_cycloidal_real nddq, const cam_cycloidal_real dq[],
-                                        const cam_cycloidal_real ddq[])
+                                        cam_cycloidal_real ndq, cam_cycloidal_real nddq, const cam_cycloidal_real q[],
+                                        const cam_cycloidal_real dq[], const cam_cycloidal_real ddq[], cam_cycloidal_real t,
+                                        const cam_cycloidal_real p[])
 {
+    static const cam_cycloidal_real zeros[CAM_CYCLOIDAL_NQ];
+    const cam_cycloidal_real s = report->inv_norm / sqrt((cam_cycloidal_real)CAM_CYCLOIDAL_NQ);
     const cam_cycloidal_real u = CAM_CYCLOIDAL_UNIT_ROUNDOFF;
-    const cam_cycloidal_real root = sqrt((cam_cycloidal_real)CAM_CYCLOIDAL_NQ);
-    const cam_cycloidal_real s = report->inv_norm / root;
-    const cam_cycloidal_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    cam_cycloidal_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    cam_cycloidal_real e_q, errors[2], e_dq, e_ddq;
     if (!cam_cycloidal_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = cam_cycloidal_inverse_norm1_rows(&work->lu, cam_cycloidal_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? cam_cycloidal_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? cam_cycloidal_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * cam_cycloidal_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * cam_cycloidal_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * cam_cycloidal_at_least_1(ndq_n));
-    return CAM_CYCLOIDAL_SAFETY * e_q > options->target_q * cam_cycloidal_at_least_1(nq)
-        || CAM_CYCLOIDAL_SAFETY * e_dq > options->target_dq * cam_cycloidal_at_least_1(ndq)
-        || CAM_CYCLOIDAL_SAFETY * e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq);
+    e_q = cam_cycloidal_position_error(work, report, nq);
+    cam_cycloidal_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * cam_cycloidal_at_least_1(nq)
+        || e_dq > options->target_dq * cam_cycloidal_at_least_1(ndq)
+        || e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -530,7 +612,8 @@ int cam_cycloidal_solve_step(const cam_cycloidal_options *options, const cam_cyc
     }
     report->flagged = cam_cycloidal_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (cam_cycloidal_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

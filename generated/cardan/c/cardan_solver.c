@@ -305,52 +305,134 @@ static int cardan_flagged(const cardan_options *options,
         || CARDAN_SAFETY * e_ddq > options->target_ddq * cardan_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const cardan_real cardan_nonlinear[CARDAN_NQ] = { 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static cardan_real cardan_nonlinear_max(const cardan_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static cardan_real cardan_position_error(const cardan_workspace *work,
+                                          const cardan_report *report, cardan_real nq)
 {
-    cardan_real largest = 0;
-    int i;
-    for (i = 0; i < CARDAN_NQ; ++i) {
-        const cardan_real a = cardan_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const cardan_real s = report->inv_norm / sqrt((cardan_real)CARDAN_NQ);
+    const cardan_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const cardan_real rounding = s * CARDAN_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static cardan_real cardan_sum_abs(const cardan_real v[])
+{
+    cardan_real sum = 0;
+    int i;
+    for (i = 0; i < CARDAN_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void cardan_worst_column(const cardan_lu *lu, cardan_real y[])
+{
+    cardan_real z[CARDAN_NQ], candidate[CARDAN_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, cardan_uniform, sizeof z);
+    cardan_lu_solve(lu, y);
+    norm = cardan_sum_abs(y);
+    for (step = 0; step < CARDAN_ESTIMATOR_STEPS - 1; ++step) {
+        cardan_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < CARDAN_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        cardan_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < CARDAN_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / CARDAN_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        cardan_lu_solve(lu, candidate);
+        candidate_norm = cardan_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void cardan_jacobian_times(const cardan_real nz[], const cardan_real v[], cardan_real out[])
+{
+    int e;
+    for (e = 0; e < CARDAN_NNZ; ++e) {
+        out[cardan_phi_q_row[e]] += nz[e] * v[cardan_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void cardan_propagated(const cardan_workspace *work, cardan_real size, cardan_real nq,
+                                    const cardan_real q[], const cardan_real dq[], const cardan_real ddq[],
+                                    cardan_real t, const cardan_real p[], cardan_real errors[])
+{
+    cardan_real direction[CARDAN_NQ], moved[CARDAN_NQ], rows[CARDAN_NQ];
+    cardan_real shifted[CARDAN_NQ], nz[CARDAN_NNZ > 0 ? CARDAN_NNZ : 1];
+    const cardan_real step = sqrt(CARDAN_UNIT_ROUNDOFF) * (1 + nq);
+    cardan_real largest;
+    int i;
+    cardan_worst_column(&work->lu, direction);
+    largest = cardan_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (cardan_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < CARDAN_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    cardan_from_unit(work, moved);
+    for (i = 0; i < CARDAN_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    cardan_phi_q(moved, t, p, nz);
+    cardan_phi_t(moved, t, p, rows);
+    cardan_jacobian_times(nz, dq, rows);
+    cardan_rows_in_unit(work, rows);
+    cardan_lu_solve(&work->lu, rows);
+    for (i = 0; i < CARDAN_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = cardan_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < CARDAN_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    cardan_from_unit(work, shifted);
+    for (i = 0; i < CARDAN_NQ; ++i) shifted[i] += dq[i];
+    cardan_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < CARDAN_NQ; ++i) shifted[i] = -ddq[i];
+    cardan_jacobian_times(nz, shifted, rows);
+    cardan_rows_in_unit(work, rows);
+    cardan_lu_solve(&work->lu, rows);
+    for (i = 0; i < CARDAN_NQ; ++i) rows[i] *= size / step;
+    errors[1] = cardan_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int cardan_flagged_refined(const cardan_options *options,
                                         const cardan_workspace *work,
                                         const cardan_report *report, cardan_real nq,
-                                        cardan_real ndq, cardan_real nddq, const cardan_real dq[],
-                                        const cardan_real ddq[])
+                                        cardan_real ndq, cardan_real nddq, const cardan_real q[],
+                                        const cardan_real dq[], const cardan_real ddq[], cardan_real t,
+                                        const cardan_real p[])
 {
+    static const cardan_real zeros[CARDAN_NQ];
+    const cardan_real s = report->inv_norm / sqrt((cardan_real)CARDAN_NQ);
     const cardan_real u = CARDAN_UNIT_ROUNDOFF;
-    const cardan_real root = sqrt((cardan_real)CARDAN_NQ);
-    const cardan_real s = report->inv_norm / root;
-    const cardan_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    cardan_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    cardan_real e_q, errors[2], e_dq, e_ddq;
     if (!cardan_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = cardan_inverse_norm1_rows(&work->lu, cardan_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? cardan_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? cardan_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * cardan_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * cardan_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * cardan_at_least_1(ndq_n));
-    return CARDAN_SAFETY * e_q > options->target_q * cardan_at_least_1(nq)
-        || CARDAN_SAFETY * e_dq > options->target_dq * cardan_at_least_1(ndq)
-        || CARDAN_SAFETY * e_ddq > options->target_ddq * cardan_at_least_1(nddq);
+    e_q = cardan_position_error(work, report, nq);
+    cardan_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * cardan_at_least_1(nq)
+        || e_dq > options->target_dq * cardan_at_least_1(ndq)
+        || e_ddq > options->target_ddq * cardan_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -516,7 +598,8 @@ int cardan_solve_step(const cardan_options *options, const cardan_real p[], card
     }
     report->flagged = cardan_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (cardan_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

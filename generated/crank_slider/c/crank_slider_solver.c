@@ -326,52 +326,134 @@ static int crank_slider_flagged(const crank_slider_options *options,
         || CRANK_SLIDER_SAFETY * e_ddq > options->target_ddq * crank_slider_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const crank_slider_real crank_slider_nonlinear[CRANK_SLIDER_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 0 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static crank_slider_real crank_slider_nonlinear_max(const crank_slider_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static crank_slider_real crank_slider_position_error(const crank_slider_workspace *work,
+                                          const crank_slider_report *report, crank_slider_real nq)
 {
-    crank_slider_real largest = 0;
-    int i;
-    for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
-        const crank_slider_real a = crank_slider_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const crank_slider_real s = report->inv_norm / sqrt((crank_slider_real)CRANK_SLIDER_NQ);
+    const crank_slider_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const crank_slider_real rounding = s * CRANK_SLIDER_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static crank_slider_real crank_slider_sum_abs(const crank_slider_real v[])
+{
+    crank_slider_real sum = 0;
+    int i;
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void crank_slider_worst_column(const crank_slider_lu *lu, crank_slider_real y[])
+{
+    crank_slider_real z[CRANK_SLIDER_NQ], candidate[CRANK_SLIDER_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, crank_slider_uniform, sizeof z);
+    crank_slider_lu_solve(lu, y);
+    norm = crank_slider_sum_abs(y);
+    for (step = 0; step < CRANK_SLIDER_ESTIMATOR_STEPS - 1; ++step) {
+        crank_slider_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < CRANK_SLIDER_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        crank_slider_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < CRANK_SLIDER_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / CRANK_SLIDER_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        crank_slider_lu_solve(lu, candidate);
+        candidate_norm = crank_slider_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void crank_slider_jacobian_times(const crank_slider_real nz[], const crank_slider_real v[], crank_slider_real out[])
+{
+    int e;
+    for (e = 0; e < CRANK_SLIDER_NNZ; ++e) {
+        out[crank_slider_phi_q_row[e]] += nz[e] * v[crank_slider_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void crank_slider_propagated(const crank_slider_workspace *work, crank_slider_real size, crank_slider_real nq,
+                                    const crank_slider_real q[], const crank_slider_real dq[], const crank_slider_real ddq[],
+                                    crank_slider_real t, const crank_slider_real p[], crank_slider_real errors[])
+{
+    crank_slider_real direction[CRANK_SLIDER_NQ], moved[CRANK_SLIDER_NQ], rows[CRANK_SLIDER_NQ];
+    crank_slider_real shifted[CRANK_SLIDER_NQ], nz[CRANK_SLIDER_NNZ > 0 ? CRANK_SLIDER_NNZ : 1];
+    const crank_slider_real step = sqrt(CRANK_SLIDER_UNIT_ROUNDOFF) * (1 + nq);
+    crank_slider_real largest;
+    int i;
+    crank_slider_worst_column(&work->lu, direction);
+    largest = crank_slider_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (crank_slider_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    crank_slider_from_unit(work, moved);
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    crank_slider_phi_q(moved, t, p, nz);
+    crank_slider_phi_t(moved, t, p, rows);
+    crank_slider_jacobian_times(nz, dq, rows);
+    crank_slider_rows_in_unit(work, rows);
+    crank_slider_lu_solve(&work->lu, rows);
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = crank_slider_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    crank_slider_from_unit(work, shifted);
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) shifted[i] += dq[i];
+    crank_slider_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) shifted[i] = -ddq[i];
+    crank_slider_jacobian_times(nz, shifted, rows);
+    crank_slider_rows_in_unit(work, rows);
+    crank_slider_lu_solve(&work->lu, rows);
+    for (i = 0; i < CRANK_SLIDER_NQ; ++i) rows[i] *= size / step;
+    errors[1] = crank_slider_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int crank_slider_flagged_refined(const crank_slider_options *options,
                                         const crank_slider_workspace *work,
                                         const crank_slider_report *report, crank_slider_real nq,
-                                        crank_slider_real ndq, crank_slider_real nddq, const crank_slider_real dq[],
-                                        const crank_slider_real ddq[])
+                                        crank_slider_real ndq, crank_slider_real nddq, const crank_slider_real q[],
+                                        const crank_slider_real dq[], const crank_slider_real ddq[], crank_slider_real t,
+                                        const crank_slider_real p[])
 {
+    static const crank_slider_real zeros[CRANK_SLIDER_NQ];
+    const crank_slider_real s = report->inv_norm / sqrt((crank_slider_real)CRANK_SLIDER_NQ);
     const crank_slider_real u = CRANK_SLIDER_UNIT_ROUNDOFF;
-    const crank_slider_real root = sqrt((crank_slider_real)CRANK_SLIDER_NQ);
-    const crank_slider_real s = report->inv_norm / root;
-    const crank_slider_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    crank_slider_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    crank_slider_real e_q, errors[2], e_dq, e_ddq;
     if (!crank_slider_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = crank_slider_inverse_norm1_rows(&work->lu, crank_slider_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? crank_slider_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? crank_slider_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * crank_slider_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * crank_slider_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * crank_slider_at_least_1(ndq_n));
-    return CRANK_SLIDER_SAFETY * e_q > options->target_q * crank_slider_at_least_1(nq)
-        || CRANK_SLIDER_SAFETY * e_dq > options->target_dq * crank_slider_at_least_1(ndq)
-        || CRANK_SLIDER_SAFETY * e_ddq > options->target_ddq * crank_slider_at_least_1(nddq);
+    e_q = crank_slider_position_error(work, report, nq);
+    crank_slider_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * crank_slider_at_least_1(nq)
+        || e_dq > options->target_dq * crank_slider_at_least_1(ndq)
+        || e_ddq > options->target_ddq * crank_slider_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -537,7 +619,8 @@ int crank_slider_solve_step(const crank_slider_options *options, const crank_sli
     }
     report->flagged = crank_slider_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (crank_slider_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -349,52 +349,134 @@ static int custom_driver_flagged(const custom_driver_options *options,
         || CUSTOM_DRIVER_SAFETY * e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const custom_driver_real custom_driver_nonlinear[CUSTOM_DRIVER_NQ] = { 1, 1, 1, 0, 0, 1, 0, 0, 0 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static custom_driver_real custom_driver_nonlinear_max(const custom_driver_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static custom_driver_real custom_driver_position_error(const custom_driver_workspace *work,
+                                          const custom_driver_report *report, custom_driver_real nq)
 {
-    custom_driver_real largest = 0;
-    int i;
-    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
-        const custom_driver_real a = custom_driver_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const custom_driver_real s = report->inv_norm / sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
+    const custom_driver_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const custom_driver_real rounding = s * CUSTOM_DRIVER_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static custom_driver_real custom_driver_sum_abs(const custom_driver_real v[])
+{
+    custom_driver_real sum = 0;
+    int i;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void custom_driver_worst_column(const custom_driver_lu *lu, custom_driver_real y[])
+{
+    custom_driver_real z[CUSTOM_DRIVER_NQ], candidate[CUSTOM_DRIVER_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, custom_driver_uniform, sizeof z);
+    custom_driver_lu_solve(lu, y);
+    norm = custom_driver_sum_abs(y);
+    for (step = 0; step < CUSTOM_DRIVER_ESTIMATOR_STEPS - 1; ++step) {
+        custom_driver_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        custom_driver_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < CUSTOM_DRIVER_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / CUSTOM_DRIVER_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        custom_driver_lu_solve(lu, candidate);
+        candidate_norm = custom_driver_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void custom_driver_jacobian_times(const custom_driver_real nz[], const custom_driver_real v[], custom_driver_real out[])
+{
+    int e;
+    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e) {
+        out[custom_driver_phi_q_row[e]] += nz[e] * v[custom_driver_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void custom_driver_propagated(const custom_driver_workspace *work, custom_driver_real size, custom_driver_real nq,
+                                    const custom_driver_real q[], const custom_driver_real dq[], const custom_driver_real ddq[],
+                                    custom_driver_real t, const custom_driver_real p[], custom_driver_real errors[])
+{
+    custom_driver_real direction[CUSTOM_DRIVER_NQ], moved[CUSTOM_DRIVER_NQ], rows[CUSTOM_DRIVER_NQ];
+    custom_driver_real shifted[CUSTOM_DRIVER_NQ], nz[CUSTOM_DRIVER_NNZ > 0 ? CUSTOM_DRIVER_NNZ : 1];
+    const custom_driver_real step = sqrt(CUSTOM_DRIVER_UNIT_ROUNDOFF) * (1 + nq);
+    custom_driver_real largest;
+    int i;
+    custom_driver_worst_column(&work->lu, direction);
+    largest = custom_driver_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (custom_driver_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    custom_driver_from_unit(work, moved);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    custom_driver_phi_q(moved, t, p, nz);
+    custom_driver_phi_t(moved, t, p, rows);
+    custom_driver_jacobian_times(nz, dq, rows);
+    custom_driver_rows_in_unit(work, rows);
+    custom_driver_lu_solve(&work->lu, rows);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = custom_driver_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    custom_driver_from_unit(work, shifted);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) shifted[i] += dq[i];
+    custom_driver_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) shifted[i] = -ddq[i];
+    custom_driver_jacobian_times(nz, shifted, rows);
+    custom_driver_rows_in_unit(work, rows);
+    custom_driver_lu_solve(&work->lu, rows);
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) rows[i] *= size / step;
+    errors[1] = custom_driver_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int custom_driver_flagged_refined(const custom_driver_options *options,
                                         const custom_driver_workspace *work,
                                         const custom_driver_report *report, custom_driver_real nq,
-                                        custom_driver_real ndq, custom_driver_real nddq, const custom_driver_real dq[],
-                                        const custom_driver_real ddq[])
+                                        custom_driver_real ndq, custom_driver_real nddq, const custom_driver_real q[],
+                                        const custom_driver_real dq[], const custom_driver_real ddq[], custom_driver_real t,
+                                        const custom_driver_real p[])
 {
+    static const custom_driver_real zeros[CUSTOM_DRIVER_NQ];
+    const custom_driver_real s = report->inv_norm / sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
     const custom_driver_real u = CUSTOM_DRIVER_UNIT_ROUNDOFF;
-    const custom_driver_real root = sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
-    const custom_driver_real s = report->inv_norm / root;
-    const custom_driver_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    custom_driver_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    custom_driver_real e_q, errors[2], e_dq, e_ddq;
     if (!custom_driver_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = custom_driver_inverse_norm1_rows(&work->lu, custom_driver_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? custom_driver_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? custom_driver_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * custom_driver_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * custom_driver_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * custom_driver_at_least_1(ndq_n));
-    return CUSTOM_DRIVER_SAFETY * e_q > options->target_q * custom_driver_at_least_1(nq)
-        || CUSTOM_DRIVER_SAFETY * e_dq > options->target_dq * custom_driver_at_least_1(ndq)
-        || CUSTOM_DRIVER_SAFETY * e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
+    e_q = custom_driver_position_error(work, report, nq);
+    custom_driver_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * custom_driver_at_least_1(nq)
+        || e_dq > options->target_dq * custom_driver_at_least_1(ndq)
+        || e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -560,7 +642,8 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
     }
     report->flagged = custom_driver_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (custom_driver_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -341,52 +341,134 @@ static int four_bar_dynamics_flagged(const four_bar_dynamics_options *options,
         || FOUR_BAR_DYNAMICS_SAFETY * e_ddq > options->target_ddq * four_bar_dynamics_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const four_bar_dynamics_real four_bar_dynamics_nonlinear[FOUR_BAR_DYNAMICS_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static four_bar_dynamics_real four_bar_dynamics_nonlinear_max(const four_bar_dynamics_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static four_bar_dynamics_real four_bar_dynamics_position_error(const four_bar_dynamics_workspace *work,
+                                          const four_bar_dynamics_report *report, four_bar_dynamics_real nq)
 {
-    four_bar_dynamics_real largest = 0;
-    int i;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        const four_bar_dynamics_real a = four_bar_dynamics_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const four_bar_dynamics_real s = report->inv_norm / sqrt((four_bar_dynamics_real)FOUR_BAR_DYNAMICS_NQ);
+    const four_bar_dynamics_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const four_bar_dynamics_real rounding = s * FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static four_bar_dynamics_real four_bar_dynamics_sum_abs(const four_bar_dynamics_real v[])
+{
+    four_bar_dynamics_real sum = 0;
+    int i;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void four_bar_dynamics_worst_column(const four_bar_dynamics_lu *lu, four_bar_dynamics_real y[])
+{
+    four_bar_dynamics_real z[FOUR_BAR_DYNAMICS_NQ], candidate[FOUR_BAR_DYNAMICS_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, four_bar_dynamics_uniform, sizeof z);
+    four_bar_dynamics_lu_solve(lu, y);
+    norm = four_bar_dynamics_sum_abs(y);
+    for (step = 0; step < FOUR_BAR_DYNAMICS_ESTIMATOR_STEPS - 1; ++step) {
+        four_bar_dynamics_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        four_bar_dynamics_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < FOUR_BAR_DYNAMICS_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / FOUR_BAR_DYNAMICS_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        four_bar_dynamics_lu_solve(lu, candidate);
+        candidate_norm = four_bar_dynamics_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void four_bar_dynamics_jacobian_times(const four_bar_dynamics_real nz[], const four_bar_dynamics_real v[], four_bar_dynamics_real out[])
+{
+    int e;
+    for (e = 0; e < FOUR_BAR_DYNAMICS_NNZ; ++e) {
+        out[four_bar_dynamics_phi_q_row[e]] += nz[e] * v[four_bar_dynamics_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void four_bar_dynamics_propagated(const four_bar_dynamics_workspace *work, four_bar_dynamics_real size, four_bar_dynamics_real nq,
+                                    const four_bar_dynamics_real q[], const four_bar_dynamics_real dq[], const four_bar_dynamics_real ddq[],
+                                    four_bar_dynamics_real t, const four_bar_dynamics_real p[], four_bar_dynamics_real errors[])
+{
+    four_bar_dynamics_real direction[FOUR_BAR_DYNAMICS_NQ], moved[FOUR_BAR_DYNAMICS_NQ], rows[FOUR_BAR_DYNAMICS_NQ];
+    four_bar_dynamics_real shifted[FOUR_BAR_DYNAMICS_NQ], nz[FOUR_BAR_DYNAMICS_NNZ > 0 ? FOUR_BAR_DYNAMICS_NNZ : 1];
+    const four_bar_dynamics_real step = sqrt(FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF) * (1 + nq);
+    four_bar_dynamics_real largest;
+    int i;
+    four_bar_dynamics_worst_column(&work->lu, direction);
+    largest = four_bar_dynamics_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (four_bar_dynamics_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    four_bar_dynamics_from_unit(work, moved);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    four_bar_dynamics_phi_q(moved, t, p, nz);
+    four_bar_dynamics_phi_t(moved, t, p, rows);
+    four_bar_dynamics_jacobian_times(nz, dq, rows);
+    four_bar_dynamics_rows_in_unit(work, rows);
+    four_bar_dynamics_lu_solve(&work->lu, rows);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = four_bar_dynamics_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    four_bar_dynamics_from_unit(work, shifted);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) shifted[i] += dq[i];
+    four_bar_dynamics_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) shifted[i] = -ddq[i];
+    four_bar_dynamics_jacobian_times(nz, shifted, rows);
+    four_bar_dynamics_rows_in_unit(work, rows);
+    four_bar_dynamics_lu_solve(&work->lu, rows);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) rows[i] *= size / step;
+    errors[1] = four_bar_dynamics_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int four_bar_dynamics_flagged_refined(const four_bar_dynamics_options *options,
                                         const four_bar_dynamics_workspace *work,
                                         const four_bar_dynamics_report *report, four_bar_dynamics_real nq,
-                                        four_bar_dynamics_real ndq, four_bar_dynamics_real nddq, const four_bar_dynamics_real dq[],
-                                        const four_bar_dynamics_real ddq[])
+                                        four_bar_dynamics_real ndq, four_bar_dynamics_real nddq, const four_bar_dynamics_real q[],
+                                        const four_bar_dynamics_real dq[], const four_bar_dynamics_real ddq[], four_bar_dynamics_real t,
+                                        const four_bar_dynamics_real p[])
 {
+    static const four_bar_dynamics_real zeros[FOUR_BAR_DYNAMICS_NQ];
+    const four_bar_dynamics_real s = report->inv_norm / sqrt((four_bar_dynamics_real)FOUR_BAR_DYNAMICS_NQ);
     const four_bar_dynamics_real u = FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF;
-    const four_bar_dynamics_real root = sqrt((four_bar_dynamics_real)FOUR_BAR_DYNAMICS_NQ);
-    const four_bar_dynamics_real s = report->inv_norm / root;
-    const four_bar_dynamics_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    four_bar_dynamics_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    four_bar_dynamics_real e_q, errors[2], e_dq, e_ddq;
     if (!four_bar_dynamics_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = four_bar_dynamics_inverse_norm1_rows(&work->lu, four_bar_dynamics_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? four_bar_dynamics_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? four_bar_dynamics_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * four_bar_dynamics_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * four_bar_dynamics_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * four_bar_dynamics_at_least_1(ndq_n));
-    return FOUR_BAR_DYNAMICS_SAFETY * e_q > options->target_q * four_bar_dynamics_at_least_1(nq)
-        || FOUR_BAR_DYNAMICS_SAFETY * e_dq > options->target_dq * four_bar_dynamics_at_least_1(ndq)
-        || FOUR_BAR_DYNAMICS_SAFETY * e_ddq > options->target_ddq * four_bar_dynamics_at_least_1(nddq);
+    e_q = four_bar_dynamics_position_error(work, report, nq);
+    four_bar_dynamics_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * four_bar_dynamics_at_least_1(nq)
+        || e_dq > options->target_dq * four_bar_dynamics_at_least_1(ndq)
+        || e_ddq > options->target_ddq * four_bar_dynamics_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -552,7 +634,8 @@ int four_bar_dynamics_solve_step(const four_bar_dynamics_options *options, const
     }
     report->flagged = four_bar_dynamics_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (four_bar_dynamics_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

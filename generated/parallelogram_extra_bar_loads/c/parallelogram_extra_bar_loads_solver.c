@@ -400,52 +400,134 @@ static int parallelogram_extra_bar_loads_flagged(const parallelogram_extra_bar_l
         || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_nonlinear[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 0 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_nonlinear_max(const parallelogram_extra_bar_loads_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_position_error(const parallelogram_extra_bar_loads_workspace *work,
+                                          const parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real nq)
 {
-    parallelogram_extra_bar_loads_real largest = 0;
-    int i;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
-        const parallelogram_extra_bar_loads_real a = parallelogram_extra_bar_loads_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const parallelogram_extra_bar_loads_real s = report->inv_norm / sqrt((parallelogram_extra_bar_loads_real)PARALLELOGRAM_EXTRA_BAR_LOADS_NQ);
+    const parallelogram_extra_bar_loads_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const parallelogram_extra_bar_loads_real rounding = s * PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_sum_abs(const parallelogram_extra_bar_loads_real v[])
+{
+    parallelogram_extra_bar_loads_real sum = 0;
+    int i;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void parallelogram_extra_bar_loads_worst_column(const parallelogram_extra_bar_loads_lu *lu, parallelogram_extra_bar_loads_real y[])
+{
+    parallelogram_extra_bar_loads_real z[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], candidate[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, parallelogram_extra_bar_loads_uniform, sizeof z);
+    parallelogram_extra_bar_loads_lu_solve(lu, y);
+    norm = parallelogram_extra_bar_loads_sum_abs(y);
+    for (step = 0; step < PARALLELOGRAM_EXTRA_BAR_LOADS_ESTIMATOR_STEPS - 1; ++step) {
+        parallelogram_extra_bar_loads_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        parallelogram_extra_bar_loads_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / PARALLELOGRAM_EXTRA_BAR_LOADS_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        parallelogram_extra_bar_loads_lu_solve(lu, candidate);
+        candidate_norm = parallelogram_extra_bar_loads_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void parallelogram_extra_bar_loads_jacobian_times(const parallelogram_extra_bar_loads_real nz[], const parallelogram_extra_bar_loads_real v[], parallelogram_extra_bar_loads_real out[])
+{
+    int e;
+    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e) {
+        out[parallelogram_extra_bar_loads_phi_q_row[e]] += nz[e] * v[parallelogram_extra_bar_loads_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void parallelogram_extra_bar_loads_propagated(const parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_real size, parallelogram_extra_bar_loads_real nq,
+                                    const parallelogram_extra_bar_loads_real q[], const parallelogram_extra_bar_loads_real dq[], const parallelogram_extra_bar_loads_real ddq[],
+                                    parallelogram_extra_bar_loads_real t, const parallelogram_extra_bar_loads_real p[], parallelogram_extra_bar_loads_real errors[])
+{
+    parallelogram_extra_bar_loads_real direction[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], moved[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], rows[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];
+    parallelogram_extra_bar_loads_real shifted[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], nz[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ > 0 ? PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ : 1];
+    const parallelogram_extra_bar_loads_real step = sqrt(PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF) * (1 + nq);
+    parallelogram_extra_bar_loads_real largest;
+    int i;
+    parallelogram_extra_bar_loads_worst_column(&work->lu, direction);
+    largest = parallelogram_extra_bar_loads_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (parallelogram_extra_bar_loads_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    parallelogram_extra_bar_loads_from_unit(work, moved);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    parallelogram_extra_bar_loads_phi_q(moved, t, p, nz);
+    parallelogram_extra_bar_loads_phi_t(moved, t, p, rows);
+    parallelogram_extra_bar_loads_jacobian_times(nz, dq, rows);
+    parallelogram_extra_bar_loads_rows_in_unit(work, rows);
+    parallelogram_extra_bar_loads_lu_solve(&work->lu, rows);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = parallelogram_extra_bar_loads_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    parallelogram_extra_bar_loads_from_unit(work, shifted);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) shifted[i] += dq[i];
+    parallelogram_extra_bar_loads_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) shifted[i] = -ddq[i];
+    parallelogram_extra_bar_loads_jacobian_times(nz, shifted, rows);
+    parallelogram_extra_bar_loads_rows_in_unit(work, rows);
+    parallelogram_extra_bar_loads_lu_solve(&work->lu, rows);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) rows[i] *= size / step;
+    errors[1] = parallelogram_extra_bar_loads_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int parallelogram_extra_bar_loads_flagged_refined(const parallelogram_extra_bar_loads_options *options,
                                         const parallelogram_extra_bar_loads_workspace *work,
                                         const parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real nq,
-                                        parallelogram_extra_bar_loads_real ndq, parallelogram_extra_bar_loads_real nddq, const parallelogram_extra_bar_loads_real dq[],
-                                        const parallelogram_extra_bar_loads_real ddq[])
+                                        parallelogram_extra_bar_loads_real ndq, parallelogram_extra_bar_loads_real nddq, const parallelogram_extra_bar_loads_real q[],
+                                        const parallelogram_extra_bar_loads_real dq[], const parallelogram_extra_bar_loads_real ddq[], parallelogram_extra_bar_loads_real t,
+                                        const parallelogram_extra_bar_loads_real p[])
 {
+    static const parallelogram_extra_bar_loads_real zeros[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];
+    const parallelogram_extra_bar_loads_real s = report->inv_norm / sqrt((parallelogram_extra_bar_loads_real)PARALLELOGRAM_EXTRA_BAR_LOADS_NQ);
     const parallelogram_extra_bar_loads_real u = PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF;
-    const parallelogram_extra_bar_loads_real root = sqrt((parallelogram_extra_bar_loads_real)PARALLELOGRAM_EXTRA_BAR_LOADS_NQ);
-    const parallelogram_extra_bar_loads_real s = report->inv_norm / root;
-    const parallelogram_extra_bar_loads_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    parallelogram_extra_bar_loads_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    parallelogram_extra_bar_loads_real e_q, errors[2], e_dq, e_ddq;
     if (!parallelogram_extra_bar_loads_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = parallelogram_extra_bar_loads_inverse_norm1_rows(&work->lu, parallelogram_extra_bar_loads_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? parallelogram_extra_bar_loads_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? parallelogram_extra_bar_loads_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * parallelogram_extra_bar_loads_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * parallelogram_extra_bar_loads_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * parallelogram_extra_bar_loads_at_least_1(ndq_n));
-    return PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_q > options->target_q * parallelogram_extra_bar_loads_at_least_1(nq)
-        || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_dq > options->target_dq * parallelogram_extra_bar_loads_at_least_1(ndq)
-        || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq);
+    e_q = parallelogram_extra_bar_loads_position_error(work, report, nq);
+    parallelogram_extra_bar_loads_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * parallelogram_extra_bar_loads_at_least_1(nq)
+        || e_dq > options->target_dq * parallelogram_extra_bar_loads_at_least_1(ndq)
+        || e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -611,7 +693,8 @@ int parallelogram_extra_bar_loads_solve_step(const parallelogram_extra_bar_loads
     }
     report->flagged = parallelogram_extra_bar_loads_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (parallelogram_extra_bar_loads_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

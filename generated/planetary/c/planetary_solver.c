@@ -334,52 +334,134 @@ static int planetary_flagged(const planetary_options *options,
         || PLANETARY_SAFETY * e_ddq > options->target_ddq * planetary_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const planetary_real planetary_nonlinear[PLANETARY_NQ] = { 0, 0, 0, 0, 0, 1, 0, 0, 0 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static planetary_real planetary_nonlinear_max(const planetary_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static planetary_real planetary_position_error(const planetary_workspace *work,
+                                          const planetary_report *report, planetary_real nq)
 {
-    planetary_real largest = 0;
-    int i;
-    for (i = 0; i < PLANETARY_NQ; ++i) {
-        const planetary_real a = planetary_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const planetary_real s = report->inv_norm / sqrt((planetary_real)PLANETARY_NQ);
+    const planetary_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const planetary_real rounding = s * PLANETARY_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static planetary_real planetary_sum_abs(const planetary_real v[])
+{
+    planetary_real sum = 0;
+    int i;
+    for (i = 0; i < PLANETARY_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void planetary_worst_column(const planetary_lu *lu, planetary_real y[])
+{
+    planetary_real z[PLANETARY_NQ], candidate[PLANETARY_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, planetary_uniform, sizeof z);
+    planetary_lu_solve(lu, y);
+    norm = planetary_sum_abs(y);
+    for (step = 0; step < PLANETARY_ESTIMATOR_STEPS - 1; ++step) {
+        planetary_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < PLANETARY_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        planetary_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < PLANETARY_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / PLANETARY_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        planetary_lu_solve(lu, candidate);
+        candidate_norm = planetary_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void planetary_jacobian_times(const planetary_real nz[], const planetary_real v[], planetary_real out[])
+{
+    int e;
+    for (e = 0; e < PLANETARY_NNZ; ++e) {
+        out[planetary_phi_q_row[e]] += nz[e] * v[planetary_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void planetary_propagated(const planetary_workspace *work, planetary_real size, planetary_real nq,
+                                    const planetary_real q[], const planetary_real dq[], const planetary_real ddq[],
+                                    planetary_real t, const planetary_real p[], planetary_real errors[])
+{
+    planetary_real direction[PLANETARY_NQ], moved[PLANETARY_NQ], rows[PLANETARY_NQ];
+    planetary_real shifted[PLANETARY_NQ], nz[PLANETARY_NNZ > 0 ? PLANETARY_NNZ : 1];
+    const planetary_real step = sqrt(PLANETARY_UNIT_ROUNDOFF) * (1 + nq);
+    planetary_real largest;
+    int i;
+    planetary_worst_column(&work->lu, direction);
+    largest = planetary_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (planetary_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < PLANETARY_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    planetary_from_unit(work, moved);
+    for (i = 0; i < PLANETARY_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    planetary_phi_q(moved, t, p, nz);
+    planetary_phi_t(moved, t, p, rows);
+    planetary_jacobian_times(nz, dq, rows);
+    planetary_rows_in_unit(work, rows);
+    planetary_lu_solve(&work->lu, rows);
+    for (i = 0; i < PLANETARY_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = planetary_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < PLANETARY_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    planetary_from_unit(work, shifted);
+    for (i = 0; i < PLANETARY_NQ; ++i) shifted[i] += dq[i];
+    planetary_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < PLANETARY_NQ; ++i) shifted[i] = -ddq[i];
+    planetary_jacobian_times(nz, shifted, rows);
+    planetary_rows_in_unit(work, rows);
+    planetary_lu_solve(&work->lu, rows);
+    for (i = 0; i < PLANETARY_NQ; ++i) rows[i] *= size / step;
+    errors[1] = planetary_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int planetary_flagged_refined(const planetary_options *options,
                                         const planetary_workspace *work,
                                         const planetary_report *report, planetary_real nq,
-                                        planetary_real ndq, planetary_real nddq, const planetary_real dq[],
-                                        const planetary_real ddq[])
+                                        planetary_real ndq, planetary_real nddq, const planetary_real q[],
+                                        const planetary_real dq[], const planetary_real ddq[], planetary_real t,
+                                        const planetary_real p[])
 {
+    static const planetary_real zeros[PLANETARY_NQ];
+    const planetary_real s = report->inv_norm / sqrt((planetary_real)PLANETARY_NQ);
     const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
-    const planetary_real root = sqrt((planetary_real)PLANETARY_NQ);
-    const planetary_real s = report->inv_norm / root;
-    const planetary_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    planetary_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    planetary_real e_q, errors[2], e_dq, e_ddq;
     if (!planetary_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = planetary_inverse_norm1_rows(&work->lu, planetary_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? planetary_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? planetary_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * planetary_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * planetary_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * planetary_at_least_1(ndq_n));
-    return PLANETARY_SAFETY * e_q > options->target_q * planetary_at_least_1(nq)
-        || PLANETARY_SAFETY * e_dq > options->target_dq * planetary_at_least_1(ndq)
-        || PLANETARY_SAFETY * e_ddq > options->target_ddq * planetary_at_least_1(nddq);
+    e_q = planetary_position_error(work, report, nq);
+    planetary_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * planetary_at_least_1(nq)
+        || e_dq > options->target_dq * planetary_at_least_1(ndq)
+        || e_ddq > options->target_ddq * planetary_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -545,7 +627,8 @@ int planetary_solve_step(const planetary_options *options, const planetary_real 
     }
     report->flagged = planetary_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (planetary_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

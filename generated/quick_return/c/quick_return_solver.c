@@ -388,52 +388,134 @@ static int quick_return_flagged(const quick_return_options *options,
         || QUICK_RETURN_SAFETY * e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const quick_return_real quick_return_nonlinear[QUICK_RETURN_NQ] = { 1, 1, 1, 1, 1, 1, 0, 0, 1, 0, 0, 0 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static quick_return_real quick_return_nonlinear_max(const quick_return_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static quick_return_real quick_return_position_error(const quick_return_workspace *work,
+                                          const quick_return_report *report, quick_return_real nq)
 {
-    quick_return_real largest = 0;
-    int i;
-    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
-        const quick_return_real a = quick_return_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const quick_return_real s = report->inv_norm / sqrt((quick_return_real)QUICK_RETURN_NQ);
+    const quick_return_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const quick_return_real rounding = s * QUICK_RETURN_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static quick_return_real quick_return_sum_abs(const quick_return_real v[])
+{
+    quick_return_real sum = 0;
+    int i;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void quick_return_worst_column(const quick_return_lu *lu, quick_return_real y[])
+{
+    quick_return_real z[QUICK_RETURN_NQ], candidate[QUICK_RETURN_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, quick_return_uniform, sizeof z);
+    quick_return_lu_solve(lu, y);
+    norm = quick_return_sum_abs(y);
+    for (step = 0; step < QUICK_RETURN_ESTIMATOR_STEPS - 1; ++step) {
+        quick_return_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < QUICK_RETURN_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        quick_return_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < QUICK_RETURN_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / QUICK_RETURN_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        quick_return_lu_solve(lu, candidate);
+        candidate_norm = quick_return_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void quick_return_jacobian_times(const quick_return_real nz[], const quick_return_real v[], quick_return_real out[])
+{
+    int e;
+    for (e = 0; e < QUICK_RETURN_NNZ; ++e) {
+        out[quick_return_phi_q_row[e]] += nz[e] * v[quick_return_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void quick_return_propagated(const quick_return_workspace *work, quick_return_real size, quick_return_real nq,
+                                    const quick_return_real q[], const quick_return_real dq[], const quick_return_real ddq[],
+                                    quick_return_real t, const quick_return_real p[], quick_return_real errors[])
+{
+    quick_return_real direction[QUICK_RETURN_NQ], moved[QUICK_RETURN_NQ], rows[QUICK_RETURN_NQ];
+    quick_return_real shifted[QUICK_RETURN_NQ], nz[QUICK_RETURN_NNZ > 0 ? QUICK_RETURN_NNZ : 1];
+    const quick_return_real step = sqrt(QUICK_RETURN_UNIT_ROUNDOFF) * (1 + nq);
+    quick_return_real largest;
+    int i;
+    quick_return_worst_column(&work->lu, direction);
+    largest = quick_return_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (quick_return_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    quick_return_from_unit(work, moved);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    quick_return_phi_q(moved, t, p, nz);
+    quick_return_phi_t(moved, t, p, rows);
+    quick_return_jacobian_times(nz, dq, rows);
+    quick_return_rows_in_unit(work, rows);
+    quick_return_lu_solve(&work->lu, rows);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = quick_return_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    quick_return_from_unit(work, shifted);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) shifted[i] += dq[i];
+    quick_return_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) shifted[i] = -ddq[i];
+    quick_return_jacobian_times(nz, shifted, rows);
+    quick_return_rows_in_unit(work, rows);
+    quick_return_lu_solve(&work->lu, rows);
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) rows[i] *= size / step;
+    errors[1] = quick_return_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int quick_return_flagged_refined(const quick_return_options *options,
                                         const quick_return_workspace *work,
                                         const quick_return_report *report, quick_return_real nq,
-                                        quick_return_real ndq, quick_return_real nddq, const quick_return_real dq[],
-                                        const quick_return_real ddq[])
+                                        quick_return_real ndq, quick_return_real nddq, const quick_return_real q[],
+                                        const quick_return_real dq[], const quick_return_real ddq[], quick_return_real t,
+                                        const quick_return_real p[])
 {
+    static const quick_return_real zeros[QUICK_RETURN_NQ];
+    const quick_return_real s = report->inv_norm / sqrt((quick_return_real)QUICK_RETURN_NQ);
     const quick_return_real u = QUICK_RETURN_UNIT_ROUNDOFF;
-    const quick_return_real root = sqrt((quick_return_real)QUICK_RETURN_NQ);
-    const quick_return_real s = report->inv_norm / root;
-    const quick_return_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    quick_return_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    quick_return_real e_q, errors[2], e_dq, e_ddq;
     if (!quick_return_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = quick_return_inverse_norm1_rows(&work->lu, quick_return_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? quick_return_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? quick_return_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * quick_return_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * quick_return_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * quick_return_at_least_1(ndq_n));
-    return QUICK_RETURN_SAFETY * e_q > options->target_q * quick_return_at_least_1(nq)
-        || QUICK_RETURN_SAFETY * e_dq > options->target_dq * quick_return_at_least_1(ndq)
-        || QUICK_RETURN_SAFETY * e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
+    e_q = quick_return_position_error(work, report, nq);
+    quick_return_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * quick_return_at_least_1(nq)
+        || e_dq > options->target_dq * quick_return_at_least_1(ndq)
+        || e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -599,7 +681,8 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
     }
     report->flagged = quick_return_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (quick_return_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

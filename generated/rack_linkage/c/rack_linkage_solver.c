@@ -415,52 +415,134 @@ static int rack_linkage_flagged(const rack_linkage_options *options,
         || RACK_LINKAGE_SAFETY * e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const rack_linkage_real rack_linkage_nonlinear[RACK_LINKAGE_NQ] = { 1, 1, 0, 1, 1, 1, 0, 0, 1, 0, 0, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static rack_linkage_real rack_linkage_nonlinear_max(const rack_linkage_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static rack_linkage_real rack_linkage_position_error(const rack_linkage_workspace *work,
+                                          const rack_linkage_report *report, rack_linkage_real nq)
 {
-    rack_linkage_real largest = 0;
-    int i;
-    for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
-        const rack_linkage_real a = rack_linkage_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const rack_linkage_real s = report->inv_norm / sqrt((rack_linkage_real)RACK_LINKAGE_NQ);
+    const rack_linkage_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const rack_linkage_real rounding = s * RACK_LINKAGE_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static rack_linkage_real rack_linkage_sum_abs(const rack_linkage_real v[])
+{
+    rack_linkage_real sum = 0;
+    int i;
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void rack_linkage_worst_column(const rack_linkage_lu *lu, rack_linkage_real y[])
+{
+    rack_linkage_real z[RACK_LINKAGE_NQ], candidate[RACK_LINKAGE_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, rack_linkage_uniform, sizeof z);
+    rack_linkage_lu_solve(lu, y);
+    norm = rack_linkage_sum_abs(y);
+    for (step = 0; step < RACK_LINKAGE_ESTIMATOR_STEPS - 1; ++step) {
+        rack_linkage_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < RACK_LINKAGE_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        rack_linkage_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < RACK_LINKAGE_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / RACK_LINKAGE_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        rack_linkage_lu_solve(lu, candidate);
+        candidate_norm = rack_linkage_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void rack_linkage_jacobian_times(const rack_linkage_real nz[], const rack_linkage_real v[], rack_linkage_real out[])
+{
+    int e;
+    for (e = 0; e < RACK_LINKAGE_NNZ; ++e) {
+        out[rack_linkage_phi_q_row[e]] += nz[e] * v[rack_linkage_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void rack_linkage_propagated(const rack_linkage_workspace *work, rack_linkage_real size, rack_linkage_real nq,
+                                    const rack_linkage_real q[], const rack_linkage_real dq[], const rack_linkage_real ddq[],
+                                    rack_linkage_real t, const rack_linkage_real p[], rack_linkage_real errors[])
+{
+    rack_linkage_real direction[RACK_LINKAGE_NQ], moved[RACK_LINKAGE_NQ], rows[RACK_LINKAGE_NQ];
+    rack_linkage_real shifted[RACK_LINKAGE_NQ], nz[RACK_LINKAGE_NNZ > 0 ? RACK_LINKAGE_NNZ : 1];
+    const rack_linkage_real step = sqrt(RACK_LINKAGE_UNIT_ROUNDOFF) * (1 + nq);
+    rack_linkage_real largest;
+    int i;
+    rack_linkage_worst_column(&work->lu, direction);
+    largest = rack_linkage_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (rack_linkage_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    rack_linkage_from_unit(work, moved);
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    rack_linkage_phi_q(moved, t, p, nz);
+    rack_linkage_phi_t(moved, t, p, rows);
+    rack_linkage_jacobian_times(nz, dq, rows);
+    rack_linkage_rows_in_unit(work, rows);
+    rack_linkage_lu_solve(&work->lu, rows);
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = rack_linkage_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    rack_linkage_from_unit(work, shifted);
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) shifted[i] += dq[i];
+    rack_linkage_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) shifted[i] = -ddq[i];
+    rack_linkage_jacobian_times(nz, shifted, rows);
+    rack_linkage_rows_in_unit(work, rows);
+    rack_linkage_lu_solve(&work->lu, rows);
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) rows[i] *= size / step;
+    errors[1] = rack_linkage_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int rack_linkage_flagged_refined(const rack_linkage_options *options,
                                         const rack_linkage_workspace *work,
                                         const rack_linkage_report *report, rack_linkage_real nq,
-                                        rack_linkage_real ndq, rack_linkage_real nddq, const rack_linkage_real dq[],
-                                        const rack_linkage_real ddq[])
+                                        rack_linkage_real ndq, rack_linkage_real nddq, const rack_linkage_real q[],
+                                        const rack_linkage_real dq[], const rack_linkage_real ddq[], rack_linkage_real t,
+                                        const rack_linkage_real p[])
 {
+    static const rack_linkage_real zeros[RACK_LINKAGE_NQ];
+    const rack_linkage_real s = report->inv_norm / sqrt((rack_linkage_real)RACK_LINKAGE_NQ);
     const rack_linkage_real u = RACK_LINKAGE_UNIT_ROUNDOFF;
-    const rack_linkage_real root = sqrt((rack_linkage_real)RACK_LINKAGE_NQ);
-    const rack_linkage_real s = report->inv_norm / root;
-    const rack_linkage_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    rack_linkage_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    rack_linkage_real e_q, errors[2], e_dq, e_ddq;
     if (!rack_linkage_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = rack_linkage_inverse_norm1_rows(&work->lu, rack_linkage_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? rack_linkage_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? rack_linkage_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * rack_linkage_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * rack_linkage_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * rack_linkage_at_least_1(ndq_n));
-    return RACK_LINKAGE_SAFETY * e_q > options->target_q * rack_linkage_at_least_1(nq)
-        || RACK_LINKAGE_SAFETY * e_dq > options->target_dq * rack_linkage_at_least_1(ndq)
-        || RACK_LINKAGE_SAFETY * e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq);
+    e_q = rack_linkage_position_error(work, report, nq);
+    rack_linkage_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * rack_linkage_at_least_1(nq)
+        || e_dq > options->target_dq * rack_linkage_at_least_1(ndq)
+        || e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -626,7 +708,8 @@ int rack_linkage_solve_step(const rack_linkage_options *options, const rack_link
     }
     report->flagged = rack_linkage_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (rack_linkage_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

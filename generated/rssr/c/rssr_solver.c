@@ -670,52 +670,134 @@ static int rssr_flagged(const rssr_options *options,
         || RSSR_SAFETY * e_ddq > options->target_ddq * rssr_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const rssr_real rssr_nonlinear[RSSR_NQ] = { 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static rssr_real rssr_nonlinear_max(const rssr_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static rssr_real rssr_position_error(const rssr_workspace *work,
+                                          const rssr_report *report, rssr_real nq)
 {
-    rssr_real largest = 0;
-    int i;
-    for (i = 0; i < RSSR_NQ; ++i) {
-        const rssr_real a = rssr_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const rssr_real s = report->inv_norm / sqrt((rssr_real)RSSR_NQ);
+    const rssr_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const rssr_real rounding = s * RSSR_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static rssr_real rssr_sum_abs(const rssr_real v[])
+{
+    rssr_real sum = 0;
+    int i;
+    for (i = 0; i < RSSR_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void rssr_worst_column(const rssr_lu *lu, rssr_real y[])
+{
+    rssr_real z[RSSR_NQ], candidate[RSSR_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, rssr_uniform, sizeof z);
+    rssr_lu_solve(lu, y);
+    norm = rssr_sum_abs(y);
+    for (step = 0; step < RSSR_ESTIMATOR_STEPS - 1; ++step) {
+        rssr_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < RSSR_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        rssr_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < RSSR_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / RSSR_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        rssr_lu_solve(lu, candidate);
+        candidate_norm = rssr_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void rssr_jacobian_times(const rssr_real nz[], const rssr_real v[], rssr_real out[])
+{
+    int e;
+    for (e = 0; e < RSSR_NNZ; ++e) {
+        out[rssr_phi_q_row[e]] += nz[e] * v[rssr_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void rssr_propagated(const rssr_workspace *work, rssr_real size, rssr_real nq,
+                                    const rssr_real q[], const rssr_real dq[], const rssr_real ddq[],
+                                    rssr_real t, const rssr_real p[], rssr_real errors[])
+{
+    rssr_real direction[RSSR_NQ], moved[RSSR_NQ], rows[RSSR_NQ];
+    rssr_real shifted[RSSR_NQ], nz[RSSR_NNZ > 0 ? RSSR_NNZ : 1];
+    const rssr_real step = sqrt(RSSR_UNIT_ROUNDOFF) * (1 + nq);
+    rssr_real largest;
+    int i;
+    rssr_worst_column(&work->lu, direction);
+    largest = rssr_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (rssr_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < RSSR_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    rssr_from_unit(work, moved);
+    for (i = 0; i < RSSR_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    rssr_phi_q(moved, t, p, nz);
+    rssr_phi_t(moved, t, p, rows);
+    rssr_jacobian_times(nz, dq, rows);
+    rssr_rows_in_unit(work, rows);
+    rssr_lu_solve(&work->lu, rows);
+    for (i = 0; i < RSSR_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = rssr_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < RSSR_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    rssr_from_unit(work, shifted);
+    for (i = 0; i < RSSR_NQ; ++i) shifted[i] += dq[i];
+    rssr_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < RSSR_NQ; ++i) shifted[i] = -ddq[i];
+    rssr_jacobian_times(nz, shifted, rows);
+    rssr_rows_in_unit(work, rows);
+    rssr_lu_solve(&work->lu, rows);
+    for (i = 0; i < RSSR_NQ; ++i) rows[i] *= size / step;
+    errors[1] = rssr_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int rssr_flagged_refined(const rssr_options *options,
                                         const rssr_workspace *work,
                                         const rssr_report *report, rssr_real nq,
-                                        rssr_real ndq, rssr_real nddq, const rssr_real dq[],
-                                        const rssr_real ddq[])
+                                        rssr_real ndq, rssr_real nddq, const rssr_real q[],
+                                        const rssr_real dq[], const rssr_real ddq[], rssr_real t,
+                                        const rssr_real p[])
 {
+    static const rssr_real zeros[RSSR_NQ];
+    const rssr_real s = report->inv_norm / sqrt((rssr_real)RSSR_NQ);
     const rssr_real u = RSSR_UNIT_ROUNDOFF;
-    const rssr_real root = sqrt((rssr_real)RSSR_NQ);
-    const rssr_real s = report->inv_norm / root;
-    const rssr_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    rssr_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    rssr_real e_q, errors[2], e_dq, e_ddq;
     if (!rssr_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = rssr_inverse_norm1_rows(&work->lu, rssr_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? rssr_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? rssr_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * rssr_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * rssr_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * rssr_at_least_1(ndq_n));
-    return RSSR_SAFETY * e_q > options->target_q * rssr_at_least_1(nq)
-        || RSSR_SAFETY * e_dq > options->target_dq * rssr_at_least_1(ndq)
-        || RSSR_SAFETY * e_ddq > options->target_ddq * rssr_at_least_1(nddq);
+    e_q = rssr_position_error(work, report, nq);
+    rssr_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * rssr_at_least_1(nq)
+        || e_dq > options->target_dq * rssr_at_least_1(ndq)
+        || e_ddq > options->target_ddq * rssr_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -881,7 +963,8 @@ int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real 
     }
     report->flagged = rssr_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (rssr_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

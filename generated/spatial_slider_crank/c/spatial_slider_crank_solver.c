@@ -327,52 +327,134 @@ static int spatial_slider_crank_flagged(const spatial_slider_crank_options *opti
         || SPATIAL_SLIDER_CRANK_SAFETY * e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const spatial_slider_crank_real spatial_slider_crank_nonlinear[SPATIAL_SLIDER_CRANK_NQ] = { 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static spatial_slider_crank_real spatial_slider_crank_nonlinear_max(const spatial_slider_crank_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static spatial_slider_crank_real spatial_slider_crank_position_error(const spatial_slider_crank_workspace *work,
+                                          const spatial_slider_crank_report *report, spatial_slider_crank_real nq)
 {
-    spatial_slider_crank_real largest = 0;
-    int i;
-    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        const spatial_slider_crank_real a = spatial_slider_crank_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const spatial_slider_crank_real s = report->inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
+    const spatial_slider_crank_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const spatial_slider_crank_real rounding = s * SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static spatial_slider_crank_real spatial_slider_crank_sum_abs(const spatial_slider_crank_real v[])
+{
+    spatial_slider_crank_real sum = 0;
+    int i;
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void spatial_slider_crank_worst_column(const spatial_slider_crank_lu *lu, spatial_slider_crank_real y[])
+{
+    spatial_slider_crank_real z[SPATIAL_SLIDER_CRANK_NQ], candidate[SPATIAL_SLIDER_CRANK_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, spatial_slider_crank_uniform, sizeof z);
+    spatial_slider_crank_lu_solve(lu, y);
+    norm = spatial_slider_crank_sum_abs(y);
+    for (step = 0; step < SPATIAL_SLIDER_CRANK_ESTIMATOR_STEPS - 1; ++step) {
+        spatial_slider_crank_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        spatial_slider_crank_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / SPATIAL_SLIDER_CRANK_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        spatial_slider_crank_lu_solve(lu, candidate);
+        candidate_norm = spatial_slider_crank_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void spatial_slider_crank_jacobian_times(const spatial_slider_crank_real nz[], const spatial_slider_crank_real v[], spatial_slider_crank_real out[])
+{
+    int e;
+    for (e = 0; e < SPATIAL_SLIDER_CRANK_NNZ; ++e) {
+        out[spatial_slider_crank_phi_q_row[e]] += nz[e] * v[spatial_slider_crank_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void spatial_slider_crank_propagated(const spatial_slider_crank_workspace *work, spatial_slider_crank_real size, spatial_slider_crank_real nq,
+                                    const spatial_slider_crank_real q[], const spatial_slider_crank_real dq[], const spatial_slider_crank_real ddq[],
+                                    spatial_slider_crank_real t, const spatial_slider_crank_real p[], spatial_slider_crank_real errors[])
+{
+    spatial_slider_crank_real direction[SPATIAL_SLIDER_CRANK_NQ], moved[SPATIAL_SLIDER_CRANK_NQ], rows[SPATIAL_SLIDER_CRANK_NQ];
+    spatial_slider_crank_real shifted[SPATIAL_SLIDER_CRANK_NQ], nz[SPATIAL_SLIDER_CRANK_NNZ > 0 ? SPATIAL_SLIDER_CRANK_NNZ : 1];
+    const spatial_slider_crank_real step = sqrt(SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF) * (1 + nq);
+    spatial_slider_crank_real largest;
+    int i;
+    spatial_slider_crank_worst_column(&work->lu, direction);
+    largest = spatial_slider_crank_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (spatial_slider_crank_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    spatial_slider_crank_from_unit(work, moved);
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    spatial_slider_crank_phi_q(moved, t, p, nz);
+    spatial_slider_crank_phi_t(moved, t, p, rows);
+    spatial_slider_crank_jacobian_times(nz, dq, rows);
+    spatial_slider_crank_rows_in_unit(work, rows);
+    spatial_slider_crank_lu_solve(&work->lu, rows);
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = spatial_slider_crank_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    spatial_slider_crank_from_unit(work, shifted);
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) shifted[i] += dq[i];
+    spatial_slider_crank_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) shifted[i] = -ddq[i];
+    spatial_slider_crank_jacobian_times(nz, shifted, rows);
+    spatial_slider_crank_rows_in_unit(work, rows);
+    spatial_slider_crank_lu_solve(&work->lu, rows);
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) rows[i] *= size / step;
+    errors[1] = spatial_slider_crank_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int spatial_slider_crank_flagged_refined(const spatial_slider_crank_options *options,
                                         const spatial_slider_crank_workspace *work,
                                         const spatial_slider_crank_report *report, spatial_slider_crank_real nq,
-                                        spatial_slider_crank_real ndq, spatial_slider_crank_real nddq, const spatial_slider_crank_real dq[],
-                                        const spatial_slider_crank_real ddq[])
+                                        spatial_slider_crank_real ndq, spatial_slider_crank_real nddq, const spatial_slider_crank_real q[],
+                                        const spatial_slider_crank_real dq[], const spatial_slider_crank_real ddq[], spatial_slider_crank_real t,
+                                        const spatial_slider_crank_real p[])
 {
+    static const spatial_slider_crank_real zeros[SPATIAL_SLIDER_CRANK_NQ];
+    const spatial_slider_crank_real s = report->inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
     const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
-    const spatial_slider_crank_real root = sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
-    const spatial_slider_crank_real s = report->inv_norm / root;
-    const spatial_slider_crank_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    spatial_slider_crank_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    spatial_slider_crank_real e_q, errors[2], e_dq, e_ddq;
     if (!spatial_slider_crank_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = spatial_slider_crank_inverse_norm1_rows(&work->lu, spatial_slider_crank_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? spatial_slider_crank_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? spatial_slider_crank_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * spatial_slider_crank_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * spatial_slider_crank_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * spatial_slider_crank_at_least_1(ndq_n));
-    return SPATIAL_SLIDER_CRANK_SAFETY * e_q > options->target_q * spatial_slider_crank_at_least_1(nq)
-        || SPATIAL_SLIDER_CRANK_SAFETY * e_dq > options->target_dq * spatial_slider_crank_at_least_1(ndq)
-        || SPATIAL_SLIDER_CRANK_SAFETY * e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq);
+    e_q = spatial_slider_crank_position_error(work, report, nq);
+    spatial_slider_crank_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * spatial_slider_crank_at_least_1(nq)
+        || e_dq > options->target_dq * spatial_slider_crank_at_least_1(ndq)
+        || e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -538,7 +620,8 @@ int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options,
     }
     report->flagged = spatial_slider_crank_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (spatial_slider_crank_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -567,52 +567,134 @@ static int three_rrr_fk_flagged(const three_rrr_fk_options *options,
         || THREE_RRR_FK_SAFETY * e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const three_rrr_fk_real three_rrr_fk_nonlinear[THREE_RRR_FK_NQ] = { 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static three_rrr_fk_real three_rrr_fk_nonlinear_max(const three_rrr_fk_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static three_rrr_fk_real three_rrr_fk_position_error(const three_rrr_fk_workspace *work,
+                                          const three_rrr_fk_report *report, three_rrr_fk_real nq)
 {
-    three_rrr_fk_real largest = 0;
-    int i;
-    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
-        const three_rrr_fk_real a = three_rrr_fk_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const three_rrr_fk_real s = report->inv_norm / sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
+    const three_rrr_fk_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const three_rrr_fk_real rounding = s * THREE_RRR_FK_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static three_rrr_fk_real three_rrr_fk_sum_abs(const three_rrr_fk_real v[])
+{
+    three_rrr_fk_real sum = 0;
+    int i;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void three_rrr_fk_worst_column(const three_rrr_fk_lu *lu, three_rrr_fk_real y[])
+{
+    three_rrr_fk_real z[THREE_RRR_FK_NQ], candidate[THREE_RRR_FK_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, three_rrr_fk_uniform, sizeof z);
+    three_rrr_fk_lu_solve(lu, y);
+    norm = three_rrr_fk_sum_abs(y);
+    for (step = 0; step < THREE_RRR_FK_ESTIMATOR_STEPS - 1; ++step) {
+        three_rrr_fk_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < THREE_RRR_FK_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        three_rrr_fk_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < THREE_RRR_FK_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / THREE_RRR_FK_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        three_rrr_fk_lu_solve(lu, candidate);
+        candidate_norm = three_rrr_fk_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void three_rrr_fk_jacobian_times(const three_rrr_fk_real nz[], const three_rrr_fk_real v[], three_rrr_fk_real out[])
+{
+    int e;
+    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) {
+        out[three_rrr_fk_phi_q_row[e]] += nz[e] * v[three_rrr_fk_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void three_rrr_fk_propagated(const three_rrr_fk_workspace *work, three_rrr_fk_real size, three_rrr_fk_real nq,
+                                    const three_rrr_fk_real q[], const three_rrr_fk_real dq[], const three_rrr_fk_real ddq[],
+                                    three_rrr_fk_real t, const three_rrr_fk_real p[], three_rrr_fk_real errors[])
+{
+    three_rrr_fk_real direction[THREE_RRR_FK_NQ], moved[THREE_RRR_FK_NQ], rows[THREE_RRR_FK_NQ];
+    three_rrr_fk_real shifted[THREE_RRR_FK_NQ], nz[THREE_RRR_FK_NNZ > 0 ? THREE_RRR_FK_NNZ : 1];
+    const three_rrr_fk_real step = sqrt(THREE_RRR_FK_UNIT_ROUNDOFF) * (1 + nq);
+    three_rrr_fk_real largest;
+    int i;
+    three_rrr_fk_worst_column(&work->lu, direction);
+    largest = three_rrr_fk_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (three_rrr_fk_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    three_rrr_fk_from_unit(work, moved);
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    three_rrr_fk_phi_q(moved, t, p, nz);
+    three_rrr_fk_phi_t(moved, t, p, rows);
+    three_rrr_fk_jacobian_times(nz, dq, rows);
+    three_rrr_fk_rows_in_unit(work, rows);
+    three_rrr_fk_lu_solve(&work->lu, rows);
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = three_rrr_fk_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    three_rrr_fk_from_unit(work, shifted);
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) shifted[i] += dq[i];
+    three_rrr_fk_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) shifted[i] = -ddq[i];
+    three_rrr_fk_jacobian_times(nz, shifted, rows);
+    three_rrr_fk_rows_in_unit(work, rows);
+    three_rrr_fk_lu_solve(&work->lu, rows);
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) rows[i] *= size / step;
+    errors[1] = three_rrr_fk_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int three_rrr_fk_flagged_refined(const three_rrr_fk_options *options,
                                         const three_rrr_fk_workspace *work,
                                         const three_rrr_fk_report *report, three_rrr_fk_real nq,
-                                        three_rrr_fk_real ndq, three_rrr_fk_real nddq, const three_rrr_fk_real dq[],
-                                        const three_rrr_fk_real ddq[])
+                                        three_rrr_fk_real ndq, three_rrr_fk_real nddq, const three_rrr_fk_real q[],
+                                        const three_rrr_fk_real dq[], const three_rrr_fk_real ddq[], three_rrr_fk_real t,
+                                        const three_rrr_fk_real p[])
 {
+    static const three_rrr_fk_real zeros[THREE_RRR_FK_NQ];
+    const three_rrr_fk_real s = report->inv_norm / sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
     const three_rrr_fk_real u = THREE_RRR_FK_UNIT_ROUNDOFF;
-    const three_rrr_fk_real root = sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
-    const three_rrr_fk_real s = report->inv_norm / root;
-    const three_rrr_fk_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    three_rrr_fk_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    three_rrr_fk_real e_q, errors[2], e_dq, e_ddq;
     if (!three_rrr_fk_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = three_rrr_fk_inverse_norm1_rows(&work->lu, three_rrr_fk_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? three_rrr_fk_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? three_rrr_fk_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * three_rrr_fk_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * three_rrr_fk_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * three_rrr_fk_at_least_1(ndq_n));
-    return THREE_RRR_FK_SAFETY * e_q > options->target_q * three_rrr_fk_at_least_1(nq)
-        || THREE_RRR_FK_SAFETY * e_dq > options->target_dq * three_rrr_fk_at_least_1(ndq)
-        || THREE_RRR_FK_SAFETY * e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq);
+    e_q = three_rrr_fk_position_error(work, report, nq);
+    three_rrr_fk_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * three_rrr_fk_at_least_1(nq)
+        || e_dq > options->target_dq * three_rrr_fk_at_least_1(ndq)
+        || e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -778,7 +860,8 @@ int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr
     }
     report->flagged = three_rrr_fk_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (three_rrr_fk_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -853,8 +936,10 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
         if (!accelerations) state->ddq[i] = (three_rrr_fk_real)NAN;
     }
     report->flagged = three_rrr_fk_flagged_refined(options, work, report, nq, ndq, nddq,
+                                                   state->q,
                                                    rates ? state->dq : NULL,
-                                                   accelerations ? state->ddq : NULL);
+                                                   accelerations ? state->ddq : NULL,
+                                                   state->t, pu);
     work->norms[0] = nq;
     work->norms[1] = ndq;
     work->norms[2] = nddq;

@@ -388,52 +388,134 @@ static int whitworth_drawn_flagged(const whitworth_drawn_options *options,
         || WHITWORTH_DRAWN_SAFETY * e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq);
 }
 
-/* The coordinates that enter Phi_q or Phi_t (1, else 0): only their errors move Phi_q. */
-static const whitworth_drawn_real whitworth_drawn_nonlinear[WHITWORTH_DRAWN_NQ] = { 1, 1, 1, 1, 1, 1, 0, 0, 1, 0, 0, 0 };
-
-/* max |v_k| over the coordinates that enter Phi_q or Phi_t. */
-static whitworth_drawn_real whitworth_drawn_nonlinear_max(const whitworth_drawn_real v[])
+/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+ * correction where it was solved for), or the rounding of Phi. */
+static whitworth_drawn_real whitworth_drawn_position_error(const whitworth_drawn_workspace *work,
+                                          const whitworth_drawn_report *report, whitworth_drawn_real nq)
 {
-    whitworth_drawn_real largest = 0;
-    int i;
-    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
-        const whitworth_drawn_real a = whitworth_drawn_nonlinear[i] != 0 ? fabs(v[i]) : 0;
-        largest = a > largest ? a : largest;
-    }
-    return largest;
+    const whitworth_drawn_real s = report->inv_norm / sqrt((whitworth_drawn_real)WHITWORTH_DRAWN_NQ);
+    const whitworth_drawn_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const whitworth_drawn_real rounding = s * WHITWORTH_DRAWN_UNIT_ROUNDOFF * (1 + nq);
+    return left > rounding ? left : rounding;
 }
 
-/* The refined model of runtime.accuracy: where the model of every coordinate flags the
- * point, the error e_n of the coordinates that enter Phi_q or Phi_t (from ||P Phi_q^-1||_1,
- * P their rows) and their velocities and accelerations carry the error of q into dq and
- * ddq; the point is flagged when that model flags it too. dq, ddq: NULL where not solved
- * for (their norms over every coordinate stand in). */
+/* sum |v_i| (NaN when some v_i is). */
+static whitworth_drawn_real whitworth_drawn_sum_abs(const whitworth_drawn_real v[])
+{
+    whitworth_drawn_real sum = 0;
+    int i;
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) sum += fabs(v[i]);
+    return sum;
+}
+
+/* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
+ * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+static void whitworth_drawn_worst_column(const whitworth_drawn_lu *lu, whitworth_drawn_real y[])
+{
+    whitworth_drawn_real z[WHITWORTH_DRAWN_NQ], candidate[WHITWORTH_DRAWN_NQ], norm, candidate_norm;
+    int i, j, at = -1, step;
+    memcpy(y, whitworth_drawn_uniform, sizeof z);
+    whitworth_drawn_lu_solve(lu, y);
+    norm = whitworth_drawn_sum_abs(y);
+    for (step = 0; step < WHITWORTH_DRAWN_ESTIMATOR_STEPS - 1; ++step) {
+        whitworth_drawn_real along = 0, best;
+        if (norm - norm != 0) break;
+        for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) z[i] = y[i] >= 0 ? 1 : -1;
+        whitworth_drawn_lu_solve_transposed(lu, z);
+        for (i = 0, j = 0, best = fabs(z[0]); i < WHITWORTH_DRAWN_NQ; ++i) {
+            if (fabs(z[i]) > best) { best = fabs(z[i]); j = i; }
+            along += z[i];
+        }
+        along = at < 0 ? along / WHITWORTH_DRAWN_NQ : z[at]; /* z . x */
+        if (!(best > along)) break;
+        memset(candidate, 0, sizeof candidate);
+        candidate[j] = 1;
+        whitworth_drawn_lu_solve(lu, candidate);
+        candidate_norm = whitworth_drawn_sum_abs(candidate);
+        if (!(candidate_norm > norm)) break;
+        memcpy(y, candidate, sizeof z);
+        norm = candidate_norm;
+        at = j;
+    }
+}
+
+/* out = Phi_q(q) v from the non-zeros nz (kernel units). */
+static void whitworth_drawn_jacobian_times(const whitworth_drawn_real nz[], const whitworth_drawn_real v[], whitworth_drawn_real out[])
+{
+    int e;
+    for (e = 0; e < WHITWORTH_DRAWN_NNZ; ++e) {
+        out[whitworth_drawn_phi_q_row[e]] += nz[e] * v[whitworth_drawn_phi_q_col[e]];
+    }
+}
+
+/* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
+ * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
+static void whitworth_drawn_propagated(const whitworth_drawn_workspace *work, whitworth_drawn_real size, whitworth_drawn_real nq,
+                                    const whitworth_drawn_real q[], const whitworth_drawn_real dq[], const whitworth_drawn_real ddq[],
+                                    whitworth_drawn_real t, const whitworth_drawn_real p[], whitworth_drawn_real errors[])
+{
+    whitworth_drawn_real direction[WHITWORTH_DRAWN_NQ], moved[WHITWORTH_DRAWN_NQ], rows[WHITWORTH_DRAWN_NQ];
+    whitworth_drawn_real shifted[WHITWORTH_DRAWN_NQ], nz[WHITWORTH_DRAWN_NNZ > 0 ? WHITWORTH_DRAWN_NNZ : 1];
+    const whitworth_drawn_real step = sqrt(WHITWORTH_DRAWN_UNIT_ROUNDOFF) * (1 + nq);
+    whitworth_drawn_real largest;
+    int i;
+    whitworth_drawn_worst_column(&work->lu, direction);
+    largest = whitworth_drawn_max_abs(direction);
+    errors[0] = errors[1] = 0;
+    if (largest == 0 || size == 0) return;
+    if (!(largest - largest == 0 && size > 0)) {
+        errors[0] = errors[1] = (whitworth_drawn_real)INFINITY;
+        return;
+    }
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) moved[i] = direction[i] * (step / largest);
+    whitworth_drawn_from_unit(work, moved);
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) moved[i] += q[i];
+    /* velocity rows: Phi_q(q + d) dq + Phi_t(q + d) */
+    whitworth_drawn_phi_q(moved, t, p, nz);
+    whitworth_drawn_phi_t(moved, t, p, rows);
+    whitworth_drawn_jacobian_times(nz, dq, rows);
+    whitworth_drawn_rows_in_unit(work, rows);
+    whitworth_drawn_lu_solve(&work->lu, rows);
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) rows[i] *= -size / step;
+    errors[0] = whitworth_drawn_max_abs(rows);
+    /* acceleration rows: Gamma(q + d, dq + d_dq step / size) - Phi_q(q + d) ddq */
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) shifted[i] = rows[i] * (step / size);
+    whitworth_drawn_from_unit(work, shifted);
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) shifted[i] += dq[i];
+    whitworth_drawn_gamma(moved, shifted, t, p, rows);
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) shifted[i] = -ddq[i];
+    whitworth_drawn_jacobian_times(nz, shifted, rows);
+    whitworth_drawn_rows_in_unit(work, rows);
+    whitworth_drawn_lu_solve(&work->lu, rows);
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) rows[i] *= size / step;
+    errors[1] = whitworth_drawn_max_abs(rows);
+}
+
+/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+ * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
+ * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
+ * dq, ddq: NULL where not solved for (zero). */
 static int whitworth_drawn_flagged_refined(const whitworth_drawn_options *options,
                                         const whitworth_drawn_workspace *work,
                                         const whitworth_drawn_report *report, whitworth_drawn_real nq,
-                                        whitworth_drawn_real ndq, whitworth_drawn_real nddq, const whitworth_drawn_real dq[],
-                                        const whitworth_drawn_real ddq[])
+                                        whitworth_drawn_real ndq, whitworth_drawn_real nddq, const whitworth_drawn_real q[],
+                                        const whitworth_drawn_real dq[], const whitworth_drawn_real ddq[], whitworth_drawn_real t,
+                                        const whitworth_drawn_real p[])
 {
+    static const whitworth_drawn_real zeros[WHITWORTH_DRAWN_NQ];
+    const whitworth_drawn_real s = report->inv_norm / sqrt((whitworth_drawn_real)WHITWORTH_DRAWN_NQ);
     const whitworth_drawn_real u = WHITWORTH_DRAWN_UNIT_ROUNDOFF;
-    const whitworth_drawn_real root = sqrt((whitworth_drawn_real)WHITWORTH_DRAWN_NQ);
-    const whitworth_drawn_real s = report->inv_norm / root;
-    const whitworth_drawn_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    whitworth_drawn_real s_n, ndq_n, nddq_n, e_q, e_n, e_dq, e_dq_n, e_ddq, bound;
+    whitworth_drawn_real e_q, errors[2], e_dq, e_ddq;
     if (!whitworth_drawn_flagged(options, work, report, nq, ndq, nddq)) return 0;
-    s_n = whitworth_drawn_inverse_norm1_rows(&work->lu, whitworth_drawn_nonlinear) / root;
-    if (s_n - s_n != 0) return 1;
-    ndq_n = dq ? whitworth_drawn_nonlinear_max(dq) : ndq;
-    nddq_n = ddq ? whitworth_drawn_nonlinear_max(ddq) : nddq;
-    e_q = left > s * u * (1 + nq) ? left : s * u * (1 + nq);
-    bound = left < s_n * report->residual ? left : s_n * report->residual;
-    e_n = bound > s_n * u * (1 + nq) ? bound : s_n * u * (1 + nq);
-    e_dq = s * (u * ndq + e_n * whitworth_drawn_at_least_1(ndq_n));
-    e_dq_n = s_n * (u * ndq + e_n * whitworth_drawn_at_least_1(ndq_n));
-    e_ddq = s * (u * nddq + e_n * (nddq_n + ndq_n * ndq_n)
-                 + 2 * e_dq_n * whitworth_drawn_at_least_1(ndq_n));
-    return WHITWORTH_DRAWN_SAFETY * e_q > options->target_q * whitworth_drawn_at_least_1(nq)
-        || WHITWORTH_DRAWN_SAFETY * e_dq > options->target_dq * whitworth_drawn_at_least_1(ndq)
-        || WHITWORTH_DRAWN_SAFETY * e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq);
+    e_q = whitworth_drawn_position_error(work, report, nq);
+    whitworth_drawn_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
+    e_dq = errors[0] + s * u * ndq;
+    e_ddq = errors[1] + s * u * nddq;
+    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
+    return e_q > options->target_q * whitworth_drawn_at_least_1(nq)
+        || e_dq > options->target_dq * whitworth_drawn_at_least_1(ndq)
+        || e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -599,7 +681,8 @@ int whitworth_drawn_solve_step(const whitworth_drawn_options *options, const whi
     }
     report->flagged = whitworth_drawn_flagged_refined(options, work, report,
                                                    sum_q != sum_q ? (whitworth_drawn_real)NAN : nq, ndq,
-                                                   nddq, state->dq, state->ddq);
+                                                   nddq, state->q, state->dq, state->ddq,
+                                                   t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
