@@ -20,7 +20,6 @@ Imports NumPy only: part of the runtime.
 from __future__ import annotations
 
 import functools
-
 import math
 from dataclasses import dataclass
 

@@ -54,8 +54,11 @@ def singular_starts(kernel: KinematicsKernel, batch: BatchSolver, params: Array,
         bound = start_cond[solved] * np.maximum(ratio, 1.0 / ratio) ** 2
         clear = np.isfinite(scales) & (bound * SAFETY <= start_threshold(options))
     for j in solved[~clear]:
-        view = kernel if units[j] == 1.0 else ScaledKernel(kernel, float(units[j]))
-        q = first[j] if view is kernel else first[j] / view.column
         with np.errstate(all="ignore"):
-            singular[j] = singular_start(view, q, t0, params[j], options) is not None
+            if units[j] == 1.0:
+                found = singular_start(kernel, first[j], t0, params[j], options)
+            else:
+                view = ScaledKernel(kernel, float(units[j]))
+                found = singular_start(view, first[j] / view.column, t0, params[j], options)
+        singular[j] = found is not None
     return singular
