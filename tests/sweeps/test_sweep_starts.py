@@ -150,3 +150,29 @@ def test_scaled_sets_with_failures_equal_per_set_solve(crank_slider) -> None:
     result = symkin.sweep(crank_slider, designs, T, workers=1)
     reasons = [_per_set(crank_slider, result, j, p, T) for j, p in enumerate(designs)]
     assert reasons == ["", "limit position", "no assembly", "singular"] * 3
+
+
+def test_length_scales_in_c_are_the_largest_lever_arm(crank_slider_system) -> None:
+    """<prefix>_length_scales against the closed form. In the crank-slider's Phi_q the rows of
+    the joint rod-slider (at [b, 0] on the rod) hold -b sin phi and b cos phi in the rod's
+    angle column beside unit entries in x and y; those of the crank's tip -a sin theta and
+    a cos theta; the slide's rows no lever. At q = 0 the largest arm is b. At the assembled
+    start the crank is vertical (theta = pi/2: arm a) and the rod climbs from its tip (0, a) to
+    the guide y = c, sin phi = (c - a) / b: arms |c - a| and sqrt(b^2 - (c - a)^2). A NaN
+    coordinate gives NaN; the units follow as runtime.units decides."""
+    kernel = symkin.compile(crank_slider_system, backend="c")
+    designs = np.outer(SCALES, [1.0, 5.0, 4.0])
+    a, b, c = designs.T
+    solver = kernel.batch_solver
+    zeros = np.zeros(len(kernel.coordinates))
+    np.testing.assert_allclose(solver.length_scales(designs, zeros, 0.0), b, rtol=1e-15)
+    result = symkin.sweep(kernel, designs, T, workers=1)
+    at_start = np.maximum.reduce([a, np.abs(c - a), np.sqrt(b**2 - (c - a) ** 2)])
+    np.testing.assert_allclose(solver.length_scales(designs, result.q[:, 0], 0.0), at_start,
+                               rtol=1e-12)
+    broken = zeros.copy()
+    broken[kernel.coordinates.index("rod.phi")] = np.nan
+    assert np.isnan(solver.length_scales(designs[:1], broken, 0.0)).all()
+    # 5k = 0.005, 0.015, ..., 500, 1500, 5000: outside 0.01 .. 100 the power of 10 below it
+    expected = [1e-3, 1.0, 1.0, 1.0, 1.0, 1.0, 100.0, 1e3, 1e3]
+    assert starts.set_units(solver, designs, 0.0, zeros).tolist() == expected
