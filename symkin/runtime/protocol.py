@@ -128,10 +128,12 @@ class EdgeFound:
 
 class EdgeSolver(Protocol):
     """A backend's substeps from a solved point towards a grid point it could not reach (the
-    generated ``<prefix>_solve_edge``): start = (t, q, dq, ddq) with its condition ``cond``."""
+    generated ``<prefix>_solve_edge``): start = (t, q, dq, ddq) with its condition ``cond``,
+    decided in the length unit ``unit`` (runtime.units; the rows stay in the kernel's)."""
 
     def __call__(self, options: Options, p: Array, start: tuple[float, Array, Array, Array],
-                 cond: float, t: float, h_min: float, delta: float) -> EdgeFound: ...
+                 cond: float, t: float, h_min: float, delta: float, unit: float = 1.0
+                 ) -> EdgeFound: ...
 
 
 class KinematicsKernel(Protocol):

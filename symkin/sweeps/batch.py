@@ -89,31 +89,30 @@ def _batch(kernel: Kernel, batch: BatchSolver, params: Array, t: Array, q0: Arra
            options: Options, chunk: Chunk) -> list[int]:
     """The chunk through the backend's batch, each set in its unit (sweeps.starts); returns the
     sets left to symkin.solve: those the batch could not solve and the edge treatment does not
-    end (it runs in unit 1 only), a singular start, and a set in another unit than 1 where the
-    batch cannot honour it."""
+    end, a singular start, and a set in another unit than 1 where the batch cannot honour
+    it."""
     units = set_units(batch, params, float(t[0]), q0)
     status, iterations, solved, cond, start_cond = batch(params, t, q0, options, chunk.q,
                                                          chunk.dq, chunk.d2q, units)
     chunk.iterations[:] = iterations
     singular = singular_starts(kernel, batch, params, float(t[0]), chunk.q[:, 0], solved,
                                start_cond, units, options)
-    scaled = units != 1.0
-    rerun = singular | (scaled & (status != OK)) | (scaled & (not batch.scale_free))
+    rerun = singular | ((units != 1.0) & (not batch.scale_free))
     failed = np.flatnonzero((status != OK) & ~rerun)
     edge = kernel.edge_solver() if failed.size else None
     ended = set() if edge is None else _edges(kernel, edge, params, t, options, chunk, failed,
-                                              (solved, status, cond))
+                                              (solved, status, cond, units))
     return [int(j) for j in np.flatnonzero(rerun | (status != OK)) if int(j) not in ended]
 
 
 def _edges(kernel: Kernel, edge: EdgeSolver, params: Array, t: Array, options: Options,
            chunk: Chunk, failed: NDArray[np.intp],
-           report: tuple[NDArray[np.int32], NDArray[np.int32], Array]) -> set[int]:
+           report: tuple[NDArray[np.int32], NDArray[np.int32], Array, Array]) -> set[int]:
     """The failed sets the edge treatment ends as symkin.solve would (sweeps.stops), written
     into the chunk; the others must be re-run."""
-    solved, status, cond = report
+    solved, status, cond, units = report
     stopped = [Stopped((chunk.q[j], chunk.dq[j], chunk.d2q[j]), int(solved[j]),
-                       int(status[j]), float(cond[j])) for j in failed]
+                       int(status[j]), float(cond[j]), float(units[j])) for j in failed]
     ended = set()
     for j, stop in zip(failed.tolist(), edge_stops(kernel, edge, params[failed], t, stopped,
                                                    options)):

@@ -13,8 +13,9 @@ grid point t[k], with the same bisected time and message (runtime.failures.expla
 
 Left to ``symkin.solve`` (None here): a set whose substeps reach t[k] or find a position the
 motion passes (it goes on), one stopped at its first point (the assembly) or on a value that
-is not finite (no edge treatment there), and stop_at_singular runs. The caller hands only sets
-solved in unit 1 whose start is not singular (sweeps.starts decided both for the chunk).
+is not finite (no edge treatment there), and stop_at_singular runs. A set solved in another
+length unit (runtime.units) is treated in it, as symkin.solve treats it; the caller hands only
+sets whose start is not singular (sweeps.starts decided both for the chunk).
 Imports NumPy and the runtime only.
 """
 
@@ -30,6 +31,7 @@ from symkin.contract.status import NOT_FINITE, OK
 from symkin.runtime import edges, failures
 from symkin.runtime.newton import Point
 from symkin.runtime.protocol import EDGE_STOPPED, EdgeSolver, KinematicsKernel
+from symkin.runtime.units import ScaledKernel
 
 Array = NDArray[np.float64]
 
@@ -47,12 +49,14 @@ class Stop:
 @dataclass(frozen=True)
 class Stopped:
     """How the batch left one set: its rows (q, dq, ddq, each (T, N)), the rows solved, its
-    status and the condition estimate at its last row."""
+    status, the condition estimate at its last row, and the length unit it was decided in
+    (runtime.units; the rows are in the kernel's own)."""
 
     rows: tuple[Array, Array, Array]
     solved: int
     status: int
     cond: float
+    unit: float = 1.0
 
 
 def edge_stop(kernel: KinematicsKernel, edge: EdgeSolver, p: Array, t: Array,
@@ -69,7 +73,8 @@ def edge_stops(kernel: KinematicsKernel, edge: EdgeSolver, params: Array, t: Arr
     limits = [j for j, stop in enumerate(found) if stop is not None and stop[0].limit]
     if limits:
         with np.errstate(all="ignore"):
-            jacobians = np.array([_jacobian(kernel, params[j], found[j]) for j in limits])
+            jacobians = np.array([_jacobian(kernel, params[j], found[j], stopped[j].unit)
+                                  for j in limits])
             names = edges.limit_motions(kernel, jacobians)
         for j, (aligned, drivers) in zip(limits, names):
             resolution = found[j][0]  # type: ignore[index]
@@ -87,7 +92,7 @@ def _edge(kernel: KinematicsKernel, edge: EdgeSolver, p: Array, t: Array, stoppe
     with np.errstate(all="ignore"):
         _, h_min, delta = edges.substeps(float(t[k - 1]), float(t[k]))
         found = edge(options, p, (float(t[k - 1]), q[k - 1], dq[k - 1], ddq[k - 1]),
-                     stopped.cond, float(t[k]), h_min, delta)
+                     stopped.cond, float(t[k]), h_min, delta, stopped.unit)
         if found.outcome != EDGE_STOPPED:
             return None
         reached = edges.State(found.t, Point(found.q, found.dq, found.ddq, found.cond, False))
@@ -96,11 +101,15 @@ def _edge(kernel: KinematicsKernel, edge: EdgeSolver, p: Array, t: Array, stoppe
     return stop, float(t[k])
 
 
-def _jacobian(kernel: KinematicsKernel, p: Array, stop: tuple[edges.Resolution, float] | None
-              ) -> Array:
+def _jacobian(kernel: KinematicsKernel, p: Array, stop: tuple[edges.Resolution, float] | None,
+              unit: float) -> Array:
+    """Phi_q where the set stopped, seen in its unit (as symkin.solve names the limit)."""
     assert stop is not None and stop[0].reached is not None
     reached = stop[0].reached
-    return np.asarray(kernel.phi_q(reached.point.q, reached.t, p), dtype=np.float64)
+    if unit == 1.0:
+        return np.asarray(kernel.phi_q(reached.point.q, reached.t, p), dtype=np.float64)
+    view = ScaledKernel(kernel, unit)
+    return view.phi_q(reached.point.q / view.column, reached.t, p)
 
 
 def _explained(stop: edges.Resolution, t: float) -> Stop:

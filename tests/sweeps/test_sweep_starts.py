@@ -142,14 +142,17 @@ def test_sets_far_from_unit_size_are_solved_in_their_unit_in_the_batch(crank_sli
                                atol=1e-12)
 
 
-def test_scaled_sets_with_failures_equal_per_set_solve(crank_slider) -> None:
-    """Scaled sets that reach a limit position or cannot be assembled, and a singular start
-    at 1e3 times the size, mixed with regular ones: each as its own symkin.solve."""
+def test_scaled_sets_with_failures_equal_per_set_solve(crank_slider, reruns) -> None:
+    """Scaled sets that reach a limit position or cannot be assembled, and a singular start,
+    at 1e-3, 1 and 1e3 times the size: each as its own symkin.solve. On C the limits are
+    bisected in the set's unit without a re-run."""
     base = np.array([[1.0, 5.0, 4.0], [1.0, 5.0, 5.9], [1.0, 5.0, 7.0], [1.0, 5.0, -4.0 + 1e-12]])
     designs = np.concatenate([base * 1e-3, base, base * 1e3])
     result = symkin.sweep(crank_slider, designs, T, workers=1)
     reasons = [_per_set(crank_slider, result, j, p, T) for j, p in enumerate(designs)]
     assert reasons == ["", "limit position", "no assembly", "singular"] * 3
+    if crank_slider.backend == "c":
+        assert sorted(reruns) == [2, 3, 6, 7, 10, 11]
 
 
 def test_length_scales_in_c_are_the_largest_lever_arm(crank_slider_system) -> None:
