@@ -86,12 +86,13 @@ def main() -> None:
         print(f"  one C loop over <prefix>_solve_grid   {c_time * 1e3:8.2f} ms")
         print(f"  symkin.sweep (public API)             {sweep_time * 1e3:8.2f} ms   "
               f"{sweep_time / c_time:.2f}x the C loop")
-        rerun = batch.edge_stop
-        batch.edge_stop = lambda *_: None  # every failed set re-run, as before sweeps.stops
+        rerun = batch.edge_stops
+        # every failed set re-run, as before sweeps.stops
+        batch.edge_stops = lambda *arguments: [None] * len(arguments[4])
         try:
             old = best(run_sweep, max(2, args.repeat // 10))
         finally:
-            batch.edge_stop = rerun
+            batch.edge_stops = rerun
         print(f"  the same, failed sets re-run          {old * 1e3:8.2f} ms   "
               f"{old / c_time:.2f}x the C loop")
 

@@ -19,6 +19,7 @@ Imports NumPy only: part of the runtime.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -239,14 +240,16 @@ def limit_threshold(options: Options) -> float:
 
 
 def stopped_at(kernel: KinematicsKernel, p: Array, options: Options, state: State,
-               failed: float, start_cond: float) -> Resolution:
+               failed: float, start_cond: float, named: bool = True) -> Resolution:
     """The stop at state.t (a step of ``failed`` from it failed; start_cond: the condition at
     the grid point the substeps began from), told a limit position or no convergence, with
-    the aligned joints and held drivers of a limit (not its dependent rows: ``_stopped``)."""
+    the aligned joints and held drivers of a limit (not its dependent rows: ``_stopped``;
+    ``named`` False: not those either, for a caller that names many stops at once with
+    limit_motions)."""
     cond = state.point.cond
     limit = cond > limit_threshold(options) or cond > LIMIT_GROWTH * start_cond
     stop = Resolution(None, limit=limit, reached=state, failed_at=state.t + failed)
-    if limit:
+    if limit and named:
         stop.aligned, stop.drivers = limit_motion(kernel, kernel.phi_q(state.point.q, state.t,
                                                                         p))
     return stop
@@ -259,14 +262,47 @@ def limit_motion(kernel: KinematicsKernel, jacobian: Array
     The right null vector of Phi_q is the motion the constraints allow with every driver held:
     the bodies it moves are the aligned links, and the joints on them are the aligned joints;
     the drivers are the rows that the dependent set holds besides."""
-    _, _, vt = np.linalg.svd(jacobian)
-    motion = np.abs(vt[-1])
-    body = [name.rsplit(".", 1)[0] for name in kernel.coordinates]
-    bodies = {body[c] for c in np.flatnonzero(motion > 1e-3 * motion.max())}
-    rows = sorted({int(r) for r, c in zip(kernel.pattern_rows, kernel.pattern_cols)
-                   if body[int(c)] in bodies})
-    names = [kernel.rows[r].rsplit(" (", 1)[0] for r in rows]
-    joints = tuple(dict.fromkeys(n for n in names if n.startswith("joints")))
-    drivers = tuple(dict.fromkeys(label.rsplit(" (", 1)[0] for label in kernel.rows
-                                  if label.startswith("drivers")))
-    return joints, drivers
+    return limit_motions(kernel, jacobian[None])[0]
+
+
+def limit_motions(kernel: KinematicsKernel, jacobians: Array
+                  ) -> list[tuple[tuple[str, ...], tuple[str, ...]]]:
+    """limit_motion of each of the stacked Jacobians (k, N, N): one SVD call for all, and the
+    names looked up once per distinct set of moving bodies."""
+    _, _, vt = np.linalg.svd(jacobians)
+    motions = np.abs(vt[:, -1])
+    moving = motions > 1e-3 * motions.max(axis=1, keepdims=True)
+    names = _names(tuple(kernel.coordinates), tuple(kernel.rows),
+                   tuple(np.asarray(kernel.pattern_rows).tolist()),
+                   tuple(np.asarray(kernel.pattern_cols).tolist()))
+    return [names.aligned(tuple(np.flatnonzero(row).tolist())) for row in moving]
+
+
+class _Names:
+    """The joints on each set of bodies and the drivers of one mechanism (limit_motions)."""
+
+    def __init__(self, coordinates: tuple[str, ...], rows: tuple[str, ...],
+                 pattern: list[tuple[int, int]]) -> None:
+        self.body = [name.rsplit(".", 1)[0] for name in coordinates]
+        self.pattern = pattern
+        self.rows = rows
+        self.drivers = tuple(dict.fromkeys(label.rsplit(" (", 1)[0] for label in rows
+                                           if label.startswith("drivers")))
+        self.found: dict[tuple[int, ...], tuple[tuple[str, ...], tuple[str, ...]]] = {}
+
+    def aligned(self, columns: tuple[int, ...]) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        """The joints on the bodies of the moving columns, and the drivers."""
+        if columns not in self.found:
+            bodies = {self.body[c] for c in columns}
+            rows = sorted({r for r, c in self.pattern if self.body[c] in bodies})
+            labels = [self.rows[r].rsplit(" (", 1)[0] for r in rows]
+            joints = tuple(dict.fromkeys(n for n in labels if n.startswith("joints")))
+            self.found[columns] = (joints, self.drivers)
+        return self.found[columns]
+
+
+@functools.lru_cache(maxsize=64)
+def _names(coordinates: tuple[str, ...], rows: tuple[str, ...], pattern_rows: tuple[int, ...],
+           pattern_cols: tuple[int, ...]) -> _Names:
+    """_Names once per mechanism: a sweep names every set that stops at a limit."""
+    return _Names(coordinates, rows, list(zip(pattern_rows, pattern_cols)))

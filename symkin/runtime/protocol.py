@@ -84,18 +84,26 @@ class GridSolver(Protocol):
         ...
 
 
-BatchStatus = tuple[NDArray[np.int32], NDArray[np.int32], NDArray[np.int32], Array]
-"""(status, iterations, solved, cond) per parameter set of a batch solve; solved: the rows
-written (a failed set stopped at the grid point t[solved]); cond: the condition estimate at
-the last row solved (NaN: none)."""
+BatchStatus = tuple[NDArray[np.int32], NDArray[np.int32], NDArray[np.int32], Array, Array]
+"""(status, iterations, solved, cond, start_cond) per parameter set of a batch solve; solved:
+the rows written (a failed set stopped at the grid point t[solved]); cond, start_cond: the
+condition estimate at the last row solved and at the first (NaN: none), in the set's unit."""
 
 
 class BatchSolver(Protocol):
     """A backend's solve of many parameter sets in one call (the generated C batch): plain
-    Newton from q0 at t[0] per set, rows written into q, dq, d2q (m, T, N)."""
+    Newton from q0 at t[0] per set, decided in the length unit units[j], rows written into
+    q, dq, d2q (m, T, N). ``scale_free``: whether it honours a unit other than 1."""
+
+    scale_free: bool
 
     def __call__(self, params: Array, t: Array, q0: Array, options: Options,
-                 q: Array, dq: Array, d2q: Array) -> BatchStatus: ...
+                 q: Array, dq: Array, d2q: Array, units: Array) -> BatchStatus: ...
+
+    def length_scales(self, params: Array, q: Array, t: float) -> Array:
+        """Per set, the largest lever arm in Phi_q at (q, t) (runtime.start.length_scale, raw:
+        0 where there is none, NaN where Phi_q is not finite); q (N,) or (m, N)."""
+        ...
 
 
 
@@ -120,10 +128,12 @@ class EdgeFound:
 
 class EdgeSolver(Protocol):
     """A backend's substeps from a solved point towards a grid point it could not reach (the
-    generated ``<prefix>_solve_edge``): start = (t, q, dq, ddq) with its condition ``cond``."""
+    generated ``<prefix>_solve_edge``): start = (t, q, dq, ddq) with its condition ``cond``,
+    decided in the length unit ``unit`` (runtime.units; the rows stay in the kernel's)."""
 
     def __call__(self, options: Options, p: Array, start: tuple[float, Array, Array, Array],
-                 cond: float, t: float, h_min: float, delta: float) -> EdgeFound: ...
+                 cond: float, t: float, h_min: float, delta: float, unit: float = 1.0
+                 ) -> EdgeFound: ...
 
 
 class KinematicsKernel(Protocol):

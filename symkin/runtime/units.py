@@ -53,6 +53,18 @@ def unit_for(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> float:
     return float(10.0 ** math.floor(math.log10(scale)))
 
 
+def units_for(scales: ArrayLike) -> Array:
+    """unit_for of many sets from their raw length scales (BatchSolver.length_scales: 0 where
+    there is none, NaN where it cannot be told; unit 1 for both, as length_scale decides)."""
+    found = np.asarray(scales, dtype=np.float64)
+    units = np.ones(found.shape)
+    with np.errstate(invalid="ignore"):
+        outside = np.isfinite(found) & (found > 0) & ((found < NATURAL[0]) | (found > NATURAL[1]))
+    for j in np.flatnonzero(outside):  # a few; math.log10 as unit_for takes it
+        units[j] = 10.0 ** math.floor(math.log10(float(found[j])))
+    return units
+
+
 class ScaledKernel:
     """A kernel seen in the unit u: q~ = q / c (c = u for positions, 1 for angles), Phi~ =
     Phi / r (r = u for length rows, 1 for the others), so Phi~_q = Phi_q c / r. Parameters are

@@ -23,8 +23,9 @@ from symkin.contract.options import Options
 from symkin.contract.status import OK
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
-from symkin.runtime.protocol import EdgeSolver
-from symkin.sweeps.stops import Stopped, edge_stop
+from symkin.runtime.protocol import BatchSolver, EdgeSolver
+from symkin.sweeps.starts import set_units, singular_starts
+from symkin.sweeps.stops import Stopped, edge_stops
 
 Array = NDArray[np.float64]
 
@@ -77,39 +78,54 @@ def solve_chunk(kernel: Kernel, params: Array, t: Array, q0: Array,
     m, size = params.shape[0], len(kernel.coordinates)
     chunk = empty_chunk(m, t, size) if into is None else into
     starts = np.broadcast_to(q0, (m, size))
-    if kernel.batch_solver is not None:
-        status, iterations, solved, cond = kernel.batch_solver(params, t, q0, options, chunk.q,
-                                                               chunk.dq, chunk.d2q)
-        chunk.iterations[:] = iterations
-        failed = np.flatnonzero(status != OK)
-        edge = kernel.edge_solver() if failed.size else None
-        pending = [int(j) for j in failed
-                   if edge is None or not _edge(kernel, edge, params[j], t, starts[j], options,
-                                                chunk, int(j), Stopped(
-                                                    (chunk.q[j], chunk.dq[j], chunk.d2q[j]),
-                                                    int(solved[j]), int(status[j]),
-                                                    float(cond[j])))]
-    else:
-        pending = list(range(m))
+    batch = kernel.batch_solver
+    pending = range(m) if batch is None else _batch(kernel, batch, params, t, q0, options, chunk)
     for j in pending:
         _solve_one(kernel, params[j], t, starts[j], options, chunk, j)
     return chunk
 
 
-def _edge(kernel: Kernel, edge: EdgeSolver, p: Array, t: Array, q0: Array, options: Options,
-          chunk: Chunk, j: int, stopped: Stopped) -> bool:
-    """Set j, stopped by the batch, ended here when the edge treatment stops it (as
-    symkin.solve would end it); False: it must be re-run."""
-    stop = edge_stop(kernel, edge, p, t, q0, stopped, options)
-    if stop is None:
-        return False
-    solved = stopped.solved
-    chunk.status[j] = REASON_CODES.get(stop.reason, max(REASON_CODES.values()) + 1)
-    chunk.reasons[j], chunk.messages[j] = stop.reason, stop.message
-    chunk.t_reached[j], chunk.solved[j] = stop.t, solved
-    for target in (chunk.q, chunk.dq, chunk.d2q):
-        target[j, solved:] = np.nan
-    return True
+def _batch(kernel: Kernel, batch: BatchSolver, params: Array, t: Array, q0: Array,
+           options: Options, chunk: Chunk) -> list[int]:
+    """The chunk through the backend's batch, each set in its unit (sweeps.starts); returns the
+    sets left to symkin.solve: those the batch could not solve and the edge treatment does not
+    end, a singular start, and a set in another unit than 1 where the batch cannot honour
+    it."""
+    units = set_units(batch, params, float(t[0]), q0)
+    status, iterations, solved, cond, start_cond = batch(params, t, q0, options, chunk.q,
+                                                         chunk.dq, chunk.d2q, units)
+    chunk.iterations[:] = iterations
+    singular = singular_starts(kernel, batch, params, float(t[0]), chunk.q[:, 0], solved,
+                               start_cond, units, options)
+    rerun = singular | ((units != 1.0) & (not batch.scale_free))
+    failed = np.flatnonzero((status != OK) & ~rerun)
+    edge = kernel.edge_solver() if failed.size else None
+    ended = set() if edge is None else _edges(kernel, edge, params, t, options, chunk, failed,
+                                              (solved, status, cond, units))
+    return [int(j) for j in np.flatnonzero(rerun | (status != OK)) if int(j) not in ended]
+
+
+def _edges(kernel: Kernel, edge: EdgeSolver, params: Array, t: Array, options: Options,
+           chunk: Chunk, failed: NDArray[np.intp],
+           report: tuple[NDArray[np.int32], NDArray[np.int32], Array, Array]) -> set[int]:
+    """The failed sets the edge treatment ends as symkin.solve would (sweeps.stops), written
+    into the chunk; the others must be re-run."""
+    solved, status, cond, units = report
+    stopped = [Stopped((chunk.q[j], chunk.dq[j], chunk.d2q[j]), int(solved[j]),
+                       int(status[j]), float(cond[j]), float(units[j])) for j in failed]
+    ended = set()
+    for j, stop in zip(failed.tolist(), edge_stops(kernel, edge, params[failed], t, stopped,
+                                                   options)):
+        if stop is None:
+            continue
+        done = int(solved[j])
+        chunk.status[j] = REASON_CODES.get(stop.reason, max(REASON_CODES.values()) + 1)
+        chunk.reasons[j], chunk.messages[j] = stop.reason, stop.message
+        chunk.t_reached[j], chunk.solved[j] = stop.t, done
+        for target in (chunk.q, chunk.dq, chunk.d2q):
+            target[j, done:] = np.nan
+        ended.add(j)
+    return ended
 
 
 def _solve_one(kernel: Kernel, p: Array, t: Array, q0: Array, options: Options, chunk: Chunk,

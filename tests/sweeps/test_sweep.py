@@ -223,8 +223,8 @@ def test_c_batch_reports_without_outputs_and_counts_newton(c_kernel) -> None:
     lib.crank_slider_default_options(options)
     reports = ffi.new("crank_slider_batch_report[]", 3)
     solved = lib.crank_slider_solve_batch(
-        options, 3, ffi.from_buffer("double[]", designs), ffi.from_buffer("double[]", c_kernel.q0),
-        0, T.size, ffi.from_buffer("double[]", times), ffi.NULL, ffi.NULL, ffi.NULL,
+        options, ffi.NULL, 3, ffi.from_buffer("double[]", designs),
+        ffi.from_buffer("double[]", c_kernel.q0), 0, T.size, ffi.from_buffer("double[]", times), ffi.NULL, ffi.NULL, ffi.NULL,
         ffi.new("crank_slider_state *"), ffi.new("crank_slider_workspace *"), reports)
     assert solved == 2
     assert [reports[j].status for j in range(3)] == [0, 1, 0]  # plain Newton: no convergence

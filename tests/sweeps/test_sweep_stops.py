@@ -163,12 +163,12 @@ def test_edge_stop_leaves_what_it_cannot_end_to_solve(crank_slider_system) -> No
     rows = (solution.q, solution.dq, solution.d2q)
     for solved, status in ((0, 1), (T.size, 1), (10, 0), (10, 3)):
         stopped = stops.Stopped(rows, solved, status, 1.0)
-        assert stops.edge_stop(kernel, edge, p, T, kernel.q0, stopped, options) is None
+        assert stops.edge_stop(kernel, edge, p, T, stopped, options) is None
     stopped = stops.Stopped(rows, 10, 1, 1.0)
     at_singular = driver.default_options(kernel).__class__(stop_at_singular=True)
-    assert stops.edge_stop(kernel, edge, p, T, kernel.q0, stopped, at_singular) is None
+    assert stops.edge_stop(kernel, edge, p, T, stopped, at_singular) is None
     # a point the plain step missed but the substeps reach: the set goes on in symkin.solve
-    assert stops.edge_stop(kernel, edge, p, T, kernel.q0, stopped, options) is None
+    assert stops.edge_stop(kernel, edge, p, T, stopped, options) is None
 
 
 @pytest.mark.parametrize("offset", [-0.02, -0.002, 0.002, 0.02])

@@ -109,6 +109,40 @@ static void all_drivers_from_unit(const all_drivers_workspace *work, all_drivers
     for (i = 0; i < ALL_DRIVERS_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (all_drivers_length_scales). */
+static all_drivers_real all_drivers_lever_arm(const all_drivers_real nz[])
+{
+    all_drivers_real moved[ALL_DRIVERS_NQ] = {0}, turned[ALL_DRIVERS_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < ALL_DRIVERS_NNZ; ++e) {
+        const all_drivers_real a = fabs(nz[e]);
+        all_drivers_real *largest = all_drivers_length_column[all_drivers_phi_q_col[e]] ? moved : turned;
+        const int row = all_drivers_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (all_drivers_real)NAN;
+    for (i = 0; i < ALL_DRIVERS_NQ; ++i) {
+        if (moved[i] > 0) {
+            const all_drivers_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void all_drivers_length_scales(int m, const all_drivers_real p[], const all_drivers_real q[],
+                                int q_stride, all_drivers_real t, all_drivers_real scales[])
+{
+    all_drivers_real nz[ALL_DRIVERS_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        all_drivers_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * ALL_DRIVERS_NP : p, nz);
+        scales[j] = all_drivers_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -892,7 +926,8 @@ static all_drivers_real *all_drivers_block(all_drivers_real out[], size_t rows)
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one all_drivers_solve_grid call would give; only the output offsets differ. */
-int all_drivers_solve_batch(const all_drivers_options *options, int m, const all_drivers_real p[],
+int all_drivers_solve_batch(const all_drivers_options *options, const all_drivers_real units[],
+                             int m, const all_drivers_real p[],
                              const all_drivers_real q0[], int q0_stride, int n,
                              const all_drivers_real t[], all_drivers_real q_out[],
                              all_drivers_real dq_out[], all_drivers_real ddq_out[],
@@ -900,6 +935,7 @@ int all_drivers_solve_batch(const all_drivers_options *options, int m, const all
                              all_drivers_batch_report reports[])
 {
     all_drivers_report report;
+    all_drivers_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * ALL_DRIVERS_NQ;
@@ -916,13 +952,15 @@ int all_drivers_solve_batch(const all_drivers_options *options, int m, const all
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (all_drivers_real)NAN;
+        out->cond = out->start_cond = (all_drivers_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (all_drivers_solve_step(options, p_set, t[k], state, work, &report) != ALL_DRIVERS_OK) {
+            if (all_drivers_solve_step(&set_options, p_set, t[k], state, work, &report) != ALL_DRIVERS_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             all_drivers_store(q_set, k, state->q);
             all_drivers_store(dq_set, k, state->dq);
             all_drivers_store(ddq_set, k, state->ddq);

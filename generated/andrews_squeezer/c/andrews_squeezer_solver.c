@@ -109,6 +109,40 @@ static void andrews_squeezer_from_unit(const andrews_squeezer_workspace *work, a
     for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (andrews_squeezer_length_scales). */
+static andrews_squeezer_real andrews_squeezer_lever_arm(const andrews_squeezer_real nz[])
+{
+    andrews_squeezer_real moved[ANDREWS_SQUEEZER_NQ] = {0}, turned[ANDREWS_SQUEEZER_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < ANDREWS_SQUEEZER_NNZ; ++e) {
+        const andrews_squeezer_real a = fabs(nz[e]);
+        andrews_squeezer_real *largest = andrews_squeezer_length_column[andrews_squeezer_phi_q_col[e]] ? moved : turned;
+        const int row = andrews_squeezer_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (andrews_squeezer_real)NAN;
+    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        if (moved[i] > 0) {
+            const andrews_squeezer_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void andrews_squeezer_length_scales(int m, const andrews_squeezer_real p[], const andrews_squeezer_real q[],
+                                int q_stride, andrews_squeezer_real t, andrews_squeezer_real scales[])
+{
+    andrews_squeezer_real nz[ANDREWS_SQUEEZER_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        andrews_squeezer_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * ANDREWS_SQUEEZER_NP : p, nz);
+        scales[j] = andrews_squeezer_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -898,7 +932,8 @@ static andrews_squeezer_real *andrews_squeezer_block(andrews_squeezer_real out[]
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one andrews_squeezer_solve_grid call would give; only the output offsets differ. */
-int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, int m, const andrews_squeezer_real p[],
+int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, const andrews_squeezer_real units[],
+                             int m, const andrews_squeezer_real p[],
                              const andrews_squeezer_real q0[], int q0_stride, int n,
                              const andrews_squeezer_real t[], andrews_squeezer_real q_out[],
                              andrews_squeezer_real dq_out[], andrews_squeezer_real ddq_out[],
@@ -906,6 +941,7 @@ int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, int m,
                              andrews_squeezer_batch_report reports[])
 {
     andrews_squeezer_report report;
+    andrews_squeezer_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * ANDREWS_SQUEEZER_NQ;
@@ -922,13 +958,15 @@ int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, int m,
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (andrews_squeezer_real)NAN;
+        out->cond = out->start_cond = (andrews_squeezer_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (andrews_squeezer_solve_step(options, p_set, t[k], state, work, &report) != ANDREWS_SQUEEZER_OK) {
+            if (andrews_squeezer_solve_step(&set_options, p_set, t[k], state, work, &report) != ANDREWS_SQUEEZER_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             andrews_squeezer_store(q_set, k, state->q);
             andrews_squeezer_store(dq_set, k, state->dq);
             andrews_squeezer_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void cam_cycloidal_from_unit(const cam_cycloidal_workspace *work, cam_cyc
     for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (cam_cycloidal_length_scales). */
+static cam_cycloidal_real cam_cycloidal_lever_arm(const cam_cycloidal_real nz[])
+{
+    cam_cycloidal_real moved[CAM_CYCLOIDAL_NQ] = {0}, turned[CAM_CYCLOIDAL_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < CAM_CYCLOIDAL_NNZ; ++e) {
+        const cam_cycloidal_real a = fabs(nz[e]);
+        cam_cycloidal_real *largest = cam_cycloidal_length_column[cam_cycloidal_phi_q_col[e]] ? moved : turned;
+        const int row = cam_cycloidal_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (cam_cycloidal_real)NAN;
+    for (i = 0; i < CAM_CYCLOIDAL_NQ; ++i) {
+        if (moved[i] > 0) {
+            const cam_cycloidal_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void cam_cycloidal_length_scales(int m, const cam_cycloidal_real p[], const cam_cycloidal_real q[],
+                                int q_stride, cam_cycloidal_real t, cam_cycloidal_real scales[])
+{
+    cam_cycloidal_real nz[CAM_CYCLOIDAL_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        cam_cycloidal_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * CAM_CYCLOIDAL_NP : p, nz);
+        scales[j] = cam_cycloidal_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -670,7 +704,8 @@ static cam_cycloidal_real *cam_cycloidal_block(cam_cycloidal_real out[], size_t 
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one cam_cycloidal_solve_grid call would give; only the output offsets differ. */
-int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, int m, const cam_cycloidal_real p[],
+int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, const cam_cycloidal_real units[],
+                             int m, const cam_cycloidal_real p[],
                              const cam_cycloidal_real q0[], int q0_stride, int n,
                              const cam_cycloidal_real t[], cam_cycloidal_real q_out[],
                              cam_cycloidal_real dq_out[], cam_cycloidal_real ddq_out[],
@@ -678,6 +713,7 @@ int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, int m, const
                              cam_cycloidal_batch_report reports[])
 {
     cam_cycloidal_report report;
+    cam_cycloidal_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * CAM_CYCLOIDAL_NQ;
@@ -694,13 +730,15 @@ int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, int m, const
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (cam_cycloidal_real)NAN;
+        out->cond = out->start_cond = (cam_cycloidal_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (cam_cycloidal_solve_step(options, p_set, t[k], state, work, &report) != CAM_CYCLOIDAL_OK) {
+            if (cam_cycloidal_solve_step(&set_options, p_set, t[k], state, work, &report) != CAM_CYCLOIDAL_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             cam_cycloidal_store(q_set, k, state->q);
             cam_cycloidal_store(dq_set, k, state->dq);
             cam_cycloidal_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void cardan_from_unit(const cardan_workspace *work, cardan_real v[])
     for (i = 0; i < CARDAN_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (cardan_length_scales). */
+static cardan_real cardan_lever_arm(const cardan_real nz[])
+{
+    cardan_real moved[CARDAN_NQ] = {0}, turned[CARDAN_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < CARDAN_NNZ; ++e) {
+        const cardan_real a = fabs(nz[e]);
+        cardan_real *largest = cardan_length_column[cardan_phi_q_col[e]] ? moved : turned;
+        const int row = cardan_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (cardan_real)NAN;
+    for (i = 0; i < CARDAN_NQ; ++i) {
+        if (moved[i] > 0) {
+            const cardan_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void cardan_length_scales(int m, const cardan_real p[], const cardan_real q[],
+                                int q_stride, cardan_real t, cardan_real scales[])
+{
+    cardan_real nz[CARDAN_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        cardan_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * CARDAN_NP : p, nz);
+        scales[j] = cardan_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -656,7 +690,8 @@ static cardan_real *cardan_block(cardan_real out[], size_t rows)
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one cardan_solve_grid call would give; only the output offsets differ. */
-int cardan_solve_batch(const cardan_options *options, int m, const cardan_real p[],
+int cardan_solve_batch(const cardan_options *options, const cardan_real units[],
+                             int m, const cardan_real p[],
                              const cardan_real q0[], int q0_stride, int n,
                              const cardan_real t[], cardan_real q_out[],
                              cardan_real dq_out[], cardan_real ddq_out[],
@@ -664,6 +699,7 @@ int cardan_solve_batch(const cardan_options *options, int m, const cardan_real p
                              cardan_batch_report reports[])
 {
     cardan_report report;
+    cardan_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * CARDAN_NQ;
@@ -680,13 +716,15 @@ int cardan_solve_batch(const cardan_options *options, int m, const cardan_real p
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (cardan_real)NAN;
+        out->cond = out->start_cond = (cardan_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (cardan_solve_step(options, p_set, t[k], state, work, &report) != CARDAN_OK) {
+            if (cardan_solve_step(&set_options, p_set, t[k], state, work, &report) != CARDAN_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             cardan_store(q_set, k, state->q);
             cardan_store(dq_set, k, state->dq);
             cardan_store(ddq_set, k, state->ddq);

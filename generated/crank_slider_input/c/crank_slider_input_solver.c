@@ -109,6 +109,40 @@ static void crank_slider_input_from_unit(const crank_slider_input_workspace *wor
     for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (crank_slider_input_length_scales). */
+static crank_slider_input_real crank_slider_input_lever_arm(const crank_slider_input_real nz[])
+{
+    crank_slider_input_real moved[CRANK_SLIDER_INPUT_NQ] = {0}, turned[CRANK_SLIDER_INPUT_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < CRANK_SLIDER_INPUT_NNZ; ++e) {
+        const crank_slider_input_real a = fabs(nz[e]);
+        crank_slider_input_real *largest = crank_slider_input_length_column[crank_slider_input_phi_q_col[e]] ? moved : turned;
+        const int row = crank_slider_input_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (crank_slider_input_real)NAN;
+    for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+        if (moved[i] > 0) {
+            const crank_slider_input_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void crank_slider_input_length_scales(int m, const crank_slider_input_real p[], const crank_slider_input_real q[],
+                                int q_stride, crank_slider_input_real t, crank_slider_input_real scales[])
+{
+    crank_slider_input_real nz[CRANK_SLIDER_INPUT_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        crank_slider_input_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * CRANK_SLIDER_INPUT_NP : p, nz);
+        scales[j] = crank_slider_input_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -754,7 +788,8 @@ static crank_slider_input_real *crank_slider_input_block(crank_slider_input_real
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one crank_slider_input_solve_grid call would give; only the output offsets differ. */
-int crank_slider_input_solve_batch(const crank_slider_input_options *options, int m, const crank_slider_input_real p[],
+int crank_slider_input_solve_batch(const crank_slider_input_options *options, const crank_slider_input_real units[],
+                             int m, const crank_slider_input_real p[],
                              const crank_slider_input_real q0[], int q0_stride, int n,
                              const crank_slider_input_real t[], crank_slider_input_real q_out[],
                              crank_slider_input_real dq_out[], crank_slider_input_real ddq_out[],
@@ -762,6 +797,7 @@ int crank_slider_input_solve_batch(const crank_slider_input_options *options, in
                              crank_slider_input_batch_report reports[])
 {
     crank_slider_input_report report;
+    crank_slider_input_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * CRANK_SLIDER_INPUT_NQ;
@@ -778,13 +814,15 @@ int crank_slider_input_solve_batch(const crank_slider_input_options *options, in
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (crank_slider_input_real)NAN;
+        out->cond = out->start_cond = (crank_slider_input_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (crank_slider_input_solve_step(options, p_set, t[k], state, work, &report) != CRANK_SLIDER_INPUT_OK) {
+            if (crank_slider_input_solve_step(&set_options, p_set, t[k], state, work, &report) != CRANK_SLIDER_INPUT_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             crank_slider_input_store(q_set, k, state->q);
             crank_slider_input_store(dq_set, k, state->dq);
             crank_slider_input_store(ddq_set, k, state->ddq);

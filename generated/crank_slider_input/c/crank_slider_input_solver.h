@@ -138,21 +138,33 @@ typedef struct {
     int iterations;              /* Newton iterations summed over the set's steps           */
     crank_slider_input_real residual;  /* max|Phi| of the last iterate                            */
     crank_slider_input_real cond;      /* the condition estimate at the last point solved (NaN: none) */
+    crank_slider_input_real start_cond; /* the condition estimate at t[0] (NaN: not solved there)   */
 } crank_slider_input_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
  * p[j*NP ...] and starts from q0[j*NQ ...] (q0_stride = NQ) or, with q0_stride = 0, every set
- * from the one guess q0[0 ... NQ-1]. Rows of set j, step k go to q_out[(j*n + k)*NQ ...] (and
- * dq_out, ddq_out; any may be NULL): caller-owned m x n x NQ arrays. reports[j] says how set j
- * ended; a set that fails stops only itself (its rows past reports[j].solved are not written)
- * and the batch goes on. state and work are scratch space, reused from set to set.
- * Returns the number of sets solved over the whole grid. */
-int crank_slider_input_solve_batch(const crank_slider_input_options *options, int m, const crank_slider_input_real p[],
+ * from the one guess q0[0 ... NQ-1]; its decisions are made in the length unit units[j]
+ * (options->unit for every set when units is NULL). Rows of set j, step k go to
+ * q_out[(j*n + k)*NQ ...] (and dq_out, ddq_out; any may be NULL): caller-owned m x n x NQ
+ * arrays. reports[j] says how set j ended; a set that fails stops only itself (its rows past
+ * reports[j].solved are not written) and the batch goes on. state and work are scratch
+ * space, reused from set to set. Returns the number of sets solved over the whole grid. */
+int crank_slider_input_solve_batch(const crank_slider_input_options *options, const crank_slider_input_real units[],
+                             int m, const crank_slider_input_real p[],
                              const crank_slider_input_real q0[], int q0_stride, int n,
                              const crank_slider_input_real t[], crank_slider_input_real q_out[],
                              crank_slider_input_real dq_out[], crank_slider_input_real ddq_out[],
                              crank_slider_input_state *state, crank_slider_input_workspace *work,
                              crank_slider_input_batch_report reports[]);
+
+/* The length scale of m configurations: per set j (parameters p[j*NP ...], coordinates
+ * q[j*q_stride ...], at time t), the largest lever arm in Phi_q, max |dPhi_i/dphi_k| /
+ * max |dPhi_i/dx_k| over the rows i with an entry in a length column (symkin's
+ * runtime.start.length_scale): 0 where there is none, NaN where an entry of Phi_q is not
+ * finite. The unit a run is decided in, and how far its condition estimate may be from the
+ * one in units of this scale, follow from it. */
+void crank_slider_input_length_scales(int m, const crank_slider_input_real p[], const crank_slider_input_real q[],
+                                int q_stride, crank_slider_input_real t, crank_slider_input_real scales[]);
 
 #define CRANK_SLIDER_INPUT_EDGE_REACHED 0  /* the substeps reached t                                */
 #define CRANK_SLIDER_INPUT_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */

@@ -109,6 +109,40 @@ static void custom_driver_from_unit(const custom_driver_workspace *work, custom_
     for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (custom_driver_length_scales). */
+static custom_driver_real custom_driver_lever_arm(const custom_driver_real nz[])
+{
+    custom_driver_real moved[CUSTOM_DRIVER_NQ] = {0}, turned[CUSTOM_DRIVER_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < CUSTOM_DRIVER_NNZ; ++e) {
+        const custom_driver_real a = fabs(nz[e]);
+        custom_driver_real *largest = custom_driver_length_column[custom_driver_phi_q_col[e]] ? moved : turned;
+        const int row = custom_driver_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (custom_driver_real)NAN;
+    for (i = 0; i < CUSTOM_DRIVER_NQ; ++i) {
+        if (moved[i] > 0) {
+            const custom_driver_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void custom_driver_length_scales(int m, const custom_driver_real p[], const custom_driver_real q[],
+                                int q_stride, custom_driver_real t, custom_driver_real scales[])
+{
+    custom_driver_real nz[CUSTOM_DRIVER_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        custom_driver_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * CUSTOM_DRIVER_NP : p, nz);
+        scales[j] = custom_driver_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -700,7 +734,8 @@ static custom_driver_real *custom_driver_block(custom_driver_real out[], size_t 
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one custom_driver_solve_grid call would give; only the output offsets differ. */
-int custom_driver_solve_batch(const custom_driver_options *options, int m, const custom_driver_real p[],
+int custom_driver_solve_batch(const custom_driver_options *options, const custom_driver_real units[],
+                             int m, const custom_driver_real p[],
                              const custom_driver_real q0[], int q0_stride, int n,
                              const custom_driver_real t[], custom_driver_real q_out[],
                              custom_driver_real dq_out[], custom_driver_real ddq_out[],
@@ -708,6 +743,7 @@ int custom_driver_solve_batch(const custom_driver_options *options, int m, const
                              custom_driver_batch_report reports[])
 {
     custom_driver_report report;
+    custom_driver_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * CUSTOM_DRIVER_NQ;
@@ -724,13 +760,15 @@ int custom_driver_solve_batch(const custom_driver_options *options, int m, const
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (custom_driver_real)NAN;
+        out->cond = out->start_cond = (custom_driver_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (custom_driver_solve_step(options, p_set, t[k], state, work, &report) != CUSTOM_DRIVER_OK) {
+            if (custom_driver_solve_step(&set_options, p_set, t[k], state, work, &report) != CUSTOM_DRIVER_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             custom_driver_store(q_set, k, state->q);
             custom_driver_store(dq_set, k, state->dq);
             custom_driver_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void delta_from_unit(const delta_workspace *work, delta_real v[])
     for (i = 0; i < DELTA_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (delta_length_scales). */
+static delta_real delta_lever_arm(const delta_real nz[])
+{
+    delta_real moved[DELTA_NQ] = {0}, turned[DELTA_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < DELTA_NNZ; ++e) {
+        const delta_real a = fabs(nz[e]);
+        delta_real *largest = delta_length_column[delta_phi_q_col[e]] ? moved : turned;
+        const int row = delta_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (delta_real)NAN;
+    for (i = 0; i < DELTA_NQ; ++i) {
+        if (moved[i] > 0) {
+            const delta_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void delta_length_scales(int m, const delta_real p[], const delta_real q[],
+                                int q_stride, delta_real t, delta_real scales[])
+{
+    delta_real nz[DELTA_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        delta_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * DELTA_NP : p, nz);
+        scales[j] = delta_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -724,7 +758,8 @@ static delta_real *delta_block(delta_real out[], size_t rows)
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one delta_solve_grid call would give; only the output offsets differ. */
-int delta_solve_batch(const delta_options *options, int m, const delta_real p[],
+int delta_solve_batch(const delta_options *options, const delta_real units[],
+                             int m, const delta_real p[],
                              const delta_real q0[], int q0_stride, int n,
                              const delta_real t[], delta_real q_out[],
                              delta_real dq_out[], delta_real ddq_out[],
@@ -732,6 +767,7 @@ int delta_solve_batch(const delta_options *options, int m, const delta_real p[],
                              delta_batch_report reports[])
 {
     delta_report report;
+    delta_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * DELTA_NQ;
@@ -748,13 +784,15 @@ int delta_solve_batch(const delta_options *options, int m, const delta_real p[],
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (delta_real)NAN;
+        out->cond = out->start_cond = (delta_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (delta_solve_step(options, p_set, t[k], state, work, &report) != DELTA_OK) {
+            if (delta_solve_step(&set_options, p_set, t[k], state, work, &report) != DELTA_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             delta_store(q_set, k, state->q);
             delta_store(dq_set, k, state->dq);
             delta_store(ddq_set, k, state->ddq);

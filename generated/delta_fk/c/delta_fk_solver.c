@@ -109,6 +109,40 @@ static void delta_fk_from_unit(const delta_fk_workspace *work, delta_fk_real v[]
     for (i = 0; i < DELTA_FK_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (delta_fk_length_scales). */
+static delta_fk_real delta_fk_lever_arm(const delta_fk_real nz[])
+{
+    delta_fk_real moved[DELTA_FK_NQ] = {0}, turned[DELTA_FK_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < DELTA_FK_NNZ; ++e) {
+        const delta_fk_real a = fabs(nz[e]);
+        delta_fk_real *largest = delta_fk_length_column[delta_fk_phi_q_col[e]] ? moved : turned;
+        const int row = delta_fk_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (delta_fk_real)NAN;
+    for (i = 0; i < DELTA_FK_NQ; ++i) {
+        if (moved[i] > 0) {
+            const delta_fk_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void delta_fk_length_scales(int m, const delta_fk_real p[], const delta_fk_real q[],
+                                int q_stride, delta_fk_real t, delta_fk_real scales[])
+{
+    delta_fk_real nz[DELTA_FK_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        delta_fk_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * DELTA_FK_NP : p, nz);
+        scales[j] = delta_fk_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -801,7 +835,8 @@ static delta_fk_real *delta_fk_block(delta_fk_real out[], size_t rows)
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one delta_fk_solve_grid call would give; only the output offsets differ. */
-int delta_fk_solve_batch(const delta_fk_options *options, int m, const delta_fk_real p[],
+int delta_fk_solve_batch(const delta_fk_options *options, const delta_fk_real units[],
+                             int m, const delta_fk_real p[],
                              const delta_fk_real q0[], int q0_stride, int n,
                              const delta_fk_real t[], delta_fk_real q_out[],
                              delta_fk_real dq_out[], delta_fk_real ddq_out[],
@@ -809,6 +844,7 @@ int delta_fk_solve_batch(const delta_fk_options *options, int m, const delta_fk_
                              delta_fk_batch_report reports[])
 {
     delta_fk_report report;
+    delta_fk_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * DELTA_FK_NQ;
@@ -825,13 +861,15 @@ int delta_fk_solve_batch(const delta_fk_options *options, int m, const delta_fk_
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (delta_fk_real)NAN;
+        out->cond = out->start_cond = (delta_fk_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (delta_fk_solve_step(options, p_set, t[k], state, work, &report) != DELTA_FK_OK) {
+            if (delta_fk_solve_step(&set_options, p_set, t[k], state, work, &report) != DELTA_FK_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             delta_fk_store(q_set, k, state->q);
             delta_fk_store(dq_set, k, state->dq);
             delta_fk_store(ddq_set, k, state->ddq);

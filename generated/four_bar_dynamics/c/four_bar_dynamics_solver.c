@@ -109,6 +109,40 @@ static void four_bar_dynamics_from_unit(const four_bar_dynamics_workspace *work,
     for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (four_bar_dynamics_length_scales). */
+static four_bar_dynamics_real four_bar_dynamics_lever_arm(const four_bar_dynamics_real nz[])
+{
+    four_bar_dynamics_real moved[FOUR_BAR_DYNAMICS_NQ] = {0}, turned[FOUR_BAR_DYNAMICS_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < FOUR_BAR_DYNAMICS_NNZ; ++e) {
+        const four_bar_dynamics_real a = fabs(nz[e]);
+        four_bar_dynamics_real *largest = four_bar_dynamics_length_column[four_bar_dynamics_phi_q_col[e]] ? moved : turned;
+        const int row = four_bar_dynamics_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (four_bar_dynamics_real)NAN;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
+        if (moved[i] > 0) {
+            const four_bar_dynamics_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void four_bar_dynamics_length_scales(int m, const four_bar_dynamics_real p[], const four_bar_dynamics_real q[],
+                                int q_stride, four_bar_dynamics_real t, four_bar_dynamics_real scales[])
+{
+    four_bar_dynamics_real nz[FOUR_BAR_DYNAMICS_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        four_bar_dynamics_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * FOUR_BAR_DYNAMICS_NP : p, nz);
+        scales[j] = four_bar_dynamics_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -714,7 +748,8 @@ static four_bar_dynamics_real *four_bar_dynamics_block(four_bar_dynamics_real ou
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one four_bar_dynamics_solve_grid call would give; only the output offsets differ. */
-int four_bar_dynamics_solve_batch(const four_bar_dynamics_options *options, int m, const four_bar_dynamics_real p[],
+int four_bar_dynamics_solve_batch(const four_bar_dynamics_options *options, const four_bar_dynamics_real units[],
+                             int m, const four_bar_dynamics_real p[],
                              const four_bar_dynamics_real q0[], int q0_stride, int n,
                              const four_bar_dynamics_real t[], four_bar_dynamics_real q_out[],
                              four_bar_dynamics_real dq_out[], four_bar_dynamics_real ddq_out[],
@@ -722,6 +757,7 @@ int four_bar_dynamics_solve_batch(const four_bar_dynamics_options *options, int 
                              four_bar_dynamics_batch_report reports[])
 {
     four_bar_dynamics_report report;
+    four_bar_dynamics_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * FOUR_BAR_DYNAMICS_NQ;
@@ -738,13 +774,15 @@ int four_bar_dynamics_solve_batch(const four_bar_dynamics_options *options, int 
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (four_bar_dynamics_real)NAN;
+        out->cond = out->start_cond = (four_bar_dynamics_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (four_bar_dynamics_solve_step(options, p_set, t[k], state, work, &report) != FOUR_BAR_DYNAMICS_OK) {
+            if (four_bar_dynamics_solve_step(&set_options, p_set, t[k], state, work, &report) != FOUR_BAR_DYNAMICS_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             four_bar_dynamics_store(q_set, k, state->q);
             four_bar_dynamics_store(dq_set, k, state->dq);
             four_bar_dynamics_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void parallelogram_extra_bar_from_unit(const parallelogram_extra_bar_work
     for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (parallelogram_extra_bar_length_scales). */
+static parallelogram_extra_bar_real parallelogram_extra_bar_lever_arm(const parallelogram_extra_bar_real nz[])
+{
+    parallelogram_extra_bar_real moved[PARALLELOGRAM_EXTRA_BAR_NQ] = {0}, turned[PARALLELOGRAM_EXTRA_BAR_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_NNZ; ++e) {
+        const parallelogram_extra_bar_real a = fabs(nz[e]);
+        parallelogram_extra_bar_real *largest = parallelogram_extra_bar_length_column[parallelogram_extra_bar_phi_q_col[e]] ? moved : turned;
+        const int row = parallelogram_extra_bar_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (parallelogram_extra_bar_real)NAN;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_NQ; ++i) {
+        if (moved[i] > 0) {
+            const parallelogram_extra_bar_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void parallelogram_extra_bar_length_scales(int m, const parallelogram_extra_bar_real p[], const parallelogram_extra_bar_real q[],
+                                int q_stride, parallelogram_extra_bar_real t, parallelogram_extra_bar_real scales[])
+{
+    parallelogram_extra_bar_real nz[PARALLELOGRAM_EXTRA_BAR_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        parallelogram_extra_bar_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * PARALLELOGRAM_EXTRA_BAR_NP : p, nz);
+        scales[j] = parallelogram_extra_bar_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -731,7 +765,8 @@ static parallelogram_extra_bar_real *parallelogram_extra_bar_block(parallelogram
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one parallelogram_extra_bar_solve_grid call would give; only the output offsets differ. */
-int parallelogram_extra_bar_solve_batch(const parallelogram_extra_bar_options *options, int m, const parallelogram_extra_bar_real p[],
+int parallelogram_extra_bar_solve_batch(const parallelogram_extra_bar_options *options, const parallelogram_extra_bar_real units[],
+                             int m, const parallelogram_extra_bar_real p[],
                              const parallelogram_extra_bar_real q0[], int q0_stride, int n,
                              const parallelogram_extra_bar_real t[], parallelogram_extra_bar_real q_out[],
                              parallelogram_extra_bar_real dq_out[], parallelogram_extra_bar_real ddq_out[],
@@ -739,6 +774,7 @@ int parallelogram_extra_bar_solve_batch(const parallelogram_extra_bar_options *o
                              parallelogram_extra_bar_batch_report reports[])
 {
     parallelogram_extra_bar_report report;
+    parallelogram_extra_bar_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * PARALLELOGRAM_EXTRA_BAR_NQ;
@@ -755,13 +791,15 @@ int parallelogram_extra_bar_solve_batch(const parallelogram_extra_bar_options *o
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (parallelogram_extra_bar_real)NAN;
+        out->cond = out->start_cond = (parallelogram_extra_bar_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (parallelogram_extra_bar_solve_step(options, p_set, t[k], state, work, &report) != PARALLELOGRAM_EXTRA_BAR_OK) {
+            if (parallelogram_extra_bar_solve_step(&set_options, p_set, t[k], state, work, &report) != PARALLELOGRAM_EXTRA_BAR_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             parallelogram_extra_bar_store(q_set, k, state->q);
             parallelogram_extra_bar_store(dq_set, k, state->dq);
             parallelogram_extra_bar_store(ddq_set, k, state->ddq);

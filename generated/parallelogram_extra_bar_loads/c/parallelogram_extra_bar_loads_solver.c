@@ -109,6 +109,40 @@ static void parallelogram_extra_bar_loads_from_unit(const parallelogram_extra_ba
     for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (parallelogram_extra_bar_loads_length_scales). */
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_lever_arm(const parallelogram_extra_bar_loads_real nz[])
+{
+    parallelogram_extra_bar_loads_real moved[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ] = {0}, turned[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e) {
+        const parallelogram_extra_bar_loads_real a = fabs(nz[e]);
+        parallelogram_extra_bar_loads_real *largest = parallelogram_extra_bar_loads_length_column[parallelogram_extra_bar_loads_phi_q_col[e]] ? moved : turned;
+        const int row = parallelogram_extra_bar_loads_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (parallelogram_extra_bar_loads_real)NAN;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
+        if (moved[i] > 0) {
+            const parallelogram_extra_bar_loads_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void parallelogram_extra_bar_loads_length_scales(int m, const parallelogram_extra_bar_loads_real p[], const parallelogram_extra_bar_loads_real q[],
+                                int q_stride, parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_real scales[])
+{
+    parallelogram_extra_bar_loads_real nz[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        parallelogram_extra_bar_loads_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * PARALLELOGRAM_EXTRA_BAR_LOADS_NP : p, nz);
+        scales[j] = parallelogram_extra_bar_loads_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -773,7 +807,8 @@ static parallelogram_extra_bar_loads_real *parallelogram_extra_bar_loads_block(p
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one parallelogram_extra_bar_loads_solve_grid call would give; only the output offsets differ. */
-int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_loads_options *options, int m, const parallelogram_extra_bar_loads_real p[],
+int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real units[],
+                             int m, const parallelogram_extra_bar_loads_real p[],
                              const parallelogram_extra_bar_loads_real q0[], int q0_stride, int n,
                              const parallelogram_extra_bar_loads_real t[], parallelogram_extra_bar_loads_real q_out[],
                              parallelogram_extra_bar_loads_real dq_out[], parallelogram_extra_bar_loads_real ddq_out[],
@@ -781,6 +816,7 @@ int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_load
                              parallelogram_extra_bar_loads_batch_report reports[])
 {
     parallelogram_extra_bar_loads_report report;
+    parallelogram_extra_bar_loads_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * PARALLELOGRAM_EXTRA_BAR_LOADS_NQ;
@@ -797,13 +833,15 @@ int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_load
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (parallelogram_extra_bar_loads_real)NAN;
+        out->cond = out->start_cond = (parallelogram_extra_bar_loads_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (parallelogram_extra_bar_loads_solve_step(options, p_set, t[k], state, work, &report) != PARALLELOGRAM_EXTRA_BAR_LOADS_OK) {
+            if (parallelogram_extra_bar_loads_solve_step(&set_options, p_set, t[k], state, work, &report) != PARALLELOGRAM_EXTRA_BAR_LOADS_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             parallelogram_extra_bar_loads_store(q_set, k, state->q);
             parallelogram_extra_bar_loads_store(dq_set, k, state->dq);
             parallelogram_extra_bar_loads_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void planetary_from_unit(const planetary_workspace *work, planetary_real 
     for (i = 0; i < PLANETARY_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (planetary_length_scales). */
+static planetary_real planetary_lever_arm(const planetary_real nz[])
+{
+    planetary_real moved[PLANETARY_NQ] = {0}, turned[PLANETARY_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < PLANETARY_NNZ; ++e) {
+        const planetary_real a = fabs(nz[e]);
+        planetary_real *largest = planetary_length_column[planetary_phi_q_col[e]] ? moved : turned;
+        const int row = planetary_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (planetary_real)NAN;
+    for (i = 0; i < PLANETARY_NQ; ++i) {
+        if (moved[i] > 0) {
+            const planetary_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void planetary_length_scales(int m, const planetary_real p[], const planetary_real q[],
+                                int q_stride, planetary_real t, planetary_real scales[])
+{
+    planetary_real nz[PLANETARY_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        planetary_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * PLANETARY_NP : p, nz);
+        scales[j] = planetary_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -685,7 +719,8 @@ static planetary_real *planetary_block(planetary_real out[], size_t rows)
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one planetary_solve_grid call would give; only the output offsets differ. */
-int planetary_solve_batch(const planetary_options *options, int m, const planetary_real p[],
+int planetary_solve_batch(const planetary_options *options, const planetary_real units[],
+                             int m, const planetary_real p[],
                              const planetary_real q0[], int q0_stride, int n,
                              const planetary_real t[], planetary_real q_out[],
                              planetary_real dq_out[], planetary_real ddq_out[],
@@ -693,6 +728,7 @@ int planetary_solve_batch(const planetary_options *options, int m, const planeta
                              planetary_batch_report reports[])
 {
     planetary_report report;
+    planetary_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * PLANETARY_NQ;
@@ -709,13 +745,15 @@ int planetary_solve_batch(const planetary_options *options, int m, const planeta
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (planetary_real)NAN;
+        out->cond = out->start_cond = (planetary_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (planetary_solve_step(options, p_set, t[k], state, work, &report) != PLANETARY_OK) {
+            if (planetary_solve_step(&set_options, p_set, t[k], state, work, &report) != PLANETARY_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             planetary_store(q_set, k, state->q);
             planetary_store(dq_set, k, state->dq);
             planetary_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void quick_return_from_unit(const quick_return_workspace *work, quick_ret
     for (i = 0; i < QUICK_RETURN_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (quick_return_length_scales). */
+static quick_return_real quick_return_lever_arm(const quick_return_real nz[])
+{
+    quick_return_real moved[QUICK_RETURN_NQ] = {0}, turned[QUICK_RETURN_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < QUICK_RETURN_NNZ; ++e) {
+        const quick_return_real a = fabs(nz[e]);
+        quick_return_real *largest = quick_return_length_column[quick_return_phi_q_col[e]] ? moved : turned;
+        const int row = quick_return_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (quick_return_real)NAN;
+    for (i = 0; i < QUICK_RETURN_NQ; ++i) {
+        if (moved[i] > 0) {
+            const quick_return_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void quick_return_length_scales(int m, const quick_return_real p[], const quick_return_real q[],
+                                int q_stride, quick_return_real t, quick_return_real scales[])
+{
+    quick_return_real nz[QUICK_RETURN_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        quick_return_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * QUICK_RETURN_NP : p, nz);
+        scales[j] = quick_return_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -739,7 +773,8 @@ static quick_return_real *quick_return_block(quick_return_real out[], size_t row
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one quick_return_solve_grid call would give; only the output offsets differ. */
-int quick_return_solve_batch(const quick_return_options *options, int m, const quick_return_real p[],
+int quick_return_solve_batch(const quick_return_options *options, const quick_return_real units[],
+                             int m, const quick_return_real p[],
                              const quick_return_real q0[], int q0_stride, int n,
                              const quick_return_real t[], quick_return_real q_out[],
                              quick_return_real dq_out[], quick_return_real ddq_out[],
@@ -747,6 +782,7 @@ int quick_return_solve_batch(const quick_return_options *options, int m, const q
                              quick_return_batch_report reports[])
 {
     quick_return_report report;
+    quick_return_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * QUICK_RETURN_NQ;
@@ -763,13 +799,15 @@ int quick_return_solve_batch(const quick_return_options *options, int m, const q
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (quick_return_real)NAN;
+        out->cond = out->start_cond = (quick_return_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (quick_return_solve_step(options, p_set, t[k], state, work, &report) != QUICK_RETURN_OK) {
+            if (quick_return_solve_step(&set_options, p_set, t[k], state, work, &report) != QUICK_RETURN_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             quick_return_store(q_set, k, state->q);
             quick_return_store(dq_set, k, state->dq);
             quick_return_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void rack_linkage_from_unit(const rack_linkage_workspace *work, rack_link
     for (i = 0; i < RACK_LINKAGE_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (rack_linkage_length_scales). */
+static rack_linkage_real rack_linkage_lever_arm(const rack_linkage_real nz[])
+{
+    rack_linkage_real moved[RACK_LINKAGE_NQ] = {0}, turned[RACK_LINKAGE_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < RACK_LINKAGE_NNZ; ++e) {
+        const rack_linkage_real a = fabs(nz[e]);
+        rack_linkage_real *largest = rack_linkage_length_column[rack_linkage_phi_q_col[e]] ? moved : turned;
+        const int row = rack_linkage_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (rack_linkage_real)NAN;
+    for (i = 0; i < RACK_LINKAGE_NQ; ++i) {
+        if (moved[i] > 0) {
+            const rack_linkage_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void rack_linkage_length_scales(int m, const rack_linkage_real p[], const rack_linkage_real q[],
+                                int q_stride, rack_linkage_real t, rack_linkage_real scales[])
+{
+    rack_linkage_real nz[RACK_LINKAGE_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        rack_linkage_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * RACK_LINKAGE_NP : p, nz);
+        scales[j] = rack_linkage_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -766,7 +800,8 @@ static rack_linkage_real *rack_linkage_block(rack_linkage_real out[], size_t row
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one rack_linkage_solve_grid call would give; only the output offsets differ. */
-int rack_linkage_solve_batch(const rack_linkage_options *options, int m, const rack_linkage_real p[],
+int rack_linkage_solve_batch(const rack_linkage_options *options, const rack_linkage_real units[],
+                             int m, const rack_linkage_real p[],
                              const rack_linkage_real q0[], int q0_stride, int n,
                              const rack_linkage_real t[], rack_linkage_real q_out[],
                              rack_linkage_real dq_out[], rack_linkage_real ddq_out[],
@@ -774,6 +809,7 @@ int rack_linkage_solve_batch(const rack_linkage_options *options, int m, const r
                              rack_linkage_batch_report reports[])
 {
     rack_linkage_report report;
+    rack_linkage_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * RACK_LINKAGE_NQ;
@@ -790,13 +826,15 @@ int rack_linkage_solve_batch(const rack_linkage_options *options, int m, const r
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (rack_linkage_real)NAN;
+        out->cond = out->start_cond = (rack_linkage_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (rack_linkage_solve_step(options, p_set, t[k], state, work, &report) != RACK_LINKAGE_OK) {
+            if (rack_linkage_solve_step(&set_options, p_set, t[k], state, work, &report) != RACK_LINKAGE_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             rack_linkage_store(q_set, k, state->q);
             rack_linkage_store(dq_set, k, state->dq);
             rack_linkage_store(ddq_set, k, state->ddq);

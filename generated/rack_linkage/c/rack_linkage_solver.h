@@ -126,21 +126,33 @@ typedef struct {
     int iterations;              /* Newton iterations summed over the set's steps           */
     rack_linkage_real residual;  /* max|Phi| of the last iterate                            */
     rack_linkage_real cond;      /* the condition estimate at the last point solved (NaN: none) */
+    rack_linkage_real start_cond; /* the condition estimate at t[0] (NaN: not solved there)   */
 } rack_linkage_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
  * p[j*NP ...] and starts from q0[j*NQ ...] (q0_stride = NQ) or, with q0_stride = 0, every set
- * from the one guess q0[0 ... NQ-1]. Rows of set j, step k go to q_out[(j*n + k)*NQ ...] (and
- * dq_out, ddq_out; any may be NULL): caller-owned m x n x NQ arrays. reports[j] says how set j
- * ended; a set that fails stops only itself (its rows past reports[j].solved are not written)
- * and the batch goes on. state and work are scratch space, reused from set to set.
- * Returns the number of sets solved over the whole grid. */
-int rack_linkage_solve_batch(const rack_linkage_options *options, int m, const rack_linkage_real p[],
+ * from the one guess q0[0 ... NQ-1]; its decisions are made in the length unit units[j]
+ * (options->unit for every set when units is NULL). Rows of set j, step k go to
+ * q_out[(j*n + k)*NQ ...] (and dq_out, ddq_out; any may be NULL): caller-owned m x n x NQ
+ * arrays. reports[j] says how set j ended; a set that fails stops only itself (its rows past
+ * reports[j].solved are not written) and the batch goes on. state and work are scratch
+ * space, reused from set to set. Returns the number of sets solved over the whole grid. */
+int rack_linkage_solve_batch(const rack_linkage_options *options, const rack_linkage_real units[],
+                             int m, const rack_linkage_real p[],
                              const rack_linkage_real q0[], int q0_stride, int n,
                              const rack_linkage_real t[], rack_linkage_real q_out[],
                              rack_linkage_real dq_out[], rack_linkage_real ddq_out[],
                              rack_linkage_state *state, rack_linkage_workspace *work,
                              rack_linkage_batch_report reports[]);
+
+/* The length scale of m configurations: per set j (parameters p[j*NP ...], coordinates
+ * q[j*q_stride ...], at time t), the largest lever arm in Phi_q, max |dPhi_i/dphi_k| /
+ * max |dPhi_i/dx_k| over the rows i with an entry in a length column (symkin's
+ * runtime.start.length_scale): 0 where there is none, NaN where an entry of Phi_q is not
+ * finite. The unit a run is decided in, and how far its condition estimate may be from the
+ * one in units of this scale, follow from it. */
+void rack_linkage_length_scales(int m, const rack_linkage_real p[], const rack_linkage_real q[],
+                                int q_stride, rack_linkage_real t, rack_linkage_real scales[]);
 
 #define RACK_LINKAGE_EDGE_REACHED 0  /* the substeps reached t                                */
 #define RACK_LINKAGE_EDGE_PASSABLE 1 /* blocked, but a step over the blocked time converges   */

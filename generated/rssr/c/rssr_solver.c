@@ -109,6 +109,40 @@ static void rssr_from_unit(const rssr_workspace *work, rssr_real v[])
     for (i = 0; i < RSSR_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (rssr_length_scales). */
+static rssr_real rssr_lever_arm(const rssr_real nz[])
+{
+    rssr_real moved[RSSR_NQ] = {0}, turned[RSSR_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < RSSR_NNZ; ++e) {
+        const rssr_real a = fabs(nz[e]);
+        rssr_real *largest = rssr_length_column[rssr_phi_q_col[e]] ? moved : turned;
+        const int row = rssr_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (rssr_real)NAN;
+    for (i = 0; i < RSSR_NQ; ++i) {
+        if (moved[i] > 0) {
+            const rssr_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void rssr_length_scales(int m, const rssr_real p[], const rssr_real q[],
+                                int q_stride, rssr_real t, rssr_real scales[])
+{
+    rssr_real nz[RSSR_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        rssr_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * RSSR_NP : p, nz);
+        scales[j] = rssr_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -1021,7 +1055,8 @@ static rssr_real *rssr_block(rssr_real out[], size_t rows)
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one rssr_solve_grid call would give; only the output offsets differ. */
-int rssr_solve_batch(const rssr_options *options, int m, const rssr_real p[],
+int rssr_solve_batch(const rssr_options *options, const rssr_real units[],
+                             int m, const rssr_real p[],
                              const rssr_real q0[], int q0_stride, int n,
                              const rssr_real t[], rssr_real q_out[],
                              rssr_real dq_out[], rssr_real ddq_out[],
@@ -1029,6 +1064,7 @@ int rssr_solve_batch(const rssr_options *options, int m, const rssr_real p[],
                              rssr_batch_report reports[])
 {
     rssr_report report;
+    rssr_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * RSSR_NQ;
@@ -1045,13 +1081,15 @@ int rssr_solve_batch(const rssr_options *options, int m, const rssr_real p[],
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (rssr_real)NAN;
+        out->cond = out->start_cond = (rssr_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (rssr_solve_step(options, p_set, t[k], state, work, &report) != RSSR_OK) {
+            if (rssr_solve_step(&set_options, p_set, t[k], state, work, &report) != RSSR_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             rssr_store(q_set, k, state->q);
             rssr_store(dq_set, k, state->dq);
             rssr_store(ddq_set, k, state->ddq);

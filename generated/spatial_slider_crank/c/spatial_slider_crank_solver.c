@@ -109,6 +109,40 @@ static void spatial_slider_crank_from_unit(const spatial_slider_crank_workspace 
     for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (spatial_slider_crank_length_scales). */
+static spatial_slider_crank_real spatial_slider_crank_lever_arm(const spatial_slider_crank_real nz[])
+{
+    spatial_slider_crank_real moved[SPATIAL_SLIDER_CRANK_NQ] = {0}, turned[SPATIAL_SLIDER_CRANK_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < SPATIAL_SLIDER_CRANK_NNZ; ++e) {
+        const spatial_slider_crank_real a = fabs(nz[e]);
+        spatial_slider_crank_real *largest = spatial_slider_crank_length_column[spatial_slider_crank_phi_q_col[e]] ? moved : turned;
+        const int row = spatial_slider_crank_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (spatial_slider_crank_real)NAN;
+    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+        if (moved[i] > 0) {
+            const spatial_slider_crank_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void spatial_slider_crank_length_scales(int m, const spatial_slider_crank_real p[], const spatial_slider_crank_real q[],
+                                int q_stride, spatial_slider_crank_real t, spatial_slider_crank_real scales[])
+{
+    spatial_slider_crank_real nz[SPATIAL_SLIDER_CRANK_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        spatial_slider_crank_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * SPATIAL_SLIDER_CRANK_NP : p, nz);
+        scales[j] = spatial_slider_crank_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -678,7 +712,8 @@ static spatial_slider_crank_real *spatial_slider_crank_block(spatial_slider_cran
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one spatial_slider_crank_solve_grid call would give; only the output offsets differ. */
-int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options, int m, const spatial_slider_crank_real p[],
+int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options, const spatial_slider_crank_real units[],
+                             int m, const spatial_slider_crank_real p[],
                              const spatial_slider_crank_real q0[], int q0_stride, int n,
                              const spatial_slider_crank_real t[], spatial_slider_crank_real q_out[],
                              spatial_slider_crank_real dq_out[], spatial_slider_crank_real ddq_out[],
@@ -686,6 +721,7 @@ int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options
                              spatial_slider_crank_batch_report reports[])
 {
     spatial_slider_crank_report report;
+    spatial_slider_crank_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * SPATIAL_SLIDER_CRANK_NQ;
@@ -702,13 +738,15 @@ int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (spatial_slider_crank_real)NAN;
+        out->cond = out->start_cond = (spatial_slider_crank_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (spatial_slider_crank_solve_step(options, p_set, t[k], state, work, &report) != SPATIAL_SLIDER_CRANK_OK) {
+            if (spatial_slider_crank_solve_step(&set_options, p_set, t[k], state, work, &report) != SPATIAL_SLIDER_CRANK_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             spatial_slider_crank_store(q_set, k, state->q);
             spatial_slider_crank_store(dq_set, k, state->dq);
             spatial_slider_crank_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void stewart_from_unit(const stewart_workspace *work, stewart_real v[])
     for (i = 0; i < STEWART_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (stewart_length_scales). */
+static stewart_real stewart_lever_arm(const stewart_real nz[])
+{
+    stewart_real moved[STEWART_NQ] = {0}, turned[STEWART_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < STEWART_NNZ; ++e) {
+        const stewart_real a = fabs(nz[e]);
+        stewart_real *largest = stewart_length_column[stewart_phi_q_col[e]] ? moved : turned;
+        const int row = stewart_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (stewart_real)NAN;
+    for (i = 0; i < STEWART_NQ; ++i) {
+        if (moved[i] > 0) {
+            const stewart_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void stewart_length_scales(int m, const stewart_real p[], const stewart_real q[],
+                                int q_stride, stewart_real t, stewart_real scales[])
+{
+    stewart_real nz[STEWART_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        stewart_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * STEWART_NP : p, nz);
+        scales[j] = stewart_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -1033,7 +1067,8 @@ static stewart_real *stewart_block(stewart_real out[], size_t rows)
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one stewart_solve_grid call would give; only the output offsets differ. */
-int stewart_solve_batch(const stewart_options *options, int m, const stewart_real p[],
+int stewart_solve_batch(const stewart_options *options, const stewart_real units[],
+                             int m, const stewart_real p[],
                              const stewart_real q0[], int q0_stride, int n,
                              const stewart_real t[], stewart_real q_out[],
                              stewart_real dq_out[], stewart_real ddq_out[],
@@ -1041,6 +1076,7 @@ int stewart_solve_batch(const stewart_options *options, int m, const stewart_rea
                              stewart_batch_report reports[])
 {
     stewart_report report;
+    stewart_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * STEWART_NQ;
@@ -1057,13 +1093,15 @@ int stewart_solve_batch(const stewart_options *options, int m, const stewart_rea
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (stewart_real)NAN;
+        out->cond = out->start_cond = (stewart_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (stewart_solve_step(options, p_set, t[k], state, work, &report) != STEWART_OK) {
+            if (stewart_solve_step(&set_options, p_set, t[k], state, work, &report) != STEWART_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             stewart_store(q_set, k, state->q);
             stewart_store(dq_set, k, state->dq);
             stewart_store(ddq_set, k, state->ddq);

@@ -115,6 +115,40 @@ static void stewart_legs_fk_from_unit(const stewart_legs_fk_workspace *work, ste
     for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (stewart_legs_fk_length_scales). */
+static stewart_legs_fk_real stewart_legs_fk_lever_arm(const stewart_legs_fk_real nz[])
+{
+    stewart_legs_fk_real moved[STEWART_LEGS_FK_NQ] = {0}, turned[STEWART_LEGS_FK_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < STEWART_LEGS_FK_NNZ; ++e) {
+        const stewart_legs_fk_real a = fabs(nz[e]);
+        stewart_legs_fk_real *largest = stewart_legs_fk_length_column[stewart_legs_fk_phi_q_col[e]] ? moved : turned;
+        const int row = stewart_legs_fk_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (stewart_legs_fk_real)NAN;
+    for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
+        if (moved[i] > 0) {
+            const stewart_legs_fk_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void stewart_legs_fk_length_scales(int m, const stewart_legs_fk_real p[], const stewart_legs_fk_real q[],
+                                int q_stride, stewart_legs_fk_real t, stewart_legs_fk_real scales[])
+{
+    stewart_legs_fk_real nz[STEWART_LEGS_FK_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        stewart_legs_fk_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * STEWART_LEGS_FK_NP : p, nz);
+        scales[j] = stewart_legs_fk_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -1071,7 +1105,8 @@ static stewart_legs_fk_real *stewart_legs_fk_block(stewart_legs_fk_real out[], s
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one stewart_legs_fk_solve_grid call would give; only the output offsets differ. */
-int stewart_legs_fk_solve_batch(const stewart_legs_fk_options *options, int m, const stewart_legs_fk_real p[],
+int stewart_legs_fk_solve_batch(const stewart_legs_fk_options *options, const stewart_legs_fk_real units[],
+                             int m, const stewart_legs_fk_real p[],
                              const stewart_legs_fk_real q0[], int q0_stride, int n,
                              const stewart_legs_fk_real t[], stewart_legs_fk_real q_out[],
                              stewart_legs_fk_real dq_out[], stewart_legs_fk_real ddq_out[],
@@ -1079,6 +1114,7 @@ int stewart_legs_fk_solve_batch(const stewart_legs_fk_options *options, int m, c
                              stewart_legs_fk_batch_report reports[])
 {
     stewart_legs_fk_report report;
+    stewart_legs_fk_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * STEWART_LEGS_FK_NQ;
@@ -1095,13 +1131,15 @@ int stewart_legs_fk_solve_batch(const stewart_legs_fk_options *options, int m, c
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (stewart_legs_fk_real)NAN;
+        out->cond = out->start_cond = (stewart_legs_fk_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (stewart_legs_fk_solve_step(options, p_set, t[k], state, work, &report) != STEWART_LEGS_FK_OK) {
+            if (stewart_legs_fk_solve_step(&set_options, p_set, t[k], state, work, &report) != STEWART_LEGS_FK_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             stewart_legs_fk_store(q_set, k, state->q);
             stewart_legs_fk_store(dq_set, k, state->dq);
             stewart_legs_fk_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void three_rrr_fk_from_unit(const three_rrr_fk_workspace *work, three_rrr
     for (i = 0; i < THREE_RRR_FK_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (three_rrr_fk_length_scales). */
+static three_rrr_fk_real three_rrr_fk_lever_arm(const three_rrr_fk_real nz[])
+{
+    three_rrr_fk_real moved[THREE_RRR_FK_NQ] = {0}, turned[THREE_RRR_FK_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) {
+        const three_rrr_fk_real a = fabs(nz[e]);
+        three_rrr_fk_real *largest = three_rrr_fk_length_column[three_rrr_fk_phi_q_col[e]] ? moved : turned;
+        const int row = three_rrr_fk_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (three_rrr_fk_real)NAN;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+        if (moved[i] > 0) {
+            const three_rrr_fk_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void three_rrr_fk_length_scales(int m, const three_rrr_fk_real p[], const three_rrr_fk_real q[],
+                                int q_stride, three_rrr_fk_real t, three_rrr_fk_real scales[])
+{
+    three_rrr_fk_real nz[THREE_RRR_FK_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        three_rrr_fk_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * THREE_RRR_FK_NP : p, nz);
+        scales[j] = three_rrr_fk_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -995,7 +1029,8 @@ static three_rrr_fk_real *three_rrr_fk_block(three_rrr_fk_real out[], size_t row
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one three_rrr_fk_solve_grid call would give; only the output offsets differ. */
-int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, int m, const three_rrr_fk_real p[],
+int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, const three_rrr_fk_real units[],
+                             int m, const three_rrr_fk_real p[],
                              const three_rrr_fk_real q0[], int q0_stride, int n,
                              const three_rrr_fk_real t[], three_rrr_fk_real q_out[],
                              three_rrr_fk_real dq_out[], three_rrr_fk_real ddq_out[],
@@ -1003,6 +1038,7 @@ int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, int m, const t
                              three_rrr_fk_batch_report reports[])
 {
     three_rrr_fk_report report;
+    three_rrr_fk_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * THREE_RRR_FK_NQ;
@@ -1019,13 +1055,15 @@ int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, int m, const t
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (three_rrr_fk_real)NAN;
+        out->cond = out->start_cond = (three_rrr_fk_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (three_rrr_fk_solve_step(options, p_set, t[k], state, work, &report) != THREE_RRR_FK_OK) {
+            if (three_rrr_fk_solve_step(&set_options, p_set, t[k], state, work, &report) != THREE_RRR_FK_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             three_rrr_fk_store(q_set, k, state->q);
             three_rrr_fk_store(dq_set, k, state->dq);
             three_rrr_fk_store(ddq_set, k, state->ddq);

@@ -109,6 +109,40 @@ static void whitworth_drawn_from_unit(const whitworth_drawn_workspace *work, whi
     for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) v[i] *= work->column[i];
 }
 
+
+/* The largest lever arm in the non-zeros nz of Phi_q (whitworth_drawn_length_scales). */
+static whitworth_drawn_real whitworth_drawn_lever_arm(const whitworth_drawn_real nz[])
+{
+    whitworth_drawn_real moved[WHITWORTH_DRAWN_NQ] = {0}, turned[WHITWORTH_DRAWN_NQ] = {0}, scale = 0, sum = 0;
+    int e, i;
+    for (e = 0; e < WHITWORTH_DRAWN_NNZ; ++e) {
+        const whitworth_drawn_real a = fabs(nz[e]);
+        whitworth_drawn_real *largest = whitworth_drawn_length_column[whitworth_drawn_phi_q_col[e]] ? moved : turned;
+        const int row = whitworth_drawn_phi_q_row[e];
+        largest[row] = a > largest[row] ? a : largest[row];
+        sum += a; /* NaN exactly when some entry is NaN or inf (none is negative) */
+    }
+    if (sum - sum != 0) return (whitworth_drawn_real)NAN;
+    for (i = 0; i < WHITWORTH_DRAWN_NQ; ++i) {
+        if (moved[i] > 0) {
+            const whitworth_drawn_real arm = turned[i] / moved[i];
+            scale = arm > scale ? arm : scale;
+        }
+    }
+    return scale;
+}
+
+void whitworth_drawn_length_scales(int m, const whitworth_drawn_real p[], const whitworth_drawn_real q[],
+                                int q_stride, whitworth_drawn_real t, whitworth_drawn_real scales[])
+{
+    whitworth_drawn_real nz[WHITWORTH_DRAWN_NNZ];
+    int j;
+    for (j = 0; j < m; ++j) {
+        whitworth_drawn_phi_q(q + (size_t)j * (size_t)q_stride, t,
+                           p ? p + (size_t)j * WHITWORTH_DRAWN_NP : p, nz);
+        scales[j] = whitworth_drawn_lever_arm(nz);
+    }
+}
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
  * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
@@ -739,7 +773,8 @@ static whitworth_drawn_real *whitworth_drawn_block(whitworth_drawn_real out[], s
 
 /* The batch is the grid loop run once per set from a fresh state, so a set's rows are the
  * same bytes one whitworth_drawn_solve_grid call would give; only the output offsets differ. */
-int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, int m, const whitworth_drawn_real p[],
+int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, const whitworth_drawn_real units[],
+                             int m, const whitworth_drawn_real p[],
                              const whitworth_drawn_real q0[], int q0_stride, int n,
                              const whitworth_drawn_real t[], whitworth_drawn_real q_out[],
                              whitworth_drawn_real dq_out[], whitworth_drawn_real ddq_out[],
@@ -747,6 +782,7 @@ int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, int m, c
                              whitworth_drawn_batch_report reports[])
 {
     whitworth_drawn_report report;
+    whitworth_drawn_options set_options = *options; /* with the set's unit */
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * WHITWORTH_DRAWN_NQ;
@@ -763,13 +799,15 @@ int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, int m, c
         report.iterations = 0;
         report.residual = 0;
         out->iterations = 0;
-        out->cond = (whitworth_drawn_real)NAN;
+        out->cond = out->start_cond = (whitworth_drawn_real)NAN;
+        set_options.unit = units ? units[j] : options->unit;
         for (k = 0; k < n; ++k) {
-            if (whitworth_drawn_solve_step(options, p_set, t[k], state, work, &report) != WHITWORTH_DRAWN_OK) {
+            if (whitworth_drawn_solve_step(&set_options, p_set, t[k], state, work, &report) != WHITWORTH_DRAWN_OK) {
                 break;
             }
             out->iterations += report.iterations;
             out->cond = report.cond;
+            if (k == 0) out->start_cond = report.cond;
             whitworth_drawn_store(q_set, k, state->q);
             whitworth_drawn_store(dq_set, k, state->dq);
             whitworth_drawn_store(ddq_set, k, state->ddq);

@@ -20,14 +20,15 @@ Array = NDArray[np.float64]
 
 
 def solve(ffi: Any, lib: Any, name: str, real: str, params: Array, t: Array, q0: Array,
-          options: Options, rows: tuple[Array, Array, Array]) -> BatchStatus:
+          options: Options, rows: tuple[Array, Array, Array], units: Array) -> BatchStatus:
     """Run ``<prefix>_solve_batch`` over all sets into ``rows`` = (q, dq, d2q), each
-    (m, T, N) float64; returns (status, iterations, solved) per set."""
+    (m, T, N) float64, set j decided in the length unit ``units[j]``; returns (status,
+    iterations, solved, cond, start_cond) per set."""
     dtype = np.float32 if real == "float" else np.float64
     m = params.shape[0]
     direct = dtype == np.float64
     outputs = rows if direct else tuple(np.empty(rows[0].shape, dtype=dtype) for _ in range(3))
-    inputs = [np.ascontiguousarray(a, dtype=dtype) for a in (params, q0, t)]
+    inputs = [np.ascontiguousarray(a, dtype=dtype) for a in (params, q0, t, units)]
     pointer = f"{name}_real *"
     pointers = [ffi.cast(pointer, ffi.from_buffer(a)) if a.size else ffi.NULL
                 for a in (*inputs, *outputs)]
@@ -37,16 +38,37 @@ def solve(ffi: Any, lib: Any, name: str, real: str, params: Array, t: Array, q0:
     reports = ffi.new(f"{name}_batch_report[]", max(m, 1))
     stride = rows[0].shape[2] if q0.ndim == 2 else 0
     getattr(lib, f"{name}_solve_batch")(
-        c_options, m, pointers[0], pointers[1], stride, t.size, pointers[2], pointers[3],
-        pointers[4], pointers[5], state, work, reports)
+        c_options, pointers[3], m, pointers[0], pointers[1], stride, t.size, pointers[2],
+        pointers[4], pointers[5], pointers[6], state, work, reports)
     if not direct:
         for target, source in zip(rows, outputs):
             target[...] = source
     status = np.frombuffer(ffi.buffer(reports, m * ffi.sizeof(f"{name}_batch_report")),
                            dtype=_report_dtype(ffi, name))
     found: BatchStatus = (status["status"].astype(np.int32), status["iterations"].astype(np.int32),
-                          status["solved"].astype(np.int32), status["cond"].astype(np.float64))
+                          status["solved"].astype(np.int32), status["cond"].astype(np.float64),
+                          status["start_cond"].astype(np.float64))
     return found
+
+
+def length_scales(ffi: Any, lib: Any, name: str, real: str, params: Array, q: Array,
+                  t: float) -> Array:
+    """``<prefix>_length_scales``: per set the largest lever arm in Phi_q at its parameters
+    ``params`` (m, NP) and coordinates ``q`` ((N,) for every set, or (m, N); any strides),
+    at time t."""
+    dtype = np.float32 if real == "float" else np.float64
+    m = params.shape[0]
+    if m == 0:
+        return np.empty(0)
+    table = np.ascontiguousarray(params, dtype=dtype)
+    rows = np.ascontiguousarray(q, dtype=dtype)
+    scales = np.empty(m, dtype=dtype)
+    pointer = f"{name}_real *"
+    p, q_rows = (ffi.cast(pointer, ffi.from_buffer(a)) if a.size else ffi.NULL
+                 for a in (table, rows))
+    getattr(lib, f"{name}_length_scales")(m, p, q_rows, rows.shape[-1] if rows.ndim == 2 else 0,
+                                          t, ffi.cast(pointer, ffi.from_buffer(scales)))
+    return scales.astype(np.float64, copy=False)
 
 
 def _report_dtype(ffi: Any, name: str) -> np.dtype[Any]:
@@ -54,7 +76,7 @@ def _report_dtype(ffi: Any, name: str) -> np.dtype[Any]:
     struct = f"{name}_batch_report"
     real = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
     fields = {"status": np.int32, "solved": np.int32, "t": real, "iterations": np.int32,
-              "residual": real, "cond": real}
+              "residual": real, "cond": real, "start_cond": real}
     return np.dtype({"names": list(fields), "formats": list(fields.values()),
                      "offsets": [ffi.offsetof(struct, f) for f in fields],
                      "itemsize": ffi.sizeof(struct)})
@@ -67,3 +89,19 @@ def _options(ffi: Any, lib: Any, name: str, options: Options) -> Any:
     c_options.max_iterations = options.max_iterations
     c_options.min_pivot_ratio = options.min_pivot_ratio
     return c_options
+
+
+class Batch:
+    """The C backend's ``runtime.protocol.BatchSolver``: ``<prefix>_solve_batch`` and
+    ``<prefix>_length_scales`` of one extension."""
+
+    def __init__(self, ffi: Any, lib: Any, name: str, real: str, scale_free: bool) -> None:
+        self._c = (ffi, lib, name, real)
+        self.scale_free = scale_free
+
+    def __call__(self, params: Array, t: Array, q0: Array, options: Options, q: Array,
+                 dq: Array, d2q: Array, units: Array) -> BatchStatus:
+        return solve(*self._c, params, t, q0, options, (q, dq, d2q), units)
+
+    def length_scales(self, params: Array, q: Array, t: float) -> Array:
+        return length_scales(*self._c, params, q, t)

@@ -26,18 +26,20 @@ class EdgeSolver:
         self._work = ffi.new_allocator(should_clear_after_alloc=False)(f"{name}_workspace *")
         self._report = ffi.new(f"{name}_report *")
         self._edge = ffi.new(f"{name}_edge_report *")
-        self._set: Options | None = None
+        self._set: tuple[Options, float] | None = None
         self._solve = getattr(lib, f"{name}_solve_edge")
         self._p = ffi.new(f"{name}_real[]", max(int(getattr(lib, f"{name.upper()}_NP")), 1))
         self.dtype = np.float32 if ffi.sizeof(f"{name}_real") == 4 else np.float64
 
     def __call__(self, options: Options, p: Array, start: tuple[float, Array, Array, Array],
-                 cond: float, t: float, h_min: float, delta: float) -> EdgeFound:
+                 cond: float, t: float, h_min: float, delta: float, unit: float = 1.0
+                 ) -> EdgeFound:
         """From the solved point ``start`` (t, q, dq, ddq; its condition estimate ``cond``)
-        towards the grid point t."""
-        if options is not self._set:
-            fill_options(self._lib, self._name, self._options, options)
-            self._set = options
+        towards the grid point t, decided in the length unit ``unit`` (q, dq, ddq in and out
+        in the mechanism's own)."""
+        if self._set is None or options is not self._set[0] or unit != self._set[1]:
+            fill_options(self._lib, self._name, self._options, options, unit)
+            self._set = (options, unit)
         state, n, memmove, dtype = self._state, self._n, self._ffi.memmove, self.dtype
         size = n * np.dtype(dtype).itemsize
         state.t = start[0]

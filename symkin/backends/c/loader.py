@@ -20,7 +20,7 @@ from symkin.backends.c.csolver import GridSolver, SolverPool
 from symkin.contract.loads import load_count
 from symkin.contract.options import Options
 from symkin.runtime.kernel import Array, Kernel, import_file
-from symkin.runtime.protocol import BatchStatus, EdgeSolver
+from symkin.runtime.protocol import EdgeSolver
 
 
 class CKernel(Kernel):
@@ -47,8 +47,9 @@ class CKernel(Kernel):
         self._has_grid_solver = hasattr(lib, f"{self.name}_solve_grid")
         # options.unit honoured (a kernel built before it, or with a literal lever arm: not)
         self.scale_free = bool(getattr(lib, f"{self.name.upper()}_SCALE_FREE", 0))
-        if hasattr(lib, f"{self.name}_solve_batch"):
-            self.batch_solver = self._solve_batch
+        # the batch that takes a unit per set (a kernel built before it: sets run one by one)
+        if hasattr(lib, f"{self.name}_length_scales"):
+            self.batch_solver = batch.Batch(ffi, lib, self.name, self.real, self.scale_free)
 
     @property
     def has_grid_solver(self) -> bool:
@@ -88,11 +89,6 @@ class CKernel(Kernel):
         if not self.nu or not hasattr(self.lib, f"{self.name}_solve_inputs"):
             return None
         return InputStepper(self.ffi, self.lib, self.name, self.real, self.nq)
-
-    def _solve_batch(self, params: Array, t: Array, q0: Array, options: Options,
-                     q: Array, dq: Array, d2q: Array) -> BatchStatus:
-        return batch.solve(self.ffi, self.lib, self.name, self.real, params, t, q0, options,
-                           (q, dq, d2q))
 
 
 class _CFunctions:

@@ -1,0 +1,181 @@
+"""Every set of a sweep starts as its own ``symkin.solve`` starts (sweeps.starts): a set drawn at
+a dead centre at t0 is reported as a singular start, also when the C batch steps through it;
+a set drawn far from unit size is solved in its own unit inside the C batch.
+
+References derived here. The crank-slider of the examples (crank a, rod b, the slider's guide
+at c) is driven by theta = t^2 + pi/2, so at t0 the crank points along the guide (sin theta =
+1): crank and rod are collinear, a dead centre, exactly when |c - a| = b. At the inner dead
+centre c = a - b the motion then moves back into range (c - a sin theta grows above -b), so
+the C batch solves the whole grid from it; at the outer one c = a + b it cannot go on. And a
+mechanism scaled by k moves the same: lengths times k, angles alike, the crank's angle t^2 +
+pi/2 at every scale. Each set is also compared with its own symkin.solve, both backends.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import symkin
+from symkin.errors import SolveError
+from symkin.sweeps import batch, starts
+from tests.driver_support import kernel_for, same_condition
+
+T = np.linspace(0.0, 1.5, 31)
+
+
+@pytest.fixture(scope="module", params=["c", "numpy"])
+def crank_slider(request, crank_slider_system):
+    return kernel_for(crank_slider_system, request.param)
+
+
+@pytest.fixture
+def reruns(monkeypatch):
+    """The sets re-run through symkin.solve, by index within their chunk."""
+    seen: list[int] = []
+    original = batch._solve_one
+
+    def spy(kernel, p, t, q0, options, chunk, j):
+        seen.append(j)
+        return original(kernel, p, t, q0, options, chunk, j)
+
+    monkeypatch.setattr(batch, "_solve_one", spy)
+    return seen
+
+
+def _regular(count: int, seed: int = 5) -> np.ndarray:
+    """Designs within ±5 % of the textbook's, far from a dead centre at t0 (|c - a| <= 3.5
+    against b >= 4.75)."""
+    rng = np.random.default_rng(seed)
+    return np.array([1.0, 5.0, 4.0]) * (1 + rng.uniform(-0.05, 0.05, size=(count, 3)))
+
+
+def _per_set(kernel, result, j: int, p: np.ndarray, t: np.ndarray, q0=None) -> str:
+    """Set j of the sweep against its own symkin.solve; returns the reason ("" if solved)."""
+    try:
+        trajectory = symkin.solve(kernel, t=t, params=p, q0=q0)
+    except SolveError as failure:
+        assert result.reasons[j] == failure.reason, (j, result.messages[j], str(failure))
+        same_condition(result.messages[j], str(failure))
+        assert result.t_reached[j] == failure.t
+        done = failure.trajectory.t.size
+        assert result.solved[j] == done
+        np.testing.assert_allclose(result.q[j, :done], failure.trajectory.q, rtol=1e-12,
+                                   atol=0)
+        assert np.isnan(result.q[j, done:]).all()
+        return failure.reason
+    assert result.status[j] == 0 and result.reasons[j] == "", result.messages[j]
+    for name in ("q", "dq", "d2q"):
+        np.testing.assert_allclose(getattr(result, name)[j], getattr(trajectory, name),
+                                   rtol=1e-12, atol=1e-12 * np.abs(getattr(trajectory, name)).max())
+    return ""
+
+
+def test_sets_drawn_at_a_dead_centre_are_singular_starts_as_per_set_solve(crank_slider,
+                                                                           reruns) -> None:
+    regular = _regular(12)
+    a, b = 1.0, 5.0
+    # inner dead centre c = a - b (exactly, and 1e-12 and 1e-10 from it: the start is still
+    # singular to the scaled test), outer c = a + b; the C batch steps through the inner ones
+    dead = np.array([[a, b, a - b], [a, b, a - b + 1e-12], [a, b, a - b + 1e-10],
+                     [2.0, b, 2.0 - b + 1e-12], [a, b, a + b], [a, b, a + b - 1e-12]])
+    designs = np.concatenate([regular[:5], dead[:3], regular[5:9], dead[3:], regular[9:]])
+    at_dead_centre = np.isin(np.arange(len(designs)), [5, 6, 7, 12, 13, 14])
+    assert np.allclose(np.abs(designs[at_dead_centre, 2] - designs[at_dead_centre, 0]), b,
+                       atol=1e-9)
+    result = symkin.sweep(crank_slider, designs, T, workers=1)
+    reasons = [_per_set(crank_slider, result, j, p, T) for j, p in enumerate(designs)]
+    assert [r == "singular" for r in reasons] == list(at_dead_centre)
+    for j in np.flatnonzero(at_dead_centre):
+        assert "in a singular or limit configuration" in result.messages[j]
+        assert result.solved[j] <= 1  # the assembled start at most, nothing stepped from it
+    assert result.ok[~at_dead_centre].all()
+    if crank_slider.backend == "c":  # only the singular starts left the C batch
+        assert sorted(reruns) == list(np.flatnonzero(at_dead_centre))
+
+
+def test_the_start_check_costs_no_python_per_set_away_from_a_dead_centre(
+        crank_slider_system, monkeypatch) -> None:
+    """Regular starts are cleared by the batch's condition estimate, in C: runtime.start's
+    check (a Phi_q evaluation and an inverse per set) never runs for them."""
+    kernel = symkin.compile(crank_slider_system, backend="c")
+    checked: list[int] = []
+    original = starts.singular_start
+
+    def spy(*arguments):
+        checked.append(1)
+        return original(*arguments)
+
+    monkeypatch.setattr(starts, "singular_start", spy)
+    result = symkin.sweep(kernel, _regular(300), T, workers=1)
+    assert "singular" not in result.reasons and checked == []  # (some reach a limit later)
+    designs = np.concatenate([_regular(3), [[1.0, 5.0, -4.0 + 1e-12]]])
+    result = symkin.sweep(kernel, designs, T, workers=1)
+    assert checked == [1] and list(result.reasons) == ["", "", "", "singular"]
+
+
+SCALES = np.array([1e-3, 3e-3, 1e-2, 0.1, 1.0, 10.0, 100.0, 300.0, 1e3])
+
+
+def test_sets_far_from_unit_size_are_solved_in_their_unit_in_the_batch(crank_slider,
+                                                                       reruns) -> None:
+    """The crank-slider scaled by k = 1e-3 .. 1e3 (its length scale 5k outside 0.01 .. 100
+    for the outer ones): every set equals its own symkin.solve, stays in the C batch, and
+    moves as the unscaled one, lengths times k."""
+    designs = np.outer(SCALES, [1.0, 5.0, 4.0])
+    result = symkin.sweep(crank_slider, designs, T, workers=1)
+    assert result.ok.all()
+    for j, p in enumerate(designs):
+        assert _per_set(crank_slider, result, j, p, T) == ""
+    if crank_slider.backend == "c":
+        assert reruns == []
+    lengths = np.array([name.endswith((".x", ".y")) for name in crank_slider.coordinates])
+    unit = SCALES.tolist().index(1.0)
+    for j, k in enumerate(SCALES):
+        for name in ("q", "dq", "d2q"):
+            rows = getattr(result, name)
+            scaled = np.where(lengths, rows[j] / k, rows[j])
+            np.testing.assert_allclose(scaled, rows[unit], rtol=1e-11, atol=1e-11)
+    crank = crank_slider.coordinates.index("crank.phi")
+    np.testing.assert_allclose(result.q[:, :, crank], np.broadcast_to(T**2 + np.pi / 2,
+                                                                      (SCALES.size, T.size)),
+                               atol=1e-12)
+
+
+def test_scaled_sets_with_failures_equal_per_set_solve(crank_slider, reruns) -> None:
+    """Scaled sets that reach a limit position or cannot be assembled, and a singular start,
+    at 1e-3, 1 and 1e3 times the size: each as its own symkin.solve. On C the limits are
+    bisected in the set's unit without a re-run."""
+    base = np.array([[1.0, 5.0, 4.0], [1.0, 5.0, 5.9], [1.0, 5.0, 7.0], [1.0, 5.0, -4.0 + 1e-12]])
+    designs = np.concatenate([base * 1e-3, base, base * 1e3])
+    result = symkin.sweep(crank_slider, designs, T, workers=1)
+    reasons = [_per_set(crank_slider, result, j, p, T) for j, p in enumerate(designs)]
+    assert reasons == ["", "limit position", "no assembly", "singular"] * 3
+    if crank_slider.backend == "c":
+        assert sorted(reruns) == [2, 3, 6, 7, 10, 11]
+
+
+def test_length_scales_in_c_are_the_largest_lever_arm(crank_slider_system) -> None:
+    """<prefix>_length_scales against the closed form. In the crank-slider's Phi_q the rows of
+    the joint rod-slider (at [b, 0] on the rod) hold -b sin phi and b cos phi in the rod's
+    angle column beside unit entries in x and y; those of the crank's tip -a sin theta and
+    a cos theta; the slide's rows no lever. At q = 0 the largest arm is b. At the assembled
+    start the crank is vertical (theta = pi/2: arm a) and the rod climbs from its tip (0, a) to
+    the guide y = c, sin phi = (c - a) / b: arms |c - a| and sqrt(b^2 - (c - a)^2). A NaN
+    coordinate gives NaN; the units follow as runtime.units decides."""
+    kernel = symkin.compile(crank_slider_system, backend="c")
+    designs = np.outer(SCALES, [1.0, 5.0, 4.0])
+    a, b, c = designs.T
+    solver = kernel.batch_solver
+    zeros = np.zeros(len(kernel.coordinates))
+    np.testing.assert_allclose(solver.length_scales(designs, zeros, 0.0), b, rtol=1e-15)
+    result = symkin.sweep(kernel, designs, T, workers=1)
+    at_start = np.maximum.reduce([a, np.abs(c - a), np.sqrt(b**2 - (c - a) ** 2)])
+    np.testing.assert_allclose(solver.length_scales(designs, result.q[:, 0], 0.0), at_start,
+                               rtol=1e-12)
+    broken = zeros.copy()
+    broken[kernel.coordinates.index("rod.phi")] = np.nan
+    assert np.isnan(solver.length_scales(designs[:1], broken, 0.0)).all()
+    # 5k = 0.005, 0.015, ..., 500, 1500, 5000: outside 0.01 .. 100 the power of 10 below it
+    expected = [1e-3, 1.0, 1.0, 1.0, 1.0, 1.0, 100.0, 1e3, 1e3]
+    assert starts.set_units(solver, designs, 0.0, zeros).tolist() == expected
