@@ -1,5 +1,5 @@
-"""Every real assembly of a mechanism at one time point (and given inputs): seeded multi-start
-Newton with deflation.
+"""Every real assembly of a mechanism at one time point (and given inputs): deterministic
+multi-start Newton with deflation.
 
 Why deflation: plain multi-start Newton finds the assemblies whose basins of attraction the
 starts happen to fall into; the wide basins are found again and again, the narrow ones
@@ -8,19 +8,26 @@ Birkisson and Funke 2015) repels Newton from the assemblies already found: it so
 M(q) Phi(q) = 0 with M(q) = prod_k (1 / |q - q_k|^2 + 1), which has the same roots as Phi
 except the known q_k, so a start that led to a known assembly now leads on to a new one. The
 deflated Newton step is the plain step scaled by 1 / (1 - grad(log M) . step) (Sherman-
-Morrison), so it costs one Phi_q solve like Newton; it is cut to STEP_CAP. From each start,
-plain Newton first, then deflated Newton again and again until it finds nothing new, then the
-next start is taken. Homotopy continuation would find
-every complex root too, but it needs the equations as polynomials, which the kernel (Phi and
-Phi_q at points) does not give; deflation needs only what Newton needs.
+Morrison), so it costs one Phi_q solve like Newton; it is cut to STEP_CAP, then halved until
+|M Phi| decreases (a line search; a start whose step cannot lower it is given up). From each
+start, plain Newton first, then deflated Newton again and again until it finds nothing new,
+then the next start is taken. Homotopy continuation would find every complex root too, but it
+needs the equations as polynomials, which the kernel (Phi and Phi_q at points) does not give;
+deflation needs only what Newton needs.
 
-The starts are seeded (the same every time): those of the damped assembly (runtime.assembly:
-q0, the bodies placed along their joints, q0 perturbed, random angles), each after q0 with
-random Euler parameters (uniform on the unit sphere). The search stops after STARTS starts
-or after PATIENCE starts in a row that found nothing new. Each root of the deflated Newton is
-polished by the runtime's Newton (the same test as a run), which gives its condition; two
-roots are one assembly when they agree to SAME (angles modulo 2 pi, Euler parameters up to
-their sign). Imports NumPy only: part of the runtime.
+The starts decide which basins are reached at all. After q0 and the damped assembly's first
+starts (runtime.assembly), they are the points of a low-discrepancy sequence (Roberts' R_d):
+each planar angle spread over [-pi, pi) with the positions placed along the joints; each
+spatial body at an orientation spread uniformly over SO(3) (Shoemake's map from the unit cube
+to unit quaternions) and its origin spread over a box about q0's origin wide enough to hold
+q0's mirror images (REACH), then moved by a few Gauss-Newton steps over the positions alone.
+(Random Euler parameters with origins drawn near q0's, as before, missed the mirror image of
+the home pose of examples/stewart_fk.yaml below its base plane.) No symmetry of the mechanism
+is assumed. The search runs in batches of BATCH starts and ends after PATIENCE batches in a
+row that found nothing new, or after STARTS starts. The sequence has no seed: a scan repeats
+exactly. Each root of the deflated Newton is polished by the runtime's Newton (the same test
+as a run), which gives its condition; two roots are one assembly when they agree to SAME
+(angles modulo 2 pi, Euler parameters up to their sign). Imports NumPy only: part of the runtime.
 """
 
 from __future__ import annotations
@@ -211,7 +218,7 @@ def _deflated_step(kernel: KinematicsKernel, shape: Shape, q: Array, phi: Array,
                    p: Array, roots: list[Array]) -> Array | None:
     """The Newton step of M Phi (Sherman-Morrison on the plain step), cut to STEP_CAP."""
     try:
-        step = np.linalg.solve(kernel.phi_q(q, t0, p), -phi)
+        step: Array = np.linalg.solve(np.asarray(kernel.phi_q(q, t0, p), dtype=float), -phi)
     except np.linalg.LinAlgError:
         return None
     denominator = 1.0 - float(_log_gradient(shape, q, roots) @ step)
@@ -250,7 +257,8 @@ def _log_gradient(shape: Shape, q: Array, roots: list[Array]) -> Array:
     squared = np.sum(differences**2, axis=1)
     weights = np.divide(-2.0, squared * (1.0 + squared), out=np.zeros_like(squared),
                         where=squared > 0.0)
-    return weights @ differences
+    gradient: Array = weights @ differences
+    return gradient
 
 
 def _starts(kernel: KinematicsKernel, shape: Shape, q0: Array, t0: float, p: Array

@@ -16,13 +16,16 @@ enters only through its products: G = x x^T = [[s, u, v], [u, a, c], [v, c, b]] 
     s = |t|^2 - tx^2 - ty^2,   u = t.r1 - tx r11 - ty r21,   v = t.r2 - tx r12 - ty r22,
     a = 1 - r11^2 - r21^2,     b = 1 - r12^2 - r22^2,        c = -(r11 r12 + r21 r22),
 
-each quadratic in lam. G has rank one: s a = u^2, s b = v^2, a b = c^2 (three quartics in
-lam), and s c = u v picks the sign (the quartics' roots with s c = -u v are not assemblies).
-Each real lam with s > 0 gives two assemblies, x and -x: the mirror images in the base plane.
+each quadratic in lam. G has rank one: s a = u^2, s b = v^2, s c = u v (three quartics in
+lam), which for s != 0 give G = x x^T with x = (sqrt s, u / sqrt s, v / sqrt s); their roots
+with s = 0 (then u = v = 0 whatever a, b, c) are no assemblies and are dropped. (The minor
+a b = c^2 is not used: its gradient vanishes where a = b = c = 0, a platform parallel to the
+base, so such an assembly would be a double root and the homotopy would lose it.) Each real
+lam with s > 0 gives two assemblies, x and -x: the mirror images in the base plane.
 
 The quartics are solved by a total-degree homotopy (64 paths, a random complex gamma,
 predictor-corrector with step halving), which finds every isolated complex root with
-probability one: the count of roots with the right sign is 20 (the 40 complex assemblies of a
+probability one: the count of roots with s != 0 is 20 (the 40 complex assemblies of a
 general 6-6 platform, in mirror pairs), which checks that no path was lost.
 """
 
