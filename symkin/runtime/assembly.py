@@ -89,17 +89,17 @@ def starts(kernel: KinematicsKernel, q0: Array, t0: float, p: Array,
     rng = np.random.default_rng(SEED)
     angles = np.array([name.endswith(".phi") for name in kernel.coordinates])
     yield np.array(q0, dtype=float)
-    yield _placed(kernel, q0, angles, t0, p)
+    yield placed(kernel, q0, angles, t0, p)
     scale = np.where(angles, 0.5, 0.2 * max(1.0, float(np.abs(q0).max(initial=0.0))))
     for _ in range(PERTURBED):
         yield q0 + scale * rng.standard_normal(q0.size)
     for _ in range(random_angles):
         q = np.array(q0, dtype=float)
         q[angles] = rng.uniform(-math.pi, math.pi, int(angles.sum()))
-        yield _placed(kernel, q, angles, t0, p)
+        yield placed(kernel, q, angles, t0, p)
 
 
-def _placed(kernel: KinematicsKernel, q: Array, angles: NDArray[np.bool_], t0: float,
+def placed(kernel: KinematicsKernel, q: Array, angles: NDArray[np.bool_], t0: float,
             p: Array) -> Array:
     """q with its angles kept and its positions solved in the least-squares sense."""
     q = np.array(q, dtype=float)

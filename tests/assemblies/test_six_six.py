@@ -1,0 +1,146 @@
+"""Every assembly of 6-6 Stewart platforms (planar base, planar platform): symkin.scan finds
+exactly the assemblies counted independently in planar_six (linear elimination to three
+unknowns, then a total-degree homotopy written with NumPy), each pose to 1e-8.
+
+The cases: examples/stewart_fk.yaml at all legs 1.0 (its three-fold symmetric design has 14
+complex solutions of the reduced system, so 28 complex assemblies, 8 of them real; the scan
+on main found 7 there), and a general platform chosen for its many real assemblies (12; its
+20 complex solutions are the 40 of a general 6-6 platform, which checks that the homotopy lost
+no path).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+import symkin
+from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.scan import scan
+from tests.assemblies.planar_six import Platform, assemblies
+
+ROOT = Path(__file__).resolve().parents[2]
+
+MANY_BASE = np.array([[0.2502, 0.7944], [0.5514, -0.5496], [-0.3997, 0.7471],
+                      [-0.9895, 0.6425], [0.5941, -0.0641], [-0.3939, -0.4431]])
+MANY_PLATFORM = np.array([[-0.1628, -0.0365], [0.003, 0.0355], [0.3291, 0.1944],
+                          [0.0812, 0.3248], [-0.1891, -0.2257], [0.0748, -0.3029]])
+MANY_LEGS = np.array([0.907, 0.9098, 1.1286, 1.2788, 0.7487, 0.6193])
+
+
+def _example_platform() -> Platform:
+    """stewart_fk's joints in their planes: the ground's, and the platform frame's (its
+    origin drawn in the joints' plane, global axes)."""
+    spec = yaml.safe_load((ROOT / "examples" / "stewart_fk.yaml").read_text())
+    ground = spec["bodies"]["ground"]["points"]
+    body = spec["bodies"]["platform"]
+    height = float(body["frame"]["origin"][2])
+    base = np.array([ground[f"B{k}"][:2] for k in range(1, 7)], dtype=float)
+    top = np.array([body["points"][f"P{k}"] for k in range(1, 7)], dtype=float)
+    assert np.all(top[:, 2] == height)
+    return Platform(base, top[:, :2])
+
+
+def _point(values: np.ndarray) -> str:
+    return "[" + ", ".join(repr(float(v)) for v in values) + "]"
+
+
+def _six_six_file(tmp_path: Path, platform: Platform) -> Path:
+    """The platform drawn level at height 1, its six legs distance drivers with input f."""
+    ground = ", ".join(f"B{k + 1}: {_point([*platform.b[k], 0.0])}" for k in range(6))
+    top = ", ".join(f"P{k + 1}: {_point([*platform.p[k], 1.0])}" for k in range(6))
+    legs = [f"  - {{type: distance, name: leg{k + 1}, i: ground, j: platform, A: B{k + 1}, "
+            f"B: P{k + 1}, f: input}}" for k in range(6)]
+    path = tmp_path / "six_six.yaml"
+    path.write_text("\n".join(["name: six_six", "space: 3d", "layout: drawn", "bodies:",
+                               f"  ground: {{points: {{{ground}}}}}",
+                               f"  platform: {{frame: {{origin: [0, 0, 1.0]}}, "
+                               f"points: {{{top}}}}}", "joints: []", "drivers:", *legs,
+                               "time: {t0: 0, t1: 1, dt: 0.1}"]) + "\n")
+    return path
+
+
+def _rotation(e: np.ndarray) -> np.ndarray:
+    """A(e) of unit Euler parameters, written out here."""
+    e0, e1, e2, e3 = e
+    return 2 * np.array([
+        [e0 * e0 + e1 * e1 - 0.5, e1 * e2 - e0 * e3, e1 * e3 + e0 * e2],
+        [e1 * e2 + e0 * e3, e0 * e0 + e2 * e2 - 0.5, e2 * e3 - e0 * e1],
+        [e1 * e3 - e0 * e2, e2 * e3 + e0 * e1, e0 * e0 + e3 * e3 - 0.5]])
+
+
+def _leg_gaps(platform: Platform, rotation: np.ndarray, origin: np.ndarray,
+              legs: np.ndarray) -> np.ndarray:
+    joints = np.column_stack([platform.p, np.zeros(6)]) @ rotation.T + origin
+    base = np.column_stack([platform.b, np.zeros(6)])
+    return np.linalg.norm(joints - base, axis=1) - legs
+
+
+def _scanned_poses(kernel: KinematicsKernel, legs: np.ndarray
+                   ) -> list[tuple[np.ndarray, np.ndarray]]:
+    names = kernel.coordinates
+    r = [names.index(f"platform.{c}") for c in "xyz"]
+    e = [names.index(f"platform.e{k}") for k in range(4)]
+    report = scan(kernel, inputs=legs)
+    return [(_rotation(branch.q[e]), branch.q[r]) for branch in report.branches]
+
+
+def _assert_the_same_poses(found: list[tuple[np.ndarray, np.ndarray]],
+                           expected: list[tuple[np.ndarray, np.ndarray]]) -> None:
+    assert len(found) == len(expected)
+    for rotation, origin in expected:
+        matches = [1 for r, t in found
+                   if max(np.abs(r - rotation).max(), np.abs(t - origin).max()) < 1e-8]
+        assert len(matches) == 1, (rotation, origin)
+
+
+def test_the_independent_count_of_a_general_platform_is_complete() -> None:
+    """20 complex solutions (the 40 complex assemblies in mirror pairs): no path was lost; two
+    homotopy constants give the same real assemblies, each closing every leg."""
+    platform = Platform(MANY_BASE, MANY_PLATFORM)
+    count = assemblies(platform, MANY_LEGS)
+    other = assemblies(platform, MANY_LEGS, gamma=complex(-0.3127, 0.9498))
+    assert count.complex == other.complex == 20
+    assert len(count.poses) == 12
+    _assert_the_same_poses(other.poses, count.poses)
+    for rotation, origin in count.poses:
+        assert np.abs(rotation.T @ rotation - np.eye(3)).max() < 1e-10
+        assert np.linalg.det(rotation) == pytest.approx(1.0, abs=1e-10)
+        assert np.abs(_leg_gaps(platform, rotation, origin, MANY_LEGS)).max() < 1e-10
+
+
+def test_the_example_platform_counts_eight_at_legs_one() -> None:
+    platform = _example_platform()
+    count = assemblies(platform, np.ones(6))
+    assert len(count.poses) == 8
+    heights = sorted(origin[2] for _, origin in count.poses)
+    assert heights == pytest.approx([-h for h in reversed(heights)], abs=1e-12)  # mirrors
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_scan_of_stewart_fk_at_legs_one_finds_the_eight(backend: str) -> None:
+    platform = _example_platform()
+    kernel = symkin.compile(symkin.derive(ROOT / "examples" / "stewart_fk.yaml"),
+                            backend=backend)
+    expected = assemblies(platform, np.ones(6)).poses
+    found = _scanned_poses(kernel, np.ones(6))
+    _assert_the_same_poses(found, expected)
+    for rotation, origin in found:
+        assert np.abs(_leg_gaps(platform, rotation, origin, np.ones(6))).max() < 1e-10
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_scan_of_a_general_six_six_finds_the_twelve(tmp_path: Path, backend: str) -> None:
+    platform = Platform(MANY_BASE, MANY_PLATFORM)
+    kernel = symkin.compile(symkin.derive(_six_six_file(tmp_path, platform)), backend=backend)
+    expected = assemblies(platform, MANY_LEGS).poses
+    found = _scanned_poses(kernel, MANY_LEGS)
+    _assert_the_same_poses(found, expected)
+    assert len(found) == 12
+    for rotation, origin in found:
+        assert np.abs(_leg_gaps(platform, rotation, origin, MANY_LEGS)).max() < 1e-10
