@@ -181,7 +181,7 @@ def _propagation(kernel: KinematicsKernel, factors: Factors | SparseFactors,
 
     def jacobian_times(moved: Array, v: Array) -> Array:
         nz = np.asarray(kernel.phi_q_nz(moved, t, p), dtype=float)
-        return np.bincount(rows, nz * v[cols], minlength=q.size)
+        return np.asarray(np.bincount(rows, nz * v[cols], minlength=q.size), dtype=np.float64)
 
     def velocity_rows(d: Array) -> Array:
         return jacobian_times(q + d, dq) + kernel.phi_t(q + d, t, p)
