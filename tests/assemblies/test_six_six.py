@@ -2,11 +2,11 @@
 exactly the assemblies counted independently in planar_six (linear elimination to three
 unknowns, then a total-degree homotopy written with NumPy), each pose to 1e-8.
 
-The cases: examples/stewart_fk.yaml at all legs 1.0 (its three-fold symmetric design has 14
-complex solutions of the reduced system, so 28 complex assemblies, 8 of them real; the scan
-on main found 7 there), and a general platform chosen for its many real assemblies (12; its
-20 complex solutions are the 40 of a general 6-6 platform, which checks that the homotopy lost
-no path).
+The cases: examples/stewart_fk.yaml at all legs 1.0 (8 real assemblies, four mirror pairs
+about the base plane; its three-fold symmetric design is not a general one, and the homotopy
+finds 14 roots with s != 0 there, not 20; the earlier starts of the scan found 7), and a
+general platform chosen for its many real assemblies (12; its 20 roots are the 40 complex
+assemblies of a general 6-6 platform, which checks that the homotopy lost no path).
 """
 
 from __future__ import annotations
