@@ -49,7 +49,7 @@ static void show(const char *name, Ops o)
            "\"call\": %lu, \"abs\": %lu, \"cmp\": %lu}\n", name, o.add, o.mul, o.div, o.sqrt,
            o.call, o.abs, o.cmp);
 }
-#define MEASURE(name, statement) \\
+#define MEASURE(name, statement) \
     do { memset(&ops, 0, sizeof ops); statement; show(name, ops); } while (0)
 """
 
