@@ -17,6 +17,7 @@ from symkin.backends import get as get_backend
 from symkin.backends.c import context, op_budget
 from symkin.codegen import lower
 from symkin.codegen.op_count import KINDS, Flops, count
+from symkin.contract import tuning
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
@@ -58,53 +59,117 @@ MAIN = r"""
 #include "counted.hpp"
 #include "@P@.c"
 #include "@P@_dense_lu.c"
-#include "@P@_sparse_lu.c"
+#include "@LINALG@"
 #include "@P@_solver.c"
-int main()
+static @P@_workspace w;
+static @P@_state s;
+static @P@_report r;
+/* One step of the run: by t, or by the inputs u = u0 + k du (positions only on odd k). */
+static int advance(const @P@_options *o, int k)
 {
-    static @P@_workspace w;
-    static @P@_state s;
-    @P@_options o;
-    @P@_report r;
-    @P@_real q[@U@_NQ], dq[@U@_NQ], out[@U@_NQ], nz[@U@_NNZ], sh[@U@_NSHARED + 1];
-    int k, i, n = @STEPS@;
-    @P@_default_options(&o);
+#if @INPUTS@
+    @P@_real u[@U@_NU], du[@U@_NU], ddu[@U@_NU];
+    int i;
+    for (i = 0; i < @U@_NU; ++i) { /* u in double: not counted */
+        du[i] = @DT@;
+        ddu[i] = 0;
+        u[i] = @P@_u0[i] + k * @DT@;
+    }
+    return @P@_solve_inputs(o, @P@_p_nominal, u, k % 2 ? NULL : du, k % 2 ? NULL : ddu, &s,
+                            &w, &r);
+#else
+    return @P@_solve_step(o, @P@_p_nominal, k * @DT@, &s, &w, &r);
+#endif
+}
+/* The run from q0, each step's count after the first (which sets up the workspace). */
+static int run(const char *name, const @P@_options *o)
+{
+    int k;
     for (k = 0; k < @U@_NQ; ++k) { s.q[k] = @P@_q0[k]; }
     s.started = 0;
-    for (k = 0; k < n; ++k) {
+    for (k = 0; k < @STEPS@; ++k) {
         memset(&ops, 0, sizeof ops);
-        if (@P@_solve_step(&o, @P@_p_nominal, k * @DT@, &s, &w, &r) != @U@_OK) return 1;
-        if (k > 0) { printf("%d ", r.iterations); show("step", ops); }
+        if (advance(o, k) != @U@_OK) return 1;
+        if (k > 0) { printf("%d %d ", r.iterations, k % 2); show(name, ops); }
     }
+    return 0;
+}
+int main()
+{
+    @P@_options o;
+    @P@_real q[@U@_NQ], dq[@U@_NQ], out[@U@_NQ], nz[@U@_NNZ], sh[@U@_NSHARED + 1];
+    int i;
+    @P@_default_options(&o);
+    if (run("step", &o)) return 1;
     for (i = 0; i < @U@_NQ; ++i) { q[i] = s.q[i]; dq[i] = s.dq[i]; }
     MEASURE("phi_phi_q", @P@_phi_phi_q(q, 0.3, @P@_p_nominal, out, nz, sh));
     MEASURE("phi_t_shared", @P@_phi_t_shared(q, 0.3, @P@_p_nominal, sh, out));
     MEASURE("gamma_shared", @P@_gamma_shared(q, dq, 0.3, @P@_p_nominal, sh, out));
+    MEASURE("norm1", @P@_norm1(nz));
     @P@_lu_init(&w.lu);
     MEASURE("factor", @P@_lu_factor(nz, &w.lu));
     MEASURE("pivot_ratio", @P@_lu_pivot_ratio(&w.lu));
     MEASURE("solve", @P@_lu_solve(&w.lu, out));
     MEASURE("solve_transposed", @P@_lu_solve_transposed(&w.lu, out));
+    MEASURE("hager", @P@_inverse_norm1(&w.lu));
+    MEASURE("hager_rows", @P@_inverse_norm1_rows(&w.lu, @P@_nonlinear));
+    w.estimated_inv_norm = -1;
+    MEASURE("estimate", @P@_estimate(&w, &r));
+    w.correction = -1;
+    MEASURE("flagged", @P@_flagged(&o, &w, &r, 1, 1, 1));
+    {   /* the refined model at its longest: q and dq pass, ddq fails; a residual of 0
+         * makes each max take its computed arm */
+        @P@_options late = o;
+        late.target_q = late.target_dq = 1e300;
+        late.target_ddq = 0;
+        r.residual = 0;
+        MEASURE("refined", @P@_flagged_refined(&late, &w, &r, 1, 1, 1, dq, dq));
+    }
+#if !@INPUTS@
+    {   /* the extra iterations at their longest: q moved off the solution, every point
+         * flagged, so Newton goes on (its step halving) for all TIGHTEN_STEPS */
+        @P@_options more = o;
+        more.tighten_cond = 1e300;
+        more.target_q = more.target_dq = 1e300; /* the model's last test flags: all run */
+        more.target_ddq = 0;
+        for (i = 0; i < @U@_NQ; ++i) q[i] = s.q[i] + 0.01 * (i % 3 + 1);
+        @P@_phi_phi_q(q, s.t, @P@_p_nominal, w.phi, w.nz, w.shared);
+        @P@_lu_factor(w.nz, &w.lu);
+        r.residual = @P@_max_abs(w.phi);
+        MEASURE("converged", @P@_converged(&more, @P@_p_nominal, s.t, q, INFINITY, &w, &r));
+    }
+#endif
+    /* every point flagged, Newton going on at every point: the checks at their most */
+    o.tighten_cond = 0;
+    o.target_q = o.target_dq = o.target_ddq = 0;
+    if (run("flagged_step", &o)) return 1;
     o.tol_phi = -1; /* never converges: Newton runs to its cap */
     o.max_iterations = @CAP@;
-    MEASURE("capped", @P@_solve_step(&o, @P@_p_nominal, n * @DT@, &s, &w, &r));
+    MEASURE("capped", advance(&o, @STEPS@));
     printf("%d %d\n", r.status, r.iterations);
     return 0;
 }
 """
 
 
-def _measure(folder: Path, prefix: str, steps: int, dt: float, cap: int) -> list[str]:
+def _measure(folder: Path, code: lower.Code, steps: int, dt: float, cap: int) -> list[str]:
     """Compile the generated folder as one C++ unit with the counting real type; its output."""
+    prefix = code.name
     header = folder / f"{prefix}.h"
     text = header.read_text()
     typedef = f"typedef double {prefix}_real;"
     assert typedef in text
     header.write_text(text.replace(typedef, f"typedef R {prefix}_real;"))
     (folder / "counted.hpp").write_text(COUNTED)
+    linalg = f"{prefix}_sparse_lu.c" if code.linalg == "sparse" else f"{prefix}_linalg.c"
+    u0 = ", ".join(repr(v) for v in code.input_values) or "0"
     source = (MAIN.replace("@P@", prefix).replace("@U@", prefix.upper())
               .replace("@STEPS@", str(steps)).replace("@DT@", repr(dt))
-              .replace("@CAP@", str(cap)))
+              .replace("@CAP@", str(cap)).replace("@LINALG@", linalg)
+              .replace("@INPUTS@", "1" if code.input_names else "0"))
+    source = source.replace("static " + prefix + "_workspace w;",
+                            f"static const double {prefix}_u0[] = {{ {u0} }};\n"
+                            f"static {prefix}_workspace w;")
     (folder / "main.cpp").write_text(source)
     compiler = shutil.which("g++") or shutil.which("c++")
     if compiler is None:
@@ -122,21 +187,30 @@ def _flops(record: dict[str, int]) -> Flops:
     return Flops(**{k: record[k] for k in KINDS})
 
 
-def _parse(lines: list[str]) -> tuple[list[tuple[int, Flops]], dict[str, Flops], list[int]]:
-    steps, named = [], {}
+def _parse(lines: list[str]) -> tuple[dict[str, list[tuple[int, int, Flops]]],
+                                      dict[str, Flops], list[int]]:
+    """(the runs' steps: iterations, odd step, count; the single calls; status, iterations
+    of the capped step)."""
+    runs: dict[str, list[tuple[int, int, Flops]]] = {}
+    named = {}
     for line in lines[:-1]:
         head, _, rest = line.partition("{")
         record = json.loads("{" + rest)
-        if record["name"] == "step":
-            steps.append((int(head), _flops(record)))
+        if head.strip():
+            iterations, odd = (int(x) for x in head.split())
+            runs.setdefault(record["name"], []).append((iterations, odd, _flops(record)))
         else:
             named[record["name"]] = _flops(record)
-    return steps, named, [int(x) for x in lines[-1].split()]
+    return runs, named, [int(x) for x in lines[-1].split()]
 
 
 def _arithmetic(f: Flops) -> tuple[int, int, int, int, int]:
     """The kinds that do not depend on which arm of a max was taken."""
     return f.add, f.mul, f.div, f.sqrt, f.call
+
+
+def _within(measured: Flops, bound: Flops) -> bool:
+    return all(getattr(measured, k) <= getattr(bound, k) for k in KINDS)
 
 
 def test_counting_of_statements_by_hand():
@@ -165,41 +239,71 @@ def test_crank_slider_phi_by_hand():
     assert op_budget._routine(code, "phi") == by_hand
 
 
-@pytest.mark.parametrize("name, steps, dt", [("crank_slider", 31, 0.05),
-                                             ("four_bar", 21, 0.05)])
-def test_budget_against_counted_run(tmp_path, name, steps, dt):
+@pytest.mark.parametrize("name, linalg", [("crank_slider", "sparse"), ("four_bar", "sparse"),
+                                          ("crank_slider", "dense"),
+                                          ("crank_slider_input", "sparse")])
+def test_budget_against_counted_run(tmp_path, name, linalg):
     """C compiled with a counting real type: each routine's count equals the one the budget
     adds up (the kinds a max's arm does not change, exactly; fabs and compares at most);
-    every step of a run, and a step that runs Newton to its cap, stays within the stated
-    worst case, which the capped step reaches for the iterations' part."""
+    every step of a run (also with every point flagged and Newton going on at each) stays
+    within the worst case for its iterations and within the header's number; a step that runs
+    Newton to its cap does exactly the predictor and iterations the budget counts."""
     system = symkin.derive(symkin.load(EXAMPLES / f"{name}.yaml"))
-    symkin.generate(system, backend="c", out_dir=tmp_path)
-    code = lower.lower(system, get_backend("c"))
+    symkin.generate(system, backend="c", out_dir=tmp_path, linalg=linalg)
+    code = lower.lower(system, get_backend("c"), linalg=linalg)
     extra = context.template_context(code)
-    cap = 6
-    lines = _measure(tmp_path, system.name, steps, dt, cap)
-    run, measured, (status, iterations) = _parse(lines)
-    algebra = op_budget.sparse_lu(extra["lu"], code.nq, code.nnz, code.name)
-    norm = op_budget.norm1(extra["norm1"], code.nq, code.nnz)
-    expected = {"phi_phi_q": op_budget._routine(code, "phi_phi_q"),
-                "phi_t_shared": op_budget._routine(code, "phi_t_shared"),
-                "gamma_shared": op_budget._routine(code, "gamma_shared"),
-                "factor": algebra.factor, "pivot_ratio": algebra.pivot_ratio,
-                "solve": algebra.solve, "solve_transposed": algebra.solve_transposed}
-    for key, value in expected.items():
+    cap, steps, dt = 6, 31, 0.05
+    runs, measured, (status, iterations) = _parse(_measure(tmp_path, code, steps, dt, cap))
+    n, nnz = code.nq, code.nnz
+    algebra = (op_budget.sparse_lu(extra["lu"], n, nnz, code.name) if linalg == "sparse"
+               else op_budget.dense_lu(n, nnz))
+    norm = op_budget.norm1(extra["norm1"], n, nnz)
+    exact = {"phi_phi_q": op_budget._routine(code, "phi_phi_q"),
+             "phi_t_shared": op_budget._routine(code, "phi_t_shared"),
+             "gamma_shared": op_budget._routine(code, "gamma_shared"),
+             "norm1": norm, "flagged": op_budget.FLAGGED,
+             "solve": algebra.solve, "solve_transposed": algebra.solve_transposed,
+             "estimate": op_budget._estimate(algebra, norm, n, nnz)}
+    at_most = {"factor": algebra.factor, "pivot_ratio": algebra.pivot_ratio,
+               "hager": op_budget._hager(algebra, n, rows=False),
+               "hager_rows": op_budget._hager(algebra, n, rows=True)}
+    if linalg == "sparse":  # straight-line: every operation runs, whatever the values
+        exact.update(factor=at_most.pop("factor"), pivot_ratio=at_most.pop("pivot_ratio"))
+    if algebra.exact_inverse is None:  # Hager's estimate: its ascent may stop early
+        at_most["estimate"] = exact.pop("estimate")
+    for key, value in exact.items():
         assert _arithmetic(measured[key]) == _arithmetic(value), key
-        assert measured[key].abs <= value.abs and measured[key].cmp <= value.cmp, key
-    # The header's numbers at the default cap, and the composition at this test's cap.
+        assert _within(measured[key], value), key
+    for key, value in at_most.items():
+        assert _within(measured[key], value), key
+    if "converged" in measured:  # TIGHTEN_STEPS extra iterations, estimates before, after
+        parts = op_budget.pieces(code, algebra, norm, scaled=False)
+        converged = parts.converged(op_budget.WOULD_FLAG + op_budget.Flops(cmp=3))
+        assert _within(measured["converged"], converged)
+        if algebra.exact_inverse is not None:
+            # where the Newton correction was solved for, the model reads it instead of
+            # ||Phi_q^-1|| times the residual: one product fewer, at the first test of each
+            # extra iteration
+            fewer = op_budget.Flops(mul=tuning.TIGHTEN_STEPS)
+            assert _arithmetic(measured["converged"] + fewer) == _arithmetic(converged)
+    refined = op_budget.REFINED + op_budget.FLAGGED + measured["hager_rows"]
+    assert _arithmetic(measured["refined"]) == _arithmetic(refined)
+    inputs = bool(code.input_names)
     header = (tmp_path / f"{system.name}_solver.h").read_text()
     stated = int(re.search(rf"{system.name.upper()}_OPS_STEP_WORST (\d+)", header)[1])
-    assert stated == extra["ops_budget"]["step"]
-    parts = op_budget.pieces(code, algebra, norm, scaled=False)
-    for iterations_taken, flops in run:
-        worst = op_budget.step(parts, max(iterations_taken, 1))
-        assert all(getattr(flops, k) <= getattr(worst, k) for k in KINDS)
-        assert flops.total <= stated
+    budget = extra["ops_budget"]
+    assert stated == budget["step"]
+    for run in ("step", "flagged_step"):
+        assert len(runs[run]) == steps - 1
+        for iterations_taken, odd, flops in runs[run]:
+            rates = not (inputs and odd)
+            parts = op_budget.pieces(code, algebra, norm, scaled=False, inputs=inputs,
+                                     rates=rates)
+            assert _within(flops, op_budget.step(parts, max(iterations_taken, 1), rates))
+            assert flops.total <= (budget["positions"] if not rates else stated)
     assert (status, iterations) == (1, cap)  # NO_CONVERGENCE at the cap
-    capped = measured["capped"]
+    parts = op_budget.pieces(code, algebra, norm, scaled=False, inputs=inputs)
     newton = parts.predictor + parts.newton(cap)
-    assert _arithmetic(capped) == _arithmetic(newton)
-    assert capped.total <= op_budget.step(parts, cap).total
+    assert _within(measured["capped"], newton)
+    if linalg == "sparse":
+        assert _arithmetic(measured["capped"]) == _arithmetic(newton)

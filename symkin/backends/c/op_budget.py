@@ -135,6 +135,8 @@ FLAGGED = Flops(sqrt=1, div=1, mul=18, add=6, cmp=11)
 # <prefix>_flagged_refined beyond its two estimators and maxima: root, s, the error left,
 # e_q, the bound, e_n, e_dq, e_dq_n, e_ddq and the three comparisons.
 REFINED = Flops(sqrt=1, div=2, mul=29, add=10, cmp=13)
+# <prefix>_would_flag: the residual against the rounding level, then the model.
+WOULD_FLAG = Flops(add=1, mul=1, cmp=1) + FLAGGED
 
 
 @dataclass(frozen=True)
@@ -195,8 +197,7 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
     evaluation = fused + Flops(add=1, cmp=1) + factor + Flops(cmp=2)
     negate_solve = Flops(add=n) + algebra.solve
     update = negate_solve + _max_abs(n) + from_unit + Flops(add=n)
-    would_flag = Flops(add=1, mul=1, cmp=1) + FLAGGED
-    tighten = (update + Flops(add=1, cmp=1) + would_flag * 2 + Flops(cmp=2, div=1)
+    tighten = (update + Flops(add=1, cmp=1) + WOULD_FLAG * 2 + Flops(cmp=2, div=1)
                + fused + factor)
     estimate = _estimate(algebra, norm, n, nnz)
     solve = rows_in_unit + algebra.solve + from_unit
@@ -216,7 +217,7 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
 def step(parts: Pieces, cap: int, rates: bool = True) -> Flops:
     """The worst case of one step with Newton capped at ``cap`` iterations; ``rates`` False:
     positions only (``<prefix>_solve_inputs`` with du, ddu NULL)."""
-    convergence = parts.converged(Flops(cmp=3) + Flops(add=1, mul=1, cmp=1) + FLAGGED)
+    convergence = parts.converged(Flops(cmp=3) + WOULD_FLAG)
     kinematics = parts.velocity + parts.acceleration if rates else ZERO
     return parts.predictor + parts.newton(cap) + convergence + kinematics + parts.checks
 
