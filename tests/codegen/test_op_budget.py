@@ -300,7 +300,8 @@ def test_budget_against_counted_run(tmp_path, name, linalg):
             parts = op_budget.pieces(code, algebra, norm, scaled=False, inputs=inputs,
                                      rates=rates)
             assert _within(flops, op_budget.step(parts, max(iterations_taken, 1), rates))
-            assert flops.total <= (budget["positions"] if not rates else stated)
+            limit = stated if not inputs else budget["inputs" if rates else "positions"]
+            assert flops.total <= limit
     assert (status, iterations) == (1, cap)  # NO_CONVERGENCE at the cap
     parts = op_budget.pieces(code, algebra, norm, scaled=False, inputs=inputs)
     newton = parts.predictor + parts.newton(cap)

@@ -39,5 +39,6 @@ def template_context(code: Code) -> dict[str, Any]:
         "ops_budget": {"lines": op_budget.header_lines(budget), "cap": budget.cap,
                        "iteration": budget.iteration.total, "fixed": budget.fixed.total,
                        "step": budget.step.total, "dense_step": budget.dense_step.total,
-                       "positions": budget.positions.total if budget.positions else None},
+                       "positions": budget.positions.total if budget.positions else None,
+                       "inputs": budget.inputs.total if budget.inputs else None},
     }
