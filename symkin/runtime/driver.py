@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -35,8 +36,8 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
-from symkin.errors import SolveError
-from symkin.runtime import failures, forces, ranges, redundant, units
+from symkin.errors import SolveError, SymkinWarning
+from symkin.runtime import branch, failures, forces, ranges, redundant, units
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
@@ -309,7 +310,13 @@ def _solve_inputs(kernel: Any, t: ArrayLike | None, q0: ArrayLike | None,
                   if run.done == 0 else None, params=p)
     # each row's efforts and reactions at its own inputs (an actuator's depend on them)
     rows = np.array([table.row(kernel, p, k) for k in range(run.done)]).reshape(run.done, -1)
-    return _trajectory(kernel, run, p, loads_p=rows)
+    trajectory = _trajectory(kernel, run, p, loads_p=rows)
+    with np.errstate(all="ignore"):
+        jumped = branch.jump_rows(kernel, trajectory.t, trajectory.q, rows)
+    trajectory.__dict__["branch_jumps"] = jumped
+    if jumped.any():
+        warnings.warn(branch.message(trajectory.t, jumped), SymkinWarning, stacklevel=3)
+    return trajectory
 
 
 def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,

@@ -102,6 +102,9 @@ class Trajectory:
     forces: Forces | None = None
     """Efforts and reactions (runtime.forces) when the mechanism has masses or forces."""
     outputs: tuple[tuple[str, NDArray[np.float64]], ...] = ()
+    branch_jumps: NDArray[np.bool_] | None = None
+    """(T,) True where an input-driven run may have jumped to another assembly than the row
+    before (runtime.branch); None for a run over t."""
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.
@@ -126,7 +129,7 @@ class Trajectory:
                              point_vectors=point_vectors, params=params,
                              lu_fallbacks=lu_fallbacks, q_p=None, dq_p=None, flagged=flagged,
                              cond=cond, singular=singular, removed=(), removed_residual=None,
-                             space=space, forces=None, outputs=())
+                             space=space, forces=None, outputs=(), branch_jumps=None)
         return self
 
     @property

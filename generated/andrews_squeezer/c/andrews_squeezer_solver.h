@@ -49,6 +49,23 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define ANDREWS_SQUEEZER_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 606 (227 add/sub, 121 mul, 28 div, 0 sqrt, 14 other calls, 116 fabs, 100 compares)
+ *   Phi, Phi_q, their factorization and tests: 417; the update (a solve): 189
+ * Condition at the converged q: 517; an extra iteration there (at most 3): 687
+ * Velocity: 125; acceleration: 148; per-point checks: 2616; predictor: 127
+ * Step, worst case with the default cap of 25 iterations: 21721 (8333 add/sub, 4600 mul, 889 div, 9 sqrt, 511 other calls, 3952 fabs, 3427 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284619
+ */
+#define ANDREWS_SQUEEZER_OPS_ITERATION 606   /* one Newton iteration */
+#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6571  /* a step without its iterations */
+#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21721  /* at the default cap, 25 */
+#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284619  /* every factorization dense */
+
 typedef struct {
     int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     andrews_squeezer_real t;         /* the time of the last step attempted           */

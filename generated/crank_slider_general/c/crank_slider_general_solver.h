@@ -49,6 +49,23 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define CRANK_SLIDER_GENERAL_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 375 (136 add/sub, 91 mul, 13 div, 0 sqrt, 6 other calls, 68 fabs, 61 compares)
+ *   Phi, Phi_q, their factorization and tests: 285; the update (a solve): 90
+ * Condition at the converged q: 211; an extra iteration there (at most 3): 456
+ * Velocity: 63; acceleration: 121; per-point checks: 1287; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 13019 (4778 add/sub, 3287 mul, 418 div, 9 sqrt, 219 other calls, 2232 fabs, 2076 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43158
+ */
+#define CRANK_SLIDER_GENERAL_OPS_ITERATION 375   /* one Newton iteration */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3644  /* a step without its iterations */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13019  /* at the default cap, 25 */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43158  /* every factorization dense */
+
 typedef struct {
     int status;                  /* CRANK_SLIDER_GENERAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     crank_slider_general_real t;         /* the time of the last step attempted           */

@@ -49,6 +49,23 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define CUSTOM_DRIVER_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 229 (90 add/sub, 46 mul, 12 div, 0 sqrt, 7 other calls, 35 fabs, 39 compares)
+ *   Phi, Phi_q, their factorization and tests: 151; the update (a solve): 78
+ * Condition at the converged q: 104; an extra iteration there (at most 3): 310
+ * Velocity: 64; acceleration: 96; per-point checks: 1155; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 8427 (3258 add/sub, 1880 mul, 389 div, 9 sqrt, 250 other calls, 1211 fabs, 1430 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38860
+ */
+#define CUSTOM_DRIVER_OPS_ITERATION 229   /* one Newton iteration */
+#define CUSTOM_DRIVER_OPS_STEP_FIXED 2702  /* a step without its iterations */
+#define CUSTOM_DRIVER_OPS_STEP_WORST 8427  /* at the default cap, 25 */
+#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38860  /* every factorization dense */
+
 typedef struct {
     int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     custom_driver_real t;         /* the time of the last step attempted           */

@@ -49,6 +49,27 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define DELTA_FK_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 3619 (1384 add/sub, 1331 mul, 48 div, 0 sqrt, 6 other calls, 485 fabs, 365 compares)
+ *   Phi, Phi_q, their factorization and tests: 3188; the update (a solve): 431
+ * Condition at the converged q: 5175; an extra iteration there (at most 3): 3700
+ * Velocity: 423; acceleration: 7053; per-point checks: 5418; predictor: 169
+ * Step, worst case with the default cap of 25 iterations: 128219 (51180 add/sub, 47440 mul, 1492 div, 9 sqrt, 594 other calls, 15678 fabs, 11826 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * solve_inputs, worst case: 122001 (51069 add/sub, 42227 mul, 596 div, 9 sqrt, 594 other calls, 15678 fabs, 11828 compares)
+ *   positions only (du, ddu NULL): 114467 (47111 add/sub, 38765 mul, 596 div, 9 sqrt, 594 other calls, 15622 fabs, 11770 compares)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689843
+ */
+#define DELTA_FK_OPS_ITERATION 3619   /* one Newton iteration */
+#define DELTA_FK_OPS_STEP_FIXED 37744  /* a step without its iterations */
+#define DELTA_FK_OPS_STEP_WORST 128219  /* at the default cap, 25 */
+#define DELTA_FK_OPS_STEP_DENSE_WORST 689843  /* every factorization dense */
+#define DELTA_FK_OPS_INPUTS_WORST 122001  /* solve_inputs with du, ddu */
+#define DELTA_FK_OPS_POSITIONS_WORST 114467  /* solve_inputs, du, ddu NULL */
+
 typedef struct {
     int status;                  /* DELTA_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     delta_fk_real t;         /* the time of the last step attempted           */

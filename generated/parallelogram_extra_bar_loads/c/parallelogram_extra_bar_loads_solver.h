@@ -49,6 +49,23 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 396 (153 add/sub, 88 mul, 19 div, 0 sqrt, 11 other calls, 63 fabs, 62 compares)
+ *   Phi, Phi_q, their factorization and tests: 267; the update (a solve): 129
+ * Condition at the converged q: 231; an extra iteration there (at most 3): 477
+ * Velocity: 88; acceleration: 113; per-point checks: 1836; predictor: 91
+ * Step, worst case with the default cap of 25 iterations: 14231 (5532 add/sub, 3289 mul, 610 div, 9 sqrt, 395 other calls, 2193 fabs, 2203 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123275
+ */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_ITERATION 396   /* one Newton iteration */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4331  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 14231  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123275  /* every factorization dense */
+
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_LOADS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     parallelogram_extra_bar_loads_real t;         /* the time of the last step attempted           */

@@ -49,6 +49,23 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define PLANETARY_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 229 (87 add/sub, 44 mul, 12 div, 0 sqrt, 2 other calls, 41 fabs, 43 compares)
+ *   Phi, Phi_q, their factorization and tests: 154; the update (a solve): 75
+ * Condition at the converged q: 70; an extra iteration there (at most 3): 310
+ * Velocity: 48; acceleration: 43; per-point checks: 1122; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 8260 (3079 add/sub, 1775 mul, 389 div, 9 sqrt, 103 other calls, 1367 fabs, 1538 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38603
+ */
+#define PLANETARY_OPS_ITERATION 229   /* one Newton iteration */
+#define PLANETARY_OPS_STEP_FIXED 2535  /* a step without its iterations */
+#define PLANETARY_OPS_STEP_WORST 8260  /* at the default cap, 25 */
+#define PLANETARY_OPS_STEP_DENSE_WORST 38603  /* every factorization dense */
+
 typedef struct {
     int status;                  /* PLANETARY_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     planetary_real t;         /* the time of the last step attempted           */

@@ -49,6 +49,23 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define QUICK_RETURN_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 296 (122 add/sub, 61 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
+ *   Phi, Phi_q, their factorization and tests: 192; the update (a solve): 104
+ * Condition at the converged q: 179; an extra iteration there (at most 3): 377
+ * Velocity: 68; acceleration: 107; per-point checks: 1501; predictor: 73
+ * Step, worst case with the default cap of 25 iterations: 10873 (4413 add/sub, 2428 mul, 485 div, 9 sqrt, 234 other calls, 1553 fabs, 1751 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72658
+ */
+#define QUICK_RETURN_OPS_ITERATION 296   /* one Newton iteration */
+#define QUICK_RETURN_OPS_STEP_FIXED 3473  /* a step without its iterations */
+#define QUICK_RETURN_OPS_STEP_WORST 10873  /* at the default cap, 25 */
+#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72658  /* every factorization dense */
+
 typedef struct {
     int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     quick_return_real t;         /* the time of the last step attempted           */

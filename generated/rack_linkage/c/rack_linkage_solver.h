@@ -49,6 +49,23 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define RACK_LINKAGE_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 370 (130 add/sub, 75 mul, 16 div, 0 sqrt, 7 other calls, 73 fabs, 69 compares)
+ *   Phi, Phi_q, their factorization and tests: 262; the update (a solve): 108
+ * Condition at the converged q: 225; an extra iteration there (at most 3): 451
+ * Velocity: 73; acceleration: 102; per-point checks: 1545; predictor: 73
+ * Step, worst case with the default cap of 25 iterations: 13151 (4701 add/sub, 2895 mul, 514 div, 9 sqrt, 264 other calls, 2400 fabs, 2368 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74700
+ */
+#define RACK_LINKAGE_OPS_ITERATION 370   /* one Newton iteration */
+#define RACK_LINKAGE_OPS_STEP_FIXED 3901  /* a step without its iterations */
+#define RACK_LINKAGE_OPS_STEP_WORST 13151  /* at the default cap, 25 */
+#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74700  /* every factorization dense */
+
 typedef struct {
     int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     rack_linkage_real t;         /* the time of the last step attempted           */

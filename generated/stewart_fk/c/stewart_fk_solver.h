@@ -49,6 +49,27 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define STEWART_FK_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 1375 (545 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 128 fabs, 113 compares)
+ *   Phi, Phi_q, their factorization and tests: 1247; the update (a solve): 128
+ * Condition at the converged q: 612; an extra iteration there (at most 3): 1456
+ * Velocity: 118; acceleration: 1863; per-point checks: 1665; predictor: 43
+ * Step, worst case with the default cap of 25 iterations: 44946 (18072 add/sub, 18796 mul, 470 div, 9 sqrt, 35 other calls, 4012 fabs, 3552 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * solve_inputs, worst case: 43111 (18045 add/sub, 17210 mul, 246 div, 9 sqrt, 35 other calls, 4012 fabs, 3554 compares)
+ *   positions only (du, ddu NULL): 41114 (17013 add/sub, 16275 mul, 246 div, 9 sqrt, 35 other calls, 3998 fabs, 3538 compares)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 60701
+ */
+#define STEWART_FK_OPS_ITERATION 1375   /* one Newton iteration */
+#define STEWART_FK_OPS_STEP_FIXED 10571  /* a step without its iterations */
+#define STEWART_FK_OPS_STEP_WORST 44946  /* at the default cap, 25 */
+#define STEWART_FK_OPS_STEP_DENSE_WORST 60701  /* every factorization dense */
+#define STEWART_FK_OPS_INPUTS_WORST 43111  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 41114  /* solve_inputs, du, ddu NULL */
+
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     stewart_fk_real t;         /* the time of the last step attempted           */

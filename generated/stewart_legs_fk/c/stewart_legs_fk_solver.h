@@ -49,6 +49,27 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define STEWART_LEGS_FK_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 15452 (6015 add/sub, 5995 mul, 165 div, 0 sqrt, 0 other calls, 1901 fabs, 1376 compares)
+ *   Phi, Phi_q, their factorization and tests: 13597; the update (a solve): 1855
+ * Condition at the converged q: 22348; an extra iteration there (at most 3): 15533
+ * Velocity: 1587; acceleration: 18931; per-point checks: 22342; predictor: 547
+ * Step, worst case with the default cap of 25 iterations: 534642 (215480 add/sub, 208386 mul, 5074 div, 9 sqrt, 1365 other calls, 60795 fabs, 43533 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * solve_inputs, worst case: 510751 (215117 add/sub, 187768 mul, 2162 div, 9 sqrt, 1365 other calls, 60795 fabs, 43535 compares)
+ *   positions only (du, ddu NULL): 490049 (204795 add/sub, 177754 mul, 2162 div, 9 sqrt, 1365 other calls, 60613 fabs, 43351 compares)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16584759
+ */
+#define STEWART_LEGS_FK_OPS_ITERATION 15452   /* one Newton iteration */
+#define STEWART_LEGS_FK_OPS_STEP_FIXED 148342  /* a step without its iterations */
+#define STEWART_LEGS_FK_OPS_STEP_WORST 534642  /* at the default cap, 25 */
+#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16584759  /* every factorization dense */
+#define STEWART_LEGS_FK_OPS_INPUTS_WORST 510751  /* solve_inputs with du, ddu */
+#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 490049  /* solve_inputs, du, ddu NULL */
+
 typedef struct {
     int status;                  /* STEWART_LEGS_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     stewart_legs_fk_real t;         /* the time of the last step attempted           */

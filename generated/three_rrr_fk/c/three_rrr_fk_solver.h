@@ -49,6 +49,27 @@ typedef struct {
  * written as a number (folded into the generated code, it cannot be rescaled at run time). */
 #define THREE_RRR_FK_SCALE_FREE 1
 
+/* Operations of one step, to budget a servo period: counted at generation from the code
+ * below, worst case (every branch that adds work taken, Newton at its cap, the extra
+ * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
+ * call of tens of instructions, each other operation about one.
+ * One Newton iteration: 682 (257 add/sub, 153 mul, 28 div, 0 sqrt, 14 other calls, 124 fabs, 106 compares)
+ *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 195
+ * Condition at the converged q: 568; an extra iteration there (at most 3): 763
+ * Velocity: 134; acceleration: 200; per-point checks: 2682; predictor: 127
+ * Step, worst case with the default cap of 25 iterations: 24148 (9288 add/sub, 5634 mul, 889 div, 9 sqrt, 511 other calls, 4216 fabs, 3601 compares)
+ *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
+ * solve_inputs, worst case: 21160 (9205 add/sub, 3399 mul, 217 div, 9 sqrt, 511 other calls, 4216 fabs, 3603 compares)
+ *   positions only (du, ddu NULL): 20782 (9015 add/sub, 3297 mul, 217 div, 9 sqrt, 511 other calls, 4174 fabs, 3559 compares)
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286702
+ */
+#define THREE_RRR_FK_OPS_ITERATION 682   /* one Newton iteration */
+#define THREE_RRR_FK_OPS_STEP_FIXED 7098  /* a step without its iterations */
+#define THREE_RRR_FK_OPS_STEP_WORST 24148  /* at the default cap, 25 */
+#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286702  /* every factorization dense */
+#define THREE_RRR_FK_OPS_INPUTS_WORST 21160  /* solve_inputs with du, ddu */
+#define THREE_RRR_FK_OPS_POSITIONS_WORST 20782  /* solve_inputs, du, ddu NULL */
+
 typedef struct {
     int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
     three_rrr_fk_real t;         /* the time of the last step attempted           */

@@ -1,0 +1,296 @@
+"""The worst-case operation count of one step of the generated C solver, for its header.
+
+An embedded engineer budgets a servo period by the most a call can cost. The straight-line
+pieces (the kernel routines, the sparse LU's factor and solves, the exact inverse norm and
+||Phi_q||_1) are counted from the statements the templates render (codegen.op_count); the
+solver's own loops (templates/c/solver.c.j2 and its partials) are counted here per call,
+each formula next to the name of the function it mirrors, taking every branch that adds
+work (the worst case). Composition, as ``<prefix>_solve_step`` runs:
+
+    predictor + (cap + 1) x evaluation + cap x Newton update + convergence checks
+    (condition, up to TIGHTEN_STEPS extra iterations, condition again)
+    + velocity + acceleration + per-point checks (norms, error model).
+
+The cap is ``options.max_iterations`` (its default here; the header gives the cost of one
+iteration so that another cap can be budgeted). The unit-scaling passes count where the
+mechanism is scale-free (options.unit != 1). The dense fall-back's worst case replaces every
+sparse factorization by a failed sparse attempt and the dense LU, every solve by dense
+substitution, and the exact inverse norm by Hager's estimate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from symkin.codegen.op_count import ZERO, Flops, count, count_all
+from symkin.contract import tuning
+
+
+def _routine(code: Any, name: str) -> Flops:
+    """One call of a kernel routine: its temporaries and outputs, every part."""
+    routine = code.routine(name)
+    return sum((count_all([text for _, text in part.temporaries]) for part in routine.parts),
+               ZERO) + count_all(routine.outputs)
+
+
+def _max_abs(n: int) -> Flops:
+    """<prefix>_max_abs: |v_i|, a branch-free max and a sum per entry, the NaN test."""
+    return Flops(abs=n, cmp=n + 1, add=n)
+
+
+@dataclass(frozen=True)
+class LinearAlgebra:
+    """The cost of one call of each LU routine the solver makes."""
+
+    factor: Flops  # lu_factor, its pivot tests included
+    pivot_ratio: Flops
+    solve: Flops
+    solve_transposed: Flops
+    exact_inverse: Flops | None  # the straight-line ||Phi_q^-1||_1, where generated
+
+
+def dense_lu(n: int, nnz: int) -> LinearAlgebra:
+    """templates/c/dense_lu.c.j2 at its worst: every row swept and updated (a full matrix)."""
+    factor = Flops(abs=2 * nnz, cmp=nnz, mul=1)  # the scatter with max |a| and the tiny bound
+    for k in range(n):
+        r = n - k - 1  # rows below the pivot, columns right of it
+        # search (|a| twice on a new best), tests, spread, 1 / pivot, used columns,
+        # multipliers with their zero test, the Schur update
+        factor += Flops(abs=1 + 2 * r, cmp=3 * r + 3, div=1, mul=r + r * r, add=r * r)
+    factor += Flops(cmp=1, div=1)  # the pivot spread
+    triangle = Flops(mul=n * (n - 1) // 2, add=n * (n - 1) // 2)
+    solve = triangle * 2 + Flops(mul=n)
+    return LinearAlgebra(factor=factor, pivot_ratio=ZERO, solve=solve,
+                         solve_transposed=solve, exact_inverse=None)
+
+
+def _amax_helpers(prefix: str) -> dict[str, Flops]:
+    """The helpers the straight-line factor calls (templates/c/sparse_lu.c.j2)."""
+    return {f"{prefix}_lu_amax": Flops(abs=2, cmp=1),  # fabs(b) > a ? fabs(b) : a
+            f"{prefix}_lu_pivot_ok": Flops(abs=2, cmp=2, mul=1)}
+
+
+def sparse_lu(lu: dict[str, Any], n: int, nnz: int, prefix: str) -> LinearAlgebra:
+    """templates/c/sparse_lu.c.j2 as rendered from ``lu`` (backends.c.lu_code's context)."""
+    if lu["style"] == "tables":
+        return _sparse_tables(lu, n, nnz)
+    helpers = _amax_helpers(prefix)
+    steps = [s for part in lu["factor_parts"] for s in part["steps"]]
+    load = Flops(abs=1, cmp=1, add=2) * len(lu["loaded"]) + Flops(mul=1, add=1)
+    factor = load + Flops(cmp=1 if lu["tiny_check"] else 0) + count_all(
+        [line for s in steps for line in s["factor"]], helpers)
+    variable = len(lu["variable_pivots"])
+    if variable == n:
+        ratio = Flops(abs=n, cmp=2 * (n - 1))
+    else:
+        ratio = Flops(abs=4 * variable, cmp=2 * variable)
+    ratio += Flops(cmp=1, div=1)  # high > 0 ? low / high : 0
+
+    def lines(key: str) -> list[str]:
+        return [line for part in lu[f"{key}_parts"] for s in part["steps"] for line in s[key]]
+
+    inverse = lu.get("inverse")
+    return LinearAlgebra(
+        factor=factor, pivot_ratio=ratio, solve=count_all(lines("forward") + lines("backward")),
+        solve_transposed=count_all(lines("upper_t") + lines("lower_t")),
+        exact_inverse=_exact_inverse(inverse) if inverse else None)
+
+
+def _sparse_tables(lu: dict[str, Any], n: int, nnz: int) -> LinearAlgebra:
+    """The table-driven loops: every operation of the plan, no number folded in."""
+    tables = lu["tables"]
+    lower = len(tables["lower"]) // 2 - 1  # each table ends in one zero record
+    upper = len(tables["upper"]) // 2 - 1
+    updates = len(tables["update"]) // 3 - 1
+    load = Flops(abs=nnz, cmp=nnz, add=2 * nnz) + Flops(mul=1, add=1)
+    factor = load + Flops(abs=3 * n + 2 * lower, cmp=lower + 2 * n, mul=n + lower + updates,
+                          div=n, add=updates)
+    ratio = Flops(abs=n, cmp=2 * (n - 1) + 1, div=1)
+    solve = Flops(mul=lower + upper + n, add=lower + upper)
+    return LinearAlgebra(factor=factor, pivot_ratio=ratio, solve=solve,
+                         solve_transposed=solve, exact_inverse=None)
+
+
+def _exact_inverse(inverse: dict[str, Any]) -> Flops:
+    """<prefix>_inverse_norm1_exact: its temporaries, then per column sum |.|, the finite
+    test and the max; then the finite test of all."""
+    sums = sum((count(s) + Flops(add=2, cmp=1) for s in inverse["sums"]), ZERO)
+    return count_all(inverse["lines"]) + sums + Flops(cmp=1)
+
+
+def norm1(context: dict[str, Any] | None, n: int, nnz: int) -> Flops:
+    """<prefix>_norm1: the straight-line column sums (each with its max), or the loop."""
+    if context is None:
+        return Flops(abs=nnz, add=nnz, cmp=n)
+    return sum((count(expression) + Flops(cmp=1) for part in context["parts"]
+                for _, expression in part), ZERO)
+
+
+# ----- the solver's own work (templates/c/solver.c.j2, _condition, _error_model, _units) -----
+
+# <prefix>_flagged: s = inv_norm / sqrt(NQ), the rounding floor, the residual's error, e_q,
+# e_dq, e_ddq, and the three comparisons with the targets.
+FLAGGED = Flops(sqrt=1, div=1, mul=18, add=6, cmp=11)
+# <prefix>_flagged_refined beyond its two estimators and maxima: root, s, the error left,
+# e_q, the bound, e_n, e_dq, e_dq_n, e_ddq and the three comparisons.
+REFINED = Flops(sqrt=1, div=2, mul=29, add=10, cmp=13)
+# <prefix>_would_flag: the residual against the rounding level, then the model.
+WOULD_FLAG = Flops(add=1, mul=1, cmp=1) + FLAGGED
+
+
+@dataclass(frozen=True)
+class Pieces:
+    """The cost of one call of each piece of a step (what the header lists)."""
+
+    evaluation: Flops  # Phi and Phi_q (fused), the residual, the factorization and its tests
+    update: Flops  # the Newton step: a solve and q += dq
+    estimate: Flops  # the condition at the converged q
+    tighten: Flops  # one extra Newton iteration at an ill-conditioned point
+    velocity: Flops
+    acceleration: Flops
+    checks: Flops  # max |q|, |dq|, |ddq| and the error model at its worst
+    predictor: Flops
+
+    def newton(self, cap: int) -> Flops:
+        return self.evaluation * (cap + 1) + self.update * cap
+
+    def converged(self, checks: Flops) -> Flops:
+        """<prefix>_converged: estimate, up to TIGHTEN_STEPS extra iterations, estimate."""
+        return (self.estimate * 2 + checks + self.tighten * tuning.TIGHTEN_STEPS)
+
+
+def _hager(algebra: LinearAlgebra, n: int, rows: bool) -> Flops:
+    """<prefix>_inverse_norm1_rows at its worst: every ascent step taken, with the full dot
+    product (a non-finite entry); ``rows``: of P Phi_q^-1."""
+    masked = 1 if rows else 0
+    first = algebra.solve + Flops(abs=n, add=n, mul=n * masked)
+    ascent = algebra.solve + Flops(mul=2 * n * masked, abs=n, add=2 * n, call=n)
+    ascent += Flops(add=1, cmp=2) + algebra.solve_transposed + Flops(abs=1 + n, add=2 * n,
+                                                                     cmp=2 * n)
+    dot = Flops(cmp=2, mul=n, add=n)
+    steps = tuning.ESTIMATOR_STEPS
+    return first + ascent * steps + dot * (steps - 1) + Flops(mul=1, div=1, add=1, cmp=2)
+
+
+def _estimate(algebra: LinearAlgebra, norm: Flops, n: int, nnz: int) -> Flops:
+    """<prefix>_estimate: the exact norm where generated, else the reuse test and a fresh
+    Hager estimate; then cond = ||Phi_q^-1||_1 ||Phi_q||_1."""
+    cond = norm + Flops(mul=1)
+    if algebra.exact_inverse is not None:
+        return algebra.exact_inverse + cond
+    reuse = Flops(mul=1, abs=nnz, add=2 * nnz, cmp=2)  # theta, difference_bound1
+    return reuse + _hager(algebra, n, rows=False) + cond
+
+
+def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
+           inputs: bool = False, rates: bool = True) -> Pieces:
+    """The pieces of ``<prefix>_solve_step`` (``inputs``: of ``<prefix>_solve_inputs``, which
+    has no predictor and decides in the mechanism's unit; ``rates`` False: du, ddu NULL)."""
+    n, nnz = code.nq, code.nnz
+    units = scaled and not inputs
+    in_unit = Flops(div=n, mul=nnz) if units else ZERO
+    rows_in_unit = Flops(div=n) if units else ZERO
+    from_unit = Flops(mul=n) if units else ZERO
+    factor = algebra.factor + algebra.pivot_ratio + Flops(cmp=1)  # factor_jacobian
+    fused = _routine(code, "phi_phi_q") + in_unit + _max_abs(n)
+    evaluation = fused + Flops(add=1, cmp=1) + factor + Flops(cmp=2)
+    negate_solve = Flops(add=n) + algebra.solve
+    update = negate_solve + _max_abs(n) + from_unit + Flops(add=n)
+    tighten = (update + Flops(add=1, cmp=1) + WOULD_FLAG * 2 + Flops(cmp=2, div=1)
+               + fused + factor)
+    estimate = _estimate(algebra, norm, n, nnz)
+    solve = rows_in_unit + algebra.solve + from_unit
+    velocity = _routine(code, "phi_t_shared") + Flops(add=n) + solve
+    acceleration = _routine(code, "gamma_shared") + solve
+    refined = REFINED + FLAGGED + _hager(algebra, n, rows=True) + Flops(cmp=2 * n, abs=n) * 2
+    if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests
+        norms = _max_abs(n) * (1 + 2 * rates) + Flops(add=2, cmp=2)
+    else:  # one pass: |q|, |dq|, |ddq| scaled, three maxima, the sum and two finite tests
+        norms = Flops(abs=3 * n, mul=3 * n, cmp=3 * n, add=5 * n) + Flops(cmp=3)
+    predictor = ZERO if inputs else Flops(add=1) + Flops(mul=3, div=1, add=2) * n
+    return Pieces(evaluation=evaluation, update=update, estimate=estimate,
+                  tighten=tighten, velocity=velocity, acceleration=acceleration,
+                  checks=norms + refined, predictor=predictor)
+
+
+def step(parts: Pieces, cap: int, rates: bool = True) -> Flops:
+    """The worst case of one step with Newton capped at ``cap`` iterations; ``rates`` False:
+    positions only (``<prefix>_solve_inputs`` with du, ddu NULL)."""
+    convergence = parts.converged(Flops(cmp=3) + WOULD_FLAG)
+    kinematics = parts.velocity + parts.acceleration if rates else ZERO
+    return parts.predictor + parts.newton(cap) + convergence + kinematics + parts.checks
+
+
+@dataclass(frozen=True)
+class Budget:
+    """What the header states: per-iteration cost, fixed part and worst cases by kind."""
+
+    cap: int
+    iteration: Flops  # one Newton iteration: evaluation + update
+    fixed: Flops  # the rest of a step: worst(cap) = fixed + cap x iteration
+    step: Flops  # solve_step's worst case at the default cap
+    pieces: Pieces
+    positions: Flops | None  # solve_inputs with du, ddu NULL (input mechanisms only)
+    inputs: Flops | None  # solve_inputs with rates and accelerations
+    dense_step: Flops  # solve_step's worst case on the dense LU (fall-back or --linalg dense)
+
+
+def budget(code: Any, lu: dict[str, Any] | None, norm1_context: dict[str, Any] | None,
+           scaled: bool, cap: int) -> Budget:
+    """The worst-case operation counts of one step of the generated solver.
+
+    Args:
+        code: the lowered mechanism (codegen.lower.Code).
+        lu: the sparse LU's template context (None: --linalg dense).
+        norm1_context: the straight-line ||Phi_q||_1 (None: the loop over the non-zeros).
+        scaled: whether options.unit rescales the solve (the mechanism is scale-free).
+        cap: the iteration cap of the default options.
+    """
+    n, nnz = code.nq, code.nnz
+    norm = norm1(norm1_context, n, nnz)
+    dense = dense_lu(n, nnz)
+    algebra = sparse_lu(lu, n, nnz, code.name) if lu else dense
+    if lu:  # the fall-back: a sparse attempt that fails at its last pivot, then dense
+        fallback = LinearAlgebra(factor=algebra.factor + dense.factor, pivot_ratio=ZERO,
+                                 solve=dense.solve, solve_transposed=dense.solve_transposed,
+                                 exact_inverse=None)
+    else:
+        fallback = dense
+    parts = pieces(code, algebra, norm, scaled)
+    worst = step(parts, cap)
+    iteration = parts.evaluation + parts.update
+    inputs = positions = None
+    if code.input_names:
+        inputs = step(pieces(code, algebra, norm, scaled, inputs=True), cap)
+        positions = step(pieces(code, algebra, norm, scaled, inputs=True, rates=False), cap,
+                         rates=False)
+    return Budget(cap=cap, iteration=iteration, fixed=worst + iteration * -cap, step=worst,
+                  pieces=parts, positions=positions, inputs=inputs,
+                  dense_step=step(pieces(code, fallback, norm, scaled), cap))
+
+
+def header_lines(plan: Budget) -> list[str]:
+    """The comment block of ``<prefix>_solver.h`` (lines without the comment markers)."""
+    def kinds(f: Flops) -> str:
+        return (f"{f.total} ({f.add} add/sub, {f.mul} mul, {f.div} div, {f.sqrt} sqrt, "
+                f"{f.call} other calls, {f.abs} fabs, {f.cmp} compares)")
+
+    p = plan.pieces
+    lines = [
+        f"One Newton iteration: {kinds(plan.iteration)}",
+        f"  Phi, Phi_q, their factorization and tests: {p.evaluation.total}; "
+        f"the update (a solve): {p.update.total}",
+        f"Condition at the converged q: {p.estimate.total}; an extra iteration there "
+        f"(at most {tuning.TIGHTEN_STEPS}): {p.tighten.total}",
+        f"Velocity: {p.velocity.total}; acceleration: {p.acceleration.total}; "
+        f"per-point checks: {p.checks.total}; predictor: {p.predictor.total}",
+        f"Step, worst case with the default cap of {plan.cap} iterations: {kinds(plan.step)}",
+        "  (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)",
+    ]
+    if plan.inputs is not None and plan.positions is not None:
+        lines += [f"solve_inputs, worst case: {kinds(plan.inputs)}",
+                  f"  positions only (du, ddu NULL): {kinds(plan.positions)}"]
+    lines.append(f"On the dense LU (a fall-back at every factorization, or --linalg dense), "
+                 f"worst case: {plan.dense_step.total}")
+    return lines
