@@ -16,10 +16,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from codegen_support import HEAVY
 
 import symkin
 from symkin.codegen import lu_interchange, lu_plan
+from symkin.codegen import sample as codegen_sample
 
 ROOT = Path(__file__).resolve().parents[2]
 # Where a fall-back cannot be avoided, and why: the parallelograms pass through a singular
@@ -131,3 +133,15 @@ def test_interchanges_hold_over_the_turn() -> None:
     for sample in samples:
         assert lu_interchange.factor(plan, sample).failed is None
         assert _solves(plan, rows, cols, sample)
+
+
+def test_the_input_walk_starts_at_the_drawing_s_leg_lengths() -> None:
+    """stewart_fk's leg rows, |B - P|^2 - u^2, are flat in u at the nominal u = 0, yet the walk
+    of its inputs starts at the drawn legs' lengths |P_i - B_i|, read here from the file."""
+    system = symkin.derive(ROOT / "examples" / "stewart_fk.yaml")
+    kernel = codegen_sample._SampleKernel(system, system.pattern())
+    p = codegen_sample.start_inputs(system, kernel, np.array(system.q0, dtype=float))
+    bodies = yaml.safe_load((ROOT / "examples" / "stewart_fk.yaml").read_text())["bodies"]
+    drawn = [np.linalg.norm(np.subtract(bodies["platform"]["points"][f"P{i}"],
+                                        bodies["ground"]["points"][f"B{i}"])) for i in range(1, 7)]
+    assert np.max(np.abs(p[len(system.p):len(system.p) + 6] - drawn)) < 1e-9
