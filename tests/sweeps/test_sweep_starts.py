@@ -179,3 +179,52 @@ def test_length_scales_in_c_are_the_largest_lever_arm(crank_slider_system) -> No
     # 5k = 0.005, 0.015, ..., 500, 1500, 5000: outside 0.01 .. 100 the power of 10 below it
     expected = [1e-3, 1.0, 1.0, 1.0, 1.0, 1.0, 100.0, 1e3, 1e3]
     assert starts.set_units(solver, designs, 0.0, zeros).tolist() == expected
+
+
+# A slider-crank a = 1, b = 3 driven by the slider's position x0 - t, each set with its own
+# first guess: the assembly at x0 in closed form (law of cosines, crank up). x0 = a + b is the
+# dead centre (crank and rod collinear along the slide).
+SLIDER_CRANK = """
+name: slider_crank_limit
+parameters: {a: 1.0, b: 3.0, x0: 3.5}
+bodies:
+  crank:  {q0: [0, 0, 0]}
+  rod:    {q0: [0, 0, 0]}
+  slider: {q0: [0, 0, 0]}
+joints:
+  - {type: revolute,  name: O,     i: ground, j: crank,  sA: [0, 0], sB: [0, 0]}
+  - {type: revolute,  name: A,     i: crank,  j: rod,    sA: [a, 0], sB: [0, 0]}
+  - {type: revolute,  name: B,     i: rod,    j: slider, sA: [b, 0], sB: [0, 0]}
+  - {type: prismatic, name: guide, i: slider, j: ground, sA: [0, 0], sB: [0, 0], v: [0, 1]}
+drivers:
+  - {type: slide, name: push, i: ground, j: slider, sA: [0, 0], sB: [0, 0], u: [1, 0],
+     f: "x0 - t"}
+time: {t0: 0, t1: 0.5, dt: 0.05}
+"""
+
+
+def _assembled(x0: float, a: float = 1.0, b: float = 3.0) -> list[float]:
+    phi = np.arccos((a * a + x0 * x0 - b * b) / (2 * a * x0))
+    ax, ay = a * np.cos(phi), a * np.sin(phi)
+    return [0.0, 0.0, phi, ax, ay, np.arctan2(-ay, x0 - ax), x0, 0.0, 0.0]
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_slider_cranks_drawn_at_their_dead_centre_with_own_guesses(tmp_path, backend) -> None:
+    path = tmp_path / "slider_crank_limit.yaml"
+    path.write_text(SLIDER_CRANK)
+    kernel = kernel_for(symkin.derive(symkin.load(path)), backend)
+    x0 = np.array([3.5, 4.0 - 1e-13, 3.9, 4.0 - 1e-11, 3.99, 4.0 - 1e-12, 3.0])
+    dead = x0 > 4.0 - 1e-10  # a + b = 4, the start within rounding of it
+    designs = np.column_stack([np.ones(x0.size), np.full(x0.size, 3.0), x0])
+    guesses = np.array([_assembled(x) for x in x0])
+    t = np.linspace(0.0, 0.5, 11)
+    result = symkin.sweep(kernel, designs, t, q0=guesses, workers=1)
+    reasons = [_per_set(kernel, result, j, p, t, guesses[j]) for j, p in enumerate(designs)]
+    assert [r == "singular" for r in reasons] == list(dead)
+    assert result.ok[~dead].all()
+    crank = kernel.coordinates.index("crank.phi")
+    for j in np.flatnonzero(~dead):  # the crank follows the law of cosines
+        x = x0[j] - t
+        np.testing.assert_allclose(result.q[j, :, crank],
+                                   np.arccos((1 + x * x - 9) / (2 * x)), atol=1e-9)
