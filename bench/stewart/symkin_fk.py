@@ -2,6 +2,7 @@
 LinuxCNC-style baseline, through fk_bench.c's documented solver signature.
 
     python3 bench/stewart/symkin_fk.py [--poses 10000] [--repeats 5] [--mechanism FILE ...]
+                                       [--committed]
 
 For each mechanism (default examples/stewart_fk.yaml, one moving body, and
 examples/stewart_legs_fk.yaml, with its 12 leg bodies; both the geometry of stewart.c) the C
@@ -13,11 +14,16 @@ turned into roll, pitch, yaw). Two solvers per mechanism: positions only (du = d
 and with rates and accelerations (du, ddu given: the harness has no leg rates, so zeros are
 passed; the two linear solves cost the same for any values). fk_bench.c, compiled with
 FK_EXTRA_SOLVERS and gcc -O2, prints one line per solver and tilt.
+``--committed`` times the folders committed under generated/ instead of generating them (the
+golden test keeps them equal to what the templates give; the leg-body file takes minutes to
+generate).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -113,12 +119,27 @@ def home_lengths() -> list[float]:
     return [sum((p - b) ** 2 for p, b in zip(pt, bs)) ** 0.5 for pt, bs in zip(top, base)]
 
 
+class Committed:
+    """What adapter needs of a System, read from a committed folder's manifest."""
+
+    def __init__(self, path: str) -> None:
+        self.name = Path(path).stem
+        self.folder = ROOT / "generated" / self.name / "c"
+        manifest = json.loads((self.folder / f"{self.name}_manifest.json").read_text())
+        self.input_names, self.coordinates = manifest["input_names"], manifest["coordinates"]
+        self.p = manifest["parameter_names"]
+
+
 def adapter(system, out: Path) -> tuple[str, str]:
-    """Generate the mechanism's C into out and write its adapter; the header lines."""
+    """Generate the mechanism's C into out (or copy the committed folder) and write its
+    adapter; the header lines."""
     name = system.name
     if tuple(system.input_names) != tuple(f"leg{i}" for i in range(1, 7)):
         sys.exit(f"{name}: expected the six inputs leg1..leg6")
-    symkin.generate(system, backend="c", out_dir=out)
+    if isinstance(system, Committed):
+        shutil.copytree(system.folder, out)
+    else:
+        symkin.generate(system, backend="c", out_dir=out)
     # The leg-body file's inputs are slides from the home lengths; the one-body file's the
     # lengths themselves (distance drivers).
     slides = any(c.startswith("piston") for c in system.coordinates)
@@ -142,12 +163,14 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--mechanism", nargs="+", default=[
         str(ROOT / "examples/stewart_fk.yaml"), str(ROOT / "examples/stewart_legs_fk.yaml")])
+    parser.add_argument("--committed", action="store_true",
+                        help="time the folders under generated/ (no code generation)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
         out = Path(folder)
         declares, tables, sources = [], [], []
         for path in args.mechanism:
-            system = symkin.derive(path)
+            system = Committed(path) if args.committed else symkin.derive(path)
             sub = out / system.name
             declare, table = adapter(system, sub)
             declares.append(declare)

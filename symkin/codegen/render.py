@@ -298,7 +298,8 @@ def template_context(code: Code) -> dict[str, Any]:
         "newton_defaults": _newton_defaults(code, literal),
         "option_fields": list(options.C_FIELDS),
         "status": dict(status.CODES),
-        "shared_constants": {name: _c_number(value) for name, value in tuning.SHARED.items()},
+        "shared_constants": {name: _c_number(value)
+                             for name, value in {**tuning.SHARED, **tuning.INPUTS}.items()},
         **code.backend.template_context(code),
     }
 

@@ -25,8 +25,21 @@ theta = ||Phi_q^-1||_1 ||Phi_q' - Phi_q||_1 (the old estimate, the change of Phi
 most this: ||Phi_q'^-1||_1 <= ||Phi_q^-1||_1 / (1 - theta) (the Banach lemma) stands for it.
 An exact norm is always made again."""
 
+CHORD_STEPS = 6
+"""Simplified Newton steps (Phi alone, the last solve's factors of Phi_q) at most before an
+input-driven solve of the generated C evaluates and factors Phi_q: from the last solution,
+inputs that moved a little in a servo period need two or three."""
+
+CHORD_CONTRACTION = 0.1
+"""A simplified Newton step is taken only while its size is at most this times the last one's:
+slower, the factors are too far from Phi_q here, and full Newton takes over."""
+
 
 SHARED = {"ESTIMATOR_STEPS": ESTIMATOR_STEPS, "TIGHTEN_STEPS": TIGHTEN_STEPS, "SAFETY": SAFETY,
           "REESTIMATE_SHIFT": REESTIMATE_SHIFT}
 """The constants the generated C solver defines too, by name (its macro is ``<PREFIX>_`` + the
 name, rendered from this table by codegen.render)."""
+
+INPUTS = {"CHORD_STEPS": CHORD_STEPS, "CHORD_CONTRACTION": CHORD_CONTRACTION}
+"""The constants the input-driven solve of the generated C defines too (only a mechanism with
+input drivers has one), by name as :data:`SHARED`."""

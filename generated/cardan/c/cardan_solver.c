@@ -278,14 +278,21 @@ static cardan_real cardan_norm1(const cardan_real nz[])
 }
 
 
-/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
- * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
-static cardan_real cardan_difference_bound1(const cardan_real a[], const cardan_real b[])
+/* ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the largest column sum of
+ * |a_e - b_e| (NaN when a difference is). Not the sum of every |a_e - b_e|, a bound as many
+ * times too large as columns move (the Euler parameters of every body): with it theta below
+ * would fail at almost every point and the estimate be made afresh each time. */
+static cardan_real cardan_difference_norm1(const cardan_real a[], const cardan_real b[])
 {
-    cardan_real sum = 0;
-    int e;
-    for (e = 0; e < CARDAN_NNZ; ++e) sum += fabs(a[e] - b[e]);
-    return sum;
+    cardan_real sums[CARDAN_NQ], largest = 0, finite = 0;
+    int e, j;
+    for (j = 0; j < CARDAN_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < CARDAN_NNZ; ++e) sums[cardan_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < CARDAN_NQ; ++j) {
+        finite += sums[j] - sums[j];
+        largest = sums[j] > largest ? sums[j] : largest;
+    }
+    return finite == 0 ? largest : (cardan_real)NAN;
 }
 
 /* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
@@ -293,7 +300,7 @@ static cardan_real cardan_difference_bound1(const cardan_real a[], const cardan_
  * or where the exact code would be long) is a chain of four or more solves, most of a dense
  * step: it is made afresh only when Phi_q has moved too far from where the last one was made
  * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
- * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
  * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
  * a few per cent above the old one (it errs towards flagging), for one pass over the
  * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
@@ -301,7 +308,7 @@ static void cardan_estimate(cardan_workspace *work, cardan_report *report)
 {
     cardan_real theta;
     /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
-    theta = work->estimated_inv_norm * cardan_difference_bound1(work->nz, work->nz_estimated);
+    theta = work->estimated_inv_norm * cardan_difference_norm1(work->nz, work->nz_estimated);
     if (work->estimated_inv_norm >= 0 && theta <= CARDAN_REESTIMATE_SHIFT) {
         report->inv_norm = work->estimated_inv_norm / (1 - theta);
     } else {

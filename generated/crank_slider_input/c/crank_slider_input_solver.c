@@ -72,6 +72,7 @@ static void crank_slider_input_prepare(crank_slider_input_real unit, crank_slide
     crank_slider_input_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->factored = 0; /* no factors of a solution yet */
     work->scaled = unit != 1 && CRANK_SLIDER_INPUT_SCALE_FREE;
     if (!work->scaled) unit = 1;
     for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
@@ -294,14 +295,21 @@ static int crank_slider_input_exact_estimate(const crank_slider_input_workspace 
     return !work->lu.dense;
 }
 
-/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
- * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
-static crank_slider_input_real crank_slider_input_difference_bound1(const crank_slider_input_real a[], const crank_slider_input_real b[])
+/* ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the largest column sum of
+ * |a_e - b_e| (NaN when a difference is). Not the sum of every |a_e - b_e|, a bound as many
+ * times too large as columns move (the Euler parameters of every body): with it theta below
+ * would fail at almost every point and the estimate be made afresh each time. */
+static crank_slider_input_real crank_slider_input_difference_norm1(const crank_slider_input_real a[], const crank_slider_input_real b[])
 {
-    crank_slider_input_real sum = 0;
-    int e;
-    for (e = 0; e < CRANK_SLIDER_INPUT_NNZ; ++e) sum += fabs(a[e] - b[e]);
-    return sum;
+    crank_slider_input_real sums[CRANK_SLIDER_INPUT_NQ], largest = 0, finite = 0;
+    int e, j;
+    for (j = 0; j < CRANK_SLIDER_INPUT_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < CRANK_SLIDER_INPUT_NNZ; ++e) sums[crank_slider_input_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < CRANK_SLIDER_INPUT_NQ; ++j) {
+        finite += sums[j] - sums[j];
+        largest = sums[j] > largest ? sums[j] : largest;
+    }
+    return finite == 0 ? largest : (crank_slider_input_real)NAN;
 }
 
 /* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
@@ -309,7 +317,7 @@ static crank_slider_input_real crank_slider_input_difference_bound1(const crank_
  * or where the exact code would be long) is a chain of four or more solves, most of a dense
  * step: it is made afresh only when Phi_q has moved too far from where the last one was made
  * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
- * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
  * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
  * a few per cent above the old one (it errs towards flagging), for one pass over the
  * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
@@ -322,7 +330,7 @@ static void crank_slider_input_estimate(crank_slider_input_workspace *work, cran
         return;
     }
     /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
-    theta = work->estimated_inv_norm * crank_slider_input_difference_bound1(work->nz, work->nz_estimated);
+    theta = work->estimated_inv_norm * crank_slider_input_difference_norm1(work->nz, work->nz_estimated);
     if (work->estimated_inv_norm >= 0 && theta <= CRANK_SLIDER_INPUT_REESTIMATE_SHIFT) {
         report->inv_norm = work->estimated_inv_norm / (1 - theta);
     } else {
@@ -685,6 +693,44 @@ static crank_slider_input_real crank_slider_input_norm_if(int computed, const cr
     return computed ? crank_slider_input_max_abs(v) : 0;
 }
 
+#define CRANK_SLIDER_INPUT_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
+#define CRANK_SLIDER_INPUT_CHORD_CONTRACTION ((crank_slider_input_real)0.1) /* as contract.tuning.INPUTS */
+
+/* Simplified Newton from the last solution: Phi alone at each iterate, each step solved with
+ * the factors of Phi_q left by the last solve (work->lu, at the last solution: for inputs that
+ * move a little in a servo period, the first step is Newton's own from there). The steps
+ * contract by theta = |step k| / |step k-1| each; a step is taken while it contracts at least
+ * CHORD_CONTRACTION, and the steps stop once theta |step| (about the error of q they leave,
+ * in the run's unit) is at the rounding level of q or after CHORD_STEPS. Newton then
+ * evaluates Phi and Phi_q at that q, factors it and tests it (usually accepting it at once),
+ * so that the tolerances, dq, ddq and the condition are those of a fresh factorization.
+ * Returns the steps taken. */
+static int crank_slider_input_chord(const crank_slider_input_real p[], crank_slider_input_real t, crank_slider_input_real q[],
+                              crank_slider_input_workspace *work)
+{
+    const crank_slider_input_real rounding = CRANK_SLIDER_INPUT_UNIT_ROUNDOFF * (1 + work->norms[0]);
+    crank_slider_input_real previous = (crank_slider_input_real)INFINITY, step;
+    int i, k;
+    for (k = 0; k < CRANK_SLIDER_INPUT_CHORD_STEPS; ++k) {
+        crank_slider_input_phi(q, t, p, work->phi);
+        crank_slider_input_rows_in_unit(work, work->phi);
+        for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+            work->phi[i] = -work->phi[i];
+        }
+        crank_slider_input_lu_solve(&work->lu, work->phi);
+        step = crank_slider_input_max_abs(work->phi);
+        /* also false for a NaN step: Newton then starts from the last good iterate */
+        if (!(step <= CRANK_SLIDER_INPUT_CHORD_CONTRACTION * previous)) break;
+        crank_slider_input_from_unit(work, work->phi);
+        for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+            q[i] += work->phi[i];
+        }
+        if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
+        previous = step;
+    }
+    return k;
+}
+
 int crank_slider_input_solve_inputs(const crank_slider_input_options *options, const crank_slider_input_real p[],
                               const crank_slider_input_real u[], const crank_slider_input_real du[], const crank_slider_input_real ddu[],
                               crank_slider_input_state *state, crank_slider_input_workspace *work,
@@ -693,15 +739,19 @@ int crank_slider_input_solve_inputs(const crank_slider_input_options *options, c
     crank_slider_input_real pu[CRANK_SLIDER_INPUT_NP + 3 * CRANK_SLIDER_INPUT_NU];
     crank_slider_input_real nq, ndq, nddq;
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
-    int i;
+    int i, chord;
     crank_slider_input_with_inputs(pu, p, u, du, ddu);
     report->flagged = 0;
     report->cond = (crank_slider_input_real)NAN;
     if (!state->started) {
         crank_slider_input_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
     }
-    /* No prediction: the inputs say where the mechanism is, the last solution is the guess. */
+    /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
+     * from it, simplified Newton steps on the last factors while work->lu holds them. */
+    chord = state->started && work->factored ? crank_slider_input_chord(pu, state->t, state->q, work) : 0;
+    work->factored = 0;
     report->status = crank_slider_input_newton(options, pu, state->t, state->q, work, report);
+    report->iterations += chord;
     report->fallbacks = crank_slider_input_lu_fallbacks(&work->lu);
     if (report->status != CRANK_SLIDER_INPUT_OK) {
         return report->status;
@@ -736,6 +786,7 @@ int crank_slider_input_solve_inputs(const crank_slider_input_options *options, c
     work->norms[0] = nq;
     work->norms[1] = ndq;
     work->norms[2] = nddq;
+    work->factored = 1;
     state->started = 1;
     return CRANK_SLIDER_INPUT_OK;
 }

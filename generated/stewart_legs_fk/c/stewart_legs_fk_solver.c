@@ -78,6 +78,7 @@ static void stewart_legs_fk_prepare(stewart_legs_fk_real unit, stewart_legs_fk_w
     stewart_legs_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->factored = 0; /* no factors of a solution yet */
     work->scaled = unit != 1 && STEWART_LEGS_FK_SCALE_FREE;
     if (!work->scaled) unit = 1;
     for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
@@ -616,14 +617,21 @@ static stewart_legs_fk_real stewart_legs_fk_norm1(const stewart_legs_fk_real nz[
 }
 
 
-/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
- * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
-static stewart_legs_fk_real stewart_legs_fk_difference_bound1(const stewart_legs_fk_real a[], const stewart_legs_fk_real b[])
+/* ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the largest column sum of
+ * |a_e - b_e| (NaN when a difference is). Not the sum of every |a_e - b_e|, a bound as many
+ * times too large as columns move (the Euler parameters of every body): with it theta below
+ * would fail at almost every point and the estimate be made afresh each time. */
+static stewart_legs_fk_real stewart_legs_fk_difference_norm1(const stewart_legs_fk_real a[], const stewart_legs_fk_real b[])
 {
-    stewart_legs_fk_real sum = 0;
-    int e;
-    for (e = 0; e < STEWART_LEGS_FK_NNZ; ++e) sum += fabs(a[e] - b[e]);
-    return sum;
+    stewart_legs_fk_real sums[STEWART_LEGS_FK_NQ], largest = 0, finite = 0;
+    int e, j;
+    for (j = 0; j < STEWART_LEGS_FK_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < STEWART_LEGS_FK_NNZ; ++e) sums[stewart_legs_fk_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < STEWART_LEGS_FK_NQ; ++j) {
+        finite += sums[j] - sums[j];
+        largest = sums[j] > largest ? sums[j] : largest;
+    }
+    return finite == 0 ? largest : (stewart_legs_fk_real)NAN;
 }
 
 /* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
@@ -631,7 +639,7 @@ static stewart_legs_fk_real stewart_legs_fk_difference_bound1(const stewart_legs
  * or where the exact code would be long) is a chain of four or more solves, most of a dense
  * step: it is made afresh only when Phi_q has moved too far from where the last one was made
  * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
- * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
  * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
  * a few per cent above the old one (it errs towards flagging), for one pass over the
  * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
@@ -639,7 +647,7 @@ static void stewart_legs_fk_estimate(stewart_legs_fk_workspace *work, stewart_le
 {
     stewart_legs_fk_real theta;
     /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
-    theta = work->estimated_inv_norm * stewart_legs_fk_difference_bound1(work->nz, work->nz_estimated);
+    theta = work->estimated_inv_norm * stewart_legs_fk_difference_norm1(work->nz, work->nz_estimated);
     if (work->estimated_inv_norm >= 0 && theta <= STEWART_LEGS_FK_REESTIMATE_SHIFT) {
         report->inv_norm = work->estimated_inv_norm / (1 - theta);
     } else {
@@ -1002,6 +1010,44 @@ static stewart_legs_fk_real stewart_legs_fk_norm_if(int computed, const stewart_
     return computed ? stewart_legs_fk_max_abs(v) : 0;
 }
 
+#define STEWART_LEGS_FK_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
+#define STEWART_LEGS_FK_CHORD_CONTRACTION ((stewart_legs_fk_real)0.1) /* as contract.tuning.INPUTS */
+
+/* Simplified Newton from the last solution: Phi alone at each iterate, each step solved with
+ * the factors of Phi_q left by the last solve (work->lu, at the last solution: for inputs that
+ * move a little in a servo period, the first step is Newton's own from there). The steps
+ * contract by theta = |step k| / |step k-1| each; a step is taken while it contracts at least
+ * CHORD_CONTRACTION, and the steps stop once theta |step| (about the error of q they leave,
+ * in the run's unit) is at the rounding level of q or after CHORD_STEPS. Newton then
+ * evaluates Phi and Phi_q at that q, factors it and tests it (usually accepting it at once),
+ * so that the tolerances, dq, ddq and the condition are those of a fresh factorization.
+ * Returns the steps taken. */
+static int stewart_legs_fk_chord(const stewart_legs_fk_real p[], stewart_legs_fk_real t, stewart_legs_fk_real q[],
+                              stewart_legs_fk_workspace *work)
+{
+    const stewart_legs_fk_real rounding = STEWART_LEGS_FK_UNIT_ROUNDOFF * (1 + work->norms[0]);
+    stewart_legs_fk_real previous = (stewart_legs_fk_real)INFINITY, step;
+    int i, k;
+    for (k = 0; k < STEWART_LEGS_FK_CHORD_STEPS; ++k) {
+        stewart_legs_fk_phi(q, t, p, work->phi);
+        stewart_legs_fk_rows_in_unit(work, work->phi);
+        for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
+            work->phi[i] = -work->phi[i];
+        }
+        stewart_legs_fk_lu_solve(&work->lu, work->phi);
+        step = stewart_legs_fk_max_abs(work->phi);
+        /* also false for a NaN step: Newton then starts from the last good iterate */
+        if (!(step <= STEWART_LEGS_FK_CHORD_CONTRACTION * previous)) break;
+        stewart_legs_fk_from_unit(work, work->phi);
+        for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
+            q[i] += work->phi[i];
+        }
+        if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
+        previous = step;
+    }
+    return k;
+}
+
 int stewart_legs_fk_solve_inputs(const stewart_legs_fk_options *options, const stewart_legs_fk_real p[],
                               const stewart_legs_fk_real u[], const stewart_legs_fk_real du[], const stewart_legs_fk_real ddu[],
                               stewart_legs_fk_state *state, stewart_legs_fk_workspace *work,
@@ -1010,15 +1056,19 @@ int stewart_legs_fk_solve_inputs(const stewart_legs_fk_options *options, const s
     stewart_legs_fk_real pu[STEWART_LEGS_FK_NP + 3 * STEWART_LEGS_FK_NU];
     stewart_legs_fk_real nq, ndq, nddq;
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
-    int i;
+    int i, chord;
     stewart_legs_fk_with_inputs(pu, p, u, du, ddu);
     report->flagged = 0;
     report->cond = (stewart_legs_fk_real)NAN;
     if (!state->started) {
         stewart_legs_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
     }
-    /* No prediction: the inputs say where the mechanism is, the last solution is the guess. */
+    /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
+     * from it, simplified Newton steps on the last factors while work->lu holds them. */
+    chord = state->started && work->factored ? stewart_legs_fk_chord(pu, state->t, state->q, work) : 0;
+    work->factored = 0;
     report->status = stewart_legs_fk_newton(options, pu, state->t, state->q, work, report);
+    report->iterations += chord;
     report->fallbacks = stewart_legs_fk_lu_fallbacks(&work->lu);
     if (report->status != STEWART_LEGS_FK_OK) {
         return report->status;
@@ -1053,6 +1103,7 @@ int stewart_legs_fk_solve_inputs(const stewart_legs_fk_options *options, const s
     work->norms[0] = nq;
     work->norms[1] = ndq;
     work->norms[2] = nddq;
+    work->factored = 1;
     state->started = 1;
     return STEWART_LEGS_FK_OK;
 }

@@ -108,6 +108,7 @@ typedef struct {
     stewart_legs_fk_real row[STEWART_LEGS_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */
     stewart_legs_fk_real nz_factor[STEWART_LEGS_FK_NNZ]; /* column / row of each non-zero */
     int scaled; /* the decisions are made in a unit other than 1 */
+    int factored; /* lu holds the factors of Phi_q at the last solution of _solve_inputs */
 } stewart_legs_fk_workspace;
 
 /* Tolerances suited to the real type. */
@@ -144,8 +145,10 @@ int stewart_legs_fk_solve_grid_checked(const stewart_legs_fk_options *options,
  * state->started is 0): Newton, then dq (Phi_q dq = -Phi_t, 2.73) when du is given and ddq
  * (Phi_q ddq = Gamma, 2.74) when du and ddu are; with du (or ddu) NULL, positions only (and
  * velocities), and state->dq (state->ddq) are set to NaN. Drivers that are functions of t
- * are taken at state->t (the caller sets it); state->t is not changed. Returns the status
- * (also in report); on failure state->q holds the last Newton iterate. */
+ * are taken at state->t (the caller sets it); state->t is not changed. From the second call,
+ * simplified Newton steps on the factors the last call left come first (report->iterations
+ * counts them too), then Newton with Phi_q evaluated and factored at their q. Returns the
+ * status (also in report); on failure state->q holds the last Newton iterate. */
 int stewart_legs_fk_solve_inputs(const stewart_legs_fk_options *options, const stewart_legs_fk_real p[],
                               const stewart_legs_fk_real u[], const stewart_legs_fk_real du[],
                               const stewart_legs_fk_real ddu[], stewart_legs_fk_state *state,

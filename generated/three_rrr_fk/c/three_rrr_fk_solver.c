@@ -72,6 +72,7 @@ static void three_rrr_fk_prepare(three_rrr_fk_real unit, three_rrr_fk_workspace 
     three_rrr_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->factored = 0; /* no factors of a solution yet */
     work->scaled = unit != 1 && THREE_RRR_FK_SCALE_FREE;
     if (!work->scaled) unit = 1;
     for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
@@ -535,14 +536,21 @@ static int three_rrr_fk_exact_estimate(const three_rrr_fk_workspace *work)
     return !work->lu.dense;
 }
 
-/* An upper bound of ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the sum
- * of all |a_e - b_e|, at least the largest column sum, in one pass without the column table. */
-static three_rrr_fk_real three_rrr_fk_difference_bound1(const three_rrr_fk_real a[], const three_rrr_fk_real b[])
+/* ||A - B||_1 for two sets of non-zeros of Phi_q (same pattern): the largest column sum of
+ * |a_e - b_e| (NaN when a difference is). Not the sum of every |a_e - b_e|, a bound as many
+ * times too large as columns move (the Euler parameters of every body): with it theta below
+ * would fail at almost every point and the estimate be made afresh each time. */
+static three_rrr_fk_real three_rrr_fk_difference_norm1(const three_rrr_fk_real a[], const three_rrr_fk_real b[])
 {
-    three_rrr_fk_real sum = 0;
-    int e;
-    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) sum += fabs(a[e] - b[e]);
-    return sum;
+    three_rrr_fk_real sums[THREE_RRR_FK_NQ], largest = 0, finite = 0;
+    int e, j;
+    for (j = 0; j < THREE_RRR_FK_NQ; ++j) sums[j] = 0;
+    for (e = 0; e < THREE_RRR_FK_NNZ; ++e) sums[three_rrr_fk_phi_q_col[e]] += fabs(a[e] - b[e]);
+    for (j = 0; j < THREE_RRR_FK_NQ; ++j) {
+        finite += sums[j] - sums[j];
+        largest = sums[j] > largest ? sums[j] : largest;
+    }
+    return finite == 0 ? largest : (three_rrr_fk_real)NAN;
 }
 
 /* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
@@ -550,7 +558,7 @@ static three_rrr_fk_real three_rrr_fk_difference_bound1(const three_rrr_fk_real 
  * or where the exact code would be long) is a chain of four or more solves, most of a dense
  * step: it is made afresh only when Phi_q has moved too far from where the last one was made
  * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
- * With theta = ||A^-1||_1 ||A' - A||_1 < 1 (here a bound of it), ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
+ * With theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
  * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
  * a few per cent above the old one (it errs towards flagging), for one pass over the
  * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
@@ -563,7 +571,7 @@ static void three_rrr_fk_estimate(three_rrr_fk_workspace *work, three_rrr_fk_rep
         return;
     }
     /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
-    theta = work->estimated_inv_norm * three_rrr_fk_difference_bound1(work->nz, work->nz_estimated);
+    theta = work->estimated_inv_norm * three_rrr_fk_difference_norm1(work->nz, work->nz_estimated);
     if (work->estimated_inv_norm >= 0 && theta <= THREE_RRR_FK_REESTIMATE_SHIFT) {
         report->inv_norm = work->estimated_inv_norm / (1 - theta);
     } else {
@@ -926,6 +934,44 @@ static three_rrr_fk_real three_rrr_fk_norm_if(int computed, const three_rrr_fk_r
     return computed ? three_rrr_fk_max_abs(v) : 0;
 }
 
+#define THREE_RRR_FK_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
+#define THREE_RRR_FK_CHORD_CONTRACTION ((three_rrr_fk_real)0.1) /* as contract.tuning.INPUTS */
+
+/* Simplified Newton from the last solution: Phi alone at each iterate, each step solved with
+ * the factors of Phi_q left by the last solve (work->lu, at the last solution: for inputs that
+ * move a little in a servo period, the first step is Newton's own from there). The steps
+ * contract by theta = |step k| / |step k-1| each; a step is taken while it contracts at least
+ * CHORD_CONTRACTION, and the steps stop once theta |step| (about the error of q they leave,
+ * in the run's unit) is at the rounding level of q or after CHORD_STEPS. Newton then
+ * evaluates Phi and Phi_q at that q, factors it and tests it (usually accepting it at once),
+ * so that the tolerances, dq, ddq and the condition are those of a fresh factorization.
+ * Returns the steps taken. */
+static int three_rrr_fk_chord(const three_rrr_fk_real p[], three_rrr_fk_real t, three_rrr_fk_real q[],
+                              three_rrr_fk_workspace *work)
+{
+    const three_rrr_fk_real rounding = THREE_RRR_FK_UNIT_ROUNDOFF * (1 + work->norms[0]);
+    three_rrr_fk_real previous = (three_rrr_fk_real)INFINITY, step;
+    int i, k;
+    for (k = 0; k < THREE_RRR_FK_CHORD_STEPS; ++k) {
+        three_rrr_fk_phi(q, t, p, work->phi);
+        three_rrr_fk_rows_in_unit(work, work->phi);
+        for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+            work->phi[i] = -work->phi[i];
+        }
+        three_rrr_fk_lu_solve(&work->lu, work->phi);
+        step = three_rrr_fk_max_abs(work->phi);
+        /* also false for a NaN step: Newton then starts from the last good iterate */
+        if (!(step <= THREE_RRR_FK_CHORD_CONTRACTION * previous)) break;
+        three_rrr_fk_from_unit(work, work->phi);
+        for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+            q[i] += work->phi[i];
+        }
+        if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
+        previous = step;
+    }
+    return k;
+}
+
 int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
                               const three_rrr_fk_real u[], const three_rrr_fk_real du[], const three_rrr_fk_real ddu[],
                               three_rrr_fk_state *state, three_rrr_fk_workspace *work,
@@ -934,15 +980,19 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
     three_rrr_fk_real pu[THREE_RRR_FK_NP + 3 * THREE_RRR_FK_NU];
     three_rrr_fk_real nq, ndq, nddq;
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
-    int i;
+    int i, chord;
     three_rrr_fk_with_inputs(pu, p, u, du, ddu);
     report->flagged = 0;
     report->cond = (three_rrr_fk_real)NAN;
     if (!state->started) {
         three_rrr_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
     }
-    /* No prediction: the inputs say where the mechanism is, the last solution is the guess. */
+    /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
+     * from it, simplified Newton steps on the last factors while work->lu holds them. */
+    chord = state->started && work->factored ? three_rrr_fk_chord(pu, state->t, state->q, work) : 0;
+    work->factored = 0;
     report->status = three_rrr_fk_newton(options, pu, state->t, state->q, work, report);
+    report->iterations += chord;
     report->fallbacks = three_rrr_fk_lu_fallbacks(&work->lu);
     if (report->status != THREE_RRR_FK_OK) {
         return report->status;
@@ -977,6 +1027,7 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
     work->norms[0] = nq;
     work->norms[1] = ndq;
     work->norms[2] = nddq;
+    work->factored = 1;
     state->started = 1;
     return THREE_RRR_FK_OK;
 }
