@@ -52,7 +52,7 @@ class Drawing3d:
             self._body(str(body), spec)
         self.joints = {item.get("name"): (item, ("joints", k))
                        for k, item in enumerate(data.get("joints") or [])
-                       if isinstance(item, Mapping) and item.get("name") is not None}
+                       if isinstance(item, Mapping) and isinstance(item.get("name"), str)}
 
     def _body(self, body: str, spec: Any) -> None:
         path: Path_ = ("bodies", body)
@@ -171,7 +171,7 @@ class Drawing3d:
 
     def joint(self, name: Any, path: Path_, kinds: tuple[str, ...]) -> dict[str, Any]:
         """The local form of the joint called ``name``, which must be one of ``kinds``."""
-        if name not in self.joints:
+        if not isinstance(name, str) or name not in self.joints:
             known = ", ".join(map(str, self.joints)) or "none"
             raise MechanismError(f"no joint named {name!r}", path,
                                  f"Name a {' or '.join(kinds)} joint; the named joints are: "
