@@ -114,7 +114,7 @@ class Drawing3d:
     # -- what a spatial pair module asks (symkin.pairs.spatial.basic.Drawing) --------------
     def body(self, data: Any, key: str, path: Path_) -> str:
         body = data.get(key)
-        if body not in self.origins:
+        if not isinstance(body, str) or body not in self.origins:
             raise MechanismError(f"unknown body {body!r}", path + (key,),
                                  f"Use one of: {', '.join(self.origins)}.")
         return str(body)

@@ -128,6 +128,9 @@ EXPECTED: dict[str, tuple[int, str]] = {
                                           "names to values"),
     "spatial_joint_name_a_list.yaml": (9, "at drivers[0].joint: no joint named ['pivot']"),
     "spatial_infinite_point.yaml": (6, "at bodies.crank.points.A[2]: inf is not a finite number"),
+    "drawn_body_a_list.yaml": (6, "at joints[0].i: unknown body ['ground']. Use one of: "
+                                  "ground, crank."),
+    "spatial_body_a_list.yaml": (7, "at joints[0].j: unknown body {'crank': 1}"),
     "spatial_unknown_point.yaml": (6, "no point named 'top'. Its points are: tip; or give a "
                                       "vector [x, y, z]."),
 }
