@@ -164,7 +164,7 @@ class Drawing3d:
             raise MechanismError("the axis is missing", path, "Give the direction as drawn, "
                                  "e.g. axis: [0, 0, 1].")
         vector = self.vector(raw, path)
-        if math.fsum(q.value ** 2 for q in vector) == 0:
+        if math.hypot(*(q.value for q in vector)) == 0:
             raise MechanismError("the axis is zero", path, "Give a non-zero direction, e.g. "
                                  "[0, 0, 1].")
         return self.texts(vector)
