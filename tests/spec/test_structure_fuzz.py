@@ -42,7 +42,7 @@ ODD_VALUES = [float("nan"), float("inf"), -float("inf"), 1e308, 1e-300, 0, -1, T
               "nan", "1e400", "t", "E**I", "acos(2)", "1/0", "x**", "2**2**2**2**2", [], {},
               [1], [1, 2, 3, 4], {"a": 1}, [[1, 2]], {"poly": [0, "t", -0.5]}, {"poly": []},
               {"input": None}, "input", np.float64(1.5), np.int64(2), np.float32(0.5)]
-CASES = int(os.environ.get("SYMKIN_FUZZ_EXAMPLES", "150"))
+CASES = int(os.environ.get("SYMKIN_FUZZ_EXAMPLES", "100"))
 FOLDER = tempfile.TemporaryDirectory(prefix="symkin-structure-fuzz-")
 
 
