@@ -47,7 +47,7 @@ def time_points(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
     """
     if t is None:
         return _file_grid(*kernel.time_grid).copy()
-    times = np.asarray(t, dtype=float)
+    times = _floats(t, "t")
     if times.ndim != 1:
         times = np.atleast_1d(times)
     # Finite ends as Python floats (their sum overflows to inf without a NumPy warning).
@@ -86,9 +86,12 @@ def parameter_values(kernel: KinematicsKernel,
             if name not in names:
                 known = ", ".join(names) or "none"
                 raise SolveError(f"unknown parameter {name!r}; the mechanism has: {known}")
-            values[names.index(name)] = float(value)
+            number = _floats(value, f"params[{name!r}]")
+            if number.ndim:
+                raise SolveError(f"params[{name!r}] must be one number, not {number.size}")
+            values[names.index(name)] = number
         return values
-    given = np.array(params, dtype=float)
+    given = np.array(_floats(params, "params"))
     if given.shape != kernel.p_values.shape:
         raise SolveError(f"params has {given.size} values; the mechanism has "
                          f"{kernel.p_values.size}")
@@ -97,8 +100,19 @@ def parameter_values(kernel: KinematicsKernel,
 
 def first_guess(kernel: KinematicsKernel, q0: ArrayLike | None) -> Array:
     """The first guess at t[0]: the file's q0, or q0 checked (read, never written)."""
-    q = np.asarray(kernel.q0 if q0 is None else q0, dtype=float)
+    q = _floats(kernel.q0 if q0 is None else q0, "q0")
     if q.shape != (len(kernel.coordinates),):
         raise SolveError(f"q0 has {q.size} values; the mechanism has "
                          f"{len(kernel.coordinates)} coordinates")
     return q
+
+
+def _floats(value: ArrayLike, what: str) -> Array:
+    """value as float64 (no copy of a float64 array); text or complex numbers are a SolveError
+    that names the argument, not a ValueError from NumPy or a silently dropped imaginary part."""
+    if getattr(value, "dtype", None) is not None and np.asarray(value).dtype.kind == "c":
+        raise SolveError(f"{what} must be real numbers, not complex")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as error:
+        raise SolveError(f"{what} must be numbers: {error}") from None

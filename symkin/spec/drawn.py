@@ -127,7 +127,7 @@ class Drawing:
     def body(self, constraint: Mapping[str, Any], key: str, path: Path_) -> str:
         """The body a constraint's ``key`` names; an error naming the known ones."""
         body = constraint.get(key)
-        if body not in self.frames:
+        if not isinstance(body, str) or body not in self.frames:
             known = ", ".join(self.frames)
             raise MechanismError(f"unknown body {body!r}", path + (key,),
                                  f"Use one of: {known}.")

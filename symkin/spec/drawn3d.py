@@ -52,7 +52,7 @@ class Drawing3d:
             self._body(str(body), spec)
         self.joints = {item.get("name"): (item, ("joints", k))
                        for k, item in enumerate(data.get("joints") or [])
-                       if isinstance(item, Mapping) and item.get("name") is not None}
+                       if isinstance(item, Mapping) and isinstance(item.get("name"), str)}
 
     def _body(self, body: str, spec: Any) -> None:
         path: Path_ = ("bodies", body)
@@ -114,7 +114,7 @@ class Drawing3d:
     # -- what a spatial pair module asks (symkin.pairs.spatial.basic.Drawing) --------------
     def body(self, data: Any, key: str, path: Path_) -> str:
         body = data.get(key)
-        if body not in self.origins:
+        if not isinstance(body, str) or body not in self.origins:
             raise MechanismError(f"unknown body {body!r}", path + (key,),
                                  f"Use one of: {', '.join(self.origins)}.")
         return str(body)
@@ -164,14 +164,14 @@ class Drawing3d:
             raise MechanismError("the axis is missing", path, "Give the direction as drawn, "
                                  "e.g. axis: [0, 0, 1].")
         vector = self.vector(raw, path)
-        if math.fsum(q.value ** 2 for q in vector) == 0:
+        if math.hypot(*(q.value for q in vector)) == 0:
             raise MechanismError("the axis is zero", path, "Give a non-zero direction, e.g. "
                                  "[0, 0, 1].")
         return self.texts(vector)
 
     def joint(self, name: Any, path: Path_, kinds: tuple[str, ...]) -> dict[str, Any]:
         """The local form of the joint called ``name``, which must be one of ``kinds``."""
-        if name not in self.joints:
+        if not isinstance(name, str) or name not in self.joints:
             known = ", ".join(map(str, self.joints)) or "none"
             raise MechanismError(f"no joint named {name!r}", path,
                                  f"Name a {' or '.join(kinds)} joint; the named joints are: "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -26,10 +27,15 @@ class Q:
 class _Context:
     """The parameters' nominal values, to check and evaluate each piece of the drawing."""
 
-    def __init__(self, parameters: Mapping[str, Any]) -> None:
-        self.symbols = {name: sp.Symbol(name, real=True) for name in parameters}
+    def __init__(self, parameters: Any) -> None:
+        if not isinstance(parameters, Mapping):
+            raise MechanismError("expected a mapping of parameter names to values",
+                                 ("parameters",), "Write parameters: {a: 1.0, b: 5.0}.")
+        # A name that is not text is named by the validation of the local form.
+        named = {name: raw for name, raw in parameters.items() if isinstance(name, str)}
+        self.symbols = {name: sp.Symbol(name, real=True) for name in named}
         self.values: dict[sp.Symbol, float] = {}
-        for name, raw in parameters.items():
+        for name, raw in named.items():
             if isinstance(raw, float) and not math.isfinite(raw):
                 # said here: every drawn point that uses it would be blamed instead
                 raise MechanismError(f"{raw} is not a finite number", ("parameters", name),
@@ -40,10 +46,16 @@ class _Context:
                 continue  # validation of the local form names it
 
     def quantity(self, raw: Any, path: Path_) -> Q:
-        if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+        if isinstance(raw, str):
+            return self._expression(raw, path)
+        if isinstance(raw, bool) or not isinstance(raw, numbers.Real):
             raise MechanismError("expected a number or an expression", path)
-        if not isinstance(raw, str):
-            return Q(raw, float(raw))
+        if not math.isfinite(raw):
+            raise MechanismError(f"{raw} is not a finite number", path, "Give a finite value.")
+        # numpy scalars become Python numbers: the text goes on into the local form
+        return Q(int(raw) if isinstance(raw, numbers.Integral) else float(raw), float(raw))
+
+    def _expression(self, raw: str, path: Path_) -> Q:
         try:
             expr = expressions.parse(raw, self.symbols)
         except ExpressionError as error:

@@ -136,7 +136,7 @@ def _eigenvalues(tensor: list[list[float]]) -> list[float]:
     (a, d, e), (_, b, f), (_, _, c) = tensor
     p1 = d * d + e * e + f * f
     mean = (a + b + c) / 3
-    p2 = (a - mean) ** 2 + (b - mean) ** 2 + (c - mean) ** 2 + 2 * p1
+    p2 = (a - mean) * (a - mean) + (b - mean) * (b - mean) + (c - mean) * (c - mean) + 2 * p1
     if p2 == 0:
         return [mean] * 3
     p = math.sqrt(p2 / 6)

@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, cast
 
+import numpy as np
 import yaml
 
 from symkin.errors import MechanismError
@@ -90,6 +92,30 @@ def read_toml(text: str, source: str) -> Document:
     if _depth(data) > MAX_NESTING:
         raise _too_deep(source)
     return Document(data, source, _toml_lines(text))
+
+
+def from_python(data: Any, source: str) -> Document:
+    """Data built in Python (``symkin.from_dict``) as a file would give it: numpy scalars and
+    arrays become Python numbers and lists, tuples lists, mappings dicts; as deep as a file may
+    nest (a mapping that contains itself is refused, not followed)."""
+    return Document(_plain(data, source, 0), source)
+
+
+def _plain(node: Any, source: str, depth: int) -> Any:
+    if depth > MAX_NESTING:
+        raise _too_deep(source)
+    if isinstance(node, Mapping):
+        return {_plain_key(key): _plain(value, source, depth + 1) for key, value in node.items()}
+    if isinstance(node, (list, tuple, np.ndarray)):
+        return [_plain(value, source, depth + 1) for value in node]
+    if isinstance(node, np.generic):
+        return node.item()  # np.float64(1.5) -> 1.5, np.bool_(True) -> True
+    return node
+
+
+def _plain_key(key: Any) -> Any:
+    """A key stays hashable (a tuple key stays a tuple, for the schema to refuse)."""
+    return key.item() if isinstance(key, np.generic) else key
 
 
 def _depth(data: Any) -> int:

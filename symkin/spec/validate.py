@@ -127,7 +127,7 @@ def _number_or_text(text: str) -> float | str:
 
 def from_dict(data: Mapping[str, Any], source: str = "<mechanism>") -> Mechanism:
     """Validate a mechanism given as plain Python data (the file's structure)."""
-    return _validate(loader.Document(dict(data) if isinstance(data, Mapping) else data, source))
+    return _validate(loader.from_python(data, source))
 
 
 def json_schema() -> dict[str, Any]:
@@ -248,7 +248,8 @@ def _point(mech: Mechanism, body: str, ref: Any, symbols: _Names,
         if ref not in points:
             known = ", ".join(points) or "none"
             raise MechanismError(f"body {body!r} has no point named {ref!r}", path,
-                                 f"Its points are: {known}; or give a vector [x, y].")
+                                 f"Its points are: {known}; or give a vector "
+                                 f"{'[x, y, z]' if mech.is_spatial else '[x, y]'}.")
         return
     for k, raw in enumerate(ref):
         _expression(raw, symbols, path + (k,), values=nominal)

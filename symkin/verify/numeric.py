@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from symkin.errors import MechanismError
 from symkin.spec.validate import Mechanism
 from symkin.symbolic.derivation import System, derive
 from symkin.verify.hand import (
@@ -93,6 +94,7 @@ def _flat(value: Any) -> np.ndarray:
 
 def derived_functions(system: System) -> Derived:
     """Lambdify Phi, Phi_t, Gamma and the non-zeros of Phi_q of a System (once)."""
+    _refuse_inputs(system)
     q = sp.symbols(f"q0:{len(system.q)}")
     dq = sp.symbols(f"dq0:{len(system.dq)}")
     p = sp.symbols(f"p0:{len(system.p)}")
@@ -110,6 +112,18 @@ def derived_functions(system: System) -> Derived:
     return Derived(system=system, phi=make(system.phi), phi_t=make(system.phi_t),
                    gamma=make(system.gamma),
                    phi_q_nz=make(system.phi_q[r, k] for r, k in pattern), pattern=pattern)
+
+
+def _refuse_inputs(system: System) -> None:
+    """A hand file's functions take (q, t, p): a driver whose values come from the caller at
+    run time has nothing to compare them with."""
+    if system.inputs:
+        first = system.inputs[0]
+        raise MechanismError(
+            f"the driver's function is an input (values given at run time), which a hand "
+            f"derivation phi(q, t, p) cannot take; inputs: {', '.join(system.input_places)}",
+            ("drivers", first.driver, first.key),
+            "To check a derivation, write the driver as a function of t (e.g. theta: w*t).")
 
 
 # ----- the comparison -------------------------------------------------------------------------

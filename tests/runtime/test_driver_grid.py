@@ -44,6 +44,25 @@ def test_parameters_by_name_and_bad_inputs(crank_slider_system) -> None:
         driver.solve(kernel, t=[0.0, 0.2, 0.1])
 
 
+@pytest.mark.parametrize("argument,fragment", [
+    ({"t": "abc"}, "t must be numbers"),
+    ({"t": [0.0, 1j]}, "t must be numbers"),
+    ({"t": np.array([0.0, 0.5 + 1e-3j])}, "t must be real numbers, not complex"),
+    ({"q0": ["x"] * 9}, "q0 must be numbers"),
+    ({"params": {"a": "x"}}, "params['a'] must be numbers"),
+    ({"params": {"a": [1.0, 2.0]}}, "params['a'] must be one number, not 2"),
+    ({"params": np.array([1.0, 5.0, 4.0 + 1j])}, "params must be real numbers, not complex"),
+])
+def test_arguments_that_are_not_real_numbers_are_a_solve_error(crank_slider_system, argument,
+                                                                fragment) -> None:
+    # found by fuzzing the API: NumPy's ValueError or TypeError came out, or a complex array
+    # lost its imaginary part without a word
+    kernel = kernel_for(crank_slider_system, "numpy")
+    with pytest.raises(SolveError) as caught:
+        driver.solve(kernel, **argument)
+    assert fragment in str(caught.value)
+
+
 def test_point_lookup_and_saving_errors(tmp_path) -> None:
     trajectory = driver.solve(kernel_for(derive("point_trajectory"), "numpy"), t=[0.0, 0.1])
     r, dr, ddr = trajectory.point("rod", "tip")

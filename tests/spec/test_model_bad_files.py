@@ -123,6 +123,16 @@ EXPECTED: dict[str, tuple[int, str]] = {
                                            "inequality"),
     "spatial_force_two_components.yaml": (10, "at forces[0].f: expected a vector of 3 numbers, "
                                               "got 2 items"),
+    # found by fuzzing the examples' structure: each was a traceback or an unlocated exit 1
+    "spatial_parameters_a_list.yaml": (4, "at parameters: expected a mapping of parameter "
+                                          "names to values"),
+    "spatial_joint_name_a_list.yaml": (9, "at drivers[0].joint: no joint named ['pivot']"),
+    "spatial_infinite_point.yaml": (6, "at bodies.crank.points.A[2]: inf is not a finite number"),
+    "drawn_body_a_list.yaml": (6, "at joints[0].i: unknown body ['ground']. Use one of: "
+                                  "ground, crank."),
+    "spatial_body_a_list.yaml": (7, "at joints[0].j: unknown body {'crank': 1}"),
+    "spatial_unknown_point.yaml": (6, "no point named 'top'. Its points are: tip; or give a "
+                                      "vector [x, y, z]."),
 }
 
 

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import jsonschema
+import numpy as np
 import pydantic
 import pytest
 import sympy as sp
@@ -182,6 +184,39 @@ def test_toml_yaml_and_python_give_the_same_mechanism(tmp_path: Path) -> None:
     phi_yaml = symkin.derive(from_yaml).phi
     phi_toml = symkin.derive(from_toml).phi
     assert sp.simplify(phi_yaml - phi_toml) == sp.zeros(9, 1)
+
+
+def _numpy_numbers(node: Any) -> Any:
+    """The same data with every number a numpy scalar and every vector a numpy array."""
+    if isinstance(node, dict):
+        return {key: _numpy_numbers(value) for key, value in node.items()}
+    if isinstance(node, list):
+        if all(isinstance(value, (int, float)) for value in node):
+            return np.array(node)
+        return [_numpy_numbers(value) for value in node]
+    if isinstance(node, float):
+        return np.float64(node)
+    return np.int64(node) if isinstance(node, int) else node
+
+
+def test_numpy_numbers_from_python_give_the_same_mechanism() -> None:
+    # a designer builds variants with numpy: np.float64(1.0) was a SymPy TypeError traceback
+    from_numpy = from_dict(_numpy_numbers(CRANK_SLIDER_DICT))
+    assert from_numpy.spec_hash() == from_dict(CRANK_SLIDER_DICT).spec_hash()
+    assert symkin.derive(from_numpy).p_values == (1.0, 5.0, 4.0)
+
+
+def test_numpy_numbers_in_a_drawn_mechanism_from_python() -> None:
+    drawn = loader.read(ROOT / "examples" / "crank_slider_drawn.yaml").data
+    from_numpy = from_dict(_numpy_numbers(drawn))
+    assert from_numpy.spec_hash() == from_dict(drawn).spec_hash()
+
+
+def test_a_mapping_that_contains_itself_is_refused() -> None:
+    looped: dict[str, Any] = dict(CRANK_SLIDER_DICT)
+    looped["parameters"] = {"a": looped}
+    with pytest.raises(MechanismError, match="nested more than"):
+        from_dict(looped)
 
 
 def test_toml_errors_name_file_line_and_field(tmp_path: Path) -> None:

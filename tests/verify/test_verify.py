@@ -272,3 +272,18 @@ def test_rounding_noise_against_an_exact_zero_is_no_mismatch() -> None:
     errors = numeric.relative_errors(np.array([[100.0, 1e-9]]), np.array([[100.0 + 1e-6, 2e-9]]))
     assert errors[0, 0] == pytest.approx(1e-8)
     assert errors[0, 1] == pytest.approx(1e-8)  # 1e-9 / (1e-3 * 100), not 0.5
+
+
+def test_an_input_driven_mechanism_is_refused_with_its_line(tmp_path, capsys) -> None:
+    # found by fuzzing: the input's symbol reached lambdify and raised a SyntaxError traceback
+    from symkin import cli
+
+    hand = tmp_path / "hand.py"
+    hand.write_text("def phi(q, t, p):\n    return [0.0] * 9\n")
+    mechanism = ROOT / "examples" / "crank_slider_input.yaml"
+    assert cli.main(["verify", str(mechanism), "--against", str(hand)]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    line = next(k for k, text in enumerate(mechanism.read_text().splitlines(), start=1)
+                if "theta: input" in text)
+    assert err.startswith(f"symkin: error: {mechanism}:{line}: at drivers[0].theta: "), err
+    assert "write the driver as a function of t" in err

@@ -12,6 +12,7 @@ the first guess q0 (the drawn distance in the drawn layout, whose q0 is the draw
 
 from __future__ import annotations
 
+import math
 from typing import Literal
 
 import sympy as sp
@@ -55,7 +56,7 @@ def check(c: Distance, checks: kit.Checks, path: kit.Path) -> None:
                                  "apart; to make them coincide use a revolute joint.")
         return
     (ax, ay), (bx, by) = checks.point_at_q0(c.i, c.A), checks.point_at_q0(c.j, c.B)
-    if (ax - bx) ** 2 + (ay - by) ** 2 == 0:
+    if math.hypot(ax - bx, ay - by) == 0:  # no overflow for huge coordinates
         raise MechanismError("A and B coincide where they start (q0, or as drawn), so the "
                              "length they keep is zero", path,
                              "Give length: (positive), or use a revolute joint to make the "

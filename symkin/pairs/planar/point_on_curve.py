@@ -10,6 +10,7 @@ drawn, and carried by i (converted to i's frame here), and P must lie on it at s
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any, Literal
 
@@ -95,7 +96,7 @@ def to_local(data: Mapping[str, Any], drawing: kit.Drawing, path: kit.Path) -> k
     j = drawing.body(data, "j", path)
     local["point"], drawn_point = drawing.point(j, data["point"], path + ("point",))
     px, py = (q.value for q in drawn_point)
-    return local, float(((px - cx) ** 2 + (py - cy) ** 2) ** 0.5)
+    return local, math.hypot(px - cx, py - cy)
 
 
 def outputs(c: PointOnCurve, geometry: kit.Geometry

@@ -3,6 +3,7 @@ apart, a rod with no body (1 equation); ``length`` defaults to the distance as d
 
 from __future__ import annotations
 
+import math
 from typing import Any, Literal
 
 import sympy as sp
@@ -41,7 +42,7 @@ def equations(c: Distance, geometry: basic.Geometry) -> list[sp.Expr]:
 def apart(c: Any, checks: Any, path: kit.Path) -> None:
     """A and B must be apart at q0 (as drawn): the row is scaled by that length."""
     a, b = checks.point_at_q0(c.i, c.A), checks.point_at_q0(c.j, c.B)
-    if sum((x - y) ** 2 for x, y in zip(a, b)) == 0:
+    if math.dist(a, b) == 0:  # no overflow for huge coordinates, unlike a sum of squares
         raise MechanismError("A and B coincide where they start (as drawn), so the length "
                              "they keep is zero", path, "Give length: (positive), or use a "
                              "spherical joint to make the two points coincide.")
