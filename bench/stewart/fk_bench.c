@@ -11,12 +11,14 @@
  * Another solver is timed by adding a line to the solvers table of main: its function has the signature of
  * fk_solve_fn (stewart.h) and its context pointer is passed through unchanged.
  *
- * Usage: fk_bench [POSES [REPEATS]]   (default 10000 poses, best of 5)
+ * Usage: fk_bench [POSES [REPEATS [SOLVER]]]   (default 10000 poses, best of 5; SOLVER: only
+ * the solvers whose name contains it, e.g. to count one solver's instructions)
  */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "linuxcnc_style_fk.h"
@@ -109,6 +111,7 @@ int main(int argc, char **argv)
     stewart_default_geometry(&geometry);
     for (t = 0; t < sizeof tilts / sizeof tilts[0]; ++t)
         for (s = 0; s < sizeof solvers / sizeof solvers[0]; ++s)
-            run(&solvers[s], &geometry, n, repeats, tilts[t]);
+            if (argc <= 3 || strstr(solvers[s].name, argv[3]) != NULL)
+                run(&solvers[s], &geometry, n, repeats, tilts[t]);
     return 0;
 }

@@ -2,7 +2,7 @@
 LinuxCNC-style baseline, through fk_bench.c's documented solver signature.
 
     python3 bench/stewart/symkin_fk.py [--poses 10000] [--repeats 5] [--mechanism FILE ...]
-                                       [--committed]
+                                       [--committed] [--instructions]
 
 For each mechanism (default examples/stewart_fk.yaml, one moving body, and
 examples/stewart_legs_fk.yaml, with its 12 leg bodies; both the geometry of stewart.c) the C
@@ -16,13 +16,16 @@ passed; the two linear solves cost the same for any values). fk_bench.c, compile
 FK_EXTRA_SOLVERS and gcc -O2, prints one line per solver and tilt.
 ``--committed`` times the folders committed under generated/ instead of generating them (the
 golden test keeps them equal to what the templates give; the leg-body file takes minutes to
-generate).
+generate). ``--instructions`` also counts each symkin solver's instructions per solve with
+callgrind (valgrind; --poses 10000 and both tilts: the adapter's inclusive count over the
+2 x poses solves), which unlike times do not move with the load of a shared machine.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -163,6 +166,8 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--mechanism", nargs="+", default=[
         str(ROOT / "examples/stewart_fk.yaml"), str(ROOT / "examples/stewart_legs_fk.yaml")])
+    parser.add_argument("--instructions", action="store_true",
+                        help="also count instructions per solve (callgrind)")
     parser.add_argument("--committed", action="store_true",
                         help="time the folders under generated/ (no code generation)")
     args = parser.parse_args()
@@ -187,6 +192,26 @@ def main() -> None:
                         str(HERE / "fk_bench.c"), str(HERE / "linuxcnc_style_fk.c"),
                         str(HERE / "stewart.c"), *sources, "-lm"], check=True)
         subprocess.run([str(exe), str(args.poses), str(args.repeats)], check=True)
+        if args.instructions:
+            for name in [n for table in tables for n in re.findall(r'"symkin_(\w+)"', table)]:
+                print(f"solver=symkin_{name} instructions_per_solve="
+                      f"{count_instructions(exe, name, args.poses):.0f}", flush=True)
+
+
+def count_instructions(exe: Path, solver: str, poses: int) -> float:
+    """Instructions per solve of one solver of fk_bench, by callgrind: its adapter's inclusive
+    count over one pass of both tilts."""
+    out = exe.parent / f"callgrind_{solver}.out"
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(exe),
+                    str(poses), "1", solver], check=True, capture_output=True)
+    table = subprocess.run(["callgrind_annotate", "--inclusive=yes", str(out)], check=True,
+                           capture_output=True, text=True).stdout
+    adapter = solver.rsplit("_", 2)[0] if solver.endswith("rates_accels") else solver.rsplit(
+        "_", 1)[0]
+    count = re.search(rf"^\s*([\d,]+) .*:{adapter}_fk \[", table, re.M)
+    if count is None:
+        sys.exit(f"no count of {adapter}_fk in callgrind's output")
+    return int(count.group(1).replace(",", "")) / (2 * poses)
 
 
 if __name__ == "__main__":
