@@ -228,3 +228,16 @@ def test_slider_cranks_drawn_at_their_dead_centre_with_own_guesses(tmp_path, bac
         x = x0[j] - t
         np.testing.assert_allclose(result.q[j, :, crank],
                                    np.arccos((1 + x * x - 9) / (2 * x)), atol=1e-9)
+
+
+def test_a_float_kernel_sweep_with_a_limit_ends_as_per_set_solve(crank_slider_system) -> None:
+    """In float the C substeps would fall below the resolution of t (they hung): such a set is
+    decided by symkin.solve's own edge treatment, in double."""
+    kernel = symkin.compile(crank_slider_system, backend="c", real="float")
+    assert kernel.edge_solver() is None
+    designs = np.array([[1.0, 5.0, 4.0], [1.0, 5.0, 5.9]])
+    result = symkin.sweep(kernel, designs, T, workers=1)
+    assert list(result.reasons) == ["", "limit position"]
+    with pytest.raises(SolveError) as caught:
+        symkin.solve(kernel, t=T, params=designs[1])
+    assert result.messages[1] == str(caught.value)

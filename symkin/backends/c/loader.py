@@ -77,8 +77,10 @@ class CKernel(Kernel):
                                            self.space))
 
     def edge_solver(self) -> EdgeSolver | None:
-        """The generated solve_edge (None in a kernel built before it)."""
-        if not hasattr(self.lib, f"{self.name}_solve_edge"):
+        """The generated solve_edge (None in a kernel built before it, and in float: its
+        substeps, down to 1e-9 of the grid step, fall below the resolution of a float t, so
+        symkin.solve's own edge treatment, in double, decides such a set)."""
+        if self.real == "float" or not hasattr(self.lib, f"{self.name}_solve_edge"):
             return None
         from symkin.backends.c.edge import EdgeSolver as CEdgeSolver
 
