@@ -13,6 +13,11 @@ pi/2 at every scale. Each set is also compared with its own symkin.solve, both b
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -21,6 +26,7 @@ from symkin.errors import SolveError
 from symkin.sweeps import batch, starts
 from tests.driver_support import kernel_for, same_condition
 
+ROOT = Path(__file__).resolve().parents[2]
 T = np.linspace(0.0, 1.5, 31)
 
 
@@ -241,3 +247,44 @@ def test_a_float_kernel_sweep_with_a_limit_ends_as_per_set_solve(crank_slider_sy
     with pytest.raises(SolveError) as caught:
         symkin.solve(kernel, t=T, params=designs[1])
     assert result.messages[1] == str(caught.value)
+
+
+
+
+_EDGE = """
+import numpy as np, symkin
+from symkin.backends.c.edge import EdgeSolver
+from symkin.contract.options import Options
+kernel = symkin.compile(symkin.derive({path!r}), backend="c", real={real!r})
+p = np.array([1.0, 5.0, 5.9])
+run = symkin.solve(kernel, t=np.linspace(0.0, 0.05, 6), params=p)
+edge = EdgeSolver(kernel.ffi, kernel.lib, kernel.name, kernel.nq)
+found = edge(Options(), p, (float(run.t[-1]), run.q[-1], run.dq[-1], run.d2q[-1]),
+             float(run.cond[-1]), 1.0, {h_min!r}, {h_min!r})
+print(found.outcome, kernel.lib.CRANK_SLIDER_EDGE_STOPPED, found.t, found.failed)
+"""
+
+
+def _edge_search(tmp_path: Path, real: str, h_min: float) -> tuple[int, int, float, float]:
+    script = tmp_path / f"edge_{real}.py"
+    path = str(ROOT / "examples" / "crank_slider.yaml")
+    script.write_text(_EDGE.format(path=path, real=real, h_min=h_min))
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=240, check=False, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0, done.stderr
+    outcome, stopped, t, failed = done.stdout.split()
+    return int(outcome), int(stopped), float(t), float(failed)
+
+
+def test_the_generated_edge_search_ends_in_float_too(tmp_path) -> None:
+    """The generated solve_edge called from C directly, towards the limit position of the
+    crank-slider with c = 5.9, where cos(theta) = (c - b) / a, theta = t^2 + pi/2 (closed
+    form, as _limit_time). In double with h_min 1e-6 it stops there; in float with h_min and
+    delta below the resolution of a float t its substeps used to double and halve forever (a
+    step that cannot move t passed as solved): now they end, blocked short of the limit, never
+    past it (float cannot reach the default tolerances near a limit)."""
+    limit = float(np.sqrt(np.arccos(0.9)))
+    outcome, stopped, t, failed = _edge_search(tmp_path, "double", 1e-6)
+    assert outcome == stopped and abs(t - limit) < 2e-6 and failed <= 2e-6
+    _, _, t, failed = _edge_search(tmp_path, "float", 1e-12)
+    assert 0 < failed and t <= limit
