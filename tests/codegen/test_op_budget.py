@@ -229,23 +229,23 @@ def _flops(record: dict[str, int]) -> Flops:
 
 
 def _parse(lines: list[str]) -> tuple[dict[str, list[tuple[int, int, Flops]]],
-                                      dict[str, Flops], list[int]]:
-    """(the runs' steps: iterations, odd step, count; the single calls; status, iterations
-    of the capped step)."""
+                                      dict[str, Flops], dict[str, int], list[int]]:
+    """(the runs' steps: iterations, odd step, count; the single calls; the steps a single
+    call reported taking; status, iterations of the capped step)."""
     runs: dict[str, list[tuple[int, int, Flops]]] = {}
     named = {}
+    taken = {}
     for line in lines[:-1]:
         head, _, rest = line.partition("{")
         record = json.loads("{" + rest)
-        if record["name"] == "chord":  # the steps it took, then its count
-            named["chord_steps"] = Flops(add=int(head))
-            named["chord"] = _flops(record)
-        elif head.strip():
-            iterations, odd = (int(x) for x in head.split())
-            runs.setdefault(record["name"], []).append((iterations, odd, _flops(record)))
+        numbers = [int(x) for x in head.split()]
+        if len(numbers) == 2:  # a step of a run
+            runs.setdefault(record["name"], []).append((*numbers, _flops(record)))
         else:
             named[record["name"]] = _flops(record)
-    return runs, named, [int(x) for x in lines[-1].split()]
+            if numbers:
+                taken[record["name"]] = numbers[0]
+    return runs, named, taken, [int(x) for x in lines[-1].split()]
 
 
 def _arithmetic(f: Flops) -> tuple[int, int, int, int, int]:
@@ -301,7 +301,9 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
     adds up (the kinds a max's arm does not change, exactly; fabs and compares at most);
     every step of a run (also with every point flagged and Newton going on at each) stays
     within the worst case for its iterations and within the header's number; a step that runs
-    Newton to its cap does exactly the predictor and iterations the budget counts."""
+    Newton to its cap does exactly the predictor and iterations the budget counts (solve_inputs:
+    the iterations exactly, its simplified Newton steps, which stop on the data, within their
+    count)."""
     system = symkin.derive(symkin.load(EXAMPLES / f"{name}.yaml"))
     if linalg == "tables":  # the sparse LU as loops over index tables, as for a large system
         monkeypatch.setattr(lu_code, "TABLE_FLOPS", 0)
@@ -313,7 +315,8 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
         assert np.allclose(code.input_values, _home_legs(), rtol=1e-12, atol=0)
     cap, steps = 6, 31
     dt = 0.002 if name == "stewart_fk" else 0.05  # the legs lengthen 2 mm a step
-    runs, measured, (status, iterations) = _parse(_measure(tmp_path, code, steps, dt, cap))
+    runs, measured, taken, (status, iterations) = _parse(
+        _measure(tmp_path, code, steps, dt, cap))
     n, nnz = code.nq, code.nnz
     algebra = (op_budget.sparse_lu(extra["lu"], n, nnz, code.name) if linalg == "sparse"
                else op_budget.dense_lu(n, nnz))
@@ -329,7 +332,7 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
                "worst_column": op_budget.worst_column(algebra, n)}
     if code.input_names:  # the steps stop once they reach rounding or stop contracting
         at_most["chord"] = op_budget.chord(code, algebra)
-        assert 1 <= measured["chord_steps"].add <= tuning.CHORD_STEPS
+        assert 1 <= taken["chord"] <= tuning.CHORD_STEPS
     if linalg == "sparse":  # every operation runs, whatever the values
         exact.update(factor=at_most.pop("factor"), pivot_ratio=at_most.pop("pivot_ratio"))
     if algebra.exact_inverse is None:  # Hager's estimate: its ascent may stop early
@@ -378,3 +381,6 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
         assert iterations == cap
     if linalg == "sparse" and not inputs:
         assert _arithmetic(measured["capped"]) == _arithmetic(newton)
+    if linalg == "sparse" and inputs:  # Newton's iterations exactly, the simplified steps more
+        steps_taken = measured["capped"] + parts.newton(cap) * -1
+        assert min(_arithmetic(steps_taken)) >= 0 and _within(steps_taken, parts.predictor)
