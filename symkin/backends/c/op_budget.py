@@ -287,6 +287,7 @@ class Budget:
     pieces: Pieces
     positions: Flops | None  # solve_inputs with du, ddu NULL (input mechanisms only)
     inputs: Flops | None  # solve_inputs with rates and accelerations
+    chord: Flops | None  # solve_inputs' simplified Newton steps, all taken (its predictor)
     dense_step: Flops  # solve_step's worst case on the dense LU (fall-back or --linalg dense)
 
 
@@ -314,13 +315,14 @@ def budget(code: Any, lu: dict[str, Any] | None, norm1_context: dict[str, Any] |
     parts = pieces(code, algebra, norm, scaled)
     worst = step(parts, cap)
     iteration = parts.evaluation + parts.update
-    inputs = positions = None
+    inputs = positions = chord_steps = None
     if code.input_names:
-        inputs = step(pieces(code, algebra, norm, scaled, inputs=True), cap)
+        inputs_parts = pieces(code, algebra, norm, scaled, inputs=True)
+        inputs, chord_steps = step(inputs_parts, cap), inputs_parts.predictor
         positions = step(pieces(code, algebra, norm, scaled, inputs=True, rates=False), cap,
                          rates=False)
     return Budget(cap=cap, iteration=iteration, fixed=worst + iteration * -cap, step=worst,
-                  pieces=parts, positions=positions, inputs=inputs,
+                  pieces=parts, positions=positions, inputs=inputs, chord=chord_steps,
                   dense_step=step(pieces(code, fallback, norm, scaled), cap))
 
 
@@ -342,9 +344,11 @@ def header_lines(plan: Budget) -> list[str]:
         f"Step, worst case with the default cap of {plan.cap} iterations: {kinds(plan.step)}",
         "  (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)",
     ]
-    if plan.inputs is not None and plan.positions is not None:
+    if plan.inputs is not None and plan.positions is not None and plan.chord is not None:
         lines += [f"solve_inputs, worst case: {kinds(plan.inputs)}",
-                  f"  positions only (du, ddu NULL): {kinds(plan.positions)}"]
+                  f"  positions only (du, ddu NULL): {kinds(plan.positions)}",
+                  f"  its simplified Newton steps before Newton (at most "
+                  f"{tuning.CHORD_STEPS}, in place of the predictor): {plan.chord.total}"]
     lines.append(f"On the dense LU (a fall-back at every factorization, or --linalg dense), "
                  f"worst case: {plan.dense_step.total}")
     return lines
