@@ -61,6 +61,7 @@ typedef struct {
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
  * solve_inputs, worst case: 6219 (2984 add/sub, 632 mul, 114 div, 10 sqrt, 148 other calls, 1031 fabs, 1300 compares)
  *   positions only (du, ddu NULL): 6109 (2928 add/sub, 616 mul, 114 div, 10 sqrt, 148 other calls, 1013 fabs, 1280 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 548
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37607
  */
 #define CRANK_SLIDER_INPUT_OPS_ITERATION 185   /* one Newton iteration */

@@ -61,6 +61,7 @@ typedef struct {
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
  * solve_inputs, worst case: 136316 (58391 add/sub, 48777 mul, 714 div, 10 sqrt, 508 other calls, 15925 fabs, 11991 compares)
  *   positions only (du, ddu NULL): 128782 (54433 add/sub, 45315 mul, 714 div, 10 sqrt, 508 other calls, 15869 fabs, 11933 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 6038
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 698232
  */
 #define DELTA_FK_OPS_ITERATION 3619   /* one Newton iteration */

@@ -61,6 +61,7 @@ typedef struct {
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
  * solve_inputs, worst case: 566035 (241579 add/sub, 215382 mul, 2532 div, 10 sqrt, 910 other calls, 61609 fabs, 44013 compares)
  *   positions only (du, ddu NULL): 545333 (231257 add/sub, 205368 mul, 2532 div, 10 sqrt, 910 other calls, 61427 fabs, 43829 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 31670
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16608737
  */
 #define STEWART_LEGS_FK_OPS_ITERATION 15452   /* one Newton iteration */

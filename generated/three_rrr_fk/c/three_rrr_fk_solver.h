@@ -61,6 +61,7 @@ typedef struct {
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
  * solve_inputs, worst case: 22317 (10303 add/sub, 3498 mul, 278 div, 10 sqrt, 518 other calls, 4139 fabs, 3571 compares)
  *   positions only (du, ddu NULL): 21939 (10111 add/sub, 3398 mul, 278 div, 10 sqrt, 518 other calls, 4097 fabs, 3527 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 1742
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286501
  */
 #define THREE_RRR_FK_OPS_ITERATION 665   /* one Newton iteration */
