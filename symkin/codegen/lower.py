@@ -175,7 +175,7 @@ class Code:
     input_names: tuple[str, ...] = ()
     """The input drivers (System.inputs): their u, du, ddu follow the parameters in p[]."""
     input_values: tuple[float, ...] = ()
-    """The inputs' values that the file's q0 satisfies (System.input_values)."""
+    """The inputs' values in the file's q0 (codegen.sample.input_values)."""
     input_places: tuple[str, ...] = ()
     """Where each input is in the file (System.input_places)."""
     nonlinear: tuple[int, ...] = ()
@@ -262,7 +262,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         ranges=coordinate_ranges(system),
         driver_names=system.dynamics.driver_names if system.dynamics else (),
         joint_names=system.dynamics.joint_names if system.dynamics else (),
-        input_names=system.input_names, input_values=system.input_values,
+        input_names=system.input_names, input_values=sample.input_values(system),
         input_places=system.input_places, nonlinear=nonlinear_coordinates(system),
     )
 

@@ -4,7 +4,8 @@ The budget of a generated solver step (``backends.c.op_budget``) adds up what ea
 executes. A routine's operations are read from the C text the templates render (its CSE'd
 temporaries and outputs, the sparse LU's straight-line statements), so whatever a printer or
 an emitter writes is counted, a new kind of statement included: every ``+ - * /`` (also in
-``+= -= *= /=``), every negation, comparison, ``fabs``, ``sqrt`` and other math call. An
+``+= -= *= /=``), every negation, comparison, ``fabs``, ``sqrt`` and other math call
+(comments and braces, as around the sparse LU's run-time row interchanges, count nothing). An
 operation between two number literals (``1.0/2.0``, a rational coefficient) is folded by the
 compiler and not counted; nor is the sign of a literal (``-1``). Index arithmetic never
 appears in these texts (indices are literal integers inside brackets, which are skipped).
@@ -61,9 +62,11 @@ _TOKEN = re.compile(r"""
     (?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?[fF]?)
   | (?P<name>[A-Za-z_]\w*)
   | (?P<index>\[[^\[\]]*\])
-  | (?P<op><<=|>>=|\+=|-=|\*=|/=|<=|>=|==|!=|&&|\|\||[-+*/<>!?:=(),;&|~%^])
+  | (?P<op><<=|>>=|\+=|-=|\*=|/=|<=|>=|==|!=|&&|\|\||[-+*/<>!?:=(),;&|~%^{}])
   | (?P<space>\s+)
 """, re.VERBOSE)
+
+_COMMENT = re.compile(r"/\*.*?\*/", re.DOTALL)
 
 _BINARY = {"+": "add", "-": "add", "*": "mul", "/": "div", "+=": "add", "-=": "add",
            "*=": "mul", "/=": "div", "<": "cmp", ">": "cmp", "<=": "cmp", ">=": "cmp",
@@ -77,6 +80,7 @@ _NOT_CALLS = {"if", "return", "while", "for", "sizeof"}
 def _tokens(text: str) -> list[tuple[str, str]]:
     """(kind, text) of each token; kind is the group name, or the operator itself."""
     out: list[tuple[str, str]] = []
+    text = _COMMENT.sub(" ", text)  # a comment's '/' and '*' are no operations
     position = 0
     while position < len(text):
         match = _TOKEN.match(text, position)

@@ -110,10 +110,25 @@ def input_walks(system: System, kernel: Any, start: np.ndarray
     return found
 
 
-def start_inputs(system: System, kernel: Any, q: np.ndarray) -> np.ndarray:
+def input_values(system: System) -> tuple[float, ...]:
+    """Each input's value in the file's q0 (start_inputs): what the generated folder's
+    example program holds the inputs at, so that its first solve starts where the mechanism
+    is assembled (a leg length, not the nominal 0 at which its row is flat)."""
+    if not system.inputs:
+        return ()
+    kernel = _SampleKernel(system, system.pattern())
+    with np.errstate(all="ignore"):
+        # polished past Newton's tolerance: these are printed as the inputs' values
+        p = start_inputs(system, kernel, np.array(system.q0, dtype=float), polish=2)
+    start = len(system.p)
+    return tuple(float(v) for v in p[start:start + len(system.inputs)])
+
+
+def start_inputs(system: System, kernel: Any, q: np.ndarray, polish: int = 0) -> np.ndarray:
     """The code's p with each input at its value in configuration q: the root of its row in u
     by Newton (numerical slope), from its nominal value, else from 1 (a length's row may be
-    flat at 0); the nominal value where neither converges."""
+    flat at 0); the nominal value where neither converges. ``polish``: Newton steps more
+    once the row is within the tolerance."""
     t0 = float(system.time_grid[0])
     p = np.array(system.code_p_values, dtype=float)
     for index, item in enumerate(system.inputs):
@@ -127,22 +142,27 @@ def start_inputs(system: System, kernel: Any, q: np.ndarray) -> np.ndarray:
             return float(kernel.phi(q, t0, trial)[row])
 
         for guess in (p[at], 1.0):
-            root = _scalar_root(residual, float(guess))
+            root = _scalar_root(residual, float(guess), polish)
             if root is not None:
                 p[at] = root
                 break
     return p
 
 
-def _scalar_root(f: Any, u: float) -> float | None:
-    """Newton on a scalar f with a central-difference slope; None when it does not converge."""
-    for _ in range(NEWTON.max_iterations):
+def _scalar_root(f: Any, u: float, polish: int = 0) -> float | None:
+    """Newton on a scalar f with a central-difference slope; None when it does not converge.
+    Within the tolerance, up to ``polish`` steps more (towards the root's rounding level: the
+    slope's small error then only scales a step that is already tiny)."""
+    for _ in range(NEWTON.max_iterations + polish):
         h = 1e-7 * max(1.0, abs(u))
         value, slope = f(u), (f(u + h) - f(u - h)) / (2 * h)
-        if abs(value) <= NEWTON.tol_phi:
+        within = abs(value) <= NEWTON.tol_phi
+        if within and (polish == 0 or value == 0.0 or not math.isfinite(slope)
+                       or slope == 0.0):
             return u
         if not (math.isfinite(value) and math.isfinite(slope)) or slope == 0.0:
             return None
+        polish -= within
         u -= value / slope
     return None
 

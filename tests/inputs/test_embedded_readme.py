@@ -52,3 +52,20 @@ def test_input_driven_readme_program(tmp_path: Path) -> None:
     # held at the input that q0 satisfies: crank angle 1.5708, tip (cos, sin) of it
     assert np.allclose(rows[:, 2], np.cos(1.5708), atol=2e-6)
     assert np.allclose(rows[:, 3], np.sin(1.5708), atol=2e-6)
+
+
+def test_input_driven_readme_program_of_length_inputs(tmp_path: Path) -> None:
+    """stewart_fk's inputs are leg lengths, whose rows |P - B|^2 - u^2 are flat at the
+    nominal u = 0: the README's program holds them at the drawn home pose's lengths (the
+    law of cosines of test_op_budget's _home_legs), so it assembles there and runs to 0."""
+    rows = np.array(_run_readme_main("stewart_fk", tmp_path))
+    assert rows.shape == (10, 4)
+    apart = np.radians([110, 10] * 3)  # base radius 1, platform 0.6 at height 1
+    legs = np.sqrt(1 + 0.6**2 + 1 - 2 * 0.6 * np.cos(apart))
+    readme = (tmp_path / "stewart_fk" / "stewart_fk_README.md").read_text()
+    held = re.search(r"u\[STEWART_FK_NU\] = \{ (.*?) \};", readme)
+    assert held is not None
+    assert np.allclose([float(v) for v in held.group(1).split(",")], legs, rtol=1e-12)
+    assert np.allclose(rows[:, 1], 0.0, atol=2e-6)  # platform.x at the home pose
+    # the first named point, the platform's P1, where the file draws it (x, y)
+    assert np.allclose(rows[:, 2:], [-0.10418890660015805, 0.5908846518073249], atol=2e-6)

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 642 (223 add/sub, 149 mul, 22 div, 0 sqrt, 9 other calls, 132 fabs, 107 compares)
  *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 155
  * Condition at the converged q: 522; an extra iteration there (at most 3): 723
- * Velocity: 127; acceleration: 219; per-point checks: 2122; predictor: 91
- * Step, worst case with the default cap of 25 iterations: 22352 (7984 add/sub, 5493 mul, 697 div, 9 sqrt, 337 other calls, 4314 fabs, 3518 compares)
+ * Velocity: 127; acceleration: 219; per-point checks: 2204; predictor: 91
+ * Step, worst case with the default cap of 25 iterations: 22434 (8007 add/sub, 5526 mul, 787 div, 10 sqrt, 280 other calls, 4354 fabs, 3470 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130040
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130214
  */
 #define ALL_DRIVERS_OPS_ITERATION 642   /* one Newton iteration */
-#define ALL_DRIVERS_OPS_STEP_FIXED 6302  /* a step without its iterations */
-#define ALL_DRIVERS_OPS_STEP_WORST 22352  /* at the default cap, 25 */
-#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130040  /* every factorization dense */
+#define ALL_DRIVERS_OPS_STEP_FIXED 6384  /* a step without its iterations */
+#define ALL_DRIVERS_OPS_STEP_WORST 22434  /* at the default cap, 25 */
+#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130214  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 606 (227 add/sub, 121 mul, 28 div, 0 sqrt, 14 other calls, 116 fabs, 100 compares)
  *   Phi, Phi_q, their factorization and tests: 417; the update (a solve): 189
  * Condition at the converged q: 517; an extra iteration there (at most 3): 687
- * Velocity: 125; acceleration: 148; per-point checks: 2616; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 21721 (8333 add/sub, 4600 mul, 889 div, 9 sqrt, 511 other calls, 3952 fabs, 3427 compares)
+ * Velocity: 125; acceleration: 148; per-point checks: 2530; predictor: 127
+ * Step, worst case with the default cap of 25 iterations: 21635 (8267 add/sub, 4538 mul, 1015 div, 10 sqrt, 434 other calls, 4010 fabs, 3361 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284619
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284661
  */
 #define ANDREWS_SQUEEZER_OPS_ITERATION 606   /* one Newton iteration */
-#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6571  /* a step without its iterations */
-#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21721  /* at the default cap, 25 */
-#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284619  /* every factorization dense */
+#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6485  /* a step without its iterations */
+#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21635  /* at the default cap, 25 */
+#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284661  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 409 (149 add/sub, 170 mul, 16 div, 1 sqrt, 18 other calls, 23 fabs, 32 compares)
  *   Phi, Phi_q, their factorization and tests: 353; the update (a solve): 56
  * Condition at the converged q: 46; an extra iteration there (at most 3): 490
- * Velocity: 34; acceleration: 520; per-point checks: 873; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 13653 (4938 add/sub, 5608 mul, 506 div, 39 sqrt, 571 other calls, 801 fabs, 1190 compares)
+ * Velocity: 34; acceleration: 520; per-point checks: 1545; predictor: 43
+ * Step, worst case with the default cap of 25 iterations: 14325 (5170 add/sub, 5988 mul, 560 div, 42 sqrt, 576 other calls, 817 fabs, 1172 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 30634
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31350
  */
 #define CAM_CYCLOIDAL_OPS_ITERATION 409   /* one Newton iteration */
-#define CAM_CYCLOIDAL_OPS_STEP_FIXED 3428  /* a step without its iterations */
-#define CAM_CYCLOIDAL_OPS_STEP_WORST 13653  /* at the default cap, 25 */
-#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 30634  /* every factorization dense */
+#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4100  /* a step without its iterations */
+#define CAM_CYCLOIDAL_OPS_STEP_WORST 14325  /* at the default cap, 25 */
+#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31350  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CAM_CYCLOIDAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

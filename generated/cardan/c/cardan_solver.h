@@ -53,18 +53,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 952 (355 add/sub, 292 mul, 23 div, 0 sqrt, 4 other calls, 152 fabs, 126 compares)
- *   Phi, Phi_q, their factorization and tests: 752; the update (a solve): 200
- * Condition at the converged q: 2345; an extra iteration there (at most 3): 1033
- * Velocity: 174; acceleration: 508; per-point checks: 2597; predictor: 85
- * Step, worst case with the default cap of 25 iterations: 35748 (13980 add/sub, 11202 mul, 725 div, 9 sqrt, 326 other calls, 5155 fabs, 4351 compares)
+ * One Newton iteration: 1008 (373 add/sub, 312 mul, 23 div, 0 sqrt, 4 other calls, 164 fabs, 132 compares)
+ *   Phi, Phi_q, their factorization and tests: 794; the update (a solve): 214
+ * Condition at the converged q: 2542; an extra iteration there (at most 3): 1089
+ * Velocity: 188; acceleration: 522; per-point checks: 3239; predictor: 85
+ * Step, worst case with the default cap of 25 iterations: 38422 (14960 add/sub, 12327 mul, 809 div, 10 sqrt, 266 other calls, 5540 fabs, 4510 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121453
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123245
  */
-#define CARDAN_OPS_ITERATION 952   /* one Newton iteration */
-#define CARDAN_OPS_STEP_FIXED 11948  /* a step without its iterations */
-#define CARDAN_OPS_STEP_WORST 35748  /* at the default cap, 25 */
-#define CARDAN_OPS_STEP_DENSE_WORST 121453  /* every factorization dense */
+#define CARDAN_OPS_ITERATION 1008   /* one Newton iteration */
+#define CARDAN_OPS_STEP_FIXED 13222  /* a step without its iterations */
+#define CARDAN_OPS_STEP_WORST 38422  /* at the default cap, 25 */
+#define CARDAN_OPS_STEP_DENSE_WORST 123245  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CARDAN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 199 (82 add/sub, 41 mul, 11 div, 1 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 126; the update (a solve): 73
  * Condition at the converged q: 57; an extra iteration there (at most 3): 280
- * Velocity: 46; acceleration: 58; per-point checks: 1100; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 7357 (2952 add/sub, 1640 mul, 360 div, 39 sqrt, 161 other calls, 955 fabs, 1250 compares)
+ * Velocity: 46; acceleration: 58; per-point checks: 1033; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 7290 (2917 add/sub, 1596 mul, 414 div, 42 sqrt, 124 other calls, 977 fabs, 1220 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38063
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38052
  */
 #define CRANK_SLIDER_DRAWN_OPS_ITERATION 199   /* one Newton iteration */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2382  /* a step without its iterations */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7357  /* at the default cap, 25 */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38063  /* every factorization dense */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2315  /* a step without its iterations */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7290  /* at the default cap, 25 */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38052  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

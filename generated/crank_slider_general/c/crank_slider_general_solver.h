@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 375 (136 add/sub, 91 mul, 13 div, 0 sqrt, 6 other calls, 68 fabs, 61 compares)
  *   Phi, Phi_q, their factorization and tests: 285; the update (a solve): 90
  * Condition at the converged q: 211; an extra iteration there (at most 3): 456
- * Velocity: 63; acceleration: 121; per-point checks: 1287; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 13019 (4778 add/sub, 3287 mul, 418 div, 9 sqrt, 219 other calls, 2232 fabs, 2076 compares)
+ * Velocity: 63; acceleration: 121; per-point checks: 1328; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 13060 (4788 add/sub, 3304 mul, 472 div, 10 sqrt, 186 other calls, 2254 fabs, 2046 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43158
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43255
  */
 #define CRANK_SLIDER_GENERAL_OPS_ITERATION 375   /* one Newton iteration */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3644  /* a step without its iterations */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13019  /* at the default cap, 25 */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43158  /* every factorization dense */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3685  /* a step without its iterations */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13060  /* at the default cap, 25 */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43255  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_GENERAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,19 +56,20 @@ typedef struct {
  * One Newton iteration: 185 (75 add/sub, 35 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 112; the update (a solve): 73
  * Condition at the converged q: 57; an extra iteration there (at most 3): 266
- * Velocity: 46; acceleration: 44; per-point checks: 1100; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 6937 (2742 add/sub, 1460 mul, 360 div, 9 sqrt, 161 other calls, 955 fabs, 1250 compares)
+ * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 6845 (2694 add/sub, 1406 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1220 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 5799 (2707 add/sub, 643 mul, 72 div, 9 sqrt, 161 other calls, 955 fabs, 1252 compares)
- *   positions only (du, ddu NULL): 5689 (2651 add/sub, 627 mul, 72 div, 9 sqrt, 161 other calls, 937 fabs, 1232 compares)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37643
+ * solve_inputs, worst case: 6219 (2984 add/sub, 632 mul, 114 div, 10 sqrt, 148 other calls, 1031 fabs, 1300 compares)
+ *   positions only (du, ddu NULL): 6109 (2928 add/sub, 616 mul, 114 div, 10 sqrt, 148 other calls, 1013 fabs, 1280 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 548
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37607
  */
 #define CRANK_SLIDER_INPUT_OPS_ITERATION 185   /* one Newton iteration */
-#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2312  /* a step without its iterations */
-#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6937  /* at the default cap, 25 */
-#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37643  /* every factorization dense */
-#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 5799  /* solve_inputs with du, ddu */
-#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 5689  /* solve_inputs, du, ddu NULL */
+#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2220  /* a step without its iterations */
+#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6845  /* at the default cap, 25 */
+#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37607  /* every factorization dense */
+#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 6219  /* solve_inputs with du, ddu */
+#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 6109  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 186 (75 add/sub, 36 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 113; the update (a solve): 73
  * Condition at the converged q: 57; an extra iteration there (at most 3): 267
- * Velocity: 46; acceleration: 44; per-point checks: 1100; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 6966 (2741 add/sub, 1490 mul, 360 div, 9 sqrt, 161 other calls, 955 fabs, 1250 compares)
+ * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 6874 (2692 add/sub, 1437 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1220 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37672
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37636
  */
 #define CRANK_SLIDER_LOAD_OPS_ITERATION 186   /* one Newton iteration */
-#define CRANK_SLIDER_LOAD_OPS_STEP_FIXED 2316  /* a step without its iterations */
-#define CRANK_SLIDER_LOAD_OPS_STEP_WORST 6966  /* at the default cap, 25 */
-#define CRANK_SLIDER_LOAD_OPS_STEP_DENSE_WORST 37672  /* every factorization dense */
+#define CRANK_SLIDER_LOAD_OPS_STEP_FIXED 2224  /* a step without its iterations */
+#define CRANK_SLIDER_LOAD_OPS_STEP_WORST 6874  /* at the default cap, 25 */
+#define CRANK_SLIDER_LOAD_OPS_STEP_DENSE_WORST 37636  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_LOAD_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 229 (90 add/sub, 46 mul, 12 div, 0 sqrt, 7 other calls, 35 fabs, 39 compares)
  *   Phi, Phi_q, their factorization and tests: 151; the update (a solve): 78
  * Condition at the converged q: 104; an extra iteration there (at most 3): 310
- * Velocity: 64; acceleration: 96; per-point checks: 1155; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8427 (3258 add/sub, 1880 mul, 389 div, 9 sqrt, 250 other calls, 1211 fabs, 1430 compares)
+ * Velocity: 64; acceleration: 96; per-point checks: 1157; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 8429 (3240 add/sub, 1877 mul, 443 div, 10 sqrt, 226 other calls, 1233 fabs, 1400 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38860
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38918
  */
 #define CUSTOM_DRIVER_OPS_ITERATION 229   /* one Newton iteration */
-#define CUSTOM_DRIVER_OPS_STEP_FIXED 2702  /* a step without its iterations */
-#define CUSTOM_DRIVER_OPS_STEP_WORST 8427  /* at the default cap, 25 */
-#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38860  /* every factorization dense */
+#define CUSTOM_DRIVER_OPS_STEP_FIXED 2704  /* a step without its iterations */
+#define CUSTOM_DRIVER_OPS_STEP_WORST 8429  /* at the default cap, 25 */
+#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38918  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -55,16 +55,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 3630 (1388 add/sub, 1335 mul, 48 div, 0 sqrt, 9 other calls, 485 fabs, 365 compares)
  *   Phi, Phi_q, their factorization and tests: 3199; the update (a solve): 431
- * Condition at the converged q: 5175; an extra iteration there (at most 3): 3711
- * Velocity: 433; acceleration: 7082; per-point checks: 5418; predictor: 169
- * Step, worst case with the default cap of 25 iterations: 128577 (51305 add/sub, 47580 mul, 1492 div, 9 sqrt, 687 other calls, 15678 fabs, 11826 compares)
+ * Condition at the converged q: 5260; an extra iteration there (at most 3): 3711
+ * Velocity: 433; acceleration: 7082; per-point checks: 13700; predictor: 169
+ * Step, worst case with the default cap of 25 iterations: 137029 (55700 add/sub, 51525 mul, 1660 div, 10 sqrt, 580 other calls, 15757 fabs, 11797 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 690201
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 698653
  */
 #define DELTA_OPS_ITERATION 3630   /* one Newton iteration */
-#define DELTA_OPS_STEP_FIXED 37827  /* a step without its iterations */
-#define DELTA_OPS_STEP_WORST 128577  /* at the default cap, 25 */
-#define DELTA_OPS_STEP_DENSE_WORST 690201  /* every factorization dense */
+#define DELTA_OPS_STEP_FIXED 46279  /* a step without its iterations */
+#define DELTA_OPS_STEP_WORST 137029  /* at the default cap, 25 */
+#define DELTA_OPS_STEP_DENSE_WORST 698653  /* every factorization dense */
 
 typedef struct {
     int status;                  /* DELTA_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

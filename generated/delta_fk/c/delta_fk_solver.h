@@ -55,20 +55,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 3619 (1384 add/sub, 1331 mul, 48 div, 0 sqrt, 6 other calls, 485 fabs, 365 compares)
  *   Phi, Phi_q, their factorization and tests: 3188; the update (a solve): 431
- * Condition at the converged q: 5175; an extra iteration there (at most 3): 3700
- * Velocity: 423; acceleration: 7053; per-point checks: 5418; predictor: 169
- * Step, worst case with the default cap of 25 iterations: 128219 (51180 add/sub, 47440 mul, 1492 div, 9 sqrt, 594 other calls, 15678 fabs, 11826 compares)
+ * Condition at the converged q: 5260; an extra iteration there (at most 3): 3700
+ * Velocity: 423; acceleration: 7053; per-point checks: 13637; predictor: 169
+ * Step, worst case with the default cap of 25 iterations: 136608 (55561 add/sub, 51351 mul, 1660 div, 10 sqrt, 472 other calls, 15757 fabs, 11797 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 122001 (51069 add/sub, 42227 mul, 596 div, 9 sqrt, 594 other calls, 15678 fabs, 11828 compares)
- *   positions only (du, ddu NULL): 114467 (47111 add/sub, 38765 mul, 596 div, 9 sqrt, 594 other calls, 15622 fabs, 11770 compares)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689843
+ * solve_inputs, worst case: 136316 (58391 add/sub, 48777 mul, 714 div, 10 sqrt, 508 other calls, 15925 fabs, 11991 compares)
+ *   positions only (du, ddu NULL): 128782 (54433 add/sub, 45315 mul, 714 div, 10 sqrt, 508 other calls, 15869 fabs, 11933 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 6038
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 698232
  */
 #define DELTA_FK_OPS_ITERATION 3619   /* one Newton iteration */
-#define DELTA_FK_OPS_STEP_FIXED 37744  /* a step without its iterations */
-#define DELTA_FK_OPS_STEP_WORST 128219  /* at the default cap, 25 */
-#define DELTA_FK_OPS_STEP_DENSE_WORST 689843  /* every factorization dense */
-#define DELTA_FK_OPS_INPUTS_WORST 122001  /* solve_inputs with du, ddu */
-#define DELTA_FK_OPS_POSITIONS_WORST 114467  /* solve_inputs, du, ddu NULL */
+#define DELTA_FK_OPS_STEP_FIXED 46133  /* a step without its iterations */
+#define DELTA_FK_OPS_STEP_WORST 136608  /* at the default cap, 25 */
+#define DELTA_FK_OPS_STEP_DENSE_WORST 698232  /* every factorization dense */
+#define DELTA_FK_OPS_INPUTS_WORST 136316  /* solve_inputs with du, ddu */
+#define DELTA_FK_OPS_POSITIONS_WORST 128782  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* DELTA_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 234 (85 add/sub, 46 mul, 12 div, 0 sqrt, 6 other calls, 42 fabs, 43 compares)
  *   Phi, Phi_q, their factorization and tests: 159; the update (a solve): 75
  * Condition at the converged q: 83; an extra iteration there (at most 3): 315
- * Velocity: 48; acceleration: 52; per-point checks: 1122; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8440 (3058 add/sub, 1817 mul, 389 div, 9 sqrt, 219 other calls, 1402 fabs, 1546 compares)
+ * Velocity: 48; acceleration: 52; per-point checks: 1051; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 8369 (3017 add/sub, 1773 mul, 443 div, 10 sqrt, 186 other calls, 1424 fabs, 1516 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39032
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39017
  */
 #define FOUR_BAR_DYNAMICS_OPS_ITERATION 234   /* one Newton iteration */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2590  /* a step without its iterations */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8440  /* at the default cap, 25 */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39032  /* every factorization dense */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2519  /* a step without its iterations */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8369  /* at the default cap, 25 */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39017  /* every factorization dense */
 
 typedef struct {
     int status;                  /* FOUR_BAR_DYNAMICS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

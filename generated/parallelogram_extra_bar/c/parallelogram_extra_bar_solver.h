@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 326 (120 add/sub, 71 mul, 16 div, 0 sqrt, 10 other calls, 55 fabs, 54 compares)
  *   Phi, Phi_q, their factorization and tests: 224; the update (a solve): 102
  * Condition at the converged q: 154; an extra iteration there (at most 3): 407
- * Velocity: 65; acceleration: 92; per-point checks: 1479; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 11655 (4322 add/sub, 2679 mul, 514 div, 9 sqrt, 350 other calls, 1858 fabs, 1923 compares)
+ * Velocity: 65; acceleration: 92; per-point checks: 1432; predictor: 73
+ * Step, worst case with the default cap of 25 iterations: 11608 (4282 add/sub, 2647 mul, 586 div, 10 sqrt, 310 other calls, 1889 fabs, 1884 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73378
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73405
  */
 #define PARALLELOGRAM_EXTRA_BAR_OPS_ITERATION 326   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3505  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11655  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73378  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3458  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11608  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73405  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

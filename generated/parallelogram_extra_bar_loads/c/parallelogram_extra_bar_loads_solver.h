@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 396 (153 add/sub, 88 mul, 19 div, 0 sqrt, 11 other calls, 63 fabs, 62 compares)
  *   Phi, Phi_q, their factorization and tests: 267; the update (a solve): 129
  * Condition at the converged q: 231; an extra iteration there (at most 3): 477
- * Velocity: 88; acceleration: 113; per-point checks: 1836; predictor: 91
- * Step, worst case with the default cap of 25 iterations: 14231 (5532 add/sub, 3289 mul, 610 div, 9 sqrt, 395 other calls, 2193 fabs, 2203 compares)
+ * Velocity: 88; acceleration: 113; per-point checks: 1784; predictor: 91
+ * Step, worst case with the default cap of 25 iterations: 14179 (5483 add/sub, 3256 mul, 700 div, 10 sqrt, 342 other calls, 2233 fabs, 2155 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123275
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123315
  */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_ITERATION 396   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4331  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 14231  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123275  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4279  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 14179  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123315  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_LOADS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

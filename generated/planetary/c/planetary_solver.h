@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 229 (87 add/sub, 44 mul, 12 div, 0 sqrt, 2 other calls, 41 fabs, 43 compares)
  *   Phi, Phi_q, their factorization and tests: 154; the update (a solve): 75
  * Condition at the converged q: 70; an extra iteration there (at most 3): 310
- * Velocity: 48; acceleration: 43; per-point checks: 1122; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8260 (3079 add/sub, 1775 mul, 389 div, 9 sqrt, 103 other calls, 1367 fabs, 1538 compares)
+ * Velocity: 48; acceleration: 43; per-point checks: 1018; predictor: 55
+ * Step, worst case with the default cap of 25 iterations: 8156 (3031 add/sub, 1713 mul, 443 div, 10 sqrt, 62 other calls, 1389 fabs, 1508 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38603
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38555
  */
 #define PLANETARY_OPS_ITERATION 229   /* one Newton iteration */
-#define PLANETARY_OPS_STEP_FIXED 2535  /* a step without its iterations */
-#define PLANETARY_OPS_STEP_WORST 8260  /* at the default cap, 25 */
-#define PLANETARY_OPS_STEP_DENSE_WORST 38603  /* every factorization dense */
+#define PLANETARY_OPS_STEP_FIXED 2431  /* a step without its iterations */
+#define PLANETARY_OPS_STEP_WORST 8156  /* at the default cap, 25 */
+#define PLANETARY_OPS_STEP_DENSE_WORST 38555  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PLANETARY_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 296 (122 add/sub, 61 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
  *   Phi, Phi_q, their factorization and tests: 192; the update (a solve): 104
  * Condition at the converged q: 179; an extra iteration there (at most 3): 377
- * Velocity: 68; acceleration: 107; per-point checks: 1501; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 10873 (4413 add/sub, 2428 mul, 485 div, 9 sqrt, 234 other calls, 1553 fabs, 1751 compares)
+ * Velocity: 68; acceleration: 107; per-point checks: 1456; predictor: 73
+ * Step, worst case with the default cap of 25 iterations: 10828 (4388 add/sub, 2391 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1712 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72658
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72687
  */
 #define QUICK_RETURN_OPS_ITERATION 296   /* one Newton iteration */
-#define QUICK_RETURN_OPS_STEP_FIXED 3473  /* a step without its iterations */
-#define QUICK_RETURN_OPS_STEP_WORST 10873  /* at the default cap, 25 */
-#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72658  /* every factorization dense */
+#define QUICK_RETURN_OPS_STEP_FIXED 3428  /* a step without its iterations */
+#define QUICK_RETURN_OPS_STEP_WORST 10828  /* at the default cap, 25 */
+#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72687  /* every factorization dense */
 
 typedef struct {
     int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

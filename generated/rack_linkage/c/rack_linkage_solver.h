@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 370 (130 add/sub, 75 mul, 16 div, 0 sqrt, 7 other calls, 73 fabs, 69 compares)
  *   Phi, Phi_q, their factorization and tests: 262; the update (a solve): 108
  * Condition at the converged q: 225; an extra iteration there (at most 3): 451
- * Velocity: 73; acceleration: 102; per-point checks: 1545; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 13151 (4701 add/sub, 2895 mul, 514 div, 9 sqrt, 264 other calls, 2400 fabs, 2368 compares)
+ * Velocity: 73; acceleration: 102; per-point checks: 1495; predictor: 73
+ * Step, worst case with the default cap of 25 iterations: 13101 (4668 add/sub, 2859 mul, 586 div, 10 sqrt, 218 other calls, 2431 fabs, 2329 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74700
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74724
  */
 #define RACK_LINKAGE_OPS_ITERATION 370   /* one Newton iteration */
-#define RACK_LINKAGE_OPS_STEP_FIXED 3901  /* a step without its iterations */
-#define RACK_LINKAGE_OPS_STEP_WORST 13151  /* at the default cap, 25 */
-#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74700  /* every factorization dense */
+#define RACK_LINKAGE_OPS_STEP_FIXED 3851  /* a step without its iterations */
+#define RACK_LINKAGE_OPS_STEP_WORST 13101  /* at the default cap, 25 */
+#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74724  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -53,18 +53,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 916 (320 add/sub, 279 mul, 24 div, 1 sqrt, 2 other calls, 158 fabs, 132 compares)
- *   Phi, Phi_q, their factorization and tests: 749; the update (a solve): 167
- * Condition at the converged q: 628; an extra iteration there (at most 3): 997
- * Velocity: 141; acceleration: 755; per-point checks: 2234; predictor: 85
- * Step, worst case with the default cap of 25 iterations: 31154 (11094 add/sub, 9873 mul, 752 div, 38 sqrt, 129 other calls, 5025 fabs, 4243 compares)
+ * One Newton iteration: 928 (320 add/sub, 279 mul, 24 div, 1 sqrt, 2 other calls, 166 fabs, 136 compares)
+ *   Phi, Phi_q, their factorization and tests: 761; the update (a solve): 167
+ * Condition at the converged q: 628; an extra iteration there (at most 3): 1009
+ * Velocity: 141; acceleration: 755; per-point checks: 3014; predictor: 85
+ * Step, worst case with the default cap of 25 iterations: 32282 (11412 add/sub, 10319 mul, 837 div, 40 sqrt, 66 other calls, 5294 fabs, 4314 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 120611
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121825
  */
-#define RSSR_OPS_ITERATION 916   /* one Newton iteration */
-#define RSSR_OPS_STEP_FIXED 8254  /* a step without its iterations */
-#define RSSR_OPS_STEP_WORST 31154  /* at the default cap, 25 */
-#define RSSR_OPS_STEP_DENSE_WORST 120611  /* every factorization dense */
+#define RSSR_OPS_ITERATION 928   /* one Newton iteration */
+#define RSSR_OPS_STEP_FIXED 9082  /* a step without its iterations */
+#define RSSR_OPS_STEP_WORST 32282  /* at the default cap, 25 */
+#define RSSR_OPS_STEP_DENSE_WORST 121825  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RSSR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -53,18 +53,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 1363 (513 add/sub, 407 mul, 34 div, 1 sqrt, 3 other calls, 224 fabs, 181 compares)
- *   Phi, Phi_q, their factorization and tests: 1073; the update (a solve): 290
- * Condition at the converged q: 3376; an extra iteration there (at most 3): 1444
- * Velocity: 243; acceleration: 702; per-point checks: 3727; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 51074 (20126 add/sub, 15641 mul, 1065 div, 39 sqrt, 403 other calls, 7594 fabs, 6206 compares)
+ * One Newton iteration: 1375 (513 add/sub, 407 mul, 34 div, 1 sqrt, 3 other calls, 232 fabs, 185 compares)
+ *   Phi, Phi_q, their factorization and tests: 1085; the update (a solve): 290
+ * Condition at the converged q: 3440; an extra iteration there (at most 3): 1456
+ * Velocity: 243; acceleration: 702; per-point checks: 4394; predictor: 127
+ * Step, worst case with the default cap of 25 iterations: 52217 (20484 add/sub, 16010 mul, 1191 div, 42 sqrt, 306 other calls, 7884 fabs, 6300 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 306429
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 307572
  */
-#define SPATIAL_SLIDER_CRANK_OPS_ITERATION 1363   /* one Newton iteration */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 16999  /* a step without its iterations */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51074  /* at the default cap, 25 */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 306429  /* every factorization dense */
+#define SPATIAL_SLIDER_CRANK_OPS_ITERATION 1375   /* one Newton iteration */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17842  /* a step without its iterations */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 52217  /* at the default cap, 25 */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 307572  /* every factorization dense */
 
 typedef struct {
     int status;                  /* SPATIAL_SLIDER_CRANK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

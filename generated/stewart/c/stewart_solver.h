@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 1492 (631 add/sub, 586 mul, 21 div, 6 sqrt, 7 other calls, 128 fabs, 113 compares)
  *   Phi, Phi_q, their factorization and tests: 1364; the update (a solve): 128
  * Condition at the converged q: 612; an extra iteration there (at most 3): 1573
- * Velocity: 376; acceleration: 2317; per-point checks: 1665; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 49051 (20909 add/sub, 19493 mul, 650 div, 189 sqrt, 246 other calls, 4012 fabs, 3552 compares)
+ * Velocity: 376; acceleration: 2317; per-point checks: 4763; predictor: 43
+ * Step, worst case with the default cap of 25 iterations: 52149 (22482 add/sub, 20972 mul, 704 div, 202 sqrt, 233 other calls, 4028 fabs, 3528 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 64806
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 67948
  */
 #define STEWART_OPS_ITERATION 1492   /* one Newton iteration */
-#define STEWART_OPS_STEP_FIXED 11751  /* a step without its iterations */
-#define STEWART_OPS_STEP_WORST 49051  /* at the default cap, 25 */
-#define STEWART_OPS_STEP_DENSE_WORST 64806  /* every factorization dense */
+#define STEWART_OPS_STEP_FIXED 14849  /* a step without its iterations */
+#define STEWART_OPS_STEP_WORST 52149  /* at the default cap, 25 */
+#define STEWART_OPS_STEP_DENSE_WORST 67948  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -53,22 +53,23 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 1375 (545 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 128 fabs, 113 compares)
- *   Phi, Phi_q, their factorization and tests: 1247; the update (a solve): 128
- * Condition at the converged q: 612; an extra iteration there (at most 3): 1456
- * Velocity: 118; acceleration: 1863; per-point checks: 1665; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 44946 (18072 add/sub, 18796 mul, 470 div, 9 sqrt, 35 other calls, 4012 fabs, 3552 compares)
+ * One Newton iteration: 1402 (545 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 146 fabs, 122 compares)
+ *   Phi, Phi_q, their factorization and tests: 1274; the update (a solve): 128
+ * Condition at the converged q: 612; an extra iteration there (at most 3): 1483
+ * Velocity: 118; acceleration: 1863; per-point checks: 4091; predictor: 43
+ * Step, worst case with the default cap of 25 iterations: 48155 (19319 add/sub, 19975 mul, 512 div, 10 sqrt, 0 other calls, 4550 fabs, 3789 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 43111 (18045 add/sub, 17210 mul, 246 div, 9 sqrt, 35 other calls, 4012 fabs, 3554 compares)
- *   positions only (du, ddu NULL): 41114 (17013 add/sub, 16275 mul, 246 div, 9 sqrt, 35 other calls, 3998 fabs, 3538 compares)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 60701
+ * solve_inputs, worst case: 48562 (20373 add/sub, 19450 mul, 280 div, 10 sqrt, 0 other calls, 4592 fabs, 3857 compares)
+ *   positions only (du, ddu NULL): 46565 (19341 add/sub, 18515 mul, 280 div, 10 sqrt, 0 other calls, 4578 fabs, 3841 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2270
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 63954
  */
-#define STEWART_FK_OPS_ITERATION 1375   /* one Newton iteration */
-#define STEWART_FK_OPS_STEP_FIXED 10571  /* a step without its iterations */
-#define STEWART_FK_OPS_STEP_WORST 44946  /* at the default cap, 25 */
-#define STEWART_FK_OPS_STEP_DENSE_WORST 60701  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 43111  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 41114  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_ITERATION 1402   /* one Newton iteration */
+#define STEWART_FK_OPS_STEP_FIXED 13105  /* a step without its iterations */
+#define STEWART_FK_OPS_STEP_WORST 48155  /* at the default cap, 25 */
+#define STEWART_FK_OPS_STEP_DENSE_WORST 63954  /* every factorization dense */
+#define STEWART_FK_OPS_INPUTS_WORST 48562  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 46565  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -55,16 +55,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 15716 (6153 add/sub, 6101 mul, 165 div, 6 sqrt, 14 other calls, 1901 fabs, 1376 compares)
  *   Phi, Phi_q, their factorization and tests: 13861; the update (a solve): 1855
- * Condition at the converged q: 22348; an extra iteration there (at most 3): 15797
- * Velocity: 1885; acceleration: 19661; per-point checks: 22342; predictor: 547
- * Step, worst case with the default cap of 25 iterations: 543326 (219907 add/sub, 212025 mul, 5092 div, 195 sqrt, 1779 other calls, 60795 fabs, 43533 compares)
+ * Condition at the converged q: 22622; an extra iteration there (at most 3): 15797
+ * Velocity: 1885; acceleration: 19661; per-point checks: 46783; predictor: 547
+ * Step, worst case with the default cap of 25 iterations: 568315 (232217 add/sub, 224384 mul, 5656 div, 208 sqrt, 1346 other calls, 61063 fabs, 43441 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16593443
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16618432
  */
 #define STEWART_LEGS_OPS_ITERATION 15716   /* one Newton iteration */
-#define STEWART_LEGS_OPS_STEP_FIXED 150426  /* a step without its iterations */
-#define STEWART_LEGS_OPS_STEP_WORST 543326  /* at the default cap, 25 */
-#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16593443  /* every factorization dense */
+#define STEWART_LEGS_OPS_STEP_FIXED 175415  /* a step without its iterations */
+#define STEWART_LEGS_OPS_STEP_WORST 568315  /* at the default cap, 25 */
+#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16618432  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

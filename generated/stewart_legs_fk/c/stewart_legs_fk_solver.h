@@ -55,20 +55,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 15452 (6015 add/sub, 5995 mul, 165 div, 0 sqrt, 0 other calls, 1901 fabs, 1376 compares)
  *   Phi, Phi_q, their factorization and tests: 13597; the update (a solve): 1855
- * Condition at the converged q: 22348; an extra iteration there (at most 3): 15533
- * Velocity: 1587; acceleration: 18931; per-point checks: 22342; predictor: 547
- * Step, worst case with the default cap of 25 iterations: 534642 (215480 add/sub, 208386 mul, 5074 div, 9 sqrt, 1365 other calls, 60795 fabs, 43533 compares)
+ * Condition at the converged q: 22622; an extra iteration there (at most 3): 15533
+ * Velocity: 1587; acceleration: 18931; per-point checks: 45772; predictor: 547
+ * Step, worst case with the default cap of 25 iterations: 558620 (227379 add/sub, 220197 mul, 5620 div, 10 sqrt, 910 other calls, 61063 fabs, 43441 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 510751 (215117 add/sub, 187768 mul, 2162 div, 9 sqrt, 1365 other calls, 60795 fabs, 43535 compares)
- *   positions only (du, ddu NULL): 490049 (204795 add/sub, 177754 mul, 2162 div, 9 sqrt, 1365 other calls, 60613 fabs, 43351 compares)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16584759
+ * solve_inputs, worst case: 566035 (241579 add/sub, 215382 mul, 2532 div, 10 sqrt, 910 other calls, 61609 fabs, 44013 compares)
+ *   positions only (du, ddu NULL): 545333 (231257 add/sub, 205368 mul, 2532 div, 10 sqrt, 910 other calls, 61427 fabs, 43829 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 31670
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16608737
  */
 #define STEWART_LEGS_FK_OPS_ITERATION 15452   /* one Newton iteration */
-#define STEWART_LEGS_FK_OPS_STEP_FIXED 148342  /* a step without its iterations */
-#define STEWART_LEGS_FK_OPS_STEP_WORST 534642  /* at the default cap, 25 */
-#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16584759  /* every factorization dense */
-#define STEWART_LEGS_FK_OPS_INPUTS_WORST 510751  /* solve_inputs with du, ddu */
-#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 490049  /* solve_inputs, du, ddu NULL */
+#define STEWART_LEGS_FK_OPS_STEP_FIXED 172320  /* a step without its iterations */
+#define STEWART_LEGS_FK_OPS_STEP_WORST 558620  /* at the default cap, 25 */
+#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16608737  /* every factorization dense */
+#define STEWART_LEGS_FK_OPS_INPUTS_WORST 566035  /* solve_inputs with du, ddu */
+#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 545333  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

@@ -53,22 +53,23 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 682 (257 add/sub, 153 mul, 28 div, 0 sqrt, 14 other calls, 124 fabs, 106 compares)
- *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 195
- * Condition at the converged q: 568; an extra iteration there (at most 3): 763
- * Velocity: 134; acceleration: 200; per-point checks: 2682; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 24148 (9288 add/sub, 5634 mul, 889 div, 9 sqrt, 511 other calls, 4216 fabs, 3601 compares)
+ * One Newton iteration: 665 (259 add/sub, 148 mul, 27 div, 0 sqrt, 14 other calls, 115 fabs, 102 compares)
+ *   Phi, Phi_q, their factorization and tests: 470; the update (a solve): 195
+ * Condition at the converged q: 569; an extra iteration there (at most 3): 746
+ * Velocity: 134; acceleration: 200; per-point checks: 2672; predictor: 127
+ * Step, worst case with the default cap of 25 iterations: 23647 (9335 add/sub, 5450 mul, 986 div, 10 sqrt, 434 other calls, 4013 fabs, 3419 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 21160 (9205 add/sub, 3399 mul, 217 div, 9 sqrt, 511 other calls, 4216 fabs, 3603 compares)
- *   positions only (du, ddu NULL): 20782 (9015 add/sub, 3297 mul, 217 div, 9 sqrt, 511 other calls, 4174 fabs, 3559 compares)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286702
+ * solve_inputs, worst case: 22317 (10303 add/sub, 3498 mul, 278 div, 10 sqrt, 518 other calls, 4139 fabs, 3571 compares)
+ *   positions only (du, ddu NULL): 21939 (10111 add/sub, 3398 mul, 278 div, 10 sqrt, 518 other calls, 4097 fabs, 3527 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 1742
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286501
  */
-#define THREE_RRR_FK_OPS_ITERATION 682   /* one Newton iteration */
-#define THREE_RRR_FK_OPS_STEP_FIXED 7098  /* a step without its iterations */
-#define THREE_RRR_FK_OPS_STEP_WORST 24148  /* at the default cap, 25 */
-#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286702  /* every factorization dense */
-#define THREE_RRR_FK_OPS_INPUTS_WORST 21160  /* solve_inputs with du, ddu */
-#define THREE_RRR_FK_OPS_POSITIONS_WORST 20782  /* solve_inputs, du, ddu NULL */
+#define THREE_RRR_FK_OPS_ITERATION 665   /* one Newton iteration */
+#define THREE_RRR_FK_OPS_STEP_FIXED 7022  /* a step without its iterations */
+#define THREE_RRR_FK_OPS_STEP_WORST 23647  /* at the default cap, 25 */
+#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286501  /* every factorization dense */
+#define THREE_RRR_FK_OPS_INPUTS_WORST 22317  /* solve_inputs with du, ddu */
+#define THREE_RRR_FK_OPS_POSITIONS_WORST 21939  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

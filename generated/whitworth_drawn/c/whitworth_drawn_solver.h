@@ -56,15 +56,15 @@ typedef struct {
  * One Newton iteration: 316 (130 add/sub, 73 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
  *   Phi, Phi_q, their factorization and tests: 212; the update (a solve): 104
  * Condition at the converged q: 179; an extra iteration there (at most 3): 397
- * Velocity: 68; acceleration: 126; per-point checks: 1501; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 11472 (4653 add/sub, 2787 mul, 485 div, 9 sqrt, 234 other calls, 1553 fabs, 1751 compares)
+ * Velocity: 68; acceleration: 126; per-point checks: 1491; predictor: 73
+ * Step, worst case with the default cap of 25 iterations: 11462 (4642 add/sub, 2771 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1712 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73257
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73321
  */
 #define WHITWORTH_DRAWN_OPS_ITERATION 316   /* one Newton iteration */
-#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3572  /* a step without its iterations */
-#define WHITWORTH_DRAWN_OPS_STEP_WORST 11472  /* at the default cap, 25 */
-#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73257  /* every factorization dense */
+#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3562  /* a step without its iterations */
+#define WHITWORTH_DRAWN_OPS_STEP_WORST 11462  /* at the default cap, 25 */
+#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73321  /* every factorization dense */
 
 typedef struct {
     int status;                  /* WHITWORTH_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */

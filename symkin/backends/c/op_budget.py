@@ -11,6 +11,12 @@ work (the worst case). Composition, as ``<prefix>_solve_step`` runs:
     (condition, up to TIGHTEN_STEPS extra iterations, condition again)
     + velocity + acceleration + per-point checks (norms, error model).
 
+The error model at its worst is the norm bound flagging the point and the propagated model
+run to its end (Hager's worst column, Phi_q and Phi_t at q moved along it, Gamma, two
+solves). ``<prefix>_solve_inputs`` has no predictor but up to CHORD_STEPS simplified Newton
+steps on the last factors (Phi and a solve each) before Newton. The sparse factor's run-time
+row interchanges are counted from their statements (a comparison of two magnitudes each).
+
 The cap is ``options.max_iterations`` (its default here; the header gives the cost of one
 iteration so that another cap can be budgeted). The unit-scaling passes count where the
 mechanism is scale-free (options.unit != 1). The dense fall-back's worst case replaces every
@@ -132,11 +138,59 @@ def norm1(context: dict[str, Any] | None, n: int, nnz: int) -> Flops:
 # <prefix>_flagged: s = inv_norm / sqrt(NQ), the rounding floor, the residual's error, e_q,
 # e_dq, e_ddq, and the three comparisons with the targets.
 FLAGGED = Flops(sqrt=1, div=1, mul=18, add=6, cmp=11)
-# <prefix>_flagged_refined beyond its two estimators and maxima: root, s, the error left,
-# e_q, the bound, e_n, e_dq, e_dq_n, e_ddq and the three comparisons.
-REFINED = Flops(sqrt=1, div=2, mul=29, add=10, cmp=13)
 # <prefix>_would_flag: the residual against the rounding level, then the model.
 WOULD_FLAG = Flops(add=1, mul=1, cmp=1) + FLAGGED
+# <prefix>_position_error: s, the residual's error, the rounding floor and their max.
+POSITION_ERROR = Flops(sqrt=1, div=1, mul=3, add=1, cmp=2)
+# <prefix>_flagged_refined around its calls: s, e_dq, e_ddq, the three finite tests and the
+# three comparisons with the targets (each with its at_least_1).
+REFINED = Flops(sqrt=1, div=1, mul=7, add=5, cmp=9)
+
+
+def worst_column(algebra: LinearAlgebra, n: int) -> Flops:
+    """<prefix>_worst_column with every ascent step taken: the first solve and its sum, then
+    per step the sign vector, a transposed solve, the largest |z_i| (a new one at every i
+    after the first), z . x (a division at the first step), a solve and its sum."""
+    first = algebra.solve + Flops(abs=n, add=n)
+    ascent = (algebra.solve_transposed + algebra.solve
+              + Flops(add=1 + 2 * n, cmp=3 + 2 * n, abs=3 * n))
+    return first + ascent * (tuning.ESTIMATOR_STEPS - 1) + Flops(div=1)
+
+
+def propagated(code: Any, algebra: LinearAlgebra, units: bool) -> Flops:
+    """<prefix>_propagated through to its end: the worst column and its max, q moved along
+    it, Phi_q and Phi_t there times dq, a solve; dq shifted, Gamma and Phi_q ddq, a solve."""
+    n, nnz = code.nq, code.nnz
+    times = Flops(mul=nnz, add=nnz)  # <prefix>_jacobian_times
+    scale = Flops(div=n, mul=n)  # v[i] * (a / b), or v[i] *= a / b
+    from_unit = Flops(mul=n) if units else ZERO
+    rows_in_unit = Flops(div=n) if units else ZERO
+    # the finite-difference step: sqrt of the unit roundoff, a constant the compiler folds
+    start = Flops(mul=1, add=1) + worst_column(algebra, n) + _max_abs(n)
+    start += Flops(cmp=4, add=1)  # largest or size zero; both finite, size positive
+    velocity = (scale + from_unit + Flops(add=n) + _routine(code, "phi_q")
+                + _routine(code, "phi_t") + times + rows_in_unit + algebra.solve
+                + scale + Flops(add=n) + _max_abs(n))  # rows *= -size / step
+    acceleration = (scale + from_unit + Flops(add=n) + _routine(code, "gamma")
+                    + Flops(add=n) + times + rows_in_unit + algebra.solve + scale
+                    + _max_abs(n))
+    return start + velocity + acceleration
+
+
+def refined(code: Any, algebra: LinearAlgebra, units: bool) -> Flops:
+    """<prefix>_flagged_refined at its longest: the norm bound flags the point, the
+    propagated model runs to its end and every comparison is made."""
+    return REFINED + FLAGGED + POSITION_ERROR + propagated(code, algebra, units)
+
+
+def chord(code: Any, algebra: LinearAlgebra) -> Flops:
+    """<prefix>_chord (solve_inputs, in the mechanism's unit) with all CHORD_STEPS taken:
+    the rounding level, then per step Phi, the negated solve, its max, the contraction test,
+    q += step and the two stopping tests."""
+    n = code.nq
+    one = (_routine(code, "phi") + Flops(add=n) + algebra.solve + _max_abs(n)
+           + Flops(mul=1, cmp=1) + Flops(add=n) + Flops(cmp=2, mul=1, div=1))
+    return Flops(mul=1, add=1) + one * tuning.CHORD_STEPS
 
 
 @dataclass(frozen=True)
@@ -150,7 +204,7 @@ class Pieces:
     velocity: Flops
     acceleration: Flops
     checks: Flops  # max |q|, |dq|, |ddq| and the error model at its worst
-    predictor: Flops
+    predictor: Flops  # solve_step's prediction, or solve_inputs' simplified Newton steps
 
     def newton(self, cap: int) -> Flops:
         return self.evaluation * (cap + 1) + self.update * cap
@@ -160,12 +214,11 @@ class Pieces:
         return (self.estimate * 2 + checks + self.tighten * tuning.TIGHTEN_STEPS)
 
 
-def _hager(algebra: LinearAlgebra, n: int, rows: bool) -> Flops:
-    """<prefix>_inverse_norm1_rows at its worst: every ascent step taken, with the full dot
-    product (a non-finite entry); ``rows``: of P Phi_q^-1."""
-    masked = 1 if rows else 0
-    first = algebra.solve + Flops(abs=n, add=n, mul=n * masked)
-    ascent = algebra.solve + Flops(mul=2 * n * masked, abs=n, add=2 * n, call=n)
+def _hager(algebra: LinearAlgebra, n: int) -> Flops:
+    """<prefix>_inverse_norm1 at its worst: every ascent step taken, with the full dot
+    product (a non-finite entry)."""
+    first = algebra.solve + Flops(abs=n, add=n)  # Higham's test vector
+    ascent = algebra.solve + Flops(abs=n, add=2 * n, call=n)
     ascent += Flops(add=1, cmp=2) + algebra.solve_transposed + Flops(abs=1 + n, add=2 * n,
                                                                      cmp=2 * n)
     dot = Flops(cmp=2, mul=n, add=n)
@@ -179,8 +232,9 @@ def _estimate(algebra: LinearAlgebra, norm: Flops, n: int, nnz: int) -> Flops:
     cond = norm + Flops(mul=1)
     if algebra.exact_inverse is not None:
         return algebra.exact_inverse + cond
-    reuse = Flops(mul=1, abs=nnz, add=2 * nnz, cmp=2)  # theta, difference_bound1
-    return reuse + _hager(algebra, n, rows=False) + cond
+    # theta: <prefix>_difference_norm1 (column sums, their finite test and max), the test
+    reuse = Flops(mul=1, abs=nnz, add=2 * nnz + 2 * n, cmp=n + 3)
+    return reuse + _hager(algebra, n) + cond
 
 
 def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
@@ -203,15 +257,15 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
     solve = rows_in_unit + algebra.solve + from_unit
     velocity = _routine(code, "phi_t_shared") + Flops(add=n) + solve
     acceleration = _routine(code, "gamma_shared") + solve
-    refined = REFINED + FLAGGED + _hager(algebra, n, rows=True) + Flops(cmp=2 * n, abs=n) * 2
     if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests
         norms = _max_abs(n) * (1 + 2 * rates) + Flops(add=2, cmp=2)
     else:  # one pass: |q|, |dq|, |ddq| scaled, three maxima, the sum and two finite tests
         norms = Flops(abs=3 * n, mul=3 * n, cmp=3 * n, add=5 * n) + Flops(cmp=3)
-    predictor = ZERO if inputs else Flops(add=1) + Flops(mul=3, div=1, add=2) * n
+    prediction = Flops(add=1) + Flops(mul=3, div=1, add=2) * n  # (2.76)
+    predictor = chord(code, algebra) if inputs else prediction
     return Pieces(evaluation=evaluation, update=update, estimate=estimate,
                   tighten=tighten, velocity=velocity, acceleration=acceleration,
-                  checks=norms + refined, predictor=predictor)
+                  checks=norms + refined(code, algebra, units), predictor=predictor)
 
 
 def step(parts: Pieces, cap: int, rates: bool = True) -> Flops:
@@ -233,6 +287,7 @@ class Budget:
     pieces: Pieces
     positions: Flops | None  # solve_inputs with du, ddu NULL (input mechanisms only)
     inputs: Flops | None  # solve_inputs with rates and accelerations
+    chord: Flops | None  # solve_inputs' simplified Newton steps, all taken (its predictor)
     dense_step: Flops  # solve_step's worst case on the dense LU (fall-back or --linalg dense)
 
 
@@ -260,13 +315,14 @@ def budget(code: Any, lu: dict[str, Any] | None, norm1_context: dict[str, Any] |
     parts = pieces(code, algebra, norm, scaled)
     worst = step(parts, cap)
     iteration = parts.evaluation + parts.update
-    inputs = positions = None
+    inputs = positions = chord_steps = None
     if code.input_names:
-        inputs = step(pieces(code, algebra, norm, scaled, inputs=True), cap)
+        inputs_parts = pieces(code, algebra, norm, scaled, inputs=True)
+        inputs, chord_steps = step(inputs_parts, cap), inputs_parts.predictor
         positions = step(pieces(code, algebra, norm, scaled, inputs=True, rates=False), cap,
                          rates=False)
     return Budget(cap=cap, iteration=iteration, fixed=worst + iteration * -cap, step=worst,
-                  pieces=parts, positions=positions, inputs=inputs,
+                  pieces=parts, positions=positions, inputs=inputs, chord=chord_steps,
                   dense_step=step(pieces(code, fallback, norm, scaled), cap))
 
 
@@ -288,9 +344,11 @@ def header_lines(plan: Budget) -> list[str]:
         f"Step, worst case with the default cap of {plan.cap} iterations: {kinds(plan.step)}",
         "  (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)",
     ]
-    if plan.inputs is not None and plan.positions is not None:
+    if plan.inputs is not None and plan.positions is not None and plan.chord is not None:
         lines += [f"solve_inputs, worst case: {kinds(plan.inputs)}",
-                  f"  positions only (du, ddu NULL): {kinds(plan.positions)}"]
+                  f"  positions only (du, ddu NULL): {kinds(plan.positions)}",
+                  f"  its simplified Newton steps before Newton (at most "
+                  f"{tuning.CHORD_STEPS}, in place of the predictor): {plan.chord.total}"]
     lines.append(f"On the dense LU (a fall-back at every factorization, or --linalg dense), "
                  f"worst case: {plan.dense_step.total}")
     return lines
