@@ -17,8 +17,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
@@ -191,6 +189,7 @@ def _client(address: str) -> Any:
 
 def _report(kernel: Any, result: Any, spread: Any) -> None:
     from symkin.sweeps import tolerance
+    from symkin.sweeps.result import first_of_largest
 
     summary = result.summary()
     print(f"solved {summary['solved']} of {summary['sets']} parameter sets over "
@@ -220,7 +219,7 @@ def _report(kernel: Any, result: Any, spread: Any) -> None:
     for body, name in result.points_named:
         band = tolerance.envelope(result, body, name)
         for axis, label in enumerate("xyz"[:result.point_size]):
-            k = int(np.nanargmax(band.high[:, axis] - band.low[:, axis]))
+            k = first_of_largest(band.high[:, axis] - band.low[:, axis])
             line = (f"  {body}.{name}.{label} at t = {result.t[k]:g}: min {band.low[k, axis]:.6g}"
                     f" max {band.high[k, axis]:.6g} mean {band.mean[k, axis]:.6g} "
                     f"±3σ {3 * band.std[k, axis]:.3g}")

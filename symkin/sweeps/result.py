@@ -18,6 +18,15 @@ from symkin.runtime import spatial
 Array = NDArray[np.float64]
 
 
+
+def first_of_largest(values: NDArray[np.float64]) -> int:
+    """The flat index of the first value within rounding (1e-9 relative) of the largest, NaN
+    left out: where values tie (a spread the same at every time) rounding noise, which differs
+    between the backends, does not decide which is named."""
+    flat = np.ravel(values)
+    top = np.nanmax(flat)
+    return int(np.flatnonzero(flat >= top - 1e-9 * abs(top))[0])
+
 @dataclass(frozen=True)
 class SweepResult:
     """Positions, velocities and accelerations of M parameter sets over one grid.
@@ -99,7 +108,7 @@ class SweepResult:
                     enumerate(self.joint_names) for c, part in enumerate(parts)]
         found = []
         for name, values in columns:
-            j, k = np.unravel_index(int(np.nanargmax(np.abs(values))), values.shape)
+            j, k = np.unravel_index(first_of_largest(np.abs(values)), values.shape)
             found.append((name, float(np.nanmin(values)), float(np.nanmax(values)),
                           float(self.t[k]), int(sets[j])))
         return found
