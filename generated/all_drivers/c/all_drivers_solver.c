@@ -996,10 +996,13 @@ static all_drivers_real all_drivers_march(const all_drivers_options *options, co
     while (state->t < target) {
         const all_drivers_real rest = target - state->t;
         const all_drivers_real step = h < rest ? h : rest;
+        const all_drivers_real next = step == rest ? target : state->t + step;
         const all_drivers_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (all_drivers_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == ALL_DRIVERS_OK) {
+        if (all_drivers_solve_step(options, p, next, state, work, report) == ALL_DRIVERS_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -1021,6 +1024,12 @@ int all_drivers_solve_edge(const all_drivers_options *options, const all_drivers
     const all_drivers_real h0 = t - previous.t;
     all_drivers_state before = previous, after;
     all_drivers_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const all_drivers_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const all_drivers_real resolution = 4 * ALL_DRIVERS_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     all_drivers_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

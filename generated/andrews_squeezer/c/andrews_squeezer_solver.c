@@ -1002,10 +1002,13 @@ static andrews_squeezer_real andrews_squeezer_march(const andrews_squeezer_optio
     while (state->t < target) {
         const andrews_squeezer_real rest = target - state->t;
         const andrews_squeezer_real step = h < rest ? h : rest;
+        const andrews_squeezer_real next = step == rest ? target : state->t + step;
         const andrews_squeezer_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (andrews_squeezer_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == ANDREWS_SQUEEZER_OK) {
+        if (andrews_squeezer_solve_step(options, p, next, state, work, report) == ANDREWS_SQUEEZER_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -1027,6 +1030,12 @@ int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const a
     const andrews_squeezer_real h0 = t - previous.t;
     andrews_squeezer_state before = previous, after;
     andrews_squeezer_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const andrews_squeezer_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const andrews_squeezer_real resolution = 4 * ANDREWS_SQUEEZER_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     andrews_squeezer_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

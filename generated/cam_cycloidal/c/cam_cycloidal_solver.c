@@ -774,10 +774,13 @@ static cam_cycloidal_real cam_cycloidal_march(const cam_cycloidal_options *optio
     while (state->t < target) {
         const cam_cycloidal_real rest = target - state->t;
         const cam_cycloidal_real step = h < rest ? h : rest;
+        const cam_cycloidal_real next = step == rest ? target : state->t + step;
         const cam_cycloidal_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (cam_cycloidal_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == CAM_CYCLOIDAL_OK) {
+        if (cam_cycloidal_solve_step(options, p, next, state, work, report) == CAM_CYCLOIDAL_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -799,6 +802,12 @@ int cam_cycloidal_solve_edge(const cam_cycloidal_options *options, const cam_cyc
     const cam_cycloidal_real h0 = t - previous.t;
     cam_cycloidal_state before = previous, after;
     cam_cycloidal_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const cam_cycloidal_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const cam_cycloidal_real resolution = 4 * CAM_CYCLOIDAL_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     cam_cycloidal_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -760,10 +760,13 @@ static cardan_real cardan_march(const cardan_options *options, const cardan_real
     while (state->t < target) {
         const cardan_real rest = target - state->t;
         const cardan_real step = h < rest ? h : rest;
+        const cardan_real next = step == rest ? target : state->t + step;
         const cardan_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (cardan_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == CARDAN_OK) {
+        if (cardan_solve_step(options, p, next, state, work, report) == CARDAN_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -785,6 +788,12 @@ int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
     const cardan_real h0 = t - previous.t;
     cardan_state before = previous, after;
     cardan_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const cardan_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const cardan_real resolution = 4 * CARDAN_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     cardan_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -704,13 +704,19 @@ static crank_slider_input_real crank_slider_input_norm_if(int computed, const cr
  * in the run's unit) is at the rounding level of q or after CHORD_STEPS. Newton then
  * evaluates Phi and Phi_q at that q, factors it and tests it (usually accepting it at once),
  * so that the tolerances, dq, ddq and the condition are those of a fresh factorization.
+ * Steps that stop before the rounding level (a contraction too slow, a NaN, the cap) leave
+ * q where Newton's residual test alone could accept it with an error up to its tolerance,
+ * so q goes back to the last solution and Newton starts from there as without these steps.
  * Returns the steps taken. */
 static int crank_slider_input_chord(const crank_slider_input_real p[], crank_slider_input_real t, crank_slider_input_real q[],
                               crank_slider_input_workspace *work)
 {
     const crank_slider_input_real rounding = CRANK_SLIDER_INPUT_UNIT_ROUNDOFF * (1 + work->norms[0]);
-    crank_slider_input_real previous = (crank_slider_input_real)INFINITY, step;
+    crank_slider_input_real previous = (crank_slider_input_real)INFINITY, step, last[CRANK_SLIDER_INPUT_NQ];
     int i, k;
+    for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+        last[i] = q[i];
+    }
     for (k = 0; k < CRANK_SLIDER_INPUT_CHORD_STEPS; ++k) {
         crank_slider_input_phi(q, t, p, work->phi);
         crank_slider_input_rows_in_unit(work, work->phi);
@@ -727,6 +733,9 @@ static int crank_slider_input_chord(const crank_slider_input_real p[], crank_sli
         }
         if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
         previous = step;
+    }
+    for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+        q[i] = last[i];
     }
     return k;
 }
@@ -902,10 +911,13 @@ static crank_slider_input_real crank_slider_input_march(const crank_slider_input
     while (state->t < target) {
         const crank_slider_input_real rest = target - state->t;
         const crank_slider_input_real step = h < rest ? h : rest;
+        const crank_slider_input_real next = step == rest ? target : state->t + step;
         const crank_slider_input_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (crank_slider_input_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == CRANK_SLIDER_INPUT_OK) {
+        if (crank_slider_input_solve_step(options, p, next, state, work, report) == CRANK_SLIDER_INPUT_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -927,6 +939,12 @@ int crank_slider_input_solve_edge(const crank_slider_input_options *options, con
     const crank_slider_input_real h0 = t - previous.t;
     crank_slider_input_state before = previous, after;
     crank_slider_input_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const crank_slider_input_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const crank_slider_input_real resolution = 4 * CRANK_SLIDER_INPUT_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     crank_slider_input_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

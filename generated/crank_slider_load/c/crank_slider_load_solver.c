@@ -803,10 +803,13 @@ static crank_slider_load_real crank_slider_load_march(const crank_slider_load_op
     while (state->t < target) {
         const crank_slider_load_real rest = target - state->t;
         const crank_slider_load_real step = h < rest ? h : rest;
+        const crank_slider_load_real next = step == rest ? target : state->t + step;
         const crank_slider_load_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (crank_slider_load_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == CRANK_SLIDER_LOAD_OK) {
+        if (crank_slider_load_solve_step(options, p, next, state, work, report) == CRANK_SLIDER_LOAD_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -828,6 +831,12 @@ int crank_slider_load_solve_edge(const crank_slider_load_options *options, const
     const crank_slider_load_real h0 = t - previous.t;
     crank_slider_load_state before = previous, after;
     crank_slider_load_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const crank_slider_load_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const crank_slider_load_real resolution = 4 * CRANK_SLIDER_LOAD_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     crank_slider_load_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

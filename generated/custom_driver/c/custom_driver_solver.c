@@ -804,10 +804,13 @@ static custom_driver_real custom_driver_march(const custom_driver_options *optio
     while (state->t < target) {
         const custom_driver_real rest = target - state->t;
         const custom_driver_real step = h < rest ? h : rest;
+        const custom_driver_real next = step == rest ? target : state->t + step;
         const custom_driver_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (custom_driver_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == CUSTOM_DRIVER_OK) {
+        if (custom_driver_solve_step(options, p, next, state, work, report) == CUSTOM_DRIVER_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -829,6 +832,12 @@ int custom_driver_solve_edge(const custom_driver_options *options, const custom_
     const custom_driver_real h0 = t - previous.t;
     custom_driver_state before = previous, after;
     custom_driver_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const custom_driver_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const custom_driver_real resolution = 4 * CUSTOM_DRIVER_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     custom_driver_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -828,10 +828,13 @@ static delta_real delta_march(const delta_options *options, const delta_real p[]
     while (state->t < target) {
         const delta_real rest = target - state->t;
         const delta_real step = h < rest ? h : rest;
+        const delta_real next = step == rest ? target : state->t + step;
         const delta_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (delta_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == DELTA_OK) {
+        if (delta_solve_step(options, p, next, state, work, report) == DELTA_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -853,6 +856,12 @@ int delta_solve_edge(const delta_options *options, const delta_real p[],
     const delta_real h0 = t - previous.t;
     delta_state before = previous, after;
     delta_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const delta_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const delta_real resolution = 4 * DELTA_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     delta_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -796,10 +796,13 @@ static four_bar_real four_bar_march(const four_bar_options *options, const four_
     while (state->t < target) {
         const four_bar_real rest = target - state->t;
         const four_bar_real step = h < rest ? h : rest;
+        const four_bar_real next = step == rest ? target : state->t + step;
         const four_bar_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (four_bar_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == FOUR_BAR_OK) {
+        if (four_bar_solve_step(options, p, next, state, work, report) == FOUR_BAR_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -821,6 +824,12 @@ int four_bar_solve_edge(const four_bar_options *options, const four_bar_real p[]
     const four_bar_real h0 = t - previous.t;
     four_bar_state before = previous, after;
     four_bar_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const four_bar_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const four_bar_real resolution = 4 * FOUR_BAR_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     four_bar_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -835,10 +835,13 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_march(const parallel
     while (state->t < target) {
         const parallelogram_extra_bar_real rest = target - state->t;
         const parallelogram_extra_bar_real step = h < rest ? h : rest;
+        const parallelogram_extra_bar_real next = step == rest ? target : state->t + step;
         const parallelogram_extra_bar_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (parallelogram_extra_bar_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == PARALLELOGRAM_EXTRA_BAR_OK) {
+        if (parallelogram_extra_bar_solve_step(options, p, next, state, work, report) == PARALLELOGRAM_EXTRA_BAR_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -860,6 +863,12 @@ int parallelogram_extra_bar_solve_edge(const parallelogram_extra_bar_options *op
     const parallelogram_extra_bar_real h0 = t - previous.t;
     parallelogram_extra_bar_state before = previous, after;
     parallelogram_extra_bar_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const parallelogram_extra_bar_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const parallelogram_extra_bar_real resolution = 4 * PARALLELOGRAM_EXTRA_BAR_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     parallelogram_extra_bar_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -789,10 +789,13 @@ static planetary_real planetary_march(const planetary_options *options, const pl
     while (state->t < target) {
         const planetary_real rest = target - state->t;
         const planetary_real step = h < rest ? h : rest;
+        const planetary_real next = step == rest ? target : state->t + step;
         const planetary_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (planetary_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == PLANETARY_OK) {
+        if (planetary_solve_step(options, p, next, state, work, report) == PLANETARY_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -814,6 +817,12 @@ int planetary_solve_edge(const planetary_options *options, const planetary_real 
     const planetary_real h0 = t - previous.t;
     planetary_state before = previous, after;
     planetary_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const planetary_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const planetary_real resolution = 4 * PLANETARY_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     planetary_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -843,10 +843,13 @@ static quick_return_real quick_return_march(const quick_return_options *options,
     while (state->t < target) {
         const quick_return_real rest = target - state->t;
         const quick_return_real step = h < rest ? h : rest;
+        const quick_return_real next = step == rest ? target : state->t + step;
         const quick_return_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (quick_return_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == QUICK_RETURN_OK) {
+        if (quick_return_solve_step(options, p, next, state, work, report) == QUICK_RETURN_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -868,6 +871,12 @@ int quick_return_solve_edge(const quick_return_options *options, const quick_ret
     const quick_return_real h0 = t - previous.t;
     quick_return_state before = previous, after;
     quick_return_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const quick_return_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const quick_return_real resolution = 4 * QUICK_RETURN_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     quick_return_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -870,10 +870,13 @@ static rack_linkage_real rack_linkage_march(const rack_linkage_options *options,
     while (state->t < target) {
         const rack_linkage_real rest = target - state->t;
         const rack_linkage_real step = h < rest ? h : rest;
+        const rack_linkage_real next = step == rest ? target : state->t + step;
         const rack_linkage_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (rack_linkage_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == RACK_LINKAGE_OK) {
+        if (rack_linkage_solve_step(options, p, next, state, work, report) == RACK_LINKAGE_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -895,6 +898,12 @@ int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_link
     const rack_linkage_real h0 = t - previous.t;
     rack_linkage_state before = previous, after;
     rack_linkage_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const rack_linkage_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const rack_linkage_real resolution = 4 * RACK_LINKAGE_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     rack_linkage_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

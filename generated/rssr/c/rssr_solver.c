@@ -1125,10 +1125,13 @@ static rssr_real rssr_march(const rssr_options *options, const rssr_real p[],
     while (state->t < target) {
         const rssr_real rest = target - state->t;
         const rssr_real step = h < rest ? h : rest;
+        const rssr_real next = step == rest ? target : state->t + step;
         const rssr_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (rssr_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == RSSR_OK) {
+        if (rssr_solve_step(options, p, next, state, work, report) == RSSR_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -1150,6 +1153,12 @@ int rssr_solve_edge(const rssr_options *options, const rssr_real p[],
     const rssr_real h0 = t - previous.t;
     rssr_state before = previous, after;
     rssr_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const rssr_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const rssr_real resolution = 4 * RSSR_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     rssr_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -782,10 +782,13 @@ static spatial_slider_crank_real spatial_slider_crank_march(const spatial_slider
     while (state->t < target) {
         const spatial_slider_crank_real rest = target - state->t;
         const spatial_slider_crank_real step = h < rest ? h : rest;
+        const spatial_slider_crank_real next = step == rest ? target : state->t + step;
         const spatial_slider_crank_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (spatial_slider_crank_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == SPATIAL_SLIDER_CRANK_OK) {
+        if (spatial_slider_crank_solve_step(options, p, next, state, work, report) == SPATIAL_SLIDER_CRANK_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -807,6 +810,12 @@ int spatial_slider_crank_solve_edge(const spatial_slider_crank_options *options,
     const spatial_slider_crank_real h0 = t - previous.t;
     spatial_slider_crank_state before = previous, after;
     spatial_slider_crank_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const spatial_slider_crank_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const spatial_slider_crank_real resolution = 4 * SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     spatial_slider_crank_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

@@ -1137,10 +1137,13 @@ static stewart_real stewart_march(const stewart_options *options, const stewart_
     while (state->t < target) {
         const stewart_real rest = target - state->t;
         const stewart_real step = h < rest ? h : rest;
+        const stewart_real next = step == rest ? target : state->t + step;
         const stewart_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (stewart_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == STEWART_OK) {
+        if (stewart_solve_step(options, p, next, state, work, report) == STEWART_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -1162,6 +1165,12 @@ int stewart_solve_edge(const stewart_options *options, const stewart_real p[],
     const stewart_real h0 = t - previous.t;
     stewart_state before = previous, after;
     stewart_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const stewart_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const stewart_real resolution = 4 * STEWART_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     stewart_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;

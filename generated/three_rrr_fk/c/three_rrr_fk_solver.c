@@ -945,13 +945,19 @@ static three_rrr_fk_real three_rrr_fk_norm_if(int computed, const three_rrr_fk_r
  * in the run's unit) is at the rounding level of q or after CHORD_STEPS. Newton then
  * evaluates Phi and Phi_q at that q, factors it and tests it (usually accepting it at once),
  * so that the tolerances, dq, ddq and the condition are those of a fresh factorization.
+ * Steps that stop before the rounding level (a contraction too slow, a NaN, the cap) leave
+ * q where Newton's residual test alone could accept it with an error up to its tolerance,
+ * so q goes back to the last solution and Newton starts from there as without these steps.
  * Returns the steps taken. */
 static int three_rrr_fk_chord(const three_rrr_fk_real p[], three_rrr_fk_real t, three_rrr_fk_real q[],
                               three_rrr_fk_workspace *work)
 {
     const three_rrr_fk_real rounding = THREE_RRR_FK_UNIT_ROUNDOFF * (1 + work->norms[0]);
-    three_rrr_fk_real previous = (three_rrr_fk_real)INFINITY, step;
+    three_rrr_fk_real previous = (three_rrr_fk_real)INFINITY, step, last[THREE_RRR_FK_NQ];
     int i, k;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+        last[i] = q[i];
+    }
     for (k = 0; k < THREE_RRR_FK_CHORD_STEPS; ++k) {
         three_rrr_fk_phi(q, t, p, work->phi);
         three_rrr_fk_rows_in_unit(work, work->phi);
@@ -968,6 +974,9 @@ static int three_rrr_fk_chord(const three_rrr_fk_real p[], three_rrr_fk_real t, 
         }
         if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
         previous = step;
+    }
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+        q[i] = last[i];
     }
     return k;
 }
@@ -1143,10 +1152,13 @@ static three_rrr_fk_real three_rrr_fk_march(const three_rrr_fk_options *options,
     while (state->t < target) {
         const three_rrr_fk_real rest = target - state->t;
         const three_rrr_fk_real step = h < rest ? h : rest;
+        const three_rrr_fk_real next = step == rest ? target : state->t + step;
         const three_rrr_fk_state saved = *state;
+        /* a step below the resolution of t (h_min too fine for the real type) cannot move:
+         * as fine as the march gets, it fails there instead of doubling and halving forever */
+        if (!(next > state->t)) return step;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
-        if (three_rrr_fk_solve_step(options, p, step == rest ? target : state->t + step, state,
-                                   work, report) == THREE_RRR_FK_OK) {
+        if (three_rrr_fk_solve_step(options, p, next, state, work, report) == THREE_RRR_FK_OK) {
             *cond = report->cond;
             h = 2 * step < h0 ? 2 * step : h0;
         } else {
@@ -1168,6 +1180,12 @@ int three_rrr_fk_solve_edge(const three_rrr_fk_options *options, const three_rrr
     const three_rrr_fk_real h0 = t - previous.t;
     three_rrr_fk_state before = previous, after;
     three_rrr_fk_real blocked, reach, early = 0, before_cond = cond;
+    /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
+     * a step that cannot move t would pass for converged */
+    const three_rrr_fk_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
+    const three_rrr_fk_real resolution = 4 * THREE_RRR_FK_UNIT_ROUNDOFF * reach_of_t;
+    if (h_min < resolution) h_min = resolution;
+    if (delta < resolution) delta = resolution;
     three_rrr_fk_prepare(options->unit, work);
     state->started = before.started = 1;
     edge->cond = cond;
