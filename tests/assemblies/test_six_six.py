@@ -21,6 +21,7 @@ import symkin
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.scan import scan
 from tests.assemblies.planar_six import Platform, assemblies
+from tests.assemblies.test_every_assembly import _rotation
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -61,15 +62,6 @@ def _six_six_file(tmp_path: Path, platform: Platform) -> Path:
                                f"points: {{{top}}}}}", "joints: []", "drivers:", *legs,
                                "time: {t0: 0, t1: 1, dt: 0.1}"]) + "\n")
     return path
-
-
-def _rotation(e: np.ndarray) -> np.ndarray:
-    """A(e) of unit Euler parameters, written out here."""
-    e0, e1, e2, e3 = e
-    return 2 * np.array([
-        [e0 * e0 + e1 * e1 - 0.5, e1 * e2 - e0 * e3, e1 * e3 + e0 * e2],
-        [e1 * e2 + e0 * e3, e0 * e0 + e2 * e2 - 0.5, e2 * e3 - e0 * e1],
-        [e1 * e3 - e0 * e2, e2 * e3 + e0 * e1, e0 * e0 + e3 * e3 - 0.5]])
 
 
 def _leg_gaps(platform: Platform, rotation: np.ndarray, origin: np.ndarray,

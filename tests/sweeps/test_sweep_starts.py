@@ -23,30 +23,11 @@ import pytest
 
 import symkin
 from symkin.errors import SolveError
-from symkin.sweeps import batch, starts
+from symkin.sweeps import starts
 from tests.driver_support import kernel_for, same_condition
 
 ROOT = Path(__file__).resolve().parents[2]
 T = np.linspace(0.0, 1.5, 31)
-
-
-@pytest.fixture(scope="module", params=["c", "numpy"])
-def crank_slider(request, crank_slider_system):
-    return kernel_for(crank_slider_system, request.param)
-
-
-@pytest.fixture
-def reruns(monkeypatch):
-    """The sets re-run through symkin.solve, by index within their chunk."""
-    seen: list[int] = []
-    original = batch._solve_one
-
-    def spy(kernel, p, t, q0, options, chunk, j):
-        seen.append(j)
-        return original(kernel, p, t, q0, options, chunk, j)
-
-    monkeypatch.setattr(batch, "_solve_one", spy)
-    return seen
 
 
 def _regular(count: int, seed: int = 5) -> np.ndarray:

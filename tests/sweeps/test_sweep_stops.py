@@ -22,30 +22,11 @@ import pytest
 import symkin
 from symkin.errors import SolveError
 from symkin.runtime import driver
-from symkin.sweeps import batch, stops
+from symkin.sweeps import stops
 from tests.driver_support import derive, kernel_for, same_condition
 
 T = np.linspace(0.0, 1.5, 31)
 BISECTED = re.compile(r"bisected to ([0-9.e+-]+) \.\. ([0-9.e+-]+);")
-
-
-@pytest.fixture(scope="module", params=["c", "numpy"])
-def crank_slider(request, crank_slider_system):
-    return kernel_for(crank_slider_system, request.param)
-
-
-@pytest.fixture
-def reruns(monkeypatch):
-    """The sets re-run through symkin.solve, by index within their chunk."""
-    seen: list[int] = []
-    original = batch._solve_one
-
-    def spy(kernel, p, t, q0, options, chunk, j):
-        seen.append(j)
-        return original(kernel, p, t, q0, options, chunk, j)
-
-    monkeypatch.setattr(batch, "_solve_one", spy)
-    return seen
 
 
 def _limit_time(p: np.ndarray) -> float:
