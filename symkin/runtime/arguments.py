@@ -110,7 +110,7 @@ def first_guess(kernel: KinematicsKernel, q0: ArrayLike | None) -> Array:
 def _floats(value: ArrayLike, what: str) -> Array:
     """value as float64 (no copy of a float64 array); text or complex numbers are a SolveError
     that names the argument, not a ValueError from NumPy or a silently dropped imaginary part."""
-    if getattr(value, "dtype", None) is not None and np.asarray(value).dtype.kind == "c":
+    if np.iscomplexobj(value):
         raise SolveError(f"{what} must be real numbers, not complex")
     try:
         return np.asarray(value, dtype=float)

@@ -46,7 +46,7 @@ def test_parameters_by_name_and_bad_inputs(crank_slider_system) -> None:
 
 @pytest.mark.parametrize("argument,fragment", [
     ({"t": "abc"}, "t must be numbers"),
-    ({"t": [0.0, 1j]}, "t must be numbers"),
+    ({"t": [0.0, 1j]}, "t must be real numbers, not complex"),
     ({"t": np.array([0.0, 0.5 + 1e-3j])}, "t must be real numbers, not complex"),
     ({"q0": ["x"] * 9}, "q0 must be numbers"),
     ({"params": {"a": "x"}}, "params['a'] must be numbers"),
