@@ -120,7 +120,9 @@ def magnitude_problem(key: str, values: dict[Path_, float]) -> tuple[str, str] |
         if abs(tensor[r][c] - tensor[c][r]) > 1e-12 * scale:
             return (f"the inertia tensor is not symmetric: [{r}][{c}] = {tensor[r][c]:g} but "
                     f"[{c}][{r}] = {tensor[c][r]:g}", "An inertia tensor equals its transpose.")
-    moments = _eigenvalues(tensor)
+    # in units of the largest entry: the closed form squares the entries, which overflows
+    # for entries above 1e154 (an inertia of 1e200 was accepted unchecked)
+    moments = [scale * m for m in _eigenvalues([[v / scale for v in row] for row in tensor])]
     if moments[0] < -1e-12 * scale:
         return (f"the inertia tensor has a negative principal moment {moments[0]:g}",
                 "Its principal moments (eigenvalues) are zero or positive.")

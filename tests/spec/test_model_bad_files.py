@@ -121,6 +121,9 @@ EXPECTED: dict[str, tuple[int, str]] = {
                                          "negative principal moment -2"),
     "spatial_inertia_impossible.yaml": (5, "the principal moments 1, 1, 3 break the triangle "
                                            "inequality"),
+    # the closed-form eigenvalues square the entries: at 1e200 they overflowed and passed
+    "spatial_inertia_huge_impossible.yaml": (5, "the principal moments 1e+200, 1e+200, 3e+200 "
+                                                "break the triangle inequality"),
     "spatial_force_two_components.yaml": (10, "at forces[0].f: expected a vector of 3 numbers, "
                                               "got 2 items"),
     # found by fuzzing the examples' structure: each was a traceback or an unlocated exit 1
