@@ -34,12 +34,23 @@ CHORD_CONTRACTION = 0.1
 """A simplified Newton step is taken only while its size is at most this times the last one's:
 slower, the factors are too far from Phi_q here, and full Newton takes over."""
 
+BRANCH_REGION = 0.5
+"""A solve from the last solution q_prev may have left its assembly when the converged q differs
+from q_prev + s, s Newton's first step from q_prev, by more than this fraction of s: in Newton's
+region of quadratic convergence the remainder is second order in the step, far below half of
+it (runtime.branch for a run, the generated C solve_inputs for one call)."""
+
+BRANCH_FLOOR = 1e-8
+"""Remainders below BRANCH_FLOOR (1 + max |q|) are never a jump: the inputs barely moved, and
+the rounding of two solves would otherwise count as one."""
+
 
 SHARED = {"ESTIMATOR_STEPS": ESTIMATOR_STEPS, "TIGHTEN_STEPS": TIGHTEN_STEPS, "SAFETY": SAFETY,
           "REESTIMATE_SHIFT": REESTIMATE_SHIFT}
 """The constants the generated C solver defines too, by name (its macro is ``<PREFIX>_`` + the
 name, rendered from this table by codegen.render)."""
 
-INPUTS = {"CHORD_STEPS": CHORD_STEPS, "CHORD_CONTRACTION": CHORD_CONTRACTION}
+INPUTS = {"CHORD_STEPS": CHORD_STEPS, "CHORD_CONTRACTION": CHORD_CONTRACTION,
+          "BRANCH_REGION": BRANCH_REGION, "BRANCH_FLOOR": BRANCH_FLOOR}
 """The constants the input-driven solve of the generated C defines too (only a mechanism with
 input drivers has one), by name as :data:`SHARED`."""

@@ -15,7 +15,8 @@ with the kernel's own Phi and Phi_q (so every backend flags the same rows):
   half of s, Newton wandered: the start was outside that region, and what it found may be
   another assembly.
 
-Imports NumPy only.
+The generated C solve_inputs makes the same two tests at each call (report.branch_jump), with
+the same constants (contract.tuning). Imports NumPy only.
 """
 
 from __future__ import annotations
@@ -25,15 +26,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.contract import tuning
+
 Array = NDArray[np.float64]
 
-REGION = 0.5
-"""|q - (q_prev + s)| above this fraction of |s| (the first Newton step) flags the row: with
-quadratic convergence the remainder is second order in the step, far below half of it."""
+REGION = tuning.BRANCH_REGION
+"""|q - (q_prev + s)| above this fraction of |s| (the first Newton step) flags the row."""
 
-FLOOR = 1e-8
-"""Remainders below FLOOR (1 + max |q|) are never a jump: the inputs barely moved, and the
-rounding of two solves would otherwise count as one."""
+FLOOR = tuning.BRANCH_FLOOR
+"""Remainders below FLOOR (1 + max |q|) are never a jump."""
 
 
 def _sign(matrix: Array) -> float:

@@ -33,6 +33,10 @@ class InputStepper(Protocol):
     fallbacks: int
     """The sparse LU's fall-backs to dense LU since start."""
 
+    branch_jump: bool
+    """Whether the last step's solution may lie on another assembly than the step before's
+    (the generated solve's own form of runtime.branch's tests)."""
+
     def start(self, options: Options, q: Array) -> None:
         """Begin from q (the assembled first point)."""
 

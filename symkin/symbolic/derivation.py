@@ -8,13 +8,14 @@ so the cost grows linearly with the number of joints:
 and Phi_p, the derivative with respect to the parameters, for design sensitivities: along a
 solution Phi(q(p), t, p) = 0, so Phi_q q_p = -Phi_p.
 
-Gamma is derived as the row's second derivative along the motion, -d^2/de^2 Phi(q + e dq, t + e) at
-e = 0, the same quantity: the derivative of the row's own tree keeps its shape, so a spatial
-row's A(e) s becomes A(de) s and its rate, shared by every row of the body, where the sum over
-pairs of columns of (2.74) spreads each into its monomials (Gamma's operations after CSE:
-stewart_fk 1778 -> 729, delta 6826 -> 1818, the prismatic rows of planar files a few per cent
-fewer). A row with a piecewise function (a cam's profile) keeps the sum over columns: there the
-moved argument s + e ds of every piece left CSE less to share (cam_cycloidal 541 -> 1180).
+Gamma's convective part (Phi_q dq)_q dq is derived as each row's second derivative along dq,
+d^2/de^2 Phi(q + e dq, t) at e = 0 (its time derivatives Phi_qt and Phi_tt in t as written):
+the derivative of the row's own tree keeps its shape, so a spatial row's A(e) s becomes A(de) s
+and its rate, shared by every row of the body, where the sum over pairs of columns spreads each
+into its monomials (Gamma's operations after CSE: stewart_fk 1778 -> 729, delta 6826 -> 1856,
+the prismatic rows of planar files a few per cent fewer). A row with a piecewise function (a
+cam's profile) keeps the sum over columns, where CSE shared more (cam_cycloidal 541, 1180 the
+other way), and so does a row whose derivative along dq SymPy leaves unevaluated.
 """
 
 from __future__ import annotations
@@ -405,19 +406,25 @@ def _parameter_jacobian(phi: list[sp.Expr], p: tuple[sp.Symbol, ...]
 
 def _row_gamma(row: sp.Expr, entries: dict[int, sp.Expr], row_t: sp.Expr,
                symbols: Symbols) -> sp.Expr:
-    """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt (2.74): the row's second
-    derivative along the motion, -d^2/de^2 Phi(q + e dq, t + e) at e = 0, or for a row with a
-    piecewise function the sum over its columns (module docstring)."""
-    q, dq, t = symbols.q, symbols.dq, symbols.t
-    if row.has(sp.Piecewise):
-        velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))
-        convective = sp.Add(*(sp.diff(velocity, q[k]) * dq[k] for k in entries))
-        mixed = sp.Add(*(sp.diff(value, t) * dq[k] for k, value in entries.items()))
-        return -convective - 2 * mixed - sp.diff(row_t, t)
-    along = sp.Dummy("along")
-    moved = {q[k]: q[k] + along * dq[k] for k in entries}
-    moved[t] = t + along
-    return -sp.diff(row.xreplace(moved), along, 2).xreplace({along: 0})
+    """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt (2.74)."""
+    dq, t = symbols.dq, symbols.t
+    mixed = sp.Add(*(sp.diff(value, t) * dq[k] for k, value in entries.items()))
+    return -_convective(row, entries, symbols) - 2 * mixed - sp.diff(row_t, t)
+
+
+def _convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols) -> sp.Expr:
+    """(Phi_q dq)_q dq of one row: its second derivative along dq at fixed t,
+    d^2/de^2 Phi(q + e dq, t) at e = 0, where SymPy gives it in closed form (module
+    docstring); else, and for a row with a piecewise function, the sum over its columns."""
+    q, dq = symbols.q, symbols.dq
+    if not row.has(sp.Piecewise):
+        along = sp.Dummy("along", real=True)  # as q and dq: Abs(x + e v) has a sign
+        second = sp.diff(row.xreplace({q[k]: q[k] + along * dq[k] for k in entries}),
+                         along, 2)
+        if not second.has(sp.Derivative, sp.Subs):
+            return second.xreplace({along: 0})
+    velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))
+    return sp.Add(*(sp.diff(velocity, q[k]) * dq[k] for k in entries))
 
 
 def _initial_guess(mech: Mechanism, ctx: Context,

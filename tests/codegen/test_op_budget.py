@@ -151,11 +151,13 @@ int main()
 #if @INPUTS@
     {   /* the simplified Newton steps from q moved off the last solution, on its factors */
         int taken;
+        @P@_real predicted[@U@_NQ], first;
         for (i = 0; i < @U@_NQ; ++i) q[i] = s.q[i] + 1e-4 * (i % 3 + 1);
         memset(&ops, 0, sizeof ops);
-        taken = @P@_chord(params, s.t, q, &w);
+        taken = @P@_chord(params, s.t, q, &w, predicted, &first);
         printf("%d ", taken);
         show("chord", ops);
+        MEASURE("branch_jump", @P@_branch_jump(&w, q, predicted, first, 1));
     }
 #else
     {   /* the extra iterations at their longest: q moved off the solution, every point
@@ -332,6 +334,7 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
                "worst_column": op_budget.worst_column(algebra, n)}
     if code.input_names:  # the steps stop once they reach rounding or stop contracting
         at_most["chord"] = op_budget.chord(code, algebra)
+        exact["branch_jump"] = op_budget.branch_jump(n)  # after a step: both tests made
         assert 1 <= taken["chord"] <= tuning.CHORD_STEPS
     if linalg == "sparse":  # every operation runs, whatever the values
         exact.update(factor=at_most.pop("factor"), pivot_ratio=at_most.pop("pivot_ratio"))

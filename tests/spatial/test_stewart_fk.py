@@ -7,7 +7,9 @@ The reference is independent of symkin: the benchmark's poses (stewart_trajector
 bench/stewart/stewart.c, roll, pitch, yaw as in stewart.h) and their leg lengths
 |r + R P_i - B_i| by NumPy; the solved pose is compared with the prescribed one (position, and
 the rotation matrix A(e) of the solved Euler parameters against R), and the solved rates and
-accelerations with central differences of the solved positions.
+accelerations with central differences of the solved positions and, exactly, with the
+prescribed motion's own derivatives (mpmath's differentiation of the closed form at 40 digits,
+legs and pose alike).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import mpmath
 import numpy as np
 import pytest
 
@@ -93,8 +96,8 @@ def test_poses_are_recovered_from_leg_lengths(kernel, tilt: float) -> None:
     names = k.coordinates
     at = [names.index(f"platform.{c}") for c in ("x", "y", "z", "e0", "e1", "e2", "e3")]
     for q, pose in zip(got.q, poses):
-        assert np.max(np.abs(q[at[:3]] - pose[:3])) < 1e-9
-        assert np.max(np.abs(_euler_rotation(q[at[3:]]) - _rotation(*pose[3:]))) < 1e-9
+        assert np.max(np.abs(q[at[:3]] - pose[:3])) < 1e-12  # seen: 1.6e-15
+        assert np.max(np.abs(_euler_rotation(q[at[3:]]) - _rotation(*pose[3:]))) < 1e-12
 
 
 def test_rates_and_accelerations_match_differences(kernel) -> None:
@@ -112,3 +115,74 @@ def test_rates_and_accelerations_match_differences(kernel) -> None:
     assert not got.flagged.any()
     assert np.max(np.abs((got.q[2:] - got.q[:-2]) / (2 * h) - got.dq[1:-1])) < 1e-5
     assert np.max(np.abs((got.dq[2:] - got.dq[:-2]) / (2 * h) - got.d2q[1:-1])) < 1e-3
+
+
+def _exact(tilt: float, t: float, home: np.ndarray) -> dict[str, np.ndarray]:
+    """The prescribed motion and its first two time derivatives at t, by mpmath (40 digits):
+    the legs (less ``home``) and the platform's origin r and rotation R."""
+    base, top = _geometry()
+
+    def pose(s: mpmath.mpf) -> tuple[mpmath.matrix, mpmath.matrix]:
+        w = 2 * mpmath.pi * s
+        a, b, c = tilt * mpmath.sin(w), tilt * mpmath.cos(w), tilt / 2 * mpmath.sin(3 * w)
+        rz = mpmath.matrix([[mpmath.cos(c), -mpmath.sin(c), 0], [mpmath.sin(c), mpmath.cos(c), 0],
+                            [0, 0, 1]])
+        ry = mpmath.matrix([[mpmath.cos(b), 0, mpmath.sin(b)], [0, 1, 0],
+                            [-mpmath.sin(b), 0, mpmath.cos(b)]])
+        rx = mpmath.matrix([[1, 0, 0], [0, mpmath.cos(a), -mpmath.sin(a)],
+                            [0, mpmath.sin(a), mpmath.cos(a)]])
+        r = mpmath.matrix([mpmath.mpf("0.1") * mpmath.cos(w), mpmath.mpf("0.1") * mpmath.sin(w),
+                           1 + mpmath.mpf("0.05") * mpmath.sin(2 * w)])
+        return r, rz * ry * rx
+
+    def leg(k: int, s: mpmath.mpf) -> mpmath.mpf:
+        r, rotation = pose(s)
+        arm = r + rotation * mpmath.matrix(top[k].tolist()) - mpmath.matrix(base[k].tolist())
+        return mpmath.norm(arm)
+
+    def entry(kind: str, index: int, s: mpmath.mpf) -> mpmath.mpf:
+        r, rotation = pose(s)
+        return r[index] if kind == "r" else rotation[index // 3, index % 3]
+
+    with mpmath.workdps(40):
+        at = mpmath.mpf(t)
+        out = {}
+        for n, suffix in enumerate(("", "_t", "_tt")):
+            out["legs" + suffix] = np.array(
+                [float(mpmath.diff(lambda s, k=k: leg(k, s), at, n)) for k in range(6)])
+            out["r" + suffix] = np.array(
+                [float(mpmath.diff(lambda s, i=i: entry("r", i, s), at, n)) for i in range(3)])
+            out["R" + suffix] = np.array(
+                [float(mpmath.diff(lambda s, i=i: entry("R", i, s), at, n))
+                 for i in range(9)]).reshape(3, 3)
+        out["legs"] -= home
+    return out
+
+
+@pytest.mark.parametrize("tilt", [0.05, 0.5])
+def test_rates_and_accelerations_equal_the_motions_own(kernel, tilt: float) -> None:
+    """With the legs' exact rates and accelerations, the platform's solved velocity and
+    acceleration equal the prescribed motion's (r and the rotation matrix's derivatives, from
+    the solved Euler parameters: A is quadratic in e, so A' = (A(e + e') - A(e - e')) / 2 and
+    A'' = 2 (A(e') - A(0)) + (A(e + e'') - A(e - e'')) / 2, exactly)."""
+    name, k = kernel
+    home = _legs(np.array([0, 0, 1.0, 0, 0, 0])) * FILES[name]
+    t = np.linspace(0.0, 1.0, 33)  # close enough that Newton tracks one assembly
+    exact = [_exact(tilt, float(s), home) for s in t]
+    got = symkin.solve(k, t=t, inputs=np.array([x["legs"] for x in exact]),
+                       input_rates=np.array([x["legs_t"] for x in exact]),
+                       input_accels=np.array([x["legs_tt"] for x in exact]))
+    assert not got.flagged.any() and not got.branch_jumps.any()
+    names = k.coordinates
+    r = [names.index(f"platform.{c}") for c in ("x", "y", "z")]
+    e = [names.index(f"platform.e{j}") for j in range(4)]
+    zero = _euler_rotation(np.zeros(4))
+    for q, dq, ddq, x in zip(got.q, got.dq, got.d2q, exact):
+        assert np.max(np.abs(q[r] - x["r"])) < 1e-12
+        assert np.max(np.abs(dq[r] - x["r_t"])) < 1e-11
+        assert np.max(np.abs(ddq[r] - x["r_tt"])) < 1e-10
+        rate = (_euler_rotation(q[e] + dq[e]) - _euler_rotation(q[e] - dq[e])) / 2
+        accel = (2 * (_euler_rotation(dq[e]) - zero)
+                 + (_euler_rotation(q[e] + ddq[e]) - _euler_rotation(q[e] - ddq[e])) / 2)
+        assert np.max(np.abs(rate - x["R_t"])) < 1e-11
+        assert np.max(np.abs(accel - x["R_tt"])) < 1e-10

@@ -32,6 +32,10 @@ int crank_slider_input_dense_lu_factor(const crank_slider_input_real nz[], crank
 /* min |u_kk| / max |u_kk| of a complete factorization: the reciprocal-condition estimate. */
 crank_slider_input_real crank_slider_input_dense_lu_pivot_ratio(const crank_slider_input_dense_lu *lu);
 
+/* The sign of det(Phi_q) of a complete factorization: +1 or -1, 0 when a pivot is zero or not
+ * finite. */
+int crank_slider_input_dense_lu_det_sign(const crank_slider_input_dense_lu *lu);
+
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void crank_slider_input_dense_lu_solve(const crank_slider_input_dense_lu *lu, crank_slider_input_real b[]);
 

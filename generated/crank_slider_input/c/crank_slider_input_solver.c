@@ -695,6 +695,8 @@ static crank_slider_input_real crank_slider_input_norm_if(int computed, const cr
 
 #define CRANK_SLIDER_INPUT_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
 #define CRANK_SLIDER_INPUT_CHORD_CONTRACTION ((crank_slider_input_real)0.1) /* as contract.tuning.INPUTS */
+#define CRANK_SLIDER_INPUT_BRANCH_REGION ((crank_slider_input_real)0.5) /* as contract.tuning.INPUTS */
+#define CRANK_SLIDER_INPUT_BRANCH_FLOOR ((crank_slider_input_real)1e-08) /* as contract.tuning.INPUTS */
 
 /* Simplified Newton from the last solution: Phi alone at each iterate, each step solved with
  * the factors of Phi_q left by the last solve (work->lu, at the last solution: for inputs that
@@ -707,9 +709,10 @@ static crank_slider_input_real crank_slider_input_norm_if(int computed, const cr
  * Steps that stop before the rounding level (a contraction too slow, a NaN, the cap) leave
  * q where Newton's residual test alone could accept it with an error up to its tolerance,
  * so q goes back to the last solution and Newton starts from there as without these steps.
- * Returns the steps taken. */
+ * The first step's end, q_last + s, goes to predicted[] and max |s| to *first (NaN when no
+ * step was solved), for the branch test of solve_inputs. Returns the steps taken. */
 static int crank_slider_input_chord(const crank_slider_input_real p[], crank_slider_input_real t, crank_slider_input_real q[],
-                              crank_slider_input_workspace *work)
+                              crank_slider_input_workspace *work, crank_slider_input_real predicted[], crank_slider_input_real *first)
 {
     const crank_slider_input_real rounding = CRANK_SLIDER_INPUT_UNIT_ROUNDOFF * (1 + work->norms[0]);
     crank_slider_input_real previous = (crank_slider_input_real)INFINITY, step, last[CRANK_SLIDER_INPUT_NQ];
@@ -725,11 +728,19 @@ static int crank_slider_input_chord(const crank_slider_input_real p[], crank_sli
         }
         crank_slider_input_lu_solve(&work->lu, work->phi);
         step = crank_slider_input_max_abs(work->phi);
+        if (k == 0) {
+            *first = step; /* Newton's own first step from the last solution */
+        }
         /* also false for a NaN step: Newton then starts from the last good iterate */
         if (!(step <= CRANK_SLIDER_INPUT_CHORD_CONTRACTION * previous)) break;
         crank_slider_input_from_unit(work, work->phi);
         for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
             q[i] += work->phi[i];
+        }
+        if (k == 0) {
+            for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+                predicted[i] = q[i];
+            }
         }
         if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
         previous = step;
@@ -740,24 +751,53 @@ static int crank_slider_input_chord(const crank_slider_input_real p[], crank_sli
     return k;
 }
 
+/* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
+ * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
+ * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
+ * none was solved: the first call, or after a failed one); nq: max |q|. */
+static int crank_slider_input_branch_jump(crank_slider_input_workspace *work, const crank_slider_input_real q[],
+                                    const crank_slider_input_real predicted[], crank_slider_input_real first, crank_slider_input_real nq)
+{
+    const int sign = crank_slider_input_lu_det_sign(&work->lu);
+    int jumped = sign != 0 && work->det_sign != 0 && sign != work->det_sign;
+    if (first - first == 0) {
+        const crank_slider_input_real floor = CRANK_SLIDER_INPUT_BRANCH_FLOOR * (1 + nq);
+        crank_slider_input_real remainder = 0, a, bound = CRANK_SLIDER_INPUT_BRANCH_REGION * first;
+        int i;
+        for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+            a = fabs(q[i] - predicted[i]);
+            remainder = a > remainder ? a : remainder;
+        }
+        bound = bound > floor ? bound : floor;
+        jumped |= remainder > bound;
+    }
+    if (sign != 0) {
+        work->det_sign = sign; /* a vanished pivot keeps the last sign known */
+    }
+    return jumped;
+}
+
 int crank_slider_input_solve_inputs(const crank_slider_input_options *options, const crank_slider_input_real p[],
                               const crank_slider_input_real u[], const crank_slider_input_real du[], const crank_slider_input_real ddu[],
                               crank_slider_input_state *state, crank_slider_input_workspace *work,
                               crank_slider_input_report *report)
 {
     crank_slider_input_real pu[CRANK_SLIDER_INPUT_NP + 3 * CRANK_SLIDER_INPUT_NU];
-    crank_slider_input_real nq, ndq, nddq;
+    crank_slider_input_real nq, ndq, nddq, predicted[CRANK_SLIDER_INPUT_NQ], first = (crank_slider_input_real)NAN;
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
     int i, chord;
     crank_slider_input_with_inputs(pu, p, u, du, ddu);
     report->flagged = 0;
+    report->branch_jump = 0;
     report->cond = (crank_slider_input_real)NAN;
     if (!state->started) {
         crank_slider_input_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
+        work->det_sign = 0;
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
      * from it, simplified Newton steps on the last factors while work->lu holds them. */
-    chord = state->started && work->factored ? crank_slider_input_chord(pu, state->t, state->q, work) : 0;
+    chord = state->started && work->factored
+        ? crank_slider_input_chord(pu, state->t, state->q, work, predicted, &first) : 0;
     work->factored = 0;
     report->status = crank_slider_input_newton(options, pu, state->t, state->q, work, report);
     report->iterations += chord;
@@ -777,6 +817,7 @@ int crank_slider_input_solve_inputs(const crank_slider_input_options *options, c
         crank_slider_input_lu_solve(&work->lu, state->ddq);
     }
     nq = crank_slider_input_max_abs(state->q);
+    report->branch_jump = crank_slider_input_branch_jump(work, state->q, predicted, first, nq);
     ndq = crank_slider_input_norm_if(rates, state->dq);
     nddq = crank_slider_input_norm_if(accelerations, state->ddq);
     if (ndq - ndq != 0 || nddq - nddq != 0) {

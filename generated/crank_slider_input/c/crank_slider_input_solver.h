@@ -59,8 +59,8 @@ typedef struct {
  * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
  * Step, worst case with the default cap of 25 iterations: 6845 (2694 add/sub, 1406 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1220 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 6219 (2984 add/sub, 632 mul, 114 div, 10 sqrt, 148 other calls, 1031 fabs, 1300 compares)
- *   positions only (du, ddu NULL): 6109 (2928 add/sub, 616 mul, 114 div, 10 sqrt, 148 other calls, 1013 fabs, 1280 compares)
+ * solve_inputs, worst case: 6289 (3004 add/sub, 634 mul, 114 div, 10 sqrt, 148 other calls, 1040 fabs, 1339 compares)
+ *   positions only (du, ddu NULL): 6179 (2948 add/sub, 618 mul, 114 div, 10 sqrt, 148 other calls, 1022 fabs, 1319 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 548
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37607
  */
@@ -68,8 +68,8 @@ typedef struct {
 #define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2220  /* a step without its iterations */
 #define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6845  /* at the default cap, 25 */
 #define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37607  /* every factorization dense */
-#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 6219  /* solve_inputs with du, ddu */
-#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 6109  /* solve_inputs, du, ddu NULL */
+#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 6289  /* solve_inputs with du, ddu */
+#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 6179  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -82,6 +82,8 @@ typedef struct {
     crank_slider_input_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
     crank_slider_input_real cond;      /* estimate of the 1-norm condition of Phi_q there */
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
+    int branch_jump;             /* crank_slider_input_solve_inputs: 1 when the solution may lie */
+                                 /* on another assembly than the last one (see there) */
 } crank_slider_input_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
@@ -110,6 +112,7 @@ typedef struct {
     crank_slider_input_real nz_factor[CRANK_SLIDER_INPUT_NNZ]; /* column / row of each non-zero */
     int scaled; /* the decisions are made in a unit other than 1 */
     int factored; /* lu holds the factors of Phi_q at the last solution of _solve_inputs */
+    int det_sign; /* the sign of det(Phi_q) there (0: none known yet) */
 } crank_slider_input_workspace;
 
 /* Tolerances suited to the real type. */
@@ -149,7 +152,13 @@ int crank_slider_input_solve_grid_checked(const crank_slider_input_options *opti
  * are taken at state->t (the caller sets it); state->t is not changed. From the second call,
  * simplified Newton steps on the factors the last call left come first (report->iterations
  * counts them too), then Newton with Phi_q evaluated and factored at their q. Returns the
- * status (also in report); on failure state->q holds the last Newton iterate. */
+ * status (also in report); on failure state->q holds the last Newton iterate.
+ * report->branch_jump is 1 when the solution may lie on another assembly than the last call's
+ * (Newton converges as well there, with nothing else to show for it): det(Phi_q) changed sign
+ * since the last solution (a singular configuration lies between the two), or the solution is
+ * farther from Newton's first step from the last solution than its region of quadratic
+ * convergence allows (|q - (q_last + s)| > 0.5 |s| and > 1e-08 (1 + |q|), max-norms).
+ * The call's result stands; give inputs closer together there, or check the assembly. */
 int crank_slider_input_solve_inputs(const crank_slider_input_options *options, const crank_slider_input_real p[],
                               const crank_slider_input_real u[], const crank_slider_input_real du[],
                               const crank_slider_input_real ddu[], crank_slider_input_state *state,

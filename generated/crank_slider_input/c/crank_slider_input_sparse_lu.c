@@ -116,6 +116,22 @@ unsigned long crank_slider_input_lu_fallbacks(const crank_slider_input_lu *lu)
     return lu->fallbacks;
 }
 
+int crank_slider_input_lu_det_sign(const crank_slider_input_lu *lu)
+{
+    /* The factors are those of P Phi_q Q with P, Q the fixed pivot order (even together,
+     * found at generation time), each interchange taken one more transposition of two rows:
+     * det(Phi_q) = sign(P) sign(Q) (-1)^interchanges prod u_kk, and lu->inv holds 1 / u_kk. */
+    int negative = 0, k;
+    if (lu->dense) {
+        return crank_slider_input_dense_lu_det_sign(&lu->dense_lu);
+    }
+    for (k = 0; k < CRANK_SLIDER_INPUT_NQ; ++k) {
+        if (!(lu->inv[k] != 0 && lu->inv[k] - lu->inv[k] == 0)) return 0;
+        negative ^= lu->inv[k] < 0;
+    }
+    return negative ? -1 : 1;
+}
+
 crank_slider_input_real crank_slider_input_lu_pivot_ratio(const crank_slider_input_lu *lu)
 {
     /* The sparse path keeps 1 / u_kk: min |u_kk| / max |u_kk| = min |1/u_kk| / max |1/u_kk|,

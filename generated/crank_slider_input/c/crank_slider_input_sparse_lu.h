@@ -47,6 +47,11 @@ crank_slider_input_real crank_slider_input_lu_pivot_ratio(const crank_slider_inp
 /* Factorizations that fell back to the dense path since crank_slider_input_lu_init. */
 unsigned long crank_slider_input_lu_fallbacks(const crank_slider_input_lu *lu);
 
+/* The sign of det(Phi_q) from the last factorization, whichever path it took: +1 or -1, 0
+ * when a pivot vanished (the input solve's test for a singular configuration passed between
+ * two calls). */
+int crank_slider_input_lu_det_sign(const crank_slider_input_lu *lu);
+
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void crank_slider_input_lu_solve(const crank_slider_input_lu *lu, crank_slider_input_real b[]);
 

@@ -77,6 +77,25 @@ stewart_fk_real stewart_fk_dense_lu_pivot_ratio(const stewart_fk_dense_lu *lu)
     return lu->pivot_ratio; /* kept by the factorization */
 }
 
+int stewart_fk_dense_lu_det_sign(const stewart_fk_dense_lu *lu)
+{
+    /* det(Phi_q) = sign(perm) prod u_kk: the parity of perm from its cycles (a cycle of
+     * length m is m - 1 transpositions), then the pivots' signs */
+    char seen[STEWART_FK_NQ] = {0};
+    int negative = 0, k, j;
+    for (k = 0; k < STEWART_FK_NQ; ++k) {
+        if (!(lu->inv[k] != 0 && lu->inv[k] - lu->inv[k] == 0)) return 0;
+        negative ^= lu->inv[k] < 0;
+        if (seen[k]) continue;
+        for (j = lu->perm[k]; j != k; j = lu->perm[j]) {
+            seen[j] = 1;
+            negative ^= 1;
+        }
+        seen[k] = 1;
+    }
+    return negative ? -1 : 1;
+}
+
 void stewart_fk_dense_lu_solve(const stewart_fk_dense_lu *lu, stewart_fk_real b[])
 {
     const int n = STEWART_FK_NQ;

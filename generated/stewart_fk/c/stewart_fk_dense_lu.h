@@ -32,6 +32,10 @@ int stewart_fk_dense_lu_factor(const stewart_fk_real nz[], stewart_fk_dense_lu *
 /* min |u_kk| / max |u_kk| of a complete factorization: the reciprocal-condition estimate. */
 stewart_fk_real stewart_fk_dense_lu_pivot_ratio(const stewart_fk_dense_lu *lu);
 
+/* The sign of det(Phi_q) of a complete factorization: +1 or -1, 0 when a pivot is zero or not
+ * finite. */
+int stewart_fk_dense_lu_det_sign(const stewart_fk_dense_lu *lu);
+
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void stewart_fk_dense_lu_solve(const stewart_fk_dense_lu *lu, stewart_fk_real b[]);
 

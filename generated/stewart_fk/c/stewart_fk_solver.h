@@ -59,8 +59,8 @@ typedef struct {
  * Velocity: 118; acceleration: 996; per-point checks: 3224; predictor: 43
  * Step, worst case with the default cap of 25 iterations: 46421 (18359 add/sub, 19201 mul, 512 div, 10 sqrt, 0 other calls, 4550 fabs, 3789 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 46828 (19413 add/sub, 18676 mul, 280 div, 10 sqrt, 0 other calls, 4592 fabs, 3857 compares)
- *   positions only (du, ddu NULL): 45698 (18861 add/sub, 18128 mul, 280 div, 10 sqrt, 0 other calls, 4578 fabs, 3841 compares)
+ * solve_inputs, worst case: 46884 (19429 add/sub, 18678 mul, 280 div, 10 sqrt, 0 other calls, 4599 fabs, 3888 compares)
+ *   positions only (du, ddu NULL): 45754 (18877 add/sub, 18130 mul, 280 div, 10 sqrt, 0 other calls, 4585 fabs, 3872 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2270
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62220
  */
@@ -68,8 +68,8 @@ typedef struct {
 #define STEWART_FK_OPS_STEP_FIXED 11371  /* a step without its iterations */
 #define STEWART_FK_OPS_STEP_WORST 46421  /* at the default cap, 25 */
 #define STEWART_FK_OPS_STEP_DENSE_WORST 62220  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 46828  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 45698  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_INPUTS_WORST 46884  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 45754  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -82,6 +82,8 @@ typedef struct {
     stewart_fk_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
     stewart_fk_real cond;      /* estimate of the 1-norm condition of Phi_q there */
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
+    int branch_jump;             /* stewart_fk_solve_inputs: 1 when the solution may lie */
+                                 /* on another assembly than the last one (see there) */
 } stewart_fk_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
@@ -110,6 +112,7 @@ typedef struct {
     stewart_fk_real nz_factor[STEWART_FK_NNZ]; /* column / row of each non-zero */
     int scaled; /* the decisions are made in a unit other than 1 */
     int factored; /* lu holds the factors of Phi_q at the last solution of _solve_inputs */
+    int det_sign; /* the sign of det(Phi_q) there (0: none known yet) */
 } stewart_fk_workspace;
 
 /* Tolerances suited to the real type. */
@@ -149,7 +152,13 @@ int stewart_fk_solve_grid_checked(const stewart_fk_options *options,
  * are taken at state->t (the caller sets it); state->t is not changed. From the second call,
  * simplified Newton steps on the factors the last call left come first (report->iterations
  * counts them too), then Newton with Phi_q evaluated and factored at their q. Returns the
- * status (also in report); on failure state->q holds the last Newton iterate. */
+ * status (also in report); on failure state->q holds the last Newton iterate.
+ * report->branch_jump is 1 when the solution may lie on another assembly than the last call's
+ * (Newton converges as well there, with nothing else to show for it): det(Phi_q) changed sign
+ * since the last solution (a singular configuration lies between the two), or the solution is
+ * farther from Newton's first step from the last solution than its region of quadratic
+ * convergence allows (|q - (q_last + s)| > 0.5 |s| and > 1e-08 (1 + |q|), max-norms).
+ * The call's result stands; give inputs closer together there, or check the assembly. */
 int stewart_fk_solve_inputs(const stewart_fk_options *options, const stewart_fk_real p[],
                               const stewart_fk_real u[], const stewart_fk_real du[],
                               const stewart_fk_real ddu[], stewart_fk_state *state,

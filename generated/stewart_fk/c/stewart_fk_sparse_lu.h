@@ -51,6 +51,11 @@ stewart_fk_real stewart_fk_lu_pivot_ratio(const stewart_fk_lu *lu);
 /* Factorizations that fell back to the dense path since stewart_fk_lu_init. */
 unsigned long stewart_fk_lu_fallbacks(const stewart_fk_lu *lu);
 
+/* The sign of det(Phi_q) from the last factorization, whichever path it took: +1 or -1, 0
+ * when a pivot vanished (the input solve's test for a singular configuration passed between
+ * two calls). */
+int stewart_fk_lu_det_sign(const stewart_fk_lu *lu);
+
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void stewart_fk_lu_solve(const stewart_fk_lu *lu, stewart_fk_real b[]);
 

@@ -1012,6 +1012,8 @@ static stewart_legs_fk_real stewart_legs_fk_norm_if(int computed, const stewart_
 
 #define STEWART_LEGS_FK_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
 #define STEWART_LEGS_FK_CHORD_CONTRACTION ((stewart_legs_fk_real)0.1) /* as contract.tuning.INPUTS */
+#define STEWART_LEGS_FK_BRANCH_REGION ((stewart_legs_fk_real)0.5) /* as contract.tuning.INPUTS */
+#define STEWART_LEGS_FK_BRANCH_FLOOR ((stewart_legs_fk_real)1e-08) /* as contract.tuning.INPUTS */
 
 /* Simplified Newton from the last solution: Phi alone at each iterate, each step solved with
  * the factors of Phi_q left by the last solve (work->lu, at the last solution: for inputs that
@@ -1024,9 +1026,10 @@ static stewart_legs_fk_real stewart_legs_fk_norm_if(int computed, const stewart_
  * Steps that stop before the rounding level (a contraction too slow, a NaN, the cap) leave
  * q where Newton's residual test alone could accept it with an error up to its tolerance,
  * so q goes back to the last solution and Newton starts from there as without these steps.
- * Returns the steps taken. */
+ * The first step's end, q_last + s, goes to predicted[] and max |s| to *first (NaN when no
+ * step was solved), for the branch test of solve_inputs. Returns the steps taken. */
 static int stewart_legs_fk_chord(const stewart_legs_fk_real p[], stewart_legs_fk_real t, stewart_legs_fk_real q[],
-                              stewart_legs_fk_workspace *work)
+                              stewart_legs_fk_workspace *work, stewart_legs_fk_real predicted[], stewart_legs_fk_real *first)
 {
     const stewart_legs_fk_real rounding = STEWART_LEGS_FK_UNIT_ROUNDOFF * (1 + work->norms[0]);
     stewart_legs_fk_real previous = (stewart_legs_fk_real)INFINITY, step, last[STEWART_LEGS_FK_NQ];
@@ -1042,11 +1045,19 @@ static int stewart_legs_fk_chord(const stewart_legs_fk_real p[], stewart_legs_fk
         }
         stewart_legs_fk_lu_solve(&work->lu, work->phi);
         step = stewart_legs_fk_max_abs(work->phi);
+        if (k == 0) {
+            *first = step; /* Newton's own first step from the last solution */
+        }
         /* also false for a NaN step: Newton then starts from the last good iterate */
         if (!(step <= STEWART_LEGS_FK_CHORD_CONTRACTION * previous)) break;
         stewart_legs_fk_from_unit(work, work->phi);
         for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
             q[i] += work->phi[i];
+        }
+        if (k == 0) {
+            for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
+                predicted[i] = q[i];
+            }
         }
         if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
         previous = step;
@@ -1057,24 +1068,53 @@ static int stewart_legs_fk_chord(const stewart_legs_fk_real p[], stewart_legs_fk
     return k;
 }
 
+/* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
+ * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
+ * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
+ * none was solved: the first call, or after a failed one); nq: max |q|. */
+static int stewart_legs_fk_branch_jump(stewart_legs_fk_workspace *work, const stewart_legs_fk_real q[],
+                                    const stewart_legs_fk_real predicted[], stewart_legs_fk_real first, stewart_legs_fk_real nq)
+{
+    const int sign = stewart_legs_fk_lu_det_sign(&work->lu);
+    int jumped = sign != 0 && work->det_sign != 0 && sign != work->det_sign;
+    if (first - first == 0) {
+        const stewart_legs_fk_real floor = STEWART_LEGS_FK_BRANCH_FLOOR * (1 + nq);
+        stewart_legs_fk_real remainder = 0, a, bound = STEWART_LEGS_FK_BRANCH_REGION * first;
+        int i;
+        for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
+            a = fabs(q[i] - predicted[i]);
+            remainder = a > remainder ? a : remainder;
+        }
+        bound = bound > floor ? bound : floor;
+        jumped |= remainder > bound;
+    }
+    if (sign != 0) {
+        work->det_sign = sign; /* a vanished pivot keeps the last sign known */
+    }
+    return jumped;
+}
+
 int stewart_legs_fk_solve_inputs(const stewart_legs_fk_options *options, const stewart_legs_fk_real p[],
                               const stewart_legs_fk_real u[], const stewart_legs_fk_real du[], const stewart_legs_fk_real ddu[],
                               stewart_legs_fk_state *state, stewart_legs_fk_workspace *work,
                               stewart_legs_fk_report *report)
 {
     stewart_legs_fk_real pu[STEWART_LEGS_FK_NP + 3 * STEWART_LEGS_FK_NU];
-    stewart_legs_fk_real nq, ndq, nddq;
+    stewart_legs_fk_real nq, ndq, nddq, predicted[STEWART_LEGS_FK_NQ], first = (stewart_legs_fk_real)NAN;
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
     int i, chord;
     stewart_legs_fk_with_inputs(pu, p, u, du, ddu);
     report->flagged = 0;
+    report->branch_jump = 0;
     report->cond = (stewart_legs_fk_real)NAN;
     if (!state->started) {
         stewart_legs_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
+        work->det_sign = 0;
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
      * from it, simplified Newton steps on the last factors while work->lu holds them. */
-    chord = state->started && work->factored ? stewart_legs_fk_chord(pu, state->t, state->q, work) : 0;
+    chord = state->started && work->factored
+        ? stewart_legs_fk_chord(pu, state->t, state->q, work, predicted, &first) : 0;
     work->factored = 0;
     report->status = stewart_legs_fk_newton(options, pu, state->t, state->q, work, report);
     report->iterations += chord;
@@ -1094,6 +1134,7 @@ int stewart_legs_fk_solve_inputs(const stewart_legs_fk_options *options, const s
         stewart_legs_fk_lu_solve(&work->lu, state->ddq);
     }
     nq = stewart_legs_fk_max_abs(state->q);
+    report->branch_jump = stewart_legs_fk_branch_jump(work, state->q, predicted, first, nq);
     ndq = stewart_legs_fk_norm_if(rates, state->dq);
     nddq = stewart_legs_fk_norm_if(accelerations, state->ddq);
     if (ndq - ndq != 0 || nddq - nddq != 0) {

@@ -59,8 +59,8 @@ typedef struct {
  * Velocity: 1587; acceleration: 9249; per-point checks: 36090; predictor: 547
  * Step, worst case with the default cap of 25 iterations: 539256 (216191 add/sub, 212021 mul, 5620 div, 10 sqrt, 910 other calls, 61063 fabs, 43441 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 546671 (230391 add/sub, 207206 mul, 2532 div, 10 sqrt, 910 other calls, 61609 fabs, 44013 compares)
- *   positions only (du, ddu NULL): 535651 (225663 add/sub, 201280 mul, 2532 div, 10 sqrt, 910 other calls, 61427 fabs, 43829 compares)
+ * solve_inputs, worst case: 547315 (230575 add/sub, 207208 mul, 2532 div, 10 sqrt, 910 other calls, 61700 fabs, 44380 compares)
+ *   positions only (du, ddu NULL): 536295 (225847 add/sub, 201282 mul, 2532 div, 10 sqrt, 910 other calls, 61518 fabs, 44196 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 31670
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16589373
  */
@@ -68,8 +68,8 @@ typedef struct {
 #define STEWART_LEGS_FK_OPS_STEP_FIXED 152956  /* a step without its iterations */
 #define STEWART_LEGS_FK_OPS_STEP_WORST 539256  /* at the default cap, 25 */
 #define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16589373  /* every factorization dense */
-#define STEWART_LEGS_FK_OPS_INPUTS_WORST 546671  /* solve_inputs with du, ddu */
-#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 535651  /* solve_inputs, du, ddu NULL */
+#define STEWART_LEGS_FK_OPS_INPUTS_WORST 547315  /* solve_inputs with du, ddu */
+#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 536295  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -82,6 +82,8 @@ typedef struct {
     stewart_legs_fk_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
     stewart_legs_fk_real cond;      /* estimate of the 1-norm condition of Phi_q there */
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
+    int branch_jump;             /* stewart_legs_fk_solve_inputs: 1 when the solution may lie */
+                                 /* on another assembly than the last one (see there) */
 } stewart_legs_fk_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
@@ -110,6 +112,7 @@ typedef struct {
     stewart_legs_fk_real nz_factor[STEWART_LEGS_FK_NNZ]; /* column / row of each non-zero */
     int scaled; /* the decisions are made in a unit other than 1 */
     int factored; /* lu holds the factors of Phi_q at the last solution of _solve_inputs */
+    int det_sign; /* the sign of det(Phi_q) there (0: none known yet) */
 } stewart_legs_fk_workspace;
 
 /* Tolerances suited to the real type. */
@@ -149,7 +152,13 @@ int stewart_legs_fk_solve_grid_checked(const stewart_legs_fk_options *options,
  * are taken at state->t (the caller sets it); state->t is not changed. From the second call,
  * simplified Newton steps on the factors the last call left come first (report->iterations
  * counts them too), then Newton with Phi_q evaluated and factored at their q. Returns the
- * status (also in report); on failure state->q holds the last Newton iterate. */
+ * status (also in report); on failure state->q holds the last Newton iterate.
+ * report->branch_jump is 1 when the solution may lie on another assembly than the last call's
+ * (Newton converges as well there, with nothing else to show for it): det(Phi_q) changed sign
+ * since the last solution (a singular configuration lies between the two), or the solution is
+ * farther from Newton's first step from the last solution than its region of quadratic
+ * convergence allows (|q - (q_last + s)| > 0.5 |s| and > 1e-08 (1 + |q|), max-norms).
+ * The call's result stands; give inputs closer together there, or check the assembly. */
 int stewart_legs_fk_solve_inputs(const stewart_legs_fk_options *options, const stewart_legs_fk_real p[],
                               const stewart_legs_fk_real u[], const stewart_legs_fk_real du[],
                               const stewart_legs_fk_real ddu[], stewart_legs_fk_state *state,

@@ -2287,6 +2287,22 @@ unsigned long stewart_legs_fk_lu_fallbacks(const stewart_legs_fk_lu *lu)
     return lu->fallbacks;
 }
 
+int stewart_legs_fk_lu_det_sign(const stewart_legs_fk_lu *lu)
+{
+    /* The factors are those of P Phi_q Q with P, Q the fixed pivot order (even together,
+     * found at generation time), each interchange taken one more transposition of two rows:
+     * det(Phi_q) = sign(P) sign(Q) (-1)^interchanges prod u_kk, and lu->inv holds 1 / u_kk. */
+    int negative = 0, k;
+    if (lu->dense) {
+        return stewart_legs_fk_dense_lu_det_sign(&lu->dense_lu);
+    }
+    for (k = 0; k < STEWART_LEGS_FK_NQ; ++k) {
+        if (!(lu->inv[k] != 0 && lu->inv[k] - lu->inv[k] == 0)) return 0;
+        negative ^= lu->inv[k] < 0;
+    }
+    return negative ? -1 : 1;
+}
+
 stewart_legs_fk_real stewart_legs_fk_lu_pivot_ratio(const stewart_legs_fk_lu *lu)
 {
     /* The sparse path keeps 1 / u_kk: min |u_kk| / max |u_kk| = min |1/u_kk| / max |1/u_kk|,

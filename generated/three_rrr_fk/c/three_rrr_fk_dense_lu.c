@@ -77,6 +77,25 @@ three_rrr_fk_real three_rrr_fk_dense_lu_pivot_ratio(const three_rrr_fk_dense_lu 
     return lu->pivot_ratio; /* kept by the factorization */
 }
 
+int three_rrr_fk_dense_lu_det_sign(const three_rrr_fk_dense_lu *lu)
+{
+    /* det(Phi_q) = sign(perm) prod u_kk: the parity of perm from its cycles (a cycle of
+     * length m is m - 1 transpositions), then the pivots' signs */
+    char seen[THREE_RRR_FK_NQ] = {0};
+    int negative = 0, k, j;
+    for (k = 0; k < THREE_RRR_FK_NQ; ++k) {
+        if (!(lu->inv[k] != 0 && lu->inv[k] - lu->inv[k] == 0)) return 0;
+        negative ^= lu->inv[k] < 0;
+        if (seen[k]) continue;
+        for (j = lu->perm[k]; j != k; j = lu->perm[j]) {
+            seen[j] = 1;
+            negative ^= 1;
+        }
+        seen[k] = 1;
+    }
+    return negative ? -1 : 1;
+}
+
 void three_rrr_fk_dense_lu_solve(const three_rrr_fk_dense_lu *lu, three_rrr_fk_real b[])
 {
     const int n = THREE_RRR_FK_NQ;

@@ -32,6 +32,10 @@ int three_rrr_fk_dense_lu_factor(const three_rrr_fk_real nz[], three_rrr_fk_dens
 /* min |u_kk| / max |u_kk| of a complete factorization: the reciprocal-condition estimate. */
 three_rrr_fk_real three_rrr_fk_dense_lu_pivot_ratio(const three_rrr_fk_dense_lu *lu);
 
+/* The sign of det(Phi_q) of a complete factorization: +1 or -1, 0 when a pivot is zero or not
+ * finite. */
+int three_rrr_fk_dense_lu_det_sign(const three_rrr_fk_dense_lu *lu);
+
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void three_rrr_fk_dense_lu_solve(const three_rrr_fk_dense_lu *lu, three_rrr_fk_real b[]);
 

@@ -936,6 +936,8 @@ static three_rrr_fk_real three_rrr_fk_norm_if(int computed, const three_rrr_fk_r
 
 #define THREE_RRR_FK_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
 #define THREE_RRR_FK_CHORD_CONTRACTION ((three_rrr_fk_real)0.1) /* as contract.tuning.INPUTS */
+#define THREE_RRR_FK_BRANCH_REGION ((three_rrr_fk_real)0.5) /* as contract.tuning.INPUTS */
+#define THREE_RRR_FK_BRANCH_FLOOR ((three_rrr_fk_real)1e-08) /* as contract.tuning.INPUTS */
 
 /* Simplified Newton from the last solution: Phi alone at each iterate, each step solved with
  * the factors of Phi_q left by the last solve (work->lu, at the last solution: for inputs that
@@ -948,9 +950,10 @@ static three_rrr_fk_real three_rrr_fk_norm_if(int computed, const three_rrr_fk_r
  * Steps that stop before the rounding level (a contraction too slow, a NaN, the cap) leave
  * q where Newton's residual test alone could accept it with an error up to its tolerance,
  * so q goes back to the last solution and Newton starts from there as without these steps.
- * Returns the steps taken. */
+ * The first step's end, q_last + s, goes to predicted[] and max |s| to *first (NaN when no
+ * step was solved), for the branch test of solve_inputs. Returns the steps taken. */
 static int three_rrr_fk_chord(const three_rrr_fk_real p[], three_rrr_fk_real t, three_rrr_fk_real q[],
-                              three_rrr_fk_workspace *work)
+                              three_rrr_fk_workspace *work, three_rrr_fk_real predicted[], three_rrr_fk_real *first)
 {
     const three_rrr_fk_real rounding = THREE_RRR_FK_UNIT_ROUNDOFF * (1 + work->norms[0]);
     three_rrr_fk_real previous = (three_rrr_fk_real)INFINITY, step, last[THREE_RRR_FK_NQ];
@@ -966,11 +969,19 @@ static int three_rrr_fk_chord(const three_rrr_fk_real p[], three_rrr_fk_real t, 
         }
         three_rrr_fk_lu_solve(&work->lu, work->phi);
         step = three_rrr_fk_max_abs(work->phi);
+        if (k == 0) {
+            *first = step; /* Newton's own first step from the last solution */
+        }
         /* also false for a NaN step: Newton then starts from the last good iterate */
         if (!(step <= THREE_RRR_FK_CHORD_CONTRACTION * previous)) break;
         three_rrr_fk_from_unit(work, work->phi);
         for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
             q[i] += work->phi[i];
+        }
+        if (k == 0) {
+            for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+                predicted[i] = q[i];
+            }
         }
         if (step <= rounding || (k > 0 && step * (step / previous) <= rounding)) return k + 1;
         previous = step;
@@ -981,24 +992,53 @@ static int three_rrr_fk_chord(const three_rrr_fk_real p[], three_rrr_fk_real t, 
     return k;
 }
 
+/* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
+ * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
+ * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
+ * none was solved: the first call, or after a failed one); nq: max |q|. */
+static int three_rrr_fk_branch_jump(three_rrr_fk_workspace *work, const three_rrr_fk_real q[],
+                                    const three_rrr_fk_real predicted[], three_rrr_fk_real first, three_rrr_fk_real nq)
+{
+    const int sign = three_rrr_fk_lu_det_sign(&work->lu);
+    int jumped = sign != 0 && work->det_sign != 0 && sign != work->det_sign;
+    if (first - first == 0) {
+        const three_rrr_fk_real floor = THREE_RRR_FK_BRANCH_FLOOR * (1 + nq);
+        three_rrr_fk_real remainder = 0, a, bound = THREE_RRR_FK_BRANCH_REGION * first;
+        int i;
+        for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+            a = fabs(q[i] - predicted[i]);
+            remainder = a > remainder ? a : remainder;
+        }
+        bound = bound > floor ? bound : floor;
+        jumped |= remainder > bound;
+    }
+    if (sign != 0) {
+        work->det_sign = sign; /* a vanished pivot keeps the last sign known */
+    }
+    return jumped;
+}
+
 int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
                               const three_rrr_fk_real u[], const three_rrr_fk_real du[], const three_rrr_fk_real ddu[],
                               three_rrr_fk_state *state, three_rrr_fk_workspace *work,
                               three_rrr_fk_report *report)
 {
     three_rrr_fk_real pu[THREE_RRR_FK_NP + 3 * THREE_RRR_FK_NU];
-    three_rrr_fk_real nq, ndq, nddq;
+    three_rrr_fk_real nq, ndq, nddq, predicted[THREE_RRR_FK_NQ], first = (three_rrr_fk_real)NAN;
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
     int i, chord;
     three_rrr_fk_with_inputs(pu, p, u, du, ddu);
     report->flagged = 0;
+    report->branch_jump = 0;
     report->cond = (three_rrr_fk_real)NAN;
     if (!state->started) {
         three_rrr_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
+        work->det_sign = 0;
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
      * from it, simplified Newton steps on the last factors while work->lu holds them. */
-    chord = state->started && work->factored ? three_rrr_fk_chord(pu, state->t, state->q, work) : 0;
+    chord = state->started && work->factored
+        ? three_rrr_fk_chord(pu, state->t, state->q, work, predicted, &first) : 0;
     work->factored = 0;
     report->status = three_rrr_fk_newton(options, pu, state->t, state->q, work, report);
     report->iterations += chord;
@@ -1018,6 +1058,7 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
         three_rrr_fk_lu_solve(&work->lu, state->ddq);
     }
     nq = three_rrr_fk_max_abs(state->q);
+    report->branch_jump = three_rrr_fk_branch_jump(work, state->q, predicted, first, nq);
     ndq = three_rrr_fk_norm_if(rates, state->dq);
     nddq = three_rrr_fk_norm_if(accelerations, state->ddq);
     if (ndq - ndq != 0 || nddq - nddq != 0) {

@@ -59,8 +59,8 @@ typedef struct {
  * Velocity: 134; acceleration: 198; per-point checks: 2674; predictor: 127
  * Step, worst case with the default cap of 25 iterations: 23647 (9326 add/sub, 5459 mul, 986 div, 10 sqrt, 434 other calls, 4013 fabs, 3419 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 22317 (10294 add/sub, 3507 mul, 278 div, 10 sqrt, 518 other calls, 4139 fabs, 3571 compares)
- *   positions only (du, ddu NULL): 21941 (10108 add/sub, 3403 mul, 278 div, 10 sqrt, 518 other calls, 4097 fabs, 3527 compares)
+ * solve_inputs, worst case: 22471 (10338 add/sub, 3509 mul, 278 div, 10 sqrt, 518 other calls, 4160 fabs, 3658 compares)
+ *   positions only (du, ddu NULL): 22095 (10152 add/sub, 3405 mul, 278 div, 10 sqrt, 518 other calls, 4118 fabs, 3614 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 1742
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286501
  */
@@ -68,8 +68,8 @@ typedef struct {
 #define THREE_RRR_FK_OPS_STEP_FIXED 7022  /* a step without its iterations */
 #define THREE_RRR_FK_OPS_STEP_WORST 23647  /* at the default cap, 25 */
 #define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286501  /* every factorization dense */
-#define THREE_RRR_FK_OPS_INPUTS_WORST 22317  /* solve_inputs with du, ddu */
-#define THREE_RRR_FK_OPS_POSITIONS_WORST 21941  /* solve_inputs, du, ddu NULL */
+#define THREE_RRR_FK_OPS_INPUTS_WORST 22471  /* solve_inputs with du, ddu */
+#define THREE_RRR_FK_OPS_POSITIONS_WORST 22095  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -82,6 +82,8 @@ typedef struct {
     three_rrr_fk_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
     three_rrr_fk_real cond;      /* estimate of the 1-norm condition of Phi_q there */
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
+    int branch_jump;             /* three_rrr_fk_solve_inputs: 1 when the solution may lie */
+                                 /* on another assembly than the last one (see there) */
 } three_rrr_fk_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0
@@ -110,6 +112,7 @@ typedef struct {
     three_rrr_fk_real nz_factor[THREE_RRR_FK_NNZ]; /* column / row of each non-zero */
     int scaled; /* the decisions are made in a unit other than 1 */
     int factored; /* lu holds the factors of Phi_q at the last solution of _solve_inputs */
+    int det_sign; /* the sign of det(Phi_q) there (0: none known yet) */
 } three_rrr_fk_workspace;
 
 /* Tolerances suited to the real type. */
@@ -149,7 +152,13 @@ int three_rrr_fk_solve_grid_checked(const three_rrr_fk_options *options,
  * are taken at state->t (the caller sets it); state->t is not changed. From the second call,
  * simplified Newton steps on the factors the last call left come first (report->iterations
  * counts them too), then Newton with Phi_q evaluated and factored at their q. Returns the
- * status (also in report); on failure state->q holds the last Newton iterate. */
+ * status (also in report); on failure state->q holds the last Newton iterate.
+ * report->branch_jump is 1 when the solution may lie on another assembly than the last call's
+ * (Newton converges as well there, with nothing else to show for it): det(Phi_q) changed sign
+ * since the last solution (a singular configuration lies between the two), or the solution is
+ * farther from Newton's first step from the last solution than its region of quadratic
+ * convergence allows (|q - (q_last + s)| > 0.5 |s| and > 1e-08 (1 + |q|), max-norms).
+ * The call's result stands; give inputs closer together there, or check the assembly. */
 int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
                               const three_rrr_fk_real u[], const three_rrr_fk_real du[],
                               const three_rrr_fk_real ddu[], three_rrr_fk_state *state,

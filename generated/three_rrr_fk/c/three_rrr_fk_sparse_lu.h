@@ -47,6 +47,11 @@ three_rrr_fk_real three_rrr_fk_lu_pivot_ratio(const three_rrr_fk_lu *lu);
 /* Factorizations that fell back to the dense path since three_rrr_fk_lu_init. */
 unsigned long three_rrr_fk_lu_fallbacks(const three_rrr_fk_lu *lu);
 
+/* The sign of det(Phi_q) from the last factorization, whichever path it took: +1 or -1, 0
+ * when a pivot vanished (the input solve's test for a singular configuration passed between
+ * two calls). */
+int three_rrr_fk_lu_det_sign(const three_rrr_fk_lu *lu);
+
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void three_rrr_fk_lu_solve(const three_rrr_fk_lu *lu, three_rrr_fk_real b[]);
 

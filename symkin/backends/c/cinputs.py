@@ -32,6 +32,7 @@ class InputStepper:
         self._np = int(getattr(lib, f"{name.upper()}_NP"))
         self._nu = int(getattr(lib, f"{name.upper()}_NU"))
         self.fallbacks = 0
+        self.branch_jump = False  # the last call's report.branch_jump (runtime.branch's tests)
 
     def start(self, options: Options, q: Array) -> None:
         """Begin from q: the first call initialises the workspace."""
@@ -39,6 +40,7 @@ class InputStepper:
         self._state.q[0:self._n] = [float(v) for v in q]
         self._state.started = 0
         self.fallbacks = 0
+        self.branch_jump = False
 
     def step(self, t: float, pu: Array, rates: int) -> Point | Newton:
         """One call of solve_inputs at time t with p[] = pu (parameters, u, du, ddu)."""
@@ -53,6 +55,7 @@ class InputStepper:
                              self._report)
         report = self._report
         self.fallbacks = int(report.fallbacks)
+        self.branch_jump = bool(report.branch_jump)
         q = np.array(self._ffi.unpack(self._state.q, self._n), dtype=float)
         if status != OK:
             return Newton(q, int(status), int(report.iterations), float(report.residual), None)

@@ -348,6 +348,8 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
         "solve_flops": plan.solve_flops,
         "row_perm": list(plan.row_perm),
         "col_perm": list(plan.col_perm),
+        # the fixed order's share of det(Phi_q)'s sign: sign(P) sign(Q) is -1
+        "order_negative": _odd(plan.row_perm) != _odd(plan.col_perm),
         "fill_slots": list(range(plan.nnz, plan.n_lu)),
         "unchecked": list(plan.unchecked),
         # run-time interchanges (k, p) in plan order: each a compare, then an exchange of
@@ -389,6 +391,19 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
                                                f"{prefix}_real", fabs)
                     if style == "straight" else None),
     }
+
+
+def _odd(perm: Sequence[int]) -> bool:
+    """Whether a permutation is odd: the parity of n minus its number of cycles."""
+    seen, cycles = [False] * len(perm), 0
+    for start in range(len(perm)):
+        if not seen[start]:
+            cycles += 1
+            k = start
+            while not seen[k]:
+                seen[k] = True
+                k = perm[k]
+    return (len(perm) - cycles) % 2 == 1
 
 
 def _tables(plan: LUPlan) -> dict[str, list[int]]:

@@ -183,6 +183,15 @@ def refined(code: Any, algebra: LinearAlgebra, units: bool) -> Flops:
     return REFINED + FLAGGED + POSITION_ERROR + propagated(code, algebra, units)
 
 
+def branch_jump(n: int) -> Flops:
+    """<prefix>_branch_jump (solve_inputs): the sign of det(Phi_q) from the factors (per pivot
+    the zero, finite and sign tests; the interchanges and the dense path's permutation are
+    integers), then |q - (q_last + s)| and its max, the floor and the bound."""
+    sign = Flops(cmp=3 * n, add=n)
+    remainder = Flops(add=n, abs=n, cmp=n)
+    return sign + remainder + Flops(add=2, mul=2, cmp=3)
+
+
 def chord(code: Any, algebra: LinearAlgebra) -> Flops:
     """<prefix>_chord (solve_inputs, in the mechanism's unit) with all CHORD_STEPS taken:
     the rounding level, then per step Phi, the negated solve, its max, the contraction test,
@@ -258,7 +267,7 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
     velocity = _routine(code, "phi_t_shared") + Flops(add=n) + solve
     acceleration = _routine(code, "gamma_shared") + solve
     if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests
-        norms = _max_abs(n) * (1 + 2 * rates) + Flops(add=2, cmp=2)
+        norms = _max_abs(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
     else:  # one pass: |q|, |dq|, |ddq| scaled, three maxima, the sum and two finite tests
         norms = Flops(abs=3 * n, mul=3 * n, cmp=3 * n, add=5 * n) + Flops(cmp=3)
     prediction = Flops(add=1) + Flops(mul=3, div=1, add=2) * n  # (2.76)
