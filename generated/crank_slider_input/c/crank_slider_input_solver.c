@@ -761,14 +761,14 @@ static int crank_slider_input_branch_jump(crank_slider_input_workspace *work, co
     const int sign = crank_slider_input_lu_det_sign(&work->lu);
     int jumped = sign != 0 && work->det_sign != 0 && sign != work->det_sign;
     if (first - first == 0) {
-        const crank_slider_input_real floor = CRANK_SLIDER_INPUT_BRANCH_FLOOR * (1 + nq);
+        const crank_slider_input_real least = CRANK_SLIDER_INPUT_BRANCH_FLOOR * (1 + nq);
         crank_slider_input_real remainder = 0, a, bound = CRANK_SLIDER_INPUT_BRANCH_REGION * first;
         int i;
         for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
             a = fabs(q[i] - predicted[i]);
             remainder = a > remainder ? a : remainder;
         }
-        bound = bound > floor ? bound : floor;
+        bound = bound > least ? bound : least;
         jumped |= remainder > bound;
     }
     if (sign != 0) {

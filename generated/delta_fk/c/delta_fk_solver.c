@@ -808,14 +808,14 @@ static int delta_fk_branch_jump(delta_fk_workspace *work, const delta_fk_real q[
     const int sign = delta_fk_lu_det_sign(&work->lu);
     int jumped = sign != 0 && work->det_sign != 0 && sign != work->det_sign;
     if (first - first == 0) {
-        const delta_fk_real floor = DELTA_FK_BRANCH_FLOOR * (1 + nq);
+        const delta_fk_real least = DELTA_FK_BRANCH_FLOOR * (1 + nq);
         delta_fk_real remainder = 0, a, bound = DELTA_FK_BRANCH_REGION * first;
         int i;
         for (i = 0; i < DELTA_FK_NQ; ++i) {
             a = fabs(q[i] - predicted[i]);
             remainder = a > remainder ? a : remainder;
         }
-        bound = bound > floor ? bound : floor;
+        bound = bound > least ? bound : least;
         jumped |= remainder > bound;
     }
     if (sign != 0) {

@@ -1078,14 +1078,14 @@ static int stewart_legs_fk_branch_jump(stewart_legs_fk_workspace *work, const st
     const int sign = stewart_legs_fk_lu_det_sign(&work->lu);
     int jumped = sign != 0 && work->det_sign != 0 && sign != work->det_sign;
     if (first - first == 0) {
-        const stewart_legs_fk_real floor = STEWART_LEGS_FK_BRANCH_FLOOR * (1 + nq);
+        const stewart_legs_fk_real least = STEWART_LEGS_FK_BRANCH_FLOOR * (1 + nq);
         stewart_legs_fk_real remainder = 0, a, bound = STEWART_LEGS_FK_BRANCH_REGION * first;
         int i;
         for (i = 0; i < STEWART_LEGS_FK_NQ; ++i) {
             a = fabs(q[i] - predicted[i]);
             remainder = a > remainder ? a : remainder;
         }
-        bound = bound > floor ? bound : floor;
+        bound = bound > least ? bound : least;
         jumped |= remainder > bound;
     }
     if (sign != 0) {

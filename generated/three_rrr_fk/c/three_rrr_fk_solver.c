@@ -1002,14 +1002,14 @@ static int three_rrr_fk_branch_jump(three_rrr_fk_workspace *work, const three_rr
     const int sign = three_rrr_fk_lu_det_sign(&work->lu);
     int jumped = sign != 0 && work->det_sign != 0 && sign != work->det_sign;
     if (first - first == 0) {
-        const three_rrr_fk_real floor = THREE_RRR_FK_BRANCH_FLOOR * (1 + nq);
+        const three_rrr_fk_real least = THREE_RRR_FK_BRANCH_FLOOR * (1 + nq);
         three_rrr_fk_real remainder = 0, a, bound = THREE_RRR_FK_BRANCH_REGION * first;
         int i;
         for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
             a = fabs(q[i] - predicted[i]);
             remainder = a > remainder ? a : remainder;
         }
-        bound = bound > floor ? bound : floor;
+        bound = bound > least ? bound : least;
         jumped |= remainder > bound;
     }
     if (sign != 0) {
