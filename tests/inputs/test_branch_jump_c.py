@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 import symkin
-from symkin.errors import SymkinWarning
 from symkin.contract.options import Options
+from symkin.errors import SymkinWarning
 from symkin.runtime import branch
 from tests.inputs.test_branch_jump import _assembly
 from tests.spatial.test_stewart_fk import _legs, _poses
