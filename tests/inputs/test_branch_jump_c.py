@@ -31,24 +31,26 @@ def _kernel(name: str, linalg: str = "sparse"):
                           linalg=linalg)
 
 
-def _c_sign(kernel, nz: np.ndarray, dense: bool) -> int:
+def _factored(kernel, nz: np.ndarray) -> tuple[int, object]:
+    """The status and the workspace of <prefix>_lu_factor (sparse path, or its fall-back)."""
     ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
-    values = ffi.new(f"{name}_real[]", nz.tolist())
-    if dense:
-        lu = ffi.new(f"{name}_dense_lu *")
-        assert getattr(lib, f"{name}_dense_lu_factor")(values, lu) == 0
-        return int(getattr(lib, f"{name}_dense_lu_det_sign")(lu))
     lu = ffi.new(f"{name}_lu *")
     getattr(lib, f"{name}_lu_init")(lu)
-    assert getattr(lib, f"{name}_lu_factor")(values, lu) == 0
-    assert not lu.dense  # the sparse path's own sign (the fall-back is the case above)
-    return int(getattr(lib, f"{name}_lu_det_sign")(lu))
+    return getattr(lib, f"{name}_lu_factor")(ffi.new(f"{name}_real[]", nz.tolist()), lu), lu
+
+
+def _dense_sign(kernel, nz: np.ndarray) -> int:
+    ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
+    lu = ffi.new(f"{name}_dense_lu *")
+    assert getattr(lib, f"{name}_dense_lu_factor")(ffi.new(f"{name}_real[]", nz.tolist()),
+                                                    lu) == 0
+    return int(getattr(lib, f"{name}_dense_lu_det_sign")(lu))
 
 
 @pytest.mark.parametrize("name", ["crank_slider_input", "stewart_fk", "three_rrr_fk"])
 def test_the_sign_of_det_phi_q_from_the_factors_is_numpys(name: str) -> None:
-    """At the solutions of a path and at points scattered about them (where the run-time
-    interchanges are taken and both signs occur), sparse and dense factors alike."""
+    """At points scattered about q0 (where the run-time interchanges are taken and both signs
+    occur), sparse and dense factors alike."""
     kernel = _kernel(name)
     rng = np.random.default_rng(7)
     p = kernel.with_inputs(None, np.zeros(kernel.nu))
@@ -61,14 +63,12 @@ def test_the_sign_of_det_phi_q_from_the_factors_is_numpys(name: str) -> None:
         nz = kernel.phi_q_nz(q, 0.0, p)
         expected = int(np.linalg.slogdet(kernel.phi_q(q, 0.0, p))[0])
         assert expected != 0
-        lu = kernel.ffi.new(f"{kernel.name}_lu *")
-        getattr(kernel.lib, f"{kernel.name}_lu_init")(lu)
-        getattr(kernel.lib, f"{kernel.name}_lu_factor")(
-            kernel.ffi.new(f"{kernel.name}_real[]", nz.tolist()), lu)
-        if not lu.dense:
-            assert _c_sign(kernel, nz, dense=False) == expected
+        status, lu = _factored(kernel, nz)
+        if not lu.dense:  # the sparse path's own sign (the fall-back is the dense case below)
+            assert status == 0
+            assert int(getattr(kernel.lib, f"{kernel.name}_lu_det_sign")(lu)) == expected
             swapped += sum(lu.swapped) if hasattr(lu, "swapped") else 0
-        assert _c_sign(kernel, nz, dense=True) == expected
+        assert _dense_sign(kernel, nz) == expected
         signs[expected] += 1
     assert signs[1] and signs[-1]
     if name == "stewart_fk":
