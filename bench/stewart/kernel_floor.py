@@ -54,7 +54,8 @@ static double now(void)
 }
 
 static PREFIX_real q[PREFIX_NQ], dq[PREFIX_NQ], out[PREFIX_NQ], nz[PREFIX_NNZ];
-static PREFIX_real shared[PREFIX_NSHARED > 0 ? PREFIX_NSHARED : 1], pu[PREFIX_NPU > 0 ? PREFIX_NPU : 1];
+static PREFIX_real shared[PREFIX_NSHARED > 0 ? PREFIX_NSHARED : 1];
+static PREFIX_real pu[PREFIX_NPU > 0 ? PREFIX_NPU : 1];
 static PREFIX_lu lu;
 
 /* One call of kernel k at q, which moves by 1e-12 per call. */
@@ -96,7 +97,7 @@ int main(int argc, char **argv)
         printf("kernel=%d ns_per_call=%.1f\n", k, 1e9 * best / n);
     }
     if (PREFIX_lu_fallbacks(&lu) != 0) {
-        fprintf(stderr, "the sparse LU fell back to dense: the factorization timed is not the sparse one\n");
+        fprintf(stderr, "the sparse LU fell back to dense: not the factorization meant\n");
         return 1;
     }
     return 0;

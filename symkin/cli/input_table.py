@@ -45,7 +45,8 @@ def read(path: Path, names: tuple[str, ...]) -> InputTable:
         TableError: the file cannot be read, or its header, a cell or the grid is wrong.
     """
     try:
-        with path.open(newline="", encoding="utf-8") as handle:
+        # utf-8-sig: a byte-order mark (spreadsheets' "CSV UTF-8") is not part of the header
+        with path.open(newline="", encoding="utf-8-sig") as handle:
             rows = list(csv.reader(handle))
     except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise TableError(f"{path}: cannot read the input table: {error}") from None
@@ -110,7 +111,8 @@ def _numbers(path: Path, line: int, row: list[str], header: list[str]) -> list[f
     numbers = []
     for column, cell in zip(header, row):
         try:
-            value = float(cell)
+            # float() also reads 1_5 as 15, a digit group no table means as a number
+            value = float(cell) if "_" not in cell else math.nan
         except ValueError:
             value = math.nan
         if not math.isfinite(value):

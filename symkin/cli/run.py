@@ -96,6 +96,12 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
         if clash:
             return (f"--inputs {args.inputs}: its column t is the time grid; leave out "
                     f"{', '.join(clash)}")
+        for option in SUFFIXES:  # writing there would replace the table being read
+            path = getattr(args, option)
+            if path is not None and _same_file(path, args.inputs):
+                flag = "-o" if option == "output" else f"--{option}"
+                return (f"{flag} {path} is the --inputs table; write the results to another "
+                        "file")
     if not 1 <= args.fps <= 100:
         return f"--fps {args.fps}: give 1 to 100 frames per second"
     if args.html is not None:
@@ -105,6 +111,14 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
             return ("--html needs the plotly package, which draws the report: "
                     "pip install 'symkin[html]' (or pip install plotly)")
     return None
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file (also through a link, or a hard link to it)."""
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+    except OSError:
+        return False
 
 
 def _times(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None]:

@@ -67,14 +67,19 @@ def handle(args: argparse.Namespace) -> int:
     inputs = _inputs(args.inputs)
     if isinstance(inputs, str):
         return messages.error(f"{args.mechanism}: {inputs}", EXIT_BAD_INPUT)
+    names = tuple(getattr(kernel, "input_names", ()))
+    if inputs is not None and not names:
+        return messages.error(f"{args.mechanism}: this mechanism has no input drivers (a "
+                              "driver function written `input`): leave out --input",
+                              EXIT_BAD_INPUT)
     try:
         report = scan(kernel, t=times, all_branches=args.all_branches, inputs=inputs)
     except driver.SolveInterrupted:  # a SolveError too: first
         messages.note("interrupted")
         return EXIT_INTERRUPTED
     except SolveError as error:
-        return messages.error(f"{args.mechanism}: {error} (give --input NAME=VALUE for each "
-                              "input driver)", EXIT_BAD_INPUT)
+        hint = " (give --input NAME=VALUE for each input driver)" if names else ""
+        return messages.error(f"{args.mechanism}: {error}{hint}", EXIT_BAD_INPUT)
     print(text(report, kernel.name, f"t = {t0:g} to {t1:g} by {dt:g}, {kernel.backend} backend"),
           end="")
     return EXIT_OK

@@ -20,7 +20,7 @@ from typing import Any
 from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
-from symkin.errors import SymkinError, UsageError
+from symkin.errors import SolveError, SymkinError, UsageError
 
 _VARY = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*([^:]+):([^:]+):\s*(\d+)\s*$")
 _TOLERANCE = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(?:±|\+-|\+/-)?\s*([^%\s]+)\s*(%?)\s*$")
@@ -68,6 +68,12 @@ def handle(args: argparse.Namespace) -> int:
     options = index.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
     kernel = index.prepare(args.mechanism, options).kernel
+    from symkin.runtime.inputs import refuse_inputs
+
+    try:
+        refuse_inputs(kernel, "a sweep")  # the user's file, not a failed design: exit 2
+    except SolveError as error:
+        return messages.error(f"{args.mechanism}: {error}", EXIT_BAD_INPUT)
     try:
         design, spread = _design(kernel, args)
     except UsageError as error:

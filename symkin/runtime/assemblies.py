@@ -144,15 +144,18 @@ class Shape:
 
 
 def search(kernel: KinematicsKernel, q0: Array, t0: float, p: Array, options: Options,
-           known: list[Array]) -> list[Newton]:
+           known: list[Array], turns: Array | None = None) -> list[Newton]:
     """The assemblies at t0 (generated functions' parameters p) other than ``known``, each
-    the runtime Newton's converged outcome, in the order found (see the module docstring)."""
+    the runtime Newton's converged outcome, in the order found (see the module docstring).
+    ``turns``: a configuration whose angles say about which turn the starts' angles spread
+    (an assembly found already, its driven angles at the inputs' values; default q0)."""
     shape = Shape(tuple(kernel.coordinates))
     roots = [np.array(q, dtype=float) for q in known]
     found: list[Newton] = []
     idle = 0
     batch: list[Newton] = []
-    for count, start in enumerate(_starts(kernel, shape, q0, t0, p), start=1):
+    centre = np.array(q0 if turns is None else turns, dtype=float)
+    for count, start in enumerate(_starts(kernel, shape, q0, t0, p, centre), start=1):
         batch.extend(_from_start(kernel, shape, start, t0, p, options, roots))
         if count % BATCH == 0:
             found.extend(batch)
@@ -261,21 +264,25 @@ def _log_gradient(shape: Shape, q: Array, roots: list[Array]) -> Array:
     return gradient
 
 
-def _starts(kernel: KinematicsKernel, shape: Shape, q0: Array, t0: float, p: Array
-            ) -> Iterator[Array]:
+def _starts(kernel: KinematicsKernel, shape: Shape, q0: Array, t0: float, p: Array,
+            centre: Array) -> Iterator[Array]:
     """q0 and the damped assembly's other first starts (runtime.assembly: the bodies placed
     along their joints, q0 perturbed), then the points of a low-discrepancy sequence
-    (_sequence): each planar angle uniform in [-pi, pi) with the positions placed along the
-    joints; each spatial body at a uniformly distributed orientation (Shoemake) with its
-    origin in the box of half-width REACH times the mechanism's size about q0's origin."""
+    (_sequence): each planar angle uniform over one turn, [-pi, pi) shifted by the whole
+    turns of its value in ``centre`` (an angle driven to 30 rad, an encoder's count of turns,
+    has its assemblies there: Newton from [-pi, pi) had to travel five turns in steps of
+    STEP_CAP and found none), with the positions placed along the joints; each spatial body at
+    a uniformly distributed orientation (Shoemake) with its origin in the box of half-width
+    REACH times the mechanism's size about q0's origin."""
     first = assembly_starts(kernel, q0, t0, p, random_angles=0)
     yield from first
     size = max(1.0, float(np.abs(q0[shape.positions]).max(initial=0.0)))
     angles = int(shape.angles.sum())
+    whole_turns = 2 * math.pi * np.round(centre[shape.angles] / (2 * math.pi))
     for point in _sequence(angles + 6 * len(shape.euler)):
         q = np.array(q0, dtype=float)
         if angles:
-            q[shape.angles] = math.pi * (2.0 * point[:angles] - 1.0)
+            q[shape.angles] = whole_turns + math.pi * (2.0 * point[:angles] - 1.0)
             q = placed(kernel, q, shape.angles, t0, p)
         for k, (block, origin) in enumerate(zip(shape.euler, shape.origins)):
             u = point[angles + 6 * k: angles + 6 * k + 6]

@@ -26,8 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -36,72 +35,29 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
-from symkin.errors import SolveError, SymkinWarning
-from symkin.runtime import branch, failures, forces, ranges, redundant, units
+from symkin.errors import SolveError
+from symkin.runtime import failures, forces, input_runs, ranges, redundant, units
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
-from symkin.runtime.assembly import Assembly, assemble
+from symkin.runtime.assembly import assemble
 from symkin.runtime.c_loop import _c_loop, _c_outcome, _c_run
 from symkin.runtime.edges import Resolution, resolve
-from symkin.runtime.inputs import InputValues, check_inputs, solve_points
+from symkin.runtime.inputs import InputValues
 from symkin.runtime.newton import Newton, kinematics, newton
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
 from symkin.runtime.result_arrays import Out, allocate
 from symkin.runtime.result_arrays import Run as _Run
 from symkin.runtime.results import Trajectory
+from symkin.runtime.run_outcome import SolveFailure as SolveFailure
+from symkin.runtime.run_outcome import SolveInterrupted as SolveInterrupted
+from symkin.runtime.run_outcome import _fail, _point_size
+from symkin.runtime.run_outcome import _trajectory as _trajectory
 from symkin.runtime.start import singular_start
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
-
-class SolveInterrupted(SolveError):
-    """The solve was interrupted (SIGINT, Ctrl-C); carries the rows solved before it.
-
-    Attributes:
-        trajectory: the time points solved before the interrupt.
-        t: the first time point not solved.
-    """
-
-    def __init__(self, trajectory: Trajectory, t: float) -> None:
-        super().__init__(f"interrupted at t = {t:g} after {trajectory.t.size} time points")
-        self.trajectory = trajectory
-        self.t = t
-
-
-class SolveFailure(SolveError):
-    """A solve stopped early; carries what is needed to act on it and the rows solved so far.
-
-    Attributes:
-        trajectory: the time points solved before the failure.
-        t: the time at which it failed.
-        residual: max |Phi| of the last iterate.
-        iterations: Newton iterations spent at t.
-        rows: labels of the dependent equations when Phi_q was singular, else ().
-        reason: "singular", "no convergence", "no assembly", "not finite" or
-            "limit position".
-        reached: where the step subdivision stopped (the limit time of a limit position: the
-            last time solved, bisected to within about 1e-9 of the grid step), else NaN.
-        aligned, drivers: at a limit position, the joints that become aligned and the drivers
-            that cannot be followed beyond it; else ().
-    """
-
-    def __init__(self, message: str, trajectory: Trajectory, t: float, residual: float,
-                 iterations: int, rows: Sequence[str] = (), reason: str = "",
-                 reached: float = math.nan, aligned: Sequence[str] = (),
-                 drivers: Sequence[str] = ()) -> None:
-        super().__init__(message)
-        self.trajectory = trajectory
-        self.t = t
-        self.residual = residual
-        self.iterations = iterations
-        self.rows = tuple(rows)
-        self.reason = reason
-        self.reached = reached
-        self.aligned = tuple(aligned)
-        self.drivers = tuple(drivers)
-
 
 # ----- the time loop -------------------------------------------------------------------------
 
@@ -215,7 +171,7 @@ def _solved(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         if sensitivities:
             raise SolveError("sensitivities= is not supported for a mechanism with input "
                              "drivers (q_p would need the inputs at every point)")
-        return _solve_inputs(kernel, t, q0, params, options, out,
+        return input_runs.solve_inputs(kernel, t, q0, params, options, out, progress,
                              (inputs, input_rates, input_accels))
     if input_rates is not None or input_accels is not None:
         raise SolveError("input_rates= and input_accels= need inputs= (and a mechanism with "
@@ -293,32 +249,6 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
         return _trajectory(kernel, run, p)
 
 
-def _solve_inputs(kernel: Any, t: ArrayLike | None, q0: ArrayLike | None,
-                  params: Mapping[str, float] | ArrayLike | None, options: Options,
-                  out: Out | None, given: tuple[InputValues | None, ...]) -> Trajectory:
-    """A run driven by inputs (runtime.inputs), failures raised as by the time loop."""
-    times = time_points(kernel, t)
-    table = check_inputs(kernel, times, *given)
-    p = parameter_values(kernel, params)
-    run = allocate(times, kernel.nq, out)
-    with np.errstate(all="ignore"):
-        result, pu, assembly = solve_points(kernel, run, table, first_guess(kernel, q0), p,
-                                          options)
-        if result.status != OK:
-            at = float(times[run.done])
-            _fail(kernel, run, pu, result, at, assembling=run.done == 0, assembly=assembly
-                  if run.done == 0 else None, params=p)
-    # each row's efforts and reactions at its own inputs (an actuator's depend on them)
-    rows = np.array([table.row(kernel, p, k) for k in range(run.done)]).reshape(run.done, -1)
-    trajectory = _trajectory(kernel, run, p, loads_p=rows)
-    with np.errstate(all="ignore"):
-        jumped = branch.jump_rows(kernel, trajectory.t, trajectory.q, rows)
-    trajectory.__dict__["branch_jumps"] = jumped
-    if jumped.any():
-        warnings.warn(branch.message(trajectory.t, jumped), SymkinWarning, stacklevel=3)
-    return trajectory
-
-
 def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,
           first: Newton | None, q: Array, p: Array, options: Options,
           progress: Progress | None) -> Newton | Resolution:
@@ -364,43 +294,6 @@ def _resume(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: A
     return _python_loop(kernel, run, q, p, options, progress)
 
 
-def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
-                point_vectors: Array | None = None, loads_p: Array | None = None) -> Trajectory:
-    """The Trajectory of the rows done, over the run's own arrays (p: owned by the run).
-    A run of a kernel with input drivers has efforts and reactions only given ``loads_p``,
-    each row's p[] with its inputs (T, NP + 3 NU); elsewhere they are not computed."""
-    done = run.done
-    arrays: tuple[NDArray[Any], ...] = (run.t, run.q, run.dq, run.d2q, run.flagged, run.cond)
-    if done < run.t.size:  # a partial result: the caller's rows viewed, the run's copied
-        arrays = tuple(a[:done] if run.caller_owned else a[:done].copy() for a in arrays)
-    t, q, dq, d2q, flagged, cond = arrays
-    if point_vectors is None:
-        point_vectors = np.asarray(kernel.point_vectors(p), dtype=float).reshape(
-            -1, _point_size(kernel))
-    singular = tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
-                     for s in run.passages) if run.passages else ()
-    trajectory = Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates),
-                                   tuple(kernel.points), point_vectors, p, run.fallbacks,
-                                   flagged, cond, singular, space=_space(kernel))
-    # inverse dynamics (a kernel with masses or forces): efforts and reactions of the rows
-    given = None if run.forces_out is None else tuple(a[:done] for a in run.forces_out)
-    if getattr(kernel, "nu", 0):
-        trajectory.__dict__["forces"] = (None if loads_p is None else
-                                         forces.compute(kernel, t, q, dq, d2q, loads_p))
-    else:
-        trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
-    return trajectory
-
-
-def _space(kernel: KinematicsKernel) -> str:
-    """``3d`` for a spatial kernel (a stand-in kernel without the attribute is planar)."""
-    return str(getattr(kernel, "space", "2d"))
-
-
-def _point_size(kernel: KinematicsKernel) -> int:
-    return 3 if _space(kernel) == "3d" else 2
-
-
 def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options,
                  assembled: Array | None = None) -> None:
     """Raise SolveFailure (reason "singular") when the start is a singular or limit
@@ -419,18 +312,6 @@ def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options
     raise SolveFailure(failures.explain_start(singular, t0), _trajectory(kernel, run, p), t0,
                        math.nan, 0, rows, "singular", math.nan, singular.aligned,
                        singular.drivers)
-
-
-def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
-          assembling: bool, assembly: Assembly | None = None,
-          params: Array | None = None) -> None:
-    """Raise SolveFailure with a message that says where, why and what to try (p: the
-    kernel's p[] at t; params: the parameters, when p also holds inputs)."""
-    last = None if run.done == 0 else (float(run.t[run.done - 1]), run.q[run.done - 1])
-    message, reason, rows = failures.explain(kernel, p, result, t, assembling, assembly, last)
-    params = p if params is None else params
-    raise SolveFailure(message, _trajectory(kernel, run, params), t, result.residual,
-                       result.iterations, rows, reason)
 
 
 def _fail_edge(kernel: KinematicsKernel, run: _Run, p: Array, stop: Resolution,

@@ -53,12 +53,22 @@ def explain(kernel: KinematicsKernel, p: Array, result: Newton, t: float, assemb
                                            f"Newton-Raphson then failed {where}")
         message = (f"Phi_q is singular {when} {facts}: {rows[0]}. This is a dead-centre or "
                    "toggle position, a redundant joint, or a driver that cannot move the "
-                   "mechanism here; end the time grid before it, or change the drivers.")
+                   "mechanism here; " + (
+                       "keep the inputs off it, or drive the mechanism through other joints."
+                       if _inputs(kernel) else
+                       "end the time grid before it, or change the drivers."))
     else:
         reason = "no convergence"
-        message = (f"Newton-Raphson did not converge {where} {facts}. Try a smaller time step "
-                   "dt, or check that the drivers are smooth and reachable.")
+        message = (f"Newton-Raphson did not converge {where} {facts}. " + (
+            "Give inputs closer together (a reading this far from the last one leaves "
+            "Newton's reach), or check that they are reachable." if _inputs(kernel) else
+            "Try a smaller time step dt, or check that the drivers are smooth and reachable."))
     return message, reason, rows[1:]
+
+
+def _inputs(kernel: KinematicsKernel) -> bool:
+    """Whether the kernel's drivers read inputs (the advice is then about them, not dt)."""
+    return bool(getattr(kernel, "input_names", ()))
 
 
 def options_tol(kernel: KinematicsKernel) -> float:

@@ -10,16 +10,19 @@ position-only run never pretends to know them. A C kernel solves each point in i
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.options import Options
-from symkin.contract.status import NOT_FINITE, OK
+from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
 from symkin.runtime.assembly import Assembly, assemble
+from symkin.runtime.edges import Passage
+from symkin.runtime.linalg import dependencies
 from symkin.runtime.newton import Newton, Point, kinematics, newton
 from symkin.runtime.result_arrays import Run
 
@@ -37,8 +40,9 @@ class InputStepper(Protocol):
     """Whether the last step's solution may lie on another assembly than the step before's
     (the generated solve's own form of runtime.branch's tests)."""
 
-    def start(self, options: Options, q: Array) -> None:
-        """Begin from q (the assembled first point)."""
+    def start(self, options: Options, q: Array, unit: float = 1.0) -> None:
+        """Begin from q (the assembled first point, in the kernel's unit), deciding in the
+        length unit ``unit`` (runtime.units)."""
 
     def step(self, t: float, pu: Array, rates: int) -> Point | Newton:
         """Solve at time t (for drivers that are functions of t) with the generated
@@ -159,8 +163,10 @@ def _finite(array: Array, what: str, names: tuple[str, ...], times: Array) -> No
 
 
 def solve_points(kernel: Any, run: Run, inputs: Inputs, q0: Array, p: Array,
-        options: Options) -> tuple[Newton, Array, Assembly | None]:
-    """Solve every point of the run from the last solution (the first assembled from q0).
+                 options: Options, progress: Callable[[int, int], None] | None = None
+                 ) -> tuple[Newton, Array, Assembly | None]:
+    """Solve every point of the run from the last solution (the first assembled from q0);
+    ``progress(done, total)`` after each point.
 
     Returns the outcome at the last point attempted (status OK when all are solved), the
     generated functions' p[] there and the assembly at the first point.
@@ -172,28 +178,87 @@ def solve_points(kernel: Any, run: Run, inputs: Inputs, q0: Array, p: Array,
         return assembly.result, first_p, assembly
     stepper = kernel.input_stepper()
     if stepper is not None:
-        return (*_c_points(kernel, run, inputs, stepper, assembly.result.q, p, options),
-                assembly)
-    result, pu = _python_points(kernel, run, inputs, assembly.result, p, options)
+        return (*_c_points(kernel, run, inputs, stepper, assembly.result, p, options,
+                           progress), assembly)
+    result, pu = _python_points(kernel, run, inputs, assembly.result, p, options, progress)
     return result, pu, assembly
 
 
 def _python_points(kernel: Any, run: Run, inputs: Inputs, first: Newton, p: Array,
-                   options: Options) -> tuple[Newton, Array]:
-    result, pu = first, inputs.row(kernel, p, 0)
-    for k in range(run.t.size):
-        t, pu = float(run.t[k]), inputs.row(kernel, p, k)
-        if k > 0:
-            nq, ndq, nddq = (float(np.nan_to_num(np.abs(v[k - 1])).max(initial=0.0))
-                             for v in (run.q, run.dq, run.d2q))  # NaN: not asked for
-            result = newton(kernel, run.q[k - 1].copy(), t, pu, options, (nq, ndq, nddq))
-            if result.status != OK:
-                return result, pu
-        point = kinematics(kernel, result, t, pu, options)
-        if point is None:
-            return Newton(result.q, NOT_FINITE, result.iterations, result.residual, None), pu
-        run.store(k, _without_unknown_rates(point, inputs.rates))
-    return result, pu
+                   options: Options, progress: Callable[[int, int], None] | None
+                   ) -> tuple[Newton, Array]:
+    pu = inputs.row(kernel, p, 0)
+    failed = _first_row(kernel, run, first, pu, options, inputs.rates, progress)
+    if failed is not None:
+        return failed, pu
+    regular = 0  # the last row solved off a singular configuration: the next start
+    for k in range(1, run.t.size):
+        pu = inputs.row(kernel, p, k)
+        kept, failed = _solve_row(kernel, run, *_from_row(run, regular), float(run.t[k]), pu,
+                                  options, inputs.rates)
+        if kept is None:
+            return failed, pu
+        regular = k if math.isfinite(kept.cond) else regular
+        _stored(run, k, kept, progress)
+    return first, pu
+
+
+def _first_row(kernel: Any, run: Run, first: Newton, pu: Array, options: Options, rates: int,
+               progress: Callable[[int, int], None] | None) -> Newton | None:
+    """Row 0 from the assembly's outcome (its q, dq and ddq there): stored, or the failure."""
+    point = kinematics(kernel, first, float(run.t[0]), pu, options, rates)
+    if point is None:
+        return Newton(first.q, NOT_FINITE, first.iterations, first.residual, None)
+    _stored(run, 0, _without_unknown_rates(point, rates), progress)
+    return None
+
+
+def _from_row(run: Run, k: int) -> tuple[Array, tuple[float, float, float]]:
+    """What Newton starts a row from: row k's q and its max |q|, |dq|, |ddq| (NaN rows: rates
+    not asked for, count as 0)."""
+    nq, ndq, nddq = (float(np.nan_to_num(np.abs(v[k])).max(initial=0.0))
+                     for v in (run.q, run.dq, run.d2q))
+    return run.q[k].copy(), (nq, ndq, nddq)
+
+
+def _solve_row(kernel: Any, run: Run, start: Array, norms: tuple[float, float, float],
+               t: float, pu: Array, options: Options, rates: int
+               ) -> tuple[Point | None, Newton]:
+    """One row by the runtime's Newton from ``start`` (the last row solved off a singular
+    configuration; norms: its max |q|, |dq|, |ddq|): the point to keep (a singular one too,
+    _singular_row), or None and the failed outcome (q: Newton's own last iterate, where the
+    failure is explained)."""
+    result = newton(kernel, start, t, pu, options, norms)
+    if result.status != OK:
+        return _singular_row(kernel, run, result, t, pu, options), result
+    point = kinematics(kernel, result, t, pu, options, rates)
+    if point is None:
+        return None, Newton(result.q, NOT_FINITE, result.iterations, result.residual, None)
+    return _without_unknown_rates(point, rates), result
+
+
+def _stored(run: Run, k: int, point: Point, progress: Callable[[int, int], None] | None
+            ) -> None:
+    run.store(k, point)
+    if progress is not None:
+        progress(run.done, run.t.size)
+
+
+def _singular_row(kernel: Any, run: Run, failed: Newton, t: float, pu: Array,
+                  options: Options) -> Point | None:
+    """A row whose inputs put the mechanism in a singular configuration (an encoder's tick on a
+    dead centre: Phi_q's condition over options.max_cond), or None for any other failure:
+    Newton assembled it (its residual within tol_phi) and only Phi_q is singular. Its q
+    stands; the inputs do not fix dq and ddq there (NaN), and the row is flagged, its condition
+    infinite; the passage is recorded as a run over t records the singular configuration it
+    passes. Before, such a row stopped the run, where the same motion driven by t passed it."""
+    if failed.status != SINGULAR or not failed.residual <= options.tol_phi:
+        return None
+    rank_loss, groups = dependencies(np.asarray(kernel.phi_q(failed.q, t, pu), dtype=float),
+                                     list(kernel.rows), rcond=1e-7)
+    run.passages.append(Passage(t, rank_loss, groups))
+    nan = np.full(failed.q.size, np.nan)
+    return Point(failed.q, nan, nan, math.inf, True)
 
 
 def _without_unknown_rates(point: Point, rates: int) -> Point:
@@ -204,15 +269,38 @@ def _without_unknown_rates(point: Point, rates: int) -> Point:
     return Point(point.q, point.dq if rates else nan, nan, point.cond, point.flagged)
 
 
-def _c_points(kernel: Any, run: Run, inputs: Inputs, stepper: InputStepper, q: Array,
-              p: Array, options: Options) -> tuple[Newton, Array]:
+def _c_points(kernel: Any, run: Run, inputs: Inputs, stepper: InputStepper, first: Newton,
+              p: Array, options: Options, progress: Callable[[int, int], None] | None
+              ) -> tuple[Newton, Array]:
+    """Each row one call of the generated solve; a row it fails is solved again by the
+    runtime's Newton as the NumPy backend solves every row (the C solve left its state at the
+    last solution), so that both backends keep, flag or explain that row alike, and the C
+    solve goes on from what that gave."""
     pu = inputs.row(kernel, p, 0)
-    stepper.start(options, q)
+    stepper.start(options, first.q)
+    regular, earlier = 0, 0  # the restart row; the fall-backs of the solves before a restart
     for k in range(run.t.size):
         pu = inputs.row(kernel, p, k)
         outcome = stepper.step(float(run.t[k]), pu, inputs.rates)
-        run.fallbacks = stepper.fallbacks
-        if isinstance(outcome, Newton):
-            return outcome, pu
-        run.store(k, outcome)
+        run.fallbacks = earlier + stepper.fallbacks
+        if isinstance(outcome, Point):
+            regular = k
+            _stored(run, k, outcome, progress)
+            continue
+        if k == 0:  # from the assembly's outcome, as the NumPy backend takes it
+            failure = _first_row(kernel, run, first, pu, options, inputs.rates, progress)
+            if failure is not None:
+                return failure, pu
+        else:  # from the last row solved off a singular configuration
+            kept, failed = _solve_row(kernel, run, *_from_row(run, regular), float(run.t[k]),
+                                      pu, options, inputs.rates)
+            if kept is None:
+                return failed, pu
+            if math.isfinite(kept.cond):
+                regular = k
+            _stored(run, k, kept, progress)
+        earlier = run.fallbacks
+        # From a singular q Newton would crawl (Phi_q singular at its start): after one the
+        # C solve goes on from the last row solved off it.
+        stepper.start(options, run.q[regular])
     return Newton(run.q[run.done - 1], OK, 0, 0.0, None), pu

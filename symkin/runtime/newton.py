@@ -151,15 +151,18 @@ def _estimate_again(before: Newton, after: Newton) -> Newton:
     return _estimate(after)
 
 
-def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, options: Options
-               ) -> Point | None:
+def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, options: Options,
+               solved: int = 2) -> Point | None:
     """Velocities (2.73) and accelerations (2.74) at a converged point, with its flag; None
-    when they are not finite (Phi_t or Gamma singular at t)."""
+    when they are not finite (Phi_t or Gamma singular at t). ``solved`` < 2: an input-driven
+    point whose accelerations (< 1: also rates) were not given: those are not solved for and
+    stand as zeros, for the flag too (as the generated C solve_inputs, given NULL, does)."""
     factors = result.factors
     assert factors is not None  # newton returns the factors whenever it converges
     q = result.q
-    dq = factors.solve(-kernel.phi_t(q, t, p))  # (2.73)
-    ddq = factors.solve(kernel.gamma(q, dq, t, p))  # (2.74)
+    zeros = np.zeros_like(q)
+    dq = factors.solve(-kernel.phi_t(q, t, p)) if solved >= 1 else zeros  # (2.73)
+    ddq = factors.solve(kernel.gamma(q, dq, t, p)) if solved >= 2 else zeros  # (2.74)
     if not (np.all(np.isfinite(dq)) and np.all(np.isfinite(ddq))):
         return None
     unit = UNIT_ROUNDOFF[getattr(kernel, "real", "double")]

@@ -192,7 +192,8 @@ def _branches(kernel: KinematicsKernel, t0: float, p: Array) -> list[Branch]:
     # alone are assembled, which is no assembly of the file (runtime.redundant).
     if first.status == OK and redundant.holds(kernel, first.q, t0, p, options.target_q):
         found.append(Branch(shape.canonical(first.q), first.cond, True))
-    for result in search(kernel, q0, t0, p, options, [b.q for b in found]):
+    turns = first.q if first.status == OK else q0  # the turn the angles are driven to
+    for result in search(kernel, q0, t0, p, options, [b.q for b in found], turns):
         found.append(Branch(shape.canonical(result.q), result.cond, False))
     return found
 

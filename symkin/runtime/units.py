@@ -24,6 +24,7 @@ Imports NumPy only: part of the runtime.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -31,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.options import Options
+from symkin.runtime.newton import Newton, Point
 from symkin.runtime.protocol import ChunkResult, GridSolver, KinematicsKernel
 from symkin.runtime.start import length_rows, length_scale, positions
 
@@ -94,6 +96,16 @@ class ScaledKernel:
         del unit  # q is in this view's unit already
         inner = self.kernel.grid_solver(options, self.to_length(q), p, self.unit)
         return None if inner is None else ScaledGridSolver(inner, self)
+
+    def input_stepper(self) -> ScaledInputStepper | None:
+        """The kernel's generated input solve deciding in this unit, seen in it (None where
+        the kernel has none, or one that cannot rescale, as grid_solver: the runtime's Newton
+        then solves this view)."""
+        make = getattr(self.kernel, "input_stepper", None)  # (an input kernel's, runtime.inputs)
+        if make is None or not getattr(self.kernel, "scale_free", True):
+            return None
+        inner = make()
+        return None if inner is None else ScaledInputStepper(inner, self)
 
     def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array, p: Array
                          ) -> tuple[Array, Array]:
@@ -185,3 +197,33 @@ class ScaledGridSolver:
     def release(self) -> None:
         self.rows = ()
         self.solver.release()
+
+
+class ScaledInputStepper:
+    """A kernel's generated input solve (runtime.inputs.InputStepper) run in the unit u, shown
+    in that unit like ScaledKernel: q handed to it is multiplied back, the q, dq, ddq it
+    returns (in the kernel's unit) are divided by the column scales."""
+
+    def __init__(self, stepper: Any, scaled: ScaledKernel) -> None:
+        self.stepper = stepper
+        self.scaled = scaled
+
+    @property
+    def fallbacks(self) -> int:
+        return int(self.stepper.fallbacks)
+
+    @property
+    def branch_jump(self) -> bool:
+        return bool(self.stepper.branch_jump)
+
+    def start(self, options: Options, q: Array, unit: float = 1.0) -> None:
+        del unit  # q is in this view's unit already
+        self.stepper.start(options, self.scaled.to_length(q), self.scaled.unit)
+
+    def step(self, t: float, pu: Array, rates: int) -> Point | Newton:
+        outcome: Point | Newton = self.stepper.step(t, pu, rates)
+        column = self.scaled.column
+        if isinstance(outcome, Point):
+            return dataclasses.replace(outcome, q=outcome.q / column, dq=outcome.dq / column,
+                                       ddq=outcome.ddq / column)
+        return dataclasses.replace(outcome, q=outcome.q / column)

@@ -6,7 +6,7 @@ from typing import Any
 
 from symkin import pairs
 from symkin.errors import MechanismError, format_path
-from symkin.pairs.fields import GROUND
+from symkin.pairs.fields import GROUND, is_input
 from symkin.spec.names import name_problem
 from symkin.spec.schema import MechanismSpec
 
@@ -56,3 +56,46 @@ def _check_coordinate_name(mech: MechanismSpec, constraint: Any,
         raise MechanismError(f"the name {constraint.name!r} is a body's", path + ("name",),
                              f"Its coordinate {constraint.name}.s would read as a coordinate "
                              "of that body; use another name.")
+
+
+# The suffixes of an input's rate and acceleration: columns NAME_t, NAME_tt of an inputs table.
+RATE_SUFFIXES = ("_t", "_tt")
+
+
+def input_places(mech: MechanismSpec) -> list[tuple[str, int, str, int | None]]:
+    """Every driver function written ``input``, drivers in file order, components in order:
+    (its name, the driver's index, the key, the component or None). The name is the driver's
+    (``drivers[k]`` when unnamed), with ``_x``, ``_y``, ``_z`` per component of a vector."""
+    found = []
+    for index, driver in enumerate(mech.drivers):
+        base = driver.name or f"drivers[{index}]"
+        for key in pairs.of(driver).time_functions:
+            value = getattr(driver, key)
+            components = enumerate(value) if isinstance(value, list) else ((None, value),)
+            for component, raw in components:
+                if is_input(raw):
+                    name = base if component is None else f"{base}_{'xyz'[component]}"
+                    found.append((name, index, key, component))
+    return found
+
+
+def _check_input_names(mech: MechanismSpec) -> None:
+    """Each input's value, rate and acceleration need a name of their own (a column of an
+    inputs table, a key of inputs=): two inputs of one name, or one named as another's rate
+    (v and v_t), would read one another's values."""
+    seen: dict[str, tuple[str, tuple[str | int, ...]]] = {}
+    for name, index, key, component in input_places(mech):
+        path: tuple[str | int, ...] = ("drivers", index, key) + (
+            () if component is None else (component,))
+        for suffix, what in zip(("", *RATE_SUFFIXES), ("the input", "the rate of the input",
+                                                       "the acceleration of the input")):
+            column, this = name + suffix, f"{what} {name!r}"
+            if column in seen:
+                other, where = seen[column]
+                raise MechanismError(
+                    f"{this} and {other} at {format_path(where)} share the name {column!r}",
+                    path,
+                    "Inputs are given by name (a column of the inputs table, with NAME_t and "
+                    "NAME_tt for rates and accelerations): name the drivers so that no input "
+                    "is called as another or as another's rate (v and v_t).")
+            seen[column] = (this, path)

@@ -25,7 +25,7 @@ from symkin.spec.forces3d import entries, magnitude_problem
 from symkin.spec.messages import translate
 from symkin.spec.mobility import check_degrees_of_freedom
 from symkin.spec.mobility import degrees_of_freedom as degrees_of_freedom
-from symkin.spec.name_checks import _check_coordinate_name, _check_names
+from symkin.spec.name_checks import _check_coordinate_name, _check_input_names, _check_names
 from symkin.spec.names import name_problem
 from symkin.spec.schema import MechanismSpec, SpatialMechanismSpec
 
@@ -175,6 +175,7 @@ def _check_semantics(mech: Mechanism) -> None:
                                      "rows of Phi.")
             if constraint.name is not None:
                 named[constraint.name] = path
+    _check_input_names(mech)
     _check_time(mech, symbols, nominal)
     _check_dynamics(mech, symbols, nominal)
     check_degrees_of_freedom(mech)

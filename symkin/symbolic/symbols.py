@@ -8,7 +8,8 @@ from functools import cached_property
 import sympy as sp
 
 from symkin import pairs
-from symkin.pairs.fields import GROUND, is_input
+from symkin.pairs.fields import GROUND
+from symkin.spec.name_checks import RATE_SUFFIXES, input_places
 from symkin.spec.schema import MechanismSpec
 
 
@@ -96,15 +97,8 @@ def find_inputs(mech: MechanismSpec) -> tuple[Input, ...]:
     can have such a name, so they never clash with one.
     """
     found = []
-    for index, driver in enumerate(mech.drivers):
-        base = driver.name or f"drivers[{index}]"
-        for key in pairs.of(driver).time_functions:
-            value = getattr(driver, key)
-            components = enumerate(value) if isinstance(value, list) else ((None, value),)
-            for component, raw in components:
-                if is_input(raw):
-                    name = base if component is None else f"{base}_{'xyz'[component]}"
-                    u, du, ddu = (sp.Symbol(f"input:{name}{suffix}", real=True)
-                                  for suffix in ("", "_t", "_tt"))
-                    found.append(Input(name, index, key, component, u, du, ddu))
+    for name, index, key, component in input_places(mech):
+        u, du, ddu = (sp.Symbol(f"input:{name}{suffix}", real=True)
+                      for suffix in ("", *RATE_SUFFIXES))  # distinct: spec checked the names
+        found.append(Input(name, index, key, component, u, du, ddu))
     return tuple(found)

@@ -77,6 +77,7 @@ GOOD = ["0,1.5", "0.1,1.6"]
     ("t,crank_angle", ["0,1.5", "0.2,1", "0.1,1"], "u.csv:4", "the times must increase"),
     ("t,crank_angle", ["0,1.5", "0,1"], "u.csv:3", "the times must increase"),
     ("t,crank_angle", ["1e999,1"], "u.csv:2", "not a finite number"),
+    ("t,crank_angle", ["0,1_5"], "u.csv:2", "'1_5' is not a finite number"),  # not 15
     ("t,crank_angle", [], "u.csv", "no rows of values"),
 ])
 def test_bad_tables_are_refused_with_their_place(tmp_path: Path, header: str, rows: list[str],
@@ -99,3 +100,47 @@ def test_input_mechanism_without_table_and_table_without_inputs(tmp_path: Path) 
     assert got.returncode == 2 and "leave out --dt" in got.stderr
     got = run(str(INPUT), "--backend", "numpy", "--inputs", "missing.csv", cwd=tmp_path)
     assert got.returncode == 2 and "cannot read the input table" in got.stderr
+
+
+def test_a_table_with_a_byte_order_mark_reads_as_without(tmp_path: Path) -> None:
+    """Spreadsheets write "CSV UTF-8" with a byte-order mark before the header."""
+    plain = _table(tmp_path / "plain.csv", "t,crank_angle", GOOD)
+    marked = tmp_path / "marked.csv"
+    marked.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    for table, out in ((plain, "a.npz"), (marked, "b.npz")):
+        got = run(str(INPUT), "--backend", "numpy", "--inputs", str(table), "-o", out,
+                  cwd=tmp_path)
+        assert got.returncode == 0, got.stderr
+    assert np.array_equal(np.load(tmp_path / "a.npz")["q"], np.load(tmp_path / "b.npz")["q"])
+
+
+@pytest.mark.parametrize("output", ["u.csv", "link.csv", "./sub/../u.csv"])
+def test_the_results_never_replace_the_input_table(tmp_path: Path, output: str) -> None:
+    table = _table(tmp_path / "u.csv", "t,crank_angle", GOOD)
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "link.csv").symlink_to(table)
+    before = table.read_bytes()
+    got = run(str(INPUT), "--backend", "numpy", "--inputs", "u.csv", "-o", output,
+              cwd=tmp_path)
+    assert got.returncode == 2 and "is the --inputs table" in got.stderr, got.stderr
+    assert table.read_bytes() == before
+
+
+def _symkin(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    result = subprocess.run([sys.executable, "-m", "symkin", *args], cwd=cwd, env=env,
+                            check=False, capture_output=True, text=True, timeout=300)
+    assert "Traceback" not in result.stderr, result.stderr
+    return result
+
+
+def test_sweep_and_scan_mistakes_about_inputs_are_the_users(tmp_path: Path) -> None:
+    """Exit 2, as run gives, and in the command line's words: a sweep of a mechanism with
+    inputs (it exited 1, as for a design that failed), --input for a mechanism without
+    (the message named Python's inputs= and told to give --input as well as to leave it out)."""
+    got = _symkin("sweep", str(INPUT), "--backend", "numpy", "--vary", "a=0.9:1.1:3",
+                  cwd=tmp_path)
+    assert got.returncode == 2 and "input drivers (crank_angle)" in got.stderr, got.stderr
+    got = _symkin("scan", str(TIMED), "--backend", "numpy", "--input", "x=1", cwd=tmp_path)
+    assert got.returncode == 2 and "leave out --input" in got.stderr, got.stderr
+    assert "inputs=" not in got.stderr and "give --input" not in got.stderr

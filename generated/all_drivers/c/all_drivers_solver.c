@@ -10,6 +10,13 @@
 
 #include "all_drivers_solver.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 void all_drivers_default_options(all_drivers_options *options)
 {
     options->tol_phi = 1e-10;
@@ -781,6 +788,8 @@ static int all_drivers_newton(const all_drivers_options *options, const all_driv
     int i, iteration;
     report->t = t;
     report->pivot = -1;
+    report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
+    report->residual = (all_drivers_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
         all_drivers_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */

@@ -10,6 +10,13 @@
 
 #include "cam_cycloidal_solver.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 void cam_cycloidal_default_options(cam_cycloidal_options *options)
 {
     options->tol_phi = 1e-10;
@@ -559,6 +566,8 @@ static int cam_cycloidal_newton(const cam_cycloidal_options *options, const cam_
     int i, iteration;
     report->t = t;
     report->pivot = -1;
+    report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
+    report->residual = (cam_cycloidal_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
         cam_cycloidal_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */

@@ -10,6 +10,13 @@
 
 #include "crank_slider_input_solver.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 void crank_slider_input_default_options(crank_slider_input_options *options)
 {
     options->tol_phi = 1e-10;
@@ -140,7 +147,7 @@ void crank_slider_input_length_scales(int m, const crank_slider_input_real p[], 
     int j;
     for (j = 0; j < m; ++j) {
         crank_slider_input_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * CRANK_SLIDER_INPUT_NP : p, nz);
+                           p ? p + (size_t)j * CRANK_SLIDER_INPUT_NPU : p, nz);
         scales[j] = crank_slider_input_lever_arm(nz);
     }
 }
@@ -567,6 +574,8 @@ static int crank_slider_input_newton(const crank_slider_input_options *options, 
     int i, iteration;
     report->t = t;
     report->pivot = -1;
+    report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
+    report->residual = (crank_slider_input_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
         crank_slider_input_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
@@ -687,10 +696,19 @@ static void crank_slider_input_with_inputs(crank_slider_input_real pu[], const c
     }
 }
 
-/* max |v_i| of a computed v (NaN when some v_i is NaN), else 0. */
-static crank_slider_input_real crank_slider_input_norm_if(int computed, const crank_slider_input_real v[])
+/* max |v_i| / column_i of a computed v (kernel unit): its max norm in the run's unit (NaN
+ * when some v_i is NaN); 0 when not computed. */
+static crank_slider_input_real crank_slider_input_norm_if(int computed, const crank_slider_input_workspace *work, const crank_slider_input_real v[])
 {
-    return computed ? crank_slider_input_max_abs(v) : 0;
+    crank_slider_input_real largest = 0, sum = 0;
+    int i;
+    if (!computed) return 0;
+    for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
+        const crank_slider_input_real a = fabs(v[i]) * work->inverse_column[i];
+        largest = a > largest ? a : largest;
+        sum += a; /* NaN exactly when some a is (as in max_abs) */
+    }
+    return sum != sum ? (crank_slider_input_real)NAN : largest;
 }
 
 #define CRANK_SLIDER_INPUT_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
@@ -754,7 +772,8 @@ static int crank_slider_input_chord(const crank_slider_input_real p[], crank_sli
 /* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
  * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
  * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
- * none was solved: the first call, or after a failed one); nq: max |q|. */
+ * none was solved: the first call, or after a failed one); nq: max |q|; both in the run's
+ * unit, as the distance is measured here. */
 static int crank_slider_input_branch_jump(crank_slider_input_workspace *work, const crank_slider_input_real q[],
                                     const crank_slider_input_real predicted[], crank_slider_input_real first, crank_slider_input_real nq)
 {
@@ -765,7 +784,7 @@ static int crank_slider_input_branch_jump(crank_slider_input_workspace *work, co
         crank_slider_input_real remainder = 0, a, bound = CRANK_SLIDER_INPUT_BRANCH_REGION * first;
         int i;
         for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
-            a = fabs(q[i] - predicted[i]);
+            a = fabs(q[i] - predicted[i]) * work->inverse_column[i];
             remainder = a > remainder ? a : remainder;
         }
         bound = bound > least ? bound : least;
@@ -784,14 +803,16 @@ int crank_slider_input_solve_inputs(const crank_slider_input_options *options, c
 {
     crank_slider_input_real pu[CRANK_SLIDER_INPUT_NP + 3 * CRANK_SLIDER_INPUT_NU];
     crank_slider_input_real nq, ndq, nddq, predicted[CRANK_SLIDER_INPUT_NQ], first = (crank_slider_input_real)NAN;
+    crank_slider_input_real last[CRANK_SLIDER_INPUT_NQ]; /* the last solution, kept for a call that fails */
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
     int i, chord;
     crank_slider_input_with_inputs(pu, p, u, du, ddu);
+    memcpy(last, state->q, sizeof last);
     report->flagged = 0;
     report->branch_jump = 0;
     report->cond = (crank_slider_input_real)NAN;
     if (!state->started) {
-        crank_slider_input_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
+        crank_slider_input_prepare(options->unit, work); /* decided in options->unit, as solve_step */
         work->det_sign = 0;
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
@@ -803,6 +824,9 @@ int crank_slider_input_solve_inputs(const crank_slider_input_options *options, c
     report->iterations += chord;
     report->fallbacks = crank_slider_input_lu_fallbacks(&work->lu);
     if (report->status != CRANK_SLIDER_INPUT_OK) {
+        /* Not the iterate Newton failed at (after a reading out of reach it may lie far off,
+         * and every later call would start from it): the last solution. */
+        memcpy(state->q, last, sizeof last);
         return report->status;
     }
     if (rates) { /* (2.73), Phi_t holding du; Newton's last fused call left this q's shared */
@@ -810,20 +834,25 @@ int crank_slider_input_solve_inputs(const crank_slider_input_options *options, c
         for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) {
             state->dq[i] = -state->dq[i];
         }
+        crank_slider_input_rows_in_unit(work, state->dq);
         crank_slider_input_lu_solve(&work->lu, state->dq);
+        crank_slider_input_from_unit(work, state->dq);
     }
     if (accelerations) { /* (2.74), Gamma holding ddu; the same factors */
         crank_slider_input_gamma_shared(state->q, state->dq, state->t, pu, work->shared, state->ddq);
+        crank_slider_input_rows_in_unit(work, state->ddq);
         crank_slider_input_lu_solve(&work->lu, state->ddq);
+        crank_slider_input_from_unit(work, state->ddq);
     }
-    nq = crank_slider_input_max_abs(state->q);
-    report->branch_jump = crank_slider_input_branch_jump(work, state->q, predicted, first, nq);
-    ndq = crank_slider_input_norm_if(rates, state->dq);
-    nddq = crank_slider_input_norm_if(accelerations, state->ddq);
+    ndq = crank_slider_input_norm_if(rates, work, state->dq);
+    nddq = crank_slider_input_norm_if(accelerations, work, state->ddq);
     if (ndq - ndq != 0 || nddq - nddq != 0) {
         report->status = CRANK_SLIDER_INPUT_NOT_FINITE; /* Phi_t or Gamma singular here */
+        memcpy(state->q, last, sizeof last);
         return report->status;
     }
+    nq = crank_slider_input_norm_if(1, work, state->q);
+    report->branch_jump = crank_slider_input_branch_jump(work, state->q, predicted, first, nq);
     for (i = 0; i < CRANK_SLIDER_INPUT_NQ; ++i) { /* what was not asked for is not a number */
         if (!rates) state->dq[i] = (crank_slider_input_real)NAN;
         if (!accelerations) state->ddq[i] = (crank_slider_input_real)NAN;
@@ -902,7 +931,7 @@ int crank_slider_input_solve_batch(const crank_slider_input_options *options, co
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * CRANK_SLIDER_INPUT_NQ;
-        const crank_slider_input_real *p_set = p ? p + (size_t)j * CRANK_SLIDER_INPUT_NP : p;
+        const crank_slider_input_real *p_set = p ? p + (size_t)j * CRANK_SLIDER_INPUT_NPU : p;
         crank_slider_input_real *q_set = crank_slider_input_block(q_out, rows);
         crank_slider_input_real *dq_set = crank_slider_input_block(dq_out, rows);
         crank_slider_input_real *ddq_set = crank_slider_input_block(ddq_out, rows);

@@ -28,6 +28,8 @@ typedef struct {
     crank_slider_input_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
     crank_slider_input_real tol_dq;          /* ... and the last Newton step max|dq| <= tol_dq */
     int max_iterations;                /* Newton iterations per time step                */
+                                       /* (solve_inputs: its simplified steps, at most 6, */
+                                       /* come on top)                                   */
     crank_slider_input_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     crank_slider_input_real max_cond;        /* ... or the condition estimate is above this     */
     crank_slider_input_real tighten_cond;    /* above this, or where the point would be flagged */
@@ -42,7 +44,7 @@ typedef struct {
                                        /* and out stay in the mechanism's own unit. 1 (the */
                                        /* default): that unit. A mechanism drawn in mm is  */
                                        /* decided alike with unit 1000. Ignored where      */
-                                       /* CRANK_SLIDER_INPUT_SCALE_FREE is 0 and by crank_slider_input_solve_inputs. */
+                                       /* CRANK_SLIDER_INPUT_SCALE_FREE is 0. */
 } crank_slider_input_options;
 
 /* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
@@ -59,17 +61,17 @@ typedef struct {
  * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
  * Step, worst case with the default cap of 25 iterations: 6845 (2694 add/sub, 1406 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1220 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 6289 (3004 add/sub, 634 mul, 114 div, 10 sqrt, 148 other calls, 1040 fabs, 1339 compares)
- *   positions only (du, ddu NULL): 6179 (2948 add/sub, 618 mul, 114 div, 10 sqrt, 148 other calls, 1022 fabs, 1319 compares)
- *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 548
+ * solve_inputs, worst case: 7511 (3004 add/sub, 1505 mul, 465 div, 10 sqrt, 148 other calls, 1040 fabs, 1339 compares)
+ *   positions only (du, ddu NULL): 7347 (2948 add/sub, 1453 mul, 447 div, 10 sqrt, 148 other calls, 1022 fabs, 1319 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 656
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37607
  */
 #define CRANK_SLIDER_INPUT_OPS_ITERATION 185   /* one Newton iteration */
 #define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2220  /* a step without its iterations */
 #define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6845  /* at the default cap, 25 */
 #define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37607  /* every factorization dense */
-#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 6289  /* solve_inputs with du, ddu */
-#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 6179  /* solve_inputs, du, ddu NULL */
+#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7511  /* solve_inputs with du, ddu */
+#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7347  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -118,6 +120,11 @@ typedef struct {
 /* Tolerances suited to the real type. */
 void crank_slider_input_default_options(crank_slider_input_options *options);
 
+/* With input drivers, every function of this header but crank_slider_input_solve_inputs reads
+ * p[NPU] (NPU = 6): the NP parameters, then the inputs u[NU], du[NU], ddu[NU], held at
+ * those values over the call (a motion in t with the inputs still); crank_slider_input_p_nominal
+ * alone is too short for them. crank_slider_input_solve_inputs takes p[NP] and the inputs apart. */
+
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */
 int crank_slider_input_solve_step(const crank_slider_input_options *options, const crank_slider_input_real p[],
@@ -152,7 +159,8 @@ int crank_slider_input_solve_grid_checked(const crank_slider_input_options *opti
  * are taken at state->t (the caller sets it); state->t is not changed. From the second call,
  * simplified Newton steps on the factors the last call left come first (report->iterations
  * counts them too), then Newton with Phi_q evaluated and factored at their q. Returns the
- * status (also in report); on failure state->q holds the last Newton iterate.
+ * status (also in report); on failure state->q is left at the last solution (the first guess
+ * before any), so that the next call, with inputs back in reach, starts from there again.
  * report->branch_jump is 1 when the solution may lie on another assembly than the last call's
  * (Newton converges as well there, with nothing else to show for it): det(Phi_q) changed sign
  * since the last solution (a singular configuration lies between the two), or the solution is
@@ -176,7 +184,7 @@ typedef struct {
 } crank_slider_input_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
- * p[j*NP ...] and starts from q0[j*NQ ...] (q0_stride = NQ) or, with q0_stride = 0, every set
+ * p[j*NPU ...] and starts from q0[j*NQ ...] (q0_stride = NQ) or, with q0_stride = 0, every set
  * from the one guess q0[0 ... NQ-1]; its decisions are made in the length unit units[j]
  * (options->unit for every set when units is NULL). Rows of set j, step k go to
  * q_out[(j*n + k)*NQ ...] (and dq_out, ddq_out; any may be NULL): caller-owned m x n x NQ
@@ -191,7 +199,7 @@ int crank_slider_input_solve_batch(const crank_slider_input_options *options, co
                              crank_slider_input_state *state, crank_slider_input_workspace *work,
                              crank_slider_input_batch_report reports[]);
 
-/* The length scale of m configurations: per set j (parameters p[j*NP ...], coordinates
+/* The length scale of m configurations: per set j (parameters p[j*NPU ...], coordinates
  * q[j*q_stride ...], at time t), the largest lever arm in Phi_q, max |dPhi_i/dphi_k| /
  * max |dPhi_i/dx_k| over the rows i with an entry in a length column (symkin's
  * runtime.start.length_scale): 0 where there is none, NaN where an entry of Phi_q is not

@@ -10,6 +10,13 @@
 
 #include "delta_solver.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 void delta_default_options(delta_options *options)
 {
     options->tol_phi = 1e-10;
@@ -613,6 +620,8 @@ static int delta_newton(const delta_options *options, const delta_real p[], delt
     int i, iteration;
     report->t = t;
     report->pivot = -1;
+    report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
+    report->residual = (delta_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
         delta_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */

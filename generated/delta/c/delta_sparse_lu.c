@@ -10,6 +10,13 @@
 #include <math.h>
 #include "delta_sparse_lu.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 #define DELTA_LU_TAU ((delta_real)0.01)
 /* A pivot at or below NQ * epsilon * max |Phi_q| means a numerically singular Jacobian. */
 #define DELTA_LU_TINY (DELTA_NQ * DBL_EPSILON)

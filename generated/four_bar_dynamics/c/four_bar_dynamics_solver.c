@@ -10,6 +10,13 @@
 
 #include "four_bar_dynamics_solver.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 void four_bar_dynamics_default_options(four_bar_dynamics_options *options)
 {
     options->tol_phi = 1e-10;
@@ -581,6 +588,8 @@ static int four_bar_dynamics_newton(const four_bar_dynamics_options *options, co
     int i, iteration;
     report->t = t;
     report->pivot = -1;
+    report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
+    report->residual = (four_bar_dynamics_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
         four_bar_dynamics_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */

@@ -10,6 +10,13 @@
 
 #include "rssr_solver.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 void rssr_default_options(rssr_options *options)
 {
     options->tol_phi = 1e-10;
@@ -910,6 +917,8 @@ static int rssr_newton(const rssr_options *options, const rssr_real p[], rssr_re
     int i, iteration;
     report->t = t;
     report->pivot = -1;
+    report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
+    report->residual = (rssr_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
         rssr_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */

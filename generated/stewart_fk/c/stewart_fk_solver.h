@@ -28,6 +28,8 @@ typedef struct {
     stewart_fk_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
     stewart_fk_real tol_dq;          /* ... and the last Newton step max|dq| <= tol_dq */
     int max_iterations;                /* Newton iterations per time step                */
+                                       /* (solve_inputs: its simplified steps, at most 6, */
+                                       /* come on top)                                   */
     stewart_fk_real min_pivot_ratio; /* singular when min|u_kk| / max|u_kk| is below   */
     stewart_fk_real max_cond;        /* ... or the condition estimate is above this     */
     stewart_fk_real tighten_cond;    /* above this, or where the point would be flagged */
@@ -42,7 +44,7 @@ typedef struct {
                                        /* and out stay in the mechanism's own unit. 1 (the */
                                        /* default): that unit. A mechanism drawn in mm is  */
                                        /* decided alike with unit 1000. Ignored where      */
-                                       /* STEWART_FK_SCALE_FREE is 0 and by stewart_fk_solve_inputs. */
+                                       /* STEWART_FK_SCALE_FREE is 0. */
 } stewart_fk_options;
 
 /* 1 when the solver honours options.unit; 0 for a mechanism whose Phi_q holds a lever arm
@@ -59,17 +61,17 @@ typedef struct {
  * Velocity: 118; acceleration: 996; per-point checks: 3224; predictor: 43
  * Step, worst case with the default cap of 25 iterations: 46421 (18359 add/sub, 19201 mul, 512 div, 10 sqrt, 0 other calls, 4550 fabs, 3789 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 46884 (19429 add/sub, 18678 mul, 280 div, 10 sqrt, 0 other calls, 4599 fabs, 3888 compares)
- *   positions only (du, ddu NULL): 45754 (18877 add/sub, 18130 mul, 280 div, 10 sqrt, 0 other calls, 4585 fabs, 3872 compares)
- *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2270
+ * solve_inputs, worst case: 48785 (19429 add/sub, 20306 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3888 compares)
+ *   positions only (du, ddu NULL): 47613 (18877 add/sub, 19730 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3872 compares)
+ *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2354
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62220
  */
 #define STEWART_FK_OPS_ITERATION 1402   /* one Newton iteration */
 #define STEWART_FK_OPS_STEP_FIXED 11371  /* a step without its iterations */
 #define STEWART_FK_OPS_STEP_WORST 46421  /* at the default cap, 25 */
 #define STEWART_FK_OPS_STEP_DENSE_WORST 62220  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 46884  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 45754  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_INPUTS_WORST 48785  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 47613  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
@@ -118,6 +120,11 @@ typedef struct {
 /* Tolerances suited to the real type. */
 void stewart_fk_default_options(stewart_fk_options *options);
 
+/* With input drivers, every function of this header but stewart_fk_solve_inputs reads
+ * p[NPU] (NPU = 18): the NP parameters, then the inputs u[NU], du[NU], ddu[NU], held at
+ * those values over the call (a motion in t with the inputs still); stewart_fk_p_nominal
+ * alone is too short for them. stewart_fk_solve_inputs takes p[NP] and the inputs apart. */
+
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */
 int stewart_fk_solve_step(const stewart_fk_options *options, const stewart_fk_real p[],
@@ -152,7 +159,8 @@ int stewart_fk_solve_grid_checked(const stewart_fk_options *options,
  * are taken at state->t (the caller sets it); state->t is not changed. From the second call,
  * simplified Newton steps on the factors the last call left come first (report->iterations
  * counts them too), then Newton with Phi_q evaluated and factored at their q. Returns the
- * status (also in report); on failure state->q holds the last Newton iterate.
+ * status (also in report); on failure state->q is left at the last solution (the first guess
+ * before any), so that the next call, with inputs back in reach, starts from there again.
  * report->branch_jump is 1 when the solution may lie on another assembly than the last call's
  * (Newton converges as well there, with nothing else to show for it): det(Phi_q) changed sign
  * since the last solution (a singular configuration lies between the two), or the solution is
@@ -176,7 +184,7 @@ typedef struct {
 } stewart_fk_batch_report;
 
 /* Solve m parameter sets over one grid t[0] ... t[n-1]: set j takes the parameters
- * p[j*NP ...] and starts from q0[j*NQ ...] (q0_stride = NQ) or, with q0_stride = 0, every set
+ * p[j*NPU ...] and starts from q0[j*NQ ...] (q0_stride = NQ) or, with q0_stride = 0, every set
  * from the one guess q0[0 ... NQ-1]; its decisions are made in the length unit units[j]
  * (options->unit for every set when units is NULL). Rows of set j, step k go to
  * q_out[(j*n + k)*NQ ...] (and dq_out, ddq_out; any may be NULL): caller-owned m x n x NQ
@@ -191,7 +199,7 @@ int stewart_fk_solve_batch(const stewart_fk_options *options, const stewart_fk_r
                              stewart_fk_state *state, stewart_fk_workspace *work,
                              stewart_fk_batch_report reports[]);
 
-/* The length scale of m configurations: per set j (parameters p[j*NP ...], coordinates
+/* The length scale of m configurations: per set j (parameters p[j*NPU ...], coordinates
  * q[j*q_stride ...], at time t), the largest lever arm in Phi_q, max |dPhi_i/dphi_k| /
  * max |dPhi_i/dx_k| over the rows i with an entry in a length column (symkin's
  * runtime.start.length_scale): 0 where there is none, NaN where an entry of Phi_q is not

@@ -10,6 +10,13 @@
 
 #include "three_rrr_fk_solver.h"
 
+/* The failure reports rest on IEEE arithmetic: a NaN or an infinity is found by tests such as
+ * x != x and x - x != 0, which -ffast-math and -ffinite-math-only let the compiler remove (a
+ * NaN input would then come back as a solution). Refuse those options outright. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)
+#error "compile without -ffast-math and -ffinite-math-only: the solver finds NaN and infinity by tests those options remove"
+#endif
+
 void three_rrr_fk_default_options(three_rrr_fk_options *options)
 {
     options->tol_phi = 1e-10;
@@ -140,7 +147,7 @@ void three_rrr_fk_length_scales(int m, const three_rrr_fk_real p[], const three_
     int j;
     for (j = 0; j < m; ++j) {
         three_rrr_fk_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * THREE_RRR_FK_NP : p, nz);
+                           p ? p + (size_t)j * THREE_RRR_FK_NPU : p, nz);
         scales[j] = three_rrr_fk_lever_arm(nz);
     }
 }
@@ -808,6 +815,8 @@ static int three_rrr_fk_newton(const three_rrr_fk_options *options, const three_
     int i, iteration;
     report->t = t;
     report->pivot = -1;
+    report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
+    report->residual = (three_rrr_fk_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
         three_rrr_fk_real residual;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
@@ -928,10 +937,19 @@ static void three_rrr_fk_with_inputs(three_rrr_fk_real pu[], const three_rrr_fk_
     }
 }
 
-/* max |v_i| of a computed v (NaN when some v_i is NaN), else 0. */
-static three_rrr_fk_real three_rrr_fk_norm_if(int computed, const three_rrr_fk_real v[])
+/* max |v_i| / column_i of a computed v (kernel unit): its max norm in the run's unit (NaN
+ * when some v_i is NaN); 0 when not computed. */
+static three_rrr_fk_real three_rrr_fk_norm_if(int computed, const three_rrr_fk_workspace *work, const three_rrr_fk_real v[])
 {
-    return computed ? three_rrr_fk_max_abs(v) : 0;
+    three_rrr_fk_real largest = 0, sum = 0;
+    int i;
+    if (!computed) return 0;
+    for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
+        const three_rrr_fk_real a = fabs(v[i]) * work->inverse_column[i];
+        largest = a > largest ? a : largest;
+        sum += a; /* NaN exactly when some a is (as in max_abs) */
+    }
+    return sum != sum ? (three_rrr_fk_real)NAN : largest;
 }
 
 #define THREE_RRR_FK_CHORD_STEPS 6 /* as contract.tuning.INPUTS */
@@ -995,7 +1013,8 @@ static int three_rrr_fk_chord(const three_rrr_fk_real p[], three_rrr_fk_real t, 
 /* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
  * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
  * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
- * none was solved: the first call, or after a failed one); nq: max |q|. */
+ * none was solved: the first call, or after a failed one); nq: max |q|; both in the run's
+ * unit, as the distance is measured here. */
 static int three_rrr_fk_branch_jump(three_rrr_fk_workspace *work, const three_rrr_fk_real q[],
                                     const three_rrr_fk_real predicted[], three_rrr_fk_real first, three_rrr_fk_real nq)
 {
@@ -1006,7 +1025,7 @@ static int three_rrr_fk_branch_jump(three_rrr_fk_workspace *work, const three_rr
         three_rrr_fk_real remainder = 0, a, bound = THREE_RRR_FK_BRANCH_REGION * first;
         int i;
         for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
-            a = fabs(q[i] - predicted[i]);
+            a = fabs(q[i] - predicted[i]) * work->inverse_column[i];
             remainder = a > remainder ? a : remainder;
         }
         bound = bound > least ? bound : least;
@@ -1025,14 +1044,16 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
 {
     three_rrr_fk_real pu[THREE_RRR_FK_NP + 3 * THREE_RRR_FK_NU];
     three_rrr_fk_real nq, ndq, nddq, predicted[THREE_RRR_FK_NQ], first = (three_rrr_fk_real)NAN;
+    three_rrr_fk_real last[THREE_RRR_FK_NQ]; /* the last solution, kept for a call that fails */
     const int rates = du != NULL, accelerations = du != NULL && ddu != NULL;
     int i, chord;
     three_rrr_fk_with_inputs(pu, p, u, du, ddu);
+    memcpy(last, state->q, sizeof last);
     report->flagged = 0;
     report->branch_jump = 0;
     report->cond = (three_rrr_fk_real)NAN;
     if (!state->started) {
-        three_rrr_fk_prepare(1, work); /* the inputs' solve decides in the mechanism's unit */
+        three_rrr_fk_prepare(options->unit, work); /* decided in options->unit, as solve_step */
         work->det_sign = 0;
     }
     /* No prediction: the inputs say where the mechanism is, the last solution is the guess;
@@ -1044,6 +1065,9 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
     report->iterations += chord;
     report->fallbacks = three_rrr_fk_lu_fallbacks(&work->lu);
     if (report->status != THREE_RRR_FK_OK) {
+        /* Not the iterate Newton failed at (after a reading out of reach it may lie far off,
+         * and every later call would start from it): the last solution. */
+        memcpy(state->q, last, sizeof last);
         return report->status;
     }
     if (rates) { /* (2.73), Phi_t holding du; Newton's last fused call left this q's shared */
@@ -1051,20 +1075,25 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
         for (i = 0; i < THREE_RRR_FK_NQ; ++i) {
             state->dq[i] = -state->dq[i];
         }
+        three_rrr_fk_rows_in_unit(work, state->dq);
         three_rrr_fk_lu_solve(&work->lu, state->dq);
+        three_rrr_fk_from_unit(work, state->dq);
     }
     if (accelerations) { /* (2.74), Gamma holding ddu; the same factors */
         three_rrr_fk_gamma_shared(state->q, state->dq, state->t, pu, work->shared, state->ddq);
+        three_rrr_fk_rows_in_unit(work, state->ddq);
         three_rrr_fk_lu_solve(&work->lu, state->ddq);
+        three_rrr_fk_from_unit(work, state->ddq);
     }
-    nq = three_rrr_fk_max_abs(state->q);
-    report->branch_jump = three_rrr_fk_branch_jump(work, state->q, predicted, first, nq);
-    ndq = three_rrr_fk_norm_if(rates, state->dq);
-    nddq = three_rrr_fk_norm_if(accelerations, state->ddq);
+    ndq = three_rrr_fk_norm_if(rates, work, state->dq);
+    nddq = three_rrr_fk_norm_if(accelerations, work, state->ddq);
     if (ndq - ndq != 0 || nddq - nddq != 0) {
         report->status = THREE_RRR_FK_NOT_FINITE; /* Phi_t or Gamma singular here */
+        memcpy(state->q, last, sizeof last);
         return report->status;
     }
+    nq = three_rrr_fk_norm_if(1, work, state->q);
+    report->branch_jump = three_rrr_fk_branch_jump(work, state->q, predicted, first, nq);
     for (i = 0; i < THREE_RRR_FK_NQ; ++i) { /* what was not asked for is not a number */
         if (!rates) state->dq[i] = (three_rrr_fk_real)NAN;
         if (!accelerations) state->ddq[i] = (three_rrr_fk_real)NAN;
@@ -1143,7 +1172,7 @@ int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, const three_rr
     int j, solved_sets = 0;
     for (j = 0; j < m; ++j) {
         size_t rows = (size_t)j * (size_t)n * THREE_RRR_FK_NQ;
-        const three_rrr_fk_real *p_set = p ? p + (size_t)j * THREE_RRR_FK_NP : p;
+        const three_rrr_fk_real *p_set = p ? p + (size_t)j * THREE_RRR_FK_NPU : p;
         three_rrr_fk_real *q_set = three_rrr_fk_block(q_out, rows);
         three_rrr_fk_real *dq_set = three_rrr_fk_block(dq_out, rows);
         three_rrr_fk_real *ddq_set = three_rrr_fk_block(ddq_out, rows);

@@ -34,9 +34,10 @@ class InputStepper:
         self.fallbacks = 0
         self.branch_jump = False  # the last call's report.branch_jump (runtime.branch's tests)
 
-    def start(self, options: Options, q: Array) -> None:
-        """Begin from q: the first call initialises the workspace."""
-        fill_options(self._lib, self._name, self._options, options)
+    def start(self, options: Options, q: Array, unit: float = 1.0) -> None:
+        """Begin from q (in the kernel's unit), the decisions made in the length unit ``unit``
+        (runtime.units): the first call initialises the workspace."""
+        fill_options(self._lib, self._name, self._options, options, unit)
         self._state.q[0:self._n] = [float(v) for v in q]
         self._state.started = 0
         self.fallbacks = 0

@@ -45,6 +45,11 @@ def _max_abs(n: int) -> Flops:
     return Flops(abs=n, cmp=n + 1, add=n)
 
 
+def _max_in_unit(n: int) -> Flops:
+    """<prefix>_norm_if (solve_inputs): _max_abs of |v_i| / column_i (a product each)."""
+    return _max_abs(n) + Flops(mul=n)
+
+
 @dataclass(frozen=True)
 class LinearAlgebra:
     """The cost of one call of each LU routine the solver makes."""
@@ -186,18 +191,20 @@ def refined(code: Any, algebra: LinearAlgebra, units: bool) -> Flops:
 def branch_jump(n: int) -> Flops:
     """<prefix>_branch_jump (solve_inputs): the sign of det(Phi_q) from the factors (per pivot
     the zero, finite and sign tests; the interchanges and the dense path's permutation are
-    integers), then |q - (q_last + s)| and its max, the floor and the bound."""
+    integers), then |q - (q_last + s)| / column and its max, the floor and the bound."""
     sign = Flops(cmp=3 * n, add=n)
-    remainder = Flops(add=n, abs=n, cmp=n)
+    remainder = Flops(add=n, abs=n, mul=n, cmp=n)
     return sign + remainder + Flops(add=2, mul=2, cmp=3)
 
 
-def chord(code: Any, algebra: LinearAlgebra) -> Flops:
-    """<prefix>_chord (solve_inputs, in the mechanism's unit) with all CHORD_STEPS taken:
-    the rounding level, then per step Phi, the negated solve, its max, the contraction test,
-    q += step and the two stopping tests."""
+def chord(code: Any, algebra: LinearAlgebra, scaled: bool = False) -> Flops:
+    """<prefix>_chord (solve_inputs) with all CHORD_STEPS taken: the rounding level, then per
+    step Phi (its rows in the run's unit when ``scaled``), the negated solve, its max, the
+    contraction test, the step back in the kernel's unit, q += step and the two stopping
+    tests."""
     n = code.nq
-    one = (_routine(code, "phi") + Flops(add=n) + algebra.solve + _max_abs(n)
+    units = Flops(div=n, mul=n) if scaled else ZERO
+    one = (_routine(code, "phi") + Flops(add=n) + algebra.solve + _max_abs(n) + units
            + Flops(mul=1, cmp=1) + Flops(add=n) + Flops(cmp=2, mul=1, div=1))
     return Flops(mul=1, add=1) + one * tuning.CHORD_STEPS
 
@@ -248,10 +255,11 @@ def _estimate(algebra: LinearAlgebra, norm: Flops, n: int, nnz: int) -> Flops:
 
 def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
            inputs: bool = False, rates: bool = True) -> Pieces:
-    """The pieces of ``<prefix>_solve_step`` (``inputs``: of ``<prefix>_solve_inputs``, which
-    has no predictor and decides in the mechanism's unit; ``rates`` False: du, ddu NULL)."""
+    """The pieces of ``<prefix>_solve_step`` (``inputs``: of ``<prefix>_solve_inputs``, whose
+    predictor is its simplified Newton steps; ``rates`` False: du, ddu NULL). Both decide in
+    options.unit when ``scaled``."""
     n, nnz = code.nq, code.nnz
-    units = scaled and not inputs
+    units = scaled
     in_unit = Flops(div=n, mul=nnz) if units else ZERO
     rows_in_unit = Flops(div=n) if units else ZERO
     from_unit = Flops(mul=n) if units else ZERO
@@ -267,11 +275,11 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
     velocity = _routine(code, "phi_t_shared") + Flops(add=n) + solve
     acceleration = _routine(code, "gamma_shared") + solve
     if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests
-        norms = _max_abs(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
+        norms = _max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
     else:  # one pass: |q|, |dq|, |ddq| scaled, three maxima, the sum and two finite tests
         norms = Flops(abs=3 * n, mul=3 * n, cmp=3 * n, add=5 * n) + Flops(cmp=3)
     prediction = Flops(add=1) + Flops(mul=3, div=1, add=2) * n  # (2.76)
-    predictor = chord(code, algebra) if inputs else prediction
+    predictor = chord(code, algebra, units) if inputs else prediction
     return Pieces(evaluation=evaluation, update=update, estimate=estimate,
                   tighten=tighten, velocity=velocity, acceleration=acceleration,
                   checks=norms + refined(code, algebra, units), predictor=predictor)

@@ -1,0 +1,120 @@
+"""What a run hands back or raises: the Trajectory of the rows it solved (with their efforts
+and reactions), and SolveInterrupted and SolveFailure, which carry those rows. Shared by the
+loop over a time grid (runtime.driver) and the loop over input rows (runtime.input_runs).
+Imports NumPy only: part of the runtime.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from symkin.errors import SolveError
+from symkin.runtime import failures, forces
+from symkin.runtime.assembly import Assembly
+from symkin.runtime.newton import Newton
+from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.result_arrays import Run as _Run
+from symkin.runtime.results import Trajectory
+
+Array = NDArray[np.float64]
+
+
+class SolveInterrupted(SolveError):
+    """The solve was interrupted (SIGINT, Ctrl-C); carries the rows solved before it.
+
+    Attributes:
+        trajectory: the time points solved before the interrupt.
+        t: the first time point not solved.
+    """
+
+    def __init__(self, trajectory: Trajectory, t: float) -> None:
+        super().__init__(f"interrupted at t = {t:g} after {trajectory.t.size} time points")
+        self.trajectory = trajectory
+        self.t = t
+
+
+class SolveFailure(SolveError):
+    """A solve stopped early; carries what is needed to act on it and the rows solved so far.
+
+    Attributes:
+        trajectory: the time points solved before the failure.
+        t: the time at which it failed.
+        residual: max |Phi| of the last iterate.
+        iterations: Newton iterations spent at t.
+        rows: labels of the dependent equations when Phi_q was singular, else ().
+        reason: "singular", "no convergence", "no assembly", "not finite" or
+            "limit position".
+        reached: where the step subdivision stopped (the limit time of a limit position: the
+            last time solved, bisected to within about 1e-9 of the grid step), else NaN.
+        aligned, drivers: at a limit position, the joints that become aligned and the drivers
+            that cannot be followed beyond it; else ().
+    """
+
+    def __init__(self, message: str, trajectory: Trajectory, t: float, residual: float,
+                 iterations: int, rows: Sequence[str] = (), reason: str = "",
+                 reached: float = math.nan, aligned: Sequence[str] = (),
+                 drivers: Sequence[str] = ()) -> None:
+        super().__init__(message)
+        self.trajectory = trajectory
+        self.t = t
+        self.residual = residual
+        self.iterations = iterations
+        self.rows = tuple(rows)
+        self.reason = reason
+        self.reached = reached
+        self.aligned = tuple(aligned)
+        self.drivers = tuple(drivers)
+
+
+def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
+                point_vectors: Array | None = None, loads_p: Array | None = None) -> Trajectory:
+    """The Trajectory of the rows done, over the run's own arrays (p: owned by the run).
+    A run of a kernel with input drivers has efforts and reactions only given ``loads_p``,
+    each row's p[] with its inputs (T, NP + 3 NU); elsewhere they are not computed."""
+    done = run.done
+    arrays: tuple[NDArray[Any], ...] = (run.t, run.q, run.dq, run.d2q, run.flagged, run.cond)
+    if done < run.t.size:  # a partial result: the caller's rows viewed, the run's copied
+        arrays = tuple(a[:done] if run.caller_owned else a[:done].copy() for a in arrays)
+    t, q, dq, d2q, flagged, cond = arrays
+    if point_vectors is None:
+        point_vectors = np.asarray(kernel.point_vectors(p), dtype=float).reshape(
+            -1, _point_size(kernel))
+    singular = tuple((s.t, s.rank_loss, tuple(map(tuple, s.groups)))
+                     for s in run.passages) if run.passages else ()
+    trajectory = Trajectory.solved(t, q, dq, d2q, tuple(kernel.coordinates),
+                                   tuple(kernel.points), point_vectors, p, run.fallbacks,
+                                   flagged, cond, singular, space=_space(kernel))
+    # inverse dynamics (a kernel with masses or forces): efforts and reactions of the rows
+    given = None if run.forces_out is None else tuple(a[:done] for a in run.forces_out)
+    if getattr(kernel, "nu", 0):
+        trajectory.__dict__["forces"] = (None if loads_p is None else
+                                         forces.compute(kernel, t, q, dq, d2q, loads_p))
+    else:
+        trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
+    return trajectory
+
+
+def _space(kernel: KinematicsKernel) -> str:
+    """``3d`` for a spatial kernel (a stand-in kernel without the attribute is planar)."""
+    return str(getattr(kernel, "space", "2d"))
+
+
+def _point_size(kernel: KinematicsKernel) -> int:
+    return 3 if _space(kernel) == "3d" else 2
+
+
+def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,
+          assembling: bool, assembly: Assembly | None = None,
+          params: Array | None = None) -> None:
+    """Raise SolveFailure with a message that says where, why and what to try (p: the
+    kernel's p[] at t; params: the parameters, when p also holds inputs)."""
+    last = None if run.done == 0 else (float(run.t[run.done - 1]), run.q[run.done - 1])
+    message, reason, rows = failures.explain(kernel, p, result, t, assembling, assembly, last)
+    params = p if params is None else params
+    raise SolveFailure(message, _trajectory(kernel, run, params), t, result.residual,
+                       result.iterations, rows, reason)
