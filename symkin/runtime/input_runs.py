@@ -29,11 +29,11 @@ Progress = Callable[[int, int], None]
 
 
 def solve_inputs(kernel: Any, t: ArrayLike | None, q0: ArrayLike | None,
-                  params: Mapping[str, float] | ArrayLike | None, options: Options,
-                  out: Out | None, progress: Progress | None,
-                  given: tuple[InputValues | None, ...]) -> Trajectory:
+                 params: Mapping[str, float] | ArrayLike | None, options: Options,
+                 out: Out | None, progress: Progress | None,
+                 given: tuple[InputValues | None, ...]) -> Trajectory:
     """A run driven by inputs (runtime.inputs), failures raised as by the time loop; decided
-    in the unit that brings the mechanism near unit size (runtime.units), as _solve_in_unit
+    in the unit that brings the mechanism near unit size (runtime.units), as runtime.driver
     decides a run over t, the rows converted back to the kernel's unit."""
     times = time_points(kernel, t)
     table = check_inputs(kernel, times, *given)
