@@ -176,9 +176,12 @@ class Trajectory:
             known = ", ".join(f"{b}.{p}" for b, p in self.points) or "none"
             raise SymkinError(f"no point {body}.{name}; the named points are: {known}")
         s = self.point_vectors[self.points.index((body, name))]
-        if self.spatial:
-            return spatial.point_kinematics(*self.body(body), s)
-        return point_kinematics(*self.body(body), s)
+        # rows whose rates were not asked for (NaN), or absurdly large (1e200: their square
+        # overflows), give NaN or inf here as they should, without NumPy's warning on top
+        with np.errstate(over="ignore", invalid="ignore"):
+            if self.spatial:
+                return spatial.point_kinematics(*self.body(body), s)
+            return point_kinematics(*self.body(body), s)
 
     def angular(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """omega and alpha of every body of a spatial mechanism, global, each (T, B, 3)."""

@@ -154,3 +154,23 @@ def test_an_interrupted_input_run_hands_on_the_rows_it_solved(system, backend: s
     assert seen[:5] == [(k, 21) for k in range(1, 6)]
     assert part.t.size == 5 and caught.t == t[5]
     assert np.array_equal(part.q, whole.q[:5])
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_absurd_rates_give_the_same_rows_on_both_backends_and_no_numpy_warning(
+        system, backend: str) -> None:
+    """Rates of 1e200 without accelerations: the accelerations are not evaluated (NumPy's
+    Gamma overflowed, and the run failed on NumPy where C went on), and the points' arrays
+    are NaN or inf where they must be, without NumPy's overflow warning (the CLI printed it
+    as a note)."""
+    import warnings
+
+    kernel = symkin.compile(system, backend=backend)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        run = symkin.solve(kernel, t=[0.0, 0.1], inputs=[1.5708, 1.6],
+                           input_rates=[1e200, 1e200])
+        r, dr, ddr = run.point_arrays()
+    assert run.dq[:, CRANK_ANGLE].tolist() == [1e200, 1e200]
+    assert np.isnan(run.d2q).all() and np.isnan(ddr).all()
+    assert np.abs(r[:, 0, 0] - A * np.cos([1.5708, 1.6])).max() <= 1e-14
