@@ -19,9 +19,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin import limits
+from symkin.spec.name_checks import RATE_SUFFIXES
 
 Array = NDArray[np.float64]
-SUFFIXES = ("", "_t", "_tt")
+SUFFIXES = ("", *RATE_SUFFIXES)  # a value's column, its rate's and its acceleration's
 
 
 class TableError(ValueError):

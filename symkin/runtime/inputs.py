@@ -198,7 +198,8 @@ def _python_points(kernel: Any, run: Run, inputs: Inputs, first: Newton, p: Arra
                                   options, inputs.rates)
         if kept is None:
             return failed, pu
-        regular = k if math.isfinite(kept.cond) else regular
+        if math.isfinite(kept.cond):  # (a kept singular row is no start for the next)
+            regular = k
         _stored(run, k, kept, progress)
     return first, pu
 
