@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin import limits
-from symkin.spec.name_checks import RATE_SUFFIXES
+from symkin.contract.columns import RATE_SUFFIXES
 
 Array = NDArray[np.float64]
 SUFFIXES = ("", *RATE_SUFFIXES)  # a value's column, its rate's and its acceleration's

@@ -1,6 +1,7 @@
 """Stage 7 — results: point kinematics (2.14-2.16), the Trajectory and the files a run writes.
 
-Imports only NumPy: it is part of the runtime. Plots and animation live in symkin.present.plots.
+Imports only NumPy (and the contract): it is part of the runtime. Plots and animation live
+in symkin.present.plots.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin.contract.columns import RATE_SUFFIXES
 from symkin.errors import SymkinError
 from symkin.runtime import spatial
 from symkin.runtime.forces import Forces
@@ -258,8 +260,9 @@ class Trajectory:
         return arrays
 
     def _save_csv(self, path: Path) -> None:
-        header = ["t", *self.coordinates, *(c + "_t" for c in self.coordinates),
-                  *(c + "_tt" for c in self.coordinates), *self._point_columns(),
+        header = ["t", *self.coordinates,
+                  *(c + suffix for suffix in RATE_SUFFIXES for c in self.coordinates),
+                  *self._point_columns(),
                   *self._angular_columns(), *(name for name, _ in self.outputs), "flagged",
                   *(self.forces.columns() if self.forces is not None else ())]
         r, dr, ddr = self.point_arrays()

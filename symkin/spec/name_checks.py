@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from symkin import pairs
+from symkin.contract.columns import RATE_SUFFIXES
 from symkin.errors import MechanismError, format_path
 from symkin.pairs.fields import GROUND, is_input
 from symkin.spec.names import name_problem
@@ -56,10 +57,6 @@ def _check_coordinate_name(mech: MechanismSpec, constraint: Any,
         raise MechanismError(f"the name {constraint.name!r} is a body's", path + ("name",),
                              f"Its coordinate {constraint.name}.s would read as a coordinate "
                              "of that body; use another name.")
-
-
-# The suffixes of an input's rate and acceleration: columns NAME_t, NAME_tt of an inputs table.
-RATE_SUFFIXES = ("_t", "_tt")
 
 
 def input_places(mech: MechanismSpec) -> list[tuple[str, int, str, int | None]]:

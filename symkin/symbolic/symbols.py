@@ -8,8 +8,9 @@ from functools import cached_property
 import sympy as sp
 
 from symkin import pairs
+from symkin.contract.columns import RATE_SUFFIXES
 from symkin.pairs.fields import GROUND
-from symkin.spec.name_checks import RATE_SUFFIXES, input_places
+from symkin.spec.name_checks import input_places
 from symkin.spec.schema import MechanismSpec
 
 

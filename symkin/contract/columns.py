@@ -1,0 +1,7 @@
+"""How a quantity's rate and acceleration are named, wherever names meet users: the columns of
+a run's CSV (``q_t``, ``q_tt``), of an inputs table (``NAME_t``, ``NAME_tt``) and the symbols
+SymPy derives with. Here, at the bottom, so that the command line can read a table without
+importing the stages (a warm run loads neither SymPy nor pydantic)."""
+
+RATE_SUFFIXES = ("_t", "_tt")
+"""The suffixes of a quantity's rate and of its acceleration, in that order."""
