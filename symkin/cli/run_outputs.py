@@ -193,8 +193,9 @@ class ProgressBar:
 
 
 def flag_warnings(trajectory: Any) -> list[str]:
-    """``warning: ... at t = ...`` for each stretch of flagged points: where, how
-    ill-conditioned, and the singular configuration passed there with its dependent rows."""
+    """``warning: ... at t = ...`` for each stretch of flagged points: where, Phi_q's worst
+    condition there (which need not be the cause: fast rates amplify a small error too), and
+    the singular configuration passed there with its dependent rows."""
     from symkin.contract.options import Options
 
     targets = Options()
@@ -228,9 +229,9 @@ def flag_warnings(trajectory: Any) -> list[str]:
             f"dependent rows: {'; '.join('{' + ', '.join(g) + '}' for g in groups)}), its "
             "point(s) interpolated from both sides" for t, rank, groups in passed)
         lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
-                     f"Phi_q is ill-conditioned there (condition up to {worst:.3g}), so q, dq, "
-                     f"ddq may miss {targets.target_q:g}, {targets.target_dq:g}, "
-                     f"{targets.target_ddq:g} (column 'flagged'){detail}")
+                     f"q, dq, ddq may miss {targets.target_q:g}, {targets.target_dq:g}, "
+                     f"{targets.target_ddq:g} there by the error model (Phi_q's condition up "
+                     f"to {worst:.3g}; column 'flagged'){detail}")
         k = end + 1
     return lines
 

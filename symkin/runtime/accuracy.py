@@ -177,37 +177,42 @@ worst direction (worst_column and propagated at a solved point)."""
 
 def flagged(inv_norm: float, norm_a: float, residual: float, q: Array, dq: Array, ddq: Array,
             options: Options, unit: float, correction: float = math.nan,
-            propagate: Propagate | None = None) -> bool:
+            propagate: Propagate | None = None, judged: int = 2) -> bool:
     """True when the estimated error of q, dq or ddq misses its target (options.target_*).
 
     Where the norm bound flags the point and ``propagate`` is given, the propagated model
     decides (the docstring): e_q, and the errors of dq and ddq it causes along the worst
-    direction plus the rounding of their solves."""
+    direction plus the rounding of their solves. ``judged`` < 2: an input-driven point whose
+    accelerations (< 1: also rates) were not given and not solved for: their errors are not
+    judged (they stand as zeros in the estimates of the others)."""
     nq, ndq, nddq = (float(np.abs(v).max(initial=0.0)) for v in (q, dq, ddq))
     if not flagged_norms(inv_norm, norm_a, residual, q.size, nq, ndq, nddq, options, unit,
-                         correction):
+                         correction, judged):
         return False
     if propagate is None:
         return True
     e_q = position_error(inv_norm, residual, q.size, nq, unit, correction)
     e_dq, e_ddq = propagate(e_q)
     s = inv_norm / math.sqrt(q.size)
-    estimates = (e_q, e_dq + s * unit * ndq, e_ddq + s * unit * nddq)
-    return not all(map(math.isfinite, estimates)) or _misses(estimates, nq, ndq, nddq, options)
+    estimates = (e_q, e_dq + s * unit * ndq, e_ddq + s * unit * nddq)[:judged + 1]
+    return (not all(map(math.isfinite, estimates))
+            or _misses(estimates, nq, ndq, nddq, options))
 
 
 def flagged_norms(inv_norm: float, norm_a: float, residual: float, n: int, nq: float, ndq: float,
                   nddq: float, options: Options, unit: float,
-                  correction: float = math.nan) -> bool:
-    """flagged by the norm bound, from the max norms of q, dq and ddq."""
+                  correction: float = math.nan, judged: int = 2) -> bool:
+    """flagged by the norm bound, from the max norms of q, dq and ddq (of q and the first
+    ``judged`` of dq, ddq)."""
     if not math.isfinite(inv_norm * norm_a):
         return True
-    return _misses(errors(inv_norm, residual, n, nq, ndq, nddq, unit, correction), nq, ndq,
-                   nddq, options)
+    estimates = errors(inv_norm, residual, n, nq, ndq, nddq, unit, correction)
+    return _misses(estimates[:judged + 1], nq, ndq, nddq, options)
 
 
-def _misses(estimates: tuple[float, float, float], nq: float, ndq: float, nddq: float,
+def _misses(estimates: tuple[float, ...], nq: float, ndq: float, nddq: float,
             options: Options) -> bool:
-    e_q, e_dq, e_ddq = estimates
-    return (e_q > options.target_q * max(1.0, nq) or e_dq > options.target_dq * max(1.0, ndq)
-            or e_ddq > options.target_ddq * max(1.0, nddq))
+    """Whether one of the estimates given (of q, then dq, then ddq) misses its target."""
+    targets = (options.target_q * max(1.0, nq), options.target_dq * max(1.0, ndq),
+               options.target_ddq * max(1.0, nddq))
+    return any(e > target for e, target in zip(estimates, targets))

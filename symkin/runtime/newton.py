@@ -155,8 +155,9 @@ def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
                solved: int = 2) -> Point | None:
     """Velocities (2.73) and accelerations (2.74) at a converged point, with its flag; None
     when they are not finite (Phi_t or Gamma singular at t). ``solved`` < 2: an input-driven
-    point whose accelerations (< 1: also rates) were not given: those are not solved for and
-    stand as zeros, for the flag too (as the generated C solve_inputs, given NULL, does)."""
+    point whose accelerations (< 1: also rates) were not given: those are not solved for,
+    stand as zeros in the error model and are not judged by it (as the generated C
+    solve_inputs, given NULL, does)."""
     factors = result.factors
     assert factors is not None  # newton returns the factors whenever it converges
     q = result.q
@@ -168,7 +169,7 @@ def kinematics(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
     unit = UNIT_ROUNDOFF[getattr(kernel, "real", "double")]
     flag = accuracy.flagged(result.inv_norm, result.norm_a, result.residual, q, dq, ddq,
                             options, unit, result.correction,
-                            _propagation(kernel, factors, (q, dq, ddq), t, p, unit))
+                            _propagation(kernel, factors, (q, dq, ddq), t, p, unit), solved)
     return Point(q, dq, ddq, result.cond, flag)
 
 

@@ -137,7 +137,7 @@ int main()
     w.estimated_inv_norm = -1;
     MEASURE("estimate", @P@_estimate(&w, &r));
     w.correction = -1;
-    MEASURE("flagged", @P@_flagged(&o, &w, &r, 1, 1, 1));
+    MEASURE("flagged", @P@_flagged(&o, &w, &r, 1, 1, 1, 2));
     {   /* the refined model at its longest: the norm bound flags (ddq's target 0), the
          * propagated model runs to its end, q and dq pass, ddq fails: every comparison */
         @P@_options late = o;

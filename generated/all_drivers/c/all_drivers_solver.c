@@ -567,13 +567,24 @@ static all_drivers_real all_drivers_at_least_1(all_drivers_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int all_drivers_misses(const all_drivers_options *options, int judged, all_drivers_real e_q,
+                               all_drivers_real e_dq, all_drivers_real e_ddq, all_drivers_real nq, all_drivers_real ndq,
+                               all_drivers_real nddq)
+{
+    return e_q > options->target_q * all_drivers_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * all_drivers_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * all_drivers_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int all_drivers_flagged(const all_drivers_options *options,
                                 const all_drivers_workspace *work,
                                 const all_drivers_report *report, all_drivers_real nq, all_drivers_real ndq,
-                                all_drivers_real nddq)
+                                all_drivers_real nddq, int judged)
 {
     const all_drivers_real u = ALL_DRIVERS_UNIT_ROUNDOFF;
     const all_drivers_real s = report->inv_norm / sqrt((all_drivers_real)ALL_DRIVERS_NQ);
@@ -584,9 +595,9 @@ static int all_drivers_flagged(const all_drivers_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * all_drivers_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * all_drivers_at_least_1(ndq));
-    return ALL_DRIVERS_SAFETY * e_q > options->target_q * all_drivers_at_least_1(nq)
-        || ALL_DRIVERS_SAFETY * e_dq > options->target_dq * all_drivers_at_least_1(ndq)
-        || ALL_DRIVERS_SAFETY * e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
+    return all_drivers_misses(options, judged, ALL_DRIVERS_SAFETY * e_q,
+                               ALL_DRIVERS_SAFETY * e_dq, ALL_DRIVERS_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -696,7 +707,7 @@ static void all_drivers_propagated(const all_drivers_workspace *work, all_driver
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int all_drivers_flagged_refined(const all_drivers_options *options,
                                         const all_drivers_workspace *work,
                                         const all_drivers_report *report, all_drivers_real nq,
@@ -707,16 +718,16 @@ static int all_drivers_flagged_refined(const all_drivers_options *options,
     static const all_drivers_real zeros[ALL_DRIVERS_NQ];
     const all_drivers_real s = report->inv_norm / sqrt((all_drivers_real)ALL_DRIVERS_NQ);
     const all_drivers_real u = ALL_DRIVERS_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     all_drivers_real e_q, errors[2], e_dq, e_ddq;
-    if (!all_drivers_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!all_drivers_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = all_drivers_position_error(work, report, nq);
     all_drivers_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * all_drivers_at_least_1(nq)
-        || e_dq > options->target_dq * all_drivers_at_least_1(ndq)
-        || e_ddq > options->target_ddq * all_drivers_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return all_drivers_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -727,7 +738,7 @@ static int all_drivers_would_flag(const all_drivers_options *options,
 {
     const all_drivers_real *norms = work->norms;
     return report->residual > ALL_DRIVERS_UNIT_ROUNDOFF * (1 + norms[0])
-        && all_drivers_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && all_drivers_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -573,13 +573,24 @@ static andrews_squeezer_real andrews_squeezer_at_least_1(andrews_squeezer_real x
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int andrews_squeezer_misses(const andrews_squeezer_options *options, int judged, andrews_squeezer_real e_q,
+                               andrews_squeezer_real e_dq, andrews_squeezer_real e_ddq, andrews_squeezer_real nq, andrews_squeezer_real ndq,
+                               andrews_squeezer_real nddq)
+{
+    return e_q > options->target_q * andrews_squeezer_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * andrews_squeezer_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
                                 const andrews_squeezer_workspace *work,
                                 const andrews_squeezer_report *report, andrews_squeezer_real nq, andrews_squeezer_real ndq,
-                                andrews_squeezer_real nddq)
+                                andrews_squeezer_real nddq, int judged)
 {
     const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
     const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
@@ -590,9 +601,9 @@ static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * andrews_squeezer_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * andrews_squeezer_at_least_1(ndq));
-    return ANDREWS_SQUEEZER_SAFETY * e_q > options->target_q * andrews_squeezer_at_least_1(nq)
-        || ANDREWS_SQUEEZER_SAFETY * e_dq > options->target_dq * andrews_squeezer_at_least_1(ndq)
-        || ANDREWS_SQUEEZER_SAFETY * e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
+    return andrews_squeezer_misses(options, judged, ANDREWS_SQUEEZER_SAFETY * e_q,
+                               ANDREWS_SQUEEZER_SAFETY * e_dq, ANDREWS_SQUEEZER_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -702,7 +713,7 @@ static void andrews_squeezer_propagated(const andrews_squeezer_workspace *work, 
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int andrews_squeezer_flagged_refined(const andrews_squeezer_options *options,
                                         const andrews_squeezer_workspace *work,
                                         const andrews_squeezer_report *report, andrews_squeezer_real nq,
@@ -713,16 +724,16 @@ static int andrews_squeezer_flagged_refined(const andrews_squeezer_options *opti
     static const andrews_squeezer_real zeros[ANDREWS_SQUEEZER_NQ];
     const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
     const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     andrews_squeezer_real e_q, errors[2], e_dq, e_ddq;
-    if (!andrews_squeezer_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!andrews_squeezer_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = andrews_squeezer_position_error(work, report, nq);
     andrews_squeezer_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * andrews_squeezer_at_least_1(nq)
-        || e_dq > options->target_dq * andrews_squeezer_at_least_1(ndq)
-        || e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return andrews_squeezer_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -733,7 +744,7 @@ static int andrews_squeezer_would_flag(const andrews_squeezer_options *options,
 {
     const andrews_squeezer_real *norms = work->norms;
     return report->residual > ANDREWS_SQUEEZER_UNIT_ROUNDOFF * (1 + norms[0])
-        && andrews_squeezer_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && andrews_squeezer_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

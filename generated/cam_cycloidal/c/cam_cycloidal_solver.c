@@ -345,13 +345,24 @@ static cam_cycloidal_real cam_cycloidal_at_least_1(cam_cycloidal_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int cam_cycloidal_misses(const cam_cycloidal_options *options, int judged, cam_cycloidal_real e_q,
+                               cam_cycloidal_real e_dq, cam_cycloidal_real e_ddq, cam_cycloidal_real nq, cam_cycloidal_real ndq,
+                               cam_cycloidal_real nddq)
+{
+    return e_q > options->target_q * cam_cycloidal_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * cam_cycloidal_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int cam_cycloidal_flagged(const cam_cycloidal_options *options,
                                 const cam_cycloidal_workspace *work,
                                 const cam_cycloidal_report *report, cam_cycloidal_real nq, cam_cycloidal_real ndq,
-                                cam_cycloidal_real nddq)
+                                cam_cycloidal_real nddq, int judged)
 {
     const cam_cycloidal_real u = CAM_CYCLOIDAL_UNIT_ROUNDOFF;
     const cam_cycloidal_real s = report->inv_norm / sqrt((cam_cycloidal_real)CAM_CYCLOIDAL_NQ);
@@ -362,9 +373,9 @@ static int cam_cycloidal_flagged(const cam_cycloidal_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * cam_cycloidal_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * cam_cycloidal_at_least_1(ndq));
-    return CAM_CYCLOIDAL_SAFETY * e_q > options->target_q * cam_cycloidal_at_least_1(nq)
-        || CAM_CYCLOIDAL_SAFETY * e_dq > options->target_dq * cam_cycloidal_at_least_1(ndq)
-        || CAM_CYCLOIDAL_SAFETY * e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq);
+    return cam_cycloidal_misses(options, judged, CAM_CYCLOIDAL_SAFETY * e_q,
+                               CAM_CYCLOIDAL_SAFETY * e_dq, CAM_CYCLOIDAL_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -474,7 +485,7 @@ static void cam_cycloidal_propagated(const cam_cycloidal_workspace *work, cam_cy
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int cam_cycloidal_flagged_refined(const cam_cycloidal_options *options,
                                         const cam_cycloidal_workspace *work,
                                         const cam_cycloidal_report *report, cam_cycloidal_real nq,
@@ -485,16 +496,16 @@ static int cam_cycloidal_flagged_refined(const cam_cycloidal_options *options,
     static const cam_cycloidal_real zeros[CAM_CYCLOIDAL_NQ];
     const cam_cycloidal_real s = report->inv_norm / sqrt((cam_cycloidal_real)CAM_CYCLOIDAL_NQ);
     const cam_cycloidal_real u = CAM_CYCLOIDAL_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     cam_cycloidal_real e_q, errors[2], e_dq, e_ddq;
-    if (!cam_cycloidal_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!cam_cycloidal_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = cam_cycloidal_position_error(work, report, nq);
     cam_cycloidal_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * cam_cycloidal_at_least_1(nq)
-        || e_dq > options->target_dq * cam_cycloidal_at_least_1(ndq)
-        || e_ddq > options->target_ddq * cam_cycloidal_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return cam_cycloidal_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -505,7 +516,7 @@ static int cam_cycloidal_would_flag(const cam_cycloidal_options *options,
 {
     const cam_cycloidal_real *norms = work->norms;
     return report->residual > CAM_CYCLOIDAL_UNIT_ROUNDOFF * (1 + norms[0])
-        && cam_cycloidal_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && cam_cycloidal_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -331,13 +331,24 @@ static cardan_real cardan_at_least_1(cardan_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int cardan_misses(const cardan_options *options, int judged, cardan_real e_q,
+                               cardan_real e_dq, cardan_real e_ddq, cardan_real nq, cardan_real ndq,
+                               cardan_real nddq)
+{
+    return e_q > options->target_q * cardan_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * cardan_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * cardan_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int cardan_flagged(const cardan_options *options,
                                 const cardan_workspace *work,
                                 const cardan_report *report, cardan_real nq, cardan_real ndq,
-                                cardan_real nddq)
+                                cardan_real nddq, int judged)
 {
     const cardan_real u = CARDAN_UNIT_ROUNDOFF;
     const cardan_real s = report->inv_norm / sqrt((cardan_real)CARDAN_NQ);
@@ -348,9 +359,9 @@ static int cardan_flagged(const cardan_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * cardan_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * cardan_at_least_1(ndq));
-    return CARDAN_SAFETY * e_q > options->target_q * cardan_at_least_1(nq)
-        || CARDAN_SAFETY * e_dq > options->target_dq * cardan_at_least_1(ndq)
-        || CARDAN_SAFETY * e_ddq > options->target_ddq * cardan_at_least_1(nddq);
+    return cardan_misses(options, judged, CARDAN_SAFETY * e_q,
+                               CARDAN_SAFETY * e_dq, CARDAN_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -460,7 +471,7 @@ static void cardan_propagated(const cardan_workspace *work, cardan_real size, ca
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int cardan_flagged_refined(const cardan_options *options,
                                         const cardan_workspace *work,
                                         const cardan_report *report, cardan_real nq,
@@ -471,16 +482,16 @@ static int cardan_flagged_refined(const cardan_options *options,
     static const cardan_real zeros[CARDAN_NQ];
     const cardan_real s = report->inv_norm / sqrt((cardan_real)CARDAN_NQ);
     const cardan_real u = CARDAN_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     cardan_real e_q, errors[2], e_dq, e_ddq;
-    if (!cardan_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!cardan_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = cardan_position_error(work, report, nq);
     cardan_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * cardan_at_least_1(nq)
-        || e_dq > options->target_dq * cardan_at_least_1(ndq)
-        || e_ddq > options->target_ddq * cardan_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return cardan_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -491,7 +502,7 @@ static int cardan_would_flag(const cardan_options *options,
 {
     const cardan_real *norms = work->norms;
     return report->residual > CARDAN_UNIT_ROUNDOFF * (1 + norms[0])
-        && cardan_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && cardan_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

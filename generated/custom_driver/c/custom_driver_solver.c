@@ -375,13 +375,24 @@ static custom_driver_real custom_driver_at_least_1(custom_driver_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int custom_driver_misses(const custom_driver_options *options, int judged, custom_driver_real e_q,
+                               custom_driver_real e_dq, custom_driver_real e_ddq, custom_driver_real nq, custom_driver_real ndq,
+                               custom_driver_real nddq)
+{
+    return e_q > options->target_q * custom_driver_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * custom_driver_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * custom_driver_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int custom_driver_flagged(const custom_driver_options *options,
                                 const custom_driver_workspace *work,
                                 const custom_driver_report *report, custom_driver_real nq, custom_driver_real ndq,
-                                custom_driver_real nddq)
+                                custom_driver_real nddq, int judged)
 {
     const custom_driver_real u = CUSTOM_DRIVER_UNIT_ROUNDOFF;
     const custom_driver_real s = report->inv_norm / sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
@@ -392,9 +403,9 @@ static int custom_driver_flagged(const custom_driver_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * custom_driver_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * custom_driver_at_least_1(ndq));
-    return CUSTOM_DRIVER_SAFETY * e_q > options->target_q * custom_driver_at_least_1(nq)
-        || CUSTOM_DRIVER_SAFETY * e_dq > options->target_dq * custom_driver_at_least_1(ndq)
-        || CUSTOM_DRIVER_SAFETY * e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
+    return custom_driver_misses(options, judged, CUSTOM_DRIVER_SAFETY * e_q,
+                               CUSTOM_DRIVER_SAFETY * e_dq, CUSTOM_DRIVER_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -504,7 +515,7 @@ static void custom_driver_propagated(const custom_driver_workspace *work, custom
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int custom_driver_flagged_refined(const custom_driver_options *options,
                                         const custom_driver_workspace *work,
                                         const custom_driver_report *report, custom_driver_real nq,
@@ -515,16 +526,16 @@ static int custom_driver_flagged_refined(const custom_driver_options *options,
     static const custom_driver_real zeros[CUSTOM_DRIVER_NQ];
     const custom_driver_real s = report->inv_norm / sqrt((custom_driver_real)CUSTOM_DRIVER_NQ);
     const custom_driver_real u = CUSTOM_DRIVER_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     custom_driver_real e_q, errors[2], e_dq, e_ddq;
-    if (!custom_driver_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!custom_driver_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = custom_driver_position_error(work, report, nq);
     custom_driver_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * custom_driver_at_least_1(nq)
-        || e_dq > options->target_dq * custom_driver_at_least_1(ndq)
-        || e_ddq > options->target_ddq * custom_driver_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return custom_driver_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -535,7 +546,7 @@ static int custom_driver_would_flag(const custom_driver_options *options,
 {
     const custom_driver_real *norms = work->norms;
     return report->residual > CUSTOM_DRIVER_UNIT_ROUNDOFF * (1 + norms[0])
-        && custom_driver_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && custom_driver_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -399,13 +399,24 @@ static delta_real delta_at_least_1(delta_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int delta_misses(const delta_options *options, int judged, delta_real e_q,
+                               delta_real e_dq, delta_real e_ddq, delta_real nq, delta_real ndq,
+                               delta_real nddq)
+{
+    return e_q > options->target_q * delta_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * delta_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * delta_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int delta_flagged(const delta_options *options,
                                 const delta_workspace *work,
                                 const delta_report *report, delta_real nq, delta_real ndq,
-                                delta_real nddq)
+                                delta_real nddq, int judged)
 {
     const delta_real u = DELTA_UNIT_ROUNDOFF;
     const delta_real s = report->inv_norm / sqrt((delta_real)DELTA_NQ);
@@ -416,9 +427,9 @@ static int delta_flagged(const delta_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * delta_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * delta_at_least_1(ndq));
-    return DELTA_SAFETY * e_q > options->target_q * delta_at_least_1(nq)
-        || DELTA_SAFETY * e_dq > options->target_dq * delta_at_least_1(ndq)
-        || DELTA_SAFETY * e_ddq > options->target_ddq * delta_at_least_1(nddq);
+    return delta_misses(options, judged, DELTA_SAFETY * e_q,
+                               DELTA_SAFETY * e_dq, DELTA_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -528,7 +539,7 @@ static void delta_propagated(const delta_workspace *work, delta_real size, delta
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int delta_flagged_refined(const delta_options *options,
                                         const delta_workspace *work,
                                         const delta_report *report, delta_real nq,
@@ -539,16 +550,16 @@ static int delta_flagged_refined(const delta_options *options,
     static const delta_real zeros[DELTA_NQ];
     const delta_real s = report->inv_norm / sqrt((delta_real)DELTA_NQ);
     const delta_real u = DELTA_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     delta_real e_q, errors[2], e_dq, e_ddq;
-    if (!delta_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!delta_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = delta_position_error(work, report, nq);
     delta_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * delta_at_least_1(nq)
-        || e_dq > options->target_dq * delta_at_least_1(ndq)
-        || e_ddq > options->target_ddq * delta_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return delta_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -559,7 +570,7 @@ static int delta_would_flag(const delta_options *options,
 {
     const delta_real *norms = work->norms;
     return report->residual > DELTA_UNIT_ROUNDOFF * (1 + norms[0])
-        && delta_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && delta_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

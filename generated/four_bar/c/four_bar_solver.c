@@ -367,13 +367,24 @@ static four_bar_real four_bar_at_least_1(four_bar_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int four_bar_misses(const four_bar_options *options, int judged, four_bar_real e_q,
+                               four_bar_real e_dq, four_bar_real e_ddq, four_bar_real nq, four_bar_real ndq,
+                               four_bar_real nddq)
+{
+    return e_q > options->target_q * four_bar_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * four_bar_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * four_bar_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int four_bar_flagged(const four_bar_options *options,
                                 const four_bar_workspace *work,
                                 const four_bar_report *report, four_bar_real nq, four_bar_real ndq,
-                                four_bar_real nddq)
+                                four_bar_real nddq, int judged)
 {
     const four_bar_real u = FOUR_BAR_UNIT_ROUNDOFF;
     const four_bar_real s = report->inv_norm / sqrt((four_bar_real)FOUR_BAR_NQ);
@@ -384,9 +395,9 @@ static int four_bar_flagged(const four_bar_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * four_bar_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * four_bar_at_least_1(ndq));
-    return FOUR_BAR_SAFETY * e_q > options->target_q * four_bar_at_least_1(nq)
-        || FOUR_BAR_SAFETY * e_dq > options->target_dq * four_bar_at_least_1(ndq)
-        || FOUR_BAR_SAFETY * e_ddq > options->target_ddq * four_bar_at_least_1(nddq);
+    return four_bar_misses(options, judged, FOUR_BAR_SAFETY * e_q,
+                               FOUR_BAR_SAFETY * e_dq, FOUR_BAR_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -496,7 +507,7 @@ static void four_bar_propagated(const four_bar_workspace *work, four_bar_real si
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int four_bar_flagged_refined(const four_bar_options *options,
                                         const four_bar_workspace *work,
                                         const four_bar_report *report, four_bar_real nq,
@@ -507,16 +518,16 @@ static int four_bar_flagged_refined(const four_bar_options *options,
     static const four_bar_real zeros[FOUR_BAR_NQ];
     const four_bar_real s = report->inv_norm / sqrt((four_bar_real)FOUR_BAR_NQ);
     const four_bar_real u = FOUR_BAR_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     four_bar_real e_q, errors[2], e_dq, e_ddq;
-    if (!four_bar_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!four_bar_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = four_bar_position_error(work, report, nq);
     four_bar_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * four_bar_at_least_1(nq)
-        || e_dq > options->target_dq * four_bar_at_least_1(ndq)
-        || e_ddq > options->target_ddq * four_bar_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return four_bar_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -527,7 +538,7 @@ static int four_bar_would_flag(const four_bar_options *options,
 {
     const four_bar_real *norms = work->norms;
     return report->residual > FOUR_BAR_UNIT_ROUNDOFF * (1 + norms[0])
-        && four_bar_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && four_bar_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -426,13 +426,24 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_at_least
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int parallelogram_extra_bar_loads_misses(const parallelogram_extra_bar_loads_options *options, int judged, parallelogram_extra_bar_loads_real e_q,
+                               parallelogram_extra_bar_loads_real e_dq, parallelogram_extra_bar_loads_real e_ddq, parallelogram_extra_bar_loads_real nq, parallelogram_extra_bar_loads_real ndq,
+                               parallelogram_extra_bar_loads_real nddq)
+{
+    return e_q > options->target_q * parallelogram_extra_bar_loads_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * parallelogram_extra_bar_loads_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int parallelogram_extra_bar_loads_flagged(const parallelogram_extra_bar_loads_options *options,
                                 const parallelogram_extra_bar_loads_workspace *work,
                                 const parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real nq, parallelogram_extra_bar_loads_real ndq,
-                                parallelogram_extra_bar_loads_real nddq)
+                                parallelogram_extra_bar_loads_real nddq, int judged)
 {
     const parallelogram_extra_bar_loads_real u = PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF;
     const parallelogram_extra_bar_loads_real s = report->inv_norm / sqrt((parallelogram_extra_bar_loads_real)PARALLELOGRAM_EXTRA_BAR_LOADS_NQ);
@@ -443,9 +454,9 @@ static int parallelogram_extra_bar_loads_flagged(const parallelogram_extra_bar_l
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * parallelogram_extra_bar_loads_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * parallelogram_extra_bar_loads_at_least_1(ndq));
-    return PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_q > options->target_q * parallelogram_extra_bar_loads_at_least_1(nq)
-        || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_dq > options->target_dq * parallelogram_extra_bar_loads_at_least_1(ndq)
-        || PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq);
+    return parallelogram_extra_bar_loads_misses(options, judged, PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_q,
+                               PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_dq, PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -555,7 +566,7 @@ static void parallelogram_extra_bar_loads_propagated(const parallelogram_extra_b
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int parallelogram_extra_bar_loads_flagged_refined(const parallelogram_extra_bar_loads_options *options,
                                         const parallelogram_extra_bar_loads_workspace *work,
                                         const parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real nq,
@@ -566,16 +577,16 @@ static int parallelogram_extra_bar_loads_flagged_refined(const parallelogram_ext
     static const parallelogram_extra_bar_loads_real zeros[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];
     const parallelogram_extra_bar_loads_real s = report->inv_norm / sqrt((parallelogram_extra_bar_loads_real)PARALLELOGRAM_EXTRA_BAR_LOADS_NQ);
     const parallelogram_extra_bar_loads_real u = PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     parallelogram_extra_bar_loads_real e_q, errors[2], e_dq, e_ddq;
-    if (!parallelogram_extra_bar_loads_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!parallelogram_extra_bar_loads_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = parallelogram_extra_bar_loads_position_error(work, report, nq);
     parallelogram_extra_bar_loads_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * parallelogram_extra_bar_loads_at_least_1(nq)
-        || e_dq > options->target_dq * parallelogram_extra_bar_loads_at_least_1(ndq)
-        || e_ddq > options->target_ddq * parallelogram_extra_bar_loads_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return parallelogram_extra_bar_loads_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -586,7 +597,7 @@ static int parallelogram_extra_bar_loads_would_flag(const parallelogram_extra_ba
 {
     const parallelogram_extra_bar_loads_real *norms = work->norms;
     return report->residual > PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF * (1 + norms[0])
-        && parallelogram_extra_bar_loads_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && parallelogram_extra_bar_loads_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

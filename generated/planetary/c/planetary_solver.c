@@ -360,13 +360,24 @@ static planetary_real planetary_at_least_1(planetary_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int planetary_misses(const planetary_options *options, int judged, planetary_real e_q,
+                               planetary_real e_dq, planetary_real e_ddq, planetary_real nq, planetary_real ndq,
+                               planetary_real nddq)
+{
+    return e_q > options->target_q * planetary_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * planetary_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * planetary_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int planetary_flagged(const planetary_options *options,
                                 const planetary_workspace *work,
                                 const planetary_report *report, planetary_real nq, planetary_real ndq,
-                                planetary_real nddq)
+                                planetary_real nddq, int judged)
 {
     const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
     const planetary_real s = report->inv_norm / sqrt((planetary_real)PLANETARY_NQ);
@@ -377,9 +388,9 @@ static int planetary_flagged(const planetary_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * planetary_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * planetary_at_least_1(ndq));
-    return PLANETARY_SAFETY * e_q > options->target_q * planetary_at_least_1(nq)
-        || PLANETARY_SAFETY * e_dq > options->target_dq * planetary_at_least_1(ndq)
-        || PLANETARY_SAFETY * e_ddq > options->target_ddq * planetary_at_least_1(nddq);
+    return planetary_misses(options, judged, PLANETARY_SAFETY * e_q,
+                               PLANETARY_SAFETY * e_dq, PLANETARY_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -489,7 +500,7 @@ static void planetary_propagated(const planetary_workspace *work, planetary_real
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int planetary_flagged_refined(const planetary_options *options,
                                         const planetary_workspace *work,
                                         const planetary_report *report, planetary_real nq,
@@ -500,16 +511,16 @@ static int planetary_flagged_refined(const planetary_options *options,
     static const planetary_real zeros[PLANETARY_NQ];
     const planetary_real s = report->inv_norm / sqrt((planetary_real)PLANETARY_NQ);
     const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     planetary_real e_q, errors[2], e_dq, e_ddq;
-    if (!planetary_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!planetary_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = planetary_position_error(work, report, nq);
     planetary_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * planetary_at_least_1(nq)
-        || e_dq > options->target_dq * planetary_at_least_1(ndq)
-        || e_ddq > options->target_ddq * planetary_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return planetary_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -520,7 +531,7 @@ static int planetary_would_flag(const planetary_options *options,
 {
     const planetary_real *norms = work->norms;
     return report->residual > PLANETARY_UNIT_ROUNDOFF * (1 + norms[0])
-        && planetary_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && planetary_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -414,13 +414,24 @@ static quick_return_real quick_return_at_least_1(quick_return_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int quick_return_misses(const quick_return_options *options, int judged, quick_return_real e_q,
+                               quick_return_real e_dq, quick_return_real e_ddq, quick_return_real nq, quick_return_real ndq,
+                               quick_return_real nddq)
+{
+    return e_q > options->target_q * quick_return_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * quick_return_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * quick_return_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int quick_return_flagged(const quick_return_options *options,
                                 const quick_return_workspace *work,
                                 const quick_return_report *report, quick_return_real nq, quick_return_real ndq,
-                                quick_return_real nddq)
+                                quick_return_real nddq, int judged)
 {
     const quick_return_real u = QUICK_RETURN_UNIT_ROUNDOFF;
     const quick_return_real s = report->inv_norm / sqrt((quick_return_real)QUICK_RETURN_NQ);
@@ -431,9 +442,9 @@ static int quick_return_flagged(const quick_return_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * quick_return_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * quick_return_at_least_1(ndq));
-    return QUICK_RETURN_SAFETY * e_q > options->target_q * quick_return_at_least_1(nq)
-        || QUICK_RETURN_SAFETY * e_dq > options->target_dq * quick_return_at_least_1(ndq)
-        || QUICK_RETURN_SAFETY * e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
+    return quick_return_misses(options, judged, QUICK_RETURN_SAFETY * e_q,
+                               QUICK_RETURN_SAFETY * e_dq, QUICK_RETURN_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -543,7 +554,7 @@ static void quick_return_propagated(const quick_return_workspace *work, quick_re
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int quick_return_flagged_refined(const quick_return_options *options,
                                         const quick_return_workspace *work,
                                         const quick_return_report *report, quick_return_real nq,
@@ -554,16 +565,16 @@ static int quick_return_flagged_refined(const quick_return_options *options,
     static const quick_return_real zeros[QUICK_RETURN_NQ];
     const quick_return_real s = report->inv_norm / sqrt((quick_return_real)QUICK_RETURN_NQ);
     const quick_return_real u = QUICK_RETURN_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     quick_return_real e_q, errors[2], e_dq, e_ddq;
-    if (!quick_return_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!quick_return_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = quick_return_position_error(work, report, nq);
     quick_return_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * quick_return_at_least_1(nq)
-        || e_dq > options->target_dq * quick_return_at_least_1(ndq)
-        || e_ddq > options->target_ddq * quick_return_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return quick_return_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -574,7 +585,7 @@ static int quick_return_would_flag(const quick_return_options *options,
 {
     const quick_return_real *norms = work->norms;
     return report->residual > QUICK_RETURN_UNIT_ROUNDOFF * (1 + norms[0])
-        && quick_return_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && quick_return_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -441,13 +441,24 @@ static rack_linkage_real rack_linkage_at_least_1(rack_linkage_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int rack_linkage_misses(const rack_linkage_options *options, int judged, rack_linkage_real e_q,
+                               rack_linkage_real e_dq, rack_linkage_real e_ddq, rack_linkage_real nq, rack_linkage_real ndq,
+                               rack_linkage_real nddq)
+{
+    return e_q > options->target_q * rack_linkage_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * rack_linkage_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int rack_linkage_flagged(const rack_linkage_options *options,
                                 const rack_linkage_workspace *work,
                                 const rack_linkage_report *report, rack_linkage_real nq, rack_linkage_real ndq,
-                                rack_linkage_real nddq)
+                                rack_linkage_real nddq, int judged)
 {
     const rack_linkage_real u = RACK_LINKAGE_UNIT_ROUNDOFF;
     const rack_linkage_real s = report->inv_norm / sqrt((rack_linkage_real)RACK_LINKAGE_NQ);
@@ -458,9 +469,9 @@ static int rack_linkage_flagged(const rack_linkage_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * rack_linkage_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * rack_linkage_at_least_1(ndq));
-    return RACK_LINKAGE_SAFETY * e_q > options->target_q * rack_linkage_at_least_1(nq)
-        || RACK_LINKAGE_SAFETY * e_dq > options->target_dq * rack_linkage_at_least_1(ndq)
-        || RACK_LINKAGE_SAFETY * e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq);
+    return rack_linkage_misses(options, judged, RACK_LINKAGE_SAFETY * e_q,
+                               RACK_LINKAGE_SAFETY * e_dq, RACK_LINKAGE_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -570,7 +581,7 @@ static void rack_linkage_propagated(const rack_linkage_workspace *work, rack_lin
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int rack_linkage_flagged_refined(const rack_linkage_options *options,
                                         const rack_linkage_workspace *work,
                                         const rack_linkage_report *report, rack_linkage_real nq,
@@ -581,16 +592,16 @@ static int rack_linkage_flagged_refined(const rack_linkage_options *options,
     static const rack_linkage_real zeros[RACK_LINKAGE_NQ];
     const rack_linkage_real s = report->inv_norm / sqrt((rack_linkage_real)RACK_LINKAGE_NQ);
     const rack_linkage_real u = RACK_LINKAGE_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     rack_linkage_real e_q, errors[2], e_dq, e_ddq;
-    if (!rack_linkage_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!rack_linkage_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = rack_linkage_position_error(work, report, nq);
     rack_linkage_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * rack_linkage_at_least_1(nq)
-        || e_dq > options->target_dq * rack_linkage_at_least_1(ndq)
-        || e_ddq > options->target_ddq * rack_linkage_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return rack_linkage_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -601,7 +612,7 @@ static int rack_linkage_would_flag(const rack_linkage_options *options,
 {
     const rack_linkage_real *norms = work->norms;
     return report->residual > RACK_LINKAGE_UNIT_ROUNDOFF * (1 + norms[0])
-        && rack_linkage_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && rack_linkage_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -696,13 +696,24 @@ static rssr_real rssr_at_least_1(rssr_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int rssr_misses(const rssr_options *options, int judged, rssr_real e_q,
+                               rssr_real e_dq, rssr_real e_ddq, rssr_real nq, rssr_real ndq,
+                               rssr_real nddq)
+{
+    return e_q > options->target_q * rssr_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * rssr_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * rssr_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int rssr_flagged(const rssr_options *options,
                                 const rssr_workspace *work,
                                 const rssr_report *report, rssr_real nq, rssr_real ndq,
-                                rssr_real nddq)
+                                rssr_real nddq, int judged)
 {
     const rssr_real u = RSSR_UNIT_ROUNDOFF;
     const rssr_real s = report->inv_norm / sqrt((rssr_real)RSSR_NQ);
@@ -713,9 +724,9 @@ static int rssr_flagged(const rssr_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * rssr_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * rssr_at_least_1(ndq));
-    return RSSR_SAFETY * e_q > options->target_q * rssr_at_least_1(nq)
-        || RSSR_SAFETY * e_dq > options->target_dq * rssr_at_least_1(ndq)
-        || RSSR_SAFETY * e_ddq > options->target_ddq * rssr_at_least_1(nddq);
+    return rssr_misses(options, judged, RSSR_SAFETY * e_q,
+                               RSSR_SAFETY * e_dq, RSSR_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -825,7 +836,7 @@ static void rssr_propagated(const rssr_workspace *work, rssr_real size, rssr_rea
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int rssr_flagged_refined(const rssr_options *options,
                                         const rssr_workspace *work,
                                         const rssr_report *report, rssr_real nq,
@@ -836,16 +847,16 @@ static int rssr_flagged_refined(const rssr_options *options,
     static const rssr_real zeros[RSSR_NQ];
     const rssr_real s = report->inv_norm / sqrt((rssr_real)RSSR_NQ);
     const rssr_real u = RSSR_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     rssr_real e_q, errors[2], e_dq, e_ddq;
-    if (!rssr_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!rssr_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = rssr_position_error(work, report, nq);
     rssr_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * rssr_at_least_1(nq)
-        || e_dq > options->target_dq * rssr_at_least_1(ndq)
-        || e_ddq > options->target_ddq * rssr_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return rssr_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -856,7 +867,7 @@ static int rssr_would_flag(const rssr_options *options,
 {
     const rssr_real *norms = work->norms;
     return report->residual > RSSR_UNIT_ROUNDOFF * (1 + norms[0])
-        && rssr_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && rssr_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

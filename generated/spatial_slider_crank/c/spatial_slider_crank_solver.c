@@ -353,13 +353,24 @@ static spatial_slider_crank_real spatial_slider_crank_at_least_1(spatial_slider_
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int spatial_slider_crank_misses(const spatial_slider_crank_options *options, int judged, spatial_slider_crank_real e_q,
+                               spatial_slider_crank_real e_dq, spatial_slider_crank_real e_ddq, spatial_slider_crank_real nq, spatial_slider_crank_real ndq,
+                               spatial_slider_crank_real nddq)
+{
+    return e_q > options->target_q * spatial_slider_crank_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * spatial_slider_crank_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int spatial_slider_crank_flagged(const spatial_slider_crank_options *options,
                                 const spatial_slider_crank_workspace *work,
                                 const spatial_slider_crank_report *report, spatial_slider_crank_real nq, spatial_slider_crank_real ndq,
-                                spatial_slider_crank_real nddq)
+                                spatial_slider_crank_real nddq, int judged)
 {
     const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
     const spatial_slider_crank_real s = report->inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
@@ -370,9 +381,9 @@ static int spatial_slider_crank_flagged(const spatial_slider_crank_options *opti
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * spatial_slider_crank_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * spatial_slider_crank_at_least_1(ndq));
-    return SPATIAL_SLIDER_CRANK_SAFETY * e_q > options->target_q * spatial_slider_crank_at_least_1(nq)
-        || SPATIAL_SLIDER_CRANK_SAFETY * e_dq > options->target_dq * spatial_slider_crank_at_least_1(ndq)
-        || SPATIAL_SLIDER_CRANK_SAFETY * e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq);
+    return spatial_slider_crank_misses(options, judged, SPATIAL_SLIDER_CRANK_SAFETY * e_q,
+                               SPATIAL_SLIDER_CRANK_SAFETY * e_dq, SPATIAL_SLIDER_CRANK_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -482,7 +493,7 @@ static void spatial_slider_crank_propagated(const spatial_slider_crank_workspace
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int spatial_slider_crank_flagged_refined(const spatial_slider_crank_options *options,
                                         const spatial_slider_crank_workspace *work,
                                         const spatial_slider_crank_report *report, spatial_slider_crank_real nq,
@@ -493,16 +504,16 @@ static int spatial_slider_crank_flagged_refined(const spatial_slider_crank_optio
     static const spatial_slider_crank_real zeros[SPATIAL_SLIDER_CRANK_NQ];
     const spatial_slider_crank_real s = report->inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
     const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     spatial_slider_crank_real e_q, errors[2], e_dq, e_ddq;
-    if (!spatial_slider_crank_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!spatial_slider_crank_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = spatial_slider_crank_position_error(work, report, nq);
     spatial_slider_crank_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * spatial_slider_crank_at_least_1(nq)
-        || e_dq > options->target_dq * spatial_slider_crank_at_least_1(ndq)
-        || e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return spatial_slider_crank_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -513,7 +524,7 @@ static int spatial_slider_crank_would_flag(const spatial_slider_crank_options *o
 {
     const spatial_slider_crank_real *norms = work->norms;
     return report->residual > SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF * (1 + norms[0])
-        && spatial_slider_crank_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && spatial_slider_crank_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -708,13 +708,24 @@ static stewart_real stewart_at_least_1(stewart_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int stewart_misses(const stewart_options *options, int judged, stewart_real e_q,
+                               stewart_real e_dq, stewart_real e_ddq, stewart_real nq, stewart_real ndq,
+                               stewart_real nddq)
+{
+    return e_q > options->target_q * stewart_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * stewart_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * stewart_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int stewart_flagged(const stewart_options *options,
                                 const stewart_workspace *work,
                                 const stewart_report *report, stewart_real nq, stewart_real ndq,
-                                stewart_real nddq)
+                                stewart_real nddq, int judged)
 {
     const stewart_real u = STEWART_UNIT_ROUNDOFF;
     const stewart_real s = report->inv_norm / sqrt((stewart_real)STEWART_NQ);
@@ -725,9 +736,9 @@ static int stewart_flagged(const stewart_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * stewart_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * stewart_at_least_1(ndq));
-    return STEWART_SAFETY * e_q > options->target_q * stewart_at_least_1(nq)
-        || STEWART_SAFETY * e_dq > options->target_dq * stewart_at_least_1(ndq)
-        || STEWART_SAFETY * e_ddq > options->target_ddq * stewart_at_least_1(nddq);
+    return stewart_misses(options, judged, STEWART_SAFETY * e_q,
+                               STEWART_SAFETY * e_dq, STEWART_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -837,7 +848,7 @@ static void stewart_propagated(const stewart_workspace *work, stewart_real size,
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int stewart_flagged_refined(const stewart_options *options,
                                         const stewart_workspace *work,
                                         const stewart_report *report, stewart_real nq,
@@ -848,16 +859,16 @@ static int stewart_flagged_refined(const stewart_options *options,
     static const stewart_real zeros[STEWART_NQ];
     const stewart_real s = report->inv_norm / sqrt((stewart_real)STEWART_NQ);
     const stewart_real u = STEWART_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     stewart_real e_q, errors[2], e_dq, e_ddq;
-    if (!stewart_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!stewart_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = stewart_position_error(work, report, nq);
     stewart_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * stewart_at_least_1(nq)
-        || e_dq > options->target_dq * stewart_at_least_1(ndq)
-        || e_ddq > options->target_ddq * stewart_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return stewart_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -868,7 +879,7 @@ static int stewart_would_flag(const stewart_options *options,
 {
     const stewart_real *norms = work->norms;
     return report->residual > STEWART_UNIT_ROUNDOFF * (1 + norms[0])
-        && stewart_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && stewart_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -670,13 +670,24 @@ static stewart_legs_fk_real stewart_legs_fk_at_least_1(stewart_legs_fk_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int stewart_legs_fk_misses(const stewart_legs_fk_options *options, int judged, stewart_legs_fk_real e_q,
+                               stewart_legs_fk_real e_dq, stewart_legs_fk_real e_ddq, stewart_legs_fk_real nq, stewart_legs_fk_real ndq,
+                               stewart_legs_fk_real nddq)
+{
+    return e_q > options->target_q * stewart_legs_fk_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * stewart_legs_fk_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * stewart_legs_fk_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int stewart_legs_fk_flagged(const stewart_legs_fk_options *options,
                                 const stewart_legs_fk_workspace *work,
                                 const stewart_legs_fk_report *report, stewart_legs_fk_real nq, stewart_legs_fk_real ndq,
-                                stewart_legs_fk_real nddq)
+                                stewart_legs_fk_real nddq, int judged)
 {
     const stewart_legs_fk_real u = STEWART_LEGS_FK_UNIT_ROUNDOFF;
     const stewart_legs_fk_real s = report->inv_norm / sqrt((stewart_legs_fk_real)STEWART_LEGS_FK_NQ);
@@ -687,9 +698,9 @@ static int stewart_legs_fk_flagged(const stewart_legs_fk_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * stewart_legs_fk_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * stewart_legs_fk_at_least_1(ndq));
-    return STEWART_LEGS_FK_SAFETY * e_q > options->target_q * stewart_legs_fk_at_least_1(nq)
-        || STEWART_LEGS_FK_SAFETY * e_dq > options->target_dq * stewart_legs_fk_at_least_1(ndq)
-        || STEWART_LEGS_FK_SAFETY * e_ddq > options->target_ddq * stewart_legs_fk_at_least_1(nddq);
+    return stewart_legs_fk_misses(options, judged, STEWART_LEGS_FK_SAFETY * e_q,
+                               STEWART_LEGS_FK_SAFETY * e_dq, STEWART_LEGS_FK_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -799,7 +810,7 @@ static void stewart_legs_fk_propagated(const stewart_legs_fk_workspace *work, st
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int stewart_legs_fk_flagged_refined(const stewart_legs_fk_options *options,
                                         const stewart_legs_fk_workspace *work,
                                         const stewart_legs_fk_report *report, stewart_legs_fk_real nq,
@@ -810,16 +821,16 @@ static int stewart_legs_fk_flagged_refined(const stewart_legs_fk_options *option
     static const stewart_legs_fk_real zeros[STEWART_LEGS_FK_NQ];
     const stewart_legs_fk_real s = report->inv_norm / sqrt((stewart_legs_fk_real)STEWART_LEGS_FK_NQ);
     const stewart_legs_fk_real u = STEWART_LEGS_FK_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     stewart_legs_fk_real e_q, errors[2], e_dq, e_ddq;
-    if (!stewart_legs_fk_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!stewart_legs_fk_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = stewart_legs_fk_position_error(work, report, nq);
     stewart_legs_fk_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * stewart_legs_fk_at_least_1(nq)
-        || e_dq > options->target_dq * stewart_legs_fk_at_least_1(ndq)
-        || e_ddq > options->target_ddq * stewart_legs_fk_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return stewart_legs_fk_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -830,7 +841,7 @@ static int stewart_legs_fk_would_flag(const stewart_legs_fk_options *options,
 {
     const stewart_legs_fk_real *norms = work->norms;
     return report->residual > STEWART_LEGS_FK_UNIT_ROUNDOFF * (1 + norms[0])
-        && stewart_legs_fk_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && stewart_legs_fk_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -594,13 +594,24 @@ static three_rrr_fk_real three_rrr_fk_at_least_1(three_rrr_fk_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int three_rrr_fk_misses(const three_rrr_fk_options *options, int judged, three_rrr_fk_real e_q,
+                               three_rrr_fk_real e_dq, three_rrr_fk_real e_ddq, three_rrr_fk_real nq, three_rrr_fk_real ndq,
+                               three_rrr_fk_real nddq)
+{
+    return e_q > options->target_q * three_rrr_fk_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * three_rrr_fk_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int three_rrr_fk_flagged(const three_rrr_fk_options *options,
                                 const three_rrr_fk_workspace *work,
                                 const three_rrr_fk_report *report, three_rrr_fk_real nq, three_rrr_fk_real ndq,
-                                three_rrr_fk_real nddq)
+                                three_rrr_fk_real nddq, int judged)
 {
     const three_rrr_fk_real u = THREE_RRR_FK_UNIT_ROUNDOFF;
     const three_rrr_fk_real s = report->inv_norm / sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
@@ -611,9 +622,9 @@ static int three_rrr_fk_flagged(const three_rrr_fk_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * three_rrr_fk_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * three_rrr_fk_at_least_1(ndq));
-    return THREE_RRR_FK_SAFETY * e_q > options->target_q * three_rrr_fk_at_least_1(nq)
-        || THREE_RRR_FK_SAFETY * e_dq > options->target_dq * three_rrr_fk_at_least_1(ndq)
-        || THREE_RRR_FK_SAFETY * e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq);
+    return three_rrr_fk_misses(options, judged, THREE_RRR_FK_SAFETY * e_q,
+                               THREE_RRR_FK_SAFETY * e_dq, THREE_RRR_FK_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -723,7 +734,7 @@ static void three_rrr_fk_propagated(const three_rrr_fk_workspace *work, three_rr
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int three_rrr_fk_flagged_refined(const three_rrr_fk_options *options,
                                         const three_rrr_fk_workspace *work,
                                         const three_rrr_fk_report *report, three_rrr_fk_real nq,
@@ -734,16 +745,16 @@ static int three_rrr_fk_flagged_refined(const three_rrr_fk_options *options,
     static const three_rrr_fk_real zeros[THREE_RRR_FK_NQ];
     const three_rrr_fk_real s = report->inv_norm / sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
     const three_rrr_fk_real u = THREE_RRR_FK_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     three_rrr_fk_real e_q, errors[2], e_dq, e_ddq;
-    if (!three_rrr_fk_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!three_rrr_fk_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = three_rrr_fk_position_error(work, report, nq);
     three_rrr_fk_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * three_rrr_fk_at_least_1(nq)
-        || e_dq > options->target_dq * three_rrr_fk_at_least_1(ndq)
-        || e_ddq > options->target_ddq * three_rrr_fk_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return three_rrr_fk_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -754,7 +765,7 @@ static int three_rrr_fk_would_flag(const three_rrr_fk_options *options,
 {
     const three_rrr_fk_real *norms = work->norms;
     return report->residual > THREE_RRR_FK_UNIT_ROUNDOFF * (1 + norms[0])
-        && three_rrr_fk_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && three_rrr_fk_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point

@@ -414,13 +414,24 @@ static whitworth_drawn_real whitworth_drawn_at_least_1(whitworth_drawn_real x)
     return x > 1 ? x : 1;
 }
 
+/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+ * its target (an input-driven point's rates or accelerations not solved for are not judged). */
+static int whitworth_drawn_misses(const whitworth_drawn_options *options, int judged, whitworth_drawn_real e_q,
+                               whitworth_drawn_real e_dq, whitworth_drawn_real e_ddq, whitworth_drawn_real nq, whitworth_drawn_real ndq,
+                               whitworth_drawn_real nddq)
+{
+    return e_q > options->target_q * whitworth_drawn_at_least_1(nq)
+        || (judged > 0 && e_dq > options->target_dq * whitworth_drawn_at_least_1(ndq))
+        || (judged > 1 && e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq));
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
 static int whitworth_drawn_flagged(const whitworth_drawn_options *options,
                                 const whitworth_drawn_workspace *work,
                                 const whitworth_drawn_report *report, whitworth_drawn_real nq, whitworth_drawn_real ndq,
-                                whitworth_drawn_real nddq)
+                                whitworth_drawn_real nddq, int judged)
 {
     const whitworth_drawn_real u = WHITWORTH_DRAWN_UNIT_ROUNDOFF;
     const whitworth_drawn_real s = report->inv_norm / sqrt((whitworth_drawn_real)WHITWORTH_DRAWN_NQ);
@@ -431,9 +442,9 @@ static int whitworth_drawn_flagged(const whitworth_drawn_options *options,
     e_q = left > rounding ? left : rounding;
     e_dq = s * (u * ndq + e_q * whitworth_drawn_at_least_1(ndq));
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * whitworth_drawn_at_least_1(ndq));
-    return WHITWORTH_DRAWN_SAFETY * e_q > options->target_q * whitworth_drawn_at_least_1(nq)
-        || WHITWORTH_DRAWN_SAFETY * e_dq > options->target_dq * whitworth_drawn_at_least_1(ndq)
-        || WHITWORTH_DRAWN_SAFETY * e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq);
+    return whitworth_drawn_misses(options, judged, WHITWORTH_DRAWN_SAFETY * e_q,
+                               WHITWORTH_DRAWN_SAFETY * e_dq, WHITWORTH_DRAWN_SAFETY * e_ddq, nq, ndq,
+                               nddq);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -543,7 +554,7 @@ static void whitworth_drawn_propagated(const whitworth_drawn_workspace *work, wh
 /* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
- * dq, ddq: NULL where not solved for (zero). */
+ * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int whitworth_drawn_flagged_refined(const whitworth_drawn_options *options,
                                         const whitworth_drawn_workspace *work,
                                         const whitworth_drawn_report *report, whitworth_drawn_real nq,
@@ -554,16 +565,16 @@ static int whitworth_drawn_flagged_refined(const whitworth_drawn_options *option
     static const whitworth_drawn_real zeros[WHITWORTH_DRAWN_NQ];
     const whitworth_drawn_real s = report->inv_norm / sqrt((whitworth_drawn_real)WHITWORTH_DRAWN_NQ);
     const whitworth_drawn_real u = WHITWORTH_DRAWN_UNIT_ROUNDOFF;
+    const int judged = dq == NULL ? 0 : ddq == NULL ? 1 : 2;
     whitworth_drawn_real e_q, errors[2], e_dq, e_ddq;
-    if (!whitworth_drawn_flagged(options, work, report, nq, ndq, nddq)) return 0;
+    if (!whitworth_drawn_flagged(options, work, report, nq, ndq, nddq, judged)) return 0;
     e_q = whitworth_drawn_position_error(work, report, nq);
     whitworth_drawn_propagated(work, e_q, nq, q, dq ? dq : zeros, ddq ? ddq : zeros, t, p, errors);
     e_dq = errors[0] + s * u * ndq;
     e_ddq = errors[1] + s * u * nddq;
-    if (e_q - e_q != 0 || e_dq - e_dq != 0 || e_ddq - e_ddq != 0) return 1;
-    return e_q > options->target_q * whitworth_drawn_at_least_1(nq)
-        || e_dq > options->target_dq * whitworth_drawn_at_least_1(ndq)
-        || e_ddq > options->target_ddq * whitworth_drawn_at_least_1(nddq);
+    if (e_q - e_q != 0 || (judged > 0 && e_dq - e_dq != 0)
+        || (judged > 1 && e_ddq - e_ddq != 0)) return 1;
+    return whitworth_drawn_misses(options, judged, e_q, e_dq, e_ddq, nq, ndq, nddq);
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
@@ -574,7 +585,7 @@ static int whitworth_drawn_would_flag(const whitworth_drawn_options *options,
 {
     const whitworth_drawn_real *norms = work->norms;
     return report->residual > WHITWORTH_DRAWN_UNIT_ROUNDOFF * (1 + norms[0])
-        && whitworth_drawn_flagged(options, work, report, norms[0], norms[1], norms[2]);
+        && whitworth_drawn_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point
