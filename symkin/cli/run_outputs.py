@@ -229,9 +229,9 @@ def flag_warnings(trajectory: Any) -> list[str]:
             f"dependent rows: {'; '.join('{' + ', '.join(g) + '}' for g in groups)}), its "
             "point(s) interpolated from both sides" for t, rank, groups in passed)
         lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
-                     f"q, dq, ddq may miss {targets.target_q:g}, {targets.target_dq:g}, "
-                     f"{targets.target_ddq:g} there by the error model (Phi_q's condition up "
-                     f"to {worst:.3g}; column 'flagged'){detail}")
+                     f"the error model says q, dq, ddq may miss {targets.target_q:g}, "
+                     f"{targets.target_dq:g}, {targets.target_ddq:g} there (Phi_q's condition "
+                     f"up to {worst:.3g}; column 'flagged'){detail}")
         k = end + 1
     return lines
 
