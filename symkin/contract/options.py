@@ -4,7 +4,12 @@ rendered from :data:`SOLVER_FIELDS` and :data:`DEFAULTS` (codegen.render)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+import math
+import numbers
+from dataclasses import Field, dataclass, fields
+from typing import Any
+
+from symkin.errors import UsageError
 
 
 @dataclass(frozen=True)
@@ -42,6 +47,32 @@ class Options:
     target_dq: float = 1e-7
     target_ddq: float = 1e-6
     stop_at_singular: bool = False
+
+    def __post_init__(self) -> None:
+        # Checked here, where they are made: a bad value would otherwise surface far away as a
+        # failure that blames the mechanism (tol_phi < 0: "cannot be assembled") or as a
+        # ZeroDivisionError (max_cond = 0).
+        problems = [problem for problem in map(self._problem, fields(self)) if problem]
+        if problems:
+            raise UsageError("Options: " + "; ".join(problems))
+
+    def _problem(self, field: Field[Any]) -> str | None:
+        value = getattr(self, field.name)
+        if field.name == "stop_at_singular":
+            return None if isinstance(value, bool) else "stop_at_singular must be True or False"
+        if field.name == "max_iterations":
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+                return f"max_iterations must be a whole number >= 0, got {value!r}"
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return f"{field.name} must be a number, got {value!r}"
+        if field.name == "tol_phi" and not (0 < value < math.inf):
+            return f"tol_phi must be positive and finite, got {value!r}"
+        if field.name == "min_pivot_ratio" and not 0 <= value <= 1:
+            return f"min_pivot_ratio must be from 0 to 1, got {value!r}"
+        if field.name != "min_pivot_ratio" and not value > 0:  # inf allowed: no such limit
+            return f"{field.name} must be positive (inf for no limit), got {value!r}"
+        return None
 
 
 # The defaults per real type, defined once: the generated C's <prefix>_default_options is
