@@ -240,3 +240,26 @@ def test_c_batch_reports_without_outputs_and_counts_newton(c_kernel) -> None:
             assert lib.crank_slider_solve_step(options, p, time_point, state, work, report) == 0
             total += report.iterations
         assert reports[j].iterations == total
+
+
+def test_c_batch_runs_with_every_option_given(c_kernel) -> None:
+    """The options reach the C batch whole: with max_cond below the condition the crank-slider
+    reaches along T (21 at t = 0, about 32 later), the batch stops where it passes it, as
+    singular; with the defaults it solves every point. Before, only the Newton tolerances
+    were copied: the batch ran on with the default max_cond (1e7) whatever was given."""
+    from symkin.backends.c import batch as c_batch
+    from symkin.contract.options import Options
+    from symkin.contract.status import OK, SINGULAR
+
+    def run(options: Options) -> tuple[int, int]:
+        rows = tuple(np.empty((1, T.size, c_kernel.nq)) for _ in range(3))
+        status, _, solved, _, _ = c_batch.solve(
+            c_kernel.ffi, c_kernel.lib, c_kernel.name, c_kernel.real,
+            c_kernel.p_values[None, :], T, c_kernel.q0, options, rows, np.ones(1))
+        return int(status[0]), int(solved[0])
+
+    assert run(Options()) == (OK, T.size)
+    status, solved = run(Options(max_cond=25.0, tighten_cond=25.0))
+    assert status == SINGULAR and 0 < solved < T.size
+    conditions = symkin.solve(c_kernel, t=T).cond
+    assert conditions[:solved].max() <= 25.0 < conditions[solved]

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.backends.c.csolver import fill_options
 from symkin.contract.options import Options
 from symkin.runtime.protocol import BatchStatus
 
@@ -83,11 +84,11 @@ def _report_dtype(ffi: Any, name: str) -> np.dtype[Any]:
 
 
 def _options(ffi: Any, lib: Any, name: str, options: Options) -> Any:
+    """The C options struct from every field of ``options`` (each set's unit is passed apart,
+    in ``units``). Before, only the Newton tolerances were copied and the batch ran with the
+    default max_cond, tighten_cond and targets whatever the caller gave."""
     c_options = ffi.new(f"{name}_options *")
-    getattr(lib, f"{name}_default_options")(c_options)
-    c_options.tol_phi, c_options.tol_dq = options.tol_phi, options.tol_dq
-    c_options.max_iterations = options.max_iterations
-    c_options.min_pivot_ratio = options.min_pivot_ratio
+    fill_options(lib, name, c_options, options)
     return c_options
 
 
