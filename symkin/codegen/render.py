@@ -297,6 +297,7 @@ def template_context(code: Code) -> dict[str, Any]:
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
         "option_fields": list(options.C_FIELDS),
+        "option_rules": dict(options.RULES),
         "status": dict(status.CODES),
         "shared_constants": {name: _c_number(value)
                              for name, value in {**tuning.SHARED, **tuning.INPUTS}.items()},

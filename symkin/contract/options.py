@@ -1,6 +1,7 @@
 """Newton's tolerances and the singularity test, with their defaults per real type. Defined
 once: the generated C's ``<prefix>_options`` fields and ``<prefix>_default_options`` are
-rendered from :data:`SOLVER_FIELDS` and :data:`DEFAULTS` (codegen.render)."""
+rendered from :data:`SOLVER_FIELDS` and :data:`DEFAULTS` (codegen.render), its
+``<prefix>_check_options`` from :data:`RULES`, which Options keeps too."""
 
 from __future__ import annotations
 
@@ -10,6 +11,29 @@ from dataclasses import Field, dataclass, fields
 from typing import Any
 
 from symkin.errors import UsageError
+
+RULES = {"tol_phi": "positive finite", "tol_dq": "positive", "max_iterations": "count",
+         "min_pivot_ratio": "ratio", "max_cond": "positive", "tighten_cond": "positive",
+         "target_q": "positive", "target_dq": "positive", "target_ddq": "positive",
+         "unit": "positive finite"}  # LENGTH_UNIT
+"""What each field of the C options struct may hold, checked by Options when it is made and by
+the generated ``<prefix>_check_options`` (rendered from this table) at every solve: a
+tolerance, limit or target > 0 (inf: no such limit), tol_phi and the unit also finite, the
+iteration cap a whole number >= 0, the pivot ratio from 0 to 1. NaN passes none."""
+
+RULE_WORDS = {"positive finite": "positive and finite", "positive": "positive (inf for no limit)",
+              "count": "a whole number >= 0", "ratio": "from 0 to 1"}
+
+
+def allowed(rule: str, value: float) -> bool:
+    """Whether ``value`` keeps ``rule`` (of :data:`RULES`)."""
+    if rule == "positive finite":
+        return 0 < value < math.inf
+    if rule == "positive":
+        return value > 0
+    if rule == "count":
+        return value >= 0 and math.isfinite(value) and float(value).is_integer()
+    return 0 <= value <= 1
 
 
 @dataclass(frozen=True)
@@ -60,19 +84,15 @@ class Options:
         value = getattr(self, field.name)
         if field.name == "stop_at_singular":
             return None if isinstance(value, bool) else "stop_at_singular must be True or False"
-        if field.name == "max_iterations":
-            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
-                return f"max_iterations must be a whole number >= 0, got {value!r}"
-            return None
+        rule = RULES[field.name]
+        if rule == "count":
+            whole = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+            return None if whole and value >= 0 else \
+                f"max_iterations must be {RULE_WORDS[rule]}, got {value!r}"
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return f"{field.name} must be a number, got {value!r}"
-        if field.name == "tol_phi" and not (0 < value < math.inf):
-            return f"tol_phi must be positive and finite, got {value!r}"
-        if field.name == "min_pivot_ratio" and not 0 <= value <= 1:
-            return f"min_pivot_ratio must be from 0 to 1, got {value!r}"
-        if field.name != "min_pivot_ratio" and not value > 0:  # inf allowed: no such limit
-            return f"{field.name} must be positive (inf for no limit), got {value!r}"
-        return None
+        return None if allowed(rule, float(value)) else \
+            f"{field.name} must be {RULE_WORDS[rule]}, got {value!r}"
 
 
 # The defaults per real type, defined once: the generated C's <prefix>_default_options is

@@ -13,6 +13,11 @@ NOT_FINITE = 3
 """Phi at the predicted q, or the velocity or acceleration, is inf or NaN, i.e. an expression
 of the mechanism is singular at that time (a time function such as 1/(t - 0.5))."""
 
+BAD_OPTIONS = 4
+"""Generated C only: an option breaks its rule (contract.options.RULES: NaN, a tolerance or
+target <= 0, unit <= 0, ...); nothing was solved and the state is as it was. The runtime never
+meets it: Options refuses such values when it is made."""
+
 CODES = {"OK": OK, "NO_CONVERGENCE": NO_CONVERGENCE, "SINGULAR": SINGULAR,
-         "NOT_FINITE": NOT_FINITE}
+         "NOT_FINITE": NOT_FINITE, "BAD_OPTIONS": BAD_OPTIONS}
 """Every status by its name (the C macro is ``<PREFIX>_`` + the name)."""

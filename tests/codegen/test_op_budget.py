@@ -84,8 +84,9 @@ static void set_params(void)
     for (i = 0; i < @U@_NU; ++i) params[@U@_NP + i] = @P@_u0[i];
 #endif
 }
-/* One step of the run: by t, or by the inputs u = u0 + k du (positions only on odd k). */
-static int advance(const @P@_options *o, int k)
+/* One step of the run: by t, or by the inputs u = u0 + k du (positions only on odd k);
+ * checked: through the public function, which checks the options first. */
+static int advance(const @P@_options *o, int k, int checked)
 {
 #if @INPUTS@
     @P@_real u[@U@_NU], du[@U@_NU], ddu[@U@_NU];
@@ -95,10 +96,10 @@ static int advance(const @P@_options *o, int k)
         ddu[i] = 0;
         u[i] = @P@_u0[i] + k * @DT@;
     }
-    return @P@_solve_inputs(o, params, u, k % 2 ? NULL : du, k % 2 ? NULL : ddu, &s,
-                            &w, &r);
+    return (checked ? @P@_solve_inputs : @P@_inputs_step)(o, params, u, k % 2 ? NULL : du,
+                                                          k % 2 ? NULL : ddu, &s, &w, &r);
 #else
-    return @P@_solve_step(o, params, k * @DT@, &s, &w, &r);
+    return (checked ? @P@_solve_step : @P@_step)(o, params, k * @DT@, &s, &w, &r);
 #endif
 }
 /* The run from q0, each step's count after the first (which sets up the workspace). */
@@ -109,7 +110,7 @@ static int run(const char *name, const @P@_options *o)
     s.started = 0;
     for (k = 0; k < @STEPS@; ++k) {
         memset(&ops, 0, sizeof ops);
-        if (advance(o, k) != @U@_OK) return 1;
+        if (advance(o, k, 1) != @U@_OK) return 1;
         if (k > 0) { printf("%d %d ", r.iterations, k % 2); show(name, ops); }
     }
     return 0;
@@ -174,12 +175,12 @@ int main()
     }
 #endif
     /* every point flagged, Newton going on at every point: the checks at their most */
-    o.tighten_cond = 0;
-    o.target_q = o.target_dq = o.target_ddq = 0;
+    o.tighten_cond = 1e-300; /* (0 and below are refused: BAD_OPTIONS) */
+    o.target_q = o.target_dq = o.target_ddq = 1e-300;
     if (run("flagged_step", &o)) return 1;
-    o.tol_phi = -1; /* never converges: Newton runs to its cap */
+    o.tol_phi = -1; /* never converges: Newton runs to its cap (past the options' check) */
     o.max_iterations = @CAP@;
-    MEASURE("capped", advance(&o, @STEPS@));
+    MEASURE("capped", advance(&o, @STEPS@, 0));
     printf("%d %d\n", r.status, r.iterations);
     return 0;
 }

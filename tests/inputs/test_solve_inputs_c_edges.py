@@ -79,13 +79,25 @@ def test_a_reading_out_of_reach_leaves_the_last_solution_and_the_next_call_recov
         assert controller.q()[SLIDER_X] == pytest.approx(_slider_x(theta), abs=1e-12)
 
 
-def test_a_negative_iteration_cap_still_fills_the_report(kernel) -> None:
-    controller = _Controller(kernel, max_iterations=-1)
+def test_a_zero_iteration_cap_still_fills_the_report(kernel) -> None:
+    """Cap 0: Phi is evaluated at the first guess and not iterated on; the report holds that
+    residual (q0 lies off the assembly at theta = 1.6 by about 0.03 in the crank angle)."""
+    controller = _Controller(kernel, max_iterations=0)
     controller.report.iterations = 12345  # what a caller's stale report may hold
     controller.report.residual = 777.0
-    assert controller.solve(1.5708) == 1  # NO_CONVERGENCE: no iteration was allowed
+    assert controller.solve(1.6) == 1  # NO_CONVERGENCE: no iteration was allowed
     assert controller.report.iterations == 0
-    assert math.isnan(controller.report.residual)
+    assert 1e-3 < controller.report.residual < 1.0
+
+
+def test_a_negative_iteration_cap_is_refused_with_the_state_kept(kernel) -> None:
+    controller = _Controller(kernel, max_iterations=-1)
+    controller.report.iterations = 12345
+    before = controller.q()
+    assert controller.solve(1.6) == 4  # BAD_OPTIONS
+    assert controller.report.status == 4 and controller.report.iterations == 0
+    assert math.isnan(controller.report.residual) and controller.report.branch_jump == 0
+    assert np.array_equal(controller.q(), before) and controller.state.started == 0
 
 
 def test_the_functions_over_t_read_each_sets_inputs_after_its_parameters(kernel) -> None:

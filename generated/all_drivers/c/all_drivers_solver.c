@@ -31,6 +31,34 @@ void all_drivers_default_options(all_drivers_options *options)
     options->unit = 1.0;
 }
 
+int all_drivers_check_options(const all_drivers_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int all_drivers_refused(all_drivers_report *report, all_drivers_real t)
+{
+    report->status = ALL_DRIVERS_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (all_drivers_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (all_drivers_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define ALL_DRIVERS_UNIT_ROUNDOFF DBL_EPSILON
 #define ALL_DRIVERS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define ALL_DRIVERS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -844,9 +872,10 @@ static void all_drivers_predict(all_drivers_real t, all_drivers_state *state)
     }
 }
 
-int all_drivers_solve_step(const all_drivers_options *options, const all_drivers_real p[], all_drivers_real t,
-                            all_drivers_state *state, all_drivers_workspace *work,
-                            all_drivers_report *report)
+/* all_drivers_solve_step with its options already checked. */
+static int all_drivers_step(const all_drivers_options *options, const all_drivers_real p[],
+                             all_drivers_real t, all_drivers_state *state,
+                             all_drivers_workspace *work, all_drivers_report *report)
 {
     all_drivers_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -903,6 +932,14 @@ int all_drivers_solve_step(const all_drivers_options *options, const all_drivers
     state->t = t;
     state->started = 1;
     return ALL_DRIVERS_OK;
+}
+
+int all_drivers_solve_step(const all_drivers_options *options, const all_drivers_real p[], all_drivers_real t,
+                            all_drivers_state *state, all_drivers_workspace *work,
+                            all_drivers_report *report)
+{
+    if (all_drivers_check_options(options) != 0) return all_drivers_refused(report, t);
+    return all_drivers_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define ALL_DRIVERS_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define ALL_DRIVERS_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define ALL_DRIVERS_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define ALL_DRIVERS_BAD_OPTIONS 4    /* an option breaks its rule: see all_drivers_check_options */
 
 typedef struct {
     all_drivers_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 155
  * Condition at the converged q: 522; an extra iteration there (at most 3): 723
  * Velocity: 127; acceleration: 189; per-point checks: 2174; predictor: 91
- * Step, worst case with the default cap of 25 iterations: 22374 (7971 add/sub, 5502 mul, 787 div, 10 sqrt, 280 other calls, 4354 fabs, 3470 compares)
+ * Step, worst case with the default cap of 25 iterations: 22388 (7973 add/sub, 5502 mul, 787 div, 10 sqrt, 280 other calls, 4354 fabs, 3482 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130154
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130168
  */
 #define ALL_DRIVERS_OPS_ITERATION 642   /* one Newton iteration */
-#define ALL_DRIVERS_OPS_STEP_FIXED 6324  /* a step without its iterations */
-#define ALL_DRIVERS_OPS_STEP_WORST 22374  /* at the default cap, 25 */
-#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130154  /* every factorization dense */
+#define ALL_DRIVERS_OPS_STEP_FIXED 6338  /* a step without its iterations */
+#define ALL_DRIVERS_OPS_STEP_WORST 22388  /* at the default cap, 25 */
+#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130168  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     all_drivers_real t;         /* the time of the last step attempted           */
     all_drivers_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void all_drivers_default_options(all_drivers_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: all_drivers_default_options not called), returns
+ * ALL_DRIVERS_BAD_OPTIONS with nothing solved and the state as it was. */
+int all_drivers_check_options(const all_drivers_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

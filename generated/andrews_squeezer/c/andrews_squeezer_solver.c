@@ -31,6 +31,34 @@ void andrews_squeezer_default_options(andrews_squeezer_options *options)
     options->unit = 1.0;
 }
 
+int andrews_squeezer_check_options(const andrews_squeezer_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int andrews_squeezer_refused(andrews_squeezer_report *report, andrews_squeezer_real t)
+{
+    report->status = ANDREWS_SQUEEZER_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (andrews_squeezer_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (andrews_squeezer_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define ANDREWS_SQUEEZER_UNIT_ROUNDOFF DBL_EPSILON
 #define ANDREWS_SQUEEZER_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define ANDREWS_SQUEEZER_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -850,9 +878,10 @@ static void andrews_squeezer_predict(andrews_squeezer_real t, andrews_squeezer_s
     }
 }
 
-int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const andrews_squeezer_real p[], andrews_squeezer_real t,
-                            andrews_squeezer_state *state, andrews_squeezer_workspace *work,
-                            andrews_squeezer_report *report)
+/* andrews_squeezer_solve_step with its options already checked. */
+static int andrews_squeezer_step(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
+                             andrews_squeezer_real t, andrews_squeezer_state *state,
+                             andrews_squeezer_workspace *work, andrews_squeezer_report *report)
 {
     andrews_squeezer_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -909,6 +938,14 @@ int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const a
     state->t = t;
     state->started = 1;
     return ANDREWS_SQUEEZER_OK;
+}
+
+int andrews_squeezer_solve_step(const andrews_squeezer_options *options, const andrews_squeezer_real p[], andrews_squeezer_real t,
+                            andrews_squeezer_state *state, andrews_squeezer_workspace *work,
+                            andrews_squeezer_report *report)
+{
+    if (andrews_squeezer_check_options(options) != 0) return andrews_squeezer_refused(report, t);
+    return andrews_squeezer_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

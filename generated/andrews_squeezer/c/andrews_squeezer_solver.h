@@ -23,6 +23,7 @@
 #define ANDREWS_SQUEEZER_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define ANDREWS_SQUEEZER_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define ANDREWS_SQUEEZER_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define ANDREWS_SQUEEZER_BAD_OPTIONS 4    /* an option breaks its rule: see andrews_squeezer_check_options */
 
 typedef struct {
     andrews_squeezer_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 417; the update (a solve): 189
  * Condition at the converged q: 517; an extra iteration there (at most 3): 687
  * Velocity: 125; acceleration: 148; per-point checks: 2530; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 21635 (8267 add/sub, 4538 mul, 1015 div, 10 sqrt, 434 other calls, 4010 fabs, 3361 compares)
+ * Step, worst case with the default cap of 25 iterations: 21649 (8269 add/sub, 4538 mul, 1015 div, 10 sqrt, 434 other calls, 4010 fabs, 3373 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284661
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284675
  */
 #define ANDREWS_SQUEEZER_OPS_ITERATION 606   /* one Newton iteration */
-#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6485  /* a step without its iterations */
-#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21635  /* at the default cap, 25 */
-#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284661  /* every factorization dense */
+#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6499  /* a step without its iterations */
+#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21649  /* at the default cap, 25 */
+#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284675  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     andrews_squeezer_real t;         /* the time of the last step attempted           */
     andrews_squeezer_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void andrews_squeezer_default_options(andrews_squeezer_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: andrews_squeezer_default_options not called), returns
+ * ANDREWS_SQUEEZER_BAD_OPTIONS with nothing solved and the state as it was. */
+int andrews_squeezer_check_options(const andrews_squeezer_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

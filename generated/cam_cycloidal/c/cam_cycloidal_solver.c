@@ -31,6 +31,34 @@ void cam_cycloidal_default_options(cam_cycloidal_options *options)
     options->unit = 1.0;
 }
 
+int cam_cycloidal_check_options(const cam_cycloidal_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int cam_cycloidal_refused(cam_cycloidal_report *report, cam_cycloidal_real t)
+{
+    report->status = CAM_CYCLOIDAL_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (cam_cycloidal_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (cam_cycloidal_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define CAM_CYCLOIDAL_UNIT_ROUNDOFF DBL_EPSILON
 #define CAM_CYCLOIDAL_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define CAM_CYCLOIDAL_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -622,9 +650,10 @@ static void cam_cycloidal_predict(cam_cycloidal_real t, cam_cycloidal_state *sta
     }
 }
 
-int cam_cycloidal_solve_step(const cam_cycloidal_options *options, const cam_cycloidal_real p[], cam_cycloidal_real t,
-                            cam_cycloidal_state *state, cam_cycloidal_workspace *work,
-                            cam_cycloidal_report *report)
+/* cam_cycloidal_solve_step with its options already checked. */
+static int cam_cycloidal_step(const cam_cycloidal_options *options, const cam_cycloidal_real p[],
+                             cam_cycloidal_real t, cam_cycloidal_state *state,
+                             cam_cycloidal_workspace *work, cam_cycloidal_report *report)
 {
     cam_cycloidal_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -681,6 +710,14 @@ int cam_cycloidal_solve_step(const cam_cycloidal_options *options, const cam_cyc
     state->t = t;
     state->started = 1;
     return CAM_CYCLOIDAL_OK;
+}
+
+int cam_cycloidal_solve_step(const cam_cycloidal_options *options, const cam_cycloidal_real p[], cam_cycloidal_real t,
+                            cam_cycloidal_state *state, cam_cycloidal_workspace *work,
+                            cam_cycloidal_report *report)
+{
+    if (cam_cycloidal_check_options(options) != 0) return cam_cycloidal_refused(report, t);
+    return cam_cycloidal_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

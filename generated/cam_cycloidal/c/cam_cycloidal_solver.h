@@ -23,6 +23,7 @@
 #define CAM_CYCLOIDAL_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define CAM_CYCLOIDAL_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define CAM_CYCLOIDAL_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define CAM_CYCLOIDAL_BAD_OPTIONS 4    /* an option breaks its rule: see cam_cycloidal_check_options */
 
 typedef struct {
     cam_cycloidal_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 353; the update (a solve): 56
  * Condition at the converged q: 46; an extra iteration there (at most 3): 490
  * Velocity: 34; acceleration: 520; per-point checks: 1545; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 14325 (5170 add/sub, 5988 mul, 560 div, 42 sqrt, 576 other calls, 817 fabs, 1172 compares)
+ * Step, worst case with the default cap of 25 iterations: 14339 (5172 add/sub, 5988 mul, 560 div, 42 sqrt, 576 other calls, 817 fabs, 1184 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31350
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31364
  */
 #define CAM_CYCLOIDAL_OPS_ITERATION 409   /* one Newton iteration */
-#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4100  /* a step without its iterations */
-#define CAM_CYCLOIDAL_OPS_STEP_WORST 14325  /* at the default cap, 25 */
-#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31350  /* every factorization dense */
+#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4114  /* a step without its iterations */
+#define CAM_CYCLOIDAL_OPS_STEP_WORST 14339  /* at the default cap, 25 */
+#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31364  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* CAM_CYCLOIDAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* CAM_CYCLOIDAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     cam_cycloidal_real t;         /* the time of the last step attempted           */
     cam_cycloidal_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void cam_cycloidal_default_options(cam_cycloidal_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: cam_cycloidal_default_options not called), returns
+ * CAM_CYCLOIDAL_BAD_OPTIONS with nothing solved and the state as it was. */
+int cam_cycloidal_check_options(const cam_cycloidal_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,34 @@ void cardan_default_options(cardan_options *options)
     options->unit = 1.0;
 }
 
+int cardan_check_options(const cardan_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int cardan_refused(cardan_report *report, cardan_real t)
+{
+    report->status = CARDAN_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (cardan_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (cardan_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define CARDAN_UNIT_ROUNDOFF DBL_EPSILON
 #define CARDAN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define CARDAN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -608,9 +636,10 @@ static void cardan_predict(cardan_real t, cardan_state *state)
     }
 }
 
-int cardan_solve_step(const cardan_options *options, const cardan_real p[], cardan_real t,
-                            cardan_state *state, cardan_workspace *work,
-                            cardan_report *report)
+/* cardan_solve_step with its options already checked. */
+static int cardan_step(const cardan_options *options, const cardan_real p[],
+                             cardan_real t, cardan_state *state,
+                             cardan_workspace *work, cardan_report *report)
 {
     cardan_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -667,6 +696,14 @@ int cardan_solve_step(const cardan_options *options, const cardan_real p[], card
     state->t = t;
     state->started = 1;
     return CARDAN_OK;
+}
+
+int cardan_solve_step(const cardan_options *options, const cardan_real p[], cardan_real t,
+                            cardan_state *state, cardan_workspace *work,
+                            cardan_report *report)
+{
+    if (cardan_check_options(options) != 0) return cardan_refused(report, t);
+    return cardan_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define CARDAN_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define CARDAN_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define CARDAN_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define CARDAN_BAD_OPTIONS 4    /* an option breaks its rule: see cardan_check_options */
 
 typedef struct {
     cardan_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 794; the update (a solve): 214
  * Condition at the converged q: 2542; an extra iteration there (at most 3): 1089
  * Velocity: 188; acceleration: 382; per-point checks: 3099; predictor: 85
- * Step, worst case with the default cap of 25 iterations: 38142 (14836 add/sub, 12171 mul, 809 div, 10 sqrt, 266 other calls, 5540 fabs, 4510 compares)
+ * Step, worst case with the default cap of 25 iterations: 38156 (14838 add/sub, 12171 mul, 809 div, 10 sqrt, 266 other calls, 5540 fabs, 4522 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 122965
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 122979
  */
 #define CARDAN_OPS_ITERATION 1008   /* one Newton iteration */
-#define CARDAN_OPS_STEP_FIXED 12942  /* a step without its iterations */
-#define CARDAN_OPS_STEP_WORST 38142  /* at the default cap, 25 */
-#define CARDAN_OPS_STEP_DENSE_WORST 122965  /* every factorization dense */
+#define CARDAN_OPS_STEP_FIXED 12956  /* a step without its iterations */
+#define CARDAN_OPS_STEP_WORST 38156  /* at the default cap, 25 */
+#define CARDAN_OPS_STEP_DENSE_WORST 122979  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* CARDAN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* CARDAN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     cardan_real t;         /* the time of the last step attempted           */
     cardan_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void cardan_default_options(cardan_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: cardan_default_options not called), returns
+ * CARDAN_BAD_OPTIONS with nothing solved and the state as it was. */
+int cardan_check_options(const cardan_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

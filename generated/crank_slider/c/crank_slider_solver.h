@@ -23,6 +23,7 @@
 #define CRANK_SLIDER_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define CRANK_SLIDER_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define CRANK_SLIDER_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define CRANK_SLIDER_BAD_OPTIONS 4    /* an option breaks its rule: see crank_slider_check_options */
 
 typedef struct {
     crank_slider_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 113; the update (a solve): 73
  * Condition at the converged q: 57; an extra iteration there (at most 3): 267
  * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 6874 (2692 add/sub, 1437 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1220 compares)
+ * Step, worst case with the default cap of 25 iterations: 6888 (2694 add/sub, 1437 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1232 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37636
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37650
  */
 #define CRANK_SLIDER_OPS_ITERATION 186   /* one Newton iteration */
-#define CRANK_SLIDER_OPS_STEP_FIXED 2224  /* a step without its iterations */
-#define CRANK_SLIDER_OPS_STEP_WORST 6874  /* at the default cap, 25 */
-#define CRANK_SLIDER_OPS_STEP_DENSE_WORST 37636  /* every factorization dense */
+#define CRANK_SLIDER_OPS_STEP_FIXED 2238  /* a step without its iterations */
+#define CRANK_SLIDER_OPS_STEP_WORST 6888  /* at the default cap, 25 */
+#define CRANK_SLIDER_OPS_STEP_DENSE_WORST 37650  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* CRANK_SLIDER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* CRANK_SLIDER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     crank_slider_real t;         /* the time of the last step attempted           */
     crank_slider_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void crank_slider_default_options(crank_slider_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: crank_slider_default_options not called), returns
+ * CRANK_SLIDER_BAD_OPTIONS with nothing solved and the state as it was. */
+int crank_slider_check_options(const crank_slider_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

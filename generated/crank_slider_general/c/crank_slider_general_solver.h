@@ -23,6 +23,7 @@
 #define CRANK_SLIDER_GENERAL_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define CRANK_SLIDER_GENERAL_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define CRANK_SLIDER_GENERAL_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define CRANK_SLIDER_GENERAL_BAD_OPTIONS 4    /* an option breaks its rule: see crank_slider_general_check_options */
 
 typedef struct {
     crank_slider_general_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 285; the update (a solve): 90
  * Condition at the converged q: 211; an extra iteration there (at most 3): 456
  * Velocity: 63; acceleration: 113; per-point checks: 1320; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 13044 (4776 add/sub, 3300 mul, 472 div, 10 sqrt, 186 other calls, 2254 fabs, 2046 compares)
+ * Step, worst case with the default cap of 25 iterations: 13058 (4778 add/sub, 3300 mul, 472 div, 10 sqrt, 186 other calls, 2254 fabs, 2058 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43239
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43253
  */
 #define CRANK_SLIDER_GENERAL_OPS_ITERATION 375   /* one Newton iteration */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3669  /* a step without its iterations */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13044  /* at the default cap, 25 */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43239  /* every factorization dense */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3683  /* a step without its iterations */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13058  /* at the default cap, 25 */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43253  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* CRANK_SLIDER_GENERAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* CRANK_SLIDER_GENERAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     crank_slider_general_real t;         /* the time of the last step attempted           */
     crank_slider_general_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void crank_slider_general_default_options(crank_slider_general_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: crank_slider_general_default_options not called), returns
+ * CRANK_SLIDER_GENERAL_BAD_OPTIONS with nothing solved and the state as it was. */
+int crank_slider_general_check_options(const crank_slider_general_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,35 @@ void crank_slider_input_default_options(crank_slider_input_options *options)
     options->unit = 1.0;
 }
 
+int crank_slider_input_check_options(const crank_slider_input_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int crank_slider_input_refused(crank_slider_input_report *report, crank_slider_input_real t)
+{
+    report->status = CRANK_SLIDER_INPUT_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (crank_slider_input_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (crank_slider_input_real)NAN;
+    report->flagged = 0;
+    report->branch_jump = 0;
+    return report->status;
+}
+
 #define CRANK_SLIDER_INPUT_UNIT_ROUNDOFF DBL_EPSILON
 #define CRANK_SLIDER_INPUT_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define CRANK_SLIDER_INPUT_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -630,9 +659,10 @@ static void crank_slider_input_predict(crank_slider_input_real t, crank_slider_i
     }
 }
 
-int crank_slider_input_solve_step(const crank_slider_input_options *options, const crank_slider_input_real p[], crank_slider_input_real t,
-                            crank_slider_input_state *state, crank_slider_input_workspace *work,
-                            crank_slider_input_report *report)
+/* crank_slider_input_solve_step with its options already checked. */
+static int crank_slider_input_step(const crank_slider_input_options *options, const crank_slider_input_real p[],
+                             crank_slider_input_real t, crank_slider_input_state *state,
+                             crank_slider_input_workspace *work, crank_slider_input_report *report)
 {
     crank_slider_input_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -689,6 +719,14 @@ int crank_slider_input_solve_step(const crank_slider_input_options *options, con
     state->t = t;
     state->started = 1;
     return CRANK_SLIDER_INPUT_OK;
+}
+
+int crank_slider_input_solve_step(const crank_slider_input_options *options, const crank_slider_input_real p[], crank_slider_input_real t,
+                            crank_slider_input_state *state, crank_slider_input_workspace *work,
+                            crank_slider_input_report *report)
+{
+    if (crank_slider_input_check_options(options) != 0) return crank_slider_input_refused(report, t);
+    return crank_slider_input_step(options, p, t, state, work, report);
 }
 
 
@@ -807,10 +845,11 @@ static int crank_slider_input_branch_jump(crank_slider_input_workspace *work, co
     return jumped;
 }
 
-int crank_slider_input_solve_inputs(const crank_slider_input_options *options, const crank_slider_input_real p[],
-                              const crank_slider_input_real u[], const crank_slider_input_real du[], const crank_slider_input_real ddu[],
-                              crank_slider_input_state *state, crank_slider_input_workspace *work,
-                              crank_slider_input_report *report)
+/* crank_slider_input_solve_inputs with its options already checked. */
+static int crank_slider_input_inputs_step(const crank_slider_input_options *options, const crank_slider_input_real p[],
+                                    const crank_slider_input_real u[], const crank_slider_input_real du[],
+                                    const crank_slider_input_real ddu[], crank_slider_input_state *state,
+                                    crank_slider_input_workspace *work, crank_slider_input_report *report)
 {
     crank_slider_input_real pu[CRANK_SLIDER_INPUT_NP + 3 * CRANK_SLIDER_INPUT_NU];
     crank_slider_input_real nq, ndq, nddq, predicted[CRANK_SLIDER_INPUT_NQ], first = (crank_slider_input_real)NAN;
@@ -879,6 +918,15 @@ int crank_slider_input_solve_inputs(const crank_slider_input_options *options, c
     work->factored = 1;
     state->started = 1;
     return CRANK_SLIDER_INPUT_OK;
+}
+
+int crank_slider_input_solve_inputs(const crank_slider_input_options *options, const crank_slider_input_real p[],
+                              const crank_slider_input_real u[], const crank_slider_input_real du[], const crank_slider_input_real ddu[],
+                              crank_slider_input_state *state, crank_slider_input_workspace *work,
+                              crank_slider_input_report *report)
+{
+    if (crank_slider_input_check_options(options) != 0) return crank_slider_input_refused(report, state->t);
+    return crank_slider_input_inputs_step(options, p, u, du, ddu, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define CRANK_SLIDER_INPUT_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define CRANK_SLIDER_INPUT_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define CRANK_SLIDER_INPUT_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define CRANK_SLIDER_INPUT_BAD_OPTIONS 4    /* an option breaks its rule: see crank_slider_input_check_options */
 
 typedef struct {
     crank_slider_input_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -59,22 +60,23 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 112; the update (a solve): 73
  * Condition at the converged q: 57; an extra iteration there (at most 3): 266
  * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 6845 (2694 add/sub, 1406 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1220 compares)
+ * Step, worst case with the default cap of 25 iterations: 6859 (2696 add/sub, 1406 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1232 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 7511 (3004 add/sub, 1505 mul, 465 div, 10 sqrt, 148 other calls, 1040 fabs, 1339 compares)
- *   positions only (du, ddu NULL): 7347 (2948 add/sub, 1453 mul, 447 div, 10 sqrt, 148 other calls, 1022 fabs, 1319 compares)
+ * solve_inputs, worst case: 7525 (3006 add/sub, 1505 mul, 465 div, 10 sqrt, 148 other calls, 1040 fabs, 1351 compares)
+ *   positions only (du, ddu NULL): 7361 (2950 add/sub, 1453 mul, 447 div, 10 sqrt, 148 other calls, 1022 fabs, 1331 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 656
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37607
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37621
  */
 #define CRANK_SLIDER_INPUT_OPS_ITERATION 185   /* one Newton iteration */
-#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2220  /* a step without its iterations */
-#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6845  /* at the default cap, 25 */
-#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37607  /* every factorization dense */
-#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7511  /* solve_inputs with du, ddu */
-#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7347  /* solve_inputs, du, ddu NULL */
+#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2234  /* a step without its iterations */
+#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6859  /* at the default cap, 25 */
+#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37621  /* every factorization dense */
+#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7525  /* solve_inputs with du, ddu */
+#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7361  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
-    int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     crank_slider_input_real t;         /* the time of the last step attempted           */
     crank_slider_input_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -119,6 +121,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void crank_slider_input_default_options(crank_slider_input_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: crank_slider_input_default_options not called), returns
+ * CRANK_SLIDER_INPUT_BAD_OPTIONS with nothing solved and the state as it was. */
+int crank_slider_input_check_options(const crank_slider_input_options *options);
 
 /* With input drivers, every function of this header but crank_slider_input_solve_inputs reads
  * p[NPU] (NPU = 6): the NP parameters, then the inputs u[NU], du[NU], ddu[NU], held at

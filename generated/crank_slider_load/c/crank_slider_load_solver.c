@@ -31,6 +31,34 @@ void crank_slider_load_default_options(crank_slider_load_options *options)
     options->unit = 1.0;
 }
 
+int crank_slider_load_check_options(const crank_slider_load_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int crank_slider_load_refused(crank_slider_load_report *report, crank_slider_load_real t)
+{
+    report->status = CRANK_SLIDER_LOAD_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (crank_slider_load_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (crank_slider_load_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define CRANK_SLIDER_LOAD_UNIT_ROUNDOFF DBL_EPSILON
 #define CRANK_SLIDER_LOAD_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define CRANK_SLIDER_LOAD_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -629,9 +657,10 @@ static void crank_slider_load_predict(crank_slider_load_real t, crank_slider_loa
     }
 }
 
-int crank_slider_load_solve_step(const crank_slider_load_options *options, const crank_slider_load_real p[], crank_slider_load_real t,
-                            crank_slider_load_state *state, crank_slider_load_workspace *work,
-                            crank_slider_load_report *report)
+/* crank_slider_load_solve_step with its options already checked. */
+static int crank_slider_load_step(const crank_slider_load_options *options, const crank_slider_load_real p[],
+                             crank_slider_load_real t, crank_slider_load_state *state,
+                             crank_slider_load_workspace *work, crank_slider_load_report *report)
 {
     crank_slider_load_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -688,6 +717,14 @@ int crank_slider_load_solve_step(const crank_slider_load_options *options, const
     state->t = t;
     state->started = 1;
     return CRANK_SLIDER_LOAD_OK;
+}
+
+int crank_slider_load_solve_step(const crank_slider_load_options *options, const crank_slider_load_real p[], crank_slider_load_real t,
+                            crank_slider_load_state *state, crank_slider_load_workspace *work,
+                            crank_slider_load_report *report)
+{
+    if (crank_slider_load_check_options(options) != 0) return crank_slider_load_refused(report, t);
+    return crank_slider_load_step(options, p, t, state, work, report);
 }
 
 void crank_slider_load_multipliers(const crank_slider_load_real p[], const crank_slider_load_state *state,

@@ -31,6 +31,34 @@ void custom_driver_default_options(custom_driver_options *options)
     options->unit = 1.0;
 }
 
+int custom_driver_check_options(const custom_driver_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int custom_driver_refused(custom_driver_report *report, custom_driver_real t)
+{
+    report->status = CUSTOM_DRIVER_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (custom_driver_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (custom_driver_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define CUSTOM_DRIVER_UNIT_ROUNDOFF DBL_EPSILON
 #define CUSTOM_DRIVER_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define CUSTOM_DRIVER_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -652,9 +680,10 @@ static void custom_driver_predict(custom_driver_real t, custom_driver_state *sta
     }
 }
 
-int custom_driver_solve_step(const custom_driver_options *options, const custom_driver_real p[], custom_driver_real t,
-                            custom_driver_state *state, custom_driver_workspace *work,
-                            custom_driver_report *report)
+/* custom_driver_solve_step with its options already checked. */
+static int custom_driver_step(const custom_driver_options *options, const custom_driver_real p[],
+                             custom_driver_real t, custom_driver_state *state,
+                             custom_driver_workspace *work, custom_driver_report *report)
 {
     custom_driver_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -711,6 +740,14 @@ int custom_driver_solve_step(const custom_driver_options *options, const custom_
     state->t = t;
     state->started = 1;
     return CUSTOM_DRIVER_OK;
+}
+
+int custom_driver_solve_step(const custom_driver_options *options, const custom_driver_real p[], custom_driver_real t,
+                            custom_driver_state *state, custom_driver_workspace *work,
+                            custom_driver_report *report)
+{
+    if (custom_driver_check_options(options) != 0) return custom_driver_refused(report, t);
+    return custom_driver_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define CUSTOM_DRIVER_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define CUSTOM_DRIVER_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define CUSTOM_DRIVER_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define CUSTOM_DRIVER_BAD_OPTIONS 4    /* an option breaks its rule: see custom_driver_check_options */
 
 typedef struct {
     custom_driver_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 151; the update (a solve): 78
  * Condition at the converged q: 104; an extra iteration there (at most 3): 310
  * Velocity: 64; acceleration: 98; per-point checks: 1159; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8433 (3238 add/sub, 1883 mul, 443 div, 10 sqrt, 226 other calls, 1233 fabs, 1400 compares)
+ * Step, worst case with the default cap of 25 iterations: 8447 (3240 add/sub, 1883 mul, 443 div, 10 sqrt, 226 other calls, 1233 fabs, 1412 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38922
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38936
  */
 #define CUSTOM_DRIVER_OPS_ITERATION 229   /* one Newton iteration */
-#define CUSTOM_DRIVER_OPS_STEP_FIXED 2708  /* a step without its iterations */
-#define CUSTOM_DRIVER_OPS_STEP_WORST 8433  /* at the default cap, 25 */
-#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38922  /* every factorization dense */
+#define CUSTOM_DRIVER_OPS_STEP_FIXED 2722  /* a step without its iterations */
+#define CUSTOM_DRIVER_OPS_STEP_WORST 8447  /* at the default cap, 25 */
+#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38936  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     custom_driver_real t;         /* the time of the last step attempted           */
     custom_driver_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void custom_driver_default_options(custom_driver_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: custom_driver_default_options not called), returns
+ * CUSTOM_DRIVER_BAD_OPTIONS with nothing solved and the state as it was. */
+int custom_driver_check_options(const custom_driver_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,34 @@ void delta_default_options(delta_options *options)
     options->unit = 1.0;
 }
 
+int delta_check_options(const delta_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int delta_refused(delta_report *report, delta_real t)
+{
+    report->status = DELTA_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (delta_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (delta_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define DELTA_UNIT_ROUNDOFF DBL_EPSILON
 #define DELTA_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define DELTA_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -676,9 +704,10 @@ static void delta_predict(delta_real t, delta_state *state)
     }
 }
 
-int delta_solve_step(const delta_options *options, const delta_real p[], delta_real t,
-                            delta_state *state, delta_workspace *work,
-                            delta_report *report)
+/* delta_solve_step with its options already checked. */
+static int delta_step(const delta_options *options, const delta_real p[],
+                             delta_real t, delta_state *state,
+                             delta_workspace *work, delta_report *report)
 {
     delta_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -735,6 +764,14 @@ int delta_solve_step(const delta_options *options, const delta_real p[], delta_r
     state->t = t;
     state->started = 1;
     return DELTA_OK;
+}
+
+int delta_solve_step(const delta_options *options, const delta_real p[], delta_real t,
+                            delta_state *state, delta_workspace *work,
+                            delta_report *report)
+{
+    if (delta_check_options(options) != 0) return delta_refused(report, t);
+    return delta_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define DELTA_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define DELTA_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define DELTA_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define DELTA_BAD_OPTIONS 4    /* an option breaks its rule: see delta_check_options */
 
 typedef struct {
     delta_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 3199; the update (a solve): 431
  * Condition at the converged q: 5260; an extra iteration there (at most 3): 3711
  * Velocity: 433; acceleration: 2639; per-point checks: 9257; predictor: 169
- * Step, worst case with the default cap of 25 iterations: 128143 (50546 add/sub, 47781 mul, 1660 div, 10 sqrt, 592 other calls, 15757 fabs, 11797 compares)
+ * Step, worst case with the default cap of 25 iterations: 128157 (50548 add/sub, 47781 mul, 1660 div, 10 sqrt, 592 other calls, 15757 fabs, 11809 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689767
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689781
  */
 #define DELTA_OPS_ITERATION 3630   /* one Newton iteration */
-#define DELTA_OPS_STEP_FIXED 37393  /* a step without its iterations */
-#define DELTA_OPS_STEP_WORST 128143  /* at the default cap, 25 */
-#define DELTA_OPS_STEP_DENSE_WORST 689767  /* every factorization dense */
+#define DELTA_OPS_STEP_FIXED 37407  /* a step without its iterations */
+#define DELTA_OPS_STEP_WORST 128157  /* at the default cap, 25 */
+#define DELTA_OPS_STEP_DENSE_WORST 689781  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* DELTA_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* DELTA_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     delta_real t;         /* the time of the last step attempted           */
     delta_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void delta_default_options(delta_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: delta_default_options not called), returns
+ * DELTA_BAD_OPTIONS with nothing solved and the state as it was. */
+int delta_check_options(const delta_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,35 @@ void delta_fk_default_options(delta_fk_options *options)
     options->unit = 1.0;
 }
 
+int delta_fk_check_options(const delta_fk_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int delta_fk_refused(delta_fk_report *report, delta_fk_real t)
+{
+    report->status = DELTA_FK_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (delta_fk_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (delta_fk_real)NAN;
+    report->flagged = 0;
+    report->branch_jump = 0;
+    return report->status;
+}
+
 #define DELTA_FK_UNIT_ROUNDOFF DBL_EPSILON
 #define DELTA_FK_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define DELTA_FK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -677,9 +706,10 @@ static void delta_fk_predict(delta_fk_real t, delta_fk_state *state)
     }
 }
 
-int delta_fk_solve_step(const delta_fk_options *options, const delta_fk_real p[], delta_fk_real t,
-                            delta_fk_state *state, delta_fk_workspace *work,
-                            delta_fk_report *report)
+/* delta_fk_solve_step with its options already checked. */
+static int delta_fk_step(const delta_fk_options *options, const delta_fk_real p[],
+                             delta_fk_real t, delta_fk_state *state,
+                             delta_fk_workspace *work, delta_fk_report *report)
 {
     delta_fk_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -736,6 +766,14 @@ int delta_fk_solve_step(const delta_fk_options *options, const delta_fk_real p[]
     state->t = t;
     state->started = 1;
     return DELTA_FK_OK;
+}
+
+int delta_fk_solve_step(const delta_fk_options *options, const delta_fk_real p[], delta_fk_real t,
+                            delta_fk_state *state, delta_fk_workspace *work,
+                            delta_fk_report *report)
+{
+    if (delta_fk_check_options(options) != 0) return delta_fk_refused(report, t);
+    return delta_fk_step(options, p, t, state, work, report);
 }
 
 
@@ -854,10 +892,11 @@ static int delta_fk_branch_jump(delta_fk_workspace *work, const delta_fk_real q[
     return jumped;
 }
 
-int delta_fk_solve_inputs(const delta_fk_options *options, const delta_fk_real p[],
-                              const delta_fk_real u[], const delta_fk_real du[], const delta_fk_real ddu[],
-                              delta_fk_state *state, delta_fk_workspace *work,
-                              delta_fk_report *report)
+/* delta_fk_solve_inputs with its options already checked. */
+static int delta_fk_inputs_step(const delta_fk_options *options, const delta_fk_real p[],
+                                    const delta_fk_real u[], const delta_fk_real du[],
+                                    const delta_fk_real ddu[], delta_fk_state *state,
+                                    delta_fk_workspace *work, delta_fk_report *report)
 {
     delta_fk_real pu[DELTA_FK_NP + 3 * DELTA_FK_NU];
     delta_fk_real nq, ndq, nddq, predicted[DELTA_FK_NQ], first = (delta_fk_real)NAN;
@@ -926,6 +965,15 @@ int delta_fk_solve_inputs(const delta_fk_options *options, const delta_fk_real p
     work->factored = 1;
     state->started = 1;
     return DELTA_FK_OK;
+}
+
+int delta_fk_solve_inputs(const delta_fk_options *options, const delta_fk_real p[],
+                              const delta_fk_real u[], const delta_fk_real du[], const delta_fk_real ddu[],
+                              delta_fk_state *state, delta_fk_workspace *work,
+                              delta_fk_report *report)
+{
+    if (delta_fk_check_options(options) != 0) return delta_fk_refused(report, state->t);
+    return delta_fk_inputs_step(options, p, u, du, ddu, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

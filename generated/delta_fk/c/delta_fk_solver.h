@@ -23,6 +23,7 @@
 #define DELTA_FK_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define DELTA_FK_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define DELTA_FK_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define DELTA_FK_BAD_OPTIONS 4    /* an option breaks its rule: see delta_fk_check_options */
 
 typedef struct {
     delta_fk_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -59,22 +60,23 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 3188; the update (a solve): 431
  * Condition at the converged q: 5260; an extra iteration there (at most 3): 3700
  * Velocity: 423; acceleration: 2603; per-point checks: 9188; predictor: 169
- * Step, worst case with the default cap of 25 iterations: 127709 (50402 add/sub, 47611 mul, 1660 div, 10 sqrt, 472 other calls, 15757 fabs, 11797 compares)
+ * Step, worst case with the default cap of 25 iterations: 127723 (50404 add/sub, 47611 mul, 1660 div, 10 sqrt, 472 other calls, 15757 fabs, 11809 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 134093 (53290 add/sub, 50420 mul, 1806 div, 10 sqrt, 508 other calls, 15953 fabs, 12106 compares)
- *   positions only (du, ddu NULL): 130841 (51912 add/sub, 48716 mul, 1750 div, 10 sqrt, 508 other calls, 15897 fabs, 12048 compares)
+ * solve_inputs, worst case: 134107 (53292 add/sub, 50420 mul, 1806 div, 10 sqrt, 508 other calls, 15953 fabs, 12118 compares)
+ *   positions only (du, ddu NULL): 130855 (51914 add/sub, 48716 mul, 1750 div, 10 sqrt, 508 other calls, 15897 fabs, 12060 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 6374
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689333
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689347
  */
 #define DELTA_FK_OPS_ITERATION 3619   /* one Newton iteration */
-#define DELTA_FK_OPS_STEP_FIXED 37234  /* a step without its iterations */
-#define DELTA_FK_OPS_STEP_WORST 127709  /* at the default cap, 25 */
-#define DELTA_FK_OPS_STEP_DENSE_WORST 689333  /* every factorization dense */
-#define DELTA_FK_OPS_INPUTS_WORST 134093  /* solve_inputs with du, ddu */
-#define DELTA_FK_OPS_POSITIONS_WORST 130841  /* solve_inputs, du, ddu NULL */
+#define DELTA_FK_OPS_STEP_FIXED 37248  /* a step without its iterations */
+#define DELTA_FK_OPS_STEP_WORST 127723  /* at the default cap, 25 */
+#define DELTA_FK_OPS_STEP_DENSE_WORST 689347  /* every factorization dense */
+#define DELTA_FK_OPS_INPUTS_WORST 134107  /* solve_inputs with du, ddu */
+#define DELTA_FK_OPS_POSITIONS_WORST 130855  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
-    int status;                  /* DELTA_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* DELTA_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     delta_fk_real t;         /* the time of the last step attempted           */
     delta_fk_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -119,6 +121,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void delta_fk_default_options(delta_fk_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: delta_fk_default_options not called), returns
+ * DELTA_FK_BAD_OPTIONS with nothing solved and the state as it was. */
+int delta_fk_check_options(const delta_fk_options *options);
 
 /* With input drivers, every function of this header but delta_fk_solve_inputs reads
  * p[NPU] (NPU = 9): the NP parameters, then the inputs u[NU], du[NU], ddu[NU], held at

@@ -23,6 +23,7 @@
 #define FOUR_BAR_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define FOUR_BAR_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define FOUR_BAR_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define FOUR_BAR_BAD_OPTIONS 4    /* an option breaks its rule: see four_bar_check_options */
 
 typedef struct {
     four_bar_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 159; the update (a solve): 75
  * Condition at the converged q: 83; an extra iteration there (at most 3): 315
  * Velocity: 48; acceleration: 52; per-point checks: 1051; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8369 (3017 add/sub, 1773 mul, 443 div, 10 sqrt, 186 other calls, 1424 fabs, 1516 compares)
+ * Step, worst case with the default cap of 25 iterations: 8383 (3019 add/sub, 1773 mul, 443 div, 10 sqrt, 186 other calls, 1424 fabs, 1528 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39017
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39031
  */
 #define FOUR_BAR_OPS_ITERATION 234   /* one Newton iteration */
-#define FOUR_BAR_OPS_STEP_FIXED 2519  /* a step without its iterations */
-#define FOUR_BAR_OPS_STEP_WORST 8369  /* at the default cap, 25 */
-#define FOUR_BAR_OPS_STEP_DENSE_WORST 39017  /* every factorization dense */
+#define FOUR_BAR_OPS_STEP_FIXED 2533  /* a step without its iterations */
+#define FOUR_BAR_OPS_STEP_WORST 8383  /* at the default cap, 25 */
+#define FOUR_BAR_OPS_STEP_DENSE_WORST 39031  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* FOUR_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* FOUR_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     four_bar_real t;         /* the time of the last step attempted           */
     four_bar_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void four_bar_default_options(four_bar_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: four_bar_default_options not called), returns
+ * FOUR_BAR_BAD_OPTIONS with nothing solved and the state as it was. */
+int four_bar_check_options(const four_bar_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,34 @@ void four_bar_dynamics_default_options(four_bar_dynamics_options *options)
     options->unit = 1.0;
 }
 
+int four_bar_dynamics_check_options(const four_bar_dynamics_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int four_bar_dynamics_refused(four_bar_dynamics_report *report, four_bar_dynamics_real t)
+{
+    report->status = FOUR_BAR_DYNAMICS_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (four_bar_dynamics_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (four_bar_dynamics_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF DBL_EPSILON
 #define FOUR_BAR_DYNAMICS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define FOUR_BAR_DYNAMICS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -644,9 +672,10 @@ static void four_bar_dynamics_predict(four_bar_dynamics_real t, four_bar_dynamic
     }
 }
 
-int four_bar_dynamics_solve_step(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[], four_bar_dynamics_real t,
-                            four_bar_dynamics_state *state, four_bar_dynamics_workspace *work,
-                            four_bar_dynamics_report *report)
+/* four_bar_dynamics_solve_step with its options already checked. */
+static int four_bar_dynamics_step(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[],
+                             four_bar_dynamics_real t, four_bar_dynamics_state *state,
+                             four_bar_dynamics_workspace *work, four_bar_dynamics_report *report)
 {
     four_bar_dynamics_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -703,6 +732,14 @@ int four_bar_dynamics_solve_step(const four_bar_dynamics_options *options, const
     state->t = t;
     state->started = 1;
     return FOUR_BAR_DYNAMICS_OK;
+}
+
+int four_bar_dynamics_solve_step(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[], four_bar_dynamics_real t,
+                            four_bar_dynamics_state *state, four_bar_dynamics_workspace *work,
+                            four_bar_dynamics_report *report)
+{
+    if (four_bar_dynamics_check_options(options) != 0) return four_bar_dynamics_refused(report, t);
+    return four_bar_dynamics_step(options, p, t, state, work, report);
 }
 
 void four_bar_dynamics_multipliers(const four_bar_dynamics_real p[], const four_bar_dynamics_state *state,

@@ -23,6 +23,7 @@
 #define PARALLELOGRAM_EXTRA_BAR_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define PARALLELOGRAM_EXTRA_BAR_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define PARALLELOGRAM_EXTRA_BAR_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define PARALLELOGRAM_EXTRA_BAR_BAD_OPTIONS 4    /* an option breaks its rule: see parallelogram_extra_bar_check_options */
 
 typedef struct {
     parallelogram_extra_bar_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 224; the update (a solve): 102
  * Condition at the converged q: 154; an extra iteration there (at most 3): 407
  * Velocity: 65; acceleration: 93; per-point checks: 1431; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 11608 (4278 add/sub, 2651 mul, 586 div, 10 sqrt, 310 other calls, 1889 fabs, 1884 compares)
+ * Step, worst case with the default cap of 25 iterations: 11622 (4280 add/sub, 2651 mul, 586 div, 10 sqrt, 310 other calls, 1889 fabs, 1896 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73405
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73419
  */
 #define PARALLELOGRAM_EXTRA_BAR_OPS_ITERATION 326   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3458  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11608  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73405  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3472  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11622  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73419  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* PARALLELOGRAM_EXTRA_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* PARALLELOGRAM_EXTRA_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     parallelogram_extra_bar_real t;         /* the time of the last step attempted           */
     parallelogram_extra_bar_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void parallelogram_extra_bar_default_options(parallelogram_extra_bar_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: parallelogram_extra_bar_default_options not called), returns
+ * PARALLELOGRAM_EXTRA_BAR_BAD_OPTIONS with nothing solved and the state as it was. */
+int parallelogram_extra_bar_check_options(const parallelogram_extra_bar_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,34 @@ void parallelogram_extra_bar_loads_default_options(parallelogram_extra_bar_loads
     options->unit = 1.0;
 }
 
+int parallelogram_extra_bar_loads_check_options(const parallelogram_extra_bar_loads_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int parallelogram_extra_bar_loads_refused(parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real t)
+{
+    report->status = PARALLELOGRAM_EXTRA_BAR_LOADS_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (parallelogram_extra_bar_loads_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (parallelogram_extra_bar_loads_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF DBL_EPSILON
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -703,9 +731,10 @@ static void parallelogram_extra_bar_loads_predict(parallelogram_extra_bar_loads_
     }
 }
 
-int parallelogram_extra_bar_loads_solve_step(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[], parallelogram_extra_bar_loads_real t,
-                            parallelogram_extra_bar_loads_state *state, parallelogram_extra_bar_loads_workspace *work,
-                            parallelogram_extra_bar_loads_report *report)
+/* parallelogram_extra_bar_loads_solve_step with its options already checked. */
+static int parallelogram_extra_bar_loads_step(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
+                             parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_state *state,
+                             parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_report *report)
 {
     parallelogram_extra_bar_loads_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -762,6 +791,14 @@ int parallelogram_extra_bar_loads_solve_step(const parallelogram_extra_bar_loads
     state->t = t;
     state->started = 1;
     return PARALLELOGRAM_EXTRA_BAR_LOADS_OK;
+}
+
+int parallelogram_extra_bar_loads_solve_step(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[], parallelogram_extra_bar_loads_real t,
+                            parallelogram_extra_bar_loads_state *state, parallelogram_extra_bar_loads_workspace *work,
+                            parallelogram_extra_bar_loads_report *report)
+{
+    if (parallelogram_extra_bar_loads_check_options(options) != 0) return parallelogram_extra_bar_loads_refused(report, t);
+    return parallelogram_extra_bar_loads_step(options, p, t, state, work, report);
 }
 
 void parallelogram_extra_bar_loads_multipliers(const parallelogram_extra_bar_loads_real p[], const parallelogram_extra_bar_loads_state *state,

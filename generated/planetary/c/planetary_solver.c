@@ -31,6 +31,34 @@ void planetary_default_options(planetary_options *options)
     options->unit = 1.0;
 }
 
+int planetary_check_options(const planetary_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int planetary_refused(planetary_report *report, planetary_real t)
+{
+    report->status = PLANETARY_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (planetary_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (planetary_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define PLANETARY_UNIT_ROUNDOFF DBL_EPSILON
 #define PLANETARY_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define PLANETARY_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -637,9 +665,10 @@ static void planetary_predict(planetary_real t, planetary_state *state)
     }
 }
 
-int planetary_solve_step(const planetary_options *options, const planetary_real p[], planetary_real t,
-                            planetary_state *state, planetary_workspace *work,
-                            planetary_report *report)
+/* planetary_solve_step with its options already checked. */
+static int planetary_step(const planetary_options *options, const planetary_real p[],
+                             planetary_real t, planetary_state *state,
+                             planetary_workspace *work, planetary_report *report)
 {
     planetary_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -696,6 +725,14 @@ int planetary_solve_step(const planetary_options *options, const planetary_real 
     state->t = t;
     state->started = 1;
     return PLANETARY_OK;
+}
+
+int planetary_solve_step(const planetary_options *options, const planetary_real p[], planetary_real t,
+                            planetary_state *state, planetary_workspace *work,
+                            planetary_report *report)
+{
+    if (planetary_check_options(options) != 0) return planetary_refused(report, t);
+    return planetary_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

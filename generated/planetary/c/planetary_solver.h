@@ -23,6 +23,7 @@
 #define PLANETARY_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define PLANETARY_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define PLANETARY_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define PLANETARY_BAD_OPTIONS 4    /* an option breaks its rule: see planetary_check_options */
 
 typedef struct {
     planetary_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 154; the update (a solve): 75
  * Condition at the converged q: 70; an extra iteration there (at most 3): 310
  * Velocity: 48; acceleration: 43; per-point checks: 1018; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8156 (3031 add/sub, 1713 mul, 443 div, 10 sqrt, 62 other calls, 1389 fabs, 1508 compares)
+ * Step, worst case with the default cap of 25 iterations: 8170 (3033 add/sub, 1713 mul, 443 div, 10 sqrt, 62 other calls, 1389 fabs, 1520 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38555
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38569
  */
 #define PLANETARY_OPS_ITERATION 229   /* one Newton iteration */
-#define PLANETARY_OPS_STEP_FIXED 2431  /* a step without its iterations */
-#define PLANETARY_OPS_STEP_WORST 8156  /* at the default cap, 25 */
-#define PLANETARY_OPS_STEP_DENSE_WORST 38555  /* every factorization dense */
+#define PLANETARY_OPS_STEP_FIXED 2445  /* a step without its iterations */
+#define PLANETARY_OPS_STEP_WORST 8170  /* at the default cap, 25 */
+#define PLANETARY_OPS_STEP_DENSE_WORST 38569  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* PLANETARY_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* PLANETARY_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     planetary_real t;         /* the time of the last step attempted           */
     planetary_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void planetary_default_options(planetary_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: planetary_default_options not called), returns
+ * PLANETARY_BAD_OPTIONS with nothing solved and the state as it was. */
+int planetary_check_options(const planetary_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,34 @@ void quick_return_default_options(quick_return_options *options)
     options->unit = 1.0;
 }
 
+int quick_return_check_options(const quick_return_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int quick_return_refused(quick_return_report *report, quick_return_real t)
+{
+    report->status = QUICK_RETURN_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (quick_return_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (quick_return_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define QUICK_RETURN_UNIT_ROUNDOFF DBL_EPSILON
 #define QUICK_RETURN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define QUICK_RETURN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -691,9 +719,10 @@ static void quick_return_predict(quick_return_real t, quick_return_state *state)
     }
 }
 
-int quick_return_solve_step(const quick_return_options *options, const quick_return_real p[], quick_return_real t,
-                            quick_return_state *state, quick_return_workspace *work,
-                            quick_return_report *report)
+/* quick_return_solve_step with its options already checked. */
+static int quick_return_step(const quick_return_options *options, const quick_return_real p[],
+                             quick_return_real t, quick_return_state *state,
+                             quick_return_workspace *work, quick_return_report *report)
 {
     quick_return_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -750,6 +779,14 @@ int quick_return_solve_step(const quick_return_options *options, const quick_ret
     state->t = t;
     state->started = 1;
     return QUICK_RETURN_OK;
+}
+
+int quick_return_solve_step(const quick_return_options *options, const quick_return_real p[], quick_return_real t,
+                            quick_return_state *state, quick_return_workspace *work,
+                            quick_return_report *report)
+{
+    if (quick_return_check_options(options) != 0) return quick_return_refused(report, t);
+    return quick_return_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define QUICK_RETURN_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define QUICK_RETURN_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define QUICK_RETURN_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define QUICK_RETURN_BAD_OPTIONS 4    /* an option breaks its rule: see quick_return_check_options */
 
 typedef struct {
     quick_return_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 192; the update (a solve): 104
  * Condition at the converged q: 179; an extra iteration there (at most 3): 377
  * Velocity: 68; acceleration: 97; per-point checks: 1446; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 10808 (4372 add/sub, 2387 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1712 compares)
+ * Step, worst case with the default cap of 25 iterations: 10822 (4374 add/sub, 2387 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1724 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72667
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72681
  */
 #define QUICK_RETURN_OPS_ITERATION 296   /* one Newton iteration */
-#define QUICK_RETURN_OPS_STEP_FIXED 3408  /* a step without its iterations */
-#define QUICK_RETURN_OPS_STEP_WORST 10808  /* at the default cap, 25 */
-#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72667  /* every factorization dense */
+#define QUICK_RETURN_OPS_STEP_FIXED 3422  /* a step without its iterations */
+#define QUICK_RETURN_OPS_STEP_WORST 10822  /* at the default cap, 25 */
+#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72681  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     quick_return_real t;         /* the time of the last step attempted           */
     quick_return_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void quick_return_default_options(quick_return_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: quick_return_default_options not called), returns
+ * QUICK_RETURN_BAD_OPTIONS with nothing solved and the state as it was. */
+int quick_return_check_options(const quick_return_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

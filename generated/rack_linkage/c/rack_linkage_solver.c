@@ -31,6 +31,34 @@ void rack_linkage_default_options(rack_linkage_options *options)
     options->unit = 1.0;
 }
 
+int rack_linkage_check_options(const rack_linkage_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int rack_linkage_refused(rack_linkage_report *report, rack_linkage_real t)
+{
+    report->status = RACK_LINKAGE_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (rack_linkage_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (rack_linkage_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define RACK_LINKAGE_UNIT_ROUNDOFF DBL_EPSILON
 #define RACK_LINKAGE_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define RACK_LINKAGE_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -718,9 +746,10 @@ static void rack_linkage_predict(rack_linkage_real t, rack_linkage_state *state)
     }
 }
 
-int rack_linkage_solve_step(const rack_linkage_options *options, const rack_linkage_real p[], rack_linkage_real t,
-                            rack_linkage_state *state, rack_linkage_workspace *work,
-                            rack_linkage_report *report)
+/* rack_linkage_solve_step with its options already checked. */
+static int rack_linkage_step(const rack_linkage_options *options, const rack_linkage_real p[],
+                             rack_linkage_real t, rack_linkage_state *state,
+                             rack_linkage_workspace *work, rack_linkage_report *report)
 {
     rack_linkage_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -777,6 +806,14 @@ int rack_linkage_solve_step(const rack_linkage_options *options, const rack_link
     state->t = t;
     state->started = 1;
     return RACK_LINKAGE_OK;
+}
+
+int rack_linkage_solve_step(const rack_linkage_options *options, const rack_linkage_real p[], rack_linkage_real t,
+                            rack_linkage_state *state, rack_linkage_workspace *work,
+                            rack_linkage_report *report)
+{
+    if (rack_linkage_check_options(options) != 0) return rack_linkage_refused(report, t);
+    return rack_linkage_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

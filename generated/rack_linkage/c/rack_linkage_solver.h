@@ -23,6 +23,7 @@
 #define RACK_LINKAGE_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define RACK_LINKAGE_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define RACK_LINKAGE_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define RACK_LINKAGE_BAD_OPTIONS 4    /* an option breaks its rule: see rack_linkage_check_options */
 
 typedef struct {
     rack_linkage_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 262; the update (a solve): 108
  * Condition at the converged q: 225; an extra iteration there (at most 3): 451
  * Velocity: 73; acceleration: 93; per-point checks: 1486; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 13083 (4660 add/sub, 2849 mul, 586 div, 10 sqrt, 218 other calls, 2431 fabs, 2329 compares)
+ * Step, worst case with the default cap of 25 iterations: 13097 (4662 add/sub, 2849 mul, 586 div, 10 sqrt, 218 other calls, 2431 fabs, 2341 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74706
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74720
  */
 #define RACK_LINKAGE_OPS_ITERATION 370   /* one Newton iteration */
-#define RACK_LINKAGE_OPS_STEP_FIXED 3833  /* a step without its iterations */
-#define RACK_LINKAGE_OPS_STEP_WORST 13083  /* at the default cap, 25 */
-#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74706  /* every factorization dense */
+#define RACK_LINKAGE_OPS_STEP_FIXED 3847  /* a step without its iterations */
+#define RACK_LINKAGE_OPS_STEP_WORST 13097  /* at the default cap, 25 */
+#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74720  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     rack_linkage_real t;         /* the time of the last step attempted           */
     rack_linkage_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void rack_linkage_default_options(rack_linkage_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: rack_linkage_default_options not called), returns
+ * RACK_LINKAGE_BAD_OPTIONS with nothing solved and the state as it was. */
+int rack_linkage_check_options(const rack_linkage_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

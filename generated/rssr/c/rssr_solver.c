@@ -31,6 +31,34 @@ void rssr_default_options(rssr_options *options)
     options->unit = 1.0;
 }
 
+int rssr_check_options(const rssr_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int rssr_refused(rssr_report *report, rssr_real t)
+{
+    report->status = RSSR_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (rssr_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (rssr_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define RSSR_UNIT_ROUNDOFF DBL_EPSILON
 #define RSSR_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define RSSR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -973,9 +1001,10 @@ static void rssr_predict(rssr_real t, rssr_state *state)
     }
 }
 
-int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real t,
-                            rssr_state *state, rssr_workspace *work,
-                            rssr_report *report)
+/* rssr_solve_step with its options already checked. */
+static int rssr_step(const rssr_options *options, const rssr_real p[],
+                             rssr_real t, rssr_state *state,
+                             rssr_workspace *work, rssr_report *report)
 {
     rssr_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -1032,6 +1061,14 @@ int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real 
     state->t = t;
     state->started = 1;
     return RSSR_OK;
+}
+
+int rssr_solve_step(const rssr_options *options, const rssr_real p[], rssr_real t,
+                            rssr_state *state, rssr_workspace *work,
+                            rssr_report *report)
+{
+    if (rssr_check_options(options) != 0) return rssr_refused(report, t);
+    return rssr_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define RSSR_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define RSSR_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define RSSR_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define RSSR_BAD_OPTIONS 4    /* an option breaks its rule: see rssr_check_options */
 
 typedef struct {
     rssr_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 761; the update (a solve): 167
  * Condition at the converged q: 628; an extra iteration there (at most 3): 1009
  * Velocity: 141; acceleration: 412; per-point checks: 2671; predictor: 85
- * Step, worst case with the default cap of 25 iterations: 31596 (11132 add/sub, 9911 mul, 839 div, 42 sqrt, 64 other calls, 5294 fabs, 4314 compares)
+ * Step, worst case with the default cap of 25 iterations: 31610 (11134 add/sub, 9911 mul, 839 div, 42 sqrt, 64 other calls, 5294 fabs, 4326 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121139
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121153
  */
 #define RSSR_OPS_ITERATION 928   /* one Newton iteration */
-#define RSSR_OPS_STEP_FIXED 8396  /* a step without its iterations */
-#define RSSR_OPS_STEP_WORST 31596  /* at the default cap, 25 */
-#define RSSR_OPS_STEP_DENSE_WORST 121139  /* every factorization dense */
+#define RSSR_OPS_STEP_FIXED 8410  /* a step without its iterations */
+#define RSSR_OPS_STEP_WORST 31610  /* at the default cap, 25 */
+#define RSSR_OPS_STEP_DENSE_WORST 121153  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* RSSR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* RSSR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     rssr_real t;         /* the time of the last step attempted           */
     rssr_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void rssr_default_options(rssr_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: rssr_default_options not called), returns
+ * RSSR_BAD_OPTIONS with nothing solved and the state as it was. */
+int rssr_check_options(const rssr_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,34 @@ void spatial_slider_crank_default_options(spatial_slider_crank_options *options)
     options->unit = 1.0;
 }
 
+int spatial_slider_crank_check_options(const spatial_slider_crank_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int spatial_slider_crank_refused(spatial_slider_crank_report *report, spatial_slider_crank_real t)
+{
+    report->status = SPATIAL_SLIDER_CRANK_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (spatial_slider_crank_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (spatial_slider_crank_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF DBL_EPSILON
 #define SPATIAL_SLIDER_CRANK_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define SPATIAL_SLIDER_CRANK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -630,9 +658,10 @@ static void spatial_slider_crank_predict(spatial_slider_crank_real t, spatial_sl
     }
 }
 
-int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[], spatial_slider_crank_real t,
-                            spatial_slider_crank_state *state, spatial_slider_crank_workspace *work,
-                            spatial_slider_crank_report *report)
+/* spatial_slider_crank_solve_step with its options already checked. */
+static int spatial_slider_crank_step(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[],
+                             spatial_slider_crank_real t, spatial_slider_crank_state *state,
+                             spatial_slider_crank_workspace *work, spatial_slider_crank_report *report)
 {
     spatial_slider_crank_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -689,6 +718,14 @@ int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options,
     state->t = t;
     state->started = 1;
     return SPATIAL_SLIDER_CRANK_OK;
+}
+
+int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[], spatial_slider_crank_real t,
+                            spatial_slider_crank_state *state, spatial_slider_crank_workspace *work,
+                            spatial_slider_crank_report *report)
+{
+    if (spatial_slider_crank_check_options(options) != 0) return spatial_slider_crank_refused(report, t);
+    return spatial_slider_crank_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

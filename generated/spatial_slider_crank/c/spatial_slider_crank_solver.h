@@ -23,6 +23,7 @@
 #define SPATIAL_SLIDER_CRANK_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define SPATIAL_SLIDER_CRANK_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define SPATIAL_SLIDER_CRANK_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define SPATIAL_SLIDER_CRANK_BAD_OPTIONS 4    /* an option breaks its rule: see spatial_slider_crank_check_options */
 
 typedef struct {
     spatial_slider_crank_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 1085; the update (a solve): 290
  * Condition at the converged q: 3440; an extra iteration there (at most 3): 1456
  * Velocity: 243; acceleration: 532; per-point checks: 4224; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 51877 (20342 add/sub, 15810 mul, 1193 div, 44 sqrt, 304 other calls, 7884 fabs, 6300 compares)
+ * Step, worst case with the default cap of 25 iterations: 51891 (20344 add/sub, 15810 mul, 1193 div, 44 sqrt, 304 other calls, 7884 fabs, 6312 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 307232
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 307246
  */
 #define SPATIAL_SLIDER_CRANK_OPS_ITERATION 1375   /* one Newton iteration */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17502  /* a step without its iterations */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51877  /* at the default cap, 25 */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 307232  /* every factorization dense */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17516  /* a step without its iterations */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51891  /* at the default cap, 25 */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 307246  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* SPATIAL_SLIDER_CRANK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* SPATIAL_SLIDER_CRANK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     spatial_slider_crank_real t;         /* the time of the last step attempted           */
     spatial_slider_crank_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void spatial_slider_crank_default_options(spatial_slider_crank_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: spatial_slider_crank_default_options not called), returns
+ * SPATIAL_SLIDER_CRANK_BAD_OPTIONS with nothing solved and the state as it was. */
+int spatial_slider_crank_check_options(const spatial_slider_crank_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

@@ -31,6 +31,34 @@ void stewart_default_options(stewart_options *options)
     options->unit = 1.0;
 }
 
+int stewart_check_options(const stewart_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int stewart_refused(stewart_report *report, stewart_real t)
+{
+    report->status = STEWART_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (stewart_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (stewart_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define STEWART_UNIT_ROUNDOFF DBL_EPSILON
 #define STEWART_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define STEWART_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -985,9 +1013,10 @@ static void stewart_predict(stewart_real t, stewart_state *state)
     }
 }
 
-int stewart_solve_step(const stewart_options *options, const stewart_real p[], stewart_real t,
-                            stewart_state *state, stewart_workspace *work,
-                            stewart_report *report)
+/* stewart_solve_step with its options already checked. */
+static int stewart_step(const stewart_options *options, const stewart_real p[],
+                             stewart_real t, stewart_state *state,
+                             stewart_workspace *work, stewart_report *report)
 {
     stewart_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -1044,6 +1073,14 @@ int stewart_solve_step(const stewart_options *options, const stewart_real p[], s
     state->t = t;
     state->started = 1;
     return STEWART_OK;
+}
+
+int stewart_solve_step(const stewart_options *options, const stewart_real p[], stewart_real t,
+                            stewart_state *state, stewart_workspace *work,
+                            stewart_report *report)
+{
+    if (stewart_check_options(options) != 0) return stewart_refused(report, t);
+    return stewart_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define STEWART_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define STEWART_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define STEWART_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define STEWART_BAD_OPTIONS 4    /* an option breaks its rule: see stewart_check_options */
 
 typedef struct {
     stewart_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 1364; the update (a solve): 128
  * Condition at the converged q: 612; an extra iteration there (at most 3): 1573
  * Velocity: 376; acceleration: 1579; per-point checks: 4041; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 50689 (21624 add/sub, 20370 mul, 704 div, 202 sqrt, 233 other calls, 4028 fabs, 3528 compares)
+ * Step, worst case with the default cap of 25 iterations: 50703 (21626 add/sub, 20370 mul, 704 div, 202 sqrt, 233 other calls, 4028 fabs, 3540 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66488
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66502
  */
 #define STEWART_OPS_ITERATION 1492   /* one Newton iteration */
-#define STEWART_OPS_STEP_FIXED 13389  /* a step without its iterations */
-#define STEWART_OPS_STEP_WORST 50689  /* at the default cap, 25 */
-#define STEWART_OPS_STEP_DENSE_WORST 66488  /* every factorization dense */
+#define STEWART_OPS_STEP_FIXED 13403  /* a step without its iterations */
+#define STEWART_OPS_STEP_WORST 50703  /* at the default cap, 25 */
+#define STEWART_OPS_STEP_DENSE_WORST 66502  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* STEWART_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* STEWART_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     stewart_real t;         /* the time of the last step attempted           */
     stewart_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void stewart_default_options(stewart_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: stewart_default_options not called), returns
+ * STEWART_BAD_OPTIONS with nothing solved and the state as it was. */
+int stewart_check_options(const stewart_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

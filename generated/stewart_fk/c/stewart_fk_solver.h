@@ -23,6 +23,7 @@
 #define STEWART_FK_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define STEWART_FK_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define STEWART_FK_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define STEWART_FK_BAD_OPTIONS 4    /* an option breaks its rule: see stewart_fk_check_options */
 
 typedef struct {
     stewart_fk_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -59,22 +60,23 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 1274; the update (a solve): 128
  * Condition at the converged q: 612; an extra iteration there (at most 3): 1483
  * Velocity: 118; acceleration: 996; per-point checks: 3224; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 46421 (18359 add/sub, 19201 mul, 512 div, 10 sqrt, 0 other calls, 4550 fabs, 3789 compares)
+ * Step, worst case with the default cap of 25 iterations: 46435 (18361 add/sub, 19201 mul, 512 div, 10 sqrt, 0 other calls, 4550 fabs, 3801 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 48785 (19429 add/sub, 20306 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3888 compares)
- *   positions only (du, ddu NULL): 47613 (18877 add/sub, 19730 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3872 compares)
+ * solve_inputs, worst case: 48799 (19431 add/sub, 20306 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3900 compares)
+ *   positions only (du, ddu NULL): 47627 (18879 add/sub, 19730 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3884 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2354
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62220
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62234
  */
 #define STEWART_FK_OPS_ITERATION 1402   /* one Newton iteration */
-#define STEWART_FK_OPS_STEP_FIXED 11371  /* a step without its iterations */
-#define STEWART_FK_OPS_STEP_WORST 46421  /* at the default cap, 25 */
-#define STEWART_FK_OPS_STEP_DENSE_WORST 62220  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 48785  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 47613  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_STEP_FIXED 11385  /* a step without its iterations */
+#define STEWART_FK_OPS_STEP_WORST 46435  /* at the default cap, 25 */
+#define STEWART_FK_OPS_STEP_DENSE_WORST 62234  /* every factorization dense */
+#define STEWART_FK_OPS_INPUTS_WORST 48799  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 47627  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
-    int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     stewart_fk_real t;         /* the time of the last step attempted           */
     stewart_fk_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -119,6 +121,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void stewart_fk_default_options(stewart_fk_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: stewart_fk_default_options not called), returns
+ * STEWART_FK_BAD_OPTIONS with nothing solved and the state as it was. */
+int stewart_fk_check_options(const stewart_fk_options *options);
 
 /* With input drivers, every function of this header but stewart_fk_solve_inputs reads
  * p[NPU] (NPU = 18): the NP parameters, then the inputs u[NU], du[NU], ddu[NU], held at

@@ -31,6 +31,34 @@ void stewart_legs_default_options(stewart_legs_options *options)
     options->unit = 1.0;
 }
 
+int stewart_legs_check_options(const stewart_legs_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int stewart_legs_refused(stewart_legs_report *report, stewart_legs_real t)
+{
+    report->status = STEWART_LEGS_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (stewart_legs_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (stewart_legs_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define STEWART_LEGS_UNIT_ROUNDOFF DBL_EPSILON
 #define STEWART_LEGS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define STEWART_LEGS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -946,9 +974,10 @@ static void stewart_legs_predict(stewart_legs_real t, stewart_legs_state *state)
     }
 }
 
-int stewart_legs_solve_step(const stewart_legs_options *options, const stewart_legs_real p[], stewart_legs_real t,
-                            stewart_legs_state *state, stewart_legs_workspace *work,
-                            stewart_legs_report *report)
+/* stewart_legs_solve_step with its options already checked. */
+static int stewart_legs_step(const stewart_legs_options *options, const stewart_legs_real p[],
+                             stewart_legs_real t, stewart_legs_state *state,
+                             stewart_legs_workspace *work, stewart_legs_report *report)
 {
     stewart_legs_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -1005,6 +1034,14 @@ int stewart_legs_solve_step(const stewart_legs_options *options, const stewart_l
     state->t = t;
     state->started = 1;
     return STEWART_LEGS_OK;
+}
+
+int stewart_legs_solve_step(const stewart_legs_options *options, const stewart_legs_real p[], stewart_legs_real t,
+                            stewart_legs_state *state, stewart_legs_workspace *work,
+                            stewart_legs_report *report)
+{
+    if (stewart_legs_check_options(options) != 0) return stewart_legs_refused(report, t);
+    return stewart_legs_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define STEWART_LEGS_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define STEWART_LEGS_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define STEWART_LEGS_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define STEWART_LEGS_BAD_OPTIONS 4    /* an option breaks its rule: see stewart_legs_check_options */
 
 typedef struct {
     stewart_legs_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 13861; the update (a solve): 1855
  * Condition at the converged q: 22622; an extra iteration there (at most 3): 15797
  * Velocity: 1885; acceleration: 10074; per-point checks: 37200; predictor: 547
- * Step, worst case with the default cap of 25 iterations: 549145 (221051 add/sub, 216380 mul, 5656 div, 208 sqrt, 1346 other calls, 61063 fabs, 43441 compares)
+ * Step, worst case with the default cap of 25 iterations: 549159 (221053 add/sub, 216380 mul, 5656 div, 208 sqrt, 1346 other calls, 61063 fabs, 43453 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16599262
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16599276
  */
 #define STEWART_LEGS_OPS_ITERATION 15716   /* one Newton iteration */
-#define STEWART_LEGS_OPS_STEP_FIXED 156245  /* a step without its iterations */
-#define STEWART_LEGS_OPS_STEP_WORST 549145  /* at the default cap, 25 */
-#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16599262  /* every factorization dense */
+#define STEWART_LEGS_OPS_STEP_FIXED 156259  /* a step without its iterations */
+#define STEWART_LEGS_OPS_STEP_WORST 549159  /* at the default cap, 25 */
+#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16599276  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* STEWART_LEGS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* STEWART_LEGS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     stewart_legs_real t;         /* the time of the last step attempted           */
     stewart_legs_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void stewart_legs_default_options(stewart_legs_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: stewart_legs_default_options not called), returns
+ * STEWART_LEGS_BAD_OPTIONS with nothing solved and the state as it was. */
+int stewart_legs_check_options(const stewart_legs_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

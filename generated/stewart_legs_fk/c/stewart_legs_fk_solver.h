@@ -23,6 +23,7 @@
 #define STEWART_LEGS_FK_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define STEWART_LEGS_FK_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define STEWART_LEGS_FK_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define STEWART_LEGS_FK_BAD_OPTIONS 4    /* an option breaks its rule: see stewart_legs_fk_check_options */
 
 typedef struct {
     stewart_legs_fk_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -59,22 +60,23 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 13597; the update (a solve): 1855
  * Condition at the converged q: 22622; an extra iteration there (at most 3): 15533
  * Velocity: 1587; acceleration: 9249; per-point checks: 36090; predictor: 547
- * Step, worst case with the default cap of 25 iterations: 539256 (216191 add/sub, 212021 mul, 5620 div, 10 sqrt, 910 other calls, 61063 fabs, 43441 compares)
+ * Step, worst case with the default cap of 25 iterations: 539270 (216193 add/sub, 212021 mul, 5620 div, 10 sqrt, 910 other calls, 61063 fabs, 43453 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 572028 (230575 add/sub, 228372 mul, 6081 div, 10 sqrt, 910 other calls, 61700 fabs, 44380 compares)
- *   positions only (du, ddu NULL): 560462 (225847 add/sub, 222082 mul, 5899 div, 10 sqrt, 910 other calls, 61518 fabs, 44196 compares)
+ * solve_inputs, worst case: 572042 (230577 add/sub, 228372 mul, 6081 div, 10 sqrt, 910 other calls, 61700 fabs, 44392 compares)
+ *   positions only (du, ddu NULL): 560476 (225849 add/sub, 222082 mul, 5899 div, 10 sqrt, 910 other calls, 61518 fabs, 44208 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 32762
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16589373
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16589387
  */
 #define STEWART_LEGS_FK_OPS_ITERATION 15452   /* one Newton iteration */
-#define STEWART_LEGS_FK_OPS_STEP_FIXED 152956  /* a step without its iterations */
-#define STEWART_LEGS_FK_OPS_STEP_WORST 539256  /* at the default cap, 25 */
-#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16589373  /* every factorization dense */
-#define STEWART_LEGS_FK_OPS_INPUTS_WORST 572028  /* solve_inputs with du, ddu */
-#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 560462  /* solve_inputs, du, ddu NULL */
+#define STEWART_LEGS_FK_OPS_STEP_FIXED 152970  /* a step without its iterations */
+#define STEWART_LEGS_FK_OPS_STEP_WORST 539270  /* at the default cap, 25 */
+#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16589387  /* every factorization dense */
+#define STEWART_LEGS_FK_OPS_INPUTS_WORST 572042  /* solve_inputs with du, ddu */
+#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 560476  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
-    int status;                  /* STEWART_LEGS_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* STEWART_LEGS_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     stewart_legs_fk_real t;         /* the time of the last step attempted           */
     stewart_legs_fk_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -119,6 +121,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void stewart_legs_fk_default_options(stewart_legs_fk_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: stewart_legs_fk_default_options not called), returns
+ * STEWART_LEGS_FK_BAD_OPTIONS with nothing solved and the state as it was. */
+int stewart_legs_fk_check_options(const stewart_legs_fk_options *options);
 
 /* With input drivers, every function of this header but stewart_legs_fk_solve_inputs reads
  * p[NPU] (NPU = 18): the NP parameters, then the inputs u[NU], du[NU], ddu[NU], held at

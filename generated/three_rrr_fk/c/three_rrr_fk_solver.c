@@ -31,6 +31,35 @@ void three_rrr_fk_default_options(three_rrr_fk_options *options)
     options->unit = 1.0;
 }
 
+int three_rrr_fk_check_options(const three_rrr_fk_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int three_rrr_fk_refused(three_rrr_fk_report *report, three_rrr_fk_real t)
+{
+    report->status = THREE_RRR_FK_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (three_rrr_fk_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (three_rrr_fk_real)NAN;
+    report->flagged = 0;
+    report->branch_jump = 0;
+    return report->status;
+}
+
 #define THREE_RRR_FK_UNIT_ROUNDOFF DBL_EPSILON
 #define THREE_RRR_FK_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define THREE_RRR_FK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -871,9 +900,10 @@ static void three_rrr_fk_predict(three_rrr_fk_real t, three_rrr_fk_state *state)
     }
 }
 
-int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr_fk_real p[], three_rrr_fk_real t,
-                            three_rrr_fk_state *state, three_rrr_fk_workspace *work,
-                            three_rrr_fk_report *report)
+/* three_rrr_fk_solve_step with its options already checked. */
+static int three_rrr_fk_step(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
+                             three_rrr_fk_real t, three_rrr_fk_state *state,
+                             three_rrr_fk_workspace *work, three_rrr_fk_report *report)
 {
     three_rrr_fk_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -930,6 +960,14 @@ int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr
     state->t = t;
     state->started = 1;
     return THREE_RRR_FK_OK;
+}
+
+int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr_fk_real p[], three_rrr_fk_real t,
+                            three_rrr_fk_state *state, three_rrr_fk_workspace *work,
+                            three_rrr_fk_report *report)
+{
+    if (three_rrr_fk_check_options(options) != 0) return three_rrr_fk_refused(report, t);
+    return three_rrr_fk_step(options, p, t, state, work, report);
 }
 
 
@@ -1048,10 +1086,11 @@ static int three_rrr_fk_branch_jump(three_rrr_fk_workspace *work, const three_rr
     return jumped;
 }
 
-int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
-                              const three_rrr_fk_real u[], const three_rrr_fk_real du[], const three_rrr_fk_real ddu[],
-                              three_rrr_fk_state *state, three_rrr_fk_workspace *work,
-                              three_rrr_fk_report *report)
+/* three_rrr_fk_solve_inputs with its options already checked. */
+static int three_rrr_fk_inputs_step(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
+                                    const three_rrr_fk_real u[], const three_rrr_fk_real du[],
+                                    const three_rrr_fk_real ddu[], three_rrr_fk_state *state,
+                                    three_rrr_fk_workspace *work, three_rrr_fk_report *report)
 {
     three_rrr_fk_real pu[THREE_RRR_FK_NP + 3 * THREE_RRR_FK_NU];
     three_rrr_fk_real nq, ndq, nddq, predicted[THREE_RRR_FK_NQ], first = (three_rrr_fk_real)NAN;
@@ -1120,6 +1159,15 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
     work->factored = 1;
     state->started = 1;
     return THREE_RRR_FK_OK;
+}
+
+int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
+                              const three_rrr_fk_real u[], const three_rrr_fk_real du[], const three_rrr_fk_real ddu[],
+                              three_rrr_fk_state *state, three_rrr_fk_workspace *work,
+                              three_rrr_fk_report *report)
+{
+    if (three_rrr_fk_check_options(options) != 0) return three_rrr_fk_refused(report, state->t);
+    return three_rrr_fk_inputs_step(options, p, u, du, ddu, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

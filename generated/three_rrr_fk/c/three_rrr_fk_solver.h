@@ -23,6 +23,7 @@
 #define THREE_RRR_FK_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define THREE_RRR_FK_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define THREE_RRR_FK_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define THREE_RRR_FK_BAD_OPTIONS 4    /* an option breaks its rule: see three_rrr_fk_check_options */
 
 typedef struct {
     three_rrr_fk_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -59,22 +60,23 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 470; the update (a solve): 195
  * Condition at the converged q: 569; an extra iteration there (at most 3): 746
  * Velocity: 134; acceleration: 198; per-point checks: 2674; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 23647 (9326 add/sub, 5459 mul, 986 div, 10 sqrt, 434 other calls, 4013 fabs, 3419 compares)
+ * Step, worst case with the default cap of 25 iterations: 23661 (9328 add/sub, 5459 mul, 986 div, 10 sqrt, 434 other calls, 4013 fabs, 3431 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 25651 (10338 add/sub, 5870 mul, 1097 div, 10 sqrt, 518 other calls, 4160 fabs, 3658 compares)
- *   positions only (du, ddu NULL): 25149 (10152 add/sub, 5682 mul, 1055 div, 10 sqrt, 518 other calls, 4118 fabs, 3614 compares)
+ * solve_inputs, worst case: 25665 (10340 add/sub, 5870 mul, 1097 div, 10 sqrt, 518 other calls, 4160 fabs, 3670 compares)
+ *   positions only (du, ddu NULL): 25163 (10154 add/sub, 5682 mul, 1055 div, 10 sqrt, 518 other calls, 4118 fabs, 3626 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 1994
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286501
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286515
  */
 #define THREE_RRR_FK_OPS_ITERATION 665   /* one Newton iteration */
-#define THREE_RRR_FK_OPS_STEP_FIXED 7022  /* a step without its iterations */
-#define THREE_RRR_FK_OPS_STEP_WORST 23647  /* at the default cap, 25 */
-#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286501  /* every factorization dense */
-#define THREE_RRR_FK_OPS_INPUTS_WORST 25651  /* solve_inputs with du, ddu */
-#define THREE_RRR_FK_OPS_POSITIONS_WORST 25149  /* solve_inputs, du, ddu NULL */
+#define THREE_RRR_FK_OPS_STEP_FIXED 7036  /* a step without its iterations */
+#define THREE_RRR_FK_OPS_STEP_WORST 23661  /* at the default cap, 25 */
+#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286515  /* every factorization dense */
+#define THREE_RRR_FK_OPS_INPUTS_WORST 25665  /* solve_inputs with du, ddu */
+#define THREE_RRR_FK_OPS_POSITIONS_WORST 25163  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
-    int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     three_rrr_fk_real t;         /* the time of the last step attempted           */
     three_rrr_fk_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -119,6 +121,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void three_rrr_fk_default_options(three_rrr_fk_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: three_rrr_fk_default_options not called), returns
+ * THREE_RRR_FK_BAD_OPTIONS with nothing solved and the state as it was. */
+int three_rrr_fk_check_options(const three_rrr_fk_options *options);
 
 /* With input drivers, every function of this header but three_rrr_fk_solve_inputs reads
  * p[NPU] (NPU = 9): the NP parameters, then the inputs u[NU], du[NU], ddu[NU], held at

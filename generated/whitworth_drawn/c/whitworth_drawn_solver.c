@@ -31,6 +31,34 @@ void whitworth_drawn_default_options(whitworth_drawn_options *options)
     options->unit = 1.0;
 }
 
+int whitworth_drawn_check_options(const whitworth_drawn_options *options)
+{
+    if (!(options->tol_phi > 0 && options->tol_phi - options->tol_phi == 0)) return 1;
+    if (!(options->tol_dq > 0)) return 2;
+    if (options->max_iterations < 0) return 3;
+    if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
+    if (!(options->max_cond > 0)) return 5;
+    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->target_q > 0)) return 7;
+    if (!(options->target_dq > 0)) return 8;
+    if (!(options->target_ddq > 0)) return 9;
+    if (!(options->unit > 0 && options->unit - options->unit == 0)) return 10;
+    return 0;
+}
+
+/* The report of a call refused for its options: nothing solved, the state as it was. */
+static int whitworth_drawn_refused(whitworth_drawn_report *report, whitworth_drawn_real t)
+{
+    report->status = WHITWORTH_DRAWN_BAD_OPTIONS;
+    report->t = t;
+    report->residual = (whitworth_drawn_real)NAN;
+    report->iterations = 0;
+    report->pivot = -1;
+    report->inv_norm = report->cond = (whitworth_drawn_real)NAN;
+    report->flagged = 0;
+    return report->status;
+}
+
 #define WHITWORTH_DRAWN_UNIT_ROUNDOFF DBL_EPSILON
 #define WHITWORTH_DRAWN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
 #define WHITWORTH_DRAWN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
@@ -691,9 +719,10 @@ static void whitworth_drawn_predict(whitworth_drawn_real t, whitworth_drawn_stat
     }
 }
 
-int whitworth_drawn_solve_step(const whitworth_drawn_options *options, const whitworth_drawn_real p[], whitworth_drawn_real t,
-                            whitworth_drawn_state *state, whitworth_drawn_workspace *work,
-                            whitworth_drawn_report *report)
+/* whitworth_drawn_solve_step with its options already checked. */
+static int whitworth_drawn_step(const whitworth_drawn_options *options, const whitworth_drawn_real p[],
+                             whitworth_drawn_real t, whitworth_drawn_state *state,
+                             whitworth_drawn_workspace *work, whitworth_drawn_report *report)
 {
     whitworth_drawn_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
     int i;
@@ -750,6 +779,14 @@ int whitworth_drawn_solve_step(const whitworth_drawn_options *options, const whi
     state->t = t;
     state->started = 1;
     return WHITWORTH_DRAWN_OK;
+}
+
+int whitworth_drawn_solve_step(const whitworth_drawn_options *options, const whitworth_drawn_real p[], whitworth_drawn_real t,
+                            whitworth_drawn_state *state, whitworth_drawn_workspace *work,
+                            whitworth_drawn_report *report)
+{
+    if (whitworth_drawn_check_options(options) != 0) return whitworth_drawn_refused(report, t);
+    return whitworth_drawn_step(options, p, t, state, work, report);
 }
 
 /* Row k of out (when given): a fixed-size memcpy, which compilers turn into a few moves. */

@@ -23,6 +23,7 @@
 #define WHITWORTH_DRAWN_NO_CONVERGENCE 1 /* iteration cap reached, or the iterates diverged */
 #define WHITWORTH_DRAWN_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define WHITWORTH_DRAWN_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
+#define WHITWORTH_DRAWN_BAD_OPTIONS 4    /* an option breaks its rule: see whitworth_drawn_check_options */
 
 typedef struct {
     whitworth_drawn_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -57,17 +58,18 @@ typedef struct {
  *   Phi, Phi_q, their factorization and tests: 212; the update (a solve): 104
  * Condition at the converged q: 179; an extra iteration there (at most 3): 397
  * Velocity: 68; acceleration: 117; per-point checks: 1482; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 11444 (4636 add/sub, 2759 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1712 compares)
+ * Step, worst case with the default cap of 25 iterations: 11458 (4638 add/sub, 2759 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1724 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73303
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73317
  */
 #define WHITWORTH_DRAWN_OPS_ITERATION 316   /* one Newton iteration */
-#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3544  /* a step without its iterations */
-#define WHITWORTH_DRAWN_OPS_STEP_WORST 11444  /* at the default cap, 25 */
-#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73303  /* every factorization dense */
+#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3558  /* a step without its iterations */
+#define WHITWORTH_DRAWN_OPS_STEP_WORST 11458  /* at the default cap, 25 */
+#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73317  /* every factorization dense */
 
 typedef struct {
-    int status;                  /* WHITWORTH_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE */
+    int status;                  /* WHITWORTH_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
+                                 /* _BAD_OPTIONS                                  */
     whitworth_drawn_real t;         /* the time of the last step attempted           */
     whitworth_drawn_real residual;  /* max|Phi| of the last iterate                  */
     int iterations;              /* Newton iterations spent at t                  */
@@ -108,6 +110,14 @@ typedef struct {
 
 /* Tolerances suited to the real type. */
 void whitworth_drawn_default_options(whitworth_drawn_options *options);
+
+/* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
+ * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
+ * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
+ * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * fails (a zero-filled struct: whitworth_drawn_default_options not called), returns
+ * WHITWORTH_DRAWN_BAD_OPTIONS with nothing solved and the state as it was. */
+int whitworth_drawn_check_options(const whitworth_drawn_options *options);
 
 /* Advance state to time t. Returns the status (also in report); on failure state->q holds
  * the last Newton iterate and state->dq, state->ddq are those of the previous step. */

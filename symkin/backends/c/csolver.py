@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.contract.options import Options
+from symkin.contract.options import C_FIELDS, RULE_WORDS, RULES, Options
+from symkin.errors import UsageError
 from symkin.runtime.protocol import ChunkResult
 
 Array = NDArray[np.float64]
@@ -37,6 +38,12 @@ def fill_options(lib: Any, name: str, target: Any, options: Options, unit: float
     target.target_q, target.target_dq = options.target_q, options.target_dq
     target.target_ddq = options.target_ddq
     target.unit = unit
+    refused = getattr(lib, f"{name}_check_options")(target)
+    if refused:  # Options kept its rules; a float kernel can still round a value to 0 or inf
+        field = C_FIELDS[refused - 1]
+        raise UsageError(f"Options: {field} = {getattr(options, field, unit)!r} is "
+                         f"{getattr(target, field)!r} in the kernel's real type, where it must "
+                         f"be {RULE_WORDS[RULES[field]]}")
 
 
 class GridSolver:

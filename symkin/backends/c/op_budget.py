@@ -7,7 +7,8 @@ solver's own loops (templates/c/solver.c.j2 and its partials) are counted here p
 each formula next to the name of the function it mirrors, taking every branch that adds
 work (the worst case). Composition, as ``<prefix>_solve_step`` runs:
 
-    predictor + (cap + 1) x evaluation + cap x Newton update + convergence checks
+    options check + predictor + (cap + 1) x evaluation + cap x Newton update
+    + convergence checks
     (condition, up to TIGHTEN_STEPS extra iterations, condition again)
     + velocity + acceleration + per-point checks (norms, error model).
 
@@ -30,7 +31,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from symkin.codegen.op_count import ZERO, Flops, count, count_all
-from symkin.contract import tuning
+from symkin.contract import options, tuning
 
 
 def _routine(code: Any, name: str) -> Flops:
@@ -150,6 +151,11 @@ POSITION_ERROR = Flops(sqrt=1, div=1, mul=3, add=1, cmp=2)
 # <prefix>_flagged_refined around its calls: s, e_dq, e_ddq, the three finite tests and the
 # three comparisons with the targets (each with its at_least_1).
 REFINED = Flops(sqrt=1, div=1, mul=7, add=5, cmp=9)
+# <prefix>_check_options at the top of every solve: per field of contract.options.RULES its
+# comparisons and, where it must be finite, the x - x == 0 test (max_iterations is an int).
+_RULE_OPS = {"positive finite": Flops(add=1, cmp=2), "positive": Flops(cmp=1),
+             "ratio": Flops(cmp=2), "count": ZERO}
+OPTIONS_CHECK = sum((_RULE_OPS[rule] for rule in options.RULES.values()), ZERO)
 
 
 def worst_column(algebra: LinearAlgebra, n: int) -> Flops:
@@ -290,7 +296,8 @@ def step(parts: Pieces, cap: int, rates: bool = True) -> Flops:
     positions only (``<prefix>_solve_inputs`` with du, ddu NULL)."""
     convergence = parts.converged(Flops(cmp=3) + WOULD_FLAG)
     kinematics = parts.velocity + parts.acceleration if rates else ZERO
-    return parts.predictor + parts.newton(cap) + convergence + kinematics + parts.checks
+    return (OPTIONS_CHECK + parts.predictor + parts.newton(cap) + convergence + kinematics
+            + parts.checks)
 
 
 @dataclass(frozen=True)
