@@ -85,12 +85,10 @@ class Options:
         if field.name == "stop_at_singular":
             return None if isinstance(value, bool) else "stop_at_singular must be True or False"
         rule = RULES[field.name]
-        if rule == "count":
-            whole = isinstance(value, numbers.Integral) and not isinstance(value, bool)
-            return None if whole and value >= 0 else \
-                f"max_iterations must be {RULE_WORDS[rule]}, got {value!r}"
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            return f"{field.name} must be a number, got {value!r}"
+        wanted = numbers.Integral if rule == "count" else numbers.Real  # NumPy's too
+        if isinstance(value, bool) or not isinstance(value, wanted):
+            return f"{field.name} must be {'a whole number' if rule == 'count' else 'a number'}" \
+                f", got {value!r}"
         return None if allowed(rule, float(value)) else \
             f"{field.name} must be {RULE_WORDS[rule]}, got {value!r}"
 

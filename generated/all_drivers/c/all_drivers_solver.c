@@ -1087,9 +1087,15 @@ int all_drivers_solve_edge(const all_drivers_options *options, const all_drivers
     const all_drivers_real resolution = 4 * ALL_DRIVERS_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (all_drivers_check_options(options) != 0) { /* no step could be taken: state kept */
+        all_drivers_refused(report, t);
+        edge->outcome = ALL_DRIVERS_EDGE_STOPPED;
+        return edge->outcome;
+    }
     all_drivers_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = all_drivers_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = ALL_DRIVERS_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status ALL_DRIVERS_BAD_OPTIONS, where the options break their rules. */
 int all_drivers_solve_edge(const all_drivers_options *options, const all_drivers_real p[],
                             all_drivers_real t, all_drivers_real h_min, all_drivers_real delta,
                             all_drivers_real cond, all_drivers_state *state,

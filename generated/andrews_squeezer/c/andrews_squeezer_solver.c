@@ -1093,9 +1093,15 @@ int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const a
     const andrews_squeezer_real resolution = 4 * ANDREWS_SQUEEZER_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (andrews_squeezer_check_options(options) != 0) { /* no step could be taken: state kept */
+        andrews_squeezer_refused(report, t);
+        edge->outcome = ANDREWS_SQUEEZER_EDGE_STOPPED;
+        return edge->outcome;
+    }
     andrews_squeezer_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = andrews_squeezer_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = ANDREWS_SQUEEZER_EDGE_REACHED;

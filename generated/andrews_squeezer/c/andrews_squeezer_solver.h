@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status ANDREWS_SQUEEZER_BAD_OPTIONS, where the options break their rules. */
 int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
                             andrews_squeezer_real t, andrews_squeezer_real h_min, andrews_squeezer_real delta,
                             andrews_squeezer_real cond, andrews_squeezer_state *state,

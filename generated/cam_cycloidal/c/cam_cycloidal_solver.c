@@ -865,9 +865,15 @@ int cam_cycloidal_solve_edge(const cam_cycloidal_options *options, const cam_cyc
     const cam_cycloidal_real resolution = 4 * CAM_CYCLOIDAL_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (cam_cycloidal_check_options(options) != 0) { /* no step could be taken: state kept */
+        cam_cycloidal_refused(report, t);
+        edge->outcome = CAM_CYCLOIDAL_EDGE_STOPPED;
+        return edge->outcome;
+    }
     cam_cycloidal_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = cam_cycloidal_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = CAM_CYCLOIDAL_EDGE_REACHED;

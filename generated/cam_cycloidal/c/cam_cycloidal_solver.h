@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status CAM_CYCLOIDAL_BAD_OPTIONS, where the options break their rules. */
 int cam_cycloidal_solve_edge(const cam_cycloidal_options *options, const cam_cycloidal_real p[],
                             cam_cycloidal_real t, cam_cycloidal_real h_min, cam_cycloidal_real delta,
                             cam_cycloidal_real cond, cam_cycloidal_state *state,

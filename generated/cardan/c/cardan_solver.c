@@ -851,9 +851,15 @@ int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
     const cardan_real resolution = 4 * CARDAN_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (cardan_check_options(options) != 0) { /* no step could be taken: state kept */
+        cardan_refused(report, t);
+        edge->outcome = CARDAN_EDGE_STOPPED;
+        return edge->outcome;
+    }
     cardan_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = cardan_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = CARDAN_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status CARDAN_BAD_OPTIONS, where the options break their rules. */
 int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
                             cardan_real t, cardan_real h_min, cardan_real delta,
                             cardan_real cond, cardan_state *state,

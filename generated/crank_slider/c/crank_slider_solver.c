@@ -872,9 +872,15 @@ int crank_slider_solve_edge(const crank_slider_options *options, const crank_sli
     const crank_slider_real resolution = 4 * CRANK_SLIDER_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (crank_slider_check_options(options) != 0) { /* no step could be taken: state kept */
+        crank_slider_refused(report, t);
+        edge->outcome = CRANK_SLIDER_EDGE_STOPPED;
+        return edge->outcome;
+    }
     crank_slider_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = crank_slider_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = CRANK_SLIDER_EDGE_REACHED;

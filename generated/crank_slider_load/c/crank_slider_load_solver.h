@@ -208,7 +208,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status CRANK_SLIDER_LOAD_BAD_OPTIONS, where the options break their rules. */
 int crank_slider_load_solve_edge(const crank_slider_load_options *options, const crank_slider_load_real p[],
                             crank_slider_load_real t, crank_slider_load_real h_min, crank_slider_load_real delta,
                             crank_slider_load_real cond, crank_slider_load_state *state,

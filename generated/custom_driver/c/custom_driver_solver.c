@@ -895,9 +895,15 @@ int custom_driver_solve_edge(const custom_driver_options *options, const custom_
     const custom_driver_real resolution = 4 * CUSTOM_DRIVER_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (custom_driver_check_options(options) != 0) { /* no step could be taken: state kept */
+        custom_driver_refused(report, t);
+        edge->outcome = CUSTOM_DRIVER_EDGE_STOPPED;
+        return edge->outcome;
+    }
     custom_driver_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = custom_driver_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = CUSTOM_DRIVER_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status CUSTOM_DRIVER_BAD_OPTIONS, where the options break their rules. */
 int custom_driver_solve_edge(const custom_driver_options *options, const custom_driver_real p[],
                             custom_driver_real t, custom_driver_real h_min, custom_driver_real delta,
                             custom_driver_real cond, custom_driver_state *state,

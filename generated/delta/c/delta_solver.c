@@ -919,9 +919,15 @@ int delta_solve_edge(const delta_options *options, const delta_real p[],
     const delta_real resolution = 4 * DELTA_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (delta_check_options(options) != 0) { /* no step could be taken: state kept */
+        delta_refused(report, t);
+        edge->outcome = DELTA_EDGE_STOPPED;
+        return edge->outcome;
+    }
     delta_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = delta_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = DELTA_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status DELTA_BAD_OPTIONS, where the options break their rules. */
 int delta_solve_edge(const delta_options *options, const delta_real p[],
                             delta_real t, delta_real h_min, delta_real delta,
                             delta_real cond, delta_state *state,

@@ -1121,9 +1121,15 @@ int delta_fk_solve_edge(const delta_fk_options *options, const delta_fk_real p[]
     const delta_fk_real resolution = 4 * DELTA_FK_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (delta_fk_check_options(options) != 0) { /* no step could be taken: state kept */
+        delta_fk_refused(report, t);
+        edge->outcome = DELTA_FK_EDGE_STOPPED;
+        return edge->outcome;
+    }
     delta_fk_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = delta_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = DELTA_FK_EDGE_REACHED;

@@ -239,7 +239,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status DELTA_FK_BAD_OPTIONS, where the options break their rules. */
 int delta_fk_solve_edge(const delta_fk_options *options, const delta_fk_real p[],
                             delta_fk_real t, delta_fk_real h_min, delta_fk_real delta,
                             delta_fk_real cond, delta_fk_state *state,

@@ -887,9 +887,15 @@ int four_bar_solve_edge(const four_bar_options *options, const four_bar_real p[]
     const four_bar_real resolution = 4 * FOUR_BAR_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (four_bar_check_options(options) != 0) { /* no step could be taken: state kept */
+        four_bar_refused(report, t);
+        edge->outcome = FOUR_BAR_EDGE_STOPPED;
+        return edge->outcome;
+    }
     four_bar_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = four_bar_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = FOUR_BAR_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status FOUR_BAR_BAD_OPTIONS, where the options break their rules. */
 int four_bar_solve_edge(const four_bar_options *options, const four_bar_real p[],
                             four_bar_real t, four_bar_real h_min, four_bar_real delta,
                             four_bar_real cond, four_bar_state *state,

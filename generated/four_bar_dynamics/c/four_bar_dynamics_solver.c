@@ -909,9 +909,15 @@ int four_bar_dynamics_solve_edge(const four_bar_dynamics_options *options, const
     const four_bar_dynamics_real resolution = 4 * FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (four_bar_dynamics_check_options(options) != 0) { /* no step could be taken: state kept */
+        four_bar_dynamics_refused(report, t);
+        edge->outcome = FOUR_BAR_DYNAMICS_EDGE_STOPPED;
+        return edge->outcome;
+    }
     four_bar_dynamics_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = four_bar_dynamics_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = FOUR_BAR_DYNAMICS_EDGE_REACHED;

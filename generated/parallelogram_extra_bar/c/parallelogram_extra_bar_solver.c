@@ -926,9 +926,15 @@ int parallelogram_extra_bar_solve_edge(const parallelogram_extra_bar_options *op
     const parallelogram_extra_bar_real resolution = 4 * PARALLELOGRAM_EXTRA_BAR_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (parallelogram_extra_bar_check_options(options) != 0) { /* no step could be taken: state kept */
+        parallelogram_extra_bar_refused(report, t);
+        edge->outcome = PARALLELOGRAM_EXTRA_BAR_EDGE_STOPPED;
+        return edge->outcome;
+    }
     parallelogram_extra_bar_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = parallelogram_extra_bar_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = PARALLELOGRAM_EXTRA_BAR_EDGE_REACHED;

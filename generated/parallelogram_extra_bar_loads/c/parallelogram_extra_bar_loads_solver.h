@@ -208,7 +208,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status PARALLELOGRAM_EXTRA_BAR_LOADS_BAD_OPTIONS, where the options break their rules. */
 int parallelogram_extra_bar_loads_solve_edge(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
                             parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_real h_min, parallelogram_extra_bar_loads_real delta,
                             parallelogram_extra_bar_loads_real cond, parallelogram_extra_bar_loads_state *state,

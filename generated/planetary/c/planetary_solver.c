@@ -880,9 +880,15 @@ int planetary_solve_edge(const planetary_options *options, const planetary_real 
     const planetary_real resolution = 4 * PLANETARY_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (planetary_check_options(options) != 0) { /* no step could be taken: state kept */
+        planetary_refused(report, t);
+        edge->outcome = PLANETARY_EDGE_STOPPED;
+        return edge->outcome;
+    }
     planetary_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = planetary_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = PLANETARY_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status PLANETARY_BAD_OPTIONS, where the options break their rules. */
 int planetary_solve_edge(const planetary_options *options, const planetary_real p[],
                             planetary_real t, planetary_real h_min, planetary_real delta,
                             planetary_real cond, planetary_state *state,

@@ -934,9 +934,15 @@ int quick_return_solve_edge(const quick_return_options *options, const quick_ret
     const quick_return_real resolution = 4 * QUICK_RETURN_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (quick_return_check_options(options) != 0) { /* no step could be taken: state kept */
+        quick_return_refused(report, t);
+        edge->outcome = QUICK_RETURN_EDGE_STOPPED;
+        return edge->outcome;
+    }
     quick_return_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = quick_return_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = QUICK_RETURN_EDGE_REACHED;

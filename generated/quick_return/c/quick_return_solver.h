@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status QUICK_RETURN_BAD_OPTIONS, where the options break their rules. */
 int quick_return_solve_edge(const quick_return_options *options, const quick_return_real p[],
                             quick_return_real t, quick_return_real h_min, quick_return_real delta,
                             quick_return_real cond, quick_return_state *state,

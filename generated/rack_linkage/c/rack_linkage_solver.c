@@ -961,9 +961,15 @@ int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_link
     const rack_linkage_real resolution = 4 * RACK_LINKAGE_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (rack_linkage_check_options(options) != 0) { /* no step could be taken: state kept */
+        rack_linkage_refused(report, t);
+        edge->outcome = RACK_LINKAGE_EDGE_STOPPED;
+        return edge->outcome;
+    }
     rack_linkage_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = rack_linkage_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = RACK_LINKAGE_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status RACK_LINKAGE_BAD_OPTIONS, where the options break their rules. */
 int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_linkage_real p[],
                             rack_linkage_real t, rack_linkage_real h_min, rack_linkage_real delta,
                             rack_linkage_real cond, rack_linkage_state *state,

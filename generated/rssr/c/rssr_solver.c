@@ -1216,9 +1216,15 @@ int rssr_solve_edge(const rssr_options *options, const rssr_real p[],
     const rssr_real resolution = 4 * RSSR_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (rssr_check_options(options) != 0) { /* no step could be taken: state kept */
+        rssr_refused(report, t);
+        edge->outcome = RSSR_EDGE_STOPPED;
+        return edge->outcome;
+    }
     rssr_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = rssr_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = RSSR_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status RSSR_BAD_OPTIONS, where the options break their rules. */
 int rssr_solve_edge(const rssr_options *options, const rssr_real p[],
                             rssr_real t, rssr_real h_min, rssr_real delta,
                             rssr_real cond, rssr_state *state,

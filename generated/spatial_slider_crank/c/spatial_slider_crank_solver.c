@@ -873,9 +873,15 @@ int spatial_slider_crank_solve_edge(const spatial_slider_crank_options *options,
     const spatial_slider_crank_real resolution = 4 * SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (spatial_slider_crank_check_options(options) != 0) { /* no step could be taken: state kept */
+        spatial_slider_crank_refused(report, t);
+        edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_STOPPED;
+        return edge->outcome;
+    }
     spatial_slider_crank_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = spatial_slider_crank_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status SPATIAL_SLIDER_CRANK_BAD_OPTIONS, where the options break their rules. */
 int spatial_slider_crank_solve_edge(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[],
                             spatial_slider_crank_real t, spatial_slider_crank_real h_min, spatial_slider_crank_real delta,
                             spatial_slider_crank_real cond, spatial_slider_crank_state *state,

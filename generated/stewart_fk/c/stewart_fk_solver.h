@@ -239,7 +239,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status STEWART_FK_BAD_OPTIONS, where the options break their rules. */
 int stewart_fk_solve_edge(const stewart_fk_options *options, const stewart_fk_real p[],
                             stewart_fk_real t, stewart_fk_real h_min, stewart_fk_real delta,
                             stewart_fk_real cond, stewart_fk_state *state,

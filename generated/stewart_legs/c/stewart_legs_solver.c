@@ -1189,9 +1189,15 @@ int stewart_legs_solve_edge(const stewart_legs_options *options, const stewart_l
     const stewart_legs_real resolution = 4 * STEWART_LEGS_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (stewart_legs_check_options(options) != 0) { /* no step could be taken: state kept */
+        stewart_legs_refused(report, t);
+        edge->outcome = STEWART_LEGS_EDGE_STOPPED;
+        return edge->outcome;
+    }
     stewart_legs_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = stewart_legs_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = STEWART_LEGS_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status STEWART_LEGS_BAD_OPTIONS, where the options break their rules. */
 int stewart_legs_solve_edge(const stewart_legs_options *options, const stewart_legs_real p[],
                             stewart_legs_real t, stewart_legs_real h_min, stewart_legs_real delta,
                             stewart_legs_real cond, stewart_legs_state *state,

@@ -1391,9 +1391,15 @@ int stewart_legs_fk_solve_edge(const stewart_legs_fk_options *options, const ste
     const stewart_legs_fk_real resolution = 4 * STEWART_LEGS_FK_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (stewart_legs_fk_check_options(options) != 0) { /* no step could be taken: state kept */
+        stewart_legs_fk_refused(report, t);
+        edge->outcome = STEWART_LEGS_FK_EDGE_STOPPED;
+        return edge->outcome;
+    }
     stewart_legs_fk_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = stewart_legs_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = STEWART_LEGS_FK_EDGE_REACHED;

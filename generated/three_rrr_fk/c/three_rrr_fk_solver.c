@@ -1315,9 +1315,15 @@ int three_rrr_fk_solve_edge(const three_rrr_fk_options *options, const three_rrr
     const three_rrr_fk_real resolution = 4 * THREE_RRR_FK_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (three_rrr_fk_check_options(options) != 0) { /* no step could be taken: state kept */
+        three_rrr_fk_refused(report, t);
+        edge->outcome = THREE_RRR_FK_EDGE_STOPPED;
+        return edge->outcome;
+    }
     three_rrr_fk_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = three_rrr_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = THREE_RRR_FK_EDGE_REACHED;

@@ -934,9 +934,15 @@ int whitworth_drawn_solve_edge(const whitworth_drawn_options *options, const whi
     const whitworth_drawn_real resolution = 4 * WHITWORTH_DRAWN_UNIT_ROUNDOFF * reach_of_t;
     if (h_min < resolution) h_min = resolution;
     if (delta < resolution) delta = resolution;
+    edge->cond = cond;
+    edge->failed = 0;
+    if (whitworth_drawn_check_options(options) != 0) { /* no step could be taken: state kept */
+        whitworth_drawn_refused(report, t);
+        edge->outcome = WHITWORTH_DRAWN_EDGE_STOPPED;
+        return edge->outcome;
+    }
     whitworth_drawn_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->cond = cond;
     edge->failed = whitworth_drawn_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
     if (edge->failed == 0) {
         edge->outcome = WHITWORTH_DRAWN_EDGE_REACHED;

@@ -202,7 +202,8 @@ typedef struct {
  * model. On return state is the last point reached (t itself when reached) and
  * edge->cond its condition estimate (cond: that of the state given, solved by the caller);
  * bisection to a limit position: the motion stops between state->t and state->t +
- * edge->failed. The workspace is set up here. Returns edge->outcome. */
+ * edge->failed. The workspace is set up here. Returns edge->outcome: _STOPPED at once, the
+ * state untouched and report->status WHITWORTH_DRAWN_BAD_OPTIONS, where the options break their rules. */
 int whitworth_drawn_solve_edge(const whitworth_drawn_options *options, const whitworth_drawn_real p[],
                             whitworth_drawn_real t, whitworth_drawn_real h_min, whitworth_drawn_real delta,
                             whitworth_drawn_real cond, whitworth_drawn_state *state,

@@ -113,3 +113,16 @@ def test_a_value_a_float_kernel_rounds_away_is_refused_by_name(crank_slider_syst
     single = symkin.compile(crank_slider_system, backend="c", real="float")
     with pytest.raises(UsageError, match=r"tol_phi = 1e-50 is 0\.0 in the kernel's real type"):
         symkin.solve(single, t=[0.0, 0.1], options=Options(tol_phi=1e-50))
+
+
+def test_the_edge_treatment_stops_at_once_with_the_state_kept(kernel) -> None:
+    call = _Call(kernel)
+    assert call.step(0.0) == 0
+    before = call.q()
+    call.options.max_cond = math.nan
+    edge = call.ffi.new(f"{call.name}_edge_report *")
+    outcome = call._fn("solve_edge")(call.options, call.p, 0.1, 1e-9, 1e-9, 21.0, call.state,
+                                     call.work, call.report, edge)
+    assert outcome == int(getattr(call.lib, f"{call.name.upper()}_EDGE_STOPPED"))
+    assert edge.outcome == outcome and edge.failed == 0 and edge.cond == 21.0
+    assert call.report.status == BAD_OPTIONS and np.array_equal(call.q(), before)
