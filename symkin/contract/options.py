@@ -13,16 +13,18 @@ from typing import Any
 from symkin.errors import UsageError
 
 RULES = {"tol_phi": "positive finite", "tol_dq": "positive", "max_iterations": "count",
-         "min_pivot_ratio": "ratio", "max_cond": "positive", "tighten_cond": "positive",
+         "min_pivot_ratio": "ratio", "max_cond": "positive", "tighten_cond": "non-negative",
          "target_q": "positive", "target_dq": "positive", "target_ddq": "positive",
          "unit": "positive finite"}  # LENGTH_UNIT
 """What each field of the C options struct may hold, checked by Options when it is made and by
 the generated ``<prefix>_check_options`` (rendered from this table) at every solve: a
 tolerance, limit or target > 0 (inf: no such limit), tol_phi and the unit also finite, the
-iteration cap a whole number >= 0, the pivot ratio from 0 to 1. NaN passes none."""
+iteration cap a whole number >= 0, the pivot ratio from 0 to 1, tighten_cond >= 0 (0: every
+point tightened, a condition is at least 1). NaN passes none."""
 
 RULE_WORDS = {"positive finite": "positive and finite", "positive": "positive (inf for no limit)",
-              "count": "a whole number >= 0", "ratio": "from 0 to 1"}
+              "non-negative": "0 or more (inf for no limit)", "count": "a whole number >= 0",
+              "ratio": "from 0 to 1"}
 
 
 def allowed(rule: str, value: float) -> bool:
@@ -31,6 +33,8 @@ def allowed(rule: str, value: float) -> bool:
         return 0 < value < math.inf
     if rule == "positive":
         return value > 0
+    if rule == "non-negative":
+        return value >= 0
     if rule == "count":
         return value >= 0 and math.isfinite(value) and float(value).is_integer()
     return 0 <= value <= 1

@@ -175,8 +175,8 @@ int main()
     }
 #endif
     /* every point flagged, Newton going on at every point: the checks at their most */
-    o.tighten_cond = 1e-300; /* (0 and below are refused: BAD_OPTIONS) */
-    o.target_q = o.target_dq = o.target_ddq = 1e-300;
+    o.tighten_cond = 0;
+    o.target_q = o.target_dq = o.target_ddq = 1e-300; /* (0 is refused: BAD_OPTIONS) */
     if (run("flagged_step", &o)) return 1;
     o.tol_phi = -1; /* never converges: Newton runs to its cap (past the options' check) */
     o.max_iterations = @CAP@;

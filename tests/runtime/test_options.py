@@ -40,6 +40,7 @@ def test_every_problem_is_named_at_once() -> None:
 def test_the_defaults_and_the_limits_of_what_is_allowed_are_accepted() -> None:
     for options in DEFAULTS.values():
         Options(**{f: getattr(options, f) for f in vars(options)})
+    Options(tighten_cond=0.0)  # every point tightened
     Options(tol_dq=math.inf, max_iterations=np.int64(0), min_pivot_ratio=0.0,
             max_cond=math.inf, tighten_cond=math.inf, target_q=math.inf, target_dq=math.inf,
             target_ddq=math.inf)

@@ -114,7 +114,7 @@ void crank_slider_default_options(crank_slider_options *options);
 /* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
  * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
  * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
- * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * min_pivot_ratio from 0 to 1, tighten_cond >= 0 (0: every point tightened); NaN keeps none. Every solve checks them first and, where one
  * fails (a zero-filled struct: crank_slider_default_options not called), returns
  * CRANK_SLIDER_BAD_OPTIONS with nothing solved and the state as it was. */
 int crank_slider_check_options(const crank_slider_options *options);

@@ -114,7 +114,7 @@ void delta_default_options(delta_options *options);
 /* 0 when every option keeps its rule, else 1 + the index of the first that does not, in the
  * order of the struct (1: tol_phi, ..., 10: unit). The rules: a tolerance, limit or target
  * > 0 (INFINITY: no such limit), tol_phi and unit also finite, max_iterations >= 0,
- * min_pivot_ratio from 0 to 1; NaN keeps none. Every solve checks them first and, where one
+ * min_pivot_ratio from 0 to 1, tighten_cond >= 0 (0: every point tightened); NaN keeps none. Every solve checks them first and, where one
  * fails (a zero-filled struct: delta_default_options not called), returns
  * DELTA_BAD_OPTIONS with nothing solved and the state as it was. */
 int delta_check_options(const delta_options *options);

@@ -38,7 +38,7 @@ int delta_fk_check_options(const delta_fk_options *options)
     if (options->max_iterations < 0) return 3;
     if (!(options->min_pivot_ratio >= 0 && options->min_pivot_ratio <= 1)) return 4;
     if (!(options->max_cond > 0)) return 5;
-    if (!(options->tighten_cond > 0)) return 6;
+    if (!(options->tighten_cond >= 0)) return 6;
     if (!(options->target_q > 0)) return 7;
     if (!(options->target_dq > 0)) return 8;
     if (!(options->target_ddq > 0)) return 9;

@@ -154,7 +154,7 @@ REFINED = Flops(sqrt=1, div=1, mul=7, add=5, cmp=9)
 # <prefix>_check_options at the top of every solve: per field of contract.options.RULES its
 # comparisons and, where it must be finite, the x - x == 0 test (max_iterations is an int).
 _RULE_OPS = {"positive finite": Flops(add=1, cmp=2), "positive": Flops(cmp=1),
-             "ratio": Flops(cmp=2), "count": ZERO}
+             "non-negative": Flops(cmp=1), "ratio": Flops(cmp=2), "count": ZERO}
 OPTIONS_CHECK = sum((_RULE_OPS[rule] for rule in options.RULES.values()), ZERO)
 
 
