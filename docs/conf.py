@@ -16,7 +16,7 @@ import symkin  # noqa: E402  (after the path: the tree being documented, not an 
 
 project = "symkin"
 author = "the symkin authors"
-copyright = "the symkin authors"  # noqa: A001  (Sphinx's name)
+copyright = "the symkin authors"
 release = symkin.__version__
 version = release
 
@@ -24,7 +24,7 @@ extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "symki
 source_suffix = {".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "_ext", "README.md"]
-myst_enable_extensions = ["dollarmath", "colon_fence"]
+myst_enable_extensions = ["colon_fence"]  # no math: the pages load nothing from the network
 myst_heading_anchors = 3
 # myst.header: README-derived pages jump from # to ### in places.
 suppress_warnings = ["myst.header"]

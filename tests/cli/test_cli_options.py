@@ -183,13 +183,14 @@ def test_generate_defaults_to_the_backend_run_uses(tmp_path: Path) -> None:
     assert made.returncode == 0 and (tmp_path / "c2" / "crank_slider.c").exists()
 
 
-def test_readme_walkthrough_is_the_drawn_example() -> None:
-    """The README's 'Describe your mechanism' file is valid and is the example file."""
+def test_docs_walkthrough_is_the_drawn_example() -> None:
+    """The drawn-layout page's walk-through file (docs/file-format/drawn.md) is valid and is
+    the example file."""
     import yaml
 
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = text[text.index("## Describe your mechanism"):]
-    block = section[section.index("```yaml") + len("```yaml"):section.index("```\n", 10)]
+    section = (ROOT / "docs" / "file-format" / "drawn.md").read_text(encoding="utf-8")
+    start = section.index("```yaml") + len("```yaml")
+    block = section[start:section.index("```\n", start)]
     from_readme = symkin.from_dict(yaml.safe_load(block))
     example = symkin.load(ROOT / "examples" / "crank_slider_drawn.yaml")
     assert from_readme.canonical_json() == example.canonical_json()

@@ -37,9 +37,39 @@ def selected(examples: Path) -> list[Path]:
     return [path for path in files if path.stem in names]
 
 
+def has_inputs(example: Path) -> bool:
+    """Whether a driver of the file is written ``input`` (its values come from a table)."""
+    data = yaml.safe_load(example.read_text(encoding="utf-8"))
+    return any(value == "input" for driver in data.get("drivers") or []
+               for value in (driver.values() if isinstance(driver, dict) else ()))
+
+
 def command(example: Path) -> list[str]:
     """The command a reader types to make the same picture."""
-    return ["symkin", "run", f"examples/{example.name}", "--plot", f"{example.stem}.png"]
+    inputs = ["--inputs", f"{example.stem}_inputs.csv"] if has_inputs(example) else []
+    return ["symkin", "run", f"examples/{example.name}", *inputs, "--plot", f"{example.stem}.png"]
+
+
+WOBBLE = 0.03  # the gallery's inputs: their values at q0, times 1 + 3 % of a sine over the grid
+
+
+def inputs_table(example: Path, target: Path) -> None:
+    """A table of the file's inputs for the gallery: each at its value in the file's q0
+    (where the mechanism is assembled), moved by a few per cent along one sine period."""
+    import numpy as np
+
+    import symkin
+
+    system = symkin.derive(example)
+    grid = symkin.load(example).time
+    t = np.arange(float(grid.t0), float(grid.t1) + float(grid.dt) / 2, float(grid.dt))
+    phase = np.sin(2 * np.pi * (t - t[0]) / (t[-1] - t[0]))
+    columns = {"t": t}
+    for name, value in zip(system.input_names, system.input_values):
+        columns[name] = value * (1 + WOBBLE * phase) if value else WOBBLE * phase
+    rows = [",".join(columns)] + [",".join(f"{columns[k][n]:.12g}" for k in columns)
+                                  for n in range(t.size)]
+    target.write_text("\n".join(rows) + "\n", encoding="utf-8")
 
 
 def _render(example: Path, root: Path, cache: Path, source: str) -> tuple[Path, str | None]:
@@ -51,14 +81,18 @@ def _render(example: Path, root: Path, cache: Path, source: str) -> tuple[Path, 
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     shutil.copytree(root / "examples", work / "examples")
+    if has_inputs(example):
+        inputs_table(example, work / f"{example.stem}_inputs.csv")
+        shutil.copyfile(work / f"{example.stem}_inputs.csv", picture.with_suffix(".csv"))
     env = {**os.environ, "PYTHONPATH": str(root), "MPLBACKEND": "Agg"}
     args = [sys.executable, "-m", *command(example)[0:1], *command(example)[1:]]
     done = subprocess.run(args, cwd=work, env=env, capture_output=True, text=True,
                           timeout=TIMEOUT, check=False)
     made = work / f"{example.stem}.png"
     if not made.exists():
-        return picture, (done.stderr or done.stdout).strip().splitlines()[-1:][0] \
-            if (done.stderr or done.stdout).strip() else f"exit {done.returncode}"
+        shutil.rmtree(work, ignore_errors=True)
+        said = (done.stderr or done.stdout).strip().splitlines()
+        return picture, said[-1] if said else f"exit {done.returncode}"
     shutil.move(made, picture)
     shutil.rmtree(work, ignore_errors=True)
     return picture, done.stdout.strip()
@@ -89,6 +123,13 @@ def write(out: Path, root: Path, cache: Path) -> list[str]:
         _, about = _about(example)
         lines += [f"## {example.stem}", "", f"`examples/{example.name}`: {about}.", "",
                   "```console", "$ " + " ".join(command(example)), "```", ""]
+        table = picture.with_suffix(".csv")
+        if has_inputs(example) and table.exists():
+            head = table.read_text(encoding="utf-8").splitlines()[:3]
+            lines += [f"Its input drivers read `{example.stem}_inputs.csv`, made for the gallery: "
+                      "each input at its value in the file's `q0`, moved by "
+                      f"{WOBBLE:.0%} along one sine period (first rows):", "",
+                      "```text", *head, "...", "```", ""]
         if picture.exists():
             shutil.copyfile(picture, out / "gallery" / f"{example.stem}.png")
             lines += [f"![{example.stem}: position, velocity and acceleration]"

@@ -1,0 +1,132 @@
+"""The documentation site: it builds with no warning, its links lead somewhere, its pages
+render in headless Chromium without console errors, and a new pair type documents itself."""
+
+from __future__ import annotations
+
+import html as entities
+import re
+from html.parser import HTMLParser
+from pathlib import Path
+from urllib.parse import unquote, urlsplit
+
+import pytest
+from docs_support import build, sphinx_or_skip
+
+from symkin import pairs
+
+pytestmark = pytest.mark.slow  # one Sphinx build, about half a minute
+
+
+def test_builds_without_warnings(site) -> None:
+    status, warnings, html = site
+    assert status == 0 and warnings == "", warnings
+    pages = sorted(p.relative_to(html).as_posix() for p in html.rglob("*.html"))
+    for page in ("getting-started.html", "guides/embedded.html", "auto/types/planar-cam.html",
+                 "auto/types/spatial-universal.html", "auto/cli.html", "auto/gallery.html",
+                 "reference/api.html", "method/equations.html", "topics/index.html"):
+        assert page in pages, pages
+
+
+class _Links(HTMLParser):
+    """The href and src of a page, and the ids it defines."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.links: list[str] = []
+        self.ids: set[str] = set()
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        found = dict(attrs)
+        if found.get("id"):
+            self.ids.add(found["id"] or "")
+        for key in ("href", "src"):
+            if found.get(key):
+                self.links.append(found[key] or "")
+
+
+def _parsed(page: Path) -> _Links:
+    parser = _Links()
+    parser.feed(page.read_text(encoding="utf-8"))
+    return parser
+
+
+def broken_links(html: Path) -> list[str]:
+    """Every internal link or picture whose file, or whose #anchor in it, does not exist."""
+    parsed = {page: _parsed(page) for page in html.rglob("*.html")}
+    broken = []
+    for page, links in parsed.items():
+        for link in links.links:
+            parts = urlsplit(link)
+            if parts.scheme or parts.netloc or link.startswith(("mailto:", "javascript:")):
+                continue
+            target = (page.parent / unquote(parts.path)).resolve() if parts.path else page
+            if not target.exists():
+                broken.append(f"{page.relative_to(html)}: {link}")
+            elif parts.fragment and target.suffix == ".html":
+                ids = parsed[target].ids if target in parsed else _parsed(target).ids
+                if parts.fragment not in ids:
+                    broken.append(f"{page.relative_to(html)}: {link} (no such anchor)")
+    return broken
+
+
+def test_internal_links_lead_somewhere(site) -> None:
+    _, _, html = site
+    assert broken_links(html) == []
+
+
+def test_a_broken_link_is_seen(site, tmp_path: Path) -> None:
+    """The link check can fail: a missing page and a missing anchor are both reported."""
+    page = tmp_path / "a.html"
+    page.write_text('<a href="b.html#x">b</a><a href="gone.html">c</a><p id="y"></p>')
+    (tmp_path / "b.html").write_text('<h1 id="z">b</h1>')
+    assert sorted(broken_links(tmp_path)) == ["a.html: b.html#x (no such anchor)",
+                                              "a.html: gone.html"]
+
+
+PAGES = ["index.html", "getting-started.html", "guides/design.html",
+         "auto/types/planar-revolute.html", "auto/types/spatial-spherical.html",
+         "auto/cli.html", "auto/gallery.html", "reference/api.html", "method/equations.html",
+         "search.html"]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_page_renders_without_console_errors(site, name: str) -> None:
+    from tests.present.test_present import _browse, _console_lines
+
+    _, _, html = site
+    loaded = _browse(html / name, "--dump-dom")
+    assert loaded.returncode == 0, loaded.stderr
+    assert _console_lines(loaded.stderr) == [], loaded.stderr
+    assert 'class="body"' in loaded.stdout  # the theme laid the page out
+
+
+def test_gallery_shows_each_example_with_its_command(site) -> None:
+    _, _, html = site
+    text = (html / "auto" / "gallery.html").read_text(encoding="utf-8")
+    pictures = re.findall(r'<img alt="([a-z_]+): [^"]*" src="([^"]+)"', text)
+    assert [name for name, _ in pictures] == ["crank_slider", "four_bar"], pictures
+    words = entities.unescape(re.sub(r"<[^>]+>", "", text))  # the console block is highlighted
+    for name, src in pictures:
+        assert f"symkin run examples/{name}.yaml --plot {name}.png" in words
+        assert (html / "auto" / src).stat().st_size > 10_000  # a figure, not an empty file
+
+
+def test_a_new_pair_type_documents_itself(tmp_path: Path, gallery_cache: Path,
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """A type registered (here by the test, as a module of its own) gets its page, with its
+    keys, their roles and defaults, its meaning and equation, and a line in the index."""
+    import planted_pair
+
+    sphinx_or_skip()
+    monkeypatch.setitem(pairs._FAMILY, "2d", (*pairs.TYPES, planted_pair.TYPE))
+    status, warnings, html = build(tmp_path, gallery_cache)
+    assert status == 0 and warnings == "", warnings
+    page = (html / "auto" / "types" / "planar-tether.html").read_text(encoding="utf-8")
+    text = entities.unescape(re.sub(r"<[^>]+>", "", page))
+    for key in ("reach", "slack_factor", "sA", "sB"):
+        assert key in text, key
+    assert "within reach of point B" in text and "|r_B - r_A|^2 - reach^2 = 0" in text
+    assert "a constant: an expression of the parameters" in text  # reach's role, registered
+    assert "0.5" in text  # slack_factor's default
+    index = (html / "auto" / "types" / "index.html").read_text(encoding="utf-8")
+    assert 'href="planar-tether.html"' in index
