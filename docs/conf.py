@@ -37,4 +37,5 @@ html_theme = "alabaster"
 html_title = f"symkin {release}"
 html_static_path: list[str] = []
 html_theme_options = {"description": "symbolic kinematics and dynamics of mechanisms, "
-                                     "as C99 and NumPy", "fixed_sidebar": True}
+                                     "as C99 and NumPy", "fixed_sidebar": True,
+                      "page_width": "1240px", "sidebar_width": "240px"}

@@ -59,13 +59,16 @@ def inputs_table(example: Path, target: Path) -> None:
     import numpy as np
 
     import symkin
+    from symkin.codegen.sample import input_values
+    from symkin.runtime.arguments import grid
 
     system = symkin.derive(example)
-    grid = symkin.load(example).time
-    t = np.arange(float(grid.t0), float(grid.t1) + float(grid.dt) / 2, float(grid.dt))
+    t = grid(*system.time_grid)  # the run's own grid: the table's t must be it
     phase = np.sin(2 * np.pi * (t - t[0]) / (t[-1] - t[0]))
     columns = {"t": t}
-    for name, value in zip(system.input_names, system.input_values):
+    # where the generated folder's example program holds them (a leg's length, not the 0
+    # at which its row is flat)
+    for name, value in zip(system.input_names, input_values(system)):
         columns[name] = value * (1 + WOBBLE * phase) if value else WOBBLE * phase
     rows = [",".join(columns)] + [",".join(f"{columns[k][n]:.12g}" for k in columns)
                                   for n in range(t.size)]

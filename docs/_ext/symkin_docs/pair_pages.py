@@ -41,6 +41,8 @@ def roles(kind: PairType) -> dict[str, str]:
         said[key] = "a constant: an expression of the parameters"
     for key in kind.time_functions:
         said[key] = "a function of time `t` (or `input`: a value read at run time)"
+    if kind.drawn_model is not None and "at" in kind.drawn_model.model_fields:
+        said["at"] = "drawn layout: the point both bodies share, a name or global [x, y]"
     if kind.coordinate:
         said[kind.coordinate] = "first guess of the coordinate the pair adds"
     if kind.coordinate_range:
@@ -48,9 +50,10 @@ def roles(kind: PairType) -> dict[str, str]:
     return said
 
 
-def _example(kind: PairType, space: str, examples: Path) -> tuple[str, str] | None:
-    """The shortest entry of this type in the example files: (file name, its YAML)."""
-    found = []
+def _examples(kind: PairType, space: str, examples: Path) -> dict[str, tuple[str, str]]:
+    """The shortest entry of this type in the example files of each layout:
+    {layout: (file name, its YAML)}."""
+    found: dict[str, list[tuple[int, str, str]]] = {}
     for path in sorted(examples.glob("*.yaml")):
         data = yaml.safe_load(path.read_text(encoding="utf-8"))
         if data.get("space", "2d") != space:
@@ -58,10 +61,11 @@ def _example(kind: PairType, space: str, examples: Path) -> tuple[str, str] | No
         for section in kind.sections:
             for entry in data.get(section) or []:
                 if isinstance(entry, dict) and entry.get("type") == kind.name:
-                    text = yaml.safe_dump({section: [_shortened(entry)]}, default_flow_style=None,
-                                          sort_keys=False, width=96)
-                    found.append((len(text), path.name, text))
-    return min(found)[1:] if found else None
+                    text = yaml.safe_dump({section: [_shortened(entry)]},
+                                          default_flow_style=None, sort_keys=False, width=96)
+                    found.setdefault(data.get("layout", "local"), []).append(
+                        (len(text), path.name, text))
+    return {layout: min(entries)[1:] for layout, entries in sorted(found.items(), reverse=True)}
 
 
 def _shortened(value: Any) -> Any:
@@ -95,12 +99,13 @@ def page(kind: PairType, space: str, examples: Path) -> str:
         lines += ["## Keys (drawn layout, `layout: drawn`)", "",
                   _doc(kind.drawn_model) or "Points and directions are global, as drawn.", "",
                   roles_table(kind, kind.drawn_model), ""]
-    found = _example(kind, space, examples)
-    lines += ["## Example", ""]
-    if found is None:
+    found = _examples(kind, space, examples)
+    lines += ["## Example" + ("s" if len(found) > 1 else ""), ""]
+    if not found:
         lines += ["No example file lists this type yet.", ""]
-    else:
-        lines += [f"From `examples/{found[0]}`:", "", "```yaml", found[1].rstrip(), "```", ""]
+    for layout, (name, text) in found.items():
+        lines += [f"From `examples/{name}` ({layout} layout):", "", "```yaml", text.rstrip(),
+                  "```", ""]
     return "\n".join(lines)
 
 
@@ -141,15 +146,18 @@ def write_all(out: Path, examples: Path) -> list[str]:
              "built: every type symkin accepts, with its keys.", ""]
     for space in pairs.SPACES:
         family = pairs.in_section("joints", space) + pairs.in_section("drivers", space)
-        index += [f"## {SPACE_TITLE[space].capitalize()}", "", "| type | listed under |",
-                  "|---|---|"]
+        index += [f"## {SPACE_TITLE[space].capitalize()}", "",
+                  "| type | listed under | what it is |", "|---|---|---|"]
         for kind in dict.fromkeys(family):
             name = f"{SPACE_SLUG[space]}-{kind.name}"
             if name in names:  # a joint and a driver of one name (spatial distance)
                 name += "-" + kind.sections[-1].rstrip("s")
             _write(out / f"{name}.md", page(kind, space, examples))
             names.append(name)
-            index.append(f"| [`{kind.name}`]({name}.md) | {', '.join(kind.sections)} |")
+            module = inspect.getmodule(kind.equations)
+            summary = _doc(module).split("\n\n")[0].replace("\n", " ") if module else ""
+            index.append(f"| [`{kind.name}`]({name}.md) | {', '.join(kind.sections)} | "
+                         f"{summary.replace('|', '/')} |")
         force = f"{SPACE_SLUG[space]}-forces"
         _write(out / f"{force}.md", force_page(space))
         names.append(force)
