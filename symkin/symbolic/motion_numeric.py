@@ -20,7 +20,7 @@ from symkin.symbolic.motion import EquationsOfMotion, Given, derive
 Array = np.ndarray
 
 
-@dataclass(frozen=True)
+@dataclass  # not frozen: runtime.dynamics.model.Model's members are plain attributes
 class Functions:
     """One mechanism's motion, evaluated numerically (every array flat, float64).
 
@@ -35,6 +35,7 @@ class Functions:
             driver_names, joint_names label them; reaction_size: 3 (planar) or 6 (spatial).
         points: (body, name) of every named point; point_vectors (P, 2|3) at p_values.
         given, rtol, atol: the file's initial velocities and tolerances.
+        removed: the rows removed as redundant (their loads are then not unique).
     """
 
     name: str
@@ -62,6 +63,7 @@ class Functions:
     given: tuple[Given, ...]
     rtol: float
     atol: float
+    removed: tuple[str, ...] = ()
 
 
 def _compiled(arguments: list[Any], expr: Any, shape: tuple[int, ...]) -> Callable[..., Array]:
@@ -104,7 +106,8 @@ def functions(system: Any, equations: EquationsOfMotion) -> Functions:
         reaction_size=6 if point_size == 3 else 3,
         points=tuple((body, name) for body, name, _ in system.points),
         point_vectors=np.array(vectors, dtype=float).reshape(len(vectors), point_size),
-        given=equations.given, rtol=equations.rtol, atol=equations.atol)
+        given=equations.given, rtol=equations.rtol, atol=equations.atol,
+        removed=tuple(str(item) for item in system.removed))
 
 
 def numeric(system: Any) -> Functions:
