@@ -232,14 +232,14 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     trajectory = _with_pair_outputs(trajectory, args, prepared.system)
     written = _write(trajectory, args, prepared.outlines, picture)
     origin = ", cached kernel" if prepared.hit else ""
-    if getattr(kernel, "moves_under_forces", False):
-        origin += ", dynamics"  # integrated under its forces (runtime.dynamics)
+    # integrated under its forces (runtime.dynamics): said first, as the contract has it
+    kind = " (dynamics)" if getattr(kernel, "moves_under_forces", False) else ""
     if args.at is not None:
         backend = f"{kernel.backend} backend{origin}"
         print(run_outputs.configuration(trajectory, kernel.name, backend), end="")
     else:
         print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
-              f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
+              f"{trajectory.t[-1]:g}{kind} ({kernel.backend} backend{origin})"
               + "".join(f"; wrote {path}" for path in written))
     if not getattr(kernel, "moves_under_forces", False):  # (its start: runtime.dynamics)
         _note_far_start(kernel, trajectory)

@@ -11,12 +11,11 @@ from typing import Any
 import numpy as np
 import pytest
 import sympy as sp
+from motion_support import CRANK_SLIDER, PENDULUM, write
 from scipy.integrate import solve_ivp
 from scipy.special import ellipk
 
 import symkin
-
-from motion_support import CRANK_SLIDER, PENDULUM, crank_slider, write  # noqa: F401
 
 
 def _energy(trajectory: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -8,10 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from motion_support import write
 
 import symkin
-
-from motion_support import write
 
 FREE_BODY = """\
 name: tumbling

@@ -78,3 +78,17 @@ class MotionKernel:
     def __repr__(self) -> str:
         return (f"<MotionKernel {self.name}: {self.nq} coordinates, {len(self.rows)} "
                 f"constraints, {self.backend}>")
+
+
+def kernel_terms(kernel: Any, q: Array, dq: Array, t: float, p: Array) -> tuple[Array, Array]:
+    """M and Q - h of a generated kernel with inverse dynamics (a mechanism with the same
+    bodies and forces, driven): its multipliers solve Φ_qᵀ λ = Q - M q̈ - h, linear in q̈,
+    so Φ_qᵀ λ at q̈ = 0 is Q - h and the difference at q̈ = e_k is M's column k. The way the
+    kernels' own ``mass`` and ``applied`` can replace the lambdified ones, checked now."""
+    jacobian_t = kernel.phi_q(q, t, p).T
+    n = q.size
+    applied = jacobian_t @ kernel.multipliers(q, dq, np.zeros(n), t, p)
+    mass = np.empty((n, n))
+    for k, unit in enumerate(np.eye(n)):
+        mass[:, k] = applied - jacobian_t @ kernel.multipliers(q, dq, unit, t, p)
+    return mass, applied
