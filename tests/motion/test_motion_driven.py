@@ -5,7 +5,6 @@ closes the energy balance, and the drivers report their efforts."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -38,7 +37,7 @@ def trajectory(tmp_path_factory: pytest.TempPathFactory) -> symkin.runtime.resul
     return symkin.solve(symkin.compile(symkin.derive(path), backend="numpy"))
 
 
-def test_the_free_rate_at_t0_has_the_least_kinetic_energy(trajectory) -> None:  # noqa: ANN001
+def test_the_free_rate_at_t0_has_the_least_kinetic_energy(trajectory) -> None:
     # the cart moves at 1.2 along x; the bob's centre at v + L φ' (-sin φ, cos φ) is slowest
     # for L φ' = 1.2 sin φ (by hand)
     phi = -math.pi / 2 + 0.5
@@ -46,7 +45,7 @@ def test_the_free_rate_at_t0_has_the_least_kinetic_energy(trajectory) -> None:  
     assert trajectory.dq[0, 5] == pytest.approx(1.2 * math.sin(phi) / 0.8, abs=1e-10)
 
 
-def test_the_drivers_work_closes_the_energy_balance(trajectory) -> None:  # noqa: ANN001
+def test_the_drivers_work_closes_the_energy_balance(trajectory) -> None:
     out = dict(trajectory.outputs)
     total = out["kinetic_energy"] + out["potential_energy"] - out["work_nonconservative"]
     scale = np.max(np.abs(out["kinetic_energy"]) + np.abs(out["potential_energy"]))

@@ -100,3 +100,18 @@ def test_the_generated_kernels_give_the_same_mass_and_forces(
         mass, applied = kernel_terms(kernel, q, dq, 0.3, p)
         assert mass == pytest.approx(model.mass(q, p), abs=1e-9)
         assert applied == pytest.approx(model.applied(q, dq, 0.3, p), abs=1e-9)
+
+
+@pytest.mark.parametrize(("command", "status", "fragment"), [
+    (["generate", "--backend", "numpy", "-o", "OUT"], 1, "code generation for such a "
+                                                          "mechanism is not available yet"),
+    (["scan"], 2, "symkin scan works on a mechanism whose drivers fix its motion"),
+    (["sweep", "--vary", "L=1:2:3", "-o", "OUT.npz"], 2, "symkin sweep works on a mechanism"),
+])
+def test_commands_for_driven_kinematics_say_so(
+        pendulum: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+        command: list[str], status: int, fragment: str) -> None:
+    words = [word.replace("OUT", str(tmp_path / "out")) for word in command]
+    assert cli.main([words[0], str(pendulum), *words[1:]]) == status
+    err = capsys.readouterr().err
+    assert fragment in err and "Traceback" not in err

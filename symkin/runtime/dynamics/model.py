@@ -14,6 +14,8 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.errors import UsageError
+
 Array = NDArray[np.float64]
 
 
@@ -92,3 +94,12 @@ def kernel_terms(kernel: Any, q: Array, dq: Array, t: float, p: Array) -> tuple[
     for k, unit in enumerate(np.eye(n)):
         mass[:, k] = applied - jacobian_t @ kernel.multipliers(q, dq, unit, t, p)
     return mass, applied
+
+
+def refuse_motion(kernel: Any, command: str) -> None:
+    """A UsageError when ``kernel`` is a mechanism its forces move and ``command`` (scan,
+    sweep) works on driven kinematics only."""
+    if getattr(kernel, "moves_under_forces", False):
+        raise UsageError(f"{command} works on a mechanism whose drivers fix its motion; "
+                         f"{kernel.name} has fewer drivers than freedoms and moves under its "
+                         "forces: integrate it with symkin run or symkin.solve")
