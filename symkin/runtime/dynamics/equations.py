@@ -8,6 +8,11 @@ Index-1 form of the equations of motion (REFERENCE.md, "forces"):
 The matrix is regular when Φ_q has full row rank and M is positive definite on the
 freedoms Φ_q leaves open (a body without mass in a free direction makes it singular); its
 condition number is what flags a row, as Φ_q's does in kinematics.
+
+Redundant constraints (a parallelogram's extra bar, Bricard's linkage) leave Φ_q short of
+row rank by ``deficiency`` everywhere: q̈ is still unique, λ is not. Such a mechanism is
+solved by least squares, which gives the unique q̈ and the minimum-norm λ (the reactions'
+determinacy: runtime.dynamics.run), and its condition number is taken over the rank it has.
 """
 
 from __future__ import annotations
@@ -52,13 +57,34 @@ def augmented(model: Model, q: Array, dq: Array, t: float, p: Array
     return matrix, rhs, jacobian
 
 
-def accelerations(model: Model, q: Array, dq: Array, t: float, p: Array) -> Accelerations:
+# Singular values below this share of the largest count as zero (the rank of Φ_q at t0).
+RANK_TOLERANCE = 1e-10
+
+
+def deficiency(model: Model, q: Array, t: float, p: Array) -> int:
+    """How many rows of Φ_q at (q, t) depend on the others (0 for most mechanisms)."""
+    jacobian = model.phi_q(q, t, p)
+    if jacobian.size == 0:
+        return 0
+    values = np.linalg.svd(jacobian, compute_uv=False)
+    return int(jacobian.shape[0] - np.count_nonzero(values > RANK_TOLERANCE * values[0]))
+
+
+def accelerations(model: Model, q: Array, dq: Array, t: float, p: Array,
+                  redundant: int = 0) -> Accelerations:
     """Solve the equations of motion at (q, dq, t); :class:`Singular` where they have no
-    unique solution."""
+    unique solution. ``redundant``: the rows of Φ_q that depend on the others (module
+    docstring)."""
     matrix, rhs, _ = augmented(model, q, dq, t, p)
     n = q.size
     try:
-        solution = np.asarray(np.linalg.solve(matrix, rhs), dtype=np.float64)
+        if redundant:
+            found = np.linalg.lstsq(matrix, rhs, rcond=RANK_TOLERANCE)
+            if found[2] < matrix.shape[0] - redundant:
+                raise Singular  # short of rank by more than the redundant rows
+            solution = np.asarray(found[0], dtype=np.float64)
+        else:
+            solution = np.asarray(np.linalg.solve(matrix, rhs), dtype=np.float64)
     except np.linalg.LinAlgError:
         raise Singular from None
     if not np.all(np.isfinite(solution)):
@@ -69,7 +95,11 @@ def accelerations(model: Model, q: Array, dq: Array, t: float, p: Array) -> Acce
     return Accelerations(solution[:n], lam, power)
 
 
-def condition(model: Model, q: Array, dq: Array, t: float, p: Array) -> float:
-    """The 2-norm condition number of the augmented matrix (inf where singular)."""
+def condition(model: Model, q: Array, dq: Array, t: float, p: Array,
+              redundant: int = 0) -> float:
+    """The 2-norm condition number of the augmented matrix over its rank less the
+    ``redundant`` rows' (inf where singular)."""
     matrix, _, _ = augmented(model, q, dq, t, p)
-    return float(np.linalg.cond(matrix))
+    values = np.linalg.svd(matrix, compute_uv=False)
+    smallest = values[values.size - 1 - redundant]
+    return float(values[0] / smallest) if smallest > 0 else float("inf")

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import MechanismError, SolveError
+from symkin.runtime.dynamics.equations import RANK_TOLERANCE
 from symkin.runtime.dynamics.model import Model
 
 Array = NDArray[np.float64]
@@ -78,8 +79,10 @@ def given_rows(model: Model, q: Array) -> tuple[Array, Array, tuple[str, ...]]:
     return np.array(rows).reshape(len(rows), n), np.array(values), tuple(names)
 
 
-def velocity(model: Model, q: Array, t: float, p: Array) -> Array:
-    """The consistent initial velocity of least kinetic energy (module docstring)."""
+def velocity(model: Model, q: Array, t: float, p: Array, redundant: int = 0) -> Array:
+    """The consistent initial velocity of least kinetic energy (module docstring);
+    ``redundant``: the rows of Φ_q that depend on the others (their multipliers are not
+    unique, the velocity is)."""
     jacobian, phi_t = model.phi_q(q, t, p), model.phi_t(q, t, p)
     given, values, names = given_rows(model, q)
     _refuse_contradictions(jacobian, -phi_t, given, values, names)
@@ -92,14 +95,15 @@ def velocity(model: Model, q: Array, t: float, p: Array) -> Array:
     matrix[:n, :n] = model.mass(q, p)
     matrix[:n, n:] = rows.T
     matrix[n:, :n] = rows
-    try:
-        solution = np.linalg.solve(matrix, np.concatenate([np.zeros(n), targets]))
-    except np.linalg.LinAlgError:
+    solution, _, rank, _ = np.linalg.lstsq(matrix, np.concatenate([np.zeros(n), targets]),
+                                           rcond=RANK_TOLERANCE)
+    if rank < n + m - redundant:
         raise SolveError(f"no initial velocity at t = {t:g}: the kinetic energy does not "
                          "decide the freedoms the constraints leave open (a body without mass "
                          "or inertia moves freely). Give that body a mass and an inertia, or "
-                         "give its velocity in initial.velocities.") from None
-    return solution[:n]
+                         "give its velocity in initial.velocities.")
+    found: Array = solution[:n]
+    return found
 
 
 def _rank(matrix: Array) -> int:

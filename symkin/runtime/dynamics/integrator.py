@@ -82,13 +82,15 @@ class Stepper:
     rtol: float
     atol: float
     position_tolerance: float
+    redundant: int = 0
+    """Rows of Φ_q that depend on the others (runtime.dynamics.equations)."""
     step: float = 0.0
     singular: str = ""
     """Why the last rejected stage failed, when the equations of motion were singular."""
 
     def _derivative(self, t: float, y: Array) -> Array:
         n = len(self.model.coordinates)
-        found = accelerations(self.model, y[:n], y[n:2 * n], t, self.p)
+        found = accelerations(self.model, y[:n], y[n:2 * n], t, self.p, self.redundant)
         return np.concatenate([y[n:2 * n], found.d2q, [found.power]])
 
     def advance(self, state: State, t_end: float, interrupted: Callable[[], None]) -> State:

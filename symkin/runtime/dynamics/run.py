@@ -51,6 +51,7 @@ class _Rows:
     energy: Array  # (T, 3): kinetic, potential, work
     residual: Array
     cond: Array
+    redundant: int  # rows of Φ_q that depend on the others (equations.deficiency at t0)
     done: int = 0
 
 
@@ -71,9 +72,11 @@ def solve(kernel: MotionKernel, t: ArrayLike | None = None, q0: ArrayLike | None
     p = parameter_values(checked, params)
     q = initial.assemble(model, first_guess(checked, q0), float(times[0]), p,
                          POSITION_TOLERANCE)
-    state = State(float(times[0]), q, initial.velocity(model, q, float(times[0]), p), 0.0)
-    rows = _allocate(times, q.size, len(model.rows))
-    stepper = Stepper(model, p, model.rtol, model.atol, POSITION_TOLERANCE)
+    redundant = equations.deficiency(model, q, float(times[0]), p)
+    state = State(float(times[0]), q,
+                  initial.velocity(model, q, float(times[0]), p, redundant), 0.0)
+    rows = _allocate(times, q.size, len(model.rows), redundant)
+    stepper = Stepper(model, p, model.rtol, model.atol, POSITION_TOLERANCE, redundant)
     try:
         _record(model, rows, state, p)
         for k in range(1, times.size):
@@ -101,22 +104,23 @@ def _no_interrupt() -> None:
     """The integrator's check between steps (Ctrl-C arrives as KeyboardInterrupt)."""
 
 
-def _allocate(times: Array, n: int, m: int) -> _Rows:
+def _allocate(times: Array, n: int, m: int, redundant: int) -> _Rows:
     size = times.size
     return _Rows(times, np.full((size, n), np.nan), np.full((size, n), np.nan),
                  np.full((size, n), np.nan), np.full((size, m), np.nan),
-                 np.full((size, 3), np.nan), np.full(size, np.nan), np.full(size, np.nan))
+                 np.full((size, 3), np.nan), np.full(size, np.nan), np.full(size, np.nan),
+                 redundant)
 
 
 def _record(model: Model, rows: _Rows, state: State, p: Array) -> None:
     """One output row: the state, its accelerations and multipliers, energies, residual."""
     k = rows.done
-    found = equations.accelerations(model, state.q, state.dq, state.t, p)
+    found = equations.accelerations(model, state.q, state.dq, state.t, p, rows.redundant)
     rows.q[k], rows.dq[k], rows.d2q[k], rows.lam[k] = state.q, state.dq, found.d2q, found.lam
     kinetic = 0.5 * state.dq @ model.mass(state.q, p) @ state.dq
     rows.energy[k] = (kinetic, float(model.potential(state.q, state.t, p)), state.work)
     rows.residual[k] = float(np.max(np.abs(model.phi(state.q, state.t, p)), initial=0.0))
-    rows.cond[k] = equations.condition(model, state.q, state.dq, state.t, p)
+    rows.cond[k] = equations.condition(model, state.q, state.dq, state.t, p, rows.redundant)
     rows.done = k + 1
 
 
@@ -132,19 +136,44 @@ def _trajectory(model: Model, rows: _Rows, p: Array) -> Trajectory:
     outputs = [(name, rows.energy[:done, j].copy()) for j, name in enumerate(ENERGY)]
     outputs.append(("constraint_residual", rows.residual[:done].copy()))
     trajectory.__dict__["outputs"] = tuple(outputs)
-    trajectory.__dict__["forces"] = _forces(model, t, q, rows.lam[:done], p)
+    trajectory.__dict__["forces"] = _forces(model, t, q, rows.lam[:done], p, rows.redundant)
     return trajectory
 
 
-def _forces(model: Model, t: Array, q: Array, lam: Array, p: Array) -> Forces | None:
-    """Efforts and reactions of each row from its multipliers (as the forces section's)."""
+def _forces(model: Model, t: Array, q: Array, lam: Array, p: Array,
+            redundant: int) -> Forces | None:
+    """Efforts and reactions of each row from its multipliers (as the forces section's);
+    with redundant rows, those of the minimum-norm λ, and which are determinate."""
     if getattr(model, "removed", ()):
         return None  # rows removed as redundant: the split is not unique (not done here)
     loads = np.array([model.loads(q[k], lam[k], t[k], p) for k in range(t.size)])
     loads = loads.reshape(t.size, -1)
     n_efforts, n_joints = len(model.driver_names), len(model.joint_names)
     parts = reaction_parts(model.space)
+    determinate = _determinate(model, t, q, p, redundant) if redundant else None
     return Forces(lam.copy(), loads[:, :n_efforts],
                   loads[:, n_efforts:].reshape(t.size, n_joints, len(parts)),
-                  model.driver_names, model.joint_names, parts)
+                  model.driver_names, model.joint_names, parts, determinate)
+
+
+# A load is determinate where the multipliers' free directions move it by less than this
+# share of the largest such effect (rounding), as in runtime.indeterminate.
+DETERMINATE = 1e-8
+
+
+def _determinate(model: Model, t: Array, q: Array, p: Array, redundant: int) -> NDArray[
+        np.bool_]:
+    """(NLOADS,) True for a load that no self-balanced set of multipliers (the null space
+    of Φ_qᵀ) changes, at every row. Loads are linear in λ, so their matrix is read off
+    the unit multipliers."""
+    fixed: NDArray[np.bool_] | None = None
+    for k in range(t.size):
+        jacobian = model.phi_q(q[k], t[k], p)
+        free = np.linalg.svd(jacobian)[0][:, jacobian.shape[0] - redundant:]
+        loads = np.column_stack([model.loads(q[k], unit, t[k], p)
+                                 for unit in np.eye(jacobian.shape[0])])
+        moved = np.abs(loads @ free).max(axis=1)
+        here = moved <= DETERMINATE * max(1.0, float(np.abs(loads).max()))
+        fixed = here if fixed is None else fixed & here
+    return fixed if fixed is not None else np.zeros(0, dtype=bool)
 
