@@ -32,9 +32,9 @@ def _falling(text: str) -> str:
 def _reference() -> Any:
     """(θ, ψ, θ', ψ') -> (θ'', ψ'') of the example's numbers, by Lagrange's equations."""
     th, ps, dth, dps = sp.symbols("theta psi dtheta dpsi")
-    g, a, l, mb, mc, ml, jl = 9.81, 1.0, 0.4, 1.0, 3.0, 2.0, 0.02
+    g, a, arm, mb, mc, ml, jl = 9.81, 1.0, 0.4, 1.0, 3.0, 2.0, 0.02
     pin = a * sp.Matrix([sp.cos(th), sp.sin(th)])  # P moves with the coupler
-    lamp = pin + l * sp.Matrix([sp.sin(ps), -sp.cos(ps)])  # its centre hangs l below P
+    lamp = pin + arm * sp.Matrix([sp.sin(ps), -sp.cos(ps)])  # its centre hangs l below P
     rate = lamp.diff(th) * dth + lamp.diff(ps) * dps
     kinetic = (3 * mb * a ** 2 / 3 + mc * a ** 2) * dth ** 2 / 2 \
         + ml * (rate.T * rate)[0] / 2 + jl * dps ** 2 / 2

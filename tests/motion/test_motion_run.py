@@ -115,3 +115,20 @@ def test_commands_for_driven_kinematics_say_so(
     assert cli.main([words[0], str(pendulum), *words[1:]]) == status
     err = capsys.readouterr().err
     assert fragment in err and "Traceback" not in err
+
+
+def test_the_html_report_has_the_energy_column(pendulum: Path, tmp_path: Path) -> None:
+    pytest.importorskip("plotly")
+    page = tmp_path / "report.html"
+    assert cli.main(["run", str(pendulum), "--backend", "numpy", "--html", str(page)]) == 0
+    text = page.read_text(encoding="utf-8")
+    for name in ("kinetic T", "potential V", "work W", "T + V - W"):
+        assert f'"name":"{name}"' in text
+
+
+def test_a_driven_run_s_report_has_no_energy_column(tmp_path: Path) -> None:
+    pytest.importorskip("plotly")
+    page = tmp_path / "report.html"
+    example = Path(__file__).parents[2] / "examples" / "four_bar_dynamics.yaml"
+    assert cli.main(["run", str(example), "--backend", "numpy", "--html", str(page)]) == 0
+    assert '"name":"T + V - W"' not in page.read_text(encoding="utf-8")
