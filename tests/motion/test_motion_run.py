@@ -132,3 +132,13 @@ def test_a_driven_run_s_report_has_no_energy_column(tmp_path: Path) -> None:
     example = Path(__file__).parents[2] / "examples" / "four_bar_dynamics.yaml"
     assert cli.main(["run", str(example), "--backend", "numpy", "--html", str(page)]) == 0
     assert '"name":"T + V - W"' not in page.read_text(encoding="utf-8")
+
+
+def test_a_free_freedom_without_mass_stops_with_a_message(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    massless = write(tmp_path, "massless.yaml", PENDULUM.replace("PHI0", "0.4").replace(
+        "parameters: {L: 1.3, m: 2.0", "parameters: {L: 1.3, m: 0.0"))
+    assert cli.main(["run", str(massless), "--backend", "numpy"]) == cli.EXIT_FAILED
+    err = capsys.readouterr().err
+    assert "the kinetic energy does not decide the freedoms" in err
+    assert "Traceback" not in err and err.count("\n") <= 2
