@@ -93,8 +93,9 @@ def solve(kernel: MotionKernel, t: ArrayLike | None = None, q0: ArrayLike | None
     except (StepFailure, equations.Singular) as stop:
         at = getattr(stop, "t", float(times[rows.done]))
         reason = getattr(stop, "reason", "the equations of motion are singular")
-        raise SolveFailure(f"the motion stops at t = {at:.6g}: {reason}. The rows up to "
-                           f"t = {times[rows.done - 1]:.6g} are kept.",
+        kept = (f"The rows up to t = {times[rows.done - 1]:.6g} are kept." if rows.done
+                else "No row was solved.")
+        raise SolveFailure(f"the motion stops at t = {at:.6g}: {reason}. {kept}",
                            _trajectory(model, rows, p), at, math.nan, 0,
                            reason="singular") from None
     return _trajectory(model, rows, p)
