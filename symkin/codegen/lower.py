@@ -27,6 +27,7 @@ from symkin.codegen.system_facts import (
     parameter_pattern,
     point_names,
     point_vectors,
+    refuse_motion,
 )
 from symkin.codegen.target import Target
 from symkin.errors import BuildError
@@ -220,6 +221,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         BuildError: an unknown real type, or an expression the printer cannot print.
     """
     _check_options(backend, real, linalg)
+    refuse_motion(system)
     internal = symbol_printing.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)

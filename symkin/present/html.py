@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import UsageError
-from symkin.present import html_forces, page, series
+from symkin.present import html_energy, html_forces, page, series
 from symkin.present.animation import (
     MAX_FRAMES,
     body_shapes,
@@ -88,7 +88,10 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
     columns = series.kinds(curves)
     # with masses or forces, one more column: efforts and reactions (present.html_forces)
     forces = [] if trajectory.forces is None else [2 + len(columns)]
-    panel: list[dict[str, Any] | None] = [{} for _ in [*columns, *forces]]
+    # a run its forces integrated (runtime.dynamics): the energies (present.html_energy)
+    energy = ([] if html_energy.energies(trajectory) is None
+              else [2 + len(columns) + len(forces)])
+    panel: list[dict[str, Any] | None] = [{} for _ in [*columns, *forces, *energy]]
     specs: list[list[dict[str, Any] | None]] = [[{"rowspan": 3}, *panel]]
     specs += [[None, *panel] for _ in range(2)]
     figure = make_subplots(
@@ -103,6 +106,9 @@ def report(trajectory: Trajectory, path: str | Path, outlines: Outlines,
     for column in forces:
         cursors += html_forces.plot(go, figure, trajectory, column)
         html_forces.label(figure, column, units)
+    for column in energy:
+        cursors += html_energy.plot(go, figure, trajectory, column)
+        html_energy.label(figure, column, units)
     _animate(go, figure, trajectory, frames, scene, moving, cursors)
     _layout(figure, trajectory, frames, scene, columns, units, title)
     return page.write(figure, path)
