@@ -23,6 +23,7 @@ from symkin.codegen.cse_tidy import _count_ops, _inline_trivial, _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.system_facts import (
+    mass_pattern,
     nonlinear_coordinates,
     parameter_pattern,
     point_names,
@@ -67,6 +68,10 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     # (kept, then removed), for the runtime's minimum-norm loads (runtime.indeterminate).
     "removed_q": ("q", "t", "p"),
     "loads_full": ("q", "lam", "t", "p"),
+    # Forward dynamics, only for a file with masses: the non-zeros of M(q) (mass_rows/_cols
+    # order) and the applied forces less the velocity terms, Q - h(q, dq, t).
+    "mass": ("q", "p"),
+    "applied": ("q", "dq", "t", "p"),
 }
 DYNAMICS = ("dynamics_rhs", "loads")
 FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
@@ -181,6 +186,19 @@ class Code:
     nonlinear: tuple[int, ...] = ()
     """The coordinates that enter Phi_q or Phi_t (angles, Euler parameters, the positions of
     a prismatic pair's bodies): only their errors move Phi_q (runtime.accuracy)."""
+    mass_rows: tuple[int, ...] = ()
+    mass_cols: tuple[int, ...] = ()
+    """Forward dynamics (a file with masses): the structural non-zeros of M, row-major."""
+
+    @property
+    def forward_dynamics(self) -> bool:
+        """The ``mass`` and ``applied`` routines and the dynamics step are generated."""
+        return bool(self.mass_rows)
+
+    @property
+    def nrows(self) -> int:
+        """The rows of Phi (fewer than NQ where drivers leave freedoms to the dynamics)."""
+        return len(self.rows)
 
     @property
     def nnz(self) -> int:
@@ -223,19 +241,22 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
     internal = symbol_printing.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)
-    expressions = _routine_expressions(system, pattern, p_pattern)
+    m_pattern = mass_pattern(system)
+    expressions = _routine_expressions(system, pattern, p_pattern, m_pattern)
     printer: CodePrinter = backend.printer(real)
     prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
     prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
     fused, shared = _fused_expressions(prepared)
-    sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}
+    # Phi's rows: as many as coordinates, or fewer where the dynamics moves the rest
+    nphi = len(system.phi)
+    sizes = {"phi_phi_q": (nphi, len(pattern), len(shared))}
     orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
     # Phi and Phi_q alone are the fused routine's pieces: its CSE and printing serve all three.
     fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse,
                                  orders["phi_phi_q"])
-    nq, nnz = len(system.q), len(pattern)
-    own = {"phi": _select("phi", fused_parts, {k: k for k in range(nq)}, nq),
-           "phi_q": _select("phi_q", fused_parts, {nq + e: e for e in range(nnz)}, nnz),
+    nnz = len(pattern)
+    own = {"phi": _select("phi", fused_parts, {k: k for k in range(nphi)}, nphi),
+           "phi_q": _select("phi_q", fused_parts, {nphi + e: e for e in range(nnz)}, nnz),
            "phi_phi_q": _assemble("phi_phi_q", fused_parts, len(fused["phi_phi_q"]),
                                   sizes["phi_phi_q"])}
     routines = tuple(
@@ -264,6 +285,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         joint_names=system.dynamics.joint_names if system.dynamics else (),
         input_names=system.input_names, input_values=sample.input_values(system),
         input_places=system.input_places, nonlinear=nonlinear_coordinates(system),
+        mass_rows=tuple(r for r, _ in m_pattern), mass_cols=tuple(c for _, c in m_pattern),
     )
 
 
@@ -279,7 +301,9 @@ def _check_options(backend: Target, real: str, linalg: str) -> None:
 
 
 def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
-                         p_pattern: Sequence[tuple[int, int]]) -> dict[str, list[sp.Expr]]:
+                         p_pattern: Sequence[tuple[int, int]],
+                         m_pattern: Sequence[tuple[int, int]]) -> dict[str, list[sp.Expr]]:
+    dynamics = system.dynamics
     return {
         "phi": list(system.phi),
         "phi_q": [system.phi_q[r, c] for r, c in pattern],
@@ -295,6 +319,10 @@ def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
             "loads_full": list(system.dynamics.loads_full)}
            if system.dynamics is not None and system.dynamics.removed_q is not None
            and system.dynamics.loads_full is not None else {}),
+        # Only with masses: a file with forces alone has no equations of motion to integrate.
+        **({"mass": [dynamics.mass_matrix[r, c] for r, c in m_pattern],
+            "applied": list(dynamics.applied - dynamics.velocity_terms)}
+           if dynamics is not None and m_pattern else {}),
     }
 
 

@@ -28,3 +28,12 @@ def point_names(system: System) -> tuple[tuple[str, str], ...]:
 def point_vectors(system: System) -> list[tuple[sp.Expr, sp.Expr]]:
     """The local vector s of every named point, as expressions of the parameters."""
     return [tuple(vector) for _, _, vector in system.points]
+
+
+def mass_pattern(system: System) -> list[tuple[int, int]]:
+    """Structural non-zeros of the mass matrix M(q) as (row, column), row-major; empty when
+    the file gives no body a mass or an inertia (then it has no forward dynamics)."""
+    if system.dynamics is None:
+        return []
+    mass = system.dynamics.mass_matrix
+    return [(r, c) for r in range(mass.rows) for c in range(mass.cols) if mass[r, c] != 0]
