@@ -170,12 +170,15 @@ static int crank_slider_load_dyn_runge_kutta(const crank_slider_load_real p[], c
     return 0;
 }
 
-/* Newton's corrections of work->q onto Phi(q, t) = 0 on the last stage's factors. */
+/* Newton's corrections of work->q onto Phi(q, t) = 0, each on the factors at its q; on
+ * CRANK_SLIDER_LOAD_OK the factors are those at the corrected q (for the velocities). Returns a
+ * status, and the vanished pivot's column + 1 in *pivot when CRANK_SLIDER_LOAD_SINGULAR. */
 static int crank_slider_load_dyn_positions(const crank_slider_load_options *options, const crank_slider_load_real p[],
                                       crank_slider_load_real t, crank_slider_load_dynamics_work *work,
-                                      crank_slider_load_dynamics_report *report)
+                                      crank_slider_load_dynamics_report *report, int *pivot)
 {
     int i;
+    if ((*pivot = crank_slider_load_dyn_factor(work->q, t, p, work))) return CRANK_SLIDER_LOAD_SINGULAR;
     for (report->iterations = 0; ; ++report->iterations) {
         crank_slider_load_phi(work->q, t, p, work->phi);
         report->residual = crank_slider_load_dyn_max_abs(work->phi, CRANK_SLIDER_LOAD_NR);
@@ -187,6 +190,7 @@ static int crank_slider_load_dyn_positions(const crank_slider_load_options *opti
         for (i = 0; i < CRANK_SLIDER_LOAD_NR; ++i) work->b[CRANK_SLIDER_LOAD_NQ + i] = -work->phi[i];
         crank_slider_load_dyn_solve(work, work->b);
         for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) work->q[i] += work->b[i];
+        if ((*pivot = crank_slider_load_dyn_factor(work->q, t, p, work))) return CRANK_SLIDER_LOAD_SINGULAR;
     }
 }
 
@@ -231,10 +235,8 @@ int crank_slider_load_dynamics_step(const crank_slider_load_options *options, co
     if ((pivot = crank_slider_load_dyn_runge_kutta(p, h, state, work)))
         return crank_slider_load_dyn_stop(report, CRANK_SLIDER_LOAD_SINGULAR, pivot);
     report->t = t1;
-    status = crank_slider_load_dyn_positions(options, p, t1, work, report);
-    if (status != CRANK_SLIDER_LOAD_OK) return crank_slider_load_dyn_stop(report, status, 0);
-    if ((pivot = crank_slider_load_dyn_factor(work->q, t1, p, work)))
-        return crank_slider_load_dyn_stop(report, CRANK_SLIDER_LOAD_SINGULAR, pivot);
+    status = crank_slider_load_dyn_positions(options, p, t1, work, report, &pivot);
+    if (status != CRANK_SLIDER_LOAD_OK) return crank_slider_load_dyn_stop(report, status, pivot);
     report->velocity_residual = crank_slider_load_dyn_velocities(p, t1, work);
     crank_slider_load_dyn_accelerations(work->q, work->dq, t1, p, work, work->ddq, work->lam);
     for (i = 0; i < CRANK_SLIDER_LOAD_NQ; ++i) { /* a NaN or an infinity anywhere ends here */

@@ -13,10 +13,9 @@
  * its NA = NQ + NR square matrix per evaluation. crank_slider_load_dynamics_step takes one step
  * of the classical fourth-order Runge-Kutta method on (q, dq), its first stage the ddq the
  * last step ended with, then removes the drift the integration leaves:
- *   positions  q += dx with [M Phi_q^T; Phi_q 0] [dx; mu] = [0; -Phi(q, t + h)], repeated
- *              until max|Phi| <= options->tol_phi (at most options->max_iterations
- *              corrections, on the factors of the last stage: the correction closest to q
- *              in the metric of M);
+ *   positions  q += dx with [M Phi_q^T; Phi_q 0] [dx; mu] = [0; -Phi(q, t + h)] at q
+ *              (Newton: the correction closest to q in the metric of M), repeated until
+ *              max|Phi| <= options->tol_phi, at most options->max_iterations corrections;
  *   velocities dq += dv with the same matrix at the corrected q and the right-hand side
  *              [0; -(Phi_q dq + Phi_t)], so that Phi_q dq = -Phi_t;
  *   then ddq and lam at the new (q, dq), which also start the next step.
@@ -32,15 +31,15 @@
 
 /* Operations of one crank_slider_load_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of crank_slider_load_dynamics.c, every branch that adds work
- * taken, the position correction at its cap); each sin, cos, ... is a library call.
+ * taken, the position corrections at their cap); each sin, cos, ... is a library call.
  * One evaluation (M, Phi_q, their LU, Q - h, Gamma, a solve): 5038
- * Runge-Kutta, three stages: 15369; one position correction: 702; velocity correction: 744
- * Step, worst case with the default cap of 25 corrections: 43848 (19460 add/sub, 19702 mul, 651 div, 0 sqrt, 184 other calls, 2446 fabs, 1405 compares)
+ * Runge-Kutta, three stages: 15369; one position correction: 5072; velocity correction: 744
+ * Step, worst case with the default cap of 25 corrections: 153098 (64185 add/sub, 68652 mul, 1101 div, 0 sqrt, 384 other calls, 12246 fabs, 6530 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
  */
-#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_ITERATION 702  /* one position correction */
+#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_ITERATION 5072  /* one position correction */
 #define CRANK_SLIDER_LOAD_OPS_DYNAMICS_FIXED 26298  /* a step without its corrections */
-#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_STEP_WORST 43848  /* at the default cap, 25 */
+#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_STEP_WORST 153098  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */

@@ -465,9 +465,9 @@ def accelerations(q, dq, t, p=None, matrix=None):
 
 def dynamics_step(p, h, state, tol_phi=1e-10, max_iterations=25):
     """One step from state = {"t", "q", "dq", "ddq", "lam"} (ddq and lam None at the start):
-    classical Runge-Kutta on (q, dq), q corrected onto Phi = 0 on the last stage's matrix, dq
-    onto Phi_q dq = -Phi_t at the corrected q, then ddq and lam there. Returns (status, the
-    new state or None, iterations, max|Phi|)."""
+    classical Runge-Kutta on (q, dq), q corrected onto Phi = 0 by Newton on the augmented
+    matrix, dq onto Phi_q dq = -Phi_t at the corrected q, then ddq and lam there. Returns
+    (status, the new state or None, iterations, max|Phi|)."""
     t, q, dq = state["t"], numpy.asarray(state["q"], float), numpy.asarray(state["dq"], float)
     try:
         ddq = state["ddq"] if state.get("ddq") is not None else accelerations(q, dq, t, p)[0]
@@ -479,6 +479,7 @@ def dynamics_step(p, h, state, tol_phi=1e-10, max_iterations=25):
             rates = (stage_dq, accelerations(stage_q, stage_dq, t + c, p, matrix)[0])
             sum_q, sum_dq = sum_q + weight * rates[0], sum_dq + weight * rates[1]
         t1, q1, dq1 = t + h, q + sum_q, dq + sum_dq
+        matrix = augmented(q1, t1, p)
         for iterations in range(max_iterations + 1):
             residual = numpy.max(numpy.abs(phi(q1, t1, p)), initial=0.0)
             if not numpy.isfinite(residual):
@@ -489,7 +490,7 @@ def dynamics_step(p, h, state, tol_phi=1e-10, max_iterations=25):
                 return NO_CONVERGENCE, None, iterations, residual
             q1 = q1 + numpy.linalg.solve(matrix, numpy.concatenate(
                 [numpy.zeros(NQ), -phi(q1, t1, p)]))[:NQ]
-        matrix = augmented(q1, t1, p)
+            matrix = augmented(q1, t1, p)
         jacobian = matrix[NQ:, :NQ]
         violation = jacobian @ dq1 + phi_t(q1, t1, p)
         dq1 = dq1 + numpy.linalg.solve(matrix, numpy.concatenate(

@@ -170,12 +170,15 @@ static int four_bar_dynamics_dyn_runge_kutta(const four_bar_dynamics_real p[], f
     return 0;
 }
 
-/* Newton's corrections of work->q onto Phi(q, t) = 0 on the last stage's factors. */
+/* Newton's corrections of work->q onto Phi(q, t) = 0, each on the factors at its q; on
+ * FOUR_BAR_DYNAMICS_OK the factors are those at the corrected q (for the velocities). Returns a
+ * status, and the vanished pivot's column + 1 in *pivot when FOUR_BAR_DYNAMICS_SINGULAR. */
 static int four_bar_dynamics_dyn_positions(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[],
                                       four_bar_dynamics_real t, four_bar_dynamics_dynamics_work *work,
-                                      four_bar_dynamics_dynamics_report *report)
+                                      four_bar_dynamics_dynamics_report *report, int *pivot)
 {
     int i;
+    if ((*pivot = four_bar_dynamics_dyn_factor(work->q, t, p, work))) return FOUR_BAR_DYNAMICS_SINGULAR;
     for (report->iterations = 0; ; ++report->iterations) {
         four_bar_dynamics_phi(work->q, t, p, work->phi);
         report->residual = four_bar_dynamics_dyn_max_abs(work->phi, FOUR_BAR_DYNAMICS_NR);
@@ -187,6 +190,7 @@ static int four_bar_dynamics_dyn_positions(const four_bar_dynamics_options *opti
         for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) work->b[FOUR_BAR_DYNAMICS_NQ + i] = -work->phi[i];
         four_bar_dynamics_dyn_solve(work, work->b);
         for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->q[i] += work->b[i];
+        if ((*pivot = four_bar_dynamics_dyn_factor(work->q, t, p, work))) return FOUR_BAR_DYNAMICS_SINGULAR;
     }
 }
 
@@ -231,10 +235,8 @@ int four_bar_dynamics_dynamics_step(const four_bar_dynamics_options *options, co
     if ((pivot = four_bar_dynamics_dyn_runge_kutta(p, h, state, work)))
         return four_bar_dynamics_dyn_stop(report, FOUR_BAR_DYNAMICS_SINGULAR, pivot);
     report->t = t1;
-    status = four_bar_dynamics_dyn_positions(options, p, t1, work, report);
-    if (status != FOUR_BAR_DYNAMICS_OK) return four_bar_dynamics_dyn_stop(report, status, 0);
-    if ((pivot = four_bar_dynamics_dyn_factor(work->q, t1, p, work)))
-        return four_bar_dynamics_dyn_stop(report, FOUR_BAR_DYNAMICS_SINGULAR, pivot);
+    status = four_bar_dynamics_dyn_positions(options, p, t1, work, report, &pivot);
+    if (status != FOUR_BAR_DYNAMICS_OK) return four_bar_dynamics_dyn_stop(report, status, pivot);
     report->velocity_residual = four_bar_dynamics_dyn_velocities(p, t1, work);
     four_bar_dynamics_dyn_accelerations(work->q, work->dq, t1, p, work, work->ddq, work->lam);
     for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) { /* a NaN or an infinity anywhere ends here */

@@ -13,10 +13,9 @@
  * its NA = NQ + NR square matrix per evaluation. four_bar_dynamics_dynamics_step takes one step
  * of the classical fourth-order Runge-Kutta method on (q, dq), its first stage the ddq the
  * last step ended with, then removes the drift the integration leaves:
- *   positions  q += dx with [M Phi_q^T; Phi_q 0] [dx; mu] = [0; -Phi(q, t + h)], repeated
- *              until max|Phi| <= options->tol_phi (at most options->max_iterations
- *              corrections, on the factors of the last stage: the correction closest to q
- *              in the metric of M);
+ *   positions  q += dx with [M Phi_q^T; Phi_q 0] [dx; mu] = [0; -Phi(q, t + h)] at q
+ *              (Newton: the correction closest to q in the metric of M), repeated until
+ *              max|Phi| <= options->tol_phi, at most options->max_iterations corrections;
  *   velocities dq += dv with the same matrix at the corrected q and the right-hand side
  *              [0; -(Phi_q dq + Phi_t)], so that Phi_q dq = -Phi_t;
  *   then ddq and lam at the new (q, dq), which also start the next step.
@@ -32,15 +31,15 @@
 
 /* Operations of one four_bar_dynamics_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of four_bar_dynamics_dynamics.c, every branch that adds work
- * taken, the position correction at its cap); each sin, cos, ... is a library call.
+ * taken, the position corrections at their cap); each sin, cos, ... is a library call.
  * One evaluation (M, Phi_q, their LU, Q - h, Gamma, a solve): 5159
- * Runge-Kutta, three stages: 15732; one position correction: 711; velocity correction: 752
- * Step, worst case with the default cap of 25 corrections: 44695 (19765 add/sub, 20047 mul, 656 div, 5 sqrt, 281 other calls, 2506 fabs, 1435 compares)
+ * Runge-Kutta, three stages: 15732; one position correction: 5123; velocity correction: 752
+ * Step, worst case with the default cap of 25 corrections: 154995 (64640 add/sub, 69347 mul, 1106 div, 5 sqrt, 581 other calls, 12606 fabs, 6710 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
  */
-#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_ITERATION 711  /* one position correction */
+#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_ITERATION 5123  /* one position correction */
 #define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_FIXED 26920  /* a step without its corrections */
-#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_STEP_WORST 44695  /* at the default cap, 25 */
+#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_STEP_WORST 154995  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */

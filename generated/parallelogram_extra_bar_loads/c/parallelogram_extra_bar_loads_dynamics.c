@@ -170,12 +170,15 @@ static int parallelogram_extra_bar_loads_dyn_runge_kutta(const parallelogram_ext
     return 0;
 }
 
-/* Newton's corrections of work->q onto Phi(q, t) = 0 on the last stage's factors. */
+/* Newton's corrections of work->q onto Phi(q, t) = 0, each on the factors at its q; on
+ * PARALLELOGRAM_EXTRA_BAR_LOADS_OK the factors are those at the corrected q (for the velocities). Returns a
+ * status, and the vanished pivot's column + 1 in *pivot when PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR. */
 static int parallelogram_extra_bar_loads_dyn_positions(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
                                       parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_dynamics_work *work,
-                                      parallelogram_extra_bar_loads_dynamics_report *report)
+                                      parallelogram_extra_bar_loads_dynamics_report *report, int *pivot)
 {
     int i;
+    if ((*pivot = parallelogram_extra_bar_loads_dyn_factor(work->q, t, p, work))) return PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR;
     for (report->iterations = 0; ; ++report->iterations) {
         parallelogram_extra_bar_loads_phi(work->q, t, p, work->phi);
         report->residual = parallelogram_extra_bar_loads_dyn_max_abs(work->phi, PARALLELOGRAM_EXTRA_BAR_LOADS_NR);
@@ -187,6 +190,7 @@ static int parallelogram_extra_bar_loads_dyn_positions(const parallelogram_extra
         for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) work->b[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ + i] = -work->phi[i];
         parallelogram_extra_bar_loads_dyn_solve(work, work->b);
         for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->q[i] += work->b[i];
+        if ((*pivot = parallelogram_extra_bar_loads_dyn_factor(work->q, t, p, work))) return PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR;
     }
 }
 
@@ -231,10 +235,8 @@ int parallelogram_extra_bar_loads_dynamics_step(const parallelogram_extra_bar_lo
     if ((pivot = parallelogram_extra_bar_loads_dyn_runge_kutta(p, h, state, work)))
         return parallelogram_extra_bar_loads_dyn_stop(report, PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR, pivot);
     report->t = t1;
-    status = parallelogram_extra_bar_loads_dyn_positions(options, p, t1, work, report);
-    if (status != PARALLELOGRAM_EXTRA_BAR_LOADS_OK) return parallelogram_extra_bar_loads_dyn_stop(report, status, 0);
-    if ((pivot = parallelogram_extra_bar_loads_dyn_factor(work->q, t1, p, work)))
-        return parallelogram_extra_bar_loads_dyn_stop(report, PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR, pivot);
+    status = parallelogram_extra_bar_loads_dyn_positions(options, p, t1, work, report, &pivot);
+    if (status != PARALLELOGRAM_EXTRA_BAR_LOADS_OK) return parallelogram_extra_bar_loads_dyn_stop(report, status, pivot);
     report->velocity_residual = parallelogram_extra_bar_loads_dyn_velocities(p, t1, work);
     parallelogram_extra_bar_loads_dyn_accelerations(work->q, work->dq, t1, p, work, work->ddq, work->lam);
     for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) { /* a NaN or an infinity anywhere ends here */

@@ -13,10 +13,9 @@
  * its NA = NQ + NR square matrix per evaluation. parallelogram_extra_bar_loads_dynamics_step takes one step
  * of the classical fourth-order Runge-Kutta method on (q, dq), its first stage the ddq the
  * last step ended with, then removes the drift the integration leaves:
- *   positions  q += dx with [M Phi_q^T; Phi_q 0] [dx; mu] = [0; -Phi(q, t + h)], repeated
- *              until max|Phi| <= options->tol_phi (at most options->max_iterations
- *              corrections, on the factors of the last stage: the correction closest to q
- *              in the metric of M);
+ *   positions  q += dx with [M Phi_q^T; Phi_q 0] [dx; mu] = [0; -Phi(q, t + h)] at q
+ *              (Newton: the correction closest to q in the metric of M), repeated until
+ *              max|Phi| <= options->tol_phi, at most options->max_iterations corrections;
  *   velocities dq += dv with the same matrix at the corrected q and the right-hand side
  *              [0; -(Phi_q dq + Phi_t)], so that Phi_q dq = -Phi_t;
  *   then ddq and lam at the new (q, dq), which also start the next step.
@@ -32,15 +31,15 @@
 
 /* Operations of one parallelogram_extra_bar_loads_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of parallelogram_extra_bar_loads_dynamics.c, every branch that adds work
- * taken, the position correction at its cap); each sin, cos, ... is a library call.
+ * taken, the position corrections at their cap); each sin, cos, ... is a library call.
  * One evaluation (M, Phi_q, their LU, Q - h, Gamma, a solve): 21137
- * Runge-Kutta, three stages: 63834; one position correction: 1919; velocity correction: 1982
- * Step, worst case with the default cap of 25 corrections: 156263 (72033 add/sub, 73406 mul, 1083 div, 0 sqrt, 532 other calls, 5990 fabs, 3219 compares)
+ * Runge-Kutta, three stages: 63834; one position correction: 21146; velocity correction: 1982
+ * Step, worst case with the default cap of 25 corrections: 636938 (286408 add/sub, 299231 mul, 1833 div, 0 sqrt, 1032 other calls, 31890 fabs, 16544 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
  */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_ITERATION 1919  /* one position correction */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_ITERATION 21146  /* one position correction */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_FIXED 108288  /* a step without its corrections */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_STEP_WORST 156263  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_STEP_WORST 636938  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */

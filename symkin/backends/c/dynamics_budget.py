@@ -6,8 +6,9 @@ branch that adds work taken; the kernel routines are counted from their printed 
 
     options check + first-step evaluation (factor and accelerations at the start)
     + Runge-Kutta (3 stages, each a factorization and a solve)
-    + (cap + 1) x position check + cap x position correction
-    + factorization at the corrected q + velocity correction + accelerations.
+    + factorization at the Runge-Kutta result
+    + (cap + 1) x position check + cap x (position correction + factorization at its q)
+    + velocity correction + accelerations.
 
 The first step's evaluation is counted in every step: a budget holds for any call.
 """
@@ -58,7 +59,7 @@ class DynamicsBudget:
     cap: int
     evaluation: Flops  # a factorization and the accelerations
     runge_kutta: Flops
-    iteration: Flops  # one position check and correction
+    iteration: Flops  # one position check, correction and factorization
     velocity: Flops
     step: Flops
 
@@ -78,12 +79,12 @@ def budget(code: Any, cap: int) -> DynamicsBudget:
     runge_kutta = (Flops(div=3, mul=2 * nq) + (point + stage) * 3
                    + Flops(add=2 * nq))  # <prefix>_dyn_runge_kutta
     check = _routine(code, "phi") + max_abs(nr) + Flops(add=1, cmp=4)
-    correction = solve(na) + Flops(add=nr + nq)  # <prefix>_dyn_positions
+    correction = solve(na) + Flops(add=nr + nq) + factor(code)  # <prefix>_dyn_positions
     velocity = (_routine(code, "phi_t") + Flops(add=nr + nq) + solve(na)
                 + Flops(mul=2 * code.nnz, add=2 * code.nnz) + max_abs(nr))
-    final = factor(code) + velocity + accelerations + Flops(add=2 * nq, cmp=2 * nq)
+    final = velocity + accelerations + Flops(add=2 * nq, cmp=2 * nq)
     step = (OPTIONS_CHECK + Flops(cmp=3, add=2) + evaluation + runge_kutta
-            + check * (cap + 1) + correction * cap + final)
+            + factor(code) + check * (cap + 1) + correction * cap + final)
     return DynamicsBudget(cap=cap, evaluation=evaluation, runge_kutta=runge_kutta,
                           iteration=check + correction, velocity=velocity, step=step)
 
