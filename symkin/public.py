@@ -7,8 +7,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from symkin import backends
+from symkin.build import motion
 from symkin.build.compile import compile as compile_system
 from symkin.codegen import lower, render
+from symkin.runtime.dynamics.model import MotionKernel
 from symkin.runtime.kernel import Kernel
 from symkin.symbolic.derivation import System
 
@@ -36,7 +38,7 @@ def generate(system: System, backend: str = "c", out_dir: str | Path = "generate
 
 def compile(system: System, backend: str = backends.AUTO, *, real: str = "double",
             cse: bool = True, linalg: str = lower.DEFAULT_LINALG,
-            cache_dir: str | Path | None = None) -> Kernel:
+            cache_dir: str | Path | None = None) -> Kernel | MotionKernel:
     """Generate, compile (or find in the cache) and load the kernel of ``system``.
 
     Args:
@@ -53,6 +55,13 @@ def compile(system: System, backend: str = backends.AUTO, *, real: str = "double
         BuildError: an unknown backend name, or the compiler failed (the message has the
             command and its output).
         NoCompilerError: ``backend="c"`` and no C compiler is found.
+
+    A mechanism its forces move (fewer drivers than freedoms, symbolic.motion) gives a
+    MotionKernel whose equations of motion are evaluated through NumPy (``"auto"`` and
+    ``"numpy"``), until the generated step for it exists.
     """
+    if motion.moves_under_forces(system):
+        return motion.kernel(system, backend)
     return compile_system(system, backends.resolve(backend), real=real, cse=cse, linalg=linalg,
                          cache_dir=cache_dir)
+

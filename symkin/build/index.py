@@ -75,7 +75,7 @@ class Prepared:
         system: the derived System on a miss, None on a hit.
     """
 
-    kernel: Kernel
+    kernel: Kernel | Any  # a MotionKernel for a mechanism its forces move (build.motion)
     hit: bool
     outlines: Outlines | None = None
     system: Any = None
@@ -114,17 +114,28 @@ def prepare(mechanism: str | Path, options: Options, *, outlines: bool = False,
 
 def _full_pipeline(mechanism: Path, options: Options, cache: Path,
                    want_outlines: bool) -> Prepared:
+    from symkin.build import motion
     from symkin.build.compile import compile as compile_system
     from symkin.spec import validate
-    from symkin.symbolic import derivation, drawing
+    from symkin.symbolic import derivation
 
     system = derivation.derive(validate.load(mechanism, dict(options.parameters)))
+    if motion.moves_under_forces(system):  # forward dynamics: not in the index (build.motion)
+        return Prepared(motion.kernel(system, motion.ANY), hit=False,
+                        outlines=_drawn_outlines(system, want_outlines), system=system)
     kernel = compile_system(system, backend=options.backend, real=options.real,
                            cse=options.cse, linalg=options.linalg, cache_dir=cache)
+    return Prepared(kernel, hit=False, outlines=_drawn_outlines(system, want_outlines),
+                    system=system)
+
+
+def _drawn_outlines(system: Any, wanted: bool) -> Outlines | None:
+    """The bodies' outlines for an animation, when wanted."""
+    from symkin.symbolic import drawing
+
     # a spatial mechanism is drawn from its points; only its joints' points come from here
     outline = drawing.spatial_outlines if system.mechanism.is_spatial else drawing.outlines
-    drawn = outline(system) if want_outlines else None
-    return Prepared(kernel, hit=False, outlines=drawn, system=system)
+    return outline(system) if wanted else None
 
 
 # ----- the key -------------------------------------------------------------------------------

@@ -196,6 +196,9 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     prepared = index.prepare(args.mechanism, options,
                              outlines=args.animate is not None or args.html is not None)
     kernel = prepared.kernel
+    if getattr(kernel, "moves_under_forces", False) and kernel.backend != options.backend.name:
+        messages.note(f"the motion is integrated with {kernel.backend} NumPy functions; the "
+                      f"{options.backend.name} backend has no forward-dynamics step yet")
     picture = run_outputs.Pictures.of(args, kernel)  # --select checked before any solving
     table, problem = _input_table(kernel, args)
     if problem:
@@ -229,14 +232,17 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     trajectory = _with_pair_outputs(trajectory, args, prepared.system)
     written = _write(trajectory, args, prepared.outlines, picture)
     origin = ", cached kernel" if prepared.hit else ""
+    # integrated under its forces (runtime.dynamics): said first, as the contract has it
+    kind = " (dynamics)" if getattr(kernel, "moves_under_forces", False) else ""
     if args.at is not None:
         backend = f"{kernel.backend} backend{origin}"
         print(run_outputs.configuration(trajectory, kernel.name, backend), end="")
     else:
         print(f"solved {trajectory.t.size} time points, t = {trajectory.t[0]:g} to "
-              f"{trajectory.t[-1]:g} ({kernel.backend} backend{origin})"
+              f"{trajectory.t[-1]:g}{kind} ({kernel.backend} backend{origin})"
               + "".join(f"; wrote {path}" for path in written))
-    _note_far_start(kernel, trajectory)
+    if not getattr(kernel, "moves_under_forces", False):  # (its start: runtime.dynamics)
+        _note_far_start(kernel, trajectory)
     if trajectory.lu_fallbacks:
         messages.note(run_outputs.fallback_note(trajectory.lu_fallbacks, trajectory.t.size,
                                                 args.verbose))

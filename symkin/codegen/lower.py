@@ -235,9 +235,14 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         linalg: ``"sparse"`` (default) or ``"dense"``, the LU behind the C solver.
 
     Raises:
-        BuildError: an unknown real type, or an expression the printer cannot print.
+        BuildError: an unknown real type, or an expression the printer cannot print, or a
+            mechanism its forces move (not generated yet: symkin.solve integrates it).
     """
     _check_options(backend, real, linalg)
+    if system.phi_q.shape[0] < len(system.q):
+        raise BuildError("the mechanism has fewer driving equations than freedoms: its "
+                         "forces move it, and code generation for such a mechanism is not "
+                         "available yet; integrate it with symkin run or symkin.solve")
     internal = symbol_printing.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)

@@ -5,3 +5,7 @@ importing the stages (a warm run loads neither SymPy nor pydantic)."""
 
 RATE_SUFFIXES = ("_t", "_tt")
 """The suffixes of a quantity's rate and of its acceleration, in that order."""
+
+ENERGY_COLUMNS = {"kinetic_energy": "energy.kinetic", "potential_energy": "energy.potential",
+                  "work_nonconservative": "energy.work"}
+"""A forward-dynamics run's energy arrays: the NPZ name of each and its CSV column."""

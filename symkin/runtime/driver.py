@@ -133,6 +133,14 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         assembled at t[0], Newton does not converge, or Phi_q is singular. SolveError for a
         bad t, q0, params or out.
     """
+    if getattr(kernel, "moves_under_forces", False):  # forward dynamics: runtime.dynamics
+        from symkin.runtime.dynamics import run as motion
+
+        if options or sensitivities or out is not None or inputs is not None:
+            raise SolveError("options=, sensitivities=, out= and inputs= are not supported "
+                             "for a mechanism that its forces move")
+        return motion.solve(kernel, t, q0, params, progress=progress,  # type: ignore[arg-type]
+                            stop_at_singular=stop_at_singular)
     options = options or default_options(kernel)
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from symkin.contract.columns import RATE_SUFFIXES
+from symkin.contract.columns import ENERGY_COLUMNS, RATE_SUFFIXES
 from symkin.errors import SymkinError
 from symkin.runtime import spatial
 from symkin.runtime.forces import Forces
@@ -263,7 +263,8 @@ class Trajectory:
         header = ["t", *self.coordinates,
                   *(c + suffix for suffix in RATE_SUFFIXES for c in self.coordinates),
                   *self._point_columns(),
-                  *self._angular_columns(), *(name for name, _ in self.outputs), "flagged",
+                  *self._angular_columns(),
+                  *(ENERGY_COLUMNS.get(name, name) for name, _ in self.outputs), "flagged",
                   *(self.forces.columns() if self.forces is not None else ())]
         r, dr, ddr = self.point_arrays()
         # Per point: x, y, vx, vy, ax, ay (2.14-2.16); spatial: x, y, z, vx, vy, vz, ax...

@@ -26,6 +26,7 @@ from symkin.errors import SolveError
 from symkin.runtime import driver, redundant, units
 from symkin.runtime.assemblies import SAME, Shape, search
 from symkin.runtime.assembly import assemble
+from symkin.runtime.dynamics.model import refuse_motion
 from symkin.runtime.edges import LIMIT_COND
 from symkin.runtime.protocol import KinematicsKernel
 
@@ -113,6 +114,7 @@ def scan(kernel: KinematicsKernel, t: ArrayLike | None = None,
             meets.
         SolveInterrupted: on Ctrl-C during a motion.
     """
+    refuse_motion(kernel, "symkin scan")
     times = driver.time_points(kernel, t)
     p = driver.parameter_values(kernel, params)
     values = input_point(kernel, inputs)

@@ -6,6 +6,7 @@ from typing import Any
 
 from symkin import pairs
 from symkin.errors import MechanismError
+from symkin.spec.motion import has_masses
 from symkin.spec.schema import MechanismSpec, equation_count
 
 
@@ -22,8 +23,14 @@ def degrees_of_freedom(mech: MechanismSpec) -> int:
     return per_body * len(mech.bodies) - sum(_freedoms_taken(joint) for joint in mech.joints)
 
 
+def is_under_driven(mech: MechanismSpec) -> bool:
+    """True when the drivers give fewer equations than the count's degrees of freedom."""
+    return sum(equation_count(driver) for driver in mech.drivers) < degrees_of_freedom(mech)
+
+
 def check_degrees_of_freedom(mech: MechanismSpec) -> None:
-    """Check that the drivers supply at least as many equations as there are DOF.
+    """Check that the drivers supply at least as many equations as there are DOF, or that
+    the bodies have masses, so that the forces move the mechanism (forward dynamics).
 
     More equations than coordinates are not refused by the count: joints may repeat each
     other (a parallelogram with an extra parallel bar), which only the rank of Phi_q at the
@@ -33,6 +40,13 @@ def check_degrees_of_freedom(mech: MechanismSpec) -> None:
     driving = sum(equation_count(driver) for driver in mech.drivers)
     if driving >= dof:
         return
+    if has_masses(mech):
+        return  # the freedoms the drivers leave open move under the forces (spec.motion)
+    _needs_masses(mech, dof, driving)
+
+
+def _needs_masses(mech: MechanismSpec, dof: int, driving: int) -> None:
+    """Refuse an under-driven file without masses: its motion is undetermined."""
     if mech.is_spatial:
         _spatial_dof_error(mech, dof, driving)
     # Pairs of class 5 take two freedoms (revolute, prismatic), of class 4 one (pin-in-slot,
@@ -45,16 +59,21 @@ def check_degrees_of_freedom(mech: MechanismSpec) -> None:
     custom = dof - (3 * len(mech.bodies) - 2 * p5 - p4)
     if custom:
         formula += f" − {-custom} (custom joint equations)"
-    fix = f"Add drivers for {dof - driving} more equation(s), or add joints."
     raise MechanismError(f"the mechanism has {formula} = {dof} degree(s) of freedom but its "
-                         f"drivers give {driving} equation(s)", ("drivers",), fix)
+                         f"drivers give {driving} equation(s), and no body has a mass: the "
+                         f"motion of the {dof - driving} free degree(s) needs masses",
+                         ("drivers",), _MASS_FIX.format(more=dof - driving))
+
+
+_MASS_FIX = ("Give the bodies a mass (and inertia) so that their motion under the forces is "
+             "integrated, or add drivers for {more} more equation(s).")
 
 
 def _spatial_dof_error(mech: MechanismSpec, dof: int, driving: int) -> None:
+    """Refuse an under-driven spatial file without masses (the count in space)."""
     joints = sum(equation_count(joint) for joint in mech.joints)
-    fix = (f"Add drivers for {dof - driving} more equation(s), or add joints."
-           if driving < dof else f"Remove {driving - dof} driving equation(s), or check for "
-           "a missing joint (a joint with equations that repeat others is not handled yet).")
     raise MechanismError(f"the mechanism has w = 6·{len(mech.bodies)} − {joints} (joint "
                          f"equations) = {dof} degree(s) of freedom but its drivers give "
-                         f"{driving} equation(s)", ("drivers",), fix)
+                         f"{driving} equation(s), and no body has a mass: the motion of the "
+                         f"{dof - driving} free degree(s) needs masses", ("drivers",),
+                         _MASS_FIX.format(more=dof - driving))

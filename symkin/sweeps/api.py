@@ -21,6 +21,7 @@ from symkin import limits
 from symkin.contract.options import Options
 from symkin.errors import SolveError
 from symkin.runtime import driver, forces, redundant
+from symkin.runtime.dynamics.model import refuse_motion
 from symkin.runtime.inputs import refuse_inputs
 from symkin.runtime.kernel import Kernel
 from symkin.sweeps import parallel
@@ -62,6 +63,7 @@ def sweep(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike,
     Raises:
         SolveError: params, t or q0 that do not fit the mechanism.
     """
+    refuse_motion(kernel, "symkin sweep")
     refuse_inputs(kernel, "a sweep")
     values = parameter_table(kernel, params)
     times = driver.time_points(kernel, t)

@@ -204,7 +204,8 @@ def derive(mech: Mechanism | str | Path) -> System:
         gamma.append(_at_tau(_row_gamma(row, entries, row_t, symbols), symbols))
     phi = [_at_tau(row, symbols) for row in phi]
     size = len(symbols.q)
-    phi_q = sp.ImmutableSparseMatrix(size, size, jacobian)
+    # as many rows as equations: fewer than columns where the forces move free freedoms
+    phi_q = sp.ImmutableSparseMatrix(len(phi), size, jacobian)
     placed = _placed(mech, ctx)
     return System(
         mechanism=mech, q=symbols.q, dq=symbols.dq, t=symbols.t, p=symbols.p,

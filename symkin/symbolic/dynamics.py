@@ -198,8 +198,8 @@ def generalized_force(mech: Mechanism, ctx: Context, load: Any) -> sp.Matrix:
         total[_columns(symbols, load.body)[2]] = load_expr(ctx, load.m)
         return total
     # a spring-damper: Q = -tension dL/dq
-    a = _end(ctx, load.i, load.A)
-    b = _end(ctx, load.j, load.B)
+    a = spring_end(ctx, load.i, load.A)
+    b = spring_end(ctx, load.j, load.B)
     d = b - a
     length = sp.sqrt((d.T * d)[0, 0])
     rate = velocity(sp.Matrix([length]), symbols)[0, 0]
@@ -208,7 +208,7 @@ def generalized_force(mech: Mechanism, ctx: Context, load: Any) -> sp.Matrix:
     return sp.Matrix([-tension * length.diff(q) for q in symbols.q])
 
 
-def _end(ctx: Context, body: str, ref: Any) -> sp.Matrix:
+def spring_end(ctx: Context, body: str, ref: Any) -> sp.Matrix:
     if body == GROUND:
         return ctx.vector(ref)
     return ctx.pose(body).point(ctx.local(body, ref))

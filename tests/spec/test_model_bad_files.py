@@ -95,7 +95,8 @@ EXPECTED: dict[str, tuple[int, str]] = {
     "time_missing_t1.yaml": (9, "the required key 't1' is missing"),
     # degrees of freedom
     "dof_too_few_drivers.yaml": (7, "w = 3·1 − 2·1 − 0 = 1 degree(s) of freedom but its "
-                                    + "drivers give 0 equation(s). Add drivers for 1 more"),
+                                    + "drivers give 0 equation(s), and no body has a mass: "
+                                    + "the motion of the 1 free degree(s) needs masses"),
     # expressions
     "bad_expression_syntax.yaml": (8, "in expression 't**': this is not a valid expression"),
     "bad_expression_function.yaml": (8, "unknown function 'system'; allowed functions are Abs"),

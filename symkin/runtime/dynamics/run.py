@@ -1,0 +1,150 @@
+"""``symkin.solve`` of a mechanism its forces move: the integration over a time grid and the
+Trajectory of it, with efforts, reactions and the energy balance.
+
+Every output row is the integrator's state projected onto the constraints
+(runtime.dynamics.integrator), its accelerations and multipliers solved from the equations
+of motion there, so Φ = 0, Φ_q q̇ = -Φ_t and Φ_q q̈ = Γ hold at each row to the Newton
+tolerance; ``constraint_residual`` reports max |Φ| of each row rather than hiding it.
+Rows whose augmented matrix is ill-conditioned are flagged (``cond`` holds its condition
+number); where the equations of motion are singular the run stops with the rows before it
+(SolveFailure, reason "singular"). Ctrl-C stops it likewise (SolveInterrupted).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from symkin.contract.loads import reaction_parts
+from symkin.runtime.arguments import first_guess, parameter_values, time_points
+from symkin.runtime.dynamics import equations, initial
+from symkin.runtime.dynamics.integrator import State, StepFailure, Stepper
+from symkin.runtime.dynamics.model import Model, MotionKernel
+from symkin.runtime.forces import Forces
+from symkin.runtime.results import Trajectory
+from symkin.runtime.run_outcome import SolveFailure, SolveInterrupted
+
+Array = NDArray[np.float64]
+Progress = Callable[[int, int], None]
+
+# |Φ| every output row is projected to: the kinematic solve's position target.
+POSITION_TOLERANCE = 1e-11
+# The energy arrays by their NPZ names, in the order of _Rows.energy (their CSV columns:
+# contract.columns.ENERGY_COLUMNS).
+ENERGY = ("kinetic_energy", "potential_energy", "work_nonconservative")
+
+
+@dataclass
+class _Rows:
+    """The output arrays, filled row by row."""
+
+    t: Array
+    q: Array
+    dq: Array
+    d2q: Array
+    lam: Array
+    energy: Array  # (T, 3): kinetic, potential, work
+    residual: Array
+    cond: Array
+    done: int = 0
+
+
+def solve(kernel: MotionKernel, t: ArrayLike | None = None, q0: ArrayLike | None = None,
+          params: Mapping[str, float] | ArrayLike | None = None, *,
+          progress: Progress | None = None, stop_at_singular: bool = False) -> Trajectory:
+    """Integrate the motion over ``t`` (default: the file's grid) from the assembled q0.
+
+    Raises:
+        SolveFailure with the rows before it where the motion cannot be followed;
+        SolveInterrupted on Ctrl-C; SolveError for bad arguments or initial velocities that
+        contradict the constraints (runtime.dynamics.initial).
+    """
+    model = kernel.model
+    # the shared argument checks read only a kernel's grid, parameters, q0 and coordinates
+    checked: Any = kernel
+    times = time_points(checked, t)
+    p = parameter_values(checked, params)
+    q = initial.assemble(model, first_guess(checked, q0), float(times[0]), p,
+                         POSITION_TOLERANCE)
+    state = State(float(times[0]), q, initial.velocity(model, q, float(times[0]), p), 0.0)
+    rows = _allocate(times, q.size, len(model.rows))
+    stepper = Stepper(model, p, model.rtol, model.atol, POSITION_TOLERANCE)
+    try:
+        _record(model, rows, state, p)
+        for k in range(1, times.size):
+            state = stepper.advance(state, float(times[k]), _no_interrupt)
+            _record(model, rows, state, p)
+            if stop_at_singular and rows.cond[k] > equations.FLAG_CONDITION:
+                raise StepFailure("the equations of motion are ill-conditioned "
+                                  f"(condition {rows.cond[k]:.3g}) and --stop-at-singular "
+                                  "was given", float(times[k]))
+            if progress is not None:
+                progress(k + 1, times.size)
+    except KeyboardInterrupt:
+        raise SolveInterrupted(_trajectory(model, rows, p), float(times[rows.done])) from None
+    except (StepFailure, equations.Singular) as stop:
+        at = getattr(stop, "t", float(times[rows.done]))
+        reason = getattr(stop, "reason", "the equations of motion are singular")
+        raise SolveFailure(f"the motion stops at t = {at:.6g}: {reason}. The rows up to "
+                           f"t = {times[rows.done - 1]:.6g} are kept.",
+                           _trajectory(model, rows, p), at, math.nan, 0,
+                           reason="singular") from None
+    return _trajectory(model, rows, p)
+
+
+def _no_interrupt() -> None:
+    """The integrator's check between steps (Ctrl-C arrives as KeyboardInterrupt)."""
+
+
+def _allocate(times: Array, n: int, m: int) -> _Rows:
+    size = times.size
+    return _Rows(times, np.full((size, n), np.nan), np.full((size, n), np.nan),
+                 np.full((size, n), np.nan), np.full((size, m), np.nan),
+                 np.full((size, 3), np.nan), np.full(size, np.nan), np.full(size, np.nan))
+
+
+def _record(model: Model, rows: _Rows, state: State, p: Array) -> None:
+    """One output row: the state, its accelerations and multipliers, energies, residual."""
+    k = rows.done
+    found = equations.accelerations(model, state.q, state.dq, state.t, p)
+    rows.q[k], rows.dq[k], rows.d2q[k], rows.lam[k] = state.q, state.dq, found.d2q, found.lam
+    kinetic = 0.5 * state.dq @ model.mass(state.q, p) @ state.dq
+    rows.energy[k] = (kinetic, float(model.potential(state.q, state.t, p)), state.work)
+    rows.residual[k] = float(np.max(np.abs(model.phi(state.q, state.t, p)), initial=0.0))
+    rows.cond[k] = equations.condition(model, state.q, state.dq, state.t, p)
+    rows.done = k + 1
+
+
+def _trajectory(model: Model, rows: _Rows, p: Array) -> Trajectory:
+    """The Trajectory of the rows done, with forces and the energy outputs."""
+    done = rows.done
+    t, q, dq, d2q = (a[:done].copy() for a in (rows.t, rows.q, rows.dq, rows.d2q))
+    cond = rows.cond[:done].copy()
+    flagged = ~(cond <= equations.FLAG_CONDITION)
+    trajectory = Trajectory.solved(t, q, dq, d2q, model.coordinates, model.points,
+                                   model.point_vectors, p, 0, flagged, cond,
+                                   space=model.space)
+    outputs = [(name, rows.energy[:done, j].copy()) for j, name in enumerate(ENERGY)]
+    outputs.append(("constraint_residual", rows.residual[:done].copy()))
+    trajectory.__dict__["outputs"] = tuple(outputs)
+    trajectory.__dict__["forces"] = _forces(model, t, q, rows.lam[:done], p)
+    return trajectory
+
+
+def _forces(model: Model, t: Array, q: Array, lam: Array, p: Array) -> Forces | None:
+    """Efforts and reactions of each row from its multipliers (as the forces section's)."""
+    if getattr(model, "removed", ()):
+        return None  # rows removed as redundant: the split is not unique (not done here)
+    loads = np.array([model.loads(q[k], lam[k], t[k], p) for k in range(t.size)])
+    loads = loads.reshape(t.size, -1)
+    n_efforts, n_joints = len(model.driver_names), len(model.joint_names)
+    parts = reaction_parts(model.space)
+    return Forces(lam.copy(), loads[:, :n_efforts],
+                  loads[:, n_efforts:].reshape(t.size, n_joints, len(parts)),
+                  model.driver_names, model.joint_names, parts)
+

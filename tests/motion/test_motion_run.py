@@ -1,0 +1,117 @@
+"""symkin run and symkin.solve of a mechanism its forces move: the summary, the energy
+columns, located refusals, Ctrl-C with the rows kept; and the generated kernels (NumPy and
+C, compiled and run) agreeing with the equations of motion the integrator uses."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from motion_support import CRANK_SLIDER, PENDULUM, write
+
+import symkin
+from symkin import cli
+from symkin.runtime.dynamics.model import kernel_terms
+from symkin.runtime.run_outcome import SolveInterrupted
+
+
+@pytest.fixture
+def pendulum(tmp_path: Path) -> Path:
+    return write(tmp_path, "pendulum.yaml", PENDULUM.replace("PHI0", "0.4"))
+
+
+def test_run_says_dynamics_and_writes_the_energy_columns(
+        pendulum: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "out.csv"
+    assert cli.main(["run", str(pendulum), "--backend", "numpy", "-o", str(out)]) == 0
+    summary = capsys.readouterr().out
+    assert "solved 11 time points, t = 0 to 1 (dynamics)" in summary
+    with out.open(encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    kinetic = np.array([float(row["energy.kinetic"]) for row in rows])
+    potential = np.array([float(row["energy.potential"]) for row in rows])
+    work = np.array([float(row["energy.work"]) for row in rows])
+    assert kinetic[0] == 0.0 and kinetic[-1] > 1.0  # released from rest, falling
+    assert np.ptp(kinetic + potential - work) <= 1e-8 * np.abs(potential).max()
+
+
+def test_run_writes_the_npz_arrays(pendulum: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out.npz"
+    assert cli.main(["run", str(pendulum), "--backend", "numpy", "-o", str(out)]) == 0
+    with np.load(out) as found:
+        for name in ("kinetic_energy", "potential_energy", "work_nonconservative",
+                     "constraint_residual", "effort", "reaction"):
+            assert name in found.files
+        assert found["constraint_residual"].max() <= 1e-10
+        # released from rest at 0.4 rad: the bob accelerates along the tangent only,
+        # φ'' = -g cos φ / L, so the pivot's force is m a - m g (Newton, by hand)
+        weight, phi = 2.0 * 9.81, 0.4
+        expected = [weight * np.cos(phi) * np.sin(phi), weight - weight * np.cos(phi) ** 2]
+        assert found["reaction"][0, 0, :2] == pytest.approx(expected, abs=1e-9)
+
+
+def test_contradicting_initial_velocities_are_refused_at_their_line(
+        pendulum: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # the pivot holds the rod's origin: its x rate must be 0
+    pendulum.write_text(pendulum.read_text(encoding="utf-8")
+                        + "initial: {velocities: {rod.phi: 1.0, rod.x: 0.5}}\n",
+                        encoding="utf-8")
+    assert cli.main(["run", str(pendulum), "--backend", "numpy"]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"{pendulum}:11: at initial.velocities.rod.x: the initial velocities rod.x " \
+           "contradict the constraints" in err
+    assert "Traceback" not in err
+
+
+def test_the_c_backend_is_refused_by_the_api_until_its_step_exists(pendulum: Path) -> None:
+    with pytest.raises(symkin.BuildError, match="use the numpy backend"):
+        symkin.compile(symkin.derive(pendulum), backend="c")
+
+
+def test_ctrl_c_keeps_the_rows_solved(crank_slider: Any) -> None:
+    def interrupt(done: int, total: int) -> None:
+        if done == 5:
+            raise KeyboardInterrupt
+
+    with pytest.raises(SolveInterrupted) as caught:
+        symkin.solve(crank_slider, progress=interrupt)
+    assert caught.value.trajectory.t.size == 5
+    assert dict(caught.value.trajectory.outputs)["kinetic_energy"].shape == (5,)
+
+
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_the_generated_kernels_give_the_same_mass_and_forces(
+        crank_slider: Any, tmp_path: Path, backend: str) -> None:
+    # the same bodies and forces, driven: a generated kernel with inverse dynamics
+    driven = CRANK_SLIDER.replace("SPRING", "20.0").replace(
+        "forces:", "drivers:\n  - {type: angle, i: crank, j: ground, theta: 1.8 + t}\nforces:"
+    ).replace("initial: {velocities: {crank.phi: 2.0}}\n", "").replace(
+        "integrator: {rtol: 1e-11, atol: 1e-12}\n", "")
+    kernel = symkin.compile(symkin.derive(write(tmp_path, "driven.yaml", driven)),
+                            backend=backend)
+    assert kernel.backend == backend
+    model, p = crank_slider.model, crank_slider.p_values
+    rng = np.random.default_rng(37)
+    for _ in range(3):
+        q, dq = rng.normal(size=9), rng.normal(size=9)
+        mass, applied = kernel_terms(kernel, q, dq, 0.3, p)
+        assert mass == pytest.approx(model.mass(q, p), abs=1e-9)
+        assert applied == pytest.approx(model.applied(q, dq, 0.3, p), abs=1e-9)
+
+
+@pytest.mark.parametrize(("command", "status", "fragment"), [
+    (["generate", "--backend", "numpy", "-o", "OUT"], 1, "code generation for such a "
+                                                          "mechanism is not available yet"),
+    (["scan"], 2, "symkin scan works on a mechanism whose drivers fix its motion"),
+    (["sweep", "--vary", "L=1:2:3", "-o", "OUT.npz"], 2, "symkin sweep works on a mechanism"),
+])
+def test_commands_for_driven_kinematics_say_so(
+        pendulum: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+        command: list[str], status: int, fragment: str) -> None:
+    words = [word.replace("OUT", str(tmp_path / "out")) for word in command]
+    assert cli.main([words[0], str(pendulum), *words[1:]]) == status
+    err = capsys.readouterr().err
+    assert fragment in err and "Traceback" not in err
