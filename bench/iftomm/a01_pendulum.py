@@ -224,7 +224,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         (folder / "a01.yaml").write_text(MECHANISM)
-        system = derive_free(folder / "a01.yaml")
+        system = symkin.derive(folder / "a01.yaml")
         rows = [to_accuracy("symkin C (dynamics_step)", SymkinC(system, folder / "c"),
                             args.target, args.repeat, 1e-5),
                 to_accuracy("symkin NumPy (dynamics_step)",
@@ -238,19 +238,6 @@ def main() -> None:
     print(f"{'solver':32} {'step h [s]':>12} {'CPU [s]':>10} {'error [m]':>11}")
     for name, h, seconds, err in rows:
         print(f"{name:32} {h:12.3e} {seconds:10.4f} {err:11.2e}")
-
-
-def derive_free(path: Path) -> object:
-    """The System of the under-driven file. Until the spec accepts a file with fewer
-    drivers than freedoms (issue 37, its Python side), the count's check is lifted here."""
-    import symkin.spec.validate as validate
-
-    saved = validate.check_degrees_of_freedom
-    validate.check_degrees_of_freedom = lambda mech: None
-    try:
-        return symkin.derive(path)
-    finally:
-        validate.check_degrees_of_freedom = saved
 
 
 if __name__ == "__main__":

@@ -236,13 +236,15 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
 
     Raises:
         BuildError: an unknown real type, or an expression the printer cannot print, or a
-            mechanism its forces move (not generated yet: symkin.solve integrates it).
+            mechanism with fewer driving equations than freedoms and no masses.
     """
     _check_options(backend, real, linalg)
-    if system.phi_q.shape[0] < len(system.q):
-        raise BuildError("the mechanism has fewer driving equations than freedoms: its "
-                         "forces move it, and code generation for such a mechanism is not "
-                         "available yet; integrate it with symkin run or symkin.solve")
+    # A mechanism its forces move (fewer rows than coordinates) has no kinematic solve: its
+    # code is the kernel and the dynamics step; the solver's Phi_q has no LU plan then.
+    free = system.phi_q.shape[0] < len(system.q)
+    if free and not mass_pattern(system):
+        raise BuildError("the mechanism has fewer driving equations than freedoms and no "
+                         "masses: its motion is not determined; give its bodies masses")
     internal = symbol_printing.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)
@@ -278,10 +280,10 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         pattern_rows=tuple(r for r, _ in pattern), pattern_cols=tuple(c for _, c in pattern),
         points=point_names(system), routines=routines,
         ops_before_cse=_ops_before_cse(expressions, fused, shared),
-        linalg=linalg,
+        linalg="dense" if free else linalg,
         phi_p_rows=tuple(r for r, _ in p_pattern), phi_p_cols=tuple(c for _, c in p_pattern),
         lu_plan=(sample.sparse_lu_plan(system, pattern)
-                 if backend.plans_lu(linalg) else None),
+                 if backend.plans_lu(linalg) and not free else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         removed=tuple(str(removed) for removed in system.removed),

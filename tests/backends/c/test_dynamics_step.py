@@ -26,6 +26,7 @@ import symkin
 from symkin import backends
 from symkin.backends.c import dynamics_budget
 from symkin.backends.c.dynamics_step import DynamicsStepper
+from symkin.build.compile import compile as build_compile
 from symkin.codegen import lower
 from symkin.contract import options
 from symkin.contract.options import Options
@@ -48,25 +49,18 @@ time: {t0: 0, t1: 1, dt: 0.01}
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="no C compiler")
 
 
-def _derive_free(path: Path) -> Any:
-    """The System of a file with fewer drivers than freedoms. Until the spec accepts such a
-    file with masses (issue 37, the Python side), the count's check is lifted for the
-    derivation alone."""
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr("symkin.spec.validate.check_degrees_of_freedom", lambda mech: None)
-        return symkin.derive(path)
-
-
 @pytest.fixture(scope="module")
 def pendulum(tmp_path_factory: pytest.TempPathFactory) -> Any:
     path = tmp_path_factory.mktemp("pendulum") / "pendulum.yaml"
     path.write_text(PENDULUM)
-    return _derive_free(path)
+    return symkin.derive(path)
 
 
 @pytest.fixture(scope="module")
 def pendulum_c(pendulum: Any) -> Any:
-    return symkin.compile(pendulum, "c", linalg="dense")
+    # symkin.compile answers a mechanism its forces move with its integrator's kernel; the
+    # generated C is built directly
+    return build_compile(pendulum, backends.get("c"))
 
 
 @pytest.fixture(scope="module")
@@ -134,7 +128,7 @@ def test_numpy_step_equals_the_c_step(pendulum: Any, pendulum_c: Any,
 
 
 def test_float_step_runs_to_its_precision(pendulum: Any) -> None:
-    kernel = symkin.compile(pendulum, "c", real="float", linalg="dense")
+    kernel = build_compile(pendulum, backends.get("c"), real="float")
     motion = _stepper(kernel).run(options.defaults("float"), np.array([LENGTH, MASS]), 0.0,
                                   np.array([0.5, 0.0, 0.0]), np.zeros(3), 1e-2, 100)
     assert motion.status == OK
@@ -207,7 +201,7 @@ def test_files_without_masses_get_no_dynamics(tmp_path: Path) -> None:
 def test_readme_program_runs(pendulum: Any, tmp_path: Path) -> None:
     """The README's forward-dynamics program, compiled with the strict flags, at rest from
     the horizontal: the bar starts to fall as theta'' = -3 g / (2 L)."""
-    symkin.generate(pendulum, "c", tmp_path, linalg="dense")
+    symkin.generate(pendulum, "c", tmp_path)
     readme = (tmp_path / "pendulum_README.md").read_text()
     blocks = re.findall(r"```c\n(.*?)```", readme, re.DOTALL)
     assert len(blocks) == 2
@@ -222,3 +216,18 @@ def test_readme_program_runs(pendulum: Any, tmp_path: Path) -> None:
     assert rows.shape == (10, 4)
     theta = _minimal(rows[:, 0], 0.0, 0.0)
     assert np.allclose(rows[:, 3], theta, atol=2e-9)
+
+
+def test_c_step_equals_the_python_integrator(tmp_path: Path) -> None:
+    """The pendulum of docs/topics/forward-dynamics.md (a push, inertia about the centre):
+    symkin.solve's integrator at rtol 1e-10 against 1 ms C steps, on the file's grid."""
+    path = tmp_path / "pushed.yaml"
+    path.write_text(PENDULUM.replace("time:", "initial:\n  velocities: {bar.phi: 1.5}\n"
+                                     "integrator: {rtol: 1e-10, atol: 1e-12}\ntime:"))
+    system = symkin.derive(path)
+    trajectory = symkin.solve(symkin.compile(system, "numpy"))
+    kernel = build_compile(system, backends.get("c"))
+    motion = _stepper(kernel).run(Options(), np.array([LENGTH, MASS]), 0.0,
+                                  trajectory.q[0], trajectory.dq[0], 1e-3, 1000)
+    rows = motion.q[9::10]  # t = 0.01, 0.02, ..., the file's grid after t0
+    assert np.max(np.abs(rows - trajectory.q[1:rows.shape[0] + 1])) < 1e-8
