@@ -27,17 +27,13 @@ from symkin.codegen.system_facts import (
     nonlinear_coordinates,
     parameter_pattern,
     point_names,
-    point_vectors,
+    routine_expressions,
 )
-from symkin.codegen.target import Target
+from symkin.codegen.target import Target, check_options
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
 from symkin.symbolic.ranges import Range, coordinate_ranges
 
-REAL_TYPES = ("double", "float")
-# The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
-# pivoting) or templates/c/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
-LINALG = ("dense", "sparse")
 DEFAULT_LINALG = "sparse"
 
 # The routines every backend emits, in output order, and the arguments each one takes.
@@ -238,7 +234,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         BuildError: an unknown real type, or an expression the printer cannot print, or a
             mechanism with fewer driving equations than freedoms and no masses.
     """
-    _check_options(backend, real, linalg)
+    check_options(backend, real, linalg)
     # A mechanism its forces move (fewer rows than coordinates) has no kinematic solve: its
     # code is the kernel and the dynamics step; the solver's Phi_q has no LU plan then.
     free = system.phi_q.shape[0] < len(system.q)
@@ -249,7 +245,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)
     m_pattern = mass_pattern(system)
-    expressions = _routine_expressions(system, pattern, p_pattern, m_pattern)
+    expressions = routine_expressions(system, pattern, p_pattern, m_pattern)
     printer: CodePrinter = backend.printer(real)
     prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
     prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
@@ -294,43 +290,6 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         input_places=system.input_places, nonlinear=nonlinear_coordinates(system),
         mass_rows=tuple(r for r, _ in m_pattern), mass_cols=tuple(c for _, c in m_pattern),
     )
-
-
-def _check_options(backend: Target, real: str, linalg: str) -> None:
-    if linalg not in LINALG:
-        raise BuildError(f"unknown linear algebra {linalg!r}; choose 'dense' or 'sparse'")
-    if real not in REAL_TYPES:
-        raise BuildError(f"unknown real type {real!r}; choose 'double' or 'float'")
-    if real not in backend.real_types:
-        raise BuildError(f"the {backend.title} backend computes in "
-                         f"{' or '.join(backend.real_types)} precision; use "
-                         f"real={backend.real_types[0]!r}")
-
-
-def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
-                         p_pattern: Sequence[tuple[int, int]],
-                         m_pattern: Sequence[tuple[int, int]]) -> dict[str, list[sp.Expr]]:
-    dynamics = system.dynamics
-    return {
-        "phi": list(system.phi),
-        "phi_q": [system.phi_q[r, c] for r, c in pattern],
-        "phi_t": list(system.phi_t),
-        "gamma": list(system.gamma),
-        "points": [component for vector in point_vectors(system) for component in vector],
-        "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
-        # Only where rows were removed: every other file's generated code stays as it was.
-        **({"removed": [removed.phi for removed in system.removed]} if system.removed else {}),
-        **({"dynamics_rhs": list(system.dynamics.rhs), "loads": list(system.dynamics.loads)}
-           if system.dynamics is not None else {}),
-        **({"removed_q": list(system.dynamics.removed_q),
-            "loads_full": list(system.dynamics.loads_full)}
-           if system.dynamics is not None and system.dynamics.removed_q is not None
-           and system.dynamics.loads_full is not None else {}),
-        # Only with masses: a file with forces alone has no equations of motion to integrate.
-        **({"mass": [dynamics.mass_matrix[r, c] for r, c in m_pattern],
-            "applied": list(dynamics.applied - dynamics.velocity_terms)}
-           if dynamics is not None and m_pattern else {}),
-    }
 
 
 def _fused_expressions(prepared: dict[str, list[sp.Expr]]
