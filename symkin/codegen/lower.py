@@ -23,21 +23,17 @@ from symkin.codegen.cse_tidy import _count_ops, _inline_trivial, _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.system_facts import (
+    mass_pattern,
     nonlinear_coordinates,
     parameter_pattern,
     point_names,
-    point_vectors,
-    refuse_motion,
+    routine_expressions,
 )
-from symkin.codegen.target import Target
+from symkin.codegen.target import Target, check_options
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
 from symkin.symbolic.ranges import Range, coordinate_ranges
 
-REAL_TYPES = ("double", "float")
-# The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
-# pivoting) or templates/c/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
-LINALG = ("dense", "sparse")
 DEFAULT_LINALG = "sparse"
 
 # The routines every backend emits, in output order, and the arguments each one takes.
@@ -68,6 +64,10 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     # (kept, then removed), for the runtime's minimum-norm loads (runtime.indeterminate).
     "removed_q": ("q", "t", "p"),
     "loads_full": ("q", "lam", "t", "p"),
+    # Forward dynamics, only for a file with masses: the non-zeros of M(q) (mass_rows/_cols
+    # order) and the applied forces less the velocity terms, Q - h(q, dq, t).
+    "mass": ("q", "p"),
+    "applied": ("q", "dq", "t", "p"),
 }
 DYNAMICS = ("dynamics_rhs", "loads")
 FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
@@ -182,6 +182,19 @@ class Code:
     nonlinear: tuple[int, ...] = ()
     """The coordinates that enter Phi_q or Phi_t (angles, Euler parameters, the positions of
     a prismatic pair's bodies): only their errors move Phi_q (runtime.accuracy)."""
+    mass_rows: tuple[int, ...] = ()
+    mass_cols: tuple[int, ...] = ()
+    """Forward dynamics (a file with masses): the structural non-zeros of M, row-major."""
+
+    @property
+    def forward_dynamics(self) -> bool:
+        """The ``mass`` and ``applied`` routines and the dynamics step are generated."""
+        return bool(self.mass_rows)
+
+    @property
+    def nrows(self) -> int:
+        """The rows of Phi (fewer than NQ where drivers leave freedoms to the dynamics)."""
+        return len(self.rows)
 
     @property
     def nnz(self) -> int:
@@ -218,26 +231,35 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         linalg: ``"sparse"`` (default) or ``"dense"``, the LU behind the C solver.
 
     Raises:
-        BuildError: an unknown real type, or an expression the printer cannot print.
+        BuildError: an unknown real type, or an expression the printer cannot print, or a
+            mechanism with fewer driving equations than freedoms and no masses.
     """
-    _check_options(backend, real, linalg)
-    refuse_motion(system)
+    check_options(backend, real, linalg)
+    # A mechanism its forces move (fewer rows than coordinates) has no kinematic solve: its
+    # code is the kernel and the dynamics step; the solver's Phi_q has no LU plan then.
+    free = system.phi_q.shape[0] < len(system.q)
+    if free and not mass_pattern(system):
+        raise BuildError("the mechanism has fewer driving equations than freedoms and no "
+                         "masses: its motion is not determined; give its bodies masses")
     internal = symbol_printing.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)
-    expressions = _routine_expressions(system, pattern, p_pattern)
+    m_pattern = mass_pattern(system)
+    expressions = routine_expressions(system, pattern, p_pattern, m_pattern)
     printer: CodePrinter = backend.printer(real)
     prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
     prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
     fused, shared = _fused_expressions(prepared)
-    sizes = {"phi_phi_q": (len(system.q), len(pattern), len(shared))}
+    # Phi's rows: as many as coordinates, or fewer where the dynamics moves the rest
+    nphi = len(system.phi)
+    sizes = {"phi_phi_q": (nphi, len(pattern), len(shared))}
     orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
     # Phi and Phi_q alone are the fused routine's pieces: its CSE and printing serve all three.
     fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse,
                                  orders["phi_phi_q"])
-    nq, nnz = len(system.q), len(pattern)
-    own = {"phi": _select("phi", fused_parts, {k: k for k in range(nq)}, nq),
-           "phi_q": _select("phi_q", fused_parts, {nq + e: e for e in range(nnz)}, nnz),
+    nnz = len(pattern)
+    own = {"phi": _select("phi", fused_parts, {k: k for k in range(nphi)}, nphi),
+           "phi_q": _select("phi_q", fused_parts, {nphi + e: e for e in range(nnz)}, nnz),
            "phi_phi_q": _assemble("phi_phi_q", fused_parts, len(fused["phi_phi_q"]),
                                   sizes["phi_phi_q"])}
     routines = tuple(
@@ -254,10 +276,10 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         pattern_rows=tuple(r for r, _ in pattern), pattern_cols=tuple(c for _, c in pattern),
         points=point_names(system), routines=routines,
         ops_before_cse=_ops_before_cse(expressions, fused, shared),
-        linalg=linalg,
+        linalg="dense" if free else linalg,
         phi_p_rows=tuple(r for r, _ in p_pattern), phi_p_cols=tuple(c for _, c in p_pattern),
         lu_plan=(sample.sparse_lu_plan(system, pattern)
-                 if backend.plans_lu(linalg) else None),
+                 if backend.plans_lu(linalg) and not free else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         removed=tuple(str(removed) for removed in system.removed),
@@ -266,38 +288,8 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         joint_names=system.dynamics.joint_names if system.dynamics else (),
         input_names=system.input_names, input_values=sample.input_values(system),
         input_places=system.input_places, nonlinear=nonlinear_coordinates(system),
+        mass_rows=tuple(r for r, _ in m_pattern), mass_cols=tuple(c for _, c in m_pattern),
     )
-
-
-def _check_options(backend: Target, real: str, linalg: str) -> None:
-    if linalg not in LINALG:
-        raise BuildError(f"unknown linear algebra {linalg!r}; choose 'dense' or 'sparse'")
-    if real not in REAL_TYPES:
-        raise BuildError(f"unknown real type {real!r}; choose 'double' or 'float'")
-    if real not in backend.real_types:
-        raise BuildError(f"the {backend.title} backend computes in "
-                         f"{' or '.join(backend.real_types)} precision; use "
-                         f"real={backend.real_types[0]!r}")
-
-
-def _routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
-                         p_pattern: Sequence[tuple[int, int]]) -> dict[str, list[sp.Expr]]:
-    return {
-        "phi": list(system.phi),
-        "phi_q": [system.phi_q[r, c] for r, c in pattern],
-        "phi_t": list(system.phi_t),
-        "gamma": list(system.gamma),
-        "points": [component for vector in point_vectors(system) for component in vector],
-        "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
-        # Only where rows were removed: every other file's generated code stays as it was.
-        **({"removed": [removed.phi for removed in system.removed]} if system.removed else {}),
-        **({"dynamics_rhs": list(system.dynamics.rhs), "loads": list(system.dynamics.loads)}
-           if system.dynamics is not None else {}),
-        **({"removed_q": list(system.dynamics.removed_q),
-            "loads_full": list(system.dynamics.loads_full)}
-           if system.dynamics is not None and system.dynamics.removed_q is not None
-           and system.dynamics.loads_full is not None else {}),
-    }
 
 
 def _fused_expressions(prepared: dict[str, list[sp.Expr]]

@@ -29,14 +29,17 @@ from symkin.contract.manifest import GENERATOR, MANIFEST_SUFFIX, Manifest, Metad
 from symkin.errors import BuildError, UsageError
 from symkin.symbolic.derivation import System
 
+# Templates rendered only for a file with masses (Code.forward_dynamics).
+DYNAMICS_TEMPLATES = ("dynamics",)
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
              "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out", "removed": "out",
              "dynamics_rhs": "out", "loads": "out", "dynamics_rhs_shared": "out",
-             "loads_shared": "out", "removed_q": "out", "loads_full": "out"}
+             "loads_shared": "out", "removed_q": "out", "loads_full": "out",
+             "mass": "nz", "applied": "out"}
 # The output arrays of a routine with several (Routine.sizes), in order.
 _C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
-                "phi_phi_q": "phi_phi_q_nz"}
+                "phi_phi_q": "phi_phi_q_nz", "mass": "mass_nz"}
 _PYTHON_DOC = {
     "phi": "Phi(q, t), shape (NQ,).",
     "phi_q": "The non-zeros of Phi_q in pattern order, shape (NNZ,).",
@@ -55,6 +58,8 @@ _PYTHON_DOC = {
     "loads_shared": "loads from the shared values of phi_phi_q_nz at the same q, t, p.",
     "removed_q": "The removed rows' Jacobian, row-major, shape (NREMOVED * NQ,).",
     "loads_full": "loads from lam of every row: the kept rows' (NQ), then the removed rows'.",
+    "mass": "The non-zeros of the mass matrix M(q) in MASS_ROWS/COLS order, shape (NNZ_M,).",
+    "applied": "The applied forces less the velocity terms, Q(q, dq, t) - h(q, dq), (NQ,).",
 }
 
 
@@ -78,6 +83,8 @@ def render_sources(code: Code) -> dict[str, str]:
     files = {}
     backend = code.backend
     for template in template_names(backend, code.linalg):
+        if template.split(".")[0] in DYNAMICS_TEMPLATES and not code.forward_dynamics:
+            continue  # the dynamics step is for a file with masses only
         name = backend.output_name(template, code.name)
         files[name] = _render(backend, template,
                               {**context, "template": template, "file_name": name,
@@ -293,6 +300,10 @@ def template_context(code: Code) -> dict[str, Any]:
         # a spatial driver's effort is conjugate to its function (symbolic.dynamics3d)
         "effort_text": "lam dPhi/df" if code.space == "3d" else "-lam",
         "driver_literals": [repr(n) for n in code.driver_names],
+        # Forward dynamics (only when the file gives masses).
+        "forward_dynamics": code.forward_dynamics, "nrows": code.nrows,
+        "nnz_m": len(code.mass_rows), "mass_rows": list(code.mass_rows),
+        "mass_cols": list(code.mass_cols),
         "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "newton_defaults": _newton_defaults(code, literal),
@@ -373,8 +384,10 @@ def _labels(code: Code, routine: str) -> list[str]:
         return [lower.comment(row) for row in code.removed]
     if routine.endswith("_shared") and routine[:-len("_shared")] in lower.DYNAMICS:
         return _labels(code, routine[:-len("_shared")])
-    if routine == "dynamics_rhs":
+    if routine in ("dynamics_rhs", "applied"):
         return [lower.comment(name) for name in code.coordinates]
+    if routine == "mass":
+        return [f"({r}, {c})" for r, c in zip(code.mass_rows, code.mass_cols)]
     if routine == "removed_q":
         return [lower.comment(f"({row}, {name})") for row in code.removed
                 for name in code.coordinates]

@@ -12,6 +12,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Protocol
 
+from symkin.errors import BuildError
+
 
 class Target(Protocol):
     """One language code generation writes.
@@ -78,3 +80,21 @@ def file_name(template: str, prefix: str, module_template: str) -> str:
     stem."""
     stem, suffix = template.removesuffix(".j2").rsplit(".", 1)
     return f"{prefix}.{suffix}" if stem == module_template else f"{prefix}_{stem}.{suffix}"
+
+
+REAL_TYPES = ("double", "float")
+# The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
+# pivoting) or templates/c/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
+LINALG = ("dense", "sparse")
+
+
+def check_options(backend: Target, real: str, linalg: str) -> None:
+    """Refuse an unknown linear algebra or real type, or one ``backend`` does not compute in."""
+    if linalg not in LINALG:
+        raise BuildError(f"unknown linear algebra {linalg!r}; choose 'dense' or 'sparse'")
+    if real not in REAL_TYPES:
+        raise BuildError(f"unknown real type {real!r}; choose 'double' or 'float'")
+    if real not in backend.real_types:
+        raise BuildError(f"the {backend.title} backend computes in "
+                         f"{' or '.join(backend.real_types)} precision; use "
+                         f"real={backend.real_types[0]!r}")

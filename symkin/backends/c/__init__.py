@@ -27,6 +27,7 @@ PURPOSES = {
     "linalg": "the solver's linear algebra on the dense LU",
     "sparse_lu": "sparse LU of Phi_q with its pivot order fixed at generation time",
     "dense_lu": "dense LU with partial pivoting (also the sparse LU's fall-back)",
+    "dynamics": "forward dynamics of {name}: one integrator step a call",
     "README": "how to build and call the solver of {name} in a controller loop",
 }
 # linalg.*.j2 (on the dense LU) and sparse_lu.*.j2 define the same functions: only the chosen

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from symkin.backends.c import lu_code, norm_code, op_budget
+from symkin.backends.c import dynamics_budget, lu_code, norm_code, op_budget
 from symkin.backends.c.printer import literal
 from symkin.codegen.lower import Code
 from symkin.contract import lengths, options
@@ -21,8 +21,8 @@ def template_context(code: Code) -> dict[str, Any]:
              if not (lu and lu["style"] == "tables") else None)
     scale_free = lengths.scale_free_constants(code.constant_nz, code.pattern_rows,
                                               code.pattern_cols, code.coordinates)
-    budget = op_budget.budget(code, lu, norm1, bool(scale_free),
-                              int(options.c_defaults(code.real)["max_iterations"]))
+    cap = int(options.c_defaults(code.real)["max_iterations"])
+    budget = op_budget.budget(code, lu, norm1, bool(scale_free), cap)
     return {
         # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
         "libm_suffix": "f" if code.real == "float" else "",
@@ -41,4 +41,7 @@ def template_context(code: Code) -> dict[str, Any]:
                        "step": budget.step.total, "dense_step": budget.dense_step.total,
                        "positions": budget.positions.total if budget.positions else None,
                        "inputs": budget.inputs.total if budget.inputs else None},
+        # the same for <prefix>_dynamics_step, in a file with masses only
+        **({"dynamics_budget": dynamics_budget.template_context(code, cap)}
+           if code.forward_dynamics else {}),
     }
