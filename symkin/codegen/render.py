@@ -79,9 +79,11 @@ def render_sources(code: Code) -> dict[str, str]:
     backend = code.backend
     for template in template_names(backend, code.linalg):
         name = backend.output_name(template, code.name)
-        files[name] = _render(backend, template,
-                              {**context, "template": template, "file_name": name,
-                               "header": header_lines(code, template, name)})
+        text = _render(backend, template,
+                       {**context, "template": template, "file_name": name,
+                        "header": header_lines(code, template, name)})
+        if text.strip():  # a template for what this mechanism lacks renders to nothing
+            files[name] = text
     return dict(sorted(files.items()))
 
 
