@@ -78,16 +78,15 @@ class Session:
     def exists(self, function: str) -> bool:
         """Whether ``function`` is a function Octave finds on its path."""
         found = self.evaluate(f"double(any(exist({_string(function)}) == [2 3 5]))", function)
-        return bool(found.size and found[0])
+        return bool(found.size and found.flat[0])
 
     def arguments_of(self, function: str) -> int:
         """How many arguments ``function`` declares (nargin; negative with varargin)."""
-        return int(self.evaluate(f"nargin({_string(function)})", function)[0])
+        return int(self.evaluate(f"nargin({_string(function)})", function).flat[0])
 
     def call(self, function: str, arguments: Sequence[object], output: int = 1
              ) -> NDArray[np.float64]:
-        """``function(arguments...)``'s output number ``output`` (1-based) as a flat array,
-        column by column as MATLAB stores it."""
+        """``function(arguments...)``'s output number ``output`` (1-based), 2-D as in MATLAB."""
         if not _NAME.match(function):
             raise BuildError(f"internal error: {function!r} is not a MATLAB function name")
         text = ", ".join(argument(a) for a in arguments)  # type: ignore[arg-type]
@@ -96,16 +95,21 @@ class Session:
 
     def evaluate(self, expression: str, origin: str, target: str = "symkin_r"
                  ) -> NDArray[np.float64]:
-        """The value of an expression symkin wrote, flat (column-major)."""
-        line = (f"try, {target} = {expression}; fprintf('%.17g\\n', full(double(symkin_r)));"
-                f" fprintf('{_END}\\n'); catch symkin_e, fprintf('{_ERROR}%s\\n',"
-                f" strrep(symkin_e.message, char(10), ' ')); end")
+        """The value of an expression symkin wrote, as a 2-D array of MATLAB's shape."""
+        line = (f"try, {target} = {expression}; symkin_r = full(double(symkin_r));"
+                " fprintf('%d\\n', size(symkin_r, 1)); fprintf('%.17g\\n', symkin_r);"
+                f" fprintf('{_END}\\n'); catch symkin_e, fprintf('{_ERROR}%s',"
+                " strrep(symkin_e.message, char(10), ' ')); if ~isempty(symkin_e.stack),"
+                " fprintf(' (%s, line %d)', symkin_e.stack(1).name, symkin_e.stack(1).line);"
+                " end; fprintf('\\n'); end")
         with self._lock:
             if self._process is None or self._process.poll() is not None:
                 self._process = self._start()
             self._send(self._process, line)
             values = self._read(self._process, origin)
-        return np.array([float(v) for v in values], dtype=float)
+        rows = int(values[0]) if values else 0
+        flat = np.array([float(v) for v in values[1:]], dtype=float)
+        return flat.reshape((rows, -1) if rows else (0, 0), order="F")
 
     def _send(self, process: subprocess.Popen[str], line: str) -> None:
         assert process.stdin is not None

@@ -22,12 +22,13 @@ class _OctaveFunctions:
 
     def __init__(self, session: Session, name: str, meta: Mapping[str, Any]) -> None:
         self._session, self._name = session, name
-        self.point_size = 3 if meta.get("space") == "3d" else 2
         self.removed: Callable[[Array, float, Array], Array] | None = (
             (lambda q, t, p: self._call("removed", q, t, p)) if meta.get("removed") else None)
 
     def _call(self, what: str, *arguments: object, output: int = 1) -> Array:
-        return self._session.call(f"{self._name}_{what}", arguments, output)
+        # a column (MATLAB's shape) read flat; <prefix>_points' rows (a point each) row by row
+        return np.asarray(self._session.call(f"{self._name}_{what}", arguments, output)
+                          .reshape(-1), dtype=float)
 
     def phi(self, q: Array, t: float, p: Array) -> Array:
         return self._call("phi", q, t, p)
@@ -42,8 +43,7 @@ class _OctaveFunctions:
         return self._call("gamma", q, dq, t, p)
 
     def points(self, p: Array) -> Array:
-        # <prefix>_points gives one row a point; the Kernel wants them flat, point by point.
-        return _row_major(self._call("points", p), self.point_size)
+        return self._call("points", p)
 
     def phi_p_nz(self, q: Array, t: float, p: Array) -> Array:
         return self._call("phi_p", q, t, p, output=2)
@@ -59,11 +59,6 @@ class _OctaveFunctions:
 
     def loads_full(self, q: Array, lam: Array, t: float, p: Array) -> Array:
         return self._call("loads_full", q, lam, t, p)
-
-
-def _row_major(column_major: Array, size: int) -> Array:
-    """MATLAB's (points x size) matrix, read column by column, back to point-by-point order."""
-    return np.asarray(column_major.reshape(size, -1).T.reshape(-1), dtype=float)
 
 
 def session(folder: Path) -> Session:
