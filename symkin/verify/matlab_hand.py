@@ -66,8 +66,10 @@ def hand_names(path: Path) -> tuple[Path, list[str]]:
     if path.is_dir():
         names = [name for name in FUNCTIONS if (path / f"{name}.m").is_file()]
         if not names:
-            raise HandModuleError(f"{path} holds none of {known} (one function a file, "
-                                  "named as the function, e.g. Wiezy.m)")
+            raise HandModuleError(f"{path} is a folder that holds none of {known} (MATLAB/"
+                                  "Octave hand files: one function a file, named as the "
+                                  "function, e.g. Wiezy.m); a Python hand derivation is one "
+                                  ".py file")
         return path, names
     if not path.is_file():
         raise HandModuleError(f"{path} does not exist; give a .m file or the folder of the "
