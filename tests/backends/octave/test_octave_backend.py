@@ -122,7 +122,7 @@ def test_octave_runs_equal_numpy(path: Path) -> None:
     octave, numpy = (symkin.compile(system, backend=b) for b in ("octave", "numpy"))
     assert octave.backend == "octave"
     t0, t1, dt = system.time_grid
-    times = t0 + dt * np.arange(min(6, int(round((t1 - t0) / dt)) + 1))
+    times = t0 + dt * np.arange(min(6, round((t1 - t0) / dt) + 1))
     runs = [symkin.solve(k, t=times, **_inputs(system, times)) for k in (octave, numpy)]
     for field in ("q", "dq", "d2q"):
         ours, theirs = (np.asarray(getattr(run, field)) for run in runs)
@@ -195,8 +195,8 @@ def test_without_octave_the_backend_says_so(tmp_path: Path) -> None:
     env = {**os.environ, "PATH": str(Path(sys.executable).parent)}
     done = subprocess.run([sys.executable, "-m", "symkin", "run",
                            str(ROOT / "examples" / "crank_slider.yaml"), "--backend", "octave",
-                           "-o", str(tmp_path / "run.csv")], capture_output=True, text=True, timeout=300,
-                          env=env)
+                           "-o", str(tmp_path / "run.csv")], capture_output=True, text=True,
+                          timeout=300, env=env)
     assert done.returncode == 2
     assert "octave-cli" in done.stderr and "not on PATH" in done.stderr
     assert "Traceback" not in done.stderr
