@@ -34,8 +34,8 @@ from symkin.symbolic.derivation import System
 from symkin.symbolic.ranges import Range, coordinate_ranges
 
 REAL_TYPES = ("double", "float")
-# The linear algebra behind the C solver: templates/c/linalg.*.j2 (dense LU with partial
-# pivoting) or templates/c/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
+# The linear algebra behind the C solver: the C backend's linalg.*.j2 (dense LU with partial
+# pivoting) or sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
 LINALG = ("dense", "sparse")
 DEFAULT_LINALG = "sparse"
 

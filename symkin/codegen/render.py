@@ -19,7 +19,6 @@ from typing import Any
 
 import jinja2
 
-from symkin import resources
 from symkin.codegen import lower
 from symkin.codegen.lower import Code, Routine
 from symkin.codegen.target import Target
@@ -59,10 +58,10 @@ _PYTHON_DOC = {
 
 
 @functools.cache
-def environment(root: str | None = None) -> jinja2.Environment:
-    """The strict jinja2 environment over the template folder (cached per folder)."""
+def environment(root: str) -> jinja2.Environment:
+    """The strict jinja2 environment over a backend's template root (cached per folder)."""
     return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(root or str(resources.template_root())),
+        loader=jinja2.FileSystemLoader(root),
         undefined=jinja2.StrictUndefined, keep_trailing_newline=True, trim_blocks=True,
         lstrip_blocks=True, autoescape=False)
 
