@@ -32,7 +32,8 @@ PURPOSES = {
     "gamma": "Gamma(q, dq, t, p) of {name}: the right-hand side of Phi_q ddq = Gamma",
     "phi_p": "Phi_p(q, t, p) of {name}: d Phi / d p (sparse), and its non-zeros",
     "points": "the named points' local vectors of {name}, one row a point",
-    "positions": "the named points' global positions, velocities and accelerations of {name}",
+    "point_kinematics": "the named points' global positions, velocities and accelerations of "
+                        "{name}",
     "removed": "the rows of {name} removed as dependent at t0, for the check along the motion",
     "dynamics_rhs": "Q - M ddq - h(q, dq) of {name}: the right-hand side of Phi_q' lam = rhs",
     "loads": "the efforts and joint reactions of {name} from the multipliers lam",

@@ -73,7 +73,7 @@ def test_generated_m_files_run_in_matlab_too(generated: dict[str, Path], name: s
     files = sorted(generated[name].glob("*.m"))
     assert {f.stem for f in files} >= {f"{name}_{what}" for what in
                                         ("phi", "phi_q", "phi_t", "gamma", "points", "data",
-                                         "solve")}
+                                         "solve", "point_kinematics")}
     for path in files:
         text = path.read_text(encoding="utf-8")
         assert not lint(text), f"{path.name}: {lint(text)}"
@@ -173,6 +173,33 @@ def test_the_generated_driver_solves_as_numpy(generated: dict[str, Path], name: 
         ours = table[:, 1 + k * nq: 1 + (k + 1) * nq]
         theirs = np.asarray(getattr(numpy, field))
         assert np.max(np.abs(ours - theirs)) <= 1e-9 * (1 + np.max(np.abs(theirs))), field
+
+
+@needs_octave
+@pytest.mark.parametrize("name", ["crank_slider", "spatial_slider_crank"])
+def test_point_kinematics_equal_the_trajectorys(generated: dict[str, Path], name: str) -> None:
+    """<prefix>_point_kinematics (r + R s and its derivatives; spatial: R from the Euler
+    parameters) equals the runtime's points at a row of a NumPy run."""
+    numpy = symkin.solve(symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"),
+                                        backend="numpy"))
+    expected = numpy.point_arrays()
+    row = 7
+
+    def column(values: np.ndarray) -> str:
+        return "[" + ";".join(repr(float(v)) for v in values) + "]"
+
+    state = ", ".join(column(getattr(numpy, f)[row]) for f in ("q", "dq", "d2q"))
+    script = (f"[P, V, A] = {name}_point_kinematics({state}); "
+              "fprintf('%.17g\\n', [P(:); V(:); A(:)]);")
+    result = subprocess.run(["octave-cli", "--norc", "--quiet", "--eval", script],
+                            cwd=generated[name], capture_output=True, text=True, timeout=120,
+                            check=True)
+    values = np.array(result.stdout.split(), dtype=float)
+    count, size = expected[0].shape[1:]
+    assert values.size == 3 * count * size
+    for k, array in enumerate(expected):
+        ours = values[k * count * size:(k + 1) * count * size].reshape(size, count).T
+        assert np.max(np.abs(ours - array[row])) <= 1e-13 * (1 + np.max(np.abs(array[row])))
 
 
 @needs_octave
