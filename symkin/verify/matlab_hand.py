@@ -21,8 +21,8 @@ from symkin.errors import BuildError
 from symkin.octave_process import OctaveError, Session
 from symkin.runtime.arguments import grid
 from symkin.verify.hand import HandModuleError
-from symkin.verify.numeric import Derived, relative_errors, show_expression
-from symkin.verify.report import FunctionResult, Mismatch, Report
+from symkin.verify.numeric import FLOOR_OF_LENGTH, Derived, mismatches, show_expression
+from symkin.verify.report import FunctionResult, Report
 from symkin.verify.sampling import State, length_scale
 
 
@@ -187,20 +187,12 @@ def _compare(derived: Derived, session: Session, name: str, states: list[State],
     shape = (rows, size) if function.kind == "phi_q" else (rows,)
     hand = np.array([_call(session, name, count, s, shape, origin) for s in states])
     ours = np.array([_ours(derived, function.kind, s).reshape(shape) for s in states])
-    errors = relative_errors(ours, hand, 1e-6 * length_scale(system))
-    bad = errors > tolerance
-    mismatches = []
-    for index in zip(*np.nonzero(bad.any(axis=0))):
-        worst = int(np.argmax(errors[(slice(None), *index)]))
-        row, column = int(index[0]), (int(index[1]) if len(index) > 1 else None)
-        mismatches.append(Mismatch(
-            function=name, row=row, column=column, owner=_owner(derived, function.kind, row),
-            coordinate=system.coordinates[column] if column is not None else None,
-            derived=_expression(derived, function.kind, row, column),
-            derived_value=float(ours[(worst, *index)]), hand_value=float(hand[(worst, *index)]),
-            error=float(errors[(worst, *index)]), sample=worst,
-            failing=int(bad[(slice(None), *index)].sum()), state=states[worst], base=1))
-    return FunctionResult(name, int(np.prod(shape)), tuple(mismatches))
+    found = mismatches(
+        name, ours, hand, states, tolerance, FLOOR_OF_LENGTH * length_scale(system),
+        lambda row: _owner(derived, function.kind, row),
+        lambda row, column: _expression(derived, function.kind, row, column),
+        system.coordinates, base=1)
+    return FunctionResult(name, int(np.prod(shape)), found)
 
 
 def _owner(derived: Derived, kind: str, row: int) -> str:

@@ -10,17 +10,9 @@ from sympy.printing.octave import OctaveCodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
 from symkin.codegen.symbol_printing import symbol_text
+from symkin.octave_process import number as literal
 
 _ELEMENT = re.compile(r"(\w+)\[(\d+)\]\Z")
-
-
-def literal(value: float) -> str:
-    """A double as MATLAB reads it back exactly (repr's shortest round trip; Inf and NaN)."""
-    if value != value:
-        return "NaN"
-    if value in (float("inf"), float("-inf")):
-        return "Inf" if value > 0 else "-Inf"
-    return repr(float(value))
 
 
 class MatlabPrinter(OctaveCodePrinter):
