@@ -66,10 +66,10 @@ class OctaveBackend:
         return MatlabPrinter()
 
     def literal(self, real: str) -> Callable[[float], str]:
-        from symkin.backends.octave.printer import literal
+        from symkin.octave_process import number
 
         del real
-        return literal
+        return number
 
     def templates(self, linalg: str) -> list[str]:
         del linalg  # MATLAB's backslash does the linear algebra
