@@ -93,5 +93,10 @@ class UsageError(SymkinError):
     fit); the command line exits with status 2."""
 
 
+class MissingToolError(UsageError, BuildError):
+    """A backend asked for by name needs a program this machine lacks (GNU Octave for the
+    octave backend; exit status 2)."""
+
+
 class NoCompilerError(UsageError, BuildError):
     """The C backend was asked for by name and there is no C compiler (exit status 2)."""

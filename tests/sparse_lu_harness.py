@@ -17,9 +17,9 @@ from pathlib import Path
 import jinja2
 import numpy as np
 
+from symkin import backends
 from symkin.backends.c import lu_code
 from symkin.codegen import lu_plan as sparse_lu
-from symkin.resources import template_root
 
 CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", "-O2", "-fPIC", "-shared"]
 
@@ -94,7 +94,7 @@ def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
            constants: Sequence[float | None] | None = None) -> dict[str, str]:
     """Render the sparse LU templates and the dense LU they fall back to, with a context
     shaped like the codegen stream's."""
-    env = jinja2.Environment(loader=jinja2.FileSystemLoader(template_root()),
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(backends.get("c").template_root),
                              undefined=jinja2.StrictUndefined, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True)
     context = {"prefix": prefix, "PREFIX": prefix.upper(), "nq": nq, "nnz": len(rows),
@@ -102,7 +102,7 @@ def render(prefix: str, nq: int, rows: Sequence[int], cols: Sequence[int],
                "pattern_cols": list(cols), "spec_sha256": "0" * 64,
                "lu": lu_code.template_context(plan, style=style, constants=constants,
                                                 real=real, prefix=prefix)}
-    return {f"{prefix}_{name[:-3]}": env.get_template(f"c/{name}").render(
+    return {f"{prefix}_{name[:-3]}": env.get_template(f"templates/{name}").render(
                 template=name, header=[f"{prefix}_{name[:-3]}: sparse LU test harness"], **context)
             for name in ("sparse_lu.h.j2", "sparse_lu.c.j2", "dense_lu.h.j2", "dense_lu.c.j2")}
 

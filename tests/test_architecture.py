@@ -25,7 +25,7 @@ def test_import_contracts_are_kept() -> None:
 def test_no_module_is_too_long() -> None:
     """Modules and templates alike (a template splits into partials: {% include %} of a
     ``_name.j2`` file, which renders to no file of its own)."""
-    paths = [*(ROOT / "symkin").rglob("*.py"), *(ROOT / "templates").rglob("*.j2")]
+    paths = [*(ROOT / "symkin").rglob("*.py"), *(ROOT / "symkin").rglob("*.j2")]
     long = {str(path.relative_to(ROOT)): n for path in paths
             if (n := len(path.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES}
     assert not long, f"split these modules: {long}"
@@ -35,15 +35,17 @@ def test_partial_templates_are_included_not_rendered() -> None:
     from symkin import backends
     from symkin.codegen import render
 
-    templates = ROOT / "templates"
     for name in backends.names():
         for linalg in ("dense", "sparse"):
             rendered = render.template_names(backends.get(name), linalg)
             assert rendered and not [name for name in rendered if name.startswith("_")]
-    sources = "".join(path.read_text(encoding="utf-8") for path in templates.rglob("*.j2"))
-    for partial in templates.rglob("_*.j2"):
-        name = partial.relative_to(templates).as_posix()
-        assert f'{{% include "{name}" %}}' in sources, f"{name} is included nowhere"
+        # each backend's templates live in its own folder and include each other there
+        root = backends.get(name).template_root
+        folder = root / backends.get(name).template_folder
+        sources = "".join(path.read_text(encoding="utf-8") for path in folder.rglob("*.j2"))
+        for partial in folder.rglob("_*.j2"):
+            included = partial.relative_to(root).as_posix()
+            assert f'{{% include "{included}" %}}' in sources, f"{partial} is included nowhere"
 
 
 def _tool(module: str, *arguments: str) -> subprocess.CompletedProcess[str]:

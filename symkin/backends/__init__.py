@@ -1,4 +1,5 @@
-"""The backend registry: the one place that knows the concrete backends (``c``, ``numpy``).
+"""The backend registry: the one place that knows the concrete backends (``c``, ``numpy``,
+``octave``).
 
 Everything that takes a backend by name (the public API, the CLI, a manifest or warm-run entry
 naming one) asks here and hands the object down; the stages (codegen, build, runtime) only
@@ -13,7 +14,7 @@ import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from symkin.backends import c, numpy
+from symkin.backends import c, numpy, octave
 from symkin.build.backend import Backend
 from symkin.errors import BuildError, SymkinWarning
 
@@ -23,7 +24,9 @@ if TYPE_CHECKING:  # the CLI imports the registry for --backend: no NumPy at sta
 AUTO = "auto"
 """The first registered backend that can build on this machine (C, else NumPy with a note)."""
 
-_BUILT_IN: tuple[Backend, ...] = (c.BACKEND, numpy.BACKEND)  # in order of preference
+# in order of preference ("auto" takes the first that builds here; octave never: NumPy
+# always can)
+_BUILT_IN: tuple[Backend, ...] = (c.BACKEND, numpy.BACKEND, octave.BACKEND)
 _REGISTERED: dict[str, Backend] = {backend.name: backend for backend in _BUILT_IN}
 
 

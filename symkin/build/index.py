@@ -33,7 +33,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin import resources
 from symkin.build.backend import Backend
 from symkin.build.cache import discard, open_cache, sha256_of
 from symkin.contract.manifest import MANIFEST_SUFFIX
@@ -166,7 +165,7 @@ def code_version() -> str:
     misses. Hashing the source, not a version number, also covers a working tree.
     """
     digest = hashlib.sha256()
-    for root in sorted({_PACKAGE, resources.template_root()}):
+    for root in (_PACKAGE,):  # the backends' templates are inside it
         for path in sorted(root.rglob("*")):
             if path.is_file() and path.suffix != ".pyc" and "__pycache__" not in path.parts:
                 digest.update(path.relative_to(root).as_posix().encode() + b"\0")

@@ -1,4 +1,4 @@
-"""``symkin verify MECH --against HAND.py``."""
+"""``symkin verify MECH --against HAND.py | HAND.m | FOLDER``."""
 
 from __future__ import annotations
 
@@ -10,7 +10,14 @@ from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 from symkin.cli.messages import printable
 from symkin.symbolic.derivation import derive
 from symkin.verify.hand import HandModuleError
-from symkin.verify.numeric import DEFAULT_SAMPLES, DEFAULT_SPREAD, DEFAULT_TOLERANCE, verify
+from symkin.verify.matlab_hand import is_matlab, verify_matlab
+from symkin.verify.numeric import (
+    DEFAULT_SAMPLES,
+    DEFAULT_SPREAD,
+    DEFAULT_TOLERANCE,
+    derived_functions,
+    verify,
+)
 
 
 def command(mechanism: str | Path, against: str | Path, *, samples: int = DEFAULT_SAMPLES,
@@ -28,8 +35,12 @@ def command(mechanism: str | Path, against: str | Path, *, samples: int = DEFAUL
         return EXIT_BAD_INPUT
     system = derive(mechanism)
     try:
-        report = verify(system, against, samples=samples, seed=seed, spread=spread,
-                        tolerance=tolerance)
+        if is_matlab(against):  # .m files, run in Octave at the nominal design
+            report = verify_matlab(derived_functions(system), against, samples=samples,
+                                   seed=seed, tolerance=tolerance)
+        else:
+            report = verify(system, against, samples=samples, seed=seed, spread=spread,
+                            tolerance=tolerance)
     except HandModuleError as error:
         print(f"symkin verify: error: {printable(str(error))}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -19,7 +19,6 @@ from typing import Any
 
 import jinja2
 
-from symkin import resources
 from symkin.codegen import lower
 from symkin.codegen.lower import Code, Routine
 from symkin.codegen.target import Target
@@ -64,10 +63,10 @@ _PYTHON_DOC = {
 
 
 @functools.cache
-def environment(root: str | None = None) -> jinja2.Environment:
-    """The strict jinja2 environment over the template folder (cached per folder)."""
+def environment(root: str) -> jinja2.Environment:
+    """The strict jinja2 environment over a backend's template root (cached per folder)."""
     return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(root or str(resources.template_root())),
+        loader=jinja2.FileSystemLoader(root),
         undefined=jinja2.StrictUndefined, keep_trailing_newline=True, trim_blocks=True,
         lstrip_blocks=True, autoescape=False)
 
@@ -86,9 +85,11 @@ def render_sources(code: Code) -> dict[str, str]:
         if template.split(".")[0] in DYNAMICS_TEMPLATES and not code.forward_dynamics:
             continue  # the dynamics step is for a file with masses only
         name = backend.output_name(template, code.name)
-        files[name] = _render(backend, template,
-                              {**context, "template": template, "file_name": name,
-                               "header": header_lines(code, template, name)})
+        text = _render(backend, template,
+                       {**context, "template": template, "file_name": name,
+                        "header": header_lines(code, template, name)})
+        if text.strip():  # a template for what this mechanism lacks renders to nothing
+            files[name] = text
     return dict(sorted(files.items()))
 
 

@@ -3,7 +3,7 @@ can be trusted to the accuracy targets.
 
 The estimate of ||Phi_q^-1||_1 is Hager's method with Higham's refinements (the algorithm of
 LAPACK's xLACN2): a few solves with the factors already made, never a new factorization. The
-generated C solver (templates/c/solver.c.j2) runs the same steps and the same error model, so
+generated C solver (the C backend's solver.c.j2) runs the same steps and the same error model, so
 both backends flag the same points.
 
 The error model has two stages. The norm bound, with u the unit roundoff and
@@ -121,7 +121,7 @@ def worst_column(solve: Solve, solve_transposed: Solve, n: int) -> Array:
     """The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds (the solve of
     x = 1/n first, then of the unit vectors it moves to): near a singularity every column lies
     along the null direction, the one in which the rounding of Phi moves q. Not finite where a
-    solve is not. The generated C (templates/c/_error_model.c.j2) takes the same steps."""
+    solve is not. The generated C (the C backend's _error_model.c.j2) takes the same steps."""
     at = -1  # x = 1/n until the ascent moves to the unit vector e_at
     y = solve(np.full(n, 1.0 / n))
     norm = float(np.abs(y).sum())

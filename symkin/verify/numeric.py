@@ -173,20 +173,36 @@ def _compare_function(derived: Derived, name: str, function: Callable[..., Any],
     shape = (rows, derived.size) if name == "phi_q" else (rows,)
     hand = np.array([call_hand(name, function, s, origin, shape) for s in states])
     ours = np.array([derived.evaluate(name, s).reshape(shape) for s in states])
-    errors = relative_errors(ours, hand, FLOOR_OF_LENGTH * length_scale(derived.system))
+    system = derived.system
+    found = mismatches(
+        name, ours, hand, states, tolerance, FLOOR_OF_LENGTH * length_scale(system),
+        lambda row: str(system.rows[row]),
+        lambda row, column: show_expression(system, derived.expression(name, row, column)),
+        system.coordinates)
+    return FunctionResult(name, int(np.prod(shape)), found)
+
+
+def mismatches(name: str, ours: np.ndarray, hand: np.ndarray, states: list[State],
+               tolerance: float, least: float, owner: Callable[[int], str],
+               expression: Callable[[int, int | None], str], coordinates: tuple[str, ...],
+               base: int = 0) -> tuple[Mismatch, ...]:
+    """Every entry (row, or row and column) whose relative error exceeds ``tolerance`` in some
+    sample, with its worst sample; ``owner`` and ``expression`` label an entry, ``base`` is
+    where the hand file counts from (1 in MATLAB)."""
+    errors = relative_errors(ours, hand, least)
     bad = errors > tolerance
-    mismatches = []
+    found = []
     for index in zip(*np.nonzero(bad.any(axis=0))):
         worst = int(np.argmax(errors[(slice(None), *index)]))
         row, column = int(index[0]), (int(index[1]) if len(index) > 1 else None)
-        mismatches.append(Mismatch(
-            function=name, row=row, column=column, owner=str(derived.system.rows[row]),
-            coordinate=derived.system.coordinates[column] if column is not None else None,
-            derived=show_expression(derived.system, derived.expression(name, row, column)),
+        found.append(Mismatch(
+            function=name, row=row, column=column, owner=owner(row),
+            coordinate=coordinates[column] if column is not None else None,
+            derived=expression(row, column),
             derived_value=float(ours[(worst, *index)]), hand_value=float(hand[(worst, *index)]),
             error=float(errors[(worst, *index)]), sample=worst,
-            failing=int(bad[(slice(None), *index)].sum()), state=states[worst]))
-    return FunctionResult(name, int(np.prod(shape)), tuple(mismatches))
+            failing=int(bad[(slice(None), *index)].sum()), state=states[worst], base=base))
+    return tuple(found)
 
 
 def relative_errors(derived: np.ndarray, hand: np.ndarray, least: float = 0.0) -> np.ndarray:

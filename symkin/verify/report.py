@@ -23,11 +23,13 @@ class Mismatch:
     sample: int  # the sample where it is worst
     failing: int  # in how many samples the entry differs
     state: State | None = None  # the state of that sample
+    base: int = 0  # 1 for a MATLAB hand file: its rows and columns counted from 1, as in it
 
     @property
     def entry(self) -> str:
-        where = f"{self.row}, {self.column}" if self.column is not None else f"{self.row}"
-        return f"{self.function}[{where}]"
+        row, column = self.row + self.base, (self.column or 0) + self.base
+        where = f"{row}, {column}" if self.column is not None else f"{row}"
+        return f"{self.function}({where})" if self.base else f"{self.function}[{where}]"
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,7 @@ class Report:
     results: tuple[FunctionResult, ...]
     skipped: tuple[str, ...] = field(default=())
     scale: float = 1.0  # the length scale L used for zero parameters and positions
+    states: str = ""  # what the samples were, when not random states (a MATLAB hand file's)
 
     @property
     def ok(self) -> bool:
@@ -70,17 +73,19 @@ class Report:
 
 def format_report(report: Report) -> str:
     lines = [f"verify {report.mechanism} against {report.origin}",
-             f"  {report.samples} random states (q, dq, t), parameters "
+             f"  {report.samples} "
+             + (report.states or "random states (q, dq, t)") + ", parameters "
              + (f"within ±{report.spread:.0%} of the nominal design (zero ones within "
                 f"±{report.spread * report.scale:g})" if report.spread
                 else "at the nominal design")
              + f", seed {report.seed}, tolerance {report.tolerance:g}"]
+    width = max([6, *(len(r.name) for r in report.results)])
     for result in report.results:
         count = len(result.mismatches)
         verdict = "all match" if not count else f"{count} mismatching entr" + \
             ("y" if count == 1 else "ies")
-        lines.append(f"  {result.name:<6} {result.entries:>5} entries  {verdict}")
-    lines += [f"  {name:<6} not defined, skipped" for name in report.skipped]
+        lines.append(f"  {result.name:<{width}} {result.entries:>5} entries  {verdict}")
+    lines += [f"  {name:<{width}} not defined, skipped" for name in report.skipped]
     for m in report.mismatches:
         lines += ["", *_format_mismatch(m, report.samples)]
     owners: dict[str, list[str]] = {}
@@ -96,8 +101,9 @@ def format_report(report: Report) -> str:
 
 
 def _format_mismatch(m: Mismatch, samples: int) -> list[str]:
-    column = f", column {m.column} (d/d {m.coordinate})" if m.column is not None else ""
-    return [f"{m.entry}: row {m.row} {m.owner}{column}",
+    column = (f", column {m.column + m.base} (d/d {m.coordinate})" if m.column is not None
+              else "")
+    return [f"{m.entry}: row {m.row + m.base} {m.owner}{column}",
             f"  derived:  {m.derived}",
             (f"  values:   derived {m.derived_value:.12g}, hand {m.hand_value:.12g} "
              f"(sample {m.sample})"),

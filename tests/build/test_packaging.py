@@ -72,15 +72,18 @@ def test_console_script_runs_from_any_folder(installed: Path, tmp_path: Path) ->
 
 @pytest.mark.slow
 def test_templates_ship_inside_the_package(installed: Path, tmp_path: Path) -> None:
-    code = ("import symkin.resources as r, pathlib, sys; root = r.template_root(); "
-            "print(root); print(sorted(str(p.relative_to(root)) for p in root.rglob('*.j2')))")
+    """Each backend's templates ship in its own folder of the installed package."""
+    code = ("import symkin, pathlib; root = pathlib.Path(symkin.__file__).parent; "
+            "print(root); print(sorted(p.relative_to(root).as_posix() "
+            "for p in root.rglob('*.j2')))")
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     result = subprocess.run([str(installed / "python"), "-c", code], cwd=tmp_path,
                             capture_output=True, text=True, env=env, check=True)
     root, listing = result.stdout.splitlines()
     assert "site-packages" in root
-    expected = sorted(str(p.relative_to(ROOT / "templates")) for p in
-                      (ROOT / "templates").rglob("*.j2"))
+    expected = sorted(p.relative_to(ROOT / "symkin").as_posix() for p in
+                      (ROOT / "symkin").rglob("*.j2"))
+    assert {p.split("/")[1] for p in expected} == {"c", "numpy", "octave"}
     assert listing == repr(expected)
     assert sys.version_info >= (3, 11)
 

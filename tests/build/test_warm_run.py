@@ -42,7 +42,6 @@ def snapshot(tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("symkin-snapshot")
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc")
     shutil.copytree(ROOT / "symkin", root / "symkin", ignore=ignore)
-    shutil.copytree(ROOT / "templates", root / "templates", ignore=ignore)
     (root / "wrapper.py").write_text(WRAPPER)
     return root
 
@@ -175,7 +174,7 @@ def test_editing_a_template_misses(tmp_path: Path, snapshot: Path) -> None:
     cache = tmp_path / "cache"
     assert not symkin_run(own, cache, TEXTBOOK, "-o", "a.npz", cwd=tmp_path).hit
     assert symkin_run(own, cache, TEXTBOOK, "-o", "a.npz", cwd=tmp_path).hit
-    with (own / "templates" / "numpy" / "kernel.py.j2").open("a") as template:
+    with (own / "symkin" / "backends" / "numpy" / "templates" / "kernel.py.j2").open("a") as template:
         template.write("{# an edit that renders to nothing #}\n")
     again = symkin_run(own, cache, TEXTBOOK, "-o", "b.npz", cwd=tmp_path)
     assert again.returncode == 0 and not again.hit

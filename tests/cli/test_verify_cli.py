@@ -68,7 +68,9 @@ def test_missing_hand_file(capsys, tmp_path) -> None:
 
 
 def test_hand_file_is_a_folder(capsys, tmp_path) -> None:
-    assert "is a folder" in _bad(capsys, FOUR_BAR, "--against", str(tmp_path))
+    # a folder is read as MATLAB/Octave hand files (tests/verify/test_verify_matlab.py)
+    err = _bad(capsys, FOUR_BAR, "--against", str(tmp_path))
+    assert "is a folder that holds none of" in err and ".py file" in err
 
 
 def test_hand_file_with_a_syntax_error(capsys, tmp_path) -> None:

@@ -17,7 +17,7 @@ from symkin.codegen import render
 from symkin.codegen.lower import lower
 from symkin.contract import manifest, options, status, tuning
 
-TEMPLATES = ROOT / "templates"
+TEMPLATES = ROOT / "symkin" / "backends"
 # A contract value behind its C cast, e.g. ((crank_slider_real)0.05); F: a float literal.
 _CAST = re.compile(r"^\(\(\w+\)(.+)\)$")
 

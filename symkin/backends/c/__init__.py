@@ -4,7 +4,8 @@ Its pieces, each imported only when needed (loading a built kernel never imports
 ``printer`` (C99 text), ``lu_code``, ``norm_code``, ``inverse_code`` and ``context`` (the
 solver's template data), ``cdef`` (cffi declarations from the headers), ``toolchain`` (the
 compiler), ``cffi_build`` (the build), ``loader`` (the CKernel), ``csolver`` and ``batch``
-(the generated grid and batch solvers through cffi). Templates: ``templates/c/``.
+(the generated grid and batch solvers through cffi). Templates: ``templates/`` beside this
+module.
 """
 
 from __future__ import annotations
@@ -13,7 +14,6 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from symkin import resources
 from symkin.codegen.target import file_name, rendered_templates
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 
@@ -41,11 +41,12 @@ class CBackend:
     name = "c"
     title = "C"
     real_types: tuple[str, ...] = ("double", "float")
-    template_folder = "c"
+    template_folder = "templates"
 
     @property
     def template_root(self) -> Path:
-        return resources.template_root()
+        # The backend's own folder: its templates ship inside it, with the package.
+        return Path(__file__).resolve().parent
 
     def printer(self, real: str) -> Any:
         from symkin.backends.c.printer import CPrinter

@@ -1,6 +1,6 @@
 """The worst-case operation count of one ``<prefix>_dynamics_step``, for its header.
 
-Each formula mirrors one function of templates/c/dynamics.c.j2 (named beside it), every
+Each formula mirrors one function of backends/c/templates/dynamics.c.j2 (named beside it), every
 branch that adds work taken; the kernel routines are counted from their printed statements
 (codegen.op_count), as op_budget does for the kinematic step. Composition, as the step runs:
 

@@ -1,7 +1,7 @@
 """The generated C ``<prefix>_dynamics_step`` called through cffi: the state is carried in C
 from step to step, as in a controller loop, and each step's result copied out.
 
-Present only in a kernel of a file with masses (templates/c/dynamics.*.j2);
+Present only in a kernel of a file with masses (backends/c/templates/dynamics.*.j2);
 :func:`available` says whether a loaded kernel has it.
 """
 

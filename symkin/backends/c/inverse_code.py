@@ -106,7 +106,7 @@ def _solve_unit(plan: LUPlan, start: int, slot: Callable[[int], Value],
 def exact_context(plan: LUPlan, values: Sequence[float | None], inverses: dict[int, float],
                   literal: Callable[[float], str], real: str, fabs: str,
                   limit: int | None = None) -> dict[str, Any] | None:
-    """The exact ||Phi_q^-1||_1 for ``templates/c/solver.c.j2`` (key ``inverse``), or None
+    """The exact ||Phi_q^-1||_1 for ``templates/solver.c.j2`` (key ``inverse``), or None
     when its code would exceed ``limit`` operations.
 
     Args:

@@ -309,7 +309,7 @@ the limit, extrapolated: about 2 MB, 30 s and 420 MB."""
 def template_context(plan: LUPlan, part_ops: int = PART_OPS,
                      style: str | None = None, constants: Sequence[float | None] | None = None,
                      real: str = "double", *, prefix: str) -> dict[str, object]:
-    """The plan as plain data for ``templates/c/sparse_lu.*.j2`` (key ``lu``).
+    """The plan as plain data for ``templates/sparse_lu.*.j2`` (key ``lu``).
 
     Args:
         plan: the analysed factorization.

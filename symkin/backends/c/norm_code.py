@@ -43,7 +43,7 @@ def _column(terms: list[int], constants: Sequence[float | None], literal: Callab
 def norm1_context(cols: Sequence[int], nq: int, constants: Sequence[float | None] | None,
                   literal: Callable[[float], str], real: str,
                   part_terms: int = PART_TERMS) -> dict[str, Any]:
-    """The column sums of Phi_q for ``templates/c/solver.c.j2`` (key ``norm1``).
+    """The column sums of Phi_q for ``templates/solver.c.j2`` (key ``norm1``).
 
     Args:
         cols: the column of each non-zero, in pattern order.

@@ -3,7 +3,7 @@
 An embedded engineer budgets a servo period by the most a call can cost. The straight-line
 pieces (the kernel routines, the sparse LU's factor and solves, the exact inverse norm and
 ||Phi_q||_1) are counted from the statements the templates render (codegen.op_count); the
-solver's own loops (templates/c/solver.c.j2 and its partials) are counted here per call,
+solver's own loops (templates/solver.c.j2 and its partials) are counted here per call,
 each formula next to the name of the function it mirrors, taking every branch that adds
 work (the worst case). Composition, as ``<prefix>_solve_step`` runs:
 
@@ -63,7 +63,7 @@ class LinearAlgebra:
 
 
 def dense_lu(n: int, nnz: int) -> LinearAlgebra:
-    """templates/c/dense_lu.c.j2 at its worst: every row swept and updated (a full matrix)."""
+    """templates/dense_lu.c.j2 at its worst: every row swept and updated (a full matrix)."""
     factor = Flops(abs=2 * nnz, cmp=nnz, mul=1)  # the scatter with max |a| and the tiny bound
     for k in range(n):
         r = n - k - 1  # rows below the pivot, columns right of it
@@ -78,13 +78,13 @@ def dense_lu(n: int, nnz: int) -> LinearAlgebra:
 
 
 def _amax_helpers(prefix: str) -> dict[str, Flops]:
-    """The helpers the straight-line factor calls (templates/c/sparse_lu.c.j2)."""
+    """The helpers the straight-line factor calls (templates/sparse_lu.c.j2)."""
     return {f"{prefix}_lu_amax": Flops(abs=2, cmp=1),  # fabs(b) > a ? fabs(b) : a
             f"{prefix}_lu_pivot_ok": Flops(abs=2, cmp=2, mul=1)}
 
 
 def sparse_lu(lu: dict[str, Any], n: int, nnz: int, prefix: str) -> LinearAlgebra:
-    """templates/c/sparse_lu.c.j2 as rendered from ``lu`` (backends.c.lu_code's context)."""
+    """templates/sparse_lu.c.j2 as rendered from ``lu`` (backends.c.lu_code's context)."""
     if lu["style"] == "tables":
         return _sparse_tables(lu, n, nnz)
     helpers = _amax_helpers(prefix)
@@ -139,7 +139,7 @@ def norm1(context: dict[str, Any] | None, n: int, nnz: int) -> Flops:
                 for _, expression in part), ZERO)
 
 
-# ----- the solver's own work (templates/c/solver.c.j2, _condition, _error_model, _units) -----
+# ----- the solver's own work (templates/solver.c.j2, _condition, _error_model, _units) -----
 
 # <prefix>_flagged: s = inv_norm / sqrt(NQ), the rounding floor, the residual's error, e_q,
 # e_dq, e_ddq, and the three comparisons with the targets.

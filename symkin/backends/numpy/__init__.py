@@ -1,6 +1,7 @@
 """The NumPy backend: one Python module per mechanism, imported from the build cache; needs
 no compiler. Its pieces: ``printer`` (NumPy text; imported only when generating) and
-``loader`` (the Kernel over the module). Templates: ``templates/numpy/``.
+``loader`` (the Kernel over the module). Templates: ``templates/`` beside this
+module.
 """
 
 from __future__ import annotations
@@ -12,7 +13,6 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from symkin import resources
 from symkin.codegen.target import file_name, rendered_templates
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 
@@ -27,11 +27,12 @@ class NumPyBackend:
     name = "numpy"
     title = "NumPy"
     real_types: tuple[str, ...] = ("double",)  # NumPy computes in double
-    template_folder = "numpy"
+    template_folder = "templates"
 
     @property
     def template_root(self) -> Path:
-        return resources.template_root()
+        # The backend's own folder: its templates ship inside it, with the package.
+        return Path(__file__).resolve().parent
 
     def printer(self, real: str) -> Any:
         from symkin.backends.numpy.printer import PythonPrinter

@@ -1,4 +1,4 @@
-"""The generated forward-dynamics step (templates/c/dynamics.*.j2, the NumPy kernel's
+"""The generated forward-dynamics step (backends/c/templates/dynamics.*.j2, the NumPy kernel's
 dynamics_step), against references derived here:
 
 - a bar pendulum hinged at one end, free (one degree of freedom): its minimal-coordinate

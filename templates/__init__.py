@@ -1,1 +1,0 @@
-# symkin templates (a package only so that they ship inside the wheel)

@@ -1,0 +1,229 @@
+"""The MATLAB/Octave backend: generated .m files lint clean of Octave-only syntax, hold one
+function each, take the parameters as an argument, and — run in Octave — give the rows NumPy
+gives, for every planar and spatial example."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import symkin
+from symkin.backends import get
+from symkin.codegen import sample
+
+# Without Octave the tests that run .m files skip (under CI, which installs it,
+# tests/conftest.py makes its absence an error instead).
+needs_octave = pytest.mark.skipif(shutil.which("octave-cli") is None,
+                                  reason="GNU Octave (octave-cli) is not on PATH")
+
+ROOT = Path(__file__).resolve().parents[3]
+EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
+# What GNU Octave accepts and MATLAB does not: '#' comments, != and !, ++/+= and friends,
+# the end* keywords, double-quoted strings.
+OCTAVE_ONLY = {
+    "# (an Octave comment)": re.compile(r"#"),
+    "!= or ! (Octave's not)": re.compile(r"!"),
+    "++ or -- (increments)": re.compile(r"\+\+|--(?!-)\s*;"),
+    "+=, -=, *=, /= (compound assignment)": re.compile(r"[-+*/]="),
+    "endfunction, endif, endfor, endwhile": re.compile(r"\bend(function|if|for|while)\b"),
+    "a double-quoted string": re.compile(r'"'),
+    "printf (Octave's; MATLAB has fprintf)": re.compile(r"(?<!f)printf\("),
+}
+# a planar one with masses (multipliers), a spatial one, an over-constrained one
+LINTED = ("crank_slider", "four_bar_dynamics", "spatial_slider_crank",
+          "parallelogram_extra_bar_loads")
+
+
+def lint(text: str) -> list[str]:
+    """The Octave-only constructs in one .m file's text, as 'line N: what'."""
+    found = []
+    for number, line in enumerate(text.splitlines(), 1):
+        found += [f"line {number}: {what}" for what, pattern in OCTAVE_ONLY.items()
+                  if pattern.search(line)]
+    return found
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folders = {}
+    for name in LINTED:
+        folder = tmp_path_factory.mktemp(name)
+        symkin.generate(symkin.derive(ROOT / "examples" / f"{name}.yaml"), "octave", folder)
+        folders[name] = folder
+    return folders
+
+
+def test_lint_finds_octave_only_syntax() -> None:
+    """The lint itself: each construct it must refuse is found (and a clean line is not)."""
+    bad = ["x = 1; # note", "if a != b", "k++;", "k += 1;", "endfunction", 'disp("a")',
+           "printf('%d', 1)", "y = ~x;  % not"]
+    assert [bool(lint(line)) for line in bad] == [True] * 7 + [False]
+
+
+@pytest.mark.parametrize("name", LINTED)
+def test_generated_m_files_run_in_matlab_too(generated: dict[str, Path], name: str) -> None:
+    """No Octave-only syntax, and one function per file named as the file."""
+    files = sorted(generated[name].glob("*.m"))
+    assert {f.stem for f in files} >= {f"{name}_{what}" for what in
+                                        ("phi", "phi_q", "phi_t", "gamma", "points", "data",
+                                         "solve", "point_kinematics")}
+    for path in files:
+        text = path.read_text(encoding="utf-8")
+        assert not lint(text), f"{path.name}: {lint(text)}"
+        functions = re.findall(r"^function\b.*?(\w+)\(", text, flags=re.MULTILINE)
+        assert functions == [path.stem], f"{path.name} defines {functions}"
+        assert text.startswith("function ")
+
+
+def test_multipliers_only_where_the_file_has_masses(generated: dict[str, Path]) -> None:
+    assert not list(generated["crank_slider"].glob("*_multipliers.m"))
+    assert (generated["four_bar_dynamics"] / "four_bar_dynamics_multipliers.m").is_file()
+    assert (generated["parallelogram_extra_bar_loads"] /
+            "parallelogram_extra_bar_loads_removed.m").is_file()
+
+
+def test_row_comments_name_the_joint_or_driver(generated: dict[str, Path]) -> None:
+    phi = (generated["crank_slider"] / "crank_slider_phi.m").read_text(encoding="utf-8")
+    assert re.search(r"out\(9\) = .*% drivers\[0\] angle crank-ground", phi)
+    phi_q = (generated["crank_slider"] / "crank_slider_phi_q.m").read_text(encoding="utf-8")
+    assert re.search(r"% \(9, 3\) drivers\[0\] angle crank-ground \(angle\), crank\.phi", phi_q)
+
+
+def _inputs(system: symkin.System, times: np.ndarray) -> dict[str, np.ndarray]:
+    """For a file with input drivers: their nominal values moved a little each step, and
+    those rates."""
+    if not system.input_names:
+        return {}
+    start = np.array(sample.input_values(system), dtype=float)
+    steps = np.arange(len(times))[:, None] + 0 * start
+    return {"inputs": start + 1e-3 * steps,
+            "input_rates": 1e-3 / (times[1] - times[0]) + 0 * steps,
+            "input_accels": 0 * steps}
+
+
+# Deriving and lowering these takes SymPy a minute or more (each, twice lowered): slow.
+HEAVY = {"cam_cycloidal", "delta", "delta_fk", "stewart", "stewart_legs", "stewart_legs_fk"}
+
+
+@needs_octave
+@pytest.mark.parametrize("path", [pytest.param(p, id=p.stem, marks=[pytest.mark.slow]
+                                               if p.stem in HEAVY else []) for p in EXAMPLES])
+def test_octave_runs_equal_numpy(path: Path) -> None:
+    """symkin.solve with the octave kernel gives NumPy's rows to 1e-12 (the first steps of
+    each example's grid: Octave evaluates each call in a running process)."""
+    system = symkin.derive(path)
+    octave, numpy = (symkin.compile(system, backend=b) for b in ("octave", "numpy"))
+    assert octave.backend == "octave"
+    t0, t1, dt = system.time_grid
+    times = t0 + dt * np.arange(min(6, round((t1 - t0) / dt) + 1))
+    runs = [symkin.solve(k, t=times, **_inputs(system, times)) for k in (octave, numpy)]
+    for field in ("q", "dq", "d2q"):
+        ours, theirs = (np.asarray(getattr(run, field)) for run in runs)
+        assert ours.shape == theirs.shape
+        assert np.isfinite(theirs).all(), (path.stem, field)
+        scale = 1 + np.max(np.abs(theirs))
+        assert np.max(np.abs(ours - theirs)) <= 1e-12 * scale, (path.stem, field)
+
+
+@needs_octave
+def test_parameters_are_an_argument(generated: dict[str, Path]) -> None:
+    """Phi at other parameters than the nominal ones, in Octave, equals NumPy's there: the
+    parameters are p, never constants baked into the files."""
+    system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
+    numpy = symkin.compile(system, backend="numpy")
+    octave = get("octave").load(generated["crank_slider"],
+                                {**_manifest(generated["crank_slider"]), "backend": "octave"})
+    q = np.linspace(0.1, 0.9, numpy.nq)
+    p = numpy.p_values * np.array([1.3, 0.7, 1.1])
+    for function in ("phi", "phi_q", "phi_t"):
+        assert np.allclose(getattr(octave, function)(q, 0.4, p),
+                           getattr(numpy, function)(q, 0.4, p), rtol=1e-14, atol=1e-14)
+    assert not np.allclose(octave.phi(q, 0.4, p), octave.phi(q, 0.4))
+
+
+def _manifest(folder: Path) -> dict[str, object]:
+    import json
+
+    return dict(json.loads(next(folder.glob("*_manifest.json")).read_text(encoding="utf-8")))
+
+
+@needs_octave
+@pytest.mark.parametrize("name", ["crank_slider", "spatial_slider_crank"])
+def test_the_generated_driver_solves_as_numpy(generated: dict[str, Path], name: str) -> None:
+    """<prefix>_solve.m (predictor, Newton, velocity, acceleration) run in Octave over the
+    file's grid gives NumPy's rows."""
+    folder = generated[name]
+    script = (f"[T, Q, DQ, D2Q] = {name}_solve(); fprintf('%.17g\\n', [T; Q; DQ; D2Q]);")
+    result = subprocess.run(["octave-cli", "--norc", "--quiet", "--eval", script], cwd=folder,
+                            capture_output=True, text=True, timeout=120, check=True)
+    numpy = symkin.solve(symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"),
+                                        backend="numpy"))
+    values = np.array(result.stdout.split(), dtype=float)
+    nq = numpy.q.shape[1]
+    table = values.reshape(-1, 1 + 3 * nq)
+    assert np.allclose(table[:, 0], numpy.t, rtol=0, atol=1e-15)
+    for k, field in enumerate(("q", "dq", "d2q")):
+        ours = table[:, 1 + k * nq: 1 + (k + 1) * nq]
+        theirs = np.asarray(getattr(numpy, field))
+        assert np.max(np.abs(ours - theirs)) <= 1e-9 * (1 + np.max(np.abs(theirs))), field
+
+
+@needs_octave
+@pytest.mark.parametrize("name", ["crank_slider", "spatial_slider_crank"])
+def test_point_kinematics_equal_the_trajectorys(generated: dict[str, Path], name: str) -> None:
+    """<prefix>_point_kinematics (r + R s and its derivatives; spatial: R from the Euler
+    parameters) equals the runtime's points at a row of a NumPy run."""
+    numpy = symkin.solve(symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"),
+                                        backend="numpy"))
+    expected = numpy.point_arrays()
+    row = 7
+
+    def column(values: np.ndarray) -> str:
+        return "[" + ";".join(repr(float(v)) for v in values) + "]"
+
+    state = ", ".join(column(getattr(numpy, f)[row]) for f in ("q", "dq", "d2q"))
+    script = (f"[P, V, A] = {name}_point_kinematics({state}); "
+              "fprintf('%.17g\\n', [P(:); V(:); A(:)]);")
+    result = subprocess.run(["octave-cli", "--norc", "--quiet", "--eval", script],
+                            cwd=generated[name], capture_output=True, text=True, timeout=120,
+                            check=True)
+    values = np.array(result.stdout.split(), dtype=float)
+    count, size = expected[0].shape[1:]
+    assert values.size == 3 * count * size
+    for k, array in enumerate(expected):
+        ours = values[k * count * size:(k + 1) * count * size].reshape(size, count).T
+        assert np.max(np.abs(ours - array[row])) <= 1e-13 * (1 + np.max(np.abs(array[row])))
+
+
+@needs_octave
+def test_run_cli_with_the_octave_backend(tmp_path: Path) -> None:
+    """symkin run --backend octave writes NumPy's rows."""
+    rows = {}
+    for backend in ("octave", "numpy"):
+        out = tmp_path / f"{backend}.csv"
+        done = subprocess.run([sys.executable, "-m", "symkin", "run",
+                               str(ROOT / "examples" / "crank_slider.yaml"), "--backend",
+                               backend, "-o", str(out)], capture_output=True, text=True,
+                              timeout=300, env=os.environ)
+        assert done.returncode == 0, done.stderr
+        rows[backend] = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.max(np.abs(rows["octave"] - rows["numpy"])) <= 1e-12
+
+
+def test_without_octave_the_backend_says_so(tmp_path: Path) -> None:
+    """No octave-cli on PATH: exit 2 with a one-paragraph message, no traceback."""
+    env = {**os.environ, "PATH": str(Path(sys.executable).parent)}
+    done = subprocess.run([sys.executable, "-m", "symkin", "run",
+                           str(ROOT / "examples" / "crank_slider.yaml"), "--backend", "octave",
+                           "-o", str(tmp_path / "run.csv")], capture_output=True, text=True,
+                          timeout=300, env=env)
+    assert done.returncode == 2
+    assert "octave-cli" in done.stderr and "not on PATH" in done.stderr
+    assert "Traceback" not in done.stderr
