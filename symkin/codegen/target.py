@@ -83,8 +83,9 @@ def file_name(template: str, prefix: str, module_template: str) -> str:
 
 
 REAL_TYPES = ("double", "float")
-# The linear algebra behind the C solver: the C backend's templates/linalg.*.j2 (dense LU with partial
-# pivoting) or templates/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed here).
+# The linear algebra behind the C solver: the C backend's templates/linalg.*.j2 (dense LU
+# with partial pivoting) or templates/sparse_lu.*.j2 (a sparse LU whose pivot order is fixed
+# here).
 LINALG = ("dense", "sparse")
 
 
