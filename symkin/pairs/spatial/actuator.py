@@ -51,5 +51,5 @@ def equations(c: Actuator, geometry: basic.Geometry) -> list[sp.Expr]:
 
 TYPE = kit.PairType(name="distance", model=Actuator, sections=("drivers",),
                     equations=equations, rows=("length",), points=distance.POINTS,
-                    time_functions=("f",), check=check,
+                    time_functions=("f",), lengths=("f",), check=check,
                     to_local=distance.points_to_local, rod=True)
