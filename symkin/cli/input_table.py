@@ -39,8 +39,9 @@ class InputTable:
     ddu: Array | None
 
 
-def read(path: Path, names: tuple[str, ...]) -> InputTable:
-    """Read and check ``path`` for the input drivers ``names``.
+def read(path: Path, names: tuple[str, ...], lengths: tuple[str, ...] = ()) -> InputTable:
+    """Read and check ``path`` for the input drivers ``names``, of which ``lengths`` (a
+    distance driver's f) may not be negative.
 
     Raises:
         TableError: the file cannot be read, or its header, a cell or the grid is wrong.
@@ -63,8 +64,24 @@ def read(path: Path, names: tuple[str, ...]) -> InputTable:
         raise TableError(f"{path}: {len(body)} rows, more than the "
                          f"{limits.MAX_GRID_POINTS:,} time points a run may have")
     values = np.array([_numbers(path, line, row, rows[0]) for line, row in body])
-    _increasing(path, values[:, 0], [line for line, _ in body])
+    lines = [line for line, _ in body]
+    _increasing(path, values[:, 0], lines)
+    _not_negative(path, values, lines, [cell.strip() for cell in rows[0]], lengths)
     return _split(values, rows[0], names, kinds)
+
+
+def _not_negative(path: Path, values: Array, lines: list[int], header: list[str],
+                  lengths: tuple[str, ...]) -> None:
+    """A length's column (an actuator's |B - A|) has no negative value: its equation holds
+    the square, so -1 would be solved, silently, as 1."""
+    for name in lengths:
+        column = header.index(name)
+        negative = np.flatnonzero(values[:, column] < 0)
+        if negative.size:
+            k = int(negative[0])
+            raise TableError(f"{path}:{lines[k]}: column {name}: {values[k, column]:.10g} is "
+                             f"negative, but {name} is a distance driver's length |B - A| "
+                             f"({negative.size} negative value(s) in all); give lengths >= 0")
 
 
 def expected(names: tuple[str, ...]) -> str:

@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from symkin import backends, limits
+from symkin import backends, limits, outfiles
 from symkin.cli import messages, overrides, run_outputs
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 from symkin.cli.run_outputs import CannotWrite, ProgressBar
@@ -96,12 +96,10 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
         if clash:
             return (f"--inputs {args.inputs}: its column t is the time grid; leave out "
                     f"{', '.join(clash)}")
-        for option in SUFFIXES:  # writing there would replace the table being read
-            path = getattr(args, option)
-            if path is not None and _same_file(path, args.inputs):
-                flag = "-o" if option == "output" else f"--{option}"
-                return (f"{flag} {path} is the --inputs table; write the results to another "
-                        "file")
+    clash = outfiles.clash(output_paths(args), [("the mechanism file", args.mechanism),
+                                                ("the --inputs table", args.inputs)])
+    if clash:
+        return clash
     if not 1 <= args.fps <= 100:
         return f"--fps {args.fps}: give 1 to 100 frames per second"
     if args.html is not None:
@@ -113,12 +111,16 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
     return None
 
 
-def _same_file(a: Path, b: Path) -> bool:
-    """Whether two paths name one file (also through a link, or a hard link to it)."""
-    try:
-        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
-    except OSError:
-        return False
+def output_paths(args: argparse.Namespace) -> list[tuple[str, Path | None]]:
+    """Every file the run may write, as the command line names it: the forces' figure goes
+    next to --plot's as NAME_forces.SUFFIX."""
+    paths: list[tuple[str, Path | None]] = [
+        ("-o" if option == "output" else f"--{option}", getattr(args, option))
+        for option in SUFFIXES]
+    if args.plot is not None:
+        forces = args.plot.with_name(f"{args.plot.stem}_forces{args.plot.suffix}")
+        paths.append((f"--plot (its forces' figure {forces.name})", forces))
+    return paths
 
 
 def _times(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None]:
@@ -161,9 +163,19 @@ def _input_table(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None
                       "input drivers (a "
                       "driver function written `input`); leave out --inputs")
     try:
-        return input_table.read(args.inputs, names), None
+        return input_table.read(args.inputs, names, _length_inputs(args)), None
     except input_table.TableError as error:
         return None, str(error)
+
+
+def _length_inputs(args: argparse.Namespace) -> tuple[str, ...]:
+    """The inputs that are lengths, read from the mechanism file (only a run with --inputs
+    reads it again; a table of a file changed since the kernel was built is checked by the
+    file as it is now)."""
+    from symkin.spec import name_checks, validate
+
+    mech = validate.load(args.mechanism, overrides.parse(args.overrides))
+    return name_checks.length_inputs(mech)
 
 
 def _size(count: float) -> str:
@@ -228,9 +240,15 @@ def _solve_and_write(args: argparse.Namespace) -> int:
         return _stopped(args, prepared, failure, times.size, str(failure), EXIT_FAILED)
     if progress:
         progress.finish()
-    _warn_flagged(trajectory)
-    trajectory = _with_pair_outputs(trajectory, args, prepared.system)
-    written = _write(trajectory, args, prepared.outlines, picture)
+    # From here every row is solved: a Ctrl-C is answered only once they are all written.
+    with run_outputs.interrupts_deferred() as deferred:
+        _warn_flagged(trajectory)
+        trajectory = _with_pair_outputs(trajectory, args, prepared.system)
+        written = _write(trajectory, args, prepared.outlines, picture)
+    if deferred.interrupted:
+        said = "".join(f"; wrote {path}" for path in written)
+        return _error(f"{args.mechanism}: interrupted after the solve: all "
+                      f"{trajectory.t.size} time points solved{said}", EXIT_INTERRUPTED)
     origin = ", cached kernel" if prepared.hit else ""
     # integrated under its forces (runtime.dynamics): said first, as the issue's contract has it
     kind = " (dynamics)" if getattr(kernel, "moves_under_forces", False) else ""

@@ -79,7 +79,7 @@ def write(trajectory: Any, args: argparse.Namespace, outlines: Any,
             from symkin.present import force_plots
 
             written.append(force_plots.plot_forces(
-                trajectory, force_plots.forces_path(args.plot), picture.title))
+                trajectory, force_plots.forces_path(args.plot), picture.title, picture.units))
     if args.html:
         from symkin.present import html
 
@@ -133,6 +133,32 @@ def interrupts_held() -> Iterator[None]:
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+class Deferred:
+    """Whether a Ctrl-C came while interrupts were deferred (``interrupts_deferred``)."""
+
+    def __init__(self) -> None:
+        self.interrupted = False
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        self.interrupted = True
+
+
+@contextlib.contextmanager
+def interrupts_deferred() -> Iterator[Deferred]:
+    """Ctrl-C (SIGINT) noted, not raised, while a solved run's outputs are prepared and
+    written: the files are finished whole with every row solved, and the caller then says
+    it was interrupted. Only in the main thread; elsewhere nothing is deferred."""
+    deferred = Deferred()
+    if threading.current_thread() is not threading.main_thread():
+        yield deferred
+        return
+    previous = signal.signal(signal.SIGINT, deferred)
+    try:
+        yield deferred
     finally:
         signal.signal(signal.SIGINT, previous)
 
@@ -216,6 +242,16 @@ def flag_warnings(trajectory: Any) -> list[str]:
         passed = [s for s in trajectory.singular
                   if t0 - _step(trajectory, k) <= s[0] <= t1 + _step(trajectory, end + 1)]
         broken = _broken_removed(trajectory, k, end, targets.target_q)
+        loads = _not_finite_loads(trajectory, k, end)
+        if loads:
+            lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
+                         f"efforts or reactions are not finite there ({loads}): a load of the "
+                         "file is infinite or undefined at that time (a force such as "
+                         "1/(t - 0.5) at its pole), or Phi_q is singular; they are written as "
+                         "inf or nan (column 'flagged')")
+            if not (passed or broken):  # flagged for its loads: no word of accuracy
+                k = end + 1
+                continue
         if broken:
             lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
                          f"the equation(s) removed as redundant at t0 do not hold there "
@@ -268,6 +304,19 @@ def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
     broken: Any = redundant.exceeded(stretch, trajectory.q[k:end + 1], target).any(axis=0)
     return "; ".join(f"{label}: |Phi| up to {float(abs(stretch[:, r]).max()):.3g}"
                      for r, label in enumerate(trajectory.removed) if broken[r])
+
+
+def _not_finite_loads(trajectory: Any, k: int, end: int) -> str:
+    """The efforts and reactions that are inf or NaN between points k and end, at most ten
+    named ('' when every one is finite)."""
+    found = getattr(trajectory, "forces", None)
+    if found is None:
+        return ""
+    rows = np.zeros(trajectory.t.size, dtype=bool)
+    rows[k:end + 1] = True
+    names = found.not_finite_columns(rows)
+    more = f" and {len(names) - 10} more" if len(names) > 10 else ""
+    return ", ".join(names[:10]) + more
 
 
 def _step(trajectory: Any, k: int) -> float:

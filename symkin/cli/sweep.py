@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from symkin import backends
+from symkin import backends, outfiles
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK
 from symkin.errors import SolveError, SymkinError, UsageError
@@ -100,6 +100,11 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
         return f"-o {args.output}: a sweep is written as .npz"
     if args.plot is not None and args.plot.suffix.lower() != ".png":
         return f"--plot {args.plot}: the file must end in .png"
+    clash = outfiles.clash([("-o", args.output), ("--plot", args.plot)],
+                           [("the mechanism file", args.mechanism),
+                            ("the --params table", args.params)])
+    if clash:
+        return clash
     if args.workers is not None and args.workers < 1:
         return f"--workers {args.workers}: give at least 1"
     if args.scheduler is not None and args.workers is not None:

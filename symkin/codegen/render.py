@@ -271,6 +271,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "row_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.rows)],
         "point_comments": [f"{k}: {lower.comment(f'{body}.{name}')}"
                            for k, (body, name) in enumerate(code.points)],
+        "point_names": [lower.comment(f"{body}.{name}") for body, name in code.points],
         "point_bodies": [_body_index(code, body) for body, _ in code.points],
         "nu": len(code.input_names),
         "input_comments": [f"u[{k}] {lower.comment(n)}: {lower.comment(place)}" for k, (n, place)

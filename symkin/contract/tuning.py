@@ -44,9 +44,16 @@ BRANCH_FLOOR = 1e-8
 """Remainders below BRANCH_FLOOR (1 + max |q|) are never a jump: the inputs barely moved, and
 the rounding of two solves would otherwise count as one."""
 
+EDGE_SUBSTEPS = 1000
+"""The substeps (each one Newton solve of at most max_iter iterations) that the edge treatment
+of one grid point may take in all, over every march it makes (runtime.edges and the generated
+C's solve_edge): Newton's total work per time point is bounded, so no driver can keep a run
+spinning. Passing a singular configuration or bisecting to a limit position takes some 100;
+a driver so fast that each grid step spans thousands of turns is what meets the bound."""
+
 
 SHARED = {"ESTIMATOR_STEPS": ESTIMATOR_STEPS, "TIGHTEN_STEPS": TIGHTEN_STEPS, "SAFETY": SAFETY,
-          "REESTIMATE_SHIFT": REESTIMATE_SHIFT}
+          "REESTIMATE_SHIFT": REESTIMATE_SHIFT, "EDGE_SUBSTEPS": EDGE_SUBSTEPS}
 """The constants the generated C solver defines too, by name (its macro is ``<PREFIX>_`` + the
 name, rendered from this table by codegen.render)."""
 

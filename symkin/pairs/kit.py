@@ -67,6 +67,7 @@ class Checks(Protocol):
     def expression(self, raw: Any, path: Path, *, time: bool = False,
                    coordinates: bool = False) -> sp.Expr: ...
     def uses_coordinates(self, expr: sp.Expr) -> bool: ...
+    def over_time(self, expr: sp.Expr, count: int = 201) -> list[tuple[float, float]]: ...
     def value(self, expr: sp.Expr, path: Path) -> float: ...
     def point_at_q0(self, body: str, ref: Any) -> tuple[float, ...]: ...
     def curve(self, raw: Any, path: Path, order: int = 2) -> sp.Expr: ...
@@ -136,6 +137,9 @@ class PairType:
         directions: (vector key, body key): a direction fixed in that body; never zero.
         constants: keys holding constant expressions of the parameters.
         time_functions: keys holding functions of t (one, or a list of components).
+        lengths: those of them that are a length, never negative (its equation holds the
+            square, so a negative value would be solved as its absolute value): checked over
+            the file's grid, and in an --inputs table where one is written ``input``.
         check: its own rules beyond the generic ones (given a :class:`Checks` and its path).
         drawn_model: its keys in the drawn layout (None: as in the local layout).
         to_local: its drawn-layout derivation (None: points and directions are converted to
@@ -174,6 +178,7 @@ class PairType:
     directions: tuple[tuple[str, str], ...] = ()
     constants: tuple[str, ...] = ()
     time_functions: tuple[str, ...] = ()
+    lengths: tuple[str, ...] = ()
     check: Callable[[Any, Checks, Path], None] | None = None
     drawn_model: type[BaseModel] | None = None
     # given the family's drawing: Drawing here, or pairs.spatial.basic.Drawing

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin import outfiles
 from symkin.errors import SymkinError, UsageError
 from symkin.present import series
 from symkin.present.placement import (
@@ -180,9 +181,9 @@ def animate(trajectory: Trajectory, path: str | Path, outlines: Outlines, fps: i
     finally:
         plt.close(scene.figure)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000 / fps),
-                   loop=0)
+    with outfiles.replacing(path) as temporary:
+        images[0].save(temporary, save_all=True, append_images=images[1:],
+                       duration=round(1000 / fps), loop=0)
     return path
 
 

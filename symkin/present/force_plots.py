@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from symkin.present.plots import _pyplot, _save
+from symkin.present.series import DEFAULT_UNITS, Units
 from symkin.runtime.results import Trajectory
 
 
@@ -22,8 +23,10 @@ def forces_path(path: str | Path) -> Path:
     return path.with_name(f"{path.stem}_forces{path.suffix}")
 
 
-def plot_forces(trajectory: Trajectory, path: str | Path, title: str | None = None) -> Path:
-    """Write the efforts and reactions of ``trajectory`` (which has ``forces``) to ``path``."""
+def plot_forces(trajectory: Trajectory, path: str | Path, title: str | None = None,
+                units: Units = DEFAULT_UNITS) -> Path:
+    """Write the efforts and reactions of ``trajectory`` (which has ``forces``) to ``path``,
+    their axes in the force and moment units of ``units`` (series.Units.loads)."""
     forces = trajectory.forces
     if forces is None:
         raise ValueError("the trajectory has no efforts or reactions to plot")
@@ -32,7 +35,9 @@ def plot_forces(trajectory: Trajectory, path: str | Path, title: str | None = No
     t = trajectory.t
     for k, name in enumerate(forces.driver_names):
         axes[0].plot(t, forces.effort[:, k], label=name, linewidth=1.4)
-    axes[0].set_ylabel("effort (torque or force)")
+    effort_label, force_label, moment_label = units.load_labels(
+        spatial=forces.reaction.shape[-1] > 3)
+    axes[0].set_ylabel(effort_label)
     # the force's components are Fx, Fy (spatial: Fz too); the moment is M, or Mx, My, Mz
     # of a spatial joint, shown by its magnitude
     n_force = sum(part.startswith("F") for part in forces.parts)
@@ -48,9 +53,9 @@ def plot_forces(trajectory: Trajectory, path: str | Path, title: str | None = No
     if not axes[2].get_lines():
         axes[2].text(0.5, 0.5, "no joint carries a moment (revolute pairs only)",
                      transform=axes[2].transAxes, ha="center", va="center")
-    axes[1].set_ylabel("joint force |F|")
-    axes[2].set_ylabel("joint moment |M|" if spatial else "joint moment M")
-    axes[2].set_xlabel("t")
+    axes[1].set_ylabel(force_label)
+    axes[2].set_ylabel(moment_label)
+    axes[2].set_xlabel(units.time_label())
     for ax in axes:
         ax.grid(True, linewidth=0.4, alpha=0.5)
         if ax.get_legend_handles_labels()[0]:

@@ -19,7 +19,6 @@ from symkin.present.series import Units
 from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
-TITLES = ("effort", "joint force |F|", "joint moment M")
 MOMENT_FLOOR = 1e-9
 """A joint's moment is plotted when it exceeds this much of the largest force (not a
 revolute's zero)."""
@@ -93,9 +92,9 @@ def plot(go: Any, figure: Any, trajectory: Trajectory, column: int
 
 
 def label(figure: Any, column: int, units: Units, spatial: bool = False) -> None:
-    """The column's axis titles (a spatial run's moments are magnitudes |M|)."""
-    titles = (*TITLES[:2], "joint moment |M|") if spatial else TITLES
-    for panel, title in enumerate(titles):
+    """The column's axis titles with the force and moment units (a spatial run's moments are
+    magnitudes |M|)."""
+    for panel, title in enumerate(units.load_labels(spatial)):
         figure.update_yaxes(title_text=title, row=panel + 1, col=column)
     figure.update_xaxes(title_text=units.time_label(), row=3, col=column)
 

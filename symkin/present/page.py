@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin import outfiles
 from symkin.present.series import Units
 from symkin.runtime.results import Trajectory
 
@@ -44,8 +45,8 @@ def time_controls(trajectory: Trajectory, frames: NDArray[np.float64], units: Un
 
 def write(figure: Any, path: Path) -> Path:
     """The figure as one self-contained HTML file (plotly.js inside: it opens offline)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
-                      config={"displaylogo": False, "responsive": True},
-                      div_id="symkin-report")
+    with outfiles.replacing(path) as temporary:
+        figure.write_html(temporary, include_plotlyjs=True, full_html=True, auto_play=False,
+                          config={"displaylogo": False, "responsive": True},
+                          div_id="symkin-report")
     return path

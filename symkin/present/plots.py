@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin import outfiles
 from symkin.errors import UsageError
 from symkin.present import series
 from symkin.present.series import DEFAULT_UNITS, Units
@@ -99,9 +100,9 @@ def _legend(ax: Any, curves: Sequence[series.Curve]) -> None:
 
 
 def _save(figure: Any, plt: Any, path: Path) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        figure.savefig(path, dpi=100)
+        with outfiles.replacing(path) as temporary:
+            figure.savefig(temporary, dpi=100)
     finally:
         plt.close(figure)
     return path

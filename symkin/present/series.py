@@ -89,6 +89,25 @@ class Units:
     def time_label(self) -> str:
         return f"t [{self.time}]"
 
+    def loads(self) -> tuple[str, str]:
+        """The units of a force and of a moment. A file in metres and seconds has its masses
+        in kilograms (the file gives no mass unit: SI is the only consistent reading): N and
+        N m; other lengths or times give the derived unit with "mass" for the mass's; a
+        file without a length unit: N (SI), N m (SI), the numbers being SI only if the file's
+        are."""
+        if self.length is None:
+            return "N (SI)", "N m (SI)"
+        if self.length == "m" and self.time == "s":
+            return "N", "N m"
+        return (f"mass·{self.length}/{self.time}²",
+                f"mass·{self.length}²/{self.time}²")
+
+    def load_labels(self, spatial: bool = False) -> tuple[str, str, str]:
+        """The three force panels' axis titles: effort, joint force, joint moment."""
+        force, moment = self.loads()
+        return (f"effort [{force} or {moment}]", f"joint force |F| [{force}]",
+                f"joint moment {'|M|' if spatial else 'M'} [{moment}]")
+
 
 DEFAULT_UNITS = Units()
 

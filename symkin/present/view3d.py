@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin import outfiles
 from symkin.errors import SymkinError, UsageError
 from symkin.present import page, series
 from symkin.present.placement import REACTION, VECTOR_SHARE, Outlines, joint_points
@@ -33,6 +34,10 @@ Progress = Callable[[int, int], None]
 MAX_FRAMES = 200
 DEFAULT_SIZE = (900, 600)  # pixels
 DPI = 100
+BODY_WIDTH = 8  # a body's line in the report, in pixels
+ARROW_WIDTH = 12
+"""A reaction arrow's line: wider than a body's (and dashed), so that one along its body's
+line shows over it."""
 # Isometric view with z up: the x axis drawn down to the right, y down to the left.
 ISO_ANGLE = np.pi / 6
 
@@ -144,17 +149,24 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
         names = [f"{body}.{p}" for b, p in trajectory.points if b == body]
         figure.add_trace(go.Scatter3d(
             mode="lines+markers", name=body, text=names, hoverinfo="text+x+y+z",
-            line={"width": 8, "color": colour},
+            line={"width": BODY_WIDTH, "color": colour},
             marker={"size": 5, "color": "black", "symbol": "circle"}))
         moving.append(len(figure.data) - 1)
     names, points, forces = reactions(trajectory, outlines)
     scale = force_scale(forces, _span(lines))
+    force_unit = units.loads()[0]
     for name in names:
+        # Wider than a body's line and dashed, with a large head: an arrow that runs along
+        # its body's line (a rod pulled or pushed along itself) still shows over it.
         figure.add_trace(go.Scatter3d(
-            mode="lines+markers", name="joint reactions (i on j)", legendgroup="reactions",
-            showlegend=name == names[0], hovertemplate=f"{name} reaction<extra></extra>",
-            line={"width": 6, "color": REACTION},
-            marker={"size": [0, 4], "color": REACTION, "symbol": "diamond"}))
+            mode="lines+markers", name="joint reactions (i on j)",
+            legendgroup="reactions", showlegend=name == names[0],
+            hovertemplate=(f"{name} reaction: F = (%{{customdata[0]:.4g}}, "
+                           f"%{{customdata[1]:.4g}}, %{{customdata[2]:.4g}}) {force_unit}"
+                           "<extra></extra>"),
+            line={"width": ARROW_WIDTH, "color": REACTION, "dash": "dash"},
+            marker={"size": [0, 9], "color": REACTION, "symbol": "diamond",
+                    "line": {"width": 1, "color": "black"}}))
         moving.append(len(figure.data) - 1)
     cursors = _force_column(go, figure, trajectory, units)
     built = [go.Frame(name=f"{float(trajectory.t[k]):.6g}", traces=moving + list(cursors),
@@ -310,9 +322,9 @@ def animate(trajectory: Trajectory, path: str | Path, fps: int = 20,
     finally:
         plt.close(figure)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    images[0].save(path, save_all=True, append_images=images[1:], duration=round(1000 / fps),
-                   loop=0)
+    with outfiles.replacing(path) as temporary:
+        images[0].save(temporary, save_all=True, append_images=images[1:],
+                       duration=round(1000 / fps), loop=0)
     return path
 
 

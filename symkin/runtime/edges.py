@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from symkin.contract.options import Options
 from symkin.contract.status import OK
+from symkin.contract.tuning import EDGE_SUBSTEPS
 from symkin.runtime.linalg import dependencies
 from symkin.runtime.newton import Point, kinematics, newton
 from symkin.runtime.protocol import KinematicsKernel
@@ -84,6 +85,23 @@ class Resolution:
     groups: tuple[tuple[str, ...], ...] = ()
     aligned: tuple[str, ...] = ()
     drivers: tuple[str, ...] = ()
+    substeps: int = 0
+    """Substeps taken; EDGE_SUBSTEPS when the bound on them stopped the motion."""
+
+
+@dataclass
+class Work:
+    """The substeps one grid point's edge treatment has left (contract.tuning.EDGE_SUBSTEPS)."""
+
+    left: int = EDGE_SUBSTEPS
+
+    @property
+    def spent(self) -> bool:
+        return self.left <= 0
+
+    @property
+    def taken(self) -> int:
+        return EDGE_SUBSTEPS - self.left
 
 
 def _step(kernel: KinematicsKernel, p: Array, options: Options, state: State, t: float
@@ -100,12 +118,17 @@ def _step(kernel: KinematicsKernel, p: Array, options: Options, state: State, t:
 
 
 def march(kernel: KinematicsKernel, p: Array, options: Options, state: State, target: float,
-          h0: float, h_min: float) -> tuple[State, float]:
+          h0: float, h_min: float, work: Work | None = None) -> tuple[State, float]:
     """Advance from state to target by substeps; returns the last state reached and the step
-    that failed from it (0 when target was reached)."""
+    that failed from it (0 when target was reached). Each substep spends one of ``work``'s:
+    when none is left the next step counts as failed (``work.spent`` tells the two apart)."""
+    work = Work() if work is None else work
     h = h0
     while state.t < target:
         step = min(h, target - state.t)
+        if work.spent:
+            return state, step
+        work.left -= 1
         following = _step(kernel, p, options, state, target if step == target - state.t
                           else state.t + step)
         if following is None:
@@ -170,24 +193,38 @@ def resolve(kernel: KinematicsKernel, p: Array, options: Options, previous: Stat
             t: float) -> Resolution:
     """Solve the grid point t that the plain step from ``previous`` could not."""
     h0, h_min, delta = substeps(previous.t, t)
-    state, failed = march(kernel, p, options, previous, t, h0, h_min)
+    work = Work()
+    state, failed = march(kernel, p, options, previous, t, h0, h_min, work)
     if not failed:
-        return Resolution(state.point)
+        return Resolution(state.point, substeps=work.taken)
+    if work.spent:
+        return _exhausted(state, failed)
     blocked = state.t + failed
-    before, early = march(kernel, p, options, previous, blocked - delta, h0, h_min) \
+    before, early = march(kernel, p, options, previous, blocked - delta, h0, h_min, work) \
         if blocked - delta > previous.t else (previous, 0.0)
     after = None if early else _over(kernel, p, options, before, blocked, delta, h0)
+    if work.spent:
+        return _exhausted(state, failed)
     if after is None:
         return _stopped(kernel, p, options, state, failed, previous)
     passage = _passage(kernel, p, before, after)
     if t <= after.t:
         return Resolution(_through(kernel, p, options, before, after, t), passage)
-    rest, failed = march(kernel, p, options, after, t, h0, h_min)
+    rest, failed = march(kernel, p, options, after, t, h0, h_min, work)
+    if work.spent:
+        stop = _exhausted(rest, failed)
+        stop.passage = passage
+        return stop
     if failed:
         stop = _stopped(kernel, p, options, rest, failed, after)
         stop.passage = passage
         return stop
     return Resolution(rest.point, passage)
+
+
+def _exhausted(state: State, failed: float) -> Resolution:
+    """The stop of a grid point whose substeps used up the bound on them."""
+    return Resolution(None, reached=state, failed_at=state.t + failed, substeps=EDGE_SUBSTEPS)
 
 
 def _over(kernel: KinematicsKernel, p: Array, options: Options, before: State, blocked: float,

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 
 from symkin.contract.options import defaults
 from symkin.contract.status import NO_CONVERGENCE, NOT_FINITE, SINGULAR
+from symkin.contract.tuning import EDGE_SUBSTEPS
 from symkin.runtime.assembly import Assembly
 from symkin.runtime.edges import Resolution
 from symkin.runtime.linalg import dependencies
@@ -107,7 +108,14 @@ def explain_stop(stop: Resolution, t: float) -> tuple[str, str]:
     reached = stop.reached
     assert reached is not None
     last, failed = reached.t, stop.failed_at
-    if stop.limit:
+    if stop.substeps >= EDGE_SUBSTEPS:
+        reason = "too many substeps"
+        message = (f"the grid point t = {t:.10g} was not reached within {EDGE_SUBSTEPS} "
+                   f"substeps (the last reached t = {last:.10g}, a step of {failed - last:.3g} "
+                   "from it still failing): the motion between grid points is too fast or "
+                   "too rough for the step. Check the drivers' functions (a rate such as "
+                   "1e6*t turns thousands of times per step), or use a smaller --dt.")
+    elif stop.limit:
         reason = "limit position"
         message = (f"the driven motion reaches a limit position near t = {last:.10g} (bisected "
                    f"to {last:.13g} .. {failed:.13g}; the grid point t = {t:.10g} is beyond "

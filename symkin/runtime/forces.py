@@ -74,6 +74,16 @@ class Forces:
         return [f"{name}.effort" for name in self.driver_names] + [
             f"{name}.{part}" for name in self.joint_names for part in self.parts]
 
+    def not_finite(self) -> NDArray[np.bool_]:
+        """(T,) True where an effort or a reaction is inf or NaN: a load of the file that is
+        infinite or undefined there (a force 1/(t - 0.5) at t = 0.5), or Phi_q singular."""
+        return np.asarray(~np.isfinite(self.table()).all(axis=1))
+
+    def not_finite_columns(self, rows: NDArray[np.bool_]) -> list[str]:
+        """The :meth:`columns` that are inf or NaN in any of ``rows`` ((T,) bool)."""
+        bad = ~np.isfinite(self.table()[rows]).all(axis=0)
+        return [name for name, flag in zip(self.columns(), bad) if flag]
+
     def table(self) -> Array:
         """The values of :meth:`columns`, (T, n_driver_equations + 3 n_joints)."""
         rows = self.effort.shape[0]

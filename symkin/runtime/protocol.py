@@ -115,7 +115,8 @@ EDGE_REACHED, EDGE_PASSABLE, EDGE_STOPPED = 0, 1, 2
 class EdgeFound:
     """What a backend's edge treatment found (runtime.edges.resolve up to its decision):
     outcome (EDGE_*), the step that failed from the last point reached, that point's condition
-    estimate, time, q, dq and ddq."""
+    estimate, time, q, dq and ddq; the substeps taken (contract.tuning.EDGE_SUBSTEPS when that
+    bound stopped the motion)."""
 
     outcome: int
     failed: float
@@ -124,6 +125,7 @@ class EdgeFound:
     q: Array
     dq: Array
     ddq: Array
+    substeps: int = 0
 
 
 class EdgeSolver(Protocol):

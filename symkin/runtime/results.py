@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from symkin import outfiles
 from symkin.contract.columns import ENERGY_COLUMNS, RATE_SUFFIXES
 from symkin.errors import SymkinError
 from symkin.runtime import spatial
@@ -210,8 +211,8 @@ class Trajectory:
         suffix = path.suffix.lower()
         if suffix not in SAVE_FORMATS:
             raise SymkinError(f"cannot write {path.name}: the output must end in .npz or .csv")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        (self._save_npz if suffix == ".npz" else self._save_csv)(path)
+        with outfiles.replacing(path) as temporary:
+            (self._save_npz if suffix == ".npz" else self._save_csv)(temporary)
         return path
 
     def _point_columns(self) -> list[str]:

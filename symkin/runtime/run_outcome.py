@@ -48,7 +48,8 @@ class SolveFailure(SolveError):
         iterations: Newton iterations spent at t.
         rows: labels of the dependent equations when Phi_q was singular, else ().
         reason: "singular", "no convergence", "no assembly", "not finite" or
-            "limit position".
+            "limit position", "too many substeps" (the bound on one grid point's substeps,
+            contract.tuning.EDGE_SUBSTEPS).
         reached: where the step subdivision stopped (the limit time of a limit position: the
             last time solved, bisected to within about 1e-9 of the grid step), else NaN.
         aligned, drivers: at a limit position, the joints that become aligned and the drivers
@@ -96,7 +97,17 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
                                          forces.compute(kernel, t, q, dq, d2q, loads_p))
     else:
         trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
+    _flag_not_finite(trajectory)
     return trajectory
+
+
+def _flag_not_finite(trajectory: Trajectory) -> None:
+    """Rows whose efforts or reactions are inf or NaN are flagged (never a silent number)."""
+    found = trajectory.forces
+    if found is not None and trajectory.t.size:
+        bad = found.not_finite()
+        if bad.any():
+            trajectory.flagged[bad] = True
 
 
 def _space(kernel: KinematicsKernel) -> str:

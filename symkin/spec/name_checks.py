@@ -76,6 +76,12 @@ def input_places(mech: MechanismSpec) -> list[tuple[str, int, str, int | None]]:
     return found
 
 
+def length_inputs(mech: MechanismSpec) -> tuple[str, ...]:
+    """The inputs that are a length (PairType.lengths: a distance driver's f), by name."""
+    return tuple(name for name, index, key, _ in input_places(mech)
+                 if key in pairs.of(mech.drivers[index]).lengths)
+
+
 def _check_input_names(mech: MechanismSpec) -> None:
     """Each input's value, rate and acceleration need a name of their own (a column of an
     inputs table, a key of inputs=): two inputs of one name, or one named as another's rate

@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import contextlib
 import math
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import sympy as sp
 from pydantic import ValidationError, model_validator
 
@@ -274,6 +276,32 @@ class _Checks:
 
     def value(self, expr: sp.Expr, path: tuple[str | int, ...]) -> float:
         return _numeric(expr, self.nominal, path)
+
+    def over_time(self, expr: sp.Expr, count: int = 201) -> list[tuple[float, float]]:
+        """(t, value) of a time function at the nominal parameters, at ``count`` times spread
+        over the file's grid t0 .. t1 (both ends included); times where it has no finite real
+        value are left out (the run reports those)."""
+        try:
+            t0, t1 = (_numeric(_expression(getattr(self.mech.time, key), self.symbols,
+                                           ("time", key)), self.nominal, ("time", key))
+                      for key in ("t0", "t1"))
+        except MechanismError:  # said by the grid's own check
+            return []
+        times = np.linspace(t0, t1, count)
+        # in floats (not exact numbers), vectorised: mpmath at each time would take seconds
+        # for a long expression such as a Stewart leg's
+        floating = expr.subs(self.nominal).evalf()
+        try:
+            function = sp.lambdify(self.symbols.t, floating, modules="numpy")
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                values = np.broadcast_to(np.asarray(function(times)), times.shape)
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError, AttributeError):
+            return []
+        if np.iscomplexobj(values):
+            return []
+        values = np.asarray(values, dtype=float)
+        return [(float(t), float(v)) for t, v in zip(times, values) if math.isfinite(v)]
 
     def curve(self, raw: Any, path: tuple[str | int, ...], order: int = 2) -> sp.Expr:
         """A curve's component: an expression of the parameters and ``s``, whose derivatives

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from symkin import outfiles
 from symkin.sweeps.result import SweepResult
 from symkin.sweeps.tolerance import envelope
 
@@ -34,7 +35,9 @@ def plot_envelopes(result: SweepResult, path: str | Path) -> Path:
             axis.set_xlabel("t")
     axes[0][0].legend(loc="best", fontsize="small")
     figure.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
+    try:
+        with outfiles.replacing(path) as temporary:
+            figure.savefig(temporary, dpi=100)
+    finally:
+        plt.close(figure)
     return path

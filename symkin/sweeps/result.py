@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin import outfiles
 from symkin.contract.loads import reaction_parts
 from symkin.errors import SymkinError
 from symkin.runtime import spatial
@@ -183,7 +184,6 @@ class SweepResult:
         path = Path(path)
         if path.suffix.lower() != ".npz":
             raise SymkinError(f"cannot write {path.name}: a sweep is saved as .npz")
-        path.parent.mkdir(parents=True, exist_ok=True)
         arrays = self.point_arrays()
         forces: dict[str, Any] = {}
         if self.forces is not None:
@@ -191,6 +191,12 @@ class SweepResult:
                       "driver_names": np.array(self.driver_names, dtype=str),
                       "joint_names": np.array(self.joint_names, dtype=str)}
         write = np.savez_compressed if compress else np.savez
+        with outfiles.replacing(path) as temporary:
+            self._write(write, temporary, forces, arrays)
+        return path
+
+    def _write(self, write: Any, path: Path, forces: dict[str, Any],
+               arrays: tuple[Array, Array, Array]) -> None:
         write(path, **forces, t=self.t, q=self.q, dq=self.dq, d2q=self.d2q, status=self.status,
               params=self.params, parameter_names=np.array(self.parameter_names, dtype=str),
               coordinates=np.array(self.coordinates, dtype=str),
@@ -199,7 +205,6 @@ class SweepResult:
               solved=self.solved, iterations=self.iterations,
               points=np.array([f"{b}.{p}" for b, p in self.points_named], dtype=str),
               r=arrays[0], dr=arrays[1], ddr=arrays[2])
-        return path
 
     def point_arrays(self) -> tuple[Array, Array, Array]:
         """r, dr, ddr of every named point, each (M, T, P, 2)."""

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from symkin.contract.options import Options
 from symkin.contract.status import NOT_FINITE, OK
+from symkin.contract.tuning import EDGE_SUBSTEPS
 from symkin.runtime import edges, failures
 from symkin.runtime.newton import Point
 from symkin.runtime.protocol import EDGE_STOPPED, EdgeSolver, KinematicsKernel
@@ -98,6 +99,8 @@ def _edge(kernel: KinematicsKernel, edge: EdgeSolver, p: Array, t: Array, stoppe
         reached = edges.State(found.t, Point(found.q, found.dq, found.ddq, found.cond, False))
         stop = edges.stopped_at(kernel, p, options, reached, found.failed, stopped.cond,
                                 named=False)
+        if found.substeps >= EDGE_SUBSTEPS:  # the bound on the substeps: no limit to name
+            stop.limit, stop.substeps = False, found.substeps
     return stop, float(t[k])
 
 

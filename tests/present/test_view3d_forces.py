@@ -146,7 +146,8 @@ def test_report_force_column_is_the_npz_magnitudes(forces_run) -> None:
         np.testing.assert_allclose(curves[("y2", name)], force[:, j], rtol=1e-12)
         if moment[:, j].max() > 1e-9 * force.max():  # the spherical pin carries none
             np.testing.assert_allclose(curves[("y3", name)], moment[:, j], rtol=1e-12)
-    assert ("y3", "pin") not in curves and layout["yaxis3"]["title"]["text"] == "joint moment |M|"
+    assert ("y3", "pin") not in curves
+    assert layout["yaxis3"]["title"]["text"] == "joint moment |M| [N m (SI)]"  # no units given
     cursors = [k for k, trace in enumerate(data) if trace["type"] == "scatter"
                and not trace.get("name")]
     assert len(cursors) == 3 and set(cursors) <= set(frames[0]["traces"])
@@ -218,3 +219,45 @@ def test_report_with_forces_in_headless_chromium(forces_run, tmp_path: Path) -> 
             if not any(remark in line for remark in benign)] == [], taken.stderr
     scene = np.asarray(Image.open(shot).convert("RGB"), dtype=int)[60:650, :700]
     assert (np.abs(scene - MAGENTA).sum(axis=2) < 60).sum() > 20
+
+
+def test_report_arrows_show_over_a_body_line_and_say_their_unit(forces_run) -> None:
+    """An arrow along its body's line (a rod pushed along itself) was hidden under it: the
+    arrows are wider than the bodies' lines and dashed; the force axes and the arrows' hover
+    say the unit (the file gives none: N (SI))."""
+    _, page, _ = forces_run
+    data, _, layout = _figure(page)
+    arrows = [trace for trace in data if trace.get("name") == ARROWS]
+    bodies = [trace for trace in data if trace.get("type") == "scatter3d"
+              and trace.get("name") in ("crank", "rod", "slider")]
+    assert arrows and bodies
+    widest_body = max(trace["line"]["width"] for trace in bodies)
+    for trace in arrows:
+        assert trace["line"]["width"] > widest_body and trace["line"]["dash"] == "dash"
+        assert "N (SI)" in trace["hovertemplate"]
+    titles = [axis["title"]["text"] for name, axis in layout.items()
+              if name.startswith("yaxis") and isinstance(axis, dict) and "title" in axis]
+    assert "effort [N (SI) or N m (SI)]" in titles and "joint force |F| [N (SI)]" in titles
+    assert "joint moment |M| [N m (SI)]" in titles
+
+
+@pytest.mark.parametrize("units, force, moment", [
+    ({"length": "m"}, "[N]", "[N m]"), (None, "[N (SI)]", "[N m (SI)]"),
+    ({"length": "mm", "time": "ms"}, "[mass·mm/ms²]", "[mass·mm²/ms²]")])
+def test_force_figure_axes_give_the_units(units, force, moment, monkeypatch, tmp_path) -> None:
+    from symkin.present import force_plots
+    from symkin.present.series import Units
+    from symkin.runtime.forces import Forces
+    from symkin.runtime.results import Trajectory
+
+    saved = []
+    monkeypatch.setattr(force_plots, "_save", lambda figure, plt, path: saved.append(figure))
+    t = np.linspace(0, 1, 5)
+    trajectory = Trajectory(t, np.zeros((5, 3)), np.zeros((5, 3)), np.zeros((5, 3)),
+                            ("a.x", "a.y", "a.phi"))
+    trajectory.__dict__["forces"] = Forces(np.zeros((5, 3)), np.ones((5, 1)),
+                                           np.ones((5, 1, 3)), ("motor",), ("pin",))
+    force_plots.plot_forces(trajectory, tmp_path / "f.png", units=Units.of(units))
+    labels = [ax.get_ylabel() for ax in saved[0].axes]
+    assert labels[0].endswith(f"{force[:-1]} or {moment[1:]}")
+    assert labels[1].endswith(force) and labels[2].endswith(moment)

@@ -64,6 +64,7 @@ static int all_drivers_refused(all_drivers_report *report, all_drivers_real t)
 #define ALL_DRIVERS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define ALL_DRIVERS_SAFETY ((all_drivers_real)10) /* as runtime.accuracy.SAFETY */
 #define ALL_DRIVERS_REESTIMATE_SHIFT ((all_drivers_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define ALL_DRIVERS_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static all_drivers_real all_drivers_max_abs(const all_drivers_real v[])
@@ -1043,11 +1044,13 @@ int all_drivers_solve_batch(const all_drivers_options *options, const all_driver
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, ALL_DRIVERS_EDGE_SUBSTEPS). */
 static all_drivers_real all_drivers_march(const all_drivers_options *options, const all_drivers_real p[],
                                  all_drivers_real target, all_drivers_real h0, all_drivers_real h_min,
                                  all_drivers_state *state, all_drivers_workspace *work,
-                                 all_drivers_report *report, all_drivers_real *cond)
+                                 all_drivers_report *report, all_drivers_real *cond, int *left)
 {
     all_drivers_real h = h0;
     while (state->t < target) {
@@ -1057,7 +1060,8 @@ static all_drivers_real all_drivers_march(const all_drivers_options *options, co
         const all_drivers_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (all_drivers_solve_step(options, p, next, state, work, report) == ALL_DRIVERS_OK) {
             *cond = report->cond;
@@ -1081,6 +1085,7 @@ int all_drivers_solve_edge(const all_drivers_options *options, const all_drivers
     const all_drivers_real h0 = t - previous.t;
     all_drivers_state before = previous, after;
     all_drivers_real blocked, reach, early = 0, before_cond = cond;
+    int left = ALL_DRIVERS_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const all_drivers_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -1089,6 +1094,7 @@ int all_drivers_solve_edge(const all_drivers_options *options, const all_drivers
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (all_drivers_check_options(options) != 0) { /* no step could be taken: state kept */
         all_drivers_refused(report, t);
         edge->outcome = ALL_DRIVERS_EDGE_STOPPED;
@@ -1096,17 +1102,22 @@ int all_drivers_solve_edge(const all_drivers_options *options, const all_drivers
     }
     all_drivers_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = all_drivers_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = all_drivers_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = ALL_DRIVERS_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = ALL_DRIVERS_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = ALL_DRIVERS_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = all_drivers_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = ALL_DRIVERS_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = ALL_DRIVERS_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

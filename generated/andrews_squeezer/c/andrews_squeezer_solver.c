@@ -64,6 +64,7 @@ static int andrews_squeezer_refused(andrews_squeezer_report *report, andrews_squ
 #define ANDREWS_SQUEEZER_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define ANDREWS_SQUEEZER_SAFETY ((andrews_squeezer_real)10) /* as runtime.accuracy.SAFETY */
 #define ANDREWS_SQUEEZER_REESTIMATE_SHIFT ((andrews_squeezer_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define ANDREWS_SQUEEZER_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static andrews_squeezer_real andrews_squeezer_max_abs(const andrews_squeezer_real v[])
@@ -1049,11 +1050,13 @@ int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, const 
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, ANDREWS_SQUEEZER_EDGE_SUBSTEPS). */
 static andrews_squeezer_real andrews_squeezer_march(const andrews_squeezer_options *options, const andrews_squeezer_real p[],
                                  andrews_squeezer_real target, andrews_squeezer_real h0, andrews_squeezer_real h_min,
                                  andrews_squeezer_state *state, andrews_squeezer_workspace *work,
-                                 andrews_squeezer_report *report, andrews_squeezer_real *cond)
+                                 andrews_squeezer_report *report, andrews_squeezer_real *cond, int *left)
 {
     andrews_squeezer_real h = h0;
     while (state->t < target) {
@@ -1063,7 +1066,8 @@ static andrews_squeezer_real andrews_squeezer_march(const andrews_squeezer_optio
         const andrews_squeezer_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (andrews_squeezer_solve_step(options, p, next, state, work, report) == ANDREWS_SQUEEZER_OK) {
             *cond = report->cond;
@@ -1087,6 +1091,7 @@ int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const a
     const andrews_squeezer_real h0 = t - previous.t;
     andrews_squeezer_state before = previous, after;
     andrews_squeezer_real blocked, reach, early = 0, before_cond = cond;
+    int left = ANDREWS_SQUEEZER_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const andrews_squeezer_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -1095,6 +1100,7 @@ int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const a
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (andrews_squeezer_check_options(options) != 0) { /* no step could be taken: state kept */
         andrews_squeezer_refused(report, t);
         edge->outcome = ANDREWS_SQUEEZER_EDGE_STOPPED;
@@ -1102,17 +1108,22 @@ int andrews_squeezer_solve_edge(const andrews_squeezer_options *options, const a
     }
     andrews_squeezer_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = andrews_squeezer_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = andrews_squeezer_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = ANDREWS_SQUEEZER_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = ANDREWS_SQUEEZER_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = ANDREWS_SQUEEZER_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = andrews_squeezer_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = ANDREWS_SQUEEZER_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = ANDREWS_SQUEEZER_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -190,6 +190,8 @@ typedef struct {
     int outcome;                 /* ANDREWS_SQUEEZER_EDGE_REACHED, _PASSABLE or _STOPPED          */
     andrews_squeezer_real failed;    /* the step that failed from the last point reached (0: none) */
     andrews_squeezer_real cond;      /* the condition estimate at the last point reached          */
+    int substeps;                /* substeps taken; 1000 (the bound on them) when it stopped */
+                                 /* the motion                                               */
 } andrews_squeezer_edge_report;
 
 /* A time t that the plain step from a solved state could not reach (the point where

@@ -64,6 +64,7 @@ static int cam_cycloidal_refused(cam_cycloidal_report *report, cam_cycloidal_rea
 #define CAM_CYCLOIDAL_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define CAM_CYCLOIDAL_SAFETY ((cam_cycloidal_real)10) /* as runtime.accuracy.SAFETY */
 #define CAM_CYCLOIDAL_REESTIMATE_SHIFT ((cam_cycloidal_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CAM_CYCLOIDAL_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static cam_cycloidal_real cam_cycloidal_max_abs(const cam_cycloidal_real v[])
@@ -821,11 +822,13 @@ int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, const cam_cy
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, CAM_CYCLOIDAL_EDGE_SUBSTEPS). */
 static cam_cycloidal_real cam_cycloidal_march(const cam_cycloidal_options *options, const cam_cycloidal_real p[],
                                  cam_cycloidal_real target, cam_cycloidal_real h0, cam_cycloidal_real h_min,
                                  cam_cycloidal_state *state, cam_cycloidal_workspace *work,
-                                 cam_cycloidal_report *report, cam_cycloidal_real *cond)
+                                 cam_cycloidal_report *report, cam_cycloidal_real *cond, int *left)
 {
     cam_cycloidal_real h = h0;
     while (state->t < target) {
@@ -835,7 +838,8 @@ static cam_cycloidal_real cam_cycloidal_march(const cam_cycloidal_options *optio
         const cam_cycloidal_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (cam_cycloidal_solve_step(options, p, next, state, work, report) == CAM_CYCLOIDAL_OK) {
             *cond = report->cond;
@@ -859,6 +863,7 @@ int cam_cycloidal_solve_edge(const cam_cycloidal_options *options, const cam_cyc
     const cam_cycloidal_real h0 = t - previous.t;
     cam_cycloidal_state before = previous, after;
     cam_cycloidal_real blocked, reach, early = 0, before_cond = cond;
+    int left = CAM_CYCLOIDAL_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const cam_cycloidal_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -867,6 +872,7 @@ int cam_cycloidal_solve_edge(const cam_cycloidal_options *options, const cam_cyc
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (cam_cycloidal_check_options(options) != 0) { /* no step could be taken: state kept */
         cam_cycloidal_refused(report, t);
         edge->outcome = CAM_CYCLOIDAL_EDGE_STOPPED;
@@ -874,17 +880,22 @@ int cam_cycloidal_solve_edge(const cam_cycloidal_options *options, const cam_cyc
     }
     cam_cycloidal_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = cam_cycloidal_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = cam_cycloidal_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = CAM_CYCLOIDAL_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = CAM_CYCLOIDAL_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = CAM_CYCLOIDAL_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = cam_cycloidal_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = CAM_CYCLOIDAL_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = CAM_CYCLOIDAL_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

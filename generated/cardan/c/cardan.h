@@ -102,7 +102,10 @@ extern const int cardan_phi_p_col[CARDAN_NNZ_P];
 /* The non-zeros of Phi_p in pattern order: nz[NNZ_P]. */
 void cardan_phi_p(const cardan_real q[], cardan_real t, const cardan_real p[], cardan_real nz[]);
 /* Rows of the file removed for the run as dependent on the others at the assembled t0 (they
- * are not in Phi); the runtime checks they stay satisfied along the motion:
+ * are not in Phi, and no solve of this folder looks at them): symkin's own runtime checks
+ * they stay satisfied along the motion; a program of its own should call
+ * cardan_removed after each solved step and treat |out[i]| above its tolerance as the
+ * file's joints contradicting each other there:
  *   0: joints[2] output revolute shaft2-ground (y)
  *   1: joints[2] output revolute shaft2-ground (axis u)
  *   2: joints[2] output revolute shaft2-ground (axis v)

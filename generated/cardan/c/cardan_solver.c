@@ -64,6 +64,7 @@ static int cardan_refused(cardan_report *report, cardan_real t)
 #define CARDAN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define CARDAN_SAFETY ((cardan_real)10) /* as runtime.accuracy.SAFETY */
 #define CARDAN_REESTIMATE_SHIFT ((cardan_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CARDAN_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static cardan_real cardan_max_abs(const cardan_real v[])
@@ -807,11 +808,13 @@ int cardan_solve_batch(const cardan_options *options, const cardan_real units[],
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, CARDAN_EDGE_SUBSTEPS). */
 static cardan_real cardan_march(const cardan_options *options, const cardan_real p[],
                                  cardan_real target, cardan_real h0, cardan_real h_min,
                                  cardan_state *state, cardan_workspace *work,
-                                 cardan_report *report, cardan_real *cond)
+                                 cardan_report *report, cardan_real *cond, int *left)
 {
     cardan_real h = h0;
     while (state->t < target) {
@@ -821,7 +824,8 @@ static cardan_real cardan_march(const cardan_options *options, const cardan_real
         const cardan_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (cardan_solve_step(options, p, next, state, work, report) == CARDAN_OK) {
             *cond = report->cond;
@@ -845,6 +849,7 @@ int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
     const cardan_real h0 = t - previous.t;
     cardan_state before = previous, after;
     cardan_real blocked, reach, early = 0, before_cond = cond;
+    int left = CARDAN_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const cardan_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -853,6 +858,7 @@ int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (cardan_check_options(options) != 0) { /* no step could be taken: state kept */
         cardan_refused(report, t);
         edge->outcome = CARDAN_EDGE_STOPPED;
@@ -860,17 +866,22 @@ int cardan_solve_edge(const cardan_options *options, const cardan_real p[],
     }
     cardan_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = cardan_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = cardan_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = CARDAN_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = CARDAN_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = CARDAN_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = cardan_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = CARDAN_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = CARDAN_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

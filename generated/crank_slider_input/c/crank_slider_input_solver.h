@@ -227,6 +227,8 @@ typedef struct {
     int outcome;                 /* CRANK_SLIDER_INPUT_EDGE_REACHED, _PASSABLE or _STOPPED          */
     crank_slider_input_real failed;    /* the step that failed from the last point reached (0: none) */
     crank_slider_input_real cond;      /* the condition estimate at the last point reached          */
+    int substeps;                /* substeps taken; 1000 (the bound on them) when it stopped */
+                                 /* the motion                                               */
 } crank_slider_input_edge_report;
 
 /* A time t that the plain step from a solved state could not reach (the point where

@@ -64,6 +64,7 @@ static int crank_slider_load_refused(crank_slider_load_report *report, crank_sli
 #define CRANK_SLIDER_LOAD_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define CRANK_SLIDER_LOAD_SAFETY ((crank_slider_load_real)10) /* as runtime.accuracy.SAFETY */
 #define CRANK_SLIDER_LOAD_REESTIMATE_SHIFT ((crank_slider_load_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CRANK_SLIDER_LOAD_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static crank_slider_load_real crank_slider_load_max_abs(const crank_slider_load_real v[])
@@ -850,11 +851,13 @@ int crank_slider_load_solve_batch(const crank_slider_load_options *options, cons
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, CRANK_SLIDER_LOAD_EDGE_SUBSTEPS). */
 static crank_slider_load_real crank_slider_load_march(const crank_slider_load_options *options, const crank_slider_load_real p[],
                                  crank_slider_load_real target, crank_slider_load_real h0, crank_slider_load_real h_min,
                                  crank_slider_load_state *state, crank_slider_load_workspace *work,
-                                 crank_slider_load_report *report, crank_slider_load_real *cond)
+                                 crank_slider_load_report *report, crank_slider_load_real *cond, int *left)
 {
     crank_slider_load_real h = h0;
     while (state->t < target) {
@@ -864,7 +867,8 @@ static crank_slider_load_real crank_slider_load_march(const crank_slider_load_op
         const crank_slider_load_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (crank_slider_load_solve_step(options, p, next, state, work, report) == CRANK_SLIDER_LOAD_OK) {
             *cond = report->cond;
@@ -888,6 +892,7 @@ int crank_slider_load_solve_edge(const crank_slider_load_options *options, const
     const crank_slider_load_real h0 = t - previous.t;
     crank_slider_load_state before = previous, after;
     crank_slider_load_real blocked, reach, early = 0, before_cond = cond;
+    int left = CRANK_SLIDER_LOAD_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const crank_slider_load_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -896,6 +901,7 @@ int crank_slider_load_solve_edge(const crank_slider_load_options *options, const
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (crank_slider_load_check_options(options) != 0) { /* no step could be taken: state kept */
         crank_slider_load_refused(report, t);
         edge->outcome = CRANK_SLIDER_LOAD_EDGE_STOPPED;
@@ -903,17 +909,22 @@ int crank_slider_load_solve_edge(const crank_slider_load_options *options, const
     }
     crank_slider_load_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = crank_slider_load_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = crank_slider_load_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = CRANK_SLIDER_LOAD_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = CRANK_SLIDER_LOAD_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = CRANK_SLIDER_LOAD_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = crank_slider_load_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = CRANK_SLIDER_LOAD_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = CRANK_SLIDER_LOAD_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

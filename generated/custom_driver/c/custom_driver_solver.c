@@ -64,6 +64,7 @@ static int custom_driver_refused(custom_driver_report *report, custom_driver_rea
 #define CUSTOM_DRIVER_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define CUSTOM_DRIVER_SAFETY ((custom_driver_real)10) /* as runtime.accuracy.SAFETY */
 #define CUSTOM_DRIVER_REESTIMATE_SHIFT ((custom_driver_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CUSTOM_DRIVER_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static custom_driver_real custom_driver_max_abs(const custom_driver_real v[])
@@ -851,11 +852,13 @@ int custom_driver_solve_batch(const custom_driver_options *options, const custom
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, CUSTOM_DRIVER_EDGE_SUBSTEPS). */
 static custom_driver_real custom_driver_march(const custom_driver_options *options, const custom_driver_real p[],
                                  custom_driver_real target, custom_driver_real h0, custom_driver_real h_min,
                                  custom_driver_state *state, custom_driver_workspace *work,
-                                 custom_driver_report *report, custom_driver_real *cond)
+                                 custom_driver_report *report, custom_driver_real *cond, int *left)
 {
     custom_driver_real h = h0;
     while (state->t < target) {
@@ -865,7 +868,8 @@ static custom_driver_real custom_driver_march(const custom_driver_options *optio
         const custom_driver_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (custom_driver_solve_step(options, p, next, state, work, report) == CUSTOM_DRIVER_OK) {
             *cond = report->cond;
@@ -889,6 +893,7 @@ int custom_driver_solve_edge(const custom_driver_options *options, const custom_
     const custom_driver_real h0 = t - previous.t;
     custom_driver_state before = previous, after;
     custom_driver_real blocked, reach, early = 0, before_cond = cond;
+    int left = CUSTOM_DRIVER_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const custom_driver_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -897,6 +902,7 @@ int custom_driver_solve_edge(const custom_driver_options *options, const custom_
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (custom_driver_check_options(options) != 0) { /* no step could be taken: state kept */
         custom_driver_refused(report, t);
         edge->outcome = CUSTOM_DRIVER_EDGE_STOPPED;
@@ -904,17 +910,22 @@ int custom_driver_solve_edge(const custom_driver_options *options, const custom_
     }
     custom_driver_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = custom_driver_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = custom_driver_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = CUSTOM_DRIVER_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = CUSTOM_DRIVER_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = CUSTOM_DRIVER_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = custom_driver_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = CUSTOM_DRIVER_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = CUSTOM_DRIVER_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

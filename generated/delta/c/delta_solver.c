@@ -64,6 +64,7 @@ static int delta_refused(delta_report *report, delta_real t)
 #define DELTA_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define DELTA_SAFETY ((delta_real)10) /* as runtime.accuracy.SAFETY */
 #define DELTA_REESTIMATE_SHIFT ((delta_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define DELTA_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static delta_real delta_max_abs(const delta_real v[])
@@ -875,11 +876,13 @@ int delta_solve_batch(const delta_options *options, const delta_real units[],
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, DELTA_EDGE_SUBSTEPS). */
 static delta_real delta_march(const delta_options *options, const delta_real p[],
                                  delta_real target, delta_real h0, delta_real h_min,
                                  delta_state *state, delta_workspace *work,
-                                 delta_report *report, delta_real *cond)
+                                 delta_report *report, delta_real *cond, int *left)
 {
     delta_real h = h0;
     while (state->t < target) {
@@ -889,7 +892,8 @@ static delta_real delta_march(const delta_options *options, const delta_real p[]
         const delta_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (delta_solve_step(options, p, next, state, work, report) == DELTA_OK) {
             *cond = report->cond;
@@ -913,6 +917,7 @@ int delta_solve_edge(const delta_options *options, const delta_real p[],
     const delta_real h0 = t - previous.t;
     delta_state before = previous, after;
     delta_real blocked, reach, early = 0, before_cond = cond;
+    int left = DELTA_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const delta_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -921,6 +926,7 @@ int delta_solve_edge(const delta_options *options, const delta_real p[],
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (delta_check_options(options) != 0) { /* no step could be taken: state kept */
         delta_refused(report, t);
         edge->outcome = DELTA_EDGE_STOPPED;
@@ -928,17 +934,22 @@ int delta_solve_edge(const delta_options *options, const delta_real p[],
     }
     delta_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = delta_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = delta_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = DELTA_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = DELTA_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = DELTA_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = delta_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = DELTA_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = DELTA_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

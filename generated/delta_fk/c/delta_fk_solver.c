@@ -65,6 +65,7 @@ static int delta_fk_refused(delta_fk_report *report, delta_fk_real t)
 #define DELTA_FK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define DELTA_FK_SAFETY ((delta_fk_real)10) /* as runtime.accuracy.SAFETY */
 #define DELTA_FK_REESTIMATE_SHIFT ((delta_fk_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define DELTA_FK_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static delta_fk_real delta_fk_max_abs(const delta_fk_real v[])
@@ -1077,11 +1078,13 @@ int delta_fk_solve_batch(const delta_fk_options *options, const delta_fk_real un
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, DELTA_FK_EDGE_SUBSTEPS). */
 static delta_fk_real delta_fk_march(const delta_fk_options *options, const delta_fk_real p[],
                                  delta_fk_real target, delta_fk_real h0, delta_fk_real h_min,
                                  delta_fk_state *state, delta_fk_workspace *work,
-                                 delta_fk_report *report, delta_fk_real *cond)
+                                 delta_fk_report *report, delta_fk_real *cond, int *left)
 {
     delta_fk_real h = h0;
     while (state->t < target) {
@@ -1091,7 +1094,8 @@ static delta_fk_real delta_fk_march(const delta_fk_options *options, const delta
         const delta_fk_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (delta_fk_solve_step(options, p, next, state, work, report) == DELTA_FK_OK) {
             *cond = report->cond;
@@ -1115,6 +1119,7 @@ int delta_fk_solve_edge(const delta_fk_options *options, const delta_fk_real p[]
     const delta_fk_real h0 = t - previous.t;
     delta_fk_state before = previous, after;
     delta_fk_real blocked, reach, early = 0, before_cond = cond;
+    int left = DELTA_FK_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const delta_fk_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -1123,6 +1128,7 @@ int delta_fk_solve_edge(const delta_fk_options *options, const delta_fk_real p[]
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (delta_fk_check_options(options) != 0) { /* no step could be taken: state kept */
         delta_fk_refused(report, t);
         edge->outcome = DELTA_FK_EDGE_STOPPED;
@@ -1130,17 +1136,22 @@ int delta_fk_solve_edge(const delta_fk_options *options, const delta_fk_real p[]
     }
     delta_fk_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = delta_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = delta_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = DELTA_FK_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = DELTA_FK_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = DELTA_FK_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = delta_fk_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = DELTA_FK_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = DELTA_FK_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

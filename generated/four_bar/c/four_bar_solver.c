@@ -64,6 +64,7 @@ static int four_bar_refused(four_bar_report *report, four_bar_real t)
 #define FOUR_BAR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define FOUR_BAR_SAFETY ((four_bar_real)10) /* as runtime.accuracy.SAFETY */
 #define FOUR_BAR_REESTIMATE_SHIFT ((four_bar_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define FOUR_BAR_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static four_bar_real four_bar_max_abs(const four_bar_real v[])
@@ -843,11 +844,13 @@ int four_bar_solve_batch(const four_bar_options *options, const four_bar_real un
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, FOUR_BAR_EDGE_SUBSTEPS). */
 static four_bar_real four_bar_march(const four_bar_options *options, const four_bar_real p[],
                                  four_bar_real target, four_bar_real h0, four_bar_real h_min,
                                  four_bar_state *state, four_bar_workspace *work,
-                                 four_bar_report *report, four_bar_real *cond)
+                                 four_bar_report *report, four_bar_real *cond, int *left)
 {
     four_bar_real h = h0;
     while (state->t < target) {
@@ -857,7 +860,8 @@ static four_bar_real four_bar_march(const four_bar_options *options, const four_
         const four_bar_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (four_bar_solve_step(options, p, next, state, work, report) == FOUR_BAR_OK) {
             *cond = report->cond;
@@ -881,6 +885,7 @@ int four_bar_solve_edge(const four_bar_options *options, const four_bar_real p[]
     const four_bar_real h0 = t - previous.t;
     four_bar_state before = previous, after;
     four_bar_real blocked, reach, early = 0, before_cond = cond;
+    int left = FOUR_BAR_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const four_bar_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -889,6 +894,7 @@ int four_bar_solve_edge(const four_bar_options *options, const four_bar_real p[]
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (four_bar_check_options(options) != 0) { /* no step could be taken: state kept */
         four_bar_refused(report, t);
         edge->outcome = FOUR_BAR_EDGE_STOPPED;
@@ -896,17 +902,22 @@ int four_bar_solve_edge(const four_bar_options *options, const four_bar_real p[]
     }
     four_bar_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = four_bar_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = four_bar_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = FOUR_BAR_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = FOUR_BAR_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = FOUR_BAR_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = four_bar_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = FOUR_BAR_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = FOUR_BAR_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

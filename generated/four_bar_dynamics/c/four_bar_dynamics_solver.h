@@ -196,6 +196,8 @@ typedef struct {
     int outcome;                 /* FOUR_BAR_DYNAMICS_EDGE_REACHED, _PASSABLE or _STOPPED          */
     four_bar_dynamics_real failed;    /* the step that failed from the last point reached (0: none) */
     four_bar_dynamics_real cond;      /* the condition estimate at the last point reached          */
+    int substeps;                /* substeps taken; 1000 (the bound on them) when it stopped */
+                                 /* the motion                                               */
 } four_bar_dynamics_edge_report;
 
 /* A time t that the plain step from a solved state could not reach (the point where

@@ -105,7 +105,10 @@ extern const int parallelogram_extra_bar_phi_p_col[PARALLELOGRAM_EXTRA_BAR_NNZ_P
 /* The non-zeros of Phi_p in pattern order: nz[NNZ_P]. */
 void parallelogram_extra_bar_phi_p(const parallelogram_extra_bar_real q[], parallelogram_extra_bar_real t, const parallelogram_extra_bar_real p[], parallelogram_extra_bar_real nz[]);
 /* Rows of the file removed for the run as dependent on the others at the assembled t0 (they
- * are not in Phi); the runtime checks they stay satisfied along the motion:
+ * are not in Phi, and no solve of this folder looks at them): symkin's own runtime checks
+ * they stay satisfied along the motion; a program of its own should call
+ * parallelogram_extra_bar_removed after each solved step and treat |out[i]| above its tolerance as the
+ * file's joints contradicting each other there:
  *   0: joints[5] C revolute extra-coupler (y)
  */
 #define PARALLELOGRAM_EXTRA_BAR_NREMOVED 1

@@ -64,6 +64,7 @@ static int parallelogram_extra_bar_loads_refused(parallelogram_extra_bar_loads_r
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY ((parallelogram_extra_bar_loads_real)10) /* as runtime.accuracy.SAFETY */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_REESTIMATE_SHIFT ((parallelogram_extra_bar_loads_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_max_abs(const parallelogram_extra_bar_loads_real v[])
@@ -924,11 +925,13 @@ int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_load
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_SUBSTEPS). */
 static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_march(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
                                  parallelogram_extra_bar_loads_real target, parallelogram_extra_bar_loads_real h0, parallelogram_extra_bar_loads_real h_min,
                                  parallelogram_extra_bar_loads_state *state, parallelogram_extra_bar_loads_workspace *work,
-                                 parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real *cond)
+                                 parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real *cond, int *left)
 {
     parallelogram_extra_bar_loads_real h = h0;
     while (state->t < target) {
@@ -938,7 +941,8 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_march(co
         const parallelogram_extra_bar_loads_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (parallelogram_extra_bar_loads_solve_step(options, p, next, state, work, report) == PARALLELOGRAM_EXTRA_BAR_LOADS_OK) {
             *cond = report->cond;
@@ -962,6 +966,7 @@ int parallelogram_extra_bar_loads_solve_edge(const parallelogram_extra_bar_loads
     const parallelogram_extra_bar_loads_real h0 = t - previous.t;
     parallelogram_extra_bar_loads_state before = previous, after;
     parallelogram_extra_bar_loads_real blocked, reach, early = 0, before_cond = cond;
+    int left = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const parallelogram_extra_bar_loads_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -970,6 +975,7 @@ int parallelogram_extra_bar_loads_solve_edge(const parallelogram_extra_bar_loads
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (parallelogram_extra_bar_loads_check_options(options) != 0) { /* no step could be taken: state kept */
         parallelogram_extra_bar_loads_refused(report, t);
         edge->outcome = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_STOPPED;
@@ -977,17 +983,22 @@ int parallelogram_extra_bar_loads_solve_edge(const parallelogram_extra_bar_loads
     }
     parallelogram_extra_bar_loads_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = parallelogram_extra_bar_loads_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = parallelogram_extra_bar_loads_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = parallelogram_extra_bar_loads_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

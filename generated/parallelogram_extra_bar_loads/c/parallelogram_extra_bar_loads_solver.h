@@ -196,6 +196,8 @@ typedef struct {
     int outcome;                 /* PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_REACHED, _PASSABLE or _STOPPED          */
     parallelogram_extra_bar_loads_real failed;    /* the step that failed from the last point reached (0: none) */
     parallelogram_extra_bar_loads_real cond;      /* the condition estimate at the last point reached          */
+    int substeps;                /* substeps taken; 1000 (the bound on them) when it stopped */
+                                 /* the motion                                               */
 } parallelogram_extra_bar_loads_edge_report;
 
 /* A time t that the plain step from a solved state could not reach (the point where

@@ -64,6 +64,7 @@ static int planetary_refused(planetary_report *report, planetary_real t)
 #define PLANETARY_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define PLANETARY_SAFETY ((planetary_real)10) /* as runtime.accuracy.SAFETY */
 #define PLANETARY_REESTIMATE_SHIFT ((planetary_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define PLANETARY_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static planetary_real planetary_max_abs(const planetary_real v[])
@@ -836,11 +837,13 @@ int planetary_solve_batch(const planetary_options *options, const planetary_real
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, PLANETARY_EDGE_SUBSTEPS). */
 static planetary_real planetary_march(const planetary_options *options, const planetary_real p[],
                                  planetary_real target, planetary_real h0, planetary_real h_min,
                                  planetary_state *state, planetary_workspace *work,
-                                 planetary_report *report, planetary_real *cond)
+                                 planetary_report *report, planetary_real *cond, int *left)
 {
     planetary_real h = h0;
     while (state->t < target) {
@@ -850,7 +853,8 @@ static planetary_real planetary_march(const planetary_options *options, const pl
         const planetary_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (planetary_solve_step(options, p, next, state, work, report) == PLANETARY_OK) {
             *cond = report->cond;
@@ -874,6 +878,7 @@ int planetary_solve_edge(const planetary_options *options, const planetary_real 
     const planetary_real h0 = t - previous.t;
     planetary_state before = previous, after;
     planetary_real blocked, reach, early = 0, before_cond = cond;
+    int left = PLANETARY_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const planetary_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -882,6 +887,7 @@ int planetary_solve_edge(const planetary_options *options, const planetary_real 
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (planetary_check_options(options) != 0) { /* no step could be taken: state kept */
         planetary_refused(report, t);
         edge->outcome = PLANETARY_EDGE_STOPPED;
@@ -889,17 +895,22 @@ int planetary_solve_edge(const planetary_options *options, const planetary_real 
     }
     planetary_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = planetary_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = planetary_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = PLANETARY_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = PLANETARY_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = PLANETARY_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = planetary_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = PLANETARY_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = PLANETARY_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

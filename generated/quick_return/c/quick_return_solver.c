@@ -64,6 +64,7 @@ static int quick_return_refused(quick_return_report *report, quick_return_real t
 #define QUICK_RETURN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define QUICK_RETURN_SAFETY ((quick_return_real)10) /* as runtime.accuracy.SAFETY */
 #define QUICK_RETURN_REESTIMATE_SHIFT ((quick_return_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define QUICK_RETURN_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static quick_return_real quick_return_max_abs(const quick_return_real v[])
@@ -890,11 +891,13 @@ int quick_return_solve_batch(const quick_return_options *options, const quick_re
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, QUICK_RETURN_EDGE_SUBSTEPS). */
 static quick_return_real quick_return_march(const quick_return_options *options, const quick_return_real p[],
                                  quick_return_real target, quick_return_real h0, quick_return_real h_min,
                                  quick_return_state *state, quick_return_workspace *work,
-                                 quick_return_report *report, quick_return_real *cond)
+                                 quick_return_report *report, quick_return_real *cond, int *left)
 {
     quick_return_real h = h0;
     while (state->t < target) {
@@ -904,7 +907,8 @@ static quick_return_real quick_return_march(const quick_return_options *options,
         const quick_return_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (quick_return_solve_step(options, p, next, state, work, report) == QUICK_RETURN_OK) {
             *cond = report->cond;
@@ -928,6 +932,7 @@ int quick_return_solve_edge(const quick_return_options *options, const quick_ret
     const quick_return_real h0 = t - previous.t;
     quick_return_state before = previous, after;
     quick_return_real blocked, reach, early = 0, before_cond = cond;
+    int left = QUICK_RETURN_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const quick_return_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -936,6 +941,7 @@ int quick_return_solve_edge(const quick_return_options *options, const quick_ret
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (quick_return_check_options(options) != 0) { /* no step could be taken: state kept */
         quick_return_refused(report, t);
         edge->outcome = QUICK_RETURN_EDGE_STOPPED;
@@ -943,17 +949,22 @@ int quick_return_solve_edge(const quick_return_options *options, const quick_ret
     }
     quick_return_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = quick_return_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = quick_return_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = QUICK_RETURN_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = QUICK_RETURN_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = QUICK_RETURN_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = quick_return_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = QUICK_RETURN_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = QUICK_RETURN_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -190,6 +190,8 @@ typedef struct {
     int outcome;                 /* QUICK_RETURN_EDGE_REACHED, _PASSABLE or _STOPPED          */
     quick_return_real failed;    /* the step that failed from the last point reached (0: none) */
     quick_return_real cond;      /* the condition estimate at the last point reached          */
+    int substeps;                /* substeps taken; 1000 (the bound on them) when it stopped */
+                                 /* the motion                                               */
 } quick_return_edge_report;
 
 /* A time t that the plain step from a solved state could not reach (the point where

@@ -64,6 +64,7 @@ static int rack_linkage_refused(rack_linkage_report *report, rack_linkage_real t
 #define RACK_LINKAGE_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define RACK_LINKAGE_SAFETY ((rack_linkage_real)10) /* as runtime.accuracy.SAFETY */
 #define RACK_LINKAGE_REESTIMATE_SHIFT ((rack_linkage_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define RACK_LINKAGE_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static rack_linkage_real rack_linkage_max_abs(const rack_linkage_real v[])
@@ -917,11 +918,13 @@ int rack_linkage_solve_batch(const rack_linkage_options *options, const rack_lin
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, RACK_LINKAGE_EDGE_SUBSTEPS). */
 static rack_linkage_real rack_linkage_march(const rack_linkage_options *options, const rack_linkage_real p[],
                                  rack_linkage_real target, rack_linkage_real h0, rack_linkage_real h_min,
                                  rack_linkage_state *state, rack_linkage_workspace *work,
-                                 rack_linkage_report *report, rack_linkage_real *cond)
+                                 rack_linkage_report *report, rack_linkage_real *cond, int *left)
 {
     rack_linkage_real h = h0;
     while (state->t < target) {
@@ -931,7 +934,8 @@ static rack_linkage_real rack_linkage_march(const rack_linkage_options *options,
         const rack_linkage_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (rack_linkage_solve_step(options, p, next, state, work, report) == RACK_LINKAGE_OK) {
             *cond = report->cond;
@@ -955,6 +959,7 @@ int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_link
     const rack_linkage_real h0 = t - previous.t;
     rack_linkage_state before = previous, after;
     rack_linkage_real blocked, reach, early = 0, before_cond = cond;
+    int left = RACK_LINKAGE_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const rack_linkage_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -963,6 +968,7 @@ int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_link
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (rack_linkage_check_options(options) != 0) { /* no step could be taken: state kept */
         rack_linkage_refused(report, t);
         edge->outcome = RACK_LINKAGE_EDGE_STOPPED;
@@ -970,17 +976,22 @@ int rack_linkage_solve_edge(const rack_linkage_options *options, const rack_link
     }
     rack_linkage_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = rack_linkage_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = rack_linkage_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = RACK_LINKAGE_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = RACK_LINKAGE_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = RACK_LINKAGE_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = rack_linkage_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = RACK_LINKAGE_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = RACK_LINKAGE_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -64,6 +64,7 @@ static int rssr_refused(rssr_report *report, rssr_real t)
 #define RSSR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define RSSR_SAFETY ((rssr_real)10) /* as runtime.accuracy.SAFETY */
 #define RSSR_REESTIMATE_SHIFT ((rssr_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define RSSR_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static rssr_real rssr_max_abs(const rssr_real v[])
@@ -1172,11 +1173,13 @@ int rssr_solve_batch(const rssr_options *options, const rssr_real units[],
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, RSSR_EDGE_SUBSTEPS). */
 static rssr_real rssr_march(const rssr_options *options, const rssr_real p[],
                                  rssr_real target, rssr_real h0, rssr_real h_min,
                                  rssr_state *state, rssr_workspace *work,
-                                 rssr_report *report, rssr_real *cond)
+                                 rssr_report *report, rssr_real *cond, int *left)
 {
     rssr_real h = h0;
     while (state->t < target) {
@@ -1186,7 +1189,8 @@ static rssr_real rssr_march(const rssr_options *options, const rssr_real p[],
         const rssr_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (rssr_solve_step(options, p, next, state, work, report) == RSSR_OK) {
             *cond = report->cond;
@@ -1210,6 +1214,7 @@ int rssr_solve_edge(const rssr_options *options, const rssr_real p[],
     const rssr_real h0 = t - previous.t;
     rssr_state before = previous, after;
     rssr_real blocked, reach, early = 0, before_cond = cond;
+    int left = RSSR_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const rssr_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -1218,6 +1223,7 @@ int rssr_solve_edge(const rssr_options *options, const rssr_real p[],
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (rssr_check_options(options) != 0) { /* no step could be taken: state kept */
         rssr_refused(report, t);
         edge->outcome = RSSR_EDGE_STOPPED;
@@ -1225,17 +1231,22 @@ int rssr_solve_edge(const rssr_options *options, const rssr_real p[],
     }
     rssr_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = rssr_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = rssr_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = RSSR_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = RSSR_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = RSSR_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = rssr_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = RSSR_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = RSSR_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -64,6 +64,7 @@ static int spatial_slider_crank_refused(spatial_slider_crank_report *report, spa
 #define SPATIAL_SLIDER_CRANK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define SPATIAL_SLIDER_CRANK_SAFETY ((spatial_slider_crank_real)10) /* as runtime.accuracy.SAFETY */
 #define SPATIAL_SLIDER_CRANK_REESTIMATE_SHIFT ((spatial_slider_crank_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define SPATIAL_SLIDER_CRANK_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static spatial_slider_crank_real spatial_slider_crank_max_abs(const spatial_slider_crank_real v[])
@@ -829,11 +830,13 @@ int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, SPATIAL_SLIDER_CRANK_EDGE_SUBSTEPS). */
 static spatial_slider_crank_real spatial_slider_crank_march(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[],
                                  spatial_slider_crank_real target, spatial_slider_crank_real h0, spatial_slider_crank_real h_min,
                                  spatial_slider_crank_state *state, spatial_slider_crank_workspace *work,
-                                 spatial_slider_crank_report *report, spatial_slider_crank_real *cond)
+                                 spatial_slider_crank_report *report, spatial_slider_crank_real *cond, int *left)
 {
     spatial_slider_crank_real h = h0;
     while (state->t < target) {
@@ -843,7 +846,8 @@ static spatial_slider_crank_real spatial_slider_crank_march(const spatial_slider
         const spatial_slider_crank_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (spatial_slider_crank_solve_step(options, p, next, state, work, report) == SPATIAL_SLIDER_CRANK_OK) {
             *cond = report->cond;
@@ -867,6 +871,7 @@ int spatial_slider_crank_solve_edge(const spatial_slider_crank_options *options,
     const spatial_slider_crank_real h0 = t - previous.t;
     spatial_slider_crank_state before = previous, after;
     spatial_slider_crank_real blocked, reach, early = 0, before_cond = cond;
+    int left = SPATIAL_SLIDER_CRANK_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const spatial_slider_crank_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -875,6 +880,7 @@ int spatial_slider_crank_solve_edge(const spatial_slider_crank_options *options,
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (spatial_slider_crank_check_options(options) != 0) { /* no step could be taken: state kept */
         spatial_slider_crank_refused(report, t);
         edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_STOPPED;
@@ -882,17 +888,22 @@ int spatial_slider_crank_solve_edge(const spatial_slider_crank_options *options,
     }
     spatial_slider_crank_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = spatial_slider_crank_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = spatial_slider_crank_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = SPATIAL_SLIDER_CRANK_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = spatial_slider_crank_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = SPATIAL_SLIDER_CRANK_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = SPATIAL_SLIDER_CRANK_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -64,6 +64,7 @@ static int stewart_legs_refused(stewart_legs_report *report, stewart_legs_real t
 #define STEWART_LEGS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define STEWART_LEGS_SAFETY ((stewart_legs_real)10) /* as runtime.accuracy.SAFETY */
 #define STEWART_LEGS_REESTIMATE_SHIFT ((stewart_legs_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define STEWART_LEGS_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static stewart_legs_real stewart_legs_max_abs(const stewart_legs_real v[])
@@ -1145,11 +1146,13 @@ int stewart_legs_solve_batch(const stewart_legs_options *options, const stewart_
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, STEWART_LEGS_EDGE_SUBSTEPS). */
 static stewart_legs_real stewart_legs_march(const stewart_legs_options *options, const stewart_legs_real p[],
                                  stewart_legs_real target, stewart_legs_real h0, stewart_legs_real h_min,
                                  stewart_legs_state *state, stewart_legs_workspace *work,
-                                 stewart_legs_report *report, stewart_legs_real *cond)
+                                 stewart_legs_report *report, stewart_legs_real *cond, int *left)
 {
     stewart_legs_real h = h0;
     while (state->t < target) {
@@ -1159,7 +1162,8 @@ static stewart_legs_real stewart_legs_march(const stewart_legs_options *options,
         const stewart_legs_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (stewart_legs_solve_step(options, p, next, state, work, report) == STEWART_LEGS_OK) {
             *cond = report->cond;
@@ -1183,6 +1187,7 @@ int stewart_legs_solve_edge(const stewart_legs_options *options, const stewart_l
     const stewart_legs_real h0 = t - previous.t;
     stewart_legs_state before = previous, after;
     stewart_legs_real blocked, reach, early = 0, before_cond = cond;
+    int left = STEWART_LEGS_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const stewart_legs_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -1191,6 +1196,7 @@ int stewart_legs_solve_edge(const stewart_legs_options *options, const stewart_l
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (stewart_legs_check_options(options) != 0) { /* no step could be taken: state kept */
         stewart_legs_refused(report, t);
         edge->outcome = STEWART_LEGS_EDGE_STOPPED;
@@ -1198,17 +1204,22 @@ int stewart_legs_solve_edge(const stewart_legs_options *options, const stewart_l
     }
     stewart_legs_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = stewart_legs_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = stewart_legs_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = STEWART_LEGS_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = STEWART_LEGS_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = STEWART_LEGS_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = stewart_legs_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = STEWART_LEGS_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = STEWART_LEGS_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -65,6 +65,7 @@ static int three_rrr_fk_refused(three_rrr_fk_report *report, three_rrr_fk_real t
 #define THREE_RRR_FK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define THREE_RRR_FK_SAFETY ((three_rrr_fk_real)10) /* as runtime.accuracy.SAFETY */
 #define THREE_RRR_FK_REESTIMATE_SHIFT ((three_rrr_fk_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define THREE_RRR_FK_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static three_rrr_fk_real three_rrr_fk_max_abs(const three_rrr_fk_real v[])
@@ -1271,11 +1272,13 @@ int three_rrr_fk_solve_batch(const three_rrr_fk_options *options, const three_rr
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, THREE_RRR_FK_EDGE_SUBSTEPS). */
 static three_rrr_fk_real three_rrr_fk_march(const three_rrr_fk_options *options, const three_rrr_fk_real p[],
                                  three_rrr_fk_real target, three_rrr_fk_real h0, three_rrr_fk_real h_min,
                                  three_rrr_fk_state *state, three_rrr_fk_workspace *work,
-                                 three_rrr_fk_report *report, three_rrr_fk_real *cond)
+                                 three_rrr_fk_report *report, three_rrr_fk_real *cond, int *left)
 {
     three_rrr_fk_real h = h0;
     while (state->t < target) {
@@ -1285,7 +1288,8 @@ static three_rrr_fk_real three_rrr_fk_march(const three_rrr_fk_options *options,
         const three_rrr_fk_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (three_rrr_fk_solve_step(options, p, next, state, work, report) == THREE_RRR_FK_OK) {
             *cond = report->cond;
@@ -1309,6 +1313,7 @@ int three_rrr_fk_solve_edge(const three_rrr_fk_options *options, const three_rrr
     const three_rrr_fk_real h0 = t - previous.t;
     three_rrr_fk_state before = previous, after;
     three_rrr_fk_real blocked, reach, early = 0, before_cond = cond;
+    int left = THREE_RRR_FK_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const three_rrr_fk_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -1317,6 +1322,7 @@ int three_rrr_fk_solve_edge(const three_rrr_fk_options *options, const three_rrr
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (three_rrr_fk_check_options(options) != 0) { /* no step could be taken: state kept */
         three_rrr_fk_refused(report, t);
         edge->outcome = THREE_RRR_FK_EDGE_STOPPED;
@@ -1324,17 +1330,22 @@ int three_rrr_fk_solve_edge(const three_rrr_fk_options *options, const three_rrr
     }
     three_rrr_fk_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = three_rrr_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = three_rrr_fk_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = THREE_RRR_FK_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = THREE_RRR_FK_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = THREE_RRR_FK_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = three_rrr_fk_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = THREE_RRR_FK_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = THREE_RRR_FK_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -227,6 +227,8 @@ typedef struct {
     int outcome;                 /* THREE_RRR_FK_EDGE_REACHED, _PASSABLE or _STOPPED          */
     three_rrr_fk_real failed;    /* the step that failed from the last point reached (0: none) */
     three_rrr_fk_real cond;      /* the condition estimate at the last point reached          */
+    int substeps;                /* substeps taken; 1000 (the bound on them) when it stopped */
+                                 /* the motion                                               */
 } three_rrr_fk_edge_report;
 
 /* A time t that the plain step from a solved state could not reach (the point where

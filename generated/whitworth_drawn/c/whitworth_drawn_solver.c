@@ -64,6 +64,7 @@ static int whitworth_drawn_refused(whitworth_drawn_report *report, whitworth_dra
 #define WHITWORTH_DRAWN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
 #define WHITWORTH_DRAWN_SAFETY ((whitworth_drawn_real)10) /* as runtime.accuracy.SAFETY */
 #define WHITWORTH_DRAWN_REESTIMATE_SHIFT ((whitworth_drawn_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define WHITWORTH_DRAWN_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
 static whitworth_drawn_real whitworth_drawn_max_abs(const whitworth_drawn_real v[])
@@ -890,11 +891,13 @@ int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, const wh
 
 /* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
- * target was reached; *cond: the condition estimate at that point. */
+ * target was reached; *cond: the condition estimate at that point. Each substep spends one
+ * of *left; with none left the next step counts as failed (the bound on Newton's work at one
+ * time point, WHITWORTH_DRAWN_EDGE_SUBSTEPS). */
 static whitworth_drawn_real whitworth_drawn_march(const whitworth_drawn_options *options, const whitworth_drawn_real p[],
                                  whitworth_drawn_real target, whitworth_drawn_real h0, whitworth_drawn_real h_min,
                                  whitworth_drawn_state *state, whitworth_drawn_workspace *work,
-                                 whitworth_drawn_report *report, whitworth_drawn_real *cond)
+                                 whitworth_drawn_report *report, whitworth_drawn_real *cond, int *left)
 {
     whitworth_drawn_real h = h0;
     while (state->t < target) {
@@ -904,7 +907,8 @@ static whitworth_drawn_real whitworth_drawn_march(const whitworth_drawn_options 
         const whitworth_drawn_state saved = *state;
         /* a step below the resolution of t (h_min too fine for the real type) cannot move:
          * as fine as the march gets, it fails there instead of doubling and halving forever */
-        if (!(next > state->t)) return step;
+        if (!(next > state->t) || *left <= 0) return step;
+        --*left;
         work->norms[0] = work->norms[1] = work->norms[2] = 0; /* no last point, as edges */
         if (whitworth_drawn_solve_step(options, p, next, state, work, report) == WHITWORTH_DRAWN_OK) {
             *cond = report->cond;
@@ -928,6 +932,7 @@ int whitworth_drawn_solve_edge(const whitworth_drawn_options *options, const whi
     const whitworth_drawn_real h0 = t - previous.t;
     whitworth_drawn_state before = previous, after;
     whitworth_drawn_real blocked, reach, early = 0, before_cond = cond;
+    int left = WHITWORTH_DRAWN_EDGE_SUBSTEPS;
     /* no step finer than the resolution of t in the real type (a float t has about 7 digits):
      * a step that cannot move t would pass for converged */
     const whitworth_drawn_real reach_of_t = fabs(t) > fabs(previous.t) ? fabs(t) : fabs(previous.t);
@@ -936,6 +941,7 @@ int whitworth_drawn_solve_edge(const whitworth_drawn_options *options, const whi
     if (delta < resolution) delta = resolution;
     edge->cond = cond;
     edge->failed = 0;
+    edge->substeps = 0;
     if (whitworth_drawn_check_options(options) != 0) { /* no step could be taken: state kept */
         whitworth_drawn_refused(report, t);
         edge->outcome = WHITWORTH_DRAWN_EDGE_STOPPED;
@@ -943,17 +949,22 @@ int whitworth_drawn_solve_edge(const whitworth_drawn_options *options, const whi
     }
     whitworth_drawn_prepare(options->unit, work);
     state->started = before.started = 1;
-    edge->failed = whitworth_drawn_march(options, p, t, h0, h_min, state, work, report, &edge->cond);
+    edge->failed = whitworth_drawn_march(options, p, t, h0, h_min, state, work, report, &edge->cond,
+                                     &left);
+    edge->substeps = WHITWORTH_DRAWN_EDGE_SUBSTEPS - left;
     if (edge->failed == 0) {
         edge->outcome = WHITWORTH_DRAWN_EDGE_REACHED;
         return edge->outcome;
     }
+    edge->outcome = WHITWORTH_DRAWN_EDGE_STOPPED;
+    if (left <= 0) return edge->outcome; /* the bound reached: no step over it is tried */
     blocked = state->t + edge->failed;
     if (blocked - delta > previous.t) {
         early = whitworth_drawn_march(options, p, blocked - delta, h0, h_min, &before, work, report,
-                                  &before_cond);
+                                  &before_cond, &left);
+        edge->substeps = WHITWORTH_DRAWN_EDGE_SUBSTEPS - left;
+        if (left <= 0) return edge->outcome;
     }
-    edge->outcome = WHITWORTH_DRAWN_EDGE_STOPPED;
     for (reach = delta; early == 0 && reach <= h0; reach *= 2) {
         after = before;
         work->norms[0] = work->norms[1] = work->norms[2] = 0;

@@ -52,4 +52,4 @@ class EdgeSolver:
         rows = np.frombuffer(self._ffi.buffer(state, 3 * size), dtype=dtype).astype(np.float64)
         edge = self._edge
         return EdgeFound(int(outcome), float(edge.failed), float(edge.cond), float(state.t),
-                         rows[:n], rows[n:2 * n], rows[2 * n:])
+                         rows[:n], rows[n:2 * n], rows[2 * n:], int(edge.substeps))
