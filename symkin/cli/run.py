@@ -96,10 +96,10 @@ def _bad_usage(args: argparse.Namespace) -> str | None:
         if clash:
             return (f"--inputs {args.inputs}: its column t is the time grid; leave out "
                     f"{', '.join(clash)}")
-    clash = outfiles.clash(output_paths(args), [("the mechanism file", args.mechanism),
-                                                ("the --inputs table", args.inputs)])
-    if clash:
-        return clash
+    overwrite = outfiles.clash(output_paths(args), [("the mechanism file", args.mechanism),
+                                                    ("the --inputs table", args.inputs)])
+    if overwrite:
+        return overwrite
     if not 1 <= args.fps <= 100:
         return f"--fps {args.fps}: give 1 to 100 frames per second"
     if args.html is not None:

@@ -81,7 +81,7 @@ class Forces:
 
     def not_finite_columns(self, rows: NDArray[np.bool_]) -> list[str]:
         """The :meth:`columns` that are inf or NaN in any of ``rows`` ((T,) bool)."""
-        bad = ~np.isfinite(self.table()[rows]).all(axis=0)
+        bad = np.asarray(~np.isfinite(self.table()[rows]).all(axis=0))
         return [name for name, flag in zip(self.columns(), bad) if flag]
 
     def table(self) -> Array:

@@ -22,6 +22,8 @@ from symkin.errors import ExpressionError, MechanismError, UsageError, format_pa
 from symkin.limits import MAX_GRID_POINTS, grid_points
 from symkin.pairs.fields import GROUND, is_input
 from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, forces, loader, motion
+from symkin.spec.field_values import Names, body_ref, expression, names_of, numeric
+from symkin.spec.field_values import point as point_ref
 from symkin.spec.forces3d import coordinate_names as spatial_coordinate_names
 from symkin.spec.forces3d import entries, magnitude_problem
 from symkin.spec.messages import translate
@@ -44,30 +46,6 @@ class Mechanism(MechanismSpec):
 class SpatialMechanism(SpatialMechanismSpec, Mechanism):
     """A validated spatial mechanism (``space: 3d``)."""
 
-
-@dataclass(frozen=True)
-class _Names:
-    """What expressions of a file may name: parameters, t and (custom rows) coordinates.
-
-    The symbols equal those of :mod:`symkin.symbolic.symbols` (same names, same assumptions),
-    but validation does not depend on the symbolic stage.
-    """
-
-    parameters: dict[str, sp.Symbol]
-    t: sp.Symbol
-    by_coordinate: dict[tuple[str, str], sp.Symbol]
-
-    @property
-    def q(self) -> tuple[sp.Symbol, ...]:
-        return tuple(self.by_coordinate.values())
-
-
-def _names(mech: MechanismSpec) -> _Names:
-    return _Names(
-        parameters={name: sp.Symbol(name, real=True) for name in mech.parameters},
-        t=sp.Symbol("t", real=True),
-        by_coordinate={(body, part): sp.Symbol(f"{body}.{part}", real=True)
-                       for body in mech.bodies for part in mech.body_coordinates})
 
 def load(path: str | Path, overrides: Mapping[str, str] | None = None) -> Mechanism:
     """Read and validate a mechanism file (YAML, or TOML by suffix).
@@ -155,15 +133,15 @@ def _validate(document: loader.Document) -> Mechanism:
 
 def _check_semantics(mech: Mechanism) -> None:
     _check_names(mech)
-    symbols = _names(mech)
+    symbols = names_of(mech)
     values = _check_parameters(mech)
     nominal = {symbols.parameters[name]: value for name, value in values.items()}
     for name, body in mech.bodies.items():
         for k, raw in enumerate(body.q0):
-            _expression(raw, symbols, ("bodies", name, "q0", k), values=nominal)
+            expression(raw, symbols, ("bodies", name, "q0", k), values=nominal)
         for point, vector in body.points.items():
             for k, raw in enumerate(vector):
-                _expression(raw, symbols, ("bodies", name, "points", point, k), values=nominal)
+                expression(raw, symbols, ("bodies", name, "points", point, k), values=nominal)
     named: dict[str, tuple[str | int, ...]] = {}
     for section in ("joints", "drivers"):
         for index, constraint in enumerate(getattr(mech, section)):
@@ -193,70 +171,8 @@ def _check_parameters(mech: Mechanism) -> dict[str, float]:
             raise MechanismError(str(error), ("parameters", name),
                                  "A parameter's value is a number or an expression of numbers, "
                                  "pi and E; it cannot use t or other parameters.") from None
-        values[name] = _numeric(expr, {}, ("parameters", name))
+        values[name] = numeric(expr, {}, ("parameters", name))
     return values
-
-
-def _numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float],
-             path: tuple[str | int, ...]) -> float:
-    """The value of ``expr`` at the nominal parameters: a finite real number, or an error."""
-    try:
-        return constants.value(expr, values)
-    except ExpressionError as error:
-        raise MechanismError(f"{sp.sstr(expr)[:120]} has no finite real value at the nominal "
-                             f"parameter values: {error.message}", path,
-                             "Check the arguments of sqrt, log, asin, acos and the "
-                             "magnitudes.") from None
-
-
-def _expression(raw: Any, symbols: _Names | None, path: tuple[str | int, ...],
-                time: bool = False, coordinates: bool = False,
-                values: Mapping[sp.Symbol, float] | None = None) -> sp.Expr:
-    """Parse a field; with ``values`` (a constant field) also check its nominal value."""
-    if values is not None:
-        expr = _expression(raw, symbols, path, time, coordinates)
-        _numeric(expr, values, path)
-        return expr
-    names = dict(symbols.parameters) if symbols else {}
-    if time and symbols:
-        names["t"] = symbols.t
-    if time and symbols and isinstance(raw, Mapping):
-        # {poly: [a0, a1, ...]}: each coefficient a constant (t enters through the powers)
-        for k, coefficient in enumerate(raw["poly"]):
-            _expression(coefficient, symbols, path + ("poly", k))
-        return expressions.parse_time_function(raw, symbols.parameters, symbols.t)
-    try:
-        expr = expressions.parse(raw, names, symbols.by_coordinate if coordinates and symbols
-                                 else None)
-        if time and symbols:
-            # Phi_t and Gamma differentiate it: their derivatives must be printable too.
-            variables = [symbols.t, *sorted(expr.free_symbols & set(symbols.q), key=str)]
-            expressions.check_derivatives(expr, variables, str(raw))
-        return expr
-    except ExpressionError as error:
-        hint = "Use numbers, parameter names, pi, E, + - * / ** and the listed functions"
-        hint += ", and t." if time else "."
-        raise MechanismError(str(error), path, hint) from None
-
-
-def _body_ref(mech: Mechanism, name: str, path: tuple[str | int, ...]) -> None:
-    if name != GROUND and name not in mech.bodies:
-        known = ", ".join([GROUND, *mech.bodies])
-        raise MechanismError(f"unknown body {name!r}", path, f"Use one of: {known}.")
-
-
-def _point(mech: Mechanism, body: str, ref: Any, symbols: _Names,
-           nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
-    if isinstance(ref, str):
-        points = mech.bodies[body].points if body != GROUND else {}
-        if ref not in points:
-            known = ", ".join(points) or "none"
-            raise MechanismError(f"body {body!r} has no point named {ref!r}", path,
-                                 f"Its points are: {known}; or give a vector "
-                                 f"{'[x, y, z]' if mech.is_spatial else '[x, y]'}.")
-        return
-    for k, raw in enumerate(ref):
-        _expression(raw, symbols, path + (k,), values=nominal)
 
 
 @dataclass(frozen=True)
@@ -264,25 +180,25 @@ class _Checks:
     """What a pair module's own checks are given (:class:`symkin.pairs.kit.Checks`)."""
 
     mech: Mechanism
-    symbols: _Names
+    symbols: Names
     nominal: Mapping[sp.Symbol, float]
 
     def expression(self, raw: Any, path: tuple[str | int, ...], *, time: bool = False,
                    coordinates: bool = False) -> sp.Expr:
-        return _expression(raw, self.symbols, path, time, coordinates)
+        return expression(raw, self.symbols, path, time, coordinates)
 
     def uses_coordinates(self, expr: sp.Expr) -> bool:
         return bool(expr.free_symbols & set(self.symbols.q))
 
     def value(self, expr: sp.Expr, path: tuple[str | int, ...]) -> float:
-        return _numeric(expr, self.nominal, path)
+        return numeric(expr, self.nominal, path)
 
     def over_time(self, expr: sp.Expr, count: int = 201) -> list[tuple[float, float]]:
         """(t, value) of a time function at the nominal parameters, at ``count`` times spread
         over the file's grid t0 .. t1 (both ends included); times where it has no finite real
         value are left out (the run reports those)."""
         try:
-            t0, t1 = (_numeric(_expression(getattr(self.mech.time, key), self.symbols,
+            t0, t1 = (numeric(expression(getattr(self.mech.time, key), self.symbols,
                                            ("time", key)), self.nominal, ("time", key))
                       for key in ("t0", "t1"))
         except MechanismError:  # said by the grid's own check
@@ -322,7 +238,7 @@ class _Checks:
     def curve_value(self, expr: sp.Expr, s: float, path: tuple[str | int, ...]) -> float:
         """A curve's expression at the nominal parameters and ``s``."""
         at_s = expr.subs(self.nominal).subs(sp.Symbol("s", real=True), s)
-        return _numeric(at_s, {}, path)
+        return numeric(at_s, {}, path)
 
     def body_names(self) -> tuple[str, ...]:
         return tuple(self.mech.bodies)
@@ -333,7 +249,7 @@ class _Checks:
 
     def point(self, body: str, ref: Any, path: tuple[str | int, ...]) -> None:
         """A point of ``body`` by name, or a vector of constant expressions."""
-        _point(self.mech, body, ref, self.symbols, self.nominal, path)
+        point_ref(self.mech, body, ref, self.symbols, self.nominal, path)
 
     def pins(self, a: str, b: str) -> list[tuple[tuple[float, ...], tuple[float, ...]]]:
         """Where a pivot pair (a revolute) pins bodies ``a`` and ``b`` together: each such
@@ -382,7 +298,7 @@ def _spatial_point(s: list[float], body: str, q0: list[float] | None) -> tuple[f
     return tuple(q0[k] + sum(a[k][m] * s[m] for m in range(3)) for k in range(3))
 
 
-def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
+def _check_constraint(mech: Mechanism, constraint: Any, symbols: Names,
                       nominal: Mapping[sp.Symbol, float], path: tuple[str | int, ...]) -> None:
     """The generic checks, driven by what the pair module says its keys are, then its own."""
     kind = pairs.of(constraint)
@@ -391,7 +307,7 @@ def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
         raise MechanismError(str(name_problem(constraint.name, role)), path + ("name",),
                              "Rename it.")
     for key in kind.bodies:
-        _body_ref(mech, getattr(constraint, key), path + (key,))
+        body_ref(mech, getattr(constraint, key), path + (key,))
     if len(kind.bodies) == 2 and len(set(kind.joined_bodies(constraint))) == 1:
         raise MechanismError(f"a {kind.name} joins body {constraint.i!r} to itself",
                              path + ("j",), "A constraint needs two different bodies.")
@@ -400,20 +316,20 @@ def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
                              "ground", path + (kind.bodies[0],), "Name the body whose point "
                              "should follow f(t).")
     for key, body_key in kind.points:
-        _point(mech, getattr(constraint, body_key), getattr(constraint, key), symbols,
+        point_ref(mech, getattr(constraint, body_key), getattr(constraint, key), symbols,
                nominal, path + (key,))
     for key, _ in kind.directions:
-        vector = [_expression(raw, symbols, path + (key, k), values=nominal)
+        vector = [expression(raw, symbols, path + (key, k), values=nominal)
                   for k, raw in enumerate(getattr(constraint, key))]
         _nonzero_vector(vector, nominal, path + (key,))
     for key in kind.constants:
         if getattr(constraint, key) is not None:
-            _expression(getattr(constraint, key), symbols, path + (key,), values=nominal)
+            expression(getattr(constraint, key), symbols, path + (key,), values=nominal)
     for key in kind.time_functions:
         value = getattr(constraint, key)
         for k, raw in enumerate(value) if isinstance(value, list) else ((None, value),):
             if not is_input(raw):  # an input has no formula to check
-                _expression(raw, symbols, path + ((key, k) if k is not None else (key,)),
+                expression(raw, symbols, path + ((key, k) if k is not None else (key,)),
                             time=True)
     if kind.check is not None:
         kind.check(constraint, _Checks(mech, symbols, nominal), path)
@@ -421,16 +337,16 @@ def _check_constraint(mech: Mechanism, constraint: Any, symbols: _Names,
 
 def _nonzero_vector(vector: list[sp.Expr], nominal: Mapping[sp.Symbol, float],
                     path: tuple[str | int, ...]) -> None:
-    if all(_numeric(component, nominal, path) == 0.0 for component in vector):
+    if all(numeric(component, nominal, path) == 0.0 for component in vector):
         raise MechanismError("the direction vector is zero", path,
                              "Give a non-zero vector, e.g. [0, 1].")
 
 
-def _check_time(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, float]) -> None:
+def _check_time(mech: Mechanism, symbols: Names, nominal: Mapping[sp.Symbol, float]) -> None:
     grid = {}
     for key in ("t0", "t1", "dt"):
-        expr = _expression(getattr(mech.time, key), symbols, ("time", key))
-        grid[key] = _numeric(expr, nominal, ("time", key))
+        expr = expression(getattr(mech.time, key), symbols, ("time", key))
+        grid[key] = numeric(expr, nominal, ("time", key))
     if not grid["dt"] > 0:
         raise MechanismError(f"the time step dt = {grid['dt']} is not positive",
                              ("time", "dt"), "Use dt > 0.")
@@ -442,7 +358,7 @@ def _check_time(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, fl
                              "Use a larger dt or a shorter interval.")
 
 
-def _check_dynamics(mech: Mechanism, symbols: _Names,
+def _check_dynamics(mech: Mechanism, symbols: Names,
                     nominal: Mapping[sp.Symbol, float]) -> None:
     """Masses and inertias are constants >= 0; a load names known bodies and points, and its
     expressions use only t, parameters, coordinates and their rates."""
@@ -452,27 +368,27 @@ def _check_dynamics(mech: Mechanism, symbols: _Names,
             if raw is None:
                 continue
             path = ("bodies", name, key)
-            values = {at: _numeric(_expression(item, symbols, path + at), nominal, path + at)
+            values = {at: numeric(expression(item, symbols, path + at), nominal, path + at)
                       for at, item in entries(raw)}
             problem = magnitude_problem(key, values)
             if problem is not None:
                 raise MechanismError(problem[0], path, problem[1])
         if body.com is not None:
-            _point(mech, name, body.com, symbols, nominal, ("bodies", name, "com"))
+            point_ref(mech, name, body.com, symbols, nominal, ("bodies", name, "com"))
     names = spatial_coordinate_names if mech.is_spatial else forces.coordinate_names
-    moving = _Names(symbols.parameters, symbols.t, names(mech.bodies))
+    moving = Names(symbols.parameters, symbols.t, names(mech.bodies))
     for index, load in enumerate(mech.forces):
         where: tuple[str | int, ...] = ("forces", index)
         for key in forces.BODY_KEYS[load.type]:
-            _body_ref(mech, getattr(load, key), where + (key,))
+            body_ref(mech, getattr(load, key), where + (key,))
         if load.type in ("force", "torque") and load.body == GROUND:
             raise MechanismError(f"a {load.type} on the ground does nothing", where + ("body",),
                                  "Apply it to a moving body.")
         for key, body_key in forces.POINT_KEYS[load.type]:
-            _point(mech, getattr(load, body_key), getattr(load, key), symbols, nominal,
+            point_ref(mech, getattr(load, body_key), getattr(load, key), symbols, nominal,
                    where + (key,))
         for key in forces.EXPRESSION_KEYS[load.type]:
             raw = getattr(load, key)
             for k, item in (enumerate(raw) if isinstance(raw, list) else [(None, raw)]):
                 at: tuple[str | int, ...] = (key,) if k is None else (key, k)
-                _expression(item, moving, where + at, time=True, coordinates=True)
+                expression(item, moving, where + at, time=True, coordinates=True)

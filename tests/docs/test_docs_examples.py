@@ -3,7 +3,8 @@ the examples cannot rot.
 
 A page's Python blocks run in order in one namespace, in a fresh folder holding a copy of
 examples/ (as a reader at the repository's root would). A console block's ``$`` lines run in
-such a folder too, ``symkin`` standing for this tree's ``python -m symkin``; each must exit 0
+such a folder too, in bash (so ``cd dir && ...`` and redirections work as a reader types them),
+``symkin`` standing for this tree's ``python -m symkin``; each must exit 0
 (or the status a ``% exit: N`` line just above the block gives), and every output line the
 block shows must appear in what the command printed (a line ``...`` stands for lines left out)."""
 
@@ -47,10 +48,9 @@ def run_console(code: str, status: int, cwd: Path) -> list[str]:
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
     for command in commands:
         line, *shown = command.splitlines()
-        words = shlex.split(line)
-        if words[0] == "symkin":
-            words = [sys.executable, "-m", "symkin", *words[1:]]
-        done = subprocess.run(words, cwd=cwd, env=env, capture_output=True, text=True,
+        script = f'symkin() {{ {shlex.quote(sys.executable)} -m symkin "$@"; }}\n{line}'
+        done = subprocess.run(["bash", "-c", script], cwd=cwd, env=env, capture_output=True,
+                              text=True,
                               timeout=900, check=False)
         printed = " ".join((done.stdout + done.stderr).split())
         if done.returncode != status:
