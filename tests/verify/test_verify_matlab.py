@@ -1,5 +1,5 @@
 """symkin verify --against HAND.m | FOLDER: the chapter's MATLAB program (Examples 2.5-2.8,
-typed in from the textbook, tests/verify/chapter2) checked in Octave against what symkin
+typed in from the textbook, examples/textbook_chapter2) checked in Octave against what symkin
 derives for examples/crank_slider.yaml; planted slips are named by row, column and owner."""
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ pytestmark = pytest.mark.skipif(shutil.which("octave-cli") is None,
 
 ROOT = Path(__file__).resolve().parents[2]
 CRANK_SLIDER = ROOT / "examples" / "crank_slider.yaml"
-CHAPTER = Path(__file__).resolve().parent / "chapter2"
+CHAPTER = ROOT / "examples" / "textbook_chapter2"
 
 
 def _copy(tmp_path: Path) -> Path:

@@ -22,7 +22,7 @@ TIMEOUT = 900  # seconds per example: the slowest (a cam, a six-legged platform)
 
 def _source_hash(root: Path) -> str:
     digest = hashlib.sha256()
-    for path in sorted((root / "symkin").rglob("*.py")) + sorted((root / "templates").rglob("*")):
+    for path in sorted((root / "symkin").rglob("*.py")) + sorted((root / "symkin").rglob("*.j2")):
         if path.is_file():
             digest.update(path.read_bytes())
     return digest.hexdigest()
