@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 import numpy as np
 
+from symkin.limits import listed
 from symkin.present import series
 from symkin.present.series import Units
 
@@ -151,8 +152,8 @@ def fallback_note(count: int, points: int, verbose: bool = False) -> str:
 
 def far_start_note(moved: Sequence[Moved], scale: float) -> str:
     """A line on bodies assembled far from their q0 (runtime.start.far_from_guess)."""
-    said = ", ".join(f"{m.body} (moved {m.distance:.3g}, turned {m.turn:.3g} rad)"
-                     for m in moved)
+    said = listed(f"{m.body} (moved {m.distance:.3g}, turned {m.turn:.3g} rad)"
+                  for m in moved)
     return (f"the assembled start is far from q0 (the mechanism's length scale is "
             f"{scale:.3g}): {said}. The motion is that of the mechanism the joints describe; "
             "if it is not the one you meant, check q0, and that each prismatic or pin_slot "
@@ -226,7 +227,7 @@ def flag_warnings(trajectory: Any) -> list[str]:
             continue
         detail = "".join(
             f"; a singular configuration is passed at t = {t:.10g} (Phi_q loses rank {rank}; "
-            f"dependent rows: {'; '.join('{' + ', '.join(g) + '}' for g in groups)}), its "
+            f"dependent rows: {listed(('{' + listed(g) + '}' for g in groups), '; ')}), its "
             "point(s) interpolated from both sides" for t, rank, groups in passed)
         lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
                      f"the error model says q, dq, ddq may miss {targets.target_q:g}, "
@@ -241,7 +242,7 @@ def removed_note(trajectory: Any) -> str:
     count = len(trajectory.removed)
     return (f"{count} equation{'s' if count > 1 else ''} removed as redundant (dependent on "
             f"the others at the assembled t0) and checked along the motion: "
-            + "; ".join(trajectory.removed))
+            + listed(trajectory.removed, "; "))
 
 
 def indeterminate_note(trajectory: Any) -> str:
@@ -253,7 +254,7 @@ def indeterminate_note(trajectory: Any) -> str:
         return ""
     return ("with equations removed as redundant these reactions are not unique (the rows "
             "can share the load in any proportion); their values are the minimum-norm "
-            "solution (NPZ effort_determinate, reaction_determinate): " + ", ".join(names))
+            "solution (NPZ effort_determinate, reaction_determinate): " + listed(names))
 
 
 def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
@@ -266,8 +267,8 @@ def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
 
     stretch = residual[k:end + 1]
     broken: Any = redundant.exceeded(stretch, trajectory.q[k:end + 1], target).any(axis=0)
-    return "; ".join(f"{label}: |Phi| up to {float(abs(stretch[:, r]).max()):.3g}"
-                     for r, label in enumerate(trajectory.removed) if broken[r])
+    return listed((f"{label}: |Phi| up to {float(abs(stretch[:, r]).max()):.3g}"
+                   for r, label in enumerate(trajectory.removed) if broken[r]), "; ")
 
 
 def _step(trajectory: Any, k: int) -> float:

@@ -52,10 +52,23 @@ class Singular:
     drivers: tuple[str, ...]
 
 
-def start_threshold(options: Options) -> float:
-    """The scaled condition above which the start counts as singular: the one that makes a
-    stop a limit position (runtime.edges), so the start and the motion are judged alike."""
-    return min(LIMIT_COND, options.max_cond / 10)
+SIZE_FROM = 100
+"""Coordinates up to which the start's threshold is the limit positions' (runtime.edges); a
+larger mechanism's grows with the square of its size (start_threshold)."""
+
+
+def start_threshold(options: Options, size: int = 0) -> float:
+    """The scaled condition above which the start of a mechanism of ``size`` coordinates
+    counts as singular: up to SIZE_FROM the one that makes a stop a limit position
+    (runtime.edges), so the start and the motion are judged alike.
+
+    Beyond, it grows as (size / SIZE_FROM)^2, because the condition of a regular mechanism
+    does too: Phi_q^-1 carries a residual of one joint through every body beyond it, each
+    moved by up to a lever arm L, and the 1-norm adds them up (a regular lazy tongs of 1000
+    bars, 3000 coordinates, has 3.95e6). A dead centre's does not: its rank is lost locally
+    (the textbook crank-slider drawn at its dead centre has 6.8e6 at 9 coordinates)."""
+    growth = max(1.0, size / SIZE_FROM) ** 2
+    return min(LIMIT_COND, options.max_cond / 10) * growth
 
 
 def positions(kernel: KinematicsKernel) -> NDArray[np.bool_]:
@@ -141,7 +154,7 @@ def singular_start(kernel: KinematicsKernel, q: Array, t: float, p: Array, optio
     nz = np.asarray(kernel.phi_q_nz(q, t, p), dtype=np.float64)
     scaled, scale = scaled_nonzeros(kernel, nz)
     cond = scaled_cond(kernel, scaled)
-    threshold = start_threshold(options)
+    threshold = start_threshold(options, len(kernel.coordinates))
     if cond <= threshold:
         return None
     n = len(kernel.coordinates)

@@ -17,7 +17,7 @@ from pydantic import ValidationError, model_validator
 
 from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError, UsageError, format_path
-from symkin.limits import MAX_GRID_POINTS, grid_points
+from symkin.limits import MAX_GRID_POINTS, grid_points, listed
 from symkin.pairs.fields import GROUND, is_input
 from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, forces, loader
 from symkin.spec.forces3d import coordinate_names as spatial_coordinate_names
@@ -107,7 +107,7 @@ def override_parameters(data: Any, overrides: Mapping[str, str], source: str) ->
     for name, text in overrides.items():
         if name not in known:
             raise UsageError(f"--set {name}: {source} has no parameter {name!r}; its "
-                             f"parameters are: {', '.join(map(str, known)) or 'none'}")
+                             f"parameters are: {listed(map(str, known)) or 'none'}")
         try:
             constants.value(expressions.parse(text, {}))
         except ExpressionError as error:
@@ -238,7 +238,7 @@ def _expression(raw: Any, symbols: _Names | None, path: tuple[str | int, ...],
 
 def _body_ref(mech: Mechanism, name: str, path: tuple[str | int, ...]) -> None:
     if name != GROUND and name not in mech.bodies:
-        known = ", ".join([GROUND, *mech.bodies])
+        known = listed([GROUND, *mech.bodies])
         raise MechanismError(f"unknown body {name!r}", path, f"Use one of: {known}.")
 
 
@@ -247,7 +247,7 @@ def _point(mech: Mechanism, body: str, ref: Any, symbols: _Names,
     if isinstance(ref, str):
         points = mech.bodies[body].points if body != GROUND else {}
         if ref not in points:
-            known = ", ".join(points) or "none"
+            known = listed(points) or "none"
             raise MechanismError(f"body {body!r} has no point named {ref!r}", path,
                                  f"Its points are: {known}; or give a vector "
                                  f"{'[x, y, z]' if mech.is_spatial else '[x, y]'}.")

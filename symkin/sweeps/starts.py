@@ -52,7 +52,8 @@ def singular_starts(kernel: KinematicsKernel, batch: BatchSolver, params: Array,
     with np.errstate(all="ignore"):
         ratio = np.where(scales > 0, scales / unit, 1.0)  # no lever arm: Phi_q as it is
         bound = start_cond[solved] * np.maximum(ratio, 1.0 / ratio) ** 2
-        clear = np.isfinite(scales) & (bound * SAFETY <= start_threshold(options))
+        threshold = start_threshold(options, len(kernel.coordinates))
+        clear = np.isfinite(scales) & (bound * SAFETY <= threshold)
     for j in solved[~clear]:
         with np.errstate(all="ignore"):
             if units[j] == 1.0:
