@@ -116,8 +116,11 @@ def check_selection(selected: Sequence[str], coordinates: Sequence[str],
     valid = names(coordinates, points)
     unknown = [name for name in selected if name not in valid]
     if unknown:
+        # The message lists ten: first the names of the bodies the unknown ones name.
+        bodies = {name.rsplit(".", 1)[0] for name in unknown}
+        near = sorted(valid, key=lambda name: name.rsplit(".", 1)[0] not in bodies)
         raise UsageError(f"--select: no coordinate or named point {listed(unknown)}; "
-                         f"choose from: {listed(valid)}")
+                         f"choose from: {listed(near)}")
     if not selected:
         raise UsageError(f"--select: give at least one name; choose from: {listed(valid)}")
     return list(dict.fromkeys(selected))
