@@ -8,21 +8,17 @@ import argparse
 import contextlib
 import io
 import os
-import signal
 import sys
-import threading
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TextIO
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, NamedTuple, TextIO
 
 from symkin.limits import listed
-from symkin.present import series
-from symkin.present.series import Units
 
+# NumPy and the figures' series are imported where used: `symkin --help` builds this command's
+# parser and must not pay for them.
 if TYPE_CHECKING:
+    from symkin.present.series import Units
     from symkin.runtime.start import Moved
 
 
@@ -30,8 +26,7 @@ class CannotWrite(Exception):
     """An output file could not be written (a bad path, not a failed solve)."""
 
 
-@dataclass(frozen=True)
-class Pictures:
+class Pictures(NamedTuple):  # not a dataclass: `symkin --help` then imports no `inspect`
     """What the figures show: the selection (None: the default), units and title."""
 
     select: list[str] | None
@@ -42,18 +37,21 @@ class Pictures:
     def of(cls, args: argparse.Namespace, kernel: Any) -> Pictures:
         """From the command line and the kernel; an unknown ``--select`` name is a UsageError
         listing the valid ones (raised before anything is solved)."""
+        from symkin.present import series
+
         select = None
         if args.select is not None:
             select = series.check_selection(series.parse_selection(args.select),
                                             kernel.coordinates, kernel.points)
         # The file is read again only for pictures: a plain warm run stays free of YAML.
         wanted = args.plot is not None or args.html is not None
-        return cls(select, units_of(args.mechanism) if wanted else Units(), kernel.name)
+        return cls(select, units_of(args.mechanism) if wanted else series.Units(), kernel.name)
 
 
 def units_of(mechanism: Path) -> Units:
     """The file's ``units`` (validated with the file: on a warm run it was valid before)."""
     from symkin.errors import SymkinError
+    from symkin.present.series import Units
     from symkin.spec import loader
 
     try:
@@ -103,6 +101,8 @@ def write(trajectory: Any, args: argparse.Namespace, outlines: Any,
 def configuration(trajectory: Any, name: str, origin: str) -> str:
     """One solved instant as text: every coordinate with its first and second derivative, then
     every named point's position, velocity and acceleration (2.14-2.16)."""
+    import numpy as np
+
     t = float(trajectory.t[0])
     lines = [f"{name} at t = {t:.10g} ({origin})", "",
              f"{'coordinate':<24}{'q':>20}{'dq/dt':>20}{'d2q/dt2':>20}"]
@@ -128,6 +128,9 @@ def interrupts_held() -> Iterator[None]:
     """Ctrl-C (SIGINT) ignored while the rows solved so far are written after an interrupt:
     a second Ctrl-C would otherwise leave no file, or half of one. Only in the main thread
     (where Python handles signals); elsewhere nothing changes."""
+    import signal
+    import threading
+
     if threading.current_thread() is not threading.main_thread():
         yield
         return
