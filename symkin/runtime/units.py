@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.options import Options
 from symkin.runtime.newton import Newton, Point
 from symkin.runtime.protocol import ChunkResult, GridSolver, KinematicsKernel
-from symkin.runtime.start import length_rows, length_scale, positions
+from symkin.runtime.start import length_rows, lever_arms, positions
 
 Array = NDArray[np.float64]
 
@@ -45,11 +45,9 @@ NATURAL = (1e-2, 1e2)
 def unit_for(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> float:
     """The unit u to solve in: 1 when L is in NATURAL (or cannot be told), else 10^floor(log10
     L)."""
-    with np.errstate(all="ignore"):
-        nz = np.asarray(kernel.phi_q_nz(q0, t0, p), dtype=np.float64)
-    if not np.isfinite(nz).all():
+    _, scale = lever_arms(kernel, q0, t0, p)
+    if not math.isfinite(scale):  # Phi_q not finite at q0
         return 1.0
-    scale = length_scale(kernel, nz)
     if NATURAL[0] <= scale <= NATURAL[1]:
         return 1.0
     return float(10.0 ** math.floor(math.log10(scale)))

@@ -23,14 +23,10 @@ from numpy.typing import NDArray
 
 from symkin.contract.options import Options
 from symkin.runtime.protocol import BatchSolver, KinematicsKernel
-from symkin.runtime.start import singular_start, start_threshold
+from symkin.runtime.start import SAFETY, singular_start, start_threshold
 from symkin.runtime.units import ScaledKernel, units_for
 
 Array = NDArray[np.float64]
-
-SAFETY = 10.0
-"""The margin on the batch's condition estimate before a start counts as clearly regular."""
-
 
 def set_units(batch: BatchSolver, params: Array, t0: float, q0: Array) -> Array:
     """The unit each set is solved in (runtime.units.unit_for at its first guess q0, (N,) or
