@@ -102,6 +102,7 @@ class _Structure:
     row_of: NDArray[np.intp]
     col_of: NDArray[np.intp]
     recent: dict[tuple[bytes, float, bytes], tuple[Array, float]]
+    recent_scales: dict[tuple[bytes, float, bytes], float]
 
 
 _STRUCTURES: dict[int, tuple[object, _Structure]] = {}
@@ -132,7 +133,7 @@ def _structure(kernel: KinematicsKernel) -> _Structure:
     length = np.zeros(m, dtype=bool)
     length[rows[by_position]] = True
     structure = _Structure(slots, padded & real, ~padded & real, length, by_position, rows,
-                           cols, {})
+                           cols, {}, {})
     _STRUCTURES[id(key)] = (key, structure)
     return structure
 
@@ -173,6 +174,30 @@ def lever_arms(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> tuple[
         recent.clear()
     recent[key] = found
     return found
+
+
+def lever_arm(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> float:
+    """L at (q, t, p), NaN where Phi_q is not finite there: one call of the generated
+    ``<prefix>_length_scales`` (what sweeps use) where the kernel has a batch solver, with no
+    Phi_q through Python; else from Phi_q's non-zeros (lever_arms)."""
+    batch = getattr(kernel, "batch_solver", None)
+    if batch is None:
+        return lever_arms(kernel, q, t, p)[1]
+    q = np.ascontiguousarray(q, dtype=np.float64)
+    p = np.ascontiguousarray(p, dtype=np.float64)
+    recent = _structure(kernel).recent_scales
+    key = (q.tobytes(), float(t), p.tobytes())
+    scale = recent.get(key)
+    if scale is None:
+        scale = float(batch.length_scales(p[None, :], q, float(t))[0])
+        if not math.isfinite(scale):
+            scale = math.nan
+        elif not scale > 0:
+            scale = 1.0  # no lever arm: Phi_q as it is, as length_scale says
+        if len(recent) >= RECENT:
+            recent.clear()
+        recent[key] = scale
+    return scale
 
 
 def scaled_nonzeros(kernel: KinematicsKernel, nz: Array) -> tuple[Array, float]:
@@ -234,10 +259,12 @@ def singular_start(kernel: KinematicsKernel, q: Array, t: float, p: Array, optio
     """The start (q at t) judged before the first step: None when Phi_q is regular there.
     ``estimate``: the solver's condition estimate of Phi_q at q, from the factors it made
     there (NaN: none), which spares the check its own factorisation where it suffices."""
-    nz, scale = lever_arms(kernel, q, t, p)
     threshold = start_threshold(options, len(kernel.coordinates))
-    if math.isfinite(scale) and clearly_regular(estimate, scale, threshold):
-        return None
+    if math.isfinite(estimate):
+        scale = lever_arm(kernel, q, t, p)
+        if math.isfinite(scale) and clearly_regular(estimate, scale, threshold):
+            return None
+    nz, _ = lever_arms(kernel, q, t, p)
     scaled, scale = scaled_nonzeros(kernel, nz)
     cond = scaled_cond(kernel, scaled)
     if cond <= threshold:

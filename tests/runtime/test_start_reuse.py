@@ -78,3 +78,14 @@ def test_lever_arms_are_kept_per_configuration(crank_slider):
     doubled = np.where(angle, q, 2 * q)  # every length doubled: so is the largest lever arm
     assert start.lever_arms(crank_slider, doubled, 0.0, 2 * p)[1] == \
         pytest.approx(2 * scale, rel=1e-12)
+
+
+def test_the_generated_lever_arm_is_the_pythons(crank_slider):
+    """lever_arm asks the generated <prefix>_length_scales; it must be the L that
+    length_scale reads off Phi_q (the unit and the start are decided by it)."""
+    p = np.array(crank_slider.p_values, dtype=float)
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        q = np.array(crank_slider.q0, dtype=float) + rng.normal(size=len(crank_slider.q0))
+        python = start.length_scale(crank_slider, crank_slider.phi_q_nz(q, 0.3, p))
+        assert start.lever_arm(crank_slider, q, 0.3, p) == pytest.approx(python, rel=1e-12)
