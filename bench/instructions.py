@@ -1,6 +1,7 @@
 """Instructions per time step of the generated C solver, counted by callgrind (valgrind).
 
     python3 bench/instructions.py [--tighten-cond C] [--linalg dense] crank_slider chain:100 ...
+    python3 bench/instructions.py --solve crank_slider ...
 
 Each argument is an example's name (examples/<name>.yaml, started from its q0), FAMILY:BODIES
 of bench/scaling_limit.py (started from the closed form), or ``handwritten``: the hand-written
@@ -14,6 +15,8 @@ example (the textbook grid), 0.001 for a family.
 iterations at all, so every step does the same work at every size). ``--linalg dense``
 generates the dense LU with partial pivoting instead of the sparse one (the path of the
 sparse LU's fall-back too).
+``--solve`` counts one ``symkin.solve`` call instead (per_solve_call: the C kernel of the
+example on a 31-point grid, the Python around the generated solver included).
 """
 
 from __future__ import annotations
@@ -122,8 +125,61 @@ def per_step(spec: str, tighten_cond: str | None = None, linalg: str = "sparse"
         return spec, len(system.q), (_total(program, 121) - _total(program, 21)) / 100
 
 
+SOLVE_CALLS = r"""
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import symkin
+from symkin import backends
+from symkin.build import index
+
+kernel = index.prepare(Path(sys.argv[1]), index.Options(backend=backends.resolve("c"))).kernel
+t = np.linspace(0.0, 1.5, 31)
+for _ in range(int(sys.argv[2])):
+    symkin.solve(kernel, t=t)
+"""
+
+
+def per_solve_call(spec: str, cache_dir: str | None = None) -> float:
+    """Instructions of one ``symkin.solve(kernel, t=t)`` on a 31-point grid over 0..1.5 with
+    the C kernel of examples/<spec>.yaml: (a process of 201 calls - one of 101) / 100 (both
+    past the first calls' one-time costs), the kernel built beforehand (outside the count)
+    and loaded from the cache by both."""
+    import os
+
+    from symkin import backends
+    from symkin.build import index
+
+    path = ROOT / "examples" / f"{spec}.yaml"
+    index.prepare(path, index.Options(backend=backends.resolve("c")), cache_dir=cache_dir)
+    env = dict(os.environ, PYTHONHASHSEED="0",
+               PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    if cache_dir is not None:
+        env["SYMKIN_CACHE_DIR"] = str(cache_dir)
+    with tempfile.TemporaryDirectory() as folder:
+        script = Path(folder) / "calls.py"
+        script.write_text(SOLVE_CALLS)
+
+        def total(calls: int) -> int:
+            done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                                   sys.executable, str(script), str(path), str(calls)],
+                                  capture_output=True, text=True, check=True, env=env)
+            match = re.search(r"Collected : (\d+)", done.stderr)
+            assert match, done.stderr[-500:]
+            return int(match.group(1))
+
+        return (total(201) - total(101)) / 100
+
+
 def main() -> int:
     args = sys.argv[1:]
+    if args[:1] == ["--solve"]:
+        for spec in args[1:] or ["crank_slider"]:
+            print(f"{spec:20s} {per_solve_call(spec):10.0f} instructions/symkin.solve call",
+                  flush=True)
+        return 0
     tighten_cond = None
     if args[:1] == ["--tighten-cond"]:
         value = float(args[1])  # a C literal: INFINITY for inf (any spelling)

@@ -37,8 +37,15 @@ def pytest_sessionstart(session: pytest.Session) -> None:
 
 @pytest.fixture(scope="session", autouse=True)
 def shared_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
-    """One kernel cache for the whole run: tests never write to the user's ~/.cache/symkin."""
-    folder = tmp_path_factory.mktemp("symkin-cache")
+    """One kernel cache for the whole run: tests never write to the user's ~/.cache/symkin.
+    Under pytest-xdist the workers share it (a folder beside their own temporary folders):
+    a kernel one worker built is loaded by the others, and two that build the same kernel at
+    once publish it atomically (symkin.build.cache)."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        folder = tmp_path_factory.getbasetemp().parent / "symkin-cache"
+        folder.mkdir(exist_ok=True)
+    else:
+        folder = tmp_path_factory.mktemp("symkin-cache")
     before = os.environ.get("SYMKIN_CACHE_DIR")
     os.environ["SYMKIN_CACHE_DIR"] = str(folder)
     yield folder

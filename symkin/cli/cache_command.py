@@ -7,10 +7,8 @@ index, temporaries of builds); any other file in the folder is left alone.
 from __future__ import annotations
 
 import argparse
-import shutil
 from pathlib import Path
 
-from symkin.build import cache, index
 from symkin.cli import messages
 from symkin.cli.exits import EXIT_OK
 
@@ -26,6 +24,10 @@ def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) ->
 
 def handle(args: argparse.Namespace) -> int:
     """Run the subcommand; returns the exit status."""
+    import shutil
+
+    from symkin.build import cache, index  # not at import: `symkin --help` builds the parser
+
     root = cache.cache_root()
     owned = _symkins(root)
     if args.action == "clear":
@@ -53,6 +55,8 @@ def handle(args: argparse.Namespace) -> int:
 
 def _symkins(root: Path) -> list[Path]:
     """What symkin wrote into ``root``: kernel folders, the index, build temporaries."""
+    from symkin.build import cache, index
+
     try:
         entries = sorted(root.iterdir())
     except OSError:

@@ -272,11 +272,11 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     """A run that ended early: say why first (even if writing then fails), then write the
     rows solved so far and say where they went."""
     solved = stop.trajectory.t.size
-    _warn_flagged(stop.trajectory)
     message = f"{args.mechanism}: {why}"
     if status == EXIT_INTERRUPTED:
         message += f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
+    _warn_flagged(stop.trajectory)  # after the error: a singular start flags its one row too
     try:
         trajectory = _with_pair_outputs(stop.trajectory, args, prepared.system)
         with run_outputs.interrupts_held():  # a second Ctrl-C must not cut the file short

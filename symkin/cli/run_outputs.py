@@ -8,20 +8,17 @@ import argparse
 import contextlib
 import io
 import os
-import signal
 import sys
-import threading
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any, NamedTuple, TextIO
 
-import numpy as np
+from symkin.limits import listed
 
-from symkin.present import series
-from symkin.present.series import Units
-
+# NumPy and the figures' series are imported where used: `symkin --help` builds this command's
+# parser and must not pay for them.
 if TYPE_CHECKING:
+    from symkin.present.series import Units
     from symkin.runtime.start import Moved
 
 
@@ -29,8 +26,7 @@ class CannotWrite(Exception):
     """An output file could not be written (a bad path, not a failed solve)."""
 
 
-@dataclass(frozen=True)
-class Pictures:
+class Pictures(NamedTuple):  # not a dataclass: `symkin --help` then imports no `inspect`
     """What the figures show: the selection (None: the default), units and title."""
 
     select: list[str] | None
@@ -41,18 +37,21 @@ class Pictures:
     def of(cls, args: argparse.Namespace, kernel: Any) -> Pictures:
         """From the command line and the kernel; an unknown ``--select`` name is a UsageError
         listing the valid ones (raised before anything is solved)."""
+        from symkin.present import series
+
         select = None
         if args.select is not None:
             select = series.check_selection(series.parse_selection(args.select),
                                             kernel.coordinates, kernel.points)
         # The file is read again only for pictures: a plain warm run stays free of YAML.
         wanted = args.plot is not None or args.html is not None
-        return cls(select, units_of(args.mechanism) if wanted else Units(), kernel.name)
+        return cls(select, units_of(args.mechanism) if wanted else series.Units(), kernel.name)
 
 
 def units_of(mechanism: Path) -> Units:
     """The file's ``units`` (validated with the file: on a warm run it was valid before)."""
     from symkin.errors import SymkinError
+    from symkin.present.series import Units
     from symkin.spec import loader
 
     try:
@@ -102,6 +101,8 @@ def write(trajectory: Any, args: argparse.Namespace, outlines: Any,
 def configuration(trajectory: Any, name: str, origin: str) -> str:
     """One solved instant as text: every coordinate with its first and second derivative, then
     every named point's position, velocity and acceleration (2.14-2.16)."""
+    import numpy as np
+
     t = float(trajectory.t[0])
     lines = [f"{name} at t = {t:.10g} ({origin})", "",
              f"{'coordinate':<24}{'q':>20}{'dq/dt':>20}{'d2q/dt2':>20}"]
@@ -127,6 +128,9 @@ def interrupts_held() -> Iterator[None]:
     """Ctrl-C (SIGINT) ignored while the rows solved so far are written after an interrupt:
     a second Ctrl-C would otherwise leave no file, or half of one. Only in the main thread
     (where Python handles signals); elsewhere nothing changes."""
+    import signal
+    import threading
+
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -152,6 +156,9 @@ def interrupts_deferred() -> Iterator[Deferred]:
     """Ctrl-C (SIGINT) noted, not raised, while a solved run's outputs are prepared and
     written: the files are finished whole with every row solved, and the caller then says
     it was interrupted. Only in the main thread; elsewhere nothing is deferred."""
+    import signal  # here, not at the top: symkin --help stays light
+    import threading
+
     deferred = Deferred()
     if threading.current_thread() is not threading.main_thread():
         yield deferred
@@ -177,8 +184,8 @@ def fallback_note(count: int, points: int, verbose: bool = False) -> str:
 
 def far_start_note(moved: Sequence[Moved], scale: float) -> str:
     """A line on bodies assembled far from their q0 (runtime.start.far_from_guess)."""
-    said = ", ".join(f"{m.body} (moved {m.distance:.3g}, turned {m.turn:.3g} rad)"
-                     for m in moved)
+    said = listed(f"{m.body} (moved {m.distance:.3g}, turned {m.turn:.3g} rad)"
+                  for m in moved)
     return (f"the assembled start is far from q0 (the mechanism's length scale is "
             f"{scale:.3g}): {said}. The motion is that of the mechanism the joints describe; "
             "if it is not the one you meant, check q0, and that each prismatic or pin_slot "
@@ -262,7 +269,7 @@ def flag_warnings(trajectory: Any) -> list[str]:
             continue
         detail = "".join(
             f"; a singular configuration is passed at t = {t:.10g} (Phi_q loses rank {rank}; "
-            f"dependent rows: {'; '.join('{' + ', '.join(g) + '}' for g in groups)}), its "
+            f"dependent rows: {listed(('{' + listed(g) + '}' for g in groups), '; ')}), its "
             "point(s) interpolated from both sides" for t, rank, groups in passed)
         lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
                      f"the error model says q, dq, ddq may miss {targets.target_q:g}, "
@@ -277,7 +284,7 @@ def removed_note(trajectory: Any) -> str:
     count = len(trajectory.removed)
     return (f"{count} equation{'s' if count > 1 else ''} removed as redundant (dependent on "
             f"the others at the assembled t0) and checked along the motion: "
-            + "; ".join(trajectory.removed))
+            + listed(trajectory.removed, "; "))
 
 
 def indeterminate_note(trajectory: Any) -> str:
@@ -289,7 +296,7 @@ def indeterminate_note(trajectory: Any) -> str:
         return ""
     return ("with equations removed as redundant these reactions are not unique (the rows "
             "can share the load in any proportion); their values are the minimum-norm "
-            "solution (NPZ effort_determinate, reaction_determinate): " + ", ".join(names))
+            "solution (NPZ effort_determinate, reaction_determinate): " + listed(names))
 
 
 def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
@@ -302,21 +309,21 @@ def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
 
     stretch = residual[k:end + 1]
     broken: Any = redundant.exceeded(stretch, trajectory.q[k:end + 1], target).any(axis=0)
-    return "; ".join(f"{label}: |Phi| up to {float(abs(stretch[:, r]).max()):.3g}"
-                     for r, label in enumerate(trajectory.removed) if broken[r])
+    return listed((f"{label}: |Phi| up to {float(abs(stretch[:, r]).max()):.3g}"
+                   for r, label in enumerate(trajectory.removed) if broken[r]), "; ")
 
 
 def _not_finite_loads(trajectory: Any, k: int, end: int) -> str:
     """The efforts and reactions that are inf or NaN between points k and end, at most ten
     named ('' when every one is finite)."""
+    import numpy as np  # here, not at the top: symkin --help stays light
+
     found = getattr(trajectory, "forces", None)
     if found is None:
         return ""
     rows = np.zeros(trajectory.t.size, dtype=bool)
     rows[k:end + 1] = True
-    names = found.not_finite_columns(rows)
-    more = f" and {len(names) - 10} more" if len(names) > 10 else ""
-    return ", ".join(names[:10]) + more
+    return listed(found.not_finite_columns(rows))
 
 
 def _step(trajectory: Any, k: int) -> float:

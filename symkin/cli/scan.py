@@ -16,6 +16,7 @@ from typing import Any
 from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
+from symkin.limits import listed
 
 
 def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -132,8 +133,8 @@ def text(report: Any, name: str, grid: str) -> str:
 def _motion_lines(motion: Any, t1: float) -> list[str]:
     lines = []
     for t, rank, groups in motion.singular:
-        joints = "; ".join("{" + ", ".join(_short(row) for row in group) + "}"
-                           for group in groups)
+        joints = listed(("{" + listed(_short(row) for row in group) + "}"
+                         for group in groups), "; ")
         lines.append(f"singular configuration passed at t = {t:.10g} (Phi_q loses rank {rank}; "
                      f"dependent joints: {joints})")
     for first, last in motion.flagged:
@@ -144,8 +145,8 @@ def _motion_lines(motion: Any, t1: float) -> list[str]:
         lines.append(f"reaches the end of the grid, t = {t1:g}")
     elif stop.reason == "limit position":
         lines.append(f"limit position at t = {stop.t:.10g}: joints "
-                     f"{', '.join(_short(j) for j in stop.joints)} become aligned; "
-                     f"{' and '.join(_short(d) for d in stop.drivers)} cannot go on beyond it")
+                     f"{listed(_short(j) for j in stop.joints)} become aligned; "
+                     f"{listed((_short(d) for d in stop.drivers), ' and ')} cannot go on beyond it")
     else:
         lines.append(f"stops at t = {stop.t:.10g} ({stop.reason}): {stop.message}")
     return lines

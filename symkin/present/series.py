@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import UsageError
+from symkin.limits import listed
 from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
@@ -134,10 +135,13 @@ def check_selection(selected: Sequence[str], coordinates: Sequence[str],
     valid = names(coordinates, points)
     unknown = [name for name in selected if name not in valid]
     if unknown:
-        raise UsageError(f"--select: no coordinate or named point {', '.join(unknown)}; "
-                         f"choose from: {', '.join(valid)}")
+        # The message lists ten: first the names of the bodies the unknown ones name.
+        bodies = {name.rsplit(".", 1)[0] for name in unknown}
+        near = sorted(valid, key=lambda name: name.rsplit(".", 1)[0] not in bodies)
+        raise UsageError(f"--select: no coordinate or named point {listed(unknown)}; "
+                         f"choose from: {listed(near)}")
     if not selected:
-        raise UsageError(f"--select: give at least one name; choose from: {', '.join(valid)}")
+        raise UsageError(f"--select: give at least one name; choose from: {listed(valid)}")
     return list(dict.fromkeys(selected))
 
 

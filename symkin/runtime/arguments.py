@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin import limits
 from symkin.errors import SolveError
+from symkin.limits import listed
 from symkin.runtime.protocol import KinematicsKernel
 
 Array = NDArray[np.float64]
@@ -84,7 +85,7 @@ def parameter_values(kernel: KinematicsKernel,
         names = list(kernel.parameter_names)
         for name, value in params.items():
             if name not in names:
-                known = ", ".join(names) or "none"
+                known = listed(names) or "none"
                 raise SolveError(f"unknown parameter {name!r}; the mechanism has: {known}")
             number = _floats(value, f"params[{name!r}]")
             if number.ndim:

@@ -311,8 +311,10 @@ def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options
     if assembled is None and run.done == 0:
         return
     t0 = float(run.t[0])
+    # The solver's condition estimate at the first row, from the factors it made there.
+    estimate = float(run.cond[0]) if assembled is None else math.nan
     singular = singular_start(kernel, run.q[0] if assembled is None else assembled, t0, p,
-                              options)
+                              options, estimate)
     if singular is None:
         return
     run.done = 0 if assembled is not None else 1

@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 from symkin.contract.options import defaults
 from symkin.contract.status import NO_CONVERGENCE, NOT_FINITE, SINGULAR
 from symkin.contract.tuning import EDGE_SUBSTEPS
+from symkin.limits import listed
 from symkin.runtime.assembly import Assembly
 from symkin.runtime.edges import Resolution
 from symkin.runtime.linalg import dependencies
@@ -119,8 +120,8 @@ def explain_stop(stop: Resolution, t: float) -> tuple[str, str]:
         reason = "limit position"
         message = (f"the driven motion reaches a limit position near t = {last:.10g} (bisected "
                    f"to {last:.13g} .. {failed:.13g}; the grid point t = {t:.10g} is beyond "
-                   f"it): {', '.join(stop.aligned)} become aligned, and "
-                   f"{' and '.join(stop.drivers)} cannot be followed beyond it (Phi_q loses "
+                   f"it): {listed(stop.aligned)} become aligned, and "
+                   f"{listed(stop.drivers, ' and ')} cannot be followed beyond it (Phi_q loses "
                    f"rank 1 there, condition {reached.point.cond:.3g}). The motion can go on "
                    "only by reversing the driver from this time (the mechanism then moves back "
                    "on its other branch), or by driving one of the aligned joints instead, "
@@ -137,9 +138,9 @@ def explain_stop(stop: Resolution, t: float) -> tuple[str, str]:
 
 def explain_start(start: Singular, t: float) -> str:
     """Why the motion is not stepped from its assembled start at t."""
-    aligned = ", ".join(start.aligned) or "no joint"
-    drivers = " and ".join(start.drivers) or "no driver"
-    groups = "; ".join("{" + ", ".join(group) + "}" for group in start.groups)
+    aligned = listed(start.aligned) or "no joint"
+    drivers = listed(start.drivers, " and ") or "no driver"
+    groups = listed(("{" + listed(group) + "}" for group in start.groups), "; ")
     return (f"the mechanism is assembled at t = {t:.10g} in a singular or limit configuration "
             f"(condition of Phi_q {start.cond:.3g} in units of the mechanism's length scale "
             f"{start.scale:.3g}): {aligned} become aligned, the equations of {groups} are "
@@ -194,9 +195,9 @@ def _singular_rows(kernel: KinematicsKernel, last: tuple[float, Array] | None, p
 def _dependent(jacobian: Array, labels: Sequence[str]) -> list[str]:
     """What is singular, said first, then the dependent rows (a minimal set per lost rank)."""
     rank_loss, groups = dependencies(jacobian, labels)
-    said = "; ".join("{" + ", ".join(group) + "}" for group in groups)
+    said = listed(("{" + listed(group) + "}" for group in groups), "; ")
     summary = (f"it loses rank {rank_loss}; the equations of {said} are dependent"
-               if len(groups) > 1 else f"the equations of {'; '.join(groups[0])} are dependent")
+               if len(groups) > 1 else f"the equations of {listed(groups[0], '; ')} are dependent")
     return [summary, *dict.fromkeys(row for group in groups for row in group)]
 
 

@@ -25,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.loads import load_count
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 from symkin.contract.options import Options
+from symkin.limits import listed
 from symkin.runtime.protocol import BatchSolver, EdgeSolver, GridSolver
 
 Array = NDArray[np.float64]
@@ -272,7 +273,7 @@ class Kernel:
             return array
         if array.shape != self.p_values.shape:
             raise ValueError(f"p must have shape {self.p_values.shape} (parameters "
-                             f"{', '.join(self.parameter_names)}), got {array.shape}")
+                             f"{listed(self.parameter_names)}), got {array.shape}")
         return array
 
 

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin import outfiles
 from symkin.contract.columns import ENERGY_COLUMNS, RATE_SUFFIXES
 from symkin.errors import SymkinError
+from symkin.limits import listed
 from symkin.runtime import spatial
 from symkin.runtime.forces import Forces
 
@@ -176,7 +177,7 @@ class Trajectory:
         """Position, velocity and acceleration of a named point (2.14-2.16), each (T, 2)
         (spatial: (T, 3), from the Euler parameters)."""
         if (body, name) not in self.points:
-            known = ", ".join(f"{b}.{p}" for b, p in self.points) or "none"
+            known = listed(f"{b}.{p}" for b, p in self.points) or "none"
             raise SymkinError(f"no point {body}.{name}; the named points are: {known}")
         s = self.point_vectors[self.points.index((body, name))]
         # rows whose rates were not asked for (NaN), or absurdly large (1e200: their square

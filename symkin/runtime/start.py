@@ -52,10 +52,23 @@ class Singular:
     drivers: tuple[str, ...]
 
 
-def start_threshold(options: Options) -> float:
-    """The scaled condition above which the start counts as singular: the one that makes a
-    stop a limit position (runtime.edges), so the start and the motion are judged alike."""
-    return min(LIMIT_COND, options.max_cond / 10)
+SIZE_FROM = 100
+"""Coordinates up to which the start's threshold is the limit positions' (runtime.edges); a
+larger mechanism's grows with the square of its size (start_threshold)."""
+
+
+def start_threshold(options: Options, size: int = 0) -> float:
+    """The scaled condition above which the start of a mechanism of ``size`` coordinates
+    counts as singular: up to SIZE_FROM the one that makes a stop a limit position
+    (runtime.edges), so the start and the motion are judged alike.
+
+    Beyond, it grows as (size / SIZE_FROM)^2, because the condition of a regular mechanism
+    does too: Phi_q^-1 carries a residual of one joint through every body beyond it, each
+    moved by up to a lever arm L, and the 1-norm adds them up (a regular lazy tongs of 1000
+    bars, 3000 coordinates, has 3.95e6). A dead centre's does not: its rank is lost locally
+    (the textbook crank-slider drawn at its dead centre has 6.8e6 at 9 coordinates)."""
+    growth = max(1.0, size / SIZE_FROM) ** 2
+    return min(LIMIT_COND, options.max_cond / 10) * growth
 
 
 def positions(kernel: KinematicsKernel) -> NDArray[np.bool_]:
@@ -71,38 +84,130 @@ def _positions(coordinates: tuple[str, ...]) -> NDArray[np.bool_]:
 
 def length_rows(kernel: KinematicsKernel) -> NDArray[np.bool_]:
     """Which rows of Phi are lengths: those with a structural entry in a position column."""
-    rows = np.zeros(len(kernel.rows), dtype=bool)
-    columns = positions(kernel)[np.asarray(kernel.pattern_cols, dtype=np.intp)]
-    rows[np.asarray(kernel.pattern_rows, dtype=np.intp)[columns]] = True
-    return rows
+    return _structure(kernel).length_rows.copy()
+
+
+@dataclass(frozen=True)
+class _Structure:
+    """What the lever arms need of a kernel's pattern, worked out once per kernel: each
+    row's non-zeros as a row of ``slots`` (indices into the non-zeros, padded with one past
+    the last, which reads as 0), whether each slot is in a position column, and the scalings
+    of scaled_nonzeros less the length scale."""
+
+    slots: NDArray[np.intp]
+    moved: NDArray[np.bool_]
+    turned: NDArray[np.bool_]
+    length_rows: NDArray[np.bool_]
+    by_position: NDArray[np.bool_]
+    row_of: NDArray[np.intp]
+    col_of: NDArray[np.intp]
+    recent: dict[tuple[bytes, float, bytes], tuple[Array, float]]
+    recent_scales: dict[tuple[bytes, float, bytes], float]
+
+
+_STRUCTURES: dict[int, tuple[object, _Structure]] = {}
+"""_Structure by the id of the kernel's pattern_rows array (kept, so that the id is not
+reused while the entry lives); a kernel's ScaledKernel views share their kernel's."""
+
+
+def _structure(kernel: KinematicsKernel) -> _Structure:
+    key = kernel.pattern_rows
+    hit = _STRUCTURES.get(id(key))
+    if hit is not None and hit[0] is key:
+        return hit[1]
+    if len(_STRUCTURES) >= 64:
+        _STRUCTURES.clear()
+    rows = np.asarray(kernel.pattern_rows, dtype=np.intp)
+    cols = np.asarray(kernel.pattern_cols, dtype=np.intp)
+    by_position = _positions(tuple(kernel.coordinates))[cols]
+    m = len(kernel.rows)
+    count = np.bincount(rows, minlength=m)
+    width = max(1, int(count.max(initial=0)))
+    slots = np.full((m, width), rows.size, dtype=np.intp)
+    order = np.argsort(rows, kind="stable")
+    starts = np.concatenate(([0], np.cumsum(count)[:-1]))
+    place = np.arange(rows.size) - np.repeat(starts, count)
+    slots[rows[order], place] = order
+    padded = np.append(by_position, False)[slots]
+    real = slots < rows.size
+    length = np.zeros(m, dtype=bool)
+    length[rows[by_position]] = True
+    structure = _Structure(slots, padded & real, ~padded & real, length, by_position, rows,
+                           cols, {}, {})
+    _STRUCTURES[id(key)] = (key, structure)
+    return structure
 
 
 def length_scale(kernel: KinematicsKernel, nz: Array) -> float:
     """L, the largest lever arm in Phi_q (module docstring), from its structural non-zeros
     ``nz``; 1 where there is none (a mechanism with no rotation, whose matrix needs no
     scaling)."""
-    rows = np.asarray(kernel.pattern_rows, dtype=np.intp)
-    by_position = positions(kernel)[np.asarray(kernel.pattern_cols, dtype=np.intp)]
-    magnitude = np.abs(nz)
-    moved = np.zeros(len(kernel.rows))
-    turned = np.zeros(len(kernel.rows))
-    np.maximum.at(moved, rows[by_position], magnitude[by_position])
-    np.maximum.at(turned, rows[~by_position], magnitude[~by_position])
+    structure = _structure(kernel)
+    magnitude = np.append(np.abs(nz), 0.0)[structure.slots]
+    moved = np.where(structure.moved, magnitude, 0.0).max(axis=1)
+    turned = np.where(structure.turned, magnitude, 0.0).max(axis=1)
     lengths = moved > 0
     arms = turned[lengths] / moved[lengths]
     scale = float(arms.max(initial=0.0))
     return scale if math.isfinite(scale) and scale > 0 else 1.0
 
 
+RECENT = 8
+"""Configurations whose Phi_q and L a kernel keeps (lever_arms): a loop of solves from one
+start asks for the same few every call."""
+
+
+def lever_arms(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> tuple[Array, float]:
+    """The non-zeros of Phi_q at (q, t, p) and L from them, kept for the RECENT last
+    configurations of the kernel (read-only arrays)."""
+    recent = _structure(kernel).recent
+    key = (np.ascontiguousarray(q, dtype=np.float64).tobytes(), float(t),
+           np.ascontiguousarray(p, dtype=np.float64).tobytes())
+    hit = recent.get(key)
+    if hit is not None:
+        return hit
+    with np.errstate(all="ignore"):
+        nz = np.array(kernel.phi_q_nz(q, t, p), dtype=np.float64)
+    nz.flags.writeable = False
+    found = (nz, length_scale(kernel, nz) if np.isfinite(nz).all() else math.nan)
+    if len(recent) >= RECENT:
+        recent.clear()
+    recent[key] = found
+    return found
+
+
+def lever_arm(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> float:
+    """L at (q, t, p), NaN where Phi_q is not finite there: one call of the generated
+    ``<prefix>_length_scales`` (what sweeps use) where the kernel has a batch solver, with no
+    Phi_q through Python; else from Phi_q's non-zeros (lever_arms)."""
+    batch = getattr(kernel, "batch_solver", None)
+    if batch is None:
+        return lever_arms(kernel, q, t, p)[1]
+    q = np.ascontiguousarray(q, dtype=np.float64)
+    p = np.ascontiguousarray(p, dtype=np.float64)
+    recent = _structure(kernel).recent_scales
+    key = (q.tobytes(), float(t), p.tobytes())
+    scale = recent.get(key)
+    if scale is None:
+        scale = float(batch.length_scales(p[None, :], q, float(t))[0])
+        if not math.isfinite(scale):
+            scale = math.nan
+        elif not scale > 0:
+            scale = 1.0  # no lever arm: Phi_q as it is, as length_scale says
+        if len(recent) >= RECENT:
+            recent.clear()
+        recent[key] = scale
+    return scale
+
+
 def scaled_nonzeros(kernel: KinematicsKernel, nz: Array) -> tuple[Array, float]:
     """The non-zeros of Phi_q in the coordinates x/L, y/L, phi with its length rows divided
     by L (same pattern), and L."""
+    structure = _structure(kernel)
     scale = length_scale(kernel, nz)
-    column = np.where(positions(kernel), scale, 1.0)
-    row = np.where(length_rows(kernel), scale, 1.0)
-    rows = np.asarray(kernel.pattern_rows, dtype=np.intp)
-    cols = np.asarray(kernel.pattern_cols, dtype=np.intp)
-    return nz * column[cols] / row[rows], scale
+    column = np.where(structure.by_position, scale, 1.0)
+    row = np.where(structure.length_rows[structure.row_of], scale, 1.0)
+    return nz * column / row, scale
 
 
 def scaled_cond(kernel: KinematicsKernel, scaled: Array) -> float:
@@ -135,13 +240,33 @@ def _dense(n: int, rows: NDArray[np.intp], cols: NDArray[np.intp], nz: Array) ->
     return matrix
 
 
-def singular_start(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options
-          ) -> Singular | None:
-    """The start (q at t) judged before the first step: None when Phi_q is regular there."""
-    nz = np.asarray(kernel.phi_q_nz(q, t, p), dtype=np.float64)
+SAFETY = 10.0
+"""The margin on a solver's condition estimate before a start counts as clearly regular (the
+estimator's lower bound can fall short of the true norm)."""
+
+
+def clearly_regular(estimate: float, scale: float, threshold: float) -> bool:
+    """Whether a solver's condition ``estimate`` of Phi_q (in the unit it solved in, where
+    the length scale is ``scale``) shows the start regular without a factorisation of its
+    own: Phi_q in units of L differs from that matrix by diagonal scalings of its length
+    columns and rows by L, which change the 1-norm condition by at most max(L, 1/L)^2."""
+    bound = estimate * max(scale, 1.0 / scale) ** 2
+    return math.isfinite(bound) and bound * SAFETY <= threshold
+
+
+def singular_start(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options,
+                   estimate: float = math.nan) -> Singular | None:
+    """The start (q at t) judged before the first step: None when Phi_q is regular there.
+    ``estimate``: the solver's condition estimate of Phi_q at q, from the factors it made
+    there (NaN: none), which spares the check its own factorisation where it suffices."""
+    threshold = start_threshold(options, len(kernel.coordinates))
+    if math.isfinite(estimate):
+        scale = lever_arm(kernel, q, t, p)
+        if math.isfinite(scale) and clearly_regular(estimate, scale, threshold):
+            return None
+    nz, _ = lever_arms(kernel, q, t, p)
     scaled, scale = scaled_nonzeros(kernel, nz)
     cond = scaled_cond(kernel, scaled)
-    threshold = start_threshold(options)
     if cond <= threshold:
         return None
     n = len(kernel.coordinates)

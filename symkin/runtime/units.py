@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.options import Options
 from symkin.runtime.newton import Newton, Point
 from symkin.runtime.protocol import ChunkResult, GridSolver, KinematicsKernel
-from symkin.runtime.start import length_rows, length_scale, positions
+from symkin.runtime.start import length_rows, lever_arm, positions
 
 Array = NDArray[np.float64]
 
@@ -45,11 +45,9 @@ NATURAL = (1e-2, 1e2)
 def unit_for(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> float:
     """The unit u to solve in: 1 when L is in NATURAL (or cannot be told), else 10^floor(log10
     L)."""
-    with np.errstate(all="ignore"):
-        nz = np.asarray(kernel.phi_q_nz(q0, t0, p), dtype=np.float64)
-    if not np.isfinite(nz).all():
+    scale = lever_arm(kernel, q0, t0, p)
+    if not math.isfinite(scale):  # Phi_q not finite at q0
         return 1.0
-    scale = length_scale(kernel, nz)
     if NATURAL[0] <= scale <= NATURAL[1]:
         return 1.0
     return float(10.0 ** math.floor(math.log10(scale)))
@@ -75,6 +73,9 @@ class ScaledKernel:
     def __init__(self, kernel: KinematicsKernel, unit: float) -> None:
         self.kernel = kernel
         self.unit = unit
+        # Not the kernel's batch solver: it works in the kernel's unit, not in this view's
+        # (runtime.start.lever_arm would read its L in the wrong unit).
+        self.batch_solver = None
         self.column = np.where(positions(kernel), unit, 1.0)
         self.row = np.where(length_rows(kernel), unit, 1.0)
         rows = np.asarray(kernel.pattern_rows, dtype=np.intp)

@@ -25,6 +25,7 @@ import yaml
 
 from symkin import pairs
 from symkin.errors import MechanismError
+from symkin.limits import listed
 from symkin.pairs.fields import GROUND
 from symkin.pairs.kit import Joined, PairType
 from symkin.spec import drawn_curves, drawn_slots, forces
@@ -128,7 +129,7 @@ class Drawing:
         """The body a constraint's ``key`` names; an error naming the known ones."""
         body = constraint.get(key)
         if not isinstance(body, str) or body not in self.frames:
-            known = ", ".join(self.frames)
+            known = listed(self.frames)
             raise MechanismError(f"unknown body {body!r}", path + (key,),
                                  f"Use one of: {known}.")
         return str(body)
@@ -137,7 +138,7 @@ class Drawing:
         """A point given by name (on ``body``) or by global coordinates: (local ref, global)."""
         if isinstance(raw, str):
             if raw not in self.points.get(body, {}):
-                known = ", ".join(self.points.get(body, {})) or "none"
+                known = listed(self.points.get(body, {})) or "none"
                 raise MechanismError(f"body {body!r} has no point named {raw!r}", path,
                                      f"Its points are: {known}; or give global coordinates "
                                      "[x, y].")
@@ -356,8 +357,9 @@ def _check_closure(drawing: Drawing, residuals: list[tuple[int, Any, tuple[str, 
                    if not gap <= tolerance]
     if not open_joints:
         return
-    said = "; ".join(f"joints[{index}]{' ' + repr(joint['name']) if joint.get('name') else ''}"
-                     f" ({label}) is off by {gap:.6g}" for index, joint, label, gap in open_joints)
+    said = listed((f"joints[{index}]{' ' + repr(joint['name']) if joint.get('name') else ''}"
+                   f" ({label}) is off by {gap:.6g}" for index, joint, label, gap in open_joints),
+                  "; ")
     raise MechanismError(f"the drawing does not close: {said}", ("joints", open_joints[0][0]),
                          f"The two points of each joint must coincide (revolute) or lie on the "
                          f"slide (prismatic, pin_slot) or its curve at s0 (point_on_curve) "

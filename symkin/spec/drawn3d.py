@@ -16,6 +16,7 @@ from typing import Any
 
 from symkin import pairs
 from symkin.errors import MechanismError
+from symkin.limits import listed
 from symkin.pairs.fields import GROUND
 from symkin.spec.drawn import DYNAMICS_KEYS, body_dynamics, drawn_load, layout_of
 from symkin.spec.drawn_quantities import Q, _Context, _sub
@@ -116,14 +117,14 @@ class Drawing3d:
         body = data.get(key)
         if not isinstance(body, str) or body not in self.origins:
             raise MechanismError(f"unknown body {body!r}", path + (key,),
-                                 f"Use one of: {', '.join(self.origins)}.")
+                                 f"Use one of: {listed(self.origins)}.")
         return str(body)
 
     def point(self, body: str, raw: Any, path: Path_) -> Any:
         """A point by name (kept: the local form has the body's points) or global [x, y, z]."""
         if isinstance(raw, str):
             if raw not in self.points[body]:
-                known = ", ".join(self.points[body]) or "none"
+                known = listed(self.points[body]) or "none"
                 raise MechanismError(f"body {body!r} has no point named {raw!r}", path,
                                      f"Its points are: {known}; or give global coordinates "
                                      "[x, y, z].")
@@ -172,7 +173,7 @@ class Drawing3d:
     def joint(self, name: Any, path: Path_, kinds: tuple[str, ...]) -> dict[str, Any]:
         """The local form of the joint called ``name``, which must be one of ``kinds``."""
         if not isinstance(name, str) or name not in self.joints:
-            known = ", ".join(map(str, self.joints)) or "none"
+            known = listed(map(str, self.joints)) or "none"
             raise MechanismError(f"no joint named {name!r}", path,
                                  f"Name a {' or '.join(kinds)} joint; the named joints are: "
                                  f"{known}.")

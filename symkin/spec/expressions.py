@@ -15,6 +15,7 @@ from collections.abc import Callable, Mapping, Sequence
 import sympy as sp
 
 from symkin.errors import ExpressionError
+from symkin.limits import listed
 from symkin.spec import constants
 
 MAX_LENGTH = 1000
@@ -129,7 +130,7 @@ class _Builder:
         if node.id in _CONSTANTS:
             return _CONSTANTS[node.id]
         known = sorted(self.symbols) + sorted(_CONSTANTS)
-        raise self.fail(node, f"unknown name {node.id!r}; known names are {', '.join(known)}")
+        raise self.fail(node, f"unknown name {node.id!r}; known names are {listed(known)}")
 
     def _Attribute(self, node: ast.Attribute, depth: int) -> sp.Expr:
         # Only `body.x`, `body.y`, `body.phi` in custom constraints; nothing else.
@@ -139,7 +140,7 @@ class _Builder:
                 return self.coordinates[key]
             parts = tuple(dict.fromkeys(part for _, part in self.coordinates))
             if self.coordinates and node.attr in (*_COORDINATE_ATTRIBUTES, *parts):
-                bodies = ", ".join(dict.fromkeys(body for body, _ in self.coordinates))
+                bodies = listed(dict.fromkeys(body for body, _ in self.coordinates))
                 planar = set(parts) <= {"x", "y", "phi"}
                 said = ("body.x, body.y or body.phi" if planar else
                         ", ".join(f"body.{part}" for part in parts))

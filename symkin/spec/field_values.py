@@ -13,6 +13,7 @@ from typing import Any
 import sympy as sp
 
 from symkin.errors import ExpressionError, MechanismError
+from symkin.limits import listed
 from symkin.pairs.fields import GROUND
 from symkin.spec import constants, expressions
 from symkin.spec.schema import MechanismSpec
@@ -86,7 +87,7 @@ def expression(raw: Any, symbols: Names | None, path: tuple[str | int, ...],
 
 def body_ref(mech: MechanismSpec, name: str, path: tuple[str | int, ...]) -> None:
     if name != GROUND and name not in mech.bodies:
-        known = ", ".join([GROUND, *mech.bodies])
+        known = listed([GROUND, *mech.bodies])
         raise MechanismError(f"unknown body {name!r}", path, f"Use one of: {known}.")
 
 
@@ -95,7 +96,7 @@ def point(mech: MechanismSpec, body: str, ref: Any, symbols: Names,
     if isinstance(ref, str):
         points = mech.bodies[body].points if body != GROUND else {}
         if ref not in points:
-            known = ", ".join(points) or "none"
+            known = listed(points) or "none"
             raise MechanismError(f"body {body!r} has no point named {ref!r}", path,
                                  f"Its points are: {known}; or give a vector "
                                  f"{'[x, y, z]' if mech.is_spatial else '[x, y]'}.")

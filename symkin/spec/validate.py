@@ -19,7 +19,7 @@ from pydantic import ValidationError, model_validator
 
 from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError, UsageError, format_path
-from symkin.limits import MAX_GRID_POINTS, grid_points
+from symkin.limits import MAX_GRID_POINTS, grid_points, listed
 from symkin.pairs.fields import GROUND, is_input
 from symkin.spec import constants, drawn, drawn3d, drawn_schema, expressions, forces, loader, motion
 from symkin.spec.field_values import Names, body_ref, expression, names_of, numeric
@@ -87,7 +87,7 @@ def override_parameters(data: Any, overrides: Mapping[str, str], source: str) ->
     for name, text in overrides.items():
         if name not in known:
             raise UsageError(f"--set {name}: {source} has no parameter {name!r}; its "
-                             f"parameters are: {', '.join(map(str, known)) or 'none'}")
+                             f"parameters are: {listed(map(str, known)) or 'none'}")
         try:
             constants.value(expressions.parse(text, {}))
         except ExpressionError as error:

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from symkin import limits
 from symkin.contract.options import Options
 from symkin.errors import SolveError
+from symkin.limits import listed
 from symkin.runtime import driver, forces, redundant
 from symkin.runtime.dynamics.model import refuse_motion
 from symkin.runtime.inputs import refuse_inputs
@@ -95,7 +96,7 @@ def parameter_table(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike)
         unknown = [n for n in params if n not in names]
         if unknown:
             raise SolveError(f"unknown parameter {unknown[0]!r}; the mechanism has: "
-                             f"{', '.join(names) or 'none'}")
+                             f"{listed(names) or 'none'}")
         columns = {n: np.atleast_1d(np.asarray(v, dtype=float)) for n, v in params.items()}
         sizes = {c.shape for c in columns.values()}
         if len(sizes) != 1 or len(next(iter(sizes))) != 1:
@@ -109,7 +110,7 @@ def parameter_table(kernel: Kernel, params: Mapping[str, ArrayLike] | ArrayLike)
     table = np.asarray(params, dtype=float)
     if table.ndim != 2 or table.shape[1] != len(names):
         raise SolveError(f"params must have shape (M, {len(names)}) in the order "
-                         f"{', '.join(names) or '(none)'}, got {table.shape}")
+                         f"{listed(names) or '(none)'}, got {table.shape}")
     return np.ascontiguousarray(table)
 
 

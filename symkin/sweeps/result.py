@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 from symkin import outfiles
 from symkin.contract.loads import reaction_parts
 from symkin.errors import SymkinError
+from symkin.limits import listed
 from symkin.runtime import spatial
 
 Array = NDArray[np.float64]
@@ -147,7 +148,7 @@ class SweepResult:
     def point(self, body: str, name: str) -> tuple[Array, Array, Array]:
         """r, dr, ddr of a named point (2.14-2.16), each (M, T, 2)."""
         if (body, name) not in self.points_named:
-            known = ", ".join(f"{b}.{p}" for b, p in self.points_named) or "none"
+            known = listed(f"{b}.{p}" for b, p in self.points_named) or "none"
             raise SymkinError(f"no point {body}.{name}; the named points are: {known}")
         start = self.coordinates.index(f"{body}.x")
         s = self.point_vectors[:, self.points_named.index((body, name)), None, :]  # (M, 1, 2)

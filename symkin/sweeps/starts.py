@@ -23,14 +23,10 @@ from numpy.typing import NDArray
 
 from symkin.contract.options import Options
 from symkin.runtime.protocol import BatchSolver, KinematicsKernel
-from symkin.runtime.start import singular_start, start_threshold
+from symkin.runtime.start import SAFETY, singular_start, start_threshold
 from symkin.runtime.units import ScaledKernel, units_for
 
 Array = NDArray[np.float64]
-
-SAFETY = 10.0
-"""The margin on the batch's condition estimate before a start counts as clearly regular."""
-
 
 def set_units(batch: BatchSolver, params: Array, t0: float, q0: Array) -> Array:
     """The unit each set is solved in (runtime.units.unit_for at its first guess q0, (N,) or
@@ -52,7 +48,8 @@ def singular_starts(kernel: KinematicsKernel, batch: BatchSolver, params: Array,
     with np.errstate(all="ignore"):
         ratio = np.where(scales > 0, scales / unit, 1.0)  # no lever arm: Phi_q as it is
         bound = start_cond[solved] * np.maximum(ratio, 1.0 / ratio) ** 2
-        clear = np.isfinite(scales) & (bound * SAFETY <= start_threshold(options))
+        threshold = start_threshold(options, len(kernel.coordinates))
+        clear = np.isfinite(scales) & (bound * SAFETY <= threshold)
     for j in solved[~clear]:
         with np.errstate(all="ignore"):
             if units[j] == 1.0:

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import UsageError
+from symkin.limits import listed
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
 from symkin.sweeps.result import SweepResult
@@ -183,7 +184,7 @@ def _known(kernel: Kernel, names: Sequence[str], where: str = "") -> None:
         what = f"unknown parameter {unknown[0]!r}" if unknown else \
             f"parameter {repeated[0]!r} given twice"
         raise UsageError(f"{where}{what}; the mechanism's parameters are: "
-                         f"{', '.join(kernel.parameter_names) or 'none'}")
+                         f"{listed(kernel.parameter_names) or 'none'}")
 
 
 def _number(text: str, where: str) -> float:

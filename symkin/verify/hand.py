@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from symkin.errors import SymkinError
+from symkin.limits import listed
 from symkin.verify.sampling import State
 
 FUNCTIONS = ("phi", "phi_q", "phi_t", "gamma")
@@ -97,8 +98,8 @@ def check_order(hand: Any, origin: str, attribute: str, expected: Sequence[str])
         return
     if [str(item) for item in declared] != list(expected):
         raise HandModuleError(
-            f"{origin}: it declares {attribute} = {', '.join(map(str, declared))}, but the "
-            f"mechanism's {attribute.lower()} are {', '.join(expected) or 'none'} (in the order "
+            f"{origin}: it declares {attribute} = {listed(map(str, declared))}, but the "
+            f"mechanism's {attribute.lower()} are {listed(expected) or 'none'} (in the order "
             f"`symkin show` prints); was it written for another mechanism file?")
 
 

@@ -28,6 +28,7 @@ import numpy as np
 import sympy as sp
 
 from symkin.errors import MechanismError
+from symkin.limits import listed
 from symkin.spec.validate import Mechanism
 from symkin.symbolic.derivation import System, derive
 from symkin.verify.hand import (
@@ -121,7 +122,7 @@ def _refuse_inputs(system: System) -> None:
         first = system.inputs[0]
         raise MechanismError(
             f"the driver's function is an input (values given at run time), which a hand "
-            f"derivation phi(q, t, p) cannot take; inputs: {', '.join(system.input_places)}",
+            f"derivation phi(q, t, p) cannot take; inputs: {listed(system.input_places)}",
             ("drivers", first.driver, first.key),
             "To check a derivation, write the driver as a function of t (e.g. theta: w*t).")
 

@@ -227,3 +227,50 @@ def test_cli_says_it_before_any_step_and_exits_1(tmp_path, backend):
     assert "Traceback" not in done.stderr
     assert "singular or limit configuration" in done.stderr and "slot" in done.stderr
     assert len(out.read_text().splitlines()) == 2  # the header and the start
+
+
+# The textbook crank-slider (Example 2.5: a = 1, b = 5, offset c = 4) drawn at its outer dead
+# centre and driven by the slider: crank and rod collinear, |O B| = a + b, B at height c, so
+# B.x = sqrt((a + b)^2 - c^2) and A = (a / (a + b)) B.
+TEXTBOOK_DEAD_CENTRE = """
+name: crank_slider_dead_centre
+layout: drawn
+parameters: {a: 1.0, b: 5.0, c: 4.0}
+bodies:
+  ground: {points: {O: [0, 0]}}
+  crank:  {points: {O: [0, 0], A: [a*sqrt((a + b)**2 - c**2)/(a + b), a*c/(a + b)]}}
+  rod:    {points: {A: [a*sqrt((a + b)**2 - c**2)/(a + b), a*c/(a + b)],
+                     B: [sqrt((a + b)**2 - c**2), c]}}
+  slider: {points: {B: [sqrt((a + b)**2 - c**2), c]}}
+joints:
+  - {type: revolute,  i: ground, j: crank,  at: O}
+  - {type: revolute,  i: crank,  j: rod,    at: A}
+  - {type: revolute,  i: rod,    j: slider, at: B}
+  - {type: prismatic, i: slider, j: ground, at: B, axis: [1, 0]}
+drivers:
+  - {type: slide, name: push, i: ground, j: slider, sA: O, sB: B, u: [1, 0],
+     f: "sqrt((a + b)**2 - c**2) - t"}
+time: {t0: 0, t1: 0.5, dt: 0.05}
+"""
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("drawing", ["textbook", "exact"])
+def test_crank_slider_drawn_at_its_dead_centre_is_refused_error_first(tmp_path, backend,
+                                                                      drawing):
+    """Refused at the start whatever size a larger mechanism is allowed (runtime.start: 9
+    coordinates keep the small threshold), and the error is the first thing said: the
+    warning about the one row solved (the exact drawing's is flagged) comes after it."""
+    path = tmp_path / "dead_centre.yaml"
+    path.write_text(TEXTBOOK_DEAD_CENTRE if drawing == "textbook" else _slider_crank(4.0))
+    done = subprocess.run([sys.executable, "-m", "symkin", "run", str(path), "--backend",
+                           backend], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.splitlines()
+    assert lines[0].startswith("symkin: error:"), done.stderr
+    assert "at t = 0 in a singular or limit configuration" in lines[0]
+    assert "drivers[0] push slide ground-slider" in lines[0]
+    if drawing == "exact":
+        assert any(line.startswith("symkin: warning: 1 point flagged at t = 0")
+                   for line in lines[1:]), done.stderr
+    assert "Traceback" not in done.stderr

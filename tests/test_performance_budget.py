@@ -1,0 +1,44 @@
+"""A performance guard: instruction counts (callgrind; they do not move with the machine's
+load, unlike times) of the crank-slider's generated step and of one ``symkin.solve`` call,
+against the budgets committed in bench/budgets.json with their margins. A change that costs
+more fails here and says so in its diff by raising the budget.
+
+Skipped only where valgrind is missing (CI installs it: .ci/run)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "bench"))
+import instructions  # noqa: E402
+
+BUDGETS = json.loads((ROOT / "bench" / "budgets.json").read_text())
+
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(shutil.which("valgrind") is None or
+                                 shutil.which("callgrind_annotate") is None,
+                                 reason="valgrind (callgrind) is not installed")]
+
+
+def _within(name: str, count: float) -> None:
+    entry = BUDGETS[name]
+    limit = entry["budget"] * (1 + entry["margin"])
+    assert count <= limit, (f"{name}: {count:.0f} instructions, over the budget "
+                            f"{entry['budget']} + {entry['margin']:.0%} (measure: "
+                            f"{entry['measure']}); make it cheaper or raise the budget in "
+                            "bench/budgets.json")
+
+
+def test_the_crank_slider_step_keeps_its_budget():
+    _, _, count = instructions.per_step("crank_slider")
+    _within("crank_slider_step", count)
+
+
+def test_one_solve_call_keeps_its_budget(tmp_path):
+    _within("crank_slider_solve_call", instructions.per_solve_call("crank_slider", tmp_path))
