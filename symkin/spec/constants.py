@@ -263,6 +263,29 @@ def fold(expr: sp.Expr) -> sp.Expr:
     return expr.xreplace(replacements) if replacements else expr
 
 
+def lambdify_floats(arguments: Any, expressions: Any, modules: str = "numpy",
+                    dummify: bool = False) -> Callable[..., Any]:
+    """``sympy.lambdify`` of ``expressions`` (an expression, a sequence or a matrix of them)
+    with every constant part folded to a double first (:func:`fold`).
+
+    Without the folding an exact number reaches NumPy as it is: a long decimal read as a
+    rational, or ``sqrt`` of an integer wider than 64 bits, becomes a Python int that NumPy
+    holds as an object and its ufuncs refuse ("no callable sqrt method"). Every numeric
+    evaluation of derived expressions goes through here, so each sees the doubles the
+    generated code sees.
+
+    Raises:
+        ExpressionError: a constant part has no value (see :func:`value`).
+    """
+    if isinstance(expressions, sp.MatrixBase):
+        folded: Any = expressions.applyfunc(fold)
+    elif isinstance(expressions, sp.Basic):
+        folded = fold(expressions)
+    else:
+        folded = [fold(sp.sympify(e)) for e in expressions]
+    return sp.lambdify(arguments, folded, modules=modules, dummify=dummify)
+
+
 def check_constants(expr: sp.Expr) -> None:
     """Evaluate every largest constant part of ``expr`` once, so a constant with no value (or
     one the bounded evaluator refuses) is reported where the expression is written."""

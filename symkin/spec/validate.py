@@ -299,8 +299,9 @@ class _Checks:
         return tuple(self.mech.bodies)
 
     def at_nominal(self, expr: sp.Expr) -> sp.Expr:
-        """``expr`` with the parameters at their nominal values."""
-        return expr.subs(self.nominal)
+        """``expr`` with the parameters at their nominal values and every constant part a
+        double (exact numbers would reach NumPy as Python ints: constants.lambdify_floats)."""
+        return constants.fold(expr.subs(self.nominal))
 
     def point(self, body: str, ref: Any, path: tuple[str | int, ...]) -> None:
         """A point of ``body`` by name, or a vector of constant expressions."""

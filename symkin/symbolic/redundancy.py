@@ -47,6 +47,7 @@ import sympy as sp
 
 from symkin.contract import dense_solvers
 from symkin.contract.options import defaults
+from symkin.spec import constants
 
 RANK_TOLERANCE = 1e-8
 """Relative size (of the equilibrated Phi_q) below which a row counts as dependent."""
@@ -100,9 +101,9 @@ class _Equations:
                  p: Sequence[sp.Symbol], p_values: Sequence[float]) -> None:
         matrix = sp.Matrix(list(phi))
         arguments = (list(q), t, list(p))
-        self._phi = sp.lambdify(arguments, list(matrix), modules="numpy", dummify=True)
-        self._jacobian = sp.lambdify(arguments, matrix.jacobian(list(q)), modules="numpy",
-                                     dummify=True)
+        self._phi = constants.lambdify_floats(arguments, list(matrix), dummify=True)
+        self._jacobian = constants.lambdify_floats(arguments, matrix.jacobian(list(q)),
+                                                   dummify=True)
         self.rows, self.size = len(phi), len(q)
         self.p = np.array(p_values, dtype=float)
 
