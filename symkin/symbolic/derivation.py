@@ -124,8 +124,9 @@ class System:
     removed: tuple[Removed, ...] = ()
     """Rows of an over-constrained file dependent at t0, removed so that Phi is square."""
     mobility: int | None = None
-    """An over-constrained file's freedoms at t0 by the rank of its joints' rows (the count,
-    ``dof``, cannot judge it); None for every other file."""
+    """An over-constrained file's freedoms at t0 by the rank of its joints' rows and its
+    bodies' normalisation rows (the count, ``dof``, cannot judge it); None for every other
+    file."""
     dynamics: dynamics.Dynamics | None = None
     """Mass terms, applied forces, efforts and reactions; None for a file without masses
     and forces (inverse dynamics, symbolic.dynamics)."""
@@ -256,11 +257,15 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
             "that are functions of t: remove the repeated joint, or drive it by a function.")
     joints = [k for k, row in enumerate(rows) if row.section == "joints"]
     priority = [k for k, row in enumerate(rows) if row.section != "joints"] + joints
+    # The freedoms are what every row a coordinate is subject to leaves: the joints' and the
+    # Euler parameters' normalisation (without it each body keeps its parameters' scale).
+    subject = sorted(joints + [k for k, row in enumerate(rows)
+                               if row.section == NORMALISATION[0]])
     try:
         # A rank short at t0 is checked again half a step later (t0 singular, or a freedom).
         t0, t1, dt = grid
         found = redundancy.analyse(phi, symbols.q, symbols.t, symbols.p, p_values, q0, t0,
-                                   priority, t0 + 0.5 * min(dt, t1 - t0), joints)
+                                   priority, t0 + 0.5 * min(dt, t1 - t0), subject)
     except redundancy.Refusal as refusal:
         row = None if refusal.row is None else rows[refusal.row]
         where = (row.section, row.index) if row else ("joints",)

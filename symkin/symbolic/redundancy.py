@@ -73,7 +73,7 @@ class Finding:
         q: the assembled configuration.
         dependency: per removed row, its relative component outside the kept rows' span.
         mobility: the freedoms the joints leave at t0: coordinates less the rank of the rows
-            that are not in ``priority``'s leading group (the joints' rows).
+            given as ``joints`` (the joints' and the normalisation rows).
     """
 
     kept: tuple[int, ...]
@@ -129,7 +129,8 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
         priority: the row indices in the order they are kept (the first independent ones win).
         t_near: a time near t0 for the second assembly of a rank below the coordinates'
             count (default t0: moved in configuration only).
-        joints: the joints' rows, whose rank gives the mobility at t0.
+        joints: the rows a coordinate is subject to without the drivers (the joints' and a
+            spatial body's normalisation), whose rank gives the mobility at t0.
 
     Raises:
         Refusal: the rows contradict each other at t0 (no assembly), the rank is below the
