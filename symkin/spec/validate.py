@@ -200,7 +200,7 @@ def _numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float],
     try:
         return constants.value(expr, values)
     except ExpressionError as error:
-        raise MechanismError(f"{sp.sstr(expr)[:120]} has no finite real value at the nominal "
+        raise MechanismError(f"{constants.describe(expr, 120)} has no finite real value at the nominal "
                              f"parameter values: {error.message}", path,
                              "Check the arguments of sqrt, log, asin, acos and the "
                              "magnitudes.") from None
@@ -414,11 +414,24 @@ def _check_time(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, fl
                              "Use a larger dt or a shorter interval.")
 
 
+def _gravity(mech: Mechanism, symbols: _Names, nominal: Mapping[sp.Symbol, float]) -> float:
+    """The largest |g| component of the file's gravity loads (0 without)."""
+    found = [abs(_numeric(_expression(g, symbols, ("forces", k, "g", n)), nominal,
+                          ("forces", k, "g", n)))
+             for k, load in enumerate(mech.forces) if load.type == "gravity"
+             for n, g in enumerate(load.g)]
+    return max(found, default=0.0)
+
+
 def _check_dynamics(mech: Mechanism, symbols: _Names,
                     nominal: Mapping[sp.Symbol, float]) -> None:
     """Masses and inertias are constants >= 0; a load names known bodies and points, and its
     expressions use only t, parameters, coordinates and their rates."""
+    gravity = _gravity(mech, symbols, nominal)
     for name, body in mech.bodies.items():
+        massless = forces.massless_problem(body)
+        if massless is not None:
+            raise MechanismError(massless[0], ("bodies", name, "com"), massless[1])
         for key in ("mass", "inertia"):
             raw = getattr(body, key)
             if raw is None:
@@ -426,7 +439,8 @@ def _check_dynamics(mech: Mechanism, symbols: _Names,
             path = ("bodies", name, key)
             values = {at: _numeric(_expression(item, symbols, path + at), nominal, path + at)
                       for at, item in entries(raw)}
-            problem = magnitude_problem(key, values)
+            problem = magnitude_problem(key, values) or (
+                forces.weight_problem(values[()], gravity) if key == "mass" else None)
             if problem is not None:
                 raise MechanismError(problem[0], path, problem[1])
         if body.com is not None:

@@ -28,7 +28,7 @@ from typing import Any
 import sympy as sp
 
 from symkin import pairs
-from symkin.errors import MechanismError
+from symkin.errors import ExpressionError, MechanismError
 from symkin.spec import validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
@@ -341,13 +341,28 @@ def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tupl
             kind = pairs.of(constraint)
             if section == "drivers":
                 constraint = _with_inputs(constraint, ctx.symbols, index)
-            equations = kind.equations(constraint, ctx)
+            equations = _equations(kind, constraint, ctx, (section, index))
             parts = kind.rows or tuple(f"equation {k}" for k in range(len(equations)))
             bodies = kind.joined_bodies(constraint) or _bodies_touched(equations, ctx)
             phi.extend(equations)
             rows.extend(Row(section, index, constraint.type, bodies, part, constraint.name)
                         for part in parts)
     return phi, tuple(rows)
+
+
+def _equations(kind: Any, constraint: Any, ctx: Context, path: tuple[str, int]
+               ) -> list[sp.Expr]:
+    """A constraint's rows; a constant of its geometry that has no double value (an axis
+    component so small or so large that its exact square is beyond a double) refused at the
+    constraint, where the file is at fault."""
+    try:
+        return list(kind.equations(constraint, ctx))
+    except ExpressionError as error:
+        raise MechanismError(f"its geometry cannot be computed in double precision: "
+                             f"{error.message}", path,
+                             "Give its points and directions in numbers a double holds with "
+                             "room to spare (between about 1e-150 and 1e150 in magnitude, or "
+                             "0), e.g. in other units.") from None
 
 
 def _normalised(mech: Mechanism, ctx: Context, phi: list[sp.Expr], rows: tuple[Row, ...]
