@@ -215,8 +215,9 @@ def _side(c: Cam, exprs: list[sp.Expr], checks: kit.Checks, s0: float,
 
 
 def _curvature_along(exprs: list[sp.Expr], checks: kit.Checks, grid: np.ndarray,
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """s over the grid, |c'(s)| and the signed curvature there (nominal values)."""
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """s over the grid, |c'(s)|, the signed curvature and c'(s) itself, one row a sample
+    (nominal values)."""
     s = sp.Symbol("s", real=True)
     values = [checks.at_nominal(expr) for expr in exprs]
     derivatives = [sp.diff(v, s, k) for k in (1, 2) for v in values]
@@ -226,20 +227,39 @@ def _curvature_along(exprs: list[sp.Expr], checks: kit.Checks, grid: np.ndarray,
                           for e in derivatives)
         speed = np.hypot(x1, y1)
         curvature = (x1 * y2 - y1 * x2) / speed**3
-    return grid, speed, curvature
+    return grid, speed, curvature, np.column_stack([x1, y1])
+
+
+def _cusp(grid: np.ndarray, speed: np.ndarray, tangent: np.ndarray, finite: np.ndarray
+          ) -> float | None:
+    """Where the profile has a cusp: c'(s) zero at a sample, or c'(s) reversed between two
+    neighbouring samples (a simple cusp's c' passes through zero between them and changes
+    sign, which no sample sees as small; a smooth profile sampled this finely turns far
+    less than a right angle from one sample to the next). None where it has none."""
+    scale = float(np.max(speed[finite])) if finite.any() else 1.0
+    zero = finite & (speed <= 1e-9 * scale)
+    if zero.any():
+        return float(grid[zero][0])
+    reversed_ = (finite[:-1] & finite[1:]
+                 & (np.einsum("ij,ij->i", tangent[:-1], tangent[1:]) < 0))
+    if reversed_.any():
+        k = int(np.flatnonzero(reversed_)[0])
+        return float(0.5 * (grid[k] + grid[k + 1]))
+    return None
 
 
 def _check_followable(c: Cam, exprs: list[sp.Expr], checks: kit.Checks, s0: float,
                       roller: float, path: kit.Path) -> None:
     """No cusp; no concave part tighter than the roller; no concave part under a face."""
-    grid, speed, curvature = _curvature_along(exprs, checks, _samples(c, checks, s0, path))
+    grid, speed, curvature, tangent = _curvature_along(exprs, checks,
+                                                       _samples(c, checks, s0, path))
     finite = np.isfinite(speed) & np.isfinite(curvature)
-    scale = float(np.max(speed[finite])) if finite.any() else 1.0
-    cusp = finite & (speed <= 1e-9 * scale)
-    if cusp.any():
-        raise MechanismError(f"the profile has a cusp (c'(s) = 0) at s = "
-                             f"{grid[cusp][0]:.6g}", path, "Smooth the profile there: a "
-                             "follower cannot keep a defined contact at a cusp.")
+    at = _cusp(grid, speed, tangent, finite)
+    if at is not None:
+        raise MechanismError(f"the profile has a cusp (c'(s) = 0) at s = {at:.6g}", path,
+                             "Smooth the profile there: a follower cannot keep a defined "
+                             "contact at a cusp. A flat-faced follower's profile drawn from "
+                             "a lift law L(s) needs r_b + L + L'' > 0 all round.")
     sense = _side(c, exprs, checks, s0, grid)
     # with the normal on the follower's side, a part convex towards it has sense * curvature > 0
     concave = finite & (sense * curvature < 0)
