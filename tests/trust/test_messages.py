@@ -25,3 +25,14 @@ def test_a_control_character_is_located(text: str, line: int, column: int, code:
     err = capsys.readouterr().err
     assert f"control.yaml:{line}: this is not valid YAML: the character {code} at column " \
            f"{column} is not allowed" in err
+
+
+def test_a_drawn_parameter_defined_from_another_is_blamed_at_its_line(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    path = Path(__file__).resolve().parent / "drawn_parameter_from_parameter.yaml"
+    line = path.read_text(encoding="utf-8").splitlines().index("  b: 5*a") + 1
+    assert cli.main(["show", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"drawn_parameter_from_parameter.yaml:{line}: at parameters.b: in expression " \
+           "'5*a' at column 3: unknown name 'a'" in err
+    assert "A link too short" not in err
