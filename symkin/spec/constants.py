@@ -44,7 +44,7 @@ def describe(expr: sp.Basic, length: int = QUOTE_LENGTH) -> str:
     cut to ``length`` with an ellipsis."""
     numbers = {n: sp.Float(n, 6) for n in expr.atoms(sp.Number)
                if len(sp.sstr(n)) > 12 and mpmath.isfinite(mpmath.mpf(n.evalf(6)))}
-    text = sp.sstr(expr.xreplace(numbers) if numbers else expr)
+    text = str(sp.sstr(expr.xreplace(numbers) if numbers else expr))
     return text if len(text) <= length else text[: length - 1] + "…"
 
 
@@ -297,7 +297,9 @@ def lambdify_floats(arguments: Any, expressions: Any, modules: str = "numpy",
         folded = fold(expressions)
     else:
         folded = [fold(sp.sympify(e)) for e in expressions]
-    return sp.lambdify(arguments, folded, modules=modules, dummify=dummify)
+    function: Callable[..., Any] = sp.lambdify(arguments, folded, modules=modules,
+                                               dummify=dummify)
+    return function
 
 
 def check_constants(expr: sp.Expr) -> None:
