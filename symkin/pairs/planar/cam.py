@@ -133,9 +133,12 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     - ``pressure_angle``: the angle (radians, 0 to pi/2) between the contact normal and the
       velocity of the follower's point (the roller's centre, or the face's point F);
       undefined (NaN) where that point is at rest (a dwell), which has no direction;
-    - ``curvature_radius``: the profile's radius of curvature |c'|^3 / (c' x c''), positive
-      where the profile is convex, negative where it is hollow (a roller needs a radius
-      smaller than the hollow's);
+    - ``curvature_radius``: the profile's signed radius of curvature, positive where the
+      profile is convex, negative where it is hollow (a roller needs a radius smaller than
+      the hollow's): sigma |c'|^3 / (c' x c'') for a roller; for a flat face
+      (c' . tau)^3 / (c' x c''), tau the face's unit direction in the cam's frame, which is
+      p + p'' of the face's support function p (r_b + L + L'' for a lift law L): its sign
+      follows c' through a cusp, where |c'|^3 would stay positive;
     - ``contact_x``, ``contact_y``: the contact point c(s) in the global frame (marked in the
       pictures)."""
     s = geometry.coordinate(f"{c.name}.s")
@@ -143,7 +146,6 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     cam, follower = geometry.pose(c.i), geometry.pose(c.j)
     t, t2 = curve.diff(s), curve.diff(s, 2)
     sense = follower_side(c, curve, s, geometry)
-    speed = sp.sqrt((t.T * t)[0])
     if isinstance(c.follower, Roller):
         normal = cam.R * sp.Matrix([t[1], -t[0]])
     else:
@@ -153,8 +155,30 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     along = (normal.T * velocity)[0]
     return {"pressure_angle": (sp.atan2(sp.Abs(across), sp.Abs(along)),
                                sp.sqrt((velocity.T * velocity)[0])),
-            "curvature_radius": (sense * speed**3 / (t[0] * t2[1] - t[1] * t2[0]), None),
+            "curvature_radius": (_radius(c, t, t2, sense, geometry), None),
             **kit.contact_outputs(cam.point(curve))}
+
+
+def _radius(c: Cam, t: sp.Matrix, t2: sp.Matrix, sense: int, geometry: kit.Geometry
+            ) -> sp.Expr:
+    """The signed radius of curvature at the contact (t, t2: c'(s) and c''(s))."""
+    cross = t[0] * t2[1] - t[1] * t2[0]
+    if isinstance(c.follower, Roller):
+        return sense * sp.sqrt((t.T * t)[0]) ** 3 / cross
+    # The tangency row keeps c' along the face, so c' . tau = +-|c'|; unlike |c'| it changes
+    # sign where the envelope of the face turns back (p + p'' < 0), so the radius does too.
+    # tau is oriented so that the profile at s0 as drawn is convex (the checks refuse a flat
+    # face on a hollow).
+    m = geometry.vector(c.follower.normal)
+    s = geometry.coordinate(f"{c.name}.s")
+
+    def along(cam: kit.Pose, follower: kit.Pose) -> sp.Expr:
+        face = cam.R.T * follower.R * m / sp.sqrt((m.T * m)[0])
+        return t[0] * -face[1] + t[1] * face[0]
+
+    drawn = along(geometry.initial_pose(c.i), geometry.initial_pose(c.j))
+    orient = geometry.sign_at_nominal(drawn.subs(s, geometry.expr(c.s0))) or 1
+    return orient * along(geometry.pose(c.i), geometry.pose(c.j)) ** 3 / cross
 
 
 def check(c: Cam, checks: kit.Checks, path: kit.Path) -> None:
