@@ -135,6 +135,9 @@ class System:
     Gamma their accelerations ddu (symbols of each Input)."""
     input_values: tuple[float, ...] = ()
     """Each input's value that the file's q0 satisfies (for generation-time samples)."""
+    senses: tuple[tuple[str, sp.Expr], ...] = ()
+    """(label, expression) of what the rows leave ambiguous (PairType.senses): positive at
+    every genuine assembly (the runtime's search counts no other)."""
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -220,7 +223,7 @@ def derive(mech: Mechanism | str | Path) -> System:
         dynamics=(_dynamics(mech, ctx, phi_q, rows, placed,
                             _removed_jacobians(removed, column, symbols))
                   if has_dynamics(mech) else None),
-        inputs=symbols.inputs,
+        inputs=symbols.inputs, senses=_senses(mech, ctx),
         input_values=_input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
                                                   symbols.t: time_grid[0]}),
     )
@@ -348,6 +351,24 @@ def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tupl
             rows.extend(Row(section, index, constraint.type, bodies, part, constraint.name)
                         for part in parts)
     return phi, tuple(rows)
+
+
+def _senses(mech: Mechanism, ctx: Context) -> tuple[tuple[str, sp.Expr], ...]:
+    """Every pair's senses (PairType.senses), labelled as its rows' owner (Row.owner) with
+    ``(sense)``, in row order."""
+    found: list[tuple[str, sp.Expr]] = []
+    for section in pairs.SECTIONS:
+        for index, constraint in enumerate(getattr(mech, section)):
+            kind = pairs.of(constraint)
+            if kind.senses is None:
+                continue
+            if section == "drivers":
+                constraint = _with_inputs(constraint, ctx.symbols, index)
+            owner = Row(section, index, constraint.type,
+                        kind.joined_bodies(constraint) or (), "sense", constraint.name)
+            found.extend((str(owner), _at_tau(expr, ctx.symbols))
+                         for expr in kind.senses(constraint, ctx))
+    return tuple(found)
 
 
 def _equations(kind: Any, constraint: Any, ctx: Context, path: tuple[str, int]

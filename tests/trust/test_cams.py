@@ -23,8 +23,8 @@ import yaml
 import symkin
 from symkin.errors import MechanismError
 from symkin.pairs.planar.cam import SAMPLES
-from symkin.symbolic.outputs import with_mechanism_outputs
 from symkin.spec.validate import from_dict
+from symkin.symbolic.outputs import with_mechanism_outputs
 
 HERE = Path(__file__).resolve().parent
 
