@@ -107,7 +107,7 @@ def _inputs(pairs: list[str]) -> dict[str, float] | str | None:
 
 def text(report: Any, name: str, grid: str) -> str:
     """The report as a person reads it."""
-    from symkin.runtime.scan import distinguishing
+    from symkin.runtime.scan import distinguishing, printed
 
     lines = [f"{name}: scan over {grid}"]
     shown = distinguishing(report)
@@ -119,7 +119,7 @@ def text(report: Any, name: str, grid: str) -> str:
                  + (f" ({near} of them at or near a singular configuration, where branches "
                     "meet: those are approximate and their count is not exact)" if near else ""))
     for k, branch in enumerate(report.branches, start=1):
-        values = ", ".join(f"{report.coordinates[c]} = {branch.q[c]:.6g}" for c in shown)
+        values = ", ".join(f"{report.coordinates[c]} = {printed(branch.q[c])}" for c in shown)
         taken = " (reached from q0: a run takes it)" if branch.taken else ""
         taken += " (near a singular configuration)" if branch.near_singular else ""
         lines.append(f"  {k}{taken}: {values + '; ' if values else ''}"

@@ -44,9 +44,9 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "gamma": ("q", "dq", "t", "p"),
     "points": ("p",),
     "phi_p": ("q", "t", "p"),
-    # The rows of an over-constrained file removed as dependent at t0 (System.removed), for
-    # the check along the motion; emitted only when there are some.
+    # Only when there are some: System.removed (checked along the motion), System.senses.
     "removed": ("q", "t", "p"),
+    "senses": ("q", "t", "p"),
     # Fused evaluation (see _fused_expressions): one call per Newton iterate evaluates Phi, the
     # non-zeros of Phi_q and the shared sines and cosines; Phi_t and Gamma at the converged q
     # read those instead of calling libm again.
@@ -154,6 +154,7 @@ class Code:
     """Per non-zero of Phi_q: its value when it is a number (the same at every state)."""
     removed: tuple[str, ...] = ()
     """The labels of the rows removed as dependent at t0 (the ``removed`` routine's outputs)."""
+    senses: tuple[str, ...] = ()  # the labels of the ``senses`` routine's outputs
     ranges: tuple[Range, ...] = ()
     """The ranges the file gives the pairs' own coordinates (symbolic.ranges)."""
     space: str = "2d"
@@ -283,7 +284,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         removed=tuple(str(removed) for removed in system.removed),
-        ranges=coordinate_ranges(system),
+        ranges=coordinate_ranges(system), senses=tuple(label for label, _ in system.senses),
         driver_names=system.dynamics.driver_names if system.dynamics else (),
         joint_names=system.dynamics.joint_names if system.dynamics else (),
         input_names=system.input_names, input_values=sample.input_values(system),

@@ -32,6 +32,7 @@ from symkin.symbolic.derivation import System
 DYNAMICS_TEMPLATES = ("dynamics",)
 _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
              "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out", "removed": "out",
+             "senses": "out",
              "dynamics_rhs": "out", "loads": "out", "dynamics_rhs_shared": "out",
              "loads_shared": "out", "removed_q": "out", "loads_full": "out",
              "mass": "nz", "applied": "out"}
@@ -47,6 +48,7 @@ _PYTHON_DOC = {
     "points": "Local vectors of the named points, flat (x, y) pairs in POINTS order.",
     "phi_p": "The non-zeros of Phi_p (d Phi / d p) in PHI_P_ROWS/COLS order, shape (NNZ_P,).",
     "removed": "The rows removed as dependent at t0, in REMOVED order, shape (NREMOVED,).",
+    "senses": "Positive at a genuine assembly, in SENSES order, shape (NSENSES,).",
     "phi_phi_q": "(Phi, the non-zeros of Phi_q, the shared values) with one CSE: each sine "
                  "and cosine once.",
     "phi_t_shared": "Phi_t(q, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
@@ -233,6 +235,8 @@ def metadata(code: Code) -> Metadata:
     }
     if code.removed:  # only then: every other manifest stays as it was
         data["removed"] = list(code.removed)
+    if code.senses:  # likewise
+        data["senses"] = list(code.senses)
     if code.space == "3d":
         data["space"] = code.space
     if code.dynamics:
@@ -287,6 +291,9 @@ def template_context(code: Code) -> dict[str, Any]:
         "nremoved": len(code.removed),
         "removed_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.removed)],
         "removed_literals": [repr(r) for r in code.removed],
+        "nsenses": len(code.senses),
+        "sense_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.senses)],
+        "sense_literals": [repr(r) for r in code.senses],
         "range_literals": [repr(tuple(entry)) for entry in code.ranges],
         "point_literals": [repr(tuple(p)) for p in code.points],
         "point_size": len(code.point_axes),
@@ -384,6 +391,8 @@ def _labels(code: Code, routine: str) -> list[str]:
                 *(lower.comment(f) for f in code.shared)]
     if routine == "removed":
         return [lower.comment(row) for row in code.removed]
+    if routine == "senses":
+        return [lower.comment(label) for label in code.senses]
     if routine.endswith("_shared") and routine[:-len("_shared")] in lower.DYNAMICS:
         return _labels(code, routine[:-len("_shared")])
     if routine in ("dynamics_rhs", "applied"):

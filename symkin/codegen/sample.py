@@ -47,25 +47,49 @@ INPUT_SAMPLES = 4
 INPUT_DIRECTIONS = 16
 INPUT_SEED = 26
 
+# The seed of the one sample of Phi_q's pattern that plans the LU where no sample of the
+# motion is finite (_plan_samples).
+STRUCTURE_SEED = 41
+
 
 def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_plan.LUPlan:
     """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration and
     checked over the motion (lu_plan.analyse_over), with run-time interchanges of rows of one
     pattern where no fixed order holds (lu_interchange), so that a step's cost is predictable."""
-    kernel = _SampleKernel(system, pattern)
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        # A singular first guess (SciPy's LinAlgWarning) is expected here and handled.
-        warnings.simplefilter("ignore")
-        start = sample_configuration(system, kernel)
-        samples = [kernel.phi_q_nz(q, t, p)
-                   for q, t, p in motion_configurations(system, kernel, start)]
+    samples = _plan_samples(system, pattern)
     try:
         plan = lu_interchange.analyse_over(len(system.q), [r for r, _ in pattern],
-                                    [c for _, c in pattern],
-                                    [[float(v) for v in sample] for sample in samples])
+                                    [c for _, c in pattern], samples)
     except SolveError as error:
         raise BuildError(f"cannot plan the sparse LU of Phi_q: {error}") from None
     return plan
+
+
+def _plan_samples(system: System, pattern: Sequence[tuple[int, int]]) -> list[list[float]]:
+    """Phi_q's non-zeros along the motion, those with a non-finite entry left out: an
+    expression singular where it is sampled (sqrt(t - 2) before t = 2) is the run's to
+    report, where it happens, as the NumPy kernel does. Where no sample is finite, or SymPy
+    cannot turn Phi into NumPy at all (its printer compares a constant that has no real
+    value), one sample of seeded values on the pattern: a pivot order for the structure."""
+    try:
+        kernel = _SampleKernel(system, pattern)
+    except (TypeError, ValueError):
+        kernel = None
+    found: list[np.ndarray] = []
+    if kernel is not None:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            # A singular first guess (SciPy's LinAlgWarning) is expected here and handled.
+            warnings.simplefilter("ignore")
+            start = sample_configuration(system, kernel)
+            found = [kernel.phi_q_nz(q, t, p)
+                     for q, t, p in motion_configurations(system, kernel, start)]
+    finite = [[float(v) for v in sample] for sample in found if np.all(np.isfinite(sample))]
+    if finite:
+        return finite
+    generator = np.random.default_rng(STRUCTURE_SEED)
+    values = generator.uniform(0.5, 1.5, len(pattern)) * generator.choice([-1.0, 1.0],
+                                                                            len(pattern))
+    return [[float(v) for v in values]]
 
 
 def motion_configurations(system: System, kernel: Any, start: Sequence[float]

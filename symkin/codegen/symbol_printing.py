@@ -85,7 +85,7 @@ class Preparer:
         try:
             return self._rebuild(expr)
         except ExpressionError as error:
-            raise BuildError(f"cannot generate code for {sp.sstr(expr)[:200]}: "
+            raise BuildError(f"cannot generate code for {constants.describe(expr)}: "
                              f"{error.message}") from None
 
 

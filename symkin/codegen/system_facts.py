@@ -56,6 +56,7 @@ def routine_expressions(system: System, pattern: Sequence[tuple[int, int]],
         "phi_p": [] if system.phi_p is None else [system.phi_p[r, k] for r, k in p_pattern],
         # Only where rows were removed: every other file's generated code stays as it was.
         **({"removed": [removed.phi for removed in system.removed]} if system.removed else {}),
+        **({"senses": [expr for _, expr in system.senses]} if system.senses else {}),
         **({"dynamics_rhs": list(system.dynamics.rhs), "loads": list(system.dynamics.loads)}
            if system.dynamics is not None else {}),
         **({"removed_q": list(system.dynamics.removed_q),

@@ -50,6 +50,9 @@ class Metadata(_Dynamics):
     generated before it: every coordinate then counts)."""
     removed: NotRequired[list[str]]
     """The rows removed as dependent at t0 (only in the manifest of a file that has some)."""
+    senses: NotRequired[list[str]]
+    """What the rows leave ambiguous, positive at a genuine assembly (the ``senses`` routine's
+    outputs; only in the manifest of a file that has some: spatial revolutes, angles)."""
     space: NotRequired[str]
     """``3d`` for a spatial mechanism (points of 3 components, 7 coordinates per body);
     absent for a planar one."""
@@ -81,7 +84,8 @@ KEYS = frozenset(Manifest.__annotations__)
 DYNAMICS_KEYS = frozenset(_Dynamics.__annotations__)
 """The keys only a mechanism with masses or forces has."""
 
-OPTIONAL_KEYS = frozenset({"removed", "space", "input_names", "ranges"}) | DYNAMICS_KEYS
-"""The keys only some manifests have (``removed``: an over-constrained file's; ``space``: a
+OPTIONAL_KEYS = frozenset({"removed", "senses", "space", "input_names", "ranges"}) | DYNAMICS_KEYS
+"""The keys only some manifests have (``removed``: an over-constrained file's; ``senses``: one
+with spatial revolutes, cylindricals or angle drivers; ``space``: a
 spatial one's; ``input_names``: one with input drivers; the dynamics keys). Written out:
 with postponed annotations the TypedDict cannot see NotRequired in Python 3.11."""

@@ -160,6 +160,10 @@ class PairType:
             pair adds no coordinate.
         coordinate_range: the key of that coordinate's range [a, b] (optional in the file):
             the motion stops, naming the pair, where ``NAME.s`` leaves it.
+        senses: what its rows leave ambiguous, as expressions of q, t and the parameters
+            that are positive at the configurations it means and negative at the others its
+            rows also allow (a spatial revolute's axes anti-parallel, an angle driver half a
+            turn away): the runtime counts no assembly where one is not positive.
         pitch: a meshing's pitch point, drawn where the pitch circles touch: (body i, body
             j, r_i, r_j), r_j negative for a ring (internal) gear j; the point lies on the
             line of the two frame origins (the pitch circles' centres), r_i from i's.
@@ -191,6 +195,7 @@ class PairType:
     marks: Callable[[Any, Geometry], list[Mark]] | None = None
     coordinate_range: str | None = None
     pitch: Callable[[Any, Geometry], tuple[str, str, sp.Expr, sp.Expr]] | None = None
+    senses: Callable[[Any, Any], list[sp.Expr]] | None = None
 
     def extra_coordinates(self, constraint: Any) -> tuple[tuple[str, Any], ...]:
         """The coordinates ``constraint`` adds, as (name, first guess): ``NAME.s``."""

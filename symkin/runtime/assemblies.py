@@ -26,8 +26,10 @@ the home pose of examples/stewart_fk.yaml below its base plane.) No symmetry of 
 is assumed. The search runs in batches of BATCH starts and ends after PATIENCE batches in a
 row that found nothing new, or after STARTS starts. The sequence has no seed: a scan repeats
 exactly. Each root of the deflated Newton is polished by the runtime's Newton (the same test
-as a run), which gives its condition; two roots are one assembly when they agree to SAME
-(angles modulo 2 pi, Euler parameters up to their sign). Imports NumPy only: part of the runtime.
+as a run), which gives its condition; a root where a sense of the kernel is not positive (a
+spatial revolute's axes anti-parallel, an angle driver at theta + pi: runtime.assembly.genuine)
+is no assembly and not counted; two roots are one assembly when they agree to SAME (angles
+modulo 2 pi, Euler parameters up to their sign). Imports NumPy only: part of the runtime.
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.options import Options
 from symkin.contract.status import OK
 from symkin.runtime import redundant
-from symkin.runtime.assembly import placed
+from symkin.runtime.assembly import genuine, placed
 from symkin.runtime.assembly import starts as assembly_starts
 from symkin.runtime.newton import Newton, newton
 from symkin.runtime.protocol import KinematicsKernel
@@ -180,6 +182,7 @@ def _from_start(kernel: KinematicsKernel, shape: Shape, start: Array, t0: float,
         result = None if q is None else newton(kernel, q, t0, p, options)
         if (result is not None and result.status == OK
                 and redundant.holds(kernel, result.q, t0, p, options.target_q)
+                and genuine(kernel, result.q, t0, p)
                 and not any(shape.same(result.q, root) for root in roots)):
             roots.append(result.q)
             new.append(result)

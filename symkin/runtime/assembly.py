@@ -10,6 +10,11 @@ several starts, in a fixed order, and the first start that Newton then finishes 
 3. q0 perturbed (a fixed seed, so runs repeat);
 4. the bodies placed along their joints at random angles (fixed seed).
 
+An outcome counts only where the kernel's senses are positive (:func:`genuine`): Phi = 0
+also holds with a spatial revolute's axes reversed or an angle driver half a turn away, which
+is no assembly of the mechanism; Newton landing there is one more failed start (and only when
+every start lands on such a solution is it returned, as before).
+
 When every start fails, the outcome says how close the best came and which evidence there is:
 the same least residual reached from many different starts points at the dimensions (the
 links cannot close); different residuals from different starts point at local minima (a
@@ -53,8 +58,9 @@ def assemble(kernel: KinematicsKernel, q0: Array, t0: float, p: Array,
              options: Options) -> Assembly:
     """Assemble the mechanism at t0 from q0 (see the module docstring)."""
     first = newton(kernel, q0, t0, p, options)
-    if first.status == OK:
+    if first.status == OK and genuine(kernel, first.q, t0, p):
         return Assembly(first, 1)
+    spurious = first if first.status == OK else None  # Phi = 0, but a sense is not positive
     best: Newton | None = None
     singular: Newton | None = None  # assembled, but in a singular configuration
     residuals = []
@@ -62,17 +68,43 @@ def assemble(kernel: KinematicsKernel, q0: Array, t0: float, p: Array,
         q, residual = levenberg_marquardt(kernel, start, t0, p, options)
         polished = newton(kernel, q, t0, p, options)
         polished.iterations += first.iterations
-        if polished.status == OK:
+        if polished.status == OK and genuine(kernel, polished.q, t0, p):
             return Assembly(polished, count + 1)
         residuals.append(residual)
+        if polished.status == OK:
+            spurious = spurious or polished
+            continue
         if polished.status == SINGULAR and polished.residual <= options.tol_phi:
             singular = singular or polished
         elif best is None or residual < best.residual:
             best = Newton(q, polished.status, polished.iterations, residual, None)
+    if spurious is not None:
+        return Assembly(spurious, len(residuals) + 1)
     if singular is not None:
         return Assembly(singular, len(residuals) + 1, tuple(residuals))
     assert best is not None
     return Assembly(best, len(residuals) + 1, tuple(residuals), _evidence(residuals))
+
+
+def genuine(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> bool:
+    """Whether every sense of the kernel (``sense_values``: a spatial revolute's axes'
+    cosine, an angle driver's cos(theta - psi)) is positive at q: whether a solution of
+    Phi = 0 is an assembly of the mechanism."""
+    return not reversed_senses(kernel, q, t, p)
+
+
+def reversed_senses(kernel: KinematicsKernel, q: Array, t: float, p: Array
+                    ) -> tuple[str, ...]:
+    """The labels of the kernel's senses that are not positive at q (none: q is genuine).
+    The senses hold no lengths, so a kernel in another length unit (runtime.units) answers
+    the same."""
+    labels = tuple(getattr(kernel, "senses", ()))
+    if not labels:
+        return ()
+    with np.errstate(all="ignore"):
+        values = np.asarray(kernel.sense_values(q, t, p),  # type: ignore[attr-defined]
+                            dtype=np.float64)
+    return tuple(label for label, value in zip(labels, values) if not value > 0.0)
 
 
 def _evidence(residuals: list[float]) -> str:

@@ -151,6 +151,18 @@ def explain_start(start: Singular, t: float) -> str:
             "direction, in the local layout `v` is its normal.")
 
 
+def explain_reversed(labels: tuple[str, ...], t: float) -> str:
+    """Why a solution of Phi = 0 at t is not run from: the senses (runtime.assembly) that are
+    not positive there, at most ten named."""
+    named = "; ".join(labels[:10]) + (f"; and {len(labels) - 10} more" if len(labels) > 10
+                                      else "")
+    return (f"at t = {t:.10g} the equations are solved where the mechanism is not assembled "
+            f"as meant: {named} - a revolute's (or cylindrical's) axes reversed, or an angle "
+            "driver's joint turned half a turn from its angle (their rows hold there too). "
+            "The motion is not run from there. Give a first guess q0 (or a drawing) nearer "
+            "the mechanism as meant; `symkin scan` lists its assemblies.")
+
+
 def _not_finite(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> str | None:
     """The first of Phi, Phi_t, Phi_q, Gamma that is inf or NaN at (q, t), as the row of the
     mechanism it comes from, or None when all four are finite."""

@@ -42,6 +42,8 @@ class _Functions(Protocol):
     def phi_p_nz(self, q: Array, t: float, p: Array) -> Array: ...
     # The removed rows' Phi (over-constrained files only; None where there is none).
     removed: Callable[[Array, float, Array], Array] | None
+    # What the rows leave ambiguous (files with spatial revolutes or angles only; else None).
+    senses: Callable[[Array, float, Array], Array] | None
     # inverse dynamics (kernels of mechanisms with masses or forces only)
     def dynamics_rhs(self, q: Array, dq: Array, ddq: Array, t: float, p: Array) -> Array: ...
     def loads(self, q: Array, lam: Array, t: float, p: Array) -> Array: ...
@@ -94,6 +96,9 @@ class Kernel:
         # The rows of an over-constrained file removed as dependent at t0 (not in Phi); the
         # driver checks them along the motion with removed_phi.
         self.removed: tuple[str, ...] = tuple(meta.get("removed", ()))
+        # What the rows leave ambiguous, positive at a genuine assembly (sense_values): the
+        # assembly search counts no solution of Phi = 0 where one is not.
+        self.senses: tuple[str, ...] = tuple(meta.get("senses", ()))
         # A pair's coordinate and the range its file gives it, (name, a, b, owner): the
         # driver stops the motion where it is left (runtime.ranges).
         self.ranges = tuple(tuple(entry) for entry in meta.get("ranges", ()))
@@ -180,6 +185,17 @@ class Kernel:
             raise ValueError(f"the kernel of {self.name} names removed rows but has no "
                              "routine for them; rebuild it with symkin.compile")
         return np.asarray(evaluate(self._q(q), float(t), self._p(p)), dtype=float)
+    def sense_values(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
+        """The senses (``senses``) at (q, t), shape (NSENSES,): each positive at a genuine
+        assembly (a spatial revolute's axes' cosine, an angle driver's cos(theta - psi))."""
+        if not self.senses:
+            return np.zeros(0)
+        evaluate = self._functions.senses
+        if evaluate is None:
+            raise ValueError(f"the kernel of {self.name} names senses but has no routine "
+                             "for them; rebuild it with symkin.compile")
+        return np.asarray(evaluate(self._q(q), float(t), self._p(p)), dtype=float)
+
     # -- inverse dynamics ---------------------------------------------------------------------
     def multipliers(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, t: float,
                     p: ArrayLike | None = None) -> Array:

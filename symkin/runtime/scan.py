@@ -3,7 +3,8 @@
 At t0 (and at given values of the input drivers), the assembly branches: the damped assembly
 (runtime.assembly) from q0, then the deflated multi-start search (runtime.assemblies: seeded,
 so scans repeat) for the others, each distinct (angles modulo 2 pi, Euler parameters up to
-their sign). The branch a run takes is the one reached from q0.
+their sign) and genuine (no spatial revolute's axes reversed, no angle driver half a turn
+away: runtime.assembly.genuine). The branch a run takes is the one reached from q0.
 
 Over the time grid, the motion on that branch (and, on request, on every other): the singular
 configurations passed, the stretches of flagged points, and where the motion stops, a limit
@@ -25,7 +26,7 @@ from symkin.contract.status import OK
 from symkin.errors import SolveError
 from symkin.runtime import driver, redundant, units
 from symkin.runtime.assemblies import SAME, Shape, search
-from symkin.runtime.assembly import assemble
+from symkin.runtime.assembly import assemble, genuine
 from symkin.runtime.dynamics.model import refuse_motion
 from symkin.runtime.edges import LIMIT_COND
 from symkin.runtime.protocol import KinematicsKernel
@@ -192,7 +193,8 @@ def _branches(kernel: KinematicsKernel, t0: float, p: Array) -> list[Branch]:
     first = assemble(kernel, q0, t0, p, options).result
     # An over-constrained file's rows removed at t0 must hold too: elsewhere the kept rows
     # alone are assembled, which is no assembly of the file (runtime.redundant).
-    if first.status == OK and redundant.holds(kernel, first.q, t0, p, options.target_q):
+    if (first.status == OK and redundant.holds(kernel, first.q, t0, p, options.target_q)
+            and genuine(kernel, first.q, t0, p)):
         found.append(Branch(shape.canonical(first.q), first.cond, True))
     turns = first.q if first.status == OK else q0  # the turn the angles are driven to
     for result in search(kernel, q0, t0, p, options, [b.q for b in found], turns):
@@ -232,8 +234,11 @@ def _stretches(t: Array, flagged: NDArray[np.bool_]) -> tuple[tuple[float, float
 
 
 def distinguishing(report: ScanReport, most: int = 2) -> list[int]:
-    """The indices of the (at most ``most``) coordinates that differ most between branches:
-    the angles first (they tell elbow up from elbow down), by their spread modulo 2 pi."""
+    """The indices of the coordinates that tell the branches apart as printed (``printed``):
+    the (at most ``most``) that differ most between branches, the angles first (they tell
+    elbow up from elbow down), by their spread modulo 2 pi; then, while two branches still
+    print alike in every one of them, the coordinate that tells the most such pairs apart
+    (two branches of a spherical four-bar can agree in the two that spread most)."""
     if len(report.branches) < 2:
         return []
     qs = np.array([b.q for b in report.branches])
@@ -248,4 +253,25 @@ def distinguishing(report: ScanReport, most: int = 2) -> list[int]:
             gap = float(values.max() - values.min())
             spread.append((False, gap, c))
     spread.sort(reverse=True)
-    return [c for _, gap, c in spread[:most] if gap > SAME]
+    chosen = [c for _, gap, c in spread[:most] if gap > SAME]
+    alike = [(a, b) for a in range(len(qs)) for b in range(a)
+             if not any(_apart(qs[a, c], qs[b, c]) for c in chosen)]
+    while alike:
+        told, c = max(((sum(_apart(qs[a, c], qs[b, c]) for a, b in alike), c)
+                       for _, _, c in spread if c not in chosen), default=(0, -1))
+        if not told:
+            break  # no coordinate tells them apart: they print alike in every one
+        chosen.append(c)
+        alike = [(a, b) for a, b in alike if not _apart(qs[a, c], qs[b, c])]
+    return chosen
+
+
+def _apart(a: float, b: float) -> bool:
+    """Two values that differ beyond SAME (relative to their size) and as printed (a value
+    near zero printed -2e-17 in one branch and 4e-13 in another tells nothing apart)."""
+    return abs(a - b) > SAME * (1.0 + max(abs(a), abs(b))) and printed(a) != printed(b)
+
+
+def printed(value: float) -> str:
+    """A coordinate's value as a scan report prints it."""
+    return f"{value:.6g}"

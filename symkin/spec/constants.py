@@ -34,6 +34,20 @@ MAX_EXACT_INTEGER = 2**53
 _Number: TypeAlias = Any
 
 
+QUOTE_LENGTH = 80
+"""The longest quote of an expression in a message."""
+
+
+def describe(expr: sp.Basic, length: int = QUOTE_LENGTH) -> str:
+    """``expr`` as a message quotes it: each number of more than 12 characters in six
+    significant digits (an exact integer of 300 digits is no help cut at 80), then the whole
+    cut to ``length`` with an ellipsis."""
+    numbers = {n: sp.Float(n, 6) for n in expr.atoms(sp.Number)
+               if len(sp.sstr(n)) > 12 and mpmath.isfinite(mpmath.mpf(n.evalf(6)))}
+    text = str(sp.sstr(expr.xreplace(numbers) if numbers else expr))
+    return text if len(text) <= length else text[: length - 1] + "…"
+
+
 class _Refused(Exception):
     """Inside the evaluator: the expression has no finite real value symkin will compute."""
 
@@ -130,7 +144,7 @@ class _Evaluator:
         self.scale = mpmath.mpf(0)  # the largest magnitude met on the way
 
     def __call__(self, node: sp.Basic) -> _Number:
-        result = _check(self._node(node), sp.sstr(node)[:80])
+        result = _check(self._node(node), describe(node))
         self.scale = max(self.scale, abs(result))
         return result
 
@@ -167,16 +181,16 @@ class _Evaluator:
         exponent = node.exp
         if isinstance(exponent, sp.Integer):
             if base == 0 and exponent < 0:
-                raise _Refused(f"{sp.sstr(node)[:80]} divides by zero")
+                raise _Refused(f"{describe(node)} divides by zero")
             return base ** int(exponent)
         power = self(exponent)
         if base < 0:
-            raise _Refused(f"{sp.sstr(node)[:80]} is a fractional power of a negative number, "
+            raise _Refused(f"{describe(node)} is a fractional power of a negative number, "
                            f"which is not real")
         if base == 0 and power <= 0:
-            raise _Refused(f"{sp.sstr(node)[:80]} divides by zero")
+            raise _Refused(f"{describe(node)} divides by zero")
         if base > 0 and power * mpmath.log(base) > 709:
-            raise _Refused(f"{sp.sstr(node)[:80]} is larger than the largest double")
+            raise _Refused(f"{describe(node)} is larger than the largest double")
         return base**power
 
     def _piecewise(self, node: sp.Piecewise) -> _Number:
@@ -261,6 +275,31 @@ def fold(expr: sp.Expr) -> sp.Expr:
 
     visit(expr)
     return expr.xreplace(replacements) if replacements else expr
+
+
+def lambdify_floats(arguments: Any, expressions: Any, modules: str = "numpy",
+                    dummify: bool = False) -> Callable[..., Any]:
+    """``sympy.lambdify`` of ``expressions`` (an expression, a sequence or a matrix of them)
+    with every constant part folded to a double first (:func:`fold`).
+
+    Without the folding an exact number reaches NumPy as it is: a long decimal read as a
+    rational, or ``sqrt`` of an integer wider than 64 bits, becomes a Python int that NumPy
+    holds as an object and its ufuncs refuse ("no callable sqrt method"). Every numeric
+    evaluation of derived expressions goes through here, so each sees the doubles the
+    generated code sees.
+
+    Raises:
+        ExpressionError: a constant part has no value (see :func:`value`).
+    """
+    if isinstance(expressions, sp.MatrixBase):
+        folded: Any = expressions.applyfunc(fold)
+    elif isinstance(expressions, sp.Basic):
+        folded = fold(expressions)
+    else:
+        folded = [fold(sp.sympify(e)) for e in expressions]
+    function: Callable[..., Any] = sp.lambdify(arguments, folded, modules=modules,
+                                               dummify=dummify)
+    return function
 
 
 def check_constants(expr: sp.Expr) -> None:

@@ -35,6 +35,9 @@ class _Context:
         named = {name: raw for name, raw in parameters.items() if isinstance(name, str)}
         self.symbols = {name: sp.Symbol(name, real=True) for name in named}
         self.values: dict[sp.Symbol, float] = {}
+        # parameters with no value, each with why: blamed at their own line when the
+        # drawing uses them (a point is not where the mistake is)
+        self.unusable: dict[str, MechanismError] = {}
         for name, raw in named.items():
             if isinstance(raw, float) and not math.isfinite(raw):
                 # said here: every drawn point that uses it would be blamed instead
@@ -42,8 +45,14 @@ class _Context:
                                      "Give the parameter a finite value.")
             try:
                 self.values[self.symbols[name]] = constants.value(expressions.parse(raw, {}))
-            except (ExpressionError, TypeError, ValueError):
-                continue  # validation of the local form names it
+            except ExpressionError as error:
+                self.unusable[name] = MechanismError(
+                    str(error), ("parameters", name),
+                    "A parameter's value is a number or an expression of numbers, pi and E; "
+                    "it cannot use t or other parameters." if error.text else
+                    "Check the arguments of sqrt, log, asin, acos and the magnitudes.")
+            except (TypeError, ValueError):
+                continue  # not text: validation of the local form names it
 
     def quantity(self, raw: Any, path: Path_) -> Q:
         if isinstance(raw, str):
@@ -61,10 +70,13 @@ class _Context:
         except ExpressionError as error:
             raise MechanismError(str(error), path, "Use numbers, parameter names, pi, E and "
                                  "the listed functions.") from None
+        used = sorted(str(symbol) for symbol in expr.free_symbols)
+        for name in used:
+            if name in self.unusable:
+                raise self.unusable[name]
         try:
             value = constants.value(expr, self.values)
         except ExpressionError as error:
-            used = sorted(str(symbol) for symbol in expr.free_symbols)
             raise MechanismError(
                 f"{raw!r} is not a finite real number at the nominal parameter values: "
                 f"{error.message}", path,

@@ -49,8 +49,8 @@ def numeric(expr: sp.Expr, values: Mapping[sp.Symbol, float],
     try:
         return constants.value(expr, values)
     except ExpressionError as error:
-        raise MechanismError(f"{sp.sstr(expr)[:120]} has no finite real value at the nominal "
-                             f"parameter values: {error.message}", path,
+        raise MechanismError(f"{constants.describe(expr, 120)} has no finite real value at the "
+                             f"nominal parameter values: {error.message}", path,
                              "Check the arguments of sqrt, log, asin, acos and the "
                              "magnitudes.") from None
 

@@ -24,6 +24,7 @@ import sympy as sp
 from pydantic import Field
 
 from symkin.pairs.fields import Expr, PointRef, Strict, Vec2
+from symkin.spec.constants import MAX_MAGNITUDE
 
 RATE_SUFFIX = "_t"
 COORDINATE_PARTS = ("x", "y", "phi")
@@ -108,3 +109,27 @@ def has_dynamics(mech: Any) -> bool:
 def load_name(load: Any, index: int) -> str:
     """A load's label: its own name, or ``forces[k]``."""
     return getattr(load, "name", None) or f"forces[{index}]"
+
+
+def weight_problem(mass: float, gravity: float) -> tuple[str, str] | None:
+    """Why a mass is beyond what the generated code can weigh: its weight m |g| (``gravity``:
+    the largest |g| component of the file's gravity loads, 0 without) is no double, or its
+    mass times the unit lengths of M and h is beyond symkin's evaluator (constants:
+    MAX_MAGNITUDE); (message, hint), or None."""
+    if mass * max(1.0, gravity) <= MAX_MAGNITUDE:
+        return None
+    return (f"the mass {mass:.6g} is too large: its weight or its terms in the mass matrix "
+            f"exceed {MAX_MAGNITUDE:g}, beyond what double-precision code computes with",
+            "Give masses in a unit that brings them nearer 1 (e.g. tonnes).")
+
+
+def massless_problem(body: Any) -> tuple[str, str] | None:
+    """A body that gives ``com`` (or ``com`` and ``inertia``) but no ``mass`` would be
+    silently massless in translation: refused, since a centre of mass only says where a
+    mass acts; (message, hint), or None."""
+    if getattr(body, "com", None) is None or getattr(body, "mass", None) is not None:
+        return None
+    return ("the body gives a centre of mass (com) but no mass: it would be massless in "
+            "translation, its weight and inertial forces zero",
+            "Give its mass (mass: 0 if it truly has none), or remove com.")
+

@@ -185,6 +185,18 @@ def read_yaml(text: str, source: str) -> Document:
         line = min(error.problem_mark.line + 1, last) if error.problem_mark else None
         raise MechanismError(f"this is not valid YAML: {error.problem}",
                              source=source, line=line) from None
+    except yaml.reader.ReaderError as error:
+        # A character YAML does not allow: its reader counts characters, so say the line
+        # and column (a control character is invisible in most editors).
+        line = text.count("\n", 0, error.position) + 1
+        column = error.position - (text.rfind("\n", 0, error.position) + 1) + 1
+        what = (f"U+{error.character:04X}" if isinstance(error.character, int)
+                else repr(error.character))
+        raise MechanismError(f"this is not valid YAML: the character {what} at column "
+                             f"{column} is not allowed (a control character?)",
+                             source=source, line=line,
+                             hint="Delete it, or write it as an escape in a quoted "
+                                  "string.") from None
     except yaml.YAMLError as error:
         raise MechanismError(f"this is not valid YAML: {error}", source=source) from None
     document = Document(None, source)

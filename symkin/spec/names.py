@@ -18,6 +18,20 @@ C_KEYWORDS = frozenset(["auto", "break", "case", "char", "const", "continue", "d
 
 LIBM_NAMES = frozenset(["acos", "acosh", "asin", "asinh", "atan", "atan2", "atanh", "cbrt", "ceil", "copysign", "cos", "cosh", "erf", "erfc", "exp", "exp2", "expm1", "fabs", "fdim", "floor", "fma", "fmax", "fmin", "fmod", "frexp", "hypot", "ilogb", "ldexp", "lgamma", "llrint", "llround", "log", "log10", "log1p", "log2", "logb", "lrint", "lround", "modf", "nan", "nearbyint", "nextafter", "nexttoward", "pow", "remainder", "remquo", "rint", "round", "scalbln", "scalbn", "sin", "sinh", "sqrt", "tan", "tanh", "tgamma", "trunc", "abs"])
 
+# Every name <math.h> may declare besides LIBM_NAMES (the double functions the generated code
+# calls): their float (f) and long double (l) variants, the GNU and X/Open extras a compiler
+# declares without -std=c99 (an embedded folder is built with the user's flags), and the C99
+# classification macros. A mechanism with one of these names would define its own symbol of
+# the library's name. tests/trust checks the table against the compiler's own math.h.
+_LIBM_LEGACY = ("drem", "finite", "gamma", "isinf", "isnan", "j0", "j1", "jn", "lgamma_r",
+                "scalb", "significand", "y0", "y1", "yn")
+_LIBM_MACROS = ("fpclassify", "isfinite", "isnormal", "signbit", "isgreater", "isgreaterequal",
+                "isless", "islessequal", "islessgreater", "isunordered", "math_errhandling")
+LIBM_RESERVED = frozenset(
+    {stem + suffix for stem in (LIBM_NAMES - {"abs"}) | set(_LIBM_LEGACY)
+     for suffix in ("", "f", "l")}
+    | {"lgammaf_r", "lgammal_r", "abs"} | set(_LIBM_MACROS))
+
 # What an expression could mean instead of a parameter or a body: the time, the constants, the
 # functions of the expression language and the literals Python's parser treats specially.
 EXPRESSION_NAMES = frozenset({"t", "pi", "E", "Piecewise", "True", "False", "None", "input"}
@@ -61,8 +75,13 @@ def name_problem(name: object, kind: str = "mechanism") -> str | None:
     return None
 
 
+# A body's name stands in expressions only before a dot (crank.phi), where it cannot be the
+# driver keyword, which is a whole value: `input` is a natural name for a link.
+_BODY_NAMES_ALLOWED = frozenset({"input"})
+
+
 def _expression_clash(name: str, kind: str) -> str | None:
-    if name in EXPRESSION_NAMES:
+    if name in EXPRESSION_NAMES and not (kind == "body" and name in _BODY_NAMES_ALLOWED):
         meaning = ("the time" if name == "t" else "a constant" if name in ("pi", "E") else
                    "the word of a driver whose values the caller gives" if name == "input" else
                    "a function" if name in FUNCTIONS or
@@ -78,8 +97,8 @@ def _expression_clash(name: str, kind: str) -> str | None:
 def _identifier_clash(name: str) -> str | None:
     if name in C_KEYWORDS or keyword.iskeyword(name) or keyword.issoftkeyword(name):
         return f"{name!r} is a C or Python keyword"
-    if name in LIBM_NAMES:
-        return f"{name!r} is the name of a C math library function"
+    if name in LIBM_RESERVED:
+        return f"{name!r} is the name of a C math library function or macro"
     if name in SYSTEM_HEADERS:
         return f"{name!r} would generate {name}.h, the name of a system header"
     if name in PYTHON_MODULES:

@@ -244,8 +244,9 @@ class _Checks:
         return tuple(self.mech.bodies)
 
     def at_nominal(self, expr: sp.Expr) -> sp.Expr:
-        """``expr`` with the parameters at their nominal values."""
-        return expr.subs(self.nominal)
+        """``expr`` with the parameters at their nominal values and every constant part a
+        double (exact numbers would reach NumPy as Python ints: constants.lambdify_floats)."""
+        return constants.fold(expr.subs(self.nominal))
 
     def point(self, body: str, ref: Any, path: tuple[str | int, ...]) -> None:
         """A point of ``body`` by name, or a vector of constant expressions."""
@@ -358,11 +359,24 @@ def _check_time(mech: Mechanism, symbols: Names, nominal: Mapping[sp.Symbol, flo
                              "Use a larger dt or a shorter interval.")
 
 
+def _gravity(mech: Mechanism, symbols: Names, nominal: Mapping[sp.Symbol, float]) -> float:
+    """The largest |g| component of the file's gravity loads (0 without)."""
+    found = [abs(numeric(expression(g, symbols, ("forces", k, "g", n)), nominal,
+                         ("forces", k, "g", n)))
+             for k, load in enumerate(mech.forces) if load.type == "gravity"
+             for n, g in enumerate(load.g)]
+    return max(found, default=0.0)
+
+
 def _check_dynamics(mech: Mechanism, symbols: Names,
                     nominal: Mapping[sp.Symbol, float]) -> None:
     """Masses and inertias are constants >= 0; a load names known bodies and points, and its
     expressions use only t, parameters, coordinates and their rates."""
+    gravity = _gravity(mech, symbols, nominal)
     for name, body in mech.bodies.items():
+        massless = forces.massless_problem(body)
+        if massless is not None:
+            raise MechanismError(massless[0], ("bodies", name, "com"), massless[1])
         for key in ("mass", "inertia"):
             raw = getattr(body, key)
             if raw is None:
@@ -370,7 +384,8 @@ def _check_dynamics(mech: Mechanism, symbols: Names,
             path = ("bodies", name, key)
             values = {at: numeric(expression(item, symbols, path + at), nominal, path + at)
                       for at, item in entries(raw)}
-            problem = magnitude_problem(key, values)
+            problem = magnitude_problem(key, values) or (
+                forces.weight_problem(values[()], gravity) if key == "mass" else None)
             if problem is not None:
                 raise MechanismError(problem[0], path, problem[1])
         if body.com is not None:

@@ -28,7 +28,7 @@ from typing import Any
 import sympy as sp
 
 from symkin import pairs
-from symkin.errors import MechanismError
+from symkin.errors import ExpressionError, MechanismError
 from symkin.spec import validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
@@ -124,8 +124,9 @@ class System:
     removed: tuple[Removed, ...] = ()
     """Rows of an over-constrained file dependent at t0, removed so that Phi is square."""
     mobility: int | None = None
-    """An over-constrained file's freedoms at t0 by the rank of its joints' rows (the count,
-    ``dof``, cannot judge it); None for every other file."""
+    """An over-constrained file's freedoms at t0 by the rank of its joints' rows and its
+    bodies' normalisation rows (the count, ``dof``, cannot judge it); None for every other
+    file."""
     dynamics: dynamics.Dynamics | None = None
     """Mass terms, applied forces, efforts and reactions; None for a file without masses
     and forces (inverse dynamics, symbolic.dynamics)."""
@@ -134,6 +135,9 @@ class System:
     Gamma their accelerations ddu (symbols of each Input)."""
     input_values: tuple[float, ...] = ()
     """Each input's value that the file's q0 satisfies (for generation-time samples)."""
+    senses: tuple[tuple[str, sp.Expr], ...] = ()
+    """(label, expression) of what the rows leave ambiguous (PairType.senses): positive at
+    every genuine assembly (the runtime's search counts no other)."""
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -220,7 +224,7 @@ def derive(mech: Mechanism | str | Path) -> System:
         dynamics=(_dynamics(mech, ctx, phi_q, rows, placed,
                             _removed_jacobians(removed, column, symbols))
                   if has_dynamics(mech) else None),
-        inputs=symbols.inputs,
+        inputs=symbols.inputs, senses=_senses(mech, ctx),
         input_values=_input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
                                                   symbols.t: time_grid[0]}),
     )
@@ -257,11 +261,15 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
             "that are functions of t: remove the repeated joint, or drive it by a function.")
     joints = [k for k, row in enumerate(rows) if row.section == "joints"]
     priority = [k for k, row in enumerate(rows) if row.section != "joints"] + joints
+    # The freedoms are what every row a coordinate is subject to leaves: the joints' and the
+    # Euler parameters' normalisation (without it each body keeps its parameters' scale).
+    subject = sorted(joints + [k for k, row in enumerate(rows)
+                               if row.section == NORMALISATION[0]])
     try:
         # A rank short at t0 is checked again half a step later (t0 singular, or a freedom).
         t0, t1, dt = grid
         found = redundancy.analyse(phi, symbols.q, symbols.t, symbols.p, p_values, q0, t0,
-                                   priority, t0 + 0.5 * min(dt, t1 - t0), joints)
+                                   priority, t0 + 0.5 * min(dt, t1 - t0), subject)
     except redundancy.Refusal as refusal:
         row = None if refusal.row is None else rows[refusal.row]
         where = (row.section, row.index) if row else ("joints",)
@@ -337,13 +345,46 @@ def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tupl
             kind = pairs.of(constraint)
             if section == "drivers":
                 constraint = _with_inputs(constraint, ctx.symbols, index)
-            equations = kind.equations(constraint, ctx)
+            equations = _equations(kind, constraint, ctx, (section, index))
             parts = kind.rows or tuple(f"equation {k}" for k in range(len(equations)))
             bodies = kind.joined_bodies(constraint) or _bodies_touched(equations, ctx)
             phi.extend(equations)
             rows.extend(Row(section, index, constraint.type, bodies, part, constraint.name)
                         for part in parts)
     return phi, tuple(rows)
+
+
+def _senses(mech: Mechanism, ctx: Context) -> tuple[tuple[str, sp.Expr], ...]:
+    """Every pair's senses (PairType.senses), labelled as its rows' owner (Row.owner) with
+    ``(sense)``, in row order."""
+    found: list[tuple[str, sp.Expr]] = []
+    for section in pairs.SECTIONS:
+        for index, constraint in enumerate(getattr(mech, section)):
+            kind = pairs.of(constraint)
+            if kind.senses is None:
+                continue
+            if section == "drivers":
+                constraint = _with_inputs(constraint, ctx.symbols, index)
+            owner = Row(section, index, constraint.type,
+                        kind.joined_bodies(constraint) or (), "sense", constraint.name)
+            found.extend((str(owner), _at_tau(expr, ctx.symbols))
+                         for expr in kind.senses(constraint, ctx))
+    return tuple(found)
+
+
+def _equations(kind: Any, constraint: Any, ctx: Context, path: tuple[str, int]
+               ) -> list[sp.Expr]:
+    """A constraint's rows; a constant of its geometry that has no double value (an axis
+    component so small or so large that its exact square is beyond a double) refused at the
+    constraint, where the file is at fault."""
+    try:
+        return list(kind.equations(constraint, ctx))
+    except ExpressionError as error:
+        raise MechanismError(f"its geometry cannot be computed in double precision: "
+                             f"{error.message}", path,
+                             "Give its points and directions in numbers a double holds with "
+                             "room to spare (between about 1e-150 and 1e150 in magnitude, or "
+                             "0), e.g. in other units.") from None
 
 
 def _normalised(mech: Mechanism, ctx: Context, phi: list[sp.Expr], rows: tuple[Row, ...]

@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 
 from symkin import pairs
 from symkin.pairs.fields import GROUND
+from symkin.spec import constants
 from symkin.symbolic.derivation import Placed, System
 
 Vector = tuple[float, float]
@@ -127,8 +128,8 @@ def _marks(system: System, values: dict[sp.Symbol, float]) -> dict[str, NDArray[
                 s = np.linspace(float(start.subs(values)), float(stop.subs(values)),
                                 MARK_SAMPLES)
                 with np.errstate(all="ignore"):
-                    xy = np.column_stack([np.broadcast_to(np.asarray(sp.lambdify(
-                        S_MARK, item.subs(values), "numpy")(s), dtype=float), s.shape)
+                    xy = np.column_stack([np.broadcast_to(np.asarray(constants.lambdify_floats(
+                        S_MARK, item.subs(values))(s), dtype=float), s.shape)
                         for item in curve])
                 xy = xy[np.isfinite(xy).all(axis=1)]
                 if len(xy) > 1:

@@ -47,6 +47,7 @@ import sympy as sp
 
 from symkin.contract import dense_solvers
 from symkin.contract.options import defaults
+from symkin.spec import constants
 
 RANK_TOLERANCE = 1e-8
 """Relative size (of the equilibrated Phi_q) below which a row counts as dependent."""
@@ -72,7 +73,7 @@ class Finding:
         q: the assembled configuration.
         dependency: per removed row, its relative component outside the kept rows' span.
         mobility: the freedoms the joints leave at t0: coordinates less the rank of the rows
-            that are not in ``priority``'s leading group (the joints' rows).
+            given as ``joints`` (the joints' and the normalisation rows).
     """
 
     kept: tuple[int, ...]
@@ -100,9 +101,9 @@ class _Equations:
                  p: Sequence[sp.Symbol], p_values: Sequence[float]) -> None:
         matrix = sp.Matrix(list(phi))
         arguments = (list(q), t, list(p))
-        self._phi = sp.lambdify(arguments, list(matrix), modules="numpy", dummify=True)
-        self._jacobian = sp.lambdify(arguments, matrix.jacobian(list(q)), modules="numpy",
-                                     dummify=True)
+        self._phi = constants.lambdify_floats(arguments, list(matrix), dummify=True)
+        self._jacobian = constants.lambdify_floats(arguments, matrix.jacobian(list(q)),
+                                                   dummify=True)
         self.rows, self.size = len(phi), len(q)
         self.p = np.array(p_values, dtype=float)
 
@@ -128,7 +129,8 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
         priority: the row indices in the order they are kept (the first independent ones win).
         t_near: a time near t0 for the second assembly of a rank below the coordinates'
             count (default t0: moved in configuration only).
-        joints: the joints' rows, whose rank gives the mobility at t0.
+        joints: the rows a coordinate is subject to without the drivers (the joints' and a
+            spatial body's normalisation), whose rank gives the mobility at t0.
 
     Raises:
         Refusal: the rows contradict each other at t0 (no assembly), the rank is below the

@@ -49,8 +49,10 @@ def _removed_lines(system: System, show: Any) -> list[str]:
     if not system.removed:
         return []
     written = len(system.rows) + len(system.removed)
+    rows = ("the joints' and the normalisation rows" if system.mechanism.is_spatial
+            else "the joints' rows")
     lines = ["", f"degrees of freedom: {degrees_of_freedom(system.mechanism)} by the count, "
-             f"{system.mobility} by the rank of the joints' rows at t0",
+             f"{system.mobility} by the rank of {rows} at t0",
              f"removed as redundant ({written} equations for {len(system.q)} coordinates; "
              f"at the configuration assembled at t0 Phi_q has rank {len(system.rows)}, so "
              f"{len(system.removed)} row(s) depend on the others): each is left out of Phi "

@@ -29,6 +29,7 @@ import sympy as sp
 
 from symkin.errors import MechanismError
 from symkin.limits import listed
+from symkin.spec import constants
 from symkin.spec.validate import Mechanism
 from symkin.symbolic.derivation import System, derive
 from symkin.verify.hand import (
@@ -106,7 +107,7 @@ def derived_functions(system: System) -> Derived:
 
     def make(values: Iterable[sp.Expr]) -> Callable[..., Any]:
         column = [sp.sympify(value).xreplace(rename) for value in values]
-        function: Callable[..., Any] = sp.lambdify([q, dq, t, p], column, modules="numpy")
+        function: Callable[..., Any] = constants.lambdify_floats([q, dq, t, p], column)
         return function
 
     pattern = tuple(system.pattern())

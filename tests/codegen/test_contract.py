@@ -123,8 +123,12 @@ def test_a_spatial_manifest_says_its_space(tmp_path: Path) -> None:
     spatial = symkin.derive(ROOT / "examples" / "rssr.yaml")
     written = render.generate(spatial, backends.get("c"), out_dir=tmp_path)[-1]
     data = json.loads(written.read_text(encoding="utf-8"))
-    assert set(data) == manifest.KEYS - manifest.OPTIONAL_KEYS | {"space"}
+    assert set(data) == manifest.KEYS - manifest.OPTIONAL_KEYS | {"space", "senses"}
     assert data["space"] == "3d"
+    # its revolutes' and its angle driver's senses (what their rows leave ambiguous)
+    assert data["senses"] == ["joints[0] crank_pivot revolute ground-crank (sense)",
+                              "joints[1] rocker_pivot revolute ground-rocker (sense)",
+                              "drivers[0] angle ground-crank (sense)"]
 
 
 # The modules that read a manifest, and the names their manifest dicts go by.

@@ -38,7 +38,7 @@ class CKernel(Kernel):
                                 len(meta["pattern_rows"]),
                                 len(meta["points"]) * (3 if meta.get("space") == "3d" else 2),
                                 len(meta.get("phi_p_rows", ())), len(meta.get("removed", ())),
-                                n_loads)
+                                n_loads, len(meta.get("senses", ())))
         super().__init__("c", meta, functions, folder=folder)
         self.ffi = ffi
         self.lib = lib
@@ -98,20 +98,23 @@ class _CFunctions:
 
     def __init__(self, ffi: Any, lib: Any, prefix: str, real: str, nq: int, nnz: int,
                  point_components: int, nnz_p: int = 0, nremoved: int = 0,
-                 n_loads: int = 0) -> None:
+                 n_loads: int = 0, nsenses: int = 0) -> None:
         self._ffi = ffi
         self._dtype = np.float32 if real == "float" else np.float64
         self._ctype = f"{real}[]"
         self._sizes = {"phi": nq, "phi_q": nnz, "phi_t": nq, "gamma": nq,
                        "points": point_components, "phi_p": nnz_p, "removed": nremoved,
                        "dynamics_rhs": nq, "loads": n_loads, "removed_q": nremoved * nq,
-                       "loads_full": n_loads}
+                       "loads_full": n_loads, "senses": nsenses}
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}
         # Only an over-constrained file's kernel has it (Kernel.removed_phi).
         self.removed: Callable[[Array, float, Array], Array] | None = (
             self._removed if nremoved else None)
+        # Only the kernel of a file with spatial revolutes or angles has it.
+        self.senses: Callable[[Array, float, Array], Array] | None = (
+            self._senses if nsenses else None)
 
     def _in(self, array: Array) -> Any:
         if array.size == 0:
@@ -144,6 +147,9 @@ class _CFunctions:
 
     def _removed(self, q: Array, t: float, p: Array) -> Array:
         return self._call("removed", self._in(q), t, self._in(p))
+
+    def _senses(self, q: Array, t: float, p: Array) -> Array:
+        return self._call("senses", self._in(q), t, self._in(p))
 
     def dynamics_rhs(self, q: Array, dq: Array, ddq: Array, t: float, p: Array) -> Array:
         return self._call("dynamics_rhs", self._in(q), self._in(dq), self._in(ddq), t,

@@ -27,6 +27,9 @@ class _ModuleFunctions:
         # Only the module of an over-constrained file has it (Kernel.removed_phi).
         self.removed: Callable[[Array, float, Array], Array] | None = getattr(
             module, "removed", None)
+        # Only the module of a file with spatial revolutes or angles has it.
+        self.senses: Callable[[Array, float, Array], Array] | None = getattr(
+            module, "senses", None)
         # inverse dynamics, generated only for a mechanism with masses or forces
         self.dynamics_rhs: Callable[..., Array] = getattr(module, "dynamics_rhs", _no_dynamics)
         self.loads: Callable[..., Array] = getattr(module, "loads", _no_dynamics)
@@ -54,6 +57,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         **({"phi_p_rows": module.PHI_P_ROWS, "phi_p_cols": module.PHI_P_COLS}
            if hasattr(module, "PHI_P_ROWS") else {}),
         **({"removed": module.REMOVED} if hasattr(module, "REMOVED") else {}),
+        **({"senses": module.SENSES} if hasattr(module, "SENSES") else {}),
         **({"ranges": module.RANGES} if hasattr(module, "RANGES") else {}),
         **({"driver_names": module.DRIVER_NAMES, "joint_names": module.JOINT_NAMES}
            if hasattr(module, "JOINT_NAMES") else {}),

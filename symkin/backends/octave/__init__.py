@@ -35,6 +35,7 @@ PURPOSES = {
     "point_kinematics": "the named points' global positions, velocities and accelerations of "
                         "{name}",
     "removed": "the rows of {name} removed as dependent at t0, for the check along the motion",
+    "senses": "the senses of {name}: each positive only at the configuration the file means",
     "dynamics_rhs": "Q - M ddq - h(q, dq) of {name}: the right-hand side of Phi_q' lam = rhs",
     "loads": "the efforts and joint reactions of {name} from the multipliers lam",
     "removed_q": "the Jacobian of the rows of {name} removed as dependent at t0",

@@ -24,6 +24,8 @@ class _OctaveFunctions:
         self._session, self._name = session, name
         self.removed: Callable[[Array, float, Array], Array] | None = (
             (lambda q, t, p: self._call("removed", q, t, p)) if meta.get("removed") else None)
+        self.senses: Callable[[Array, float, Array], Array] | None = (
+            (lambda q, t, p: self._call("senses", q, t, p)) if meta.get("senses") else None)
 
     def _call(self, what: str, *arguments: object, output: int = 1) -> Array:
         # a column (MATLAB's shape) read flat; <prefix>_points' rows (a point each) row by row

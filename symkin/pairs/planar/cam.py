@@ -133,9 +133,12 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     - ``pressure_angle``: the angle (radians, 0 to pi/2) between the contact normal and the
       velocity of the follower's point (the roller's centre, or the face's point F);
       undefined (NaN) where that point is at rest (a dwell), which has no direction;
-    - ``curvature_radius``: the profile's radius of curvature |c'|^3 / (c' x c''), positive
-      where the profile is convex, negative where it is hollow (a roller needs a radius
-      smaller than the hollow's);
+    - ``curvature_radius``: the profile's signed radius of curvature, positive where the
+      profile is convex, negative where it is hollow (a roller needs a radius smaller than
+      the hollow's): sigma |c'|^3 / (c' x c'') for a roller; for a flat face
+      (c' . tau)^3 / (c' x c''), tau the face's unit direction in the cam's frame, which is
+      p + p'' of the face's support function p (r_b + L + L'' for a lift law L): its sign
+      follows c' through a cusp, where |c'|^3 would stay positive;
     - ``contact_x``, ``contact_y``: the contact point c(s) in the global frame (marked in the
       pictures)."""
     s = geometry.coordinate(f"{c.name}.s")
@@ -143,7 +146,6 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     cam, follower = geometry.pose(c.i), geometry.pose(c.j)
     t, t2 = curve.diff(s), curve.diff(s, 2)
     sense = follower_side(c, curve, s, geometry)
-    speed = sp.sqrt((t.T * t)[0])
     if isinstance(c.follower, Roller):
         normal = cam.R * sp.Matrix([t[1], -t[0]])
     else:
@@ -153,8 +155,30 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     along = (normal.T * velocity)[0]
     return {"pressure_angle": (sp.atan2(sp.Abs(across), sp.Abs(along)),
                                sp.sqrt((velocity.T * velocity)[0])),
-            "curvature_radius": (sense * speed**3 / (t[0] * t2[1] - t[1] * t2[0]), None),
+            "curvature_radius": (_radius(c, t, t2, sense, geometry), None),
             **kit.contact_outputs(cam.point(curve))}
+
+
+def _radius(c: Cam, t: sp.Matrix, t2: sp.Matrix, sense: int, geometry: kit.Geometry
+            ) -> sp.Expr:
+    """The signed radius of curvature at the contact (t, t2: c'(s) and c''(s))."""
+    cross = t[0] * t2[1] - t[1] * t2[0]
+    if isinstance(c.follower, Roller):
+        return sense * sp.sqrt((t.T * t)[0]) ** 3 / cross
+    # The tangency row keeps c' along the face, so c' . tau = +-|c'|; unlike |c'| it changes
+    # sign where the envelope of the face turns back (p + p'' < 0), so the radius does too.
+    # tau is oriented so that the profile at s0 as drawn is convex (the checks refuse a flat
+    # face on a hollow).
+    m = geometry.vector(c.follower.normal)
+    s = geometry.coordinate(f"{c.name}.s")
+
+    def along(cam: kit.Pose, follower: kit.Pose) -> sp.Expr:
+        face = cam.R.T * follower.R * m / sp.sqrt((m.T * m)[0])
+        return t[0] * -face[1] + t[1] * face[0]
+
+    drawn = along(geometry.initial_pose(c.i), geometry.initial_pose(c.j))
+    orient = geometry.sign_at_nominal(drawn.subs(s, geometry.expr(c.s0))) or 1
+    return orient * along(geometry.pose(c.i), geometry.pose(c.j)) ** 3 / cross
 
 
 def check(c: Cam, checks: kit.Checks, path: kit.Path) -> None:
@@ -215,8 +239,9 @@ def _side(c: Cam, exprs: list[sp.Expr], checks: kit.Checks, s0: float,
 
 
 def _curvature_along(exprs: list[sp.Expr], checks: kit.Checks, grid: np.ndarray,
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """s over the grid, |c'(s)| and the signed curvature there (nominal values)."""
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """s over the grid, |c'(s)|, the signed curvature and c'(s) itself, one row a sample
+    (nominal values)."""
     s = sp.Symbol("s", real=True)
     values = [checks.at_nominal(expr) for expr in exprs]
     derivatives = [sp.diff(v, s, k) for k in (1, 2) for v in values]
@@ -226,20 +251,39 @@ def _curvature_along(exprs: list[sp.Expr], checks: kit.Checks, grid: np.ndarray,
                           for e in derivatives)
         speed = np.hypot(x1, y1)
         curvature = (x1 * y2 - y1 * x2) / speed**3
-    return grid, speed, curvature
+    return grid, speed, curvature, np.column_stack([x1, y1])
+
+
+def _cusp(grid: np.ndarray, speed: np.ndarray, tangent: np.ndarray, finite: np.ndarray
+          ) -> float | None:
+    """Where the profile has a cusp: c'(s) zero at a sample, or c'(s) reversed between two
+    neighbouring samples (a simple cusp's c' passes through zero between them and changes
+    sign, which no sample sees as small; a smooth profile sampled this finely turns far
+    less than a right angle from one sample to the next). None where it has none."""
+    scale = float(np.max(speed[finite])) if finite.any() else 1.0
+    zero = finite & (speed <= 1e-9 * scale)
+    if zero.any():
+        return float(grid[zero][0])
+    reversed_ = (finite[:-1] & finite[1:]
+                 & (np.einsum("ij,ij->i", tangent[:-1], tangent[1:]) < 0))
+    if reversed_.any():
+        k = int(np.flatnonzero(reversed_)[0])
+        return float(0.5 * (grid[k] + grid[k + 1]))
+    return None
 
 
 def _check_followable(c: Cam, exprs: list[sp.Expr], checks: kit.Checks, s0: float,
                       roller: float, path: kit.Path) -> None:
     """No cusp; no concave part tighter than the roller; no concave part under a face."""
-    grid, speed, curvature = _curvature_along(exprs, checks, _samples(c, checks, s0, path))
+    grid, speed, curvature, tangent = _curvature_along(exprs, checks,
+                                                       _samples(c, checks, s0, path))
     finite = np.isfinite(speed) & np.isfinite(curvature)
-    scale = float(np.max(speed[finite])) if finite.any() else 1.0
-    cusp = finite & (speed <= 1e-9 * scale)
-    if cusp.any():
-        raise MechanismError(f"the profile has a cusp (c'(s) = 0) at s = "
-                             f"{grid[cusp][0]:.6g}", path, "Smooth the profile there: a "
-                             "follower cannot keep a defined contact at a cusp.")
+    at = _cusp(grid, speed, tangent, finite)
+    if at is not None:
+        raise MechanismError(f"the profile has a cusp (c'(s) = 0) at s = {at:.6g}", path,
+                             "Smooth the profile there: a follower cannot keep a defined "
+                             "contact at a cusp. A flat-faced follower's profile drawn from "
+                             "a lift law L(s) needs r_b + L + L'' > 0 all round.")
     sense = _side(c, exprs, checks, s0, grid)
     # with the normal on the follower's side, a part convex towards it has sense * curvature > 0
     concave = finite & (sense * curvature < 0)

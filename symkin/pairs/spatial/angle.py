@@ -51,6 +51,15 @@ def equations(c: Angle, geometry: basic.Geometry) -> list[sp.Expr]:
             - basic.perpendicular_vectors(bi, v, bj, u) * sp.cos(theta)]
 
 
+def turned(c: Angle, geometry: basic.Geometry) -> list[sp.Expr]:
+    """cos(theta - psi): +1 at the turn theta, -1 at the row's other root theta + pi."""
+    _, u, v = basic.frame_of(geometry.vector(c.axis), geometry)
+    bi, bj = geometry.pose(c.i), geometry.pose(c.j)
+    theta = geometry.time_function(c.theta)
+    return [basic.perpendicular_vectors(bi, u, bj, u) * sp.cos(theta)
+            + basic.perpendicular_vectors(bi, v, bj, u) * sp.sin(theta)]
+
+
 def to_local(data: Any, drawing: basic.Drawing, path: kit.Path) -> kit.DrawnResult:
     """The named joint's bodies and axis."""
     joint = drawing.joint(data.get("joint"), path + ("joint",), TURNING)
@@ -61,4 +70,5 @@ def to_local(data: Any, drawing: basic.Drawing, path: kit.Path) -> kit.DrawnResu
 
 TYPE = kit.PairType(name="angle", model=Angle, drawn_model=DrawnAngle, sections=("drivers",),
                     equations=equations, rows=("angle",), directions=(("axis", "i"),),
-                    time_functions=("theta",), to_local=to_local)
+                    time_functions=("theta",), to_local=to_local,
+                    senses=turned)

@@ -33,4 +33,5 @@ def equations(c: Cylindrical, geometry: basic.Geometry) -> list[sp.Expr]:
 TYPE = kit.PairType(
     name="cylindrical", model=Cylindrical, drawn_model=DrawnCylindrical, sections=("joints",),
     equations=equations, rows=("axis u", "axis v", "line u", "line v"),
-    points=models.POINTS, directions=(("axis", "i"),), to_local=revolute.to_local)
+    points=models.POINTS, directions=(("axis", "i"),), to_local=revolute.to_local,
+    senses=revolute.parallel)

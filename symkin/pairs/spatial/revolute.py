@@ -32,6 +32,12 @@ def aligned(c: Any, geometry: basic.Geometry) -> list[sp.Expr]:
     return [basic.perpendicular_vectors(bi, u, bj, a), basic.perpendicular_vectors(bi, v, bj, a)]
 
 
+def parallel(c: Any, geometry: basic.Geometry) -> list[sp.Expr]:
+    """The axes' cosine: the aligned rows hold with j's axis reversed too (cosine -1)."""
+    a = basic.unit(geometry.vector(c.axis))
+    return [((geometry.pose(c.i).A * a).T * (geometry.pose(c.j).A * a))[0]]
+
+
 def equations(c: Revolute, geometry: basic.Geometry) -> list[sp.Expr]:
     return basic.coincident(c, geometry) + aligned(c, geometry)
 
@@ -45,4 +51,5 @@ def to_local(data: Any, drawing: basic.Drawing, path: kit.Path) -> kit.DrawnResu
 TYPE = kit.PairType(
     name="revolute", model=Revolute, drawn_model=DrawnRevolute, sections=("joints",),
     equations=equations, rows=("x", "y", "z", "axis u", "axis v"), points=models.POINTS,
-    directions=(("axis", "i"),), to_local=to_local, pivot=True)
+    directions=(("axis", "i"),), to_local=to_local, pivot=True,
+    senses=parallel)

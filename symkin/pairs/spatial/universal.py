@@ -55,6 +55,9 @@ def check(c: Universal, checks: Any, path: kit.Path) -> None:
     """The two axes are perpendicular as drawn (at q0, the bodies' frames are parallel)."""
     a, b = ([checks.value(checks.expression(x, path + ("axes", n, k)), path + ("axes", n, k))
              for k, x in enumerate(axis)] for n, axis in enumerate(c.axes))
+    # each axis divided by its largest component first: at 1e-200 (or 1e200) the squares
+    # under- (over-)flow, and the cosine of two directions is the same at any length
+    a, b = ([x / max(map(abs, axis)) if any(axis) else 0.0 for x in axis] for axis in (a, b))
     dot = sum(x * y for x, y in zip(a, b))
     norm = (sum(x * x for x in a) * sum(y * y for y in b)) ** 0.5
     if norm == 0 or abs(dot) > PERPENDICULAR * norm:
