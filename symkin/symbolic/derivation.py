@@ -8,14 +8,7 @@ so the cost grows linearly with the number of joints:
 and Phi_p, the derivative with respect to the parameters, for design sensitivities: along a
 solution Phi(q(p), t, p) = 0, so Phi_q q_p = -Phi_p.
 
-Gamma's convective part (Phi_q dq)_q dq is derived as each row's second derivative along dq,
-d^2/de^2 Phi(q + e dq, t) at e = 0 (its time derivatives Phi_qt and Phi_tt in t as written):
-the derivative of the row's own tree keeps its shape, so a spatial row's A(e) s becomes A(de) s
-and its rate, shared by every row of the body, where the sum over pairs of columns spreads each
-into its monomials (Gamma's operations after CSE: stewart_fk 1778 -> 729, delta 6826 -> 1856,
-the prismatic rows of planar files a few per cent fewer). A row with a piecewise function (a
-cam's profile) keeps the sum over columns, where CSE shared more (cam_cycloidal 541, 1180 the
-other way), and so does a row whose derivative along dq SymPy leaves unevaluated.
+Gamma's convective part: :mod:`symkin.symbolic.differentiation`.
 """
 
 from __future__ import annotations
@@ -33,6 +26,7 @@ from symkin.spec import validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
 from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
+from symkin.symbolic.differentiation import parameter_jacobian, row_gamma, row_jacobian
 from symkin.symbolic.planar import TAU, Context, input_slot
 from symkin.symbolic.symbols import Input, Symbols, extra_coordinates, make_symbols
 
@@ -201,11 +195,11 @@ def derive(mech: Mechanism | str | Path) -> System:
     jacobian: dict[tuple[int, int], sp.Expr] = {}
     phi_t, gamma = [], []
     for r, row in enumerate(phi):
-        entries = _row_jacobian(row, column, symbols.q)
+        entries = row_jacobian(row, column, symbols.q)
         row_t = sp.diff(row, symbols.t)
         jacobian.update({(r, k): _at_tau(value, symbols) for k, value in entries.items()})
         phi_t.append(_at_tau(row_t, symbols))
-        gamma.append(_at_tau(_row_gamma(row, entries, row_t, symbols), symbols))
+        gamma.append(_at_tau(row_gamma(row, entries, row_t, symbols), symbols))
     phi = [_at_tau(row, symbols) for row in phi]
     size = len(symbols.q)
     # as many rows as equations: fewer than columns where the forces move free freedoms
@@ -220,7 +214,7 @@ def derive(mech: Mechanism | str | Path) -> System:
         points=tuple((body, name, sp.ImmutableMatrix(ctx.local(body, name)))
                      for body, spec in mech.bodies.items() for name in spec.points),
         placed=placed, time_grid=time_grid,
-        phi_p=_parameter_jacobian(phi, symbols.p), removed=removed, mobility=mobility,
+        phi_p=parameter_jacobian(phi, symbols.p), removed=removed, mobility=mobility,
         dynamics=(_dynamics(mech, ctx, phi_q, rows, placed,
                             _removed_jacobians(removed, column, symbols))
                   if has_dynamics(mech) else None),
@@ -288,7 +282,7 @@ def _removed_jacobians(removed: tuple[Removed, ...], column: dict[sp.Symbol, int
     found = []
     for item in removed:
         jacobian = sp.zeros(1, len(symbols.q))
-        for k, value in _row_jacobian(item.phi, column, symbols.q).items():
+        for k, value in row_jacobian(item.phi, column, symbols.q).items():
             jacobian[0, k] = value
         found.append((item.row, jacobian))
     return tuple(found)
@@ -425,48 +419,6 @@ def _bodies_touched(equations: list[sp.Expr], ctx: Context) -> tuple[str, ...]:
     used = set().union(*(e.free_symbols for e in equations))
     return tuple(dict.fromkeys(name.split(".")[0] for name, q in
                                zip(ctx.symbols.coordinates, ctx.symbols.q) if q in used))
-
-
-def _row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
-                  q: tuple[sp.Symbol, ...]) -> dict[int, sp.Expr]:
-    """The structural non-zeros of one row of Phi_q, keyed by column."""
-    touched = sorted(column[s] for s in row.free_symbols if s in column)
-    derivatives = {k: sp.diff(row, q[k]) for k in touched}
-    return {k: value for k, value in derivatives.items() if value != 0}
-
-
-def _parameter_jacobian(phi: list[sp.Expr], p: tuple[sp.Symbol, ...]
-                        ) -> sp.ImmutableSparseMatrix:
-    """Phi_p: per row, the derivatives with respect to the parameters the row contains."""
-    column = {symbol: k for k, symbol in enumerate(p)}
-    entries: dict[tuple[int, int], sp.Expr] = {}
-    for r, row in enumerate(phi):
-        entries.update({(r, k): value for k, value in
-                        _row_jacobian(row, column, p).items()})
-    return sp.ImmutableSparseMatrix(len(phi), len(p), entries)
-
-
-def _row_gamma(row: sp.Expr, entries: dict[int, sp.Expr], row_t: sp.Expr,
-               symbols: Symbols) -> sp.Expr:
-    """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt (2.74)."""
-    dq, t = symbols.dq, symbols.t
-    mixed = sp.Add(*(sp.diff(value, t) * dq[k] for k, value in entries.items()))
-    return -_convective(row, entries, symbols) - 2 * mixed - sp.diff(row_t, t)
-
-
-def _convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols) -> sp.Expr:
-    """(Phi_q dq)_q dq of one row: its second derivative along dq at fixed t,
-    d^2/de^2 Phi(q + e dq, t) at e = 0, where SymPy gives it in closed form (module
-    docstring); else, and for a row with a piecewise function, the sum over its columns."""
-    q, dq = symbols.q, symbols.dq
-    if not row.has(sp.Piecewise):
-        along = sp.Dummy("along", real=True)  # as q and dq: Abs(x + e v) has a sign
-        second = sp.diff(row.xreplace({q[k]: q[k] + along * dq[k] for k in entries}),
-                         along, 2)
-        if not second.has(sp.Derivative, sp.Subs):
-            return second.xreplace({along: 0})
-    velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))
-    return sp.Add(*(sp.diff(velocity, q[k]) * dq[k] for k in entries))
 
 
 def _initial_guess(mech: Mechanism, ctx: Context,

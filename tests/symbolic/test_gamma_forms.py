@@ -1,5 +1,5 @@
 """Gamma's convective part (Phi_q dq)_q dq, derived as a row's second derivative along dq
-(symbolic.derivation._convective), equals the sum over pairs of columns of (2.74) written out
+(symbolic.differentiation.convective), equals the sum over pairs of columns of (2.74) written out
 here, for the rows the chapter's and the spatial pairs write; a row that SymPy cannot
 differentiate along dq in closed form, or a piecewise one, gets that sum itself."""
 
@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from symkin.symbolic.derivation import _convective
+from symkin.symbolic.differentiation import convective as _convective
 from symkin.symbolic.spatial import rotation
 from symkin.symbolic.symbols import Symbols
 

@@ -1,0 +1,62 @@
+"""The derivatives a derivation takes row by row: a row's structural non-zeros of Phi_q (or of
+Phi_p, with respect to the parameters), and its row of
+
+    Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt                       (2.74)
+
+Gamma's convective part (Phi_q dq)_q dq is derived as each row's second derivative along dq,
+d^2/de^2 Phi(q + e dq, t) at e = 0 (its time derivatives Phi_qt and Phi_tt in t as written):
+the derivative of the row's own tree keeps its shape, so a spatial row's A(e) s becomes A(de) s
+and its rate, shared by every row of the body, where the sum over pairs of columns spreads each
+into its monomials (Gamma's operations after CSE: stewart_fk 1778 -> 729, delta 6826 -> 1856,
+the prismatic rows of planar files a few per cent fewer). A row with a piecewise function (a
+cam's profile) keeps the sum over columns, where CSE shared more (cam_cycloidal 541, 1180 the
+other way), and so does a row whose derivative along dq SymPy leaves unevaluated.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from symkin.symbolic.symbols import Symbols
+
+
+def row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
+                 q: tuple[sp.Symbol, ...]) -> dict[int, sp.Expr]:
+    """The structural non-zeros of one row of Phi_q, keyed by column."""
+    touched = sorted(column[s] for s in row.free_symbols if s in column)
+    derivatives = {k: sp.diff(row, q[k]) for k in touched}
+    return {k: value for k, value in derivatives.items() if value != 0}
+
+
+def parameter_jacobian(phi: list[sp.Expr], p: tuple[sp.Symbol, ...]
+                       ) -> sp.ImmutableSparseMatrix:
+    """Phi_p: per row, the derivatives with respect to the parameters the row contains."""
+    column = {symbol: k for k, symbol in enumerate(p)}
+    entries: dict[tuple[int, int], sp.Expr] = {}
+    for r, row in enumerate(phi):
+        entries.update({(r, k): value for k, value in
+                        row_jacobian(row, column, p).items()})
+    return sp.ImmutableSparseMatrix(len(phi), len(p), entries)
+
+
+def row_gamma(row: sp.Expr, entries: dict[int, sp.Expr], row_t: sp.Expr,
+              symbols: Symbols) -> sp.Expr:
+    """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt (2.74)."""
+    dq, t = symbols.dq, symbols.t
+    mixed = sp.Add(*(sp.diff(value, t) * dq[k] for k, value in entries.items()))
+    return -convective(row, entries, symbols) - 2 * mixed - sp.diff(row_t, t)
+
+
+def convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols) -> sp.Expr:
+    """(Phi_q dq)_q dq of one row: its second derivative along dq at fixed t,
+    d^2/de^2 Phi(q + e dq, t) at e = 0, where SymPy gives it in closed form (module
+    docstring); else, and for a row with a piecewise function, the sum over its columns."""
+    q, dq = symbols.q, symbols.dq
+    if not row.has(sp.Piecewise):
+        along = sp.Dummy("along", real=True)  # as q and dq: Abs(x + e v) has a sign
+        second = sp.diff(row.xreplace({q[k]: q[k] + along * dq[k] for k in entries}),
+                         along, 2)
+        if not second.has(sp.Derivative, sp.Subs):
+            return second.xreplace({along: 0})
+    velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))
+    return sp.Add(*(sp.diff(velocity, q[k]) * dq[k] for k in entries))
