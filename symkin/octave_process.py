@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from symkin.errors import BuildError
 
 PROGRAM = "octave-cli"
+_BEGIN = "@@symkin-begin"  # what a function printed itself (a missing semicolon) comes before
 _END = "@@symkin-end"
 _ERROR = "@@symkin-error "
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
@@ -97,6 +98,7 @@ class Session:
                  ) -> NDArray[np.float64]:
         """The value of an expression symkin wrote, as a 2-D array of MATLAB's shape."""
         line = (f"try, {target} = {expression}; symkin_r = full(double(symkin_r));"
+                f" fprintf('{_BEGIN}\\n');"
                 " fprintf('%d\\n', size(symkin_r, 1)); fprintf('%.17g\\n', symkin_r);"
                 f" fprintf('{_END}\\n'); catch symkin_e, fprintf('{_ERROR}%s',"
                 " strrep(symkin_e.message, char(10), ' ')); if ~isempty(symkin_e.stack),"
@@ -133,7 +135,9 @@ class Session:
                 return values
             if line.startswith(_ERROR):
                 raise OctaveError(f"{origin}: Octave says: {line[len(_ERROR):][:400]}")
-            if line:
+            if line == _BEGIN:
+                values.clear()  # anything before it the function printed itself
+            elif line:
                 values.append(line)
 
     def close(self) -> None:

@@ -24,8 +24,9 @@ def replacing(path: str | Path) -> Iterator[Path]:
     numpy.savez, matplotlib and Pillow choose the format (or add a suffix) by it."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    handle, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=f".part{target.suffix}",
-                                    dir=target.parent)
+    # the suffix in lower case: numpy.savez adds ".npz" to a name ending ".NPZ"
+    suffix = f".part{target.suffix.lower()}"
+    handle, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=suffix, dir=target.parent)
     os.close(handle)
     temporary = Path(name)
     try:

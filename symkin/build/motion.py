@@ -26,7 +26,8 @@ __all__ = ["ANY", "BACKEND", "kernel", "moves_under_forces"]
 def kernel(system: Any, backend: str) -> MotionKernel:
     """The MotionKernel of ``system``; ``backend``: the name asked for."""
     if backend not in ANSWERS:
-        raise BuildError(f"the {backend!r} backend cannot integrate a mechanism that its "
-                         "forces move yet (fewer drivers than freedoms): use the numpy "
-                         "backend (--backend numpy)")
+        raise BuildError(f"symkin.solve cannot integrate a mechanism its forces move (fewer "
+                         f"drivers than freedoms) on the {backend!r} backend yet: use the numpy "
+                         "backend (--backend numpy); symkin.generate writes that backend's "
+                         "<prefix>_dynamics_step for a real-time loop")
     return MotionKernel(motion_numeric.numeric(system), BACKEND)

@@ -208,9 +208,16 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     prepared = index.prepare(args.mechanism, options,
                              outlines=args.animate is not None or args.html is not None)
     kernel = prepared.kernel
-    if getattr(kernel, "moves_under_forces", False) and kernel.backend != options.backend.name:
-        messages.note(f"the motion is integrated with {kernel.backend} NumPy functions; the "
-                      f"{options.backend.name} backend has no forward-dynamics step yet")
+    moves = getattr(kernel, "moves_under_forces", False)
+    if moves and kernel.backend != options.backend.name:
+        messages.note(f"the motion is integrated with {kernel.backend} NumPy functions (error "
+                      f"control and projection in Python); the {options.backend.name} "
+                      "backend's generated <prefix>_dynamics_step is reached through "
+                      "symkin generate")
+    if moves and args.at is not None:
+        return _error(f"{args.mechanism}: --at solves one configuration, but this mechanism "
+                      "moves under its forces: its state at a time comes from integrating "
+                      "from t0. Use --t1 (the last row is the state at t1)", EXIT_BAD_INPUT)
     picture = run_outputs.Pictures.of(args, kernel)  # --select checked before any solving
     table, problem = _input_table(kernel, args)
     if problem:

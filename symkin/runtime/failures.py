@@ -154,8 +154,7 @@ def explain_start(start: Singular, t: float) -> str:
 def explain_reversed(labels: tuple[str, ...], t: float) -> str:
     """Why a solution of Phi = 0 at t is not run from: the senses (runtime.assembly) that are
     not positive there, at most ten named."""
-    named = "; ".join(labels[:10]) + (f"; and {len(labels) - 10} more" if len(labels) > 10
-                                      else "")
+    named = listed(labels, "; ")
     return (f"at t = {t:.10g} the equations are solved where the mechanism is not assembled "
             f"as meant: {named} - a revolute's (or cylindrical's) axes reversed, or an angle "
             "driver's joint turned half a turn from its angle (their rows hold there too). "

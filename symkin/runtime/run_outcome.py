@@ -97,11 +97,11 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
                                          forces.compute(kernel, t, q, dq, d2q, loads_p))
     else:
         trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
-    _flag_not_finite(trajectory)
+    flag_not_finite(trajectory)
     return trajectory
 
 
-def _flag_not_finite(trajectory: Trajectory) -> None:
+def flag_not_finite(trajectory: Trajectory) -> None:
     """Rows whose efforts or reactions are inf or NaN are flagged (never a silent number)."""
     found = trajectory.forces
     if found is not None and trajectory.t.size:

@@ -278,7 +278,7 @@ def fold(expr: sp.Expr) -> sp.Expr:
 
 
 def lambdify_floats(arguments: Any, expressions: Any, modules: str = "numpy",
-                    dummify: bool = False) -> Callable[..., Any]:
+                    dummify: bool = False, cse: bool = False) -> Callable[..., Any]:
     """``sympy.lambdify`` of ``expressions`` (an expression, a sequence or a matrix of them)
     with every constant part folded to a double first (:func:`fold`).
 
@@ -298,7 +298,7 @@ def lambdify_floats(arguments: Any, expressions: Any, modules: str = "numpy",
     else:
         folded = [fold(sp.sympify(e)) for e in expressions]
     function: Callable[..., Any] = sp.lambdify(arguments, folded, modules=modules,
-                                               dummify=dummify)
+                                               dummify=dummify, cse=cse)
     return function
 
 

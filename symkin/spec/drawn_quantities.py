@@ -61,6 +61,10 @@ class _Context:
             raise MechanismError("expected a number or an expression", path)
         if not math.isfinite(raw):
             raise MechanismError(f"{raw} is not a finite number", path, "Give a finite value.")
+        try:
+            expressions.number(float(raw))  # the local form's rules (e.g. no subnormal)
+        except ExpressionError as error:
+            raise MechanismError(str(error), path) from None
         # numpy scalars become Python numbers: the text goes on into the local form
         return Q(int(raw) if isinstance(raw, numbers.Integral) else float(raw), float(raw))
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ast
 import math
+import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 
@@ -87,6 +88,12 @@ def number(value: float) -> sp.Expr:
         return sp.Integer(value)
     if not math.isfinite(value):
         raise ExpressionError(f"{value!r} is not a finite number")
+    if value != 0 and abs(value) < sys.float_info.min:
+        # subnormal: a double keeps few of its digits, and products with it under- or
+        # overflow in the generated code
+        raise ExpressionError(f"{value!r} is below the smallest normal double "
+                              f"({sys.float_info.min:.3g}) in magnitude: write 0, or use a "
+                              "unit in which it is larger")
     # repr gives the shortest decimal that round-trips, i.e. what the user wrote.
     return sp.Rational(repr(value))
 

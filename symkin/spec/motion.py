@@ -27,6 +27,7 @@ from pydantic import Field
 
 from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
+from symkin.limits import listed
 from symkin.pairs.fields import Expr, Strict
 from symkin.spec import constants, expressions
 
@@ -103,8 +104,7 @@ def _check_velocities(mech: Any, parameters: Mapping[str, sp.Symbol],
     for name, raw in mech.initial.velocities.items():
         path = ("initial", "velocities", name)
         if name not in known:
-            shown = ", ".join(known[:10]) + (f" and {len(known) - 10} more"
-                                             if len(known) > 10 else "")
+            shown = listed(known)
             raise MechanismError(f"{name!r} is not a velocity of this mechanism", path,
                                  f"Use one of: {shown}.")
         try:

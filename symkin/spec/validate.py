@@ -360,11 +360,16 @@ def _check_time(mech: Mechanism, symbols: Names, nominal: Mapping[sp.Symbol, flo
 
 
 def _gravity(mech: Mechanism, symbols: Names, nominal: Mapping[sp.Symbol, float]) -> float:
-    """The largest |g| component of the file's gravity loads (0 without)."""
-    found = [abs(numeric(expression(g, symbols, ("forces", k, "g", n)), nominal,
-                         ("forces", k, "g", n)))
-             for k, load in enumerate(mech.forces) if load.type == "gravity"
-             for n, g in enumerate(load.g)]
+    """The largest |g| component of the file's gravity loads that is a constant (0 without):
+    a g that varies with t or the coordinates is checked with the other loads' expressions."""
+    found = []
+    for k, load in enumerate(mech.forces):
+        if load.type != "gravity":
+            continue
+        for n, raw in enumerate(load.g):
+            path = ("forces", k, "g", n)
+            with contextlib.suppress(MechanismError):  # not a constant: judged as a load
+                found.append(abs(numeric(expression(raw, symbols, path), nominal, path)))
     return max(found, default=0.0)
 
 

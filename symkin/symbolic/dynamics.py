@@ -152,9 +152,22 @@ def _lagrange_terms(energy: sp.Expr, columns: list[int], symbols: Any, mass: sp.
     for a in columns:
         momentum = energy.diff(symbols.dq[a])
         for b in columns:
-            mass[a, b] += sp.simplify(momentum.diff(symbols.dq[b]))
+            mass[a, b] += _tidy(momentum.diff(symbols.dq[b]))
         convective = sum(momentum.diff(symbols.q[b]) * symbols.dq[b] for b in columns)
-        velocity_terms[a] += sp.simplify(convective - energy.diff(symbols.q[a]))
+        velocity_terms[a] += _tidy(convective - energy.diff(symbols.q[a]))
+
+
+# simplify only compacts; with an exact number of this many digits (a point at 1e-200 read
+# as 1/10**200) it runs for minutes, so such a term is kept as it is (still exact).
+MAX_SIMPLIFY_DIGITS = 60
+
+
+def _tidy(expr: sp.Expr) -> sp.Expr:
+    """``expr`` simplified, unless an exact number in it is too long for simplify to finish."""
+    if any(len(str(abs(r.p))) + len(str(r.q)) > MAX_SIMPLIFY_DIGITS
+           for r in expr.atoms(sp.Rational)):
+        return expr
+    return sp.simplify(expr)
 
 
 def _names(ctx: Context) -> tuple[dict[str, sp.Symbol], dict[tuple[str, str], sp.Symbol]]:

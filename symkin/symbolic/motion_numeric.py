@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from symkin.spec import constants
 from symkin.symbolic.motion import EquationsOfMotion, Given, derive
 
 Array = np.ndarray
@@ -69,10 +70,16 @@ class Functions:
 def _compiled(arguments: list[Any], expr: Any, shape: tuple[int, ...]) -> Callable[..., Array]:
     """``expr`` of the argument groups (each a tuple of symbols, given as one flat array)."""
     # dummify: coordinate names hold dots, which are no Python identifiers
-    raw = sp.lambdify(arguments, expr, modules="numpy", dummify=True, cse=True)
+    # constants folded to doubles first (constants.lambdify_floats: exact numbers would reach
+    # NumPy as Python ints its ufuncs refuse)
+    raw = constants.lambdify_floats(arguments, expr, dummify=True, cse=True)
 
     def evaluate(*values: Any) -> Array:
-        return np.asarray(raw(*values), dtype=float).reshape(shape)
+        # NumPy numbers, also for t: a load 1/(t - 0.5) at t = 0.5 is inf (then flagged),
+        # where Python's float division raises ZeroDivisionError
+        numbers = [np.asarray(value, dtype=float) for value in values]
+        with np.errstate(all="ignore"):
+            return np.asarray(raw(*numbers), dtype=float).reshape(shape)
 
     return evaluate
 

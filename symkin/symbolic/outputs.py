@@ -98,4 +98,9 @@ def with_mechanism_outputs(mech: Mechanism, trajectory: Any) -> Any:
     symbols and the pairs' expressions, not Phi_q or Gamma, so a warm run that writes them
     does not derive the file again."""
     values = _evaluate(mech, trajectory)
-    return dataclasses.replace(trajectory, outputs=values) if values else trajectory
+    if not values:
+        return trajectory
+    # Outputs already carried (a forward-dynamics run's energies) stay; the pairs' are renewed.
+    new = {name for name, _ in values}
+    kept = tuple(item for item in trajectory.outputs if item[0] not in new)
+    return dataclasses.replace(trajectory, outputs=kept + values)

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import MechanismError, SolveError
+from symkin.limits import listed
 from symkin.runtime.dynamics.equations import RANK_TOLERANCE
 from symkin.runtime.dynamics.model import Model
 
@@ -141,7 +142,7 @@ def _refuse_contradictions(jacobian: Array, phi_rate: Array, given: Array, value
              if not _agrees(np.vstack([jacobian, given[k:k + 1]]),
                             np.concatenate([phi_rate, values[k:k + 1]]))]
     named = alone or list(names)
-    shown = ", ".join(named[:10]) + (f" and {len(named) - 10} more" if len(named) > 10 else "")
+    shown = listed(named)
     raise ContradictoryVelocities(
         f"the initial velocities {shown} contradict the constraints (Phi_q dq = -Phi_t has "
         "no solution with them)", "Remove them from initial.velocities or change their "

@@ -27,7 +27,7 @@ from symkin.runtime.dynamics.integrator import State, StepFailure, Stepper
 from symkin.runtime.dynamics.model import Model, MotionKernel
 from symkin.runtime.forces import Forces
 from symkin.runtime.results import Trajectory
-from symkin.runtime.run_outcome import SolveFailure, SolveInterrupted
+from symkin.runtime.run_outcome import SolveFailure, SolveInterrupted, flag_not_finite
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -89,7 +89,8 @@ def solve(kernel: MotionKernel, t: ArrayLike | None = None, q0: ArrayLike | None
             if progress is not None:
                 progress(k + 1, times.size)
     except KeyboardInterrupt:
-        raise SolveInterrupted(_trajectory(model, rows, p), float(times[rows.done])) from None
+        at = float(times[min(rows.done, times.size - 1)])  # Ctrl-C after the last row too
+        raise SolveInterrupted(_trajectory(model, rows, p), at) from None
     except (StepFailure, equations.Singular) as stop:
         at = getattr(stop, "t", float(times[rows.done]))
         reason = getattr(stop, "reason", "the equations of motion are singular")
@@ -138,6 +139,7 @@ def _trajectory(model: Model, rows: _Rows, p: Array) -> Trajectory:
     outputs.append(("constraint_residual", rows.residual[:done].copy()))
     trajectory.__dict__["outputs"] = tuple(outputs)
     trajectory.__dict__["forces"] = _forces(model, t, q, rows.lam[:done], p, rows.redundant)
+    flag_not_finite(trajectory)  # an infinite or undefined load: flagged, never silent
     return trajectory
 
 
@@ -145,8 +147,8 @@ def _forces(model: Model, t: Array, q: Array, lam: Array, p: Array,
             redundant: int) -> Forces | None:
     """Efforts and reactions of each row from its multipliers (as the forces section's);
     with redundant rows, those of the minimum-norm λ, and which are determinate."""
-    if getattr(model, "removed", ()):
-        return None  # rows removed as redundant: the split is not unique (not done here)
+    if getattr(model, "removed", ()) or t.size == 0:
+        return None  # rows removed as redundant (the split is not unique), or no row solved
     loads = np.array([model.loads(q[k], lam[k], t[k], p) for k in range(t.size)])
     loads = loads.reshape(t.size, -1)
     n_efforts, n_joints = len(model.driver_names), len(model.joint_names)
