@@ -47,6 +47,8 @@ class Model(Protocol):
     given: tuple[Any, ...]
     rtol: float
     atol: float
+    senses: tuple[str, ...]  # with sense_values(q, t, p): runtime.assembly.reversed_senses
+    sense_values: Any
 
 
 class MotionKernel:
