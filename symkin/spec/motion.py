@@ -116,9 +116,9 @@ def _check_velocities(mech: Any, parameters: Mapping[str, sp.Symbol],
                                  "(not of t or of coordinates).") from None
 
 
-def velocity_values(mech: Any, parameters: Mapping[str, sp.Symbol],
-                    nominal: Mapping[sp.Symbol, float]) -> dict[str, float]:
-    """The given initial velocities at the nominal parameter values (checked already)."""
+def velocity_expressions(mech: Any, parameters: Mapping[str, sp.Symbol]
+                         ) -> dict[str, sp.Expr]:
+    """The given initial velocities as expressions of the parameters (checked already):
+    a run with other parameter values evaluates them there."""
     given = mech.initial.velocities if mech.initial is not None else {}
-    return {name: constants.value(expressions.parse(raw, parameters), nominal)
-            for name, raw in given.items()}
+    return {name: expressions.parse(raw, parameters) for name, raw in given.items()}
