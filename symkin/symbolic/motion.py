@@ -75,9 +75,9 @@ class EquationsOfMotion:
 
 
 def moves_under_forces(system: Any) -> bool:
-    """True when Φ has fewer rows than coordinates: the forces move the free freedoms."""
-    rows = int(system.phi_q.shape[0])
-    return rows < len(system.q)
+    """True when Φ has fewer rows than coordinates: the forces move the free freedoms
+    (spec.motion.moves, which also decides the file's ``initial`` and ``integrator``)."""
+    return motion_spec.moves(int(system.phi_q.shape[0]), len(system.q))
 
 
 def derive(system: Any) -> EquationsOfMotion | None:
