@@ -41,7 +41,7 @@ from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
-from symkin.runtime.assembly import assemble, reversed_senses
+from symkin.runtime.assembly import assemble
 from symkin.runtime.c_loop import _c_loop, _c_outcome, _c_run
 from symkin.runtime.edges import Resolution, resolve
 from symkin.runtime.inputs import InputValues
@@ -52,7 +52,7 @@ from symkin.runtime.result_arrays import Run as _Run
 from symkin.runtime.results import Trajectory
 from symkin.runtime.run_outcome import SolveFailure as SolveFailure
 from symkin.runtime.run_outcome import SolveInterrupted as SolveInterrupted
-from symkin.runtime.run_outcome import _fail, _point_size
+from symkin.runtime.run_outcome import _fail, _point_size, refuse_reversed
 from symkin.runtime.run_outcome import _trajectory as _trajectory
 from symkin.runtime.start import singular_start
 
@@ -312,11 +312,7 @@ def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options
         return
     t0 = float(run.t[0])
     first = run.q[0] if assembled is None else assembled
-    wrong = reversed_senses(kernel, first, t0, p)
-    if wrong:
-        run.done = 0  # a solution of Phi = 0 that is no assembly: no row of it is kept
-        raise SolveFailure(failures.explain_reversed(wrong, t0), _trajectory(kernel, run, p),
-                           t0, math.nan, 0, wrong, "no assembly")
+    refuse_reversed(kernel, run, first, t0, p)
     # The solver's condition estimate at the first row, from the factors it made there.
     estimate = float(run.cond[0]) if assembled is None else math.nan
     singular = singular_start(kernel, first, t0, p, options, estimate)

@@ -25,6 +25,7 @@ from symkin.runtime.edges import Passage
 from symkin.runtime.linalg import dependencies
 from symkin.runtime.newton import Newton, Point, kinematics, newton
 from symkin.runtime.result_arrays import Run
+from symkin.runtime.run_outcome import refuse_reversed
 
 Array = NDArray[np.float64]
 InputValues = Mapping[str, ArrayLike] | ArrayLike
@@ -176,6 +177,8 @@ def solve_points(kernel: Any, run: Run, inputs: Inputs, q0: Array, p: Array,
     assembly = assemble(kernel, q0, t0, first_p, options)
     if assembly.result.status != OK:
         return assembly.result, first_p, assembly
+    # a solution of Phi = 0 with a revolute's axes reversed is no start (runtime.driver's too)
+    refuse_reversed(kernel, run, assembly.result.q, t0, first_p, params=p)
     stepper = kernel.input_stepper()
     if stepper is not None:
         return (*_c_points(kernel, run, inputs, stepper, assembly.result, p, options,

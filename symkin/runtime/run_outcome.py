@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from symkin.errors import SolveError
 from symkin.runtime import failures, forces
-from symkin.runtime.assembly import Assembly
+from symkin.runtime.assembly import Assembly, reversed_senses
 from symkin.runtime.newton import Newton
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.result_arrays import Run as _Run
@@ -117,6 +117,21 @@ def _space(kernel: KinematicsKernel) -> str:
 
 def _point_size(kernel: KinematicsKernel) -> int:
     return 3 if _space(kernel) == "3d" else 2
+
+
+def refuse_reversed(kernel: KinematicsKernel, run: _Run, q: Array, t: float, p: Array,
+                    params: Array | None = None) -> None:
+    """Raise SolveFailure (reason "no assembly", no row kept) when q, a solution of Phi = 0
+    at the first time point t, has a sense of the kernel not positive (runtime.assembly): a
+    spatial revolute's axes reversed, an angle driver half a turn away. Every run checks its
+    first row so (p: the kernel's p[] at t; params: the parameters, when p holds inputs)."""
+    wrong = reversed_senses(kernel, q, t, p)
+    if not wrong:
+        return
+    run.done = 0  # a solution of Phi = 0 that is no assembly: no row of it is kept
+    raise SolveFailure(failures.explain_reversed(wrong, t),
+                       _trajectory(kernel, run, p if params is None else params), t,
+                       math.nan, 0, wrong, "no assembly")
 
 
 def _fail(kernel: KinematicsKernel, run: _Run, p: Array, result: Newton, t: float,

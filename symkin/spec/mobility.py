@@ -23,11 +23,6 @@ def degrees_of_freedom(mech: MechanismSpec) -> int:
     return per_body * len(mech.bodies) - sum(_freedoms_taken(joint) for joint in mech.joints)
 
 
-def is_under_driven(mech: MechanismSpec) -> bool:
-    """True when the drivers give fewer equations than the count's degrees of freedom."""
-    return sum(equation_count(driver) for driver in mech.drivers) < degrees_of_freedom(mech)
-
-
 def check_degrees_of_freedom(mech: MechanismSpec) -> None:
     """Check that the drivers supply at least as many equations as there are DOF, or that
     the bodies have masses, so that the forces move the mechanism (forward dynamics).

@@ -69,16 +69,32 @@ def velocity_names(mech: Any) -> tuple[str, ...]:
     return tuple(names)
 
 
-def check(mech: Any, parameters: Mapping[str, sp.Symbol],
-          nominal: Mapping[sp.Symbol, float], under_driven: bool) -> None:
-    """Refuse ``initial`` and ``integrator`` in a file whose drivers fix its motion, an unknown
-    velocity name, a velocity that is not a finite constant, a tolerance that is not positive."""
+def moves(rows: int, coordinates: int) -> bool:
+    """Whether the forces move a mechanism: the rows of Phi left after the redundant ones are
+    removed (symbolic.redundancy) are fewer than its coordinates. The one criterion of the
+    derivation (symbolic.motion.moves_under_forces) and of these keys."""
+    return rows < coordinates
+
+
+def refuse_keys(mech: Any, moves: bool) -> None:
+    """Refuse ``initial`` and ``integrator`` unless the mechanism ``moves`` under its forces.
+    The derivation decides that (rows of Phi left after the redundant ones are removed, fewer
+    than coordinates: symbolic.motion.moves_under_forces); the spec refuses them earlier only
+    where no body has a mass, since a degree-of-freedom count cannot see redundant rows."""
     for key in ("initial", "integrator"):
-        if getattr(mech, key) is not None and not under_driven:
+        if getattr(mech, key) is not None and not moves:
             raise MechanismError(
                 f"'{key}' applies to a mechanism that moves under its forces, but this file's "
                 "drivers fix every freedom", (key,),
                 f"Remove '{key}', or remove drivers so that the forces move the mechanism.")
+
+
+def check(mech: Any, parameters: Mapping[str, sp.Symbol],
+          nominal: Mapping[sp.Symbol, float]) -> None:
+    """Refuse ``initial`` and ``integrator`` in a file without masses whose drivers fix its
+    motion (refuse_keys), an unknown velocity name, a velocity that is not a finite constant,
+    a tolerance that is not positive."""
+    refuse_keys(mech, has_masses(mech))
     if mech.initial is not None:
         _check_velocities(mech, parameters, nominal)
     if mech.integrator is not None:
@@ -116,9 +132,9 @@ def _check_velocities(mech: Any, parameters: Mapping[str, sp.Symbol],
                                  "(not of t or of coordinates).") from None
 
 
-def velocity_values(mech: Any, parameters: Mapping[str, sp.Symbol],
-                    nominal: Mapping[sp.Symbol, float]) -> dict[str, float]:
-    """The given initial velocities at the nominal parameter values (checked already)."""
+def velocity_expressions(mech: Any, parameters: Mapping[str, sp.Symbol]
+                         ) -> dict[str, sp.Expr]:
+    """The given initial velocities as expressions of the parameters (checked already):
+    a run with other parameter values evaluates them there."""
     given = mech.initial.velocities if mech.initial is not None else {}
-    return {name: constants.value(expressions.parse(raw, parameters), nominal)
-            for name, raw in given.items()}
+    return {name: expressions.parse(raw, parameters) for name, raw in given.items()}

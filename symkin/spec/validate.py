@@ -27,7 +27,7 @@ from symkin.spec.field_values import point as point_ref
 from symkin.spec.forces3d import coordinate_names as spatial_coordinate_names
 from symkin.spec.forces3d import entries, magnitude_problem
 from symkin.spec.messages import translate
-from symkin.spec.mobility import check_degrees_of_freedom, is_under_driven
+from symkin.spec.mobility import check_degrees_of_freedom
 from symkin.spec.mobility import degrees_of_freedom as degrees_of_freedom
 from symkin.spec.name_checks import _check_coordinate_name, _check_input_names, _check_names
 from symkin.spec.names import name_problem
@@ -159,7 +159,7 @@ def _check_semantics(mech: Mechanism) -> None:
     _check_time(mech, symbols, nominal)
     _check_dynamics(mech, symbols, nominal)
     check_degrees_of_freedom(mech)
-    motion.check(mech, symbols.parameters, nominal, is_under_driven(mech))
+    motion.check(mech, symbols.parameters, nominal)
 
 
 def _check_parameters(mech: Mechanism) -> dict[str, float]:

@@ -24,7 +24,7 @@ from symkin.contract.status import OK
 from symkin.runtime import driver
 from symkin.runtime.kernel import Kernel
 from symkin.runtime.protocol import BatchSolver, EdgeSolver
-from symkin.sweeps.starts import set_units, singular_starts
+from symkin.sweeps.starts import reversed_starts, set_units, singular_starts
 from symkin.sweeps.stops import Stopped, edge_stops
 
 Array = NDArray[np.float64]
@@ -89,15 +89,16 @@ def _batch(kernel: Kernel, batch: BatchSolver, params: Array, t: Array, q0: Arra
            options: Options, chunk: Chunk) -> list[int]:
     """The chunk through the backend's batch, each set in its unit (sweeps.starts); returns the
     sets left to symkin.solve: those the batch could not solve and the edge treatment does not
-    end, a singular start, and a set in another unit than 1 where the batch cannot honour
-    it."""
+    end, a singular start, a first row that is no assembly (sweeps.starts), and a set in
+    another unit than 1 where the batch cannot honour it."""
     units = set_units(batch, params, float(t[0]), q0)
     status, iterations, solved, cond, start_cond = batch(params, t, q0, options, chunk.q,
                                                          chunk.dq, chunk.d2q, units)
     chunk.iterations[:] = iterations
     singular = singular_starts(kernel, batch, params, float(t[0]), chunk.q[:, 0], solved,
                                start_cond, units, options)
-    rerun = singular | ((units != 1.0) & (not batch.scale_free))
+    unassembled = reversed_starts(kernel, params, float(t[0]), chunk.q[:, 0], solved)
+    rerun = singular | unassembled | ((units != 1.0) & (not batch.scale_free))
     failed = np.flatnonzero((status != OK) & ~rerun)
     edge = kernel.edge_solver() if failed.size else None
     ended = set() if edge is None else _edges(kernel, edge, params, t, options, chunk, failed,

@@ -14,6 +14,11 @@ max(s, 1/s)^2. A set whose estimate, so bounded and times SAFETY (the estimator'
 bound can fall short of the true norm), stays under the threshold cannot be a singular start;
 only the others, few where a sweep does not start near a singular position, are checked by
 runtime.start itself on their first row, in the set's unit as symkin.solve checks it.
+
+The senses: a first row that solves Phi = 0 with a spatial revolute's axes reversed (or an
+angle driver half a turn away) is no assembly (runtime.assembly); symkin.solve refuses to run
+from it. Only kernels with senses (spatial files) pay a call per set for that check; such a
+set is handed to symkin.solve, which searches further or stops with "no assembly".
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.contract.options import Options
+from symkin.runtime.assembly import reversed_senses
 from symkin.runtime.protocol import BatchSolver, KinematicsKernel
 from symkin.runtime.start import SAFETY, singular_start, start_threshold
 from symkin.runtime.units import ScaledKernel, units_for
@@ -59,3 +65,16 @@ def singular_starts(kernel: KinematicsKernel, batch: BatchSolver, params: Array,
                 found = singular_start(view, first[j] / view.column, t0, params[j], options)
         singular[j] = found is not None
     return singular
+
+
+def reversed_starts(kernel: KinematicsKernel, params: Array, t0: float, first: Array,
+                    rows: NDArray[np.integer]) -> NDArray[np.bool_]:
+    """Per set, whether its first row ``first[j]`` (where the batch solved ``rows[j]`` > 0
+    rows) solves Phi = 0 where a sense is not positive: no assembly, as symkin.solve judges
+    it (the senses hold no lengths: the set's unit does not matter)."""
+    found = np.zeros(params.shape[0], dtype=bool)
+    if not getattr(kernel, "senses", ()):
+        return found
+    for j in np.flatnonzero(rows > 0):
+        found[j] = bool(reversed_senses(kernel, first[j], t0, params[j]))
+    return found

@@ -22,6 +22,7 @@ import sympy as sp
 
 from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
+from symkin.spec import motion as motion_spec
 from symkin.spec import validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
@@ -191,6 +192,8 @@ def derive(mech: Mechanism | str | Path) -> System:
     time_grid = _time_grid(mech, ctx, nominal)
     phi, rows, removed, mobility = _remove_redundant(phi, rows, symbols, p_values, q0,
                                                      time_grid)
+    # the rank decides whether the forces move it (symbolic.motion.moves_under_forces)
+    motion_spec.refuse_keys(mech, motion_spec.moves(len(phi), len(symbols.q)))
     column = {q: k for k, q in enumerate(symbols.q)}
     jacobian: dict[tuple[int, int], sp.Expr] = {}
     phi_t, gamma = [], []

@@ -50,13 +50,14 @@ class Given:
         columns: the coordinates it involves: one for a rate, a body's four Euler
             parameters for a spatial angular velocity.
         axis: None for a coordinate's rate; 0, 1, 2 for the global ω_x, ω_y, ω_z = 2 E(p) ṗ.
-        value: at the nominal parameter values.
+        value: an expression of the parameters (the System's p): a run evaluates it with
+            the parameters it uses.
     """
 
     name: str
     columns: tuple[int, ...]
     axis: int | None
-    value: float
+    value: sp.Expr
 
 
 @dataclass(frozen=True)
@@ -74,9 +75,9 @@ class EquationsOfMotion:
 
 
 def moves_under_forces(system: Any) -> bool:
-    """True when Φ has fewer rows than coordinates: the forces move the free freedoms."""
-    rows = int(system.phi_q.shape[0])
-    return rows < len(system.q)
+    """True when Φ has fewer rows than coordinates: the forces move the free freedoms
+    (spec.motion.moves, which also decides the file's ``initial`` and ``integrator``)."""
+    return motion_spec.moves(int(system.phi_q.shape[0]), len(system.q))
 
 
 def derive(system: Any) -> EquationsOfMotion | None:
@@ -134,8 +135,7 @@ def _given(system: Any) -> tuple[Given, ...]:
     """The file's initial velocities, each with the coordinates it involves."""
     mech = system.mechanism
     symbols = make_symbols(mech)
-    values = motion_spec.velocity_values(mech, symbols.parameters,
-                                         dict(zip(system.p, system.p_values)))
+    values = motion_spec.velocity_expressions(mech, symbols.parameters)
     found = []
     for name, value in values.items():
         body, _, part = name.partition(".")

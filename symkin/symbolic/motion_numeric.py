@@ -35,8 +35,11 @@ class Functions:
         loads(q, lam, t, p) (NLOADS,): efforts then reactions, as the forces section's;
             driver_names, joint_names label them; reaction_size: 3 (planar) or 6 (spatial).
         points: (body, name) of every named point; point_vectors (P, 2|3) at p_values.
-        given, rtol, atol: the file's initial velocities and tolerances.
+        given, rtol, atol: the file's initial velocities and tolerances; given_values(p)
+            (G,): the given velocities at the parameters p (a run's own, not only nominal).
         removed: the rows removed as redundant (their loads are then not unique).
+        senses, sense_values(q, t, p) (S,): what the rows leave ambiguous, positive at a
+            genuine assembly (the kernels' ``senses``; runtime.assembly checks the start).
     """
 
     name: str
@@ -65,6 +68,9 @@ class Functions:
     rtol: float
     atol: float
     removed: tuple[str, ...] = ()
+    given_values: Callable[..., Array] | None = None
+    senses: tuple[str, ...] = ()
+    sense_values: Callable[..., Array] | None = None
 
 
 def _compiled(arguments: list[Any], expr: Any, shape: tuple[int, ...]) -> Callable[..., Array]:
@@ -114,7 +120,12 @@ def functions(system: Any, equations: EquationsOfMotion) -> Functions:
         points=tuple((body, name) for body, name, _ in system.points),
         point_vectors=np.array(vectors, dtype=float).reshape(len(vectors), point_size),
         given=equations.given, rtol=equations.rtol, atol=equations.atol,
-        removed=tuple(str(item) for item in system.removed))
+        removed=tuple(str(item) for item in system.removed),
+        given_values=_compiled([p], sp.Matrix([item.value for item in equations.given]),
+                               (len(equations.given),)) if equations.given else None,
+        senses=tuple(label for label, _ in system.senses),
+        sense_values=_compiled([q, t, p], sp.Matrix([expr for _, expr in system.senses]),
+                               (len(system.senses),)) if system.senses else None)
 
 
 def numeric(system: Any) -> Functions:

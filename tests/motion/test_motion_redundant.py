@@ -17,6 +17,7 @@ from motion_support import write
 from scipy.integrate import solve_ivp
 
 import symkin
+from symkin import cli
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "parallelogram_extra_bar_loads.yaml"
 
@@ -71,3 +72,32 @@ def test_a_parallelogram_with_an_extra_bar_falls_as_by_hand(tmp_path: Path) -> N
     out = dict(trajectory.outputs)
     total = out["kinetic_energy"] + out["potential_energy"] - out["work_nonconservative"]
     assert np.ptp(total) <= 1e-6 * np.abs(out["potential_energy"]).max()
+
+
+def test_its_initial_velocities_and_tolerances_are_the_motions(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The rows left after the dependent one is removed decide whether the forces move it,
+    for the ``initial`` and ``integrator`` keys as for the run: without its motors, thrown at
+    θ' = 0.8 with the lamp at rest, it moves as Lagrange's equations say; with its motors the
+    same keys are refused at their line."""
+    keys = ("initial: {velocities: {crank.phi: 0.8, lamp.phi: 0.0}}\n"
+            "integrator: {rtol: 1e-11, atol: 1e-12}\n")
+    example = EXAMPLE.read_text(encoding="utf-8")
+    kernel = symkin.compile(symkin.derive(write(tmp_path, "thrown.yaml",
+                                                _falling(example) + keys)), backend="numpy")
+    trajectory = symkin.solve(kernel, t=np.linspace(0, 0.5, 6))
+    accel = _reference()
+    reference = solve_ivp(lambda t, y: [y[2], y[3], *np.ravel(accel(*y))], (0, 0.5),
+                          [math.pi / 3, 0.0, 0.8, 0.0], method="DOP853", rtol=1e-12,
+                          atol=1e-12, t_eval=trajectory.t)
+    crank = trajectory.coordinates.index("crank.phi")
+    lamp = trajectory.coordinates.index("lamp.phi")
+    assert trajectory.dq[0, crank] == pytest.approx(0.8, abs=1e-12)
+    assert trajectory.q[:, crank] + math.pi / 3 == pytest.approx(reference.y[0], abs=1e-8)
+    assert trajectory.q[:, lamp] == pytest.approx(reference.y[1], abs=1e-8)
+    driven = write(tmp_path, "driven.yaml", example + keys)
+    assert cli.main(["show", str(driven)]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert err.startswith(f"symkin: error: {driven}:{example.count(chr(10)) + 1}: ")
+    assert err.count("\n") == 1
+    assert "'initial' applies to a mechanism that moves under its forces" in err

@@ -141,3 +141,20 @@ def test_a_loose_tolerance_does_not_let_the_constraints_drift(tmp_path: Path) ->
     rates = [model.phi_q(q, t, p) @ dq for q, dq, t in
              zip(trajectory.q, trajectory.dq, trajectory.t)]
     assert np.abs(rates).max() <= 1e-10
+
+
+def test_initial_velocities_take_the_parameters_the_run_is_given(tmp_path: Path) -> None:
+    """A pendulum whose initial rate is the parameter w: without gravity it turns uniformly,
+    phi(t) = phi0 + w t (closed form), with the w the run is given, not the file's."""
+    text = PENDULUM.replace("PHI0", "0.25").replace("g: 9.81}", "g: 9.81, w: 1.0}") + \
+        "initial: {velocities: {rod.phi: 2*w}}\n"
+    kernel = symkin.compile(symkin.derive(write(tmp_path, "w.yaml", text)), backend="numpy")
+    t = np.linspace(0.0, 1.0, 5)
+    phi = kernel.coordinates.index("rod.phi")
+    for w in (1.0, 3.0, -0.5):
+        trajectory = symkin.solve(kernel, t=t, params={"w": w, "g": 0.0})
+        assert trajectory.dq[:, phi] == pytest.approx(np.full(5, 2 * w), abs=1e-9)
+        assert trajectory.q[:, phi] == pytest.approx(0.25 + 2 * w * t, abs=1e-9)
+    assert symkin.solve(kernel, t=t).dq[0, phi] == pytest.approx(2.0, abs=1e-12)  # nominal
+    with pytest.raises(symkin.SolveError, match=r"rod\.phi"):  # not a number with these
+        symkin.solve(kernel, t=t, params={"w": math.inf})

@@ -66,18 +66,25 @@ def omega_row(e: Array, axis: int) -> Array:
     return row
 
 
-def given_rows(model: Model, q: Array) -> tuple[Array, Array, tuple[str, ...]]:
-    """C, c and the names of the given components."""
+def given_rows(model: Model, q: Array, p: Array) -> tuple[Array, Array, tuple[str, ...]]:
+    """C, c (the given values at the run's parameters p) and the names of the given
+    components."""
     n = q.size
-    rows, values, names = [], [], []
+    rows, names = [], []
     for item in model.given:
         row = np.zeros(n)
         columns = list(item.columns)
         row[columns] = 1.0 if item.axis is None else omega_row(q[columns], item.axis)
         rows.append(row)
-        values.append(item.value)
         names.append(item.name)
-    return np.array(rows).reshape(len(rows), n), np.array(values), tuple(names)
+    values = (np.zeros(0) if not names else
+              np.asarray(model.given_values(p), dtype=float).reshape(len(names)))
+    bad = [name for name, value in zip(names, values) if not np.isfinite(value)]
+    if bad:
+        raise SolveError(f"the initial velocity of {bad[0]} is {values[names.index(bad[0])]} "
+                         "with the parameters given: give parameters for which "
+                         "initial.velocities are finite numbers")
+    return np.array(rows).reshape(len(rows), n), values, tuple(names)
 
 
 def velocity(model: Model, q: Array, t: float, p: Array, redundant: int = 0) -> Array:
@@ -85,7 +92,7 @@ def velocity(model: Model, q: Array, t: float, p: Array, redundant: int = 0) -> 
     ``redundant``: the rows of Φ_q that depend on the others (their multipliers are not
     unique, the velocity is)."""
     jacobian, phi_t = model.phi_q(q, t, p), model.phi_t(q, t, p)
-    given, values, names = given_rows(model, q)
+    given, values, names = given_rows(model, q, p)
     _refuse_contradictions(jacobian, -phi_t, given, values, names)
     # keep the given rows the constraints do not already decide (they agree: checked above)
     keep = _independent(jacobian, given)

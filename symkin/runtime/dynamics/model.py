@@ -44,9 +44,12 @@ class Model(Protocol):
     reaction_size: int
     points: tuple[tuple[str, str], ...]
     point_vectors: Array
-    given: tuple[Any, ...]
+    given: tuple[Any, ...]  # name, columns, axis of each; given_values(p): their values
+    given_values: Any
     rtol: float
     atol: float
+    senses: tuple[str, ...]  # with sense_values(q, t, p): runtime.assembly.reversed_senses
+    sense_values: Any
 
 
 class MotionKernel:

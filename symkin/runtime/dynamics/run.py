@@ -21,7 +21,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.loads import reaction_parts
+from symkin.runtime import failures
 from symkin.runtime.arguments import first_guess, parameter_values, time_points
+from symkin.runtime.assembly import reversed_senses
 from symkin.runtime.dynamics import equations, initial
 from symkin.runtime.dynamics.integrator import State, StepFailure, Stepper
 from symkin.runtime.dynamics.model import Model, MotionKernel
@@ -76,6 +78,7 @@ def solve(kernel: MotionKernel, t: ArrayLike | None = None, q0: ArrayLike | None
     state = State(float(times[0]), q,
                   initial.velocity(model, q, float(times[0]), p, redundant), 0.0)
     rows = _allocate(times, q.size, len(model.rows), redundant)
+    _refuse_reversed(model, rows, q, p)
     stepper = Stepper(model, p, model.rtol, model.atol, POSITION_TOLERANCE, redundant)
     try:
         _record(model, rows, state, p)
@@ -100,6 +103,25 @@ def solve(kernel: MotionKernel, t: ArrayLike | None = None, q0: ArrayLike | None
                            _trajectory(model, rows, p), at, math.nan, 0,
                            reason="singular") from None
     return _trajectory(model, rows, p)
+
+
+def _refuse_reversed(model: Model, rows: _Rows, q: Array, p: Array) -> None:
+    """SolveFailure (reason "no assembly", no row) when the assembled q solves Φ = 0 with a
+    spatial revolute's axes reversed or an angle driver half a turn away, as a kinematic run
+    refuses to start there (runtime.run_outcome.refuse_reversed)."""
+    t0 = float(rows.t[0])
+    wrong = reversed_senses(model, q, t0, p)  # type: ignore[arg-type]
+    if not wrong:
+        return
+    # no row is kept: an empty Trajectory, without the forces of rows that are not there
+    none = np.zeros((0, rows.q.shape[1]))
+    trajectory = Trajectory.solved(rows.t[:0].copy(), none, none.copy(), none.copy(),
+                                   model.coordinates, model.points, model.point_vectors, p,
+                                   0, np.zeros(0, dtype=bool), rows.cond[:0].copy(),
+                                   space=model.space)
+    trajectory.__dict__["forces"] = None
+    raise SolveFailure(failures.explain_reversed(wrong, t0), trajectory, t0, math.nan, 0,
+                       wrong, "no assembly")
 
 
 def _no_interrupt() -> None:
