@@ -113,15 +113,9 @@ def _refuse_reversed(model: Model, rows: _Rows, q: Array, p: Array) -> None:
     wrong = reversed_senses(model, q, t0, p)  # type: ignore[arg-type]
     if not wrong:
         return
-    # no row is kept: an empty Trajectory, without the forces of rows that are not there
-    none = np.zeros((0, rows.q.shape[1]))
-    trajectory = Trajectory.solved(rows.t[:0].copy(), none, none.copy(), none.copy(),
-                                   model.coordinates, model.points, model.point_vectors, p,
-                                   0, np.zeros(0, dtype=bool), rows.cond[:0].copy(),
-                                   space=model.space)
-    trajectory.__dict__["forces"] = None
-    raise SolveFailure(failures.explain_reversed(wrong, t0), trajectory, t0, math.nan, 0,
-                       wrong, "no assembly")
+    # no row is kept (rows.done is 0): an empty Trajectory
+    raise SolveFailure(failures.explain_reversed(wrong, t0), _trajectory(model, rows, p), t0,
+                       math.nan, 0, wrong, "no assembly")
 
 
 def _no_interrupt() -> None:
