@@ -41,7 +41,7 @@ from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
-from symkin.runtime.assembly import assemble
+from symkin.runtime.assembly import assemble, genuine
 from symkin.runtime.c_loop import _c_loop, _c_outcome, _c_run
 from symkin.runtime.edges import Resolution, resolve
 from symkin.runtime.inputs import InputValues
@@ -228,12 +228,18 @@ def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
             run.forces_out = forces.allocate(kernel, times.size)
             solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
             solved = _c_run(run, solver, progress)
-            _check_start(kernel, run, p, options)
-            if run.done == times.size:  # the usual case: nothing left to treat
-                run.fallbacks = solver.fallbacks
-                return _trajectory(kernel, run, p, solver.point_vectors(len(kernel.points),
-                                                                     _point_size(kernel)))
-            first = _c_outcome(kernel, run, solver, p, solved)
+            if run.done and not genuine(kernel, run.q[0], float(times[0]), p):
+                # Plain Newton in C found Phi = 0 where the mechanism is not assembled as
+                # meant (a revolute's axes reversed): the damped assembly looks for the one
+                # meant, as without C, and the grid is run again from it.
+                run.done, first = 0, None
+            else:
+                _check_start(kernel, run, p, options)
+                if run.done == times.size:  # the usual case: nothing left to treat
+                    run.fallbacks = solver.fallbacks
+                    return _trajectory(kernel, run, p, solver.point_vectors(
+                        len(kernel.points), _point_size(kernel)))
+                first = _c_outcome(kernel, run, solver, p, solved)
         else:
             first = None
         # An expression singular at some t gives inf/NaN there; that is reported as a

@@ -38,34 +38,38 @@ def _run_readme_main(example: str, tmp_path: Path) -> list[list[float]]:
 
 
 def test_time_driven_readme_program(tmp_path: Path) -> None:
+    # each row: the step, then every named point (crank.tip, rod.P) as x y
     rows = np.array(_run_readme_main("crank_slider", tmp_path))
-    assert rows.shape == (10, 4)
+    assert rows.shape == (10, 5)
     t = 0.05 * rows[:, 0]
     phi = t**2 + np.pi / 2  # the file's crank angle; the crank tip is (cos phi, sin phi)
-    assert np.allclose(rows[:, 2], np.cos(phi), atol=2e-6)  # printed with 6 decimals
-    assert np.allclose(rows[:, 3], np.sin(phi), atol=2e-6)
+    assert np.allclose(rows[:, 1], np.cos(phi), atol=2e-6)  # printed with 6 decimals
+    assert np.allclose(rows[:, 2], np.sin(phi), atol=2e-6)
+    # rod.P is the rod's far end: the rod (b = 5) keeps its length
+    assert np.allclose(np.hypot(*(rows[:, 3:5] - rows[:, 1:3]).T), 5.0, atol=1e-5)
 
 
 def test_input_driven_readme_program(tmp_path: Path) -> None:
     rows = np.array(_run_readme_main("crank_slider_input", tmp_path))
-    assert rows.shape == (10, 4)
-    # held at the input that q0 satisfies: crank angle 1.5708, tip (cos, sin) of it
-    assert np.allclose(rows[:, 2], np.cos(1.5708), atol=2e-6)
-    assert np.allclose(rows[:, 3], np.sin(1.5708), atol=2e-6)
+    assert rows.shape == (10, 5)
+    # the program moves the input from the value q0 satisfies (crank angle 1.5708): the
+    # tip stays on the crank's circle, at the angle the rows' own x and y give
+    assert np.allclose(np.hypot(rows[:, 1], rows[:, 2]), 1.0, atol=2e-6)
+    assert np.allclose(rows[0, 1:3], [np.cos(1.5708), np.sin(1.5708)], atol=2e-6)
 
 
 def test_input_driven_readme_program_of_length_inputs(tmp_path: Path) -> None:
     """stewart_fk's inputs are leg lengths, whose rows |P - B|^2 - u^2 are flat at the
-    nominal u = 0: the README's program holds them at the drawn home pose's lengths (the
-    law of cosines of test_op_budget's _home_legs), so it assembles there and runs to 0."""
+    nominal u = 0: the README's program starts them at the drawn home pose's lengths (the
+    law of cosines of test_op_budget's _home_legs), so it assembles there, and moves them."""
     rows = np.array(_run_readme_main("stewart_fk", tmp_path))
-    assert rows.shape == (10, 4)
+    assert rows.shape == (10, 1 + 3 * 6)  # the step, then the six named points' x y z
     apart = np.radians([110, 10] * 3)  # base radius 1, platform 0.6 at height 1
     legs = np.sqrt(1 + 0.6**2 + 1 - 2 * 0.6 * np.cos(apart))
     readme = (tmp_path / "stewart_fk" / "stewart_fk_README.md").read_text()
-    held = re.search(r"u\[STEWART_FK_NU\] = \{ (.*?) \};", readme)
+    held = re.search(r"u0\[STEWART_FK_NU\] = \{ (.*?) \};", readme)
     assert held is not None
     assert np.allclose([float(v) for v in held.group(1).split(",")], legs, rtol=1e-12)
-    assert np.allclose(rows[:, 1], 0.0, atol=2e-6)  # platform.x at the home pose
-    # the first named point, the platform's P1, where the file draws it (x, y)
-    assert np.allclose(rows[:, 2:], [-0.10418890660015805, 0.5908846518073249], atol=2e-6)
+    # the first named point, the platform's P1, where the file draws it (x, y; height 1)
+    assert np.allclose(rows[0, 1:4], [-0.10418890660015805, 0.5908846518073249, 1.0],
+                       atol=2e-6)
