@@ -32,7 +32,7 @@ def build(tree: Path, gallery_cache: Path) -> tuple[int, str, Path]:
     sphinx_or_skip()
     if not (tree / "docs").exists():
         shutil.copytree(DOCS, tree / "docs", ignore=shutil.ignore_patterns("_build", "auto"))
-        for name in ("examples", "symkin", "templates"):
+        for name in ("examples", "symkin"):
             (tree / name).symlink_to(ROOT / name)
     html = tree / "html"
     warnings = io.StringIO()

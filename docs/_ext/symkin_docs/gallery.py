@@ -37,11 +37,21 @@ def selected(examples: Path) -> list[Path]:
     return [path for path in files if path.stem in names]
 
 
+# The keys of a driver that hold its function of time (a planar or spatial angle's theta,
+# every other driver's f): only there does ``input`` mean an input driver; elsewhere it may
+# name a joint or a body (the Cardan's input shaft).
+FUNCTION_KEYS = ("theta", "f")
+
+
 def has_inputs(example: Path) -> bool:
-    """Whether a driver of the file is written ``input`` (its values come from a table)."""
+    """Whether a driver's function is written ``input`` (its values come from a table)."""
     data = yaml.safe_load(example.read_text(encoding="utf-8"))
-    return any(value == "input" for driver in data.get("drivers") or []
-               for value in (driver.values() if isinstance(driver, dict) else ()))
+    for driver in data.get("drivers") or []:
+        for key in FUNCTION_KEYS:
+            value = driver.get(key) if isinstance(driver, dict) else None
+            if "input" in (value if isinstance(value, list) else [value]):
+                return True
+    return False
 
 
 def command(example: Path) -> list[str]:
