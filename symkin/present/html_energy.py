@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.present.html_forces import cursor_traces
 from symkin.present.series import Units
 from symkin.runtime.results import Trajectory
 
@@ -44,13 +45,7 @@ def plot(go: Any, figure: Any, trajectory: Trajectory, column: int
                - found["work_nonconservative"])
     figure.add_trace(go.Scatter(x=trajectory.t, y=balance, mode="lines", name="T + V - W",
                                 line={"color": COLOURS[3], "width": 1.5}), row=3, col=column)
-    cursors: list[tuple[int, int, int]] = []
-    for panel in range(3):
-        figure.add_trace(go.Scatter(x=[], y=[], mode="lines", showlegend=False,
-                                    hoverinfo="skip", line={"color": "black", "width": 1}),
-                         row=panel + 1, col=column)
-        cursors.append((len(figure.data) - 1, panel, column))
-    return cursors
+    return cursor_traces(go, figure, column)
 
 
 def label(figure: Any, column: int, units: Units) -> None:

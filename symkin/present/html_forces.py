@@ -82,6 +82,12 @@ def plot(go: Any, figure: Any, trajectory: Trajectory, column: int
                   "dash": "solid" if curve.determinate else "dot"}),
             row=curve.panel + 1, col=column)
         shown.add(label)
+    return cursor_traces(go, figure, column)
+
+
+def cursor_traces(go: Any, figure: Any, column: int) -> list[tuple[int, int, int]]:
+    """An empty line in each of the column's three panels, which the time slider moves:
+    (trace index, panel, column) of each."""
     cursors: list[tuple[int, int, int]] = []
     for panel in range(3):
         figure.add_trace(go.Scatter(x=[], y=[], mode="lines", showlegend=False,
