@@ -57,11 +57,14 @@ def compile(system: System, backend: str = backends.AUTO, *, real: str = "double
         NoCompilerError: ``backend="c"`` and no C compiler is found.
 
     A mechanism its forces move (fewer drivers than freedoms, symbolic.motion) gives a
-    MotionKernel whose equations of motion are evaluated through NumPy (``"auto"`` and
-    ``"numpy"``), until the generated step for it exists.
+    MotionKernel: the integrator of runtime.dynamics evaluating the equations of motion
+    through this backend's compiled kernel (C or NumPy; Octave is refused with a
+    UsageError).
     """
+    chosen = backends.resolve(backend)
     if motion.moves_under_forces(system):
-        return motion.kernel(system, backend)
-    return compile_system(system, backends.resolve(backend), real=real, cse=cse, linalg=linalg,
+        return motion.kernel(system, chosen, real=real, cse=cse, linalg=linalg,
+                             cache_dir=cache_dir)
+    return compile_system(system, chosen, real=real, cse=cse, linalg=linalg,
                          cache_dir=cache_dir)
 

@@ -57,8 +57,25 @@ def write(tmp: Path, name: str, text: str) -> Path:
 
 
 @pytest.fixture(scope="session")
-def crank_slider(tmp_path_factory: pytest.TempPathFactory) -> Any:
-    """The kernel of the free crank-slider with a spring of k = 20."""
+def crank_slider_system(tmp_path_factory: pytest.TempPathFactory) -> Any:
+    """The System of the free crank-slider with a spring of k = 20."""
     path = write(tmp_path_factory.mktemp("motion"), "crank_slider.yaml",
                  CRANK_SLIDER.replace("SPRING", "20.0"))
-    return symkin.compile(symkin.derive(path), backend="numpy")
+    return symkin.derive(path)
+
+
+@pytest.fixture(scope="session")
+def crank_slider(crank_slider_system: Any) -> Any:
+    """The kernel of the free crank-slider with a spring of k = 20 (generated NumPy)."""
+    return symkin.compile(crank_slider_system, backend="numpy")
+
+
+@pytest.fixture(scope="session")
+def crank_slider_c(crank_slider_system: Any) -> Any:
+    """The same through the generated C, compiled (skipped without a compiler)."""
+    from symkin.errors import NoCompilerError
+
+    try:
+        return symkin.compile(crank_slider_system, backend="c")
+    except NoCompilerError:
+        pytest.skip("no C compiler")

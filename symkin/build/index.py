@@ -103,9 +103,11 @@ def prepare(mechanism: str | Path, options: Options, *, outlines: bool = False,
             return found
     prepared = _full_pipeline(Path(mechanism), options, cache, outlines)
     # Not recorded: a C request that fell back to NumPy (no compiler; the next run must try,
-    # and warn, again), and a file that changed while it was derived (the kernel may be of
-    # other bytes than the key's).
+    # and warn, again), a file that changed while it was derived (the kernel may be of
+    # other bytes than the key's), and a mechanism its forces move (build.motion: its energy
+    # terms need the System).
     if (key is not None and prepared.kernel.backend == options.backend.name
+            and not getattr(prepared.kernel, "moves_under_forces", False)
             and index_key(Path(mechanism), options) == key):
         record(cache, key, prepared.kernel, options.backend, prepared.outlines)
     return prepared
@@ -119,11 +121,11 @@ def _full_pipeline(mechanism: Path, options: Options, cache: Path,
     from symkin.symbolic import derivation
 
     system = derivation.derive(validate.load(mechanism, dict(options.parameters)))
-    if motion.moves_under_forces(system):  # forward dynamics: not in the index (build.motion)
-        return Prepared(motion.kernel(system, motion.ANY), hit=False,
-                        outlines=_drawn_outlines(system, want_outlines), system=system)
-    kernel = compile_system(system, backend=options.backend, real=options.real,
-                           cse=options.cse, linalg=options.linalg, cache_dir=cache)
+    # Forward dynamics is not recorded in the index (record skips it): its energy terms come
+    # from the System (build.motion), so a run derives; the kernel itself is cached.
+    build = motion.kernel if motion.moves_under_forces(system) else compile_system
+    kernel = build(system, options.backend, real=options.real, cse=options.cse,
+                   linalg=options.linalg, cache_dir=cache)
     return Prepared(kernel, hit=False, outlines=_drawn_outlines(system, want_outlines),
                     system=system)
 

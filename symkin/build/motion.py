@@ -1,33 +1,57 @@
 """The kernel of a mechanism its forces move (forward dynamics, runtime.dynamics).
 
-Until the generated code carries the equations of motion, such a kernel evaluates them
-through NumPy functions lambdified from the System (symbolic.motion_numeric); its backend
-name says so (``lambdified``), and a C request is refused rather than answered by NumPy.
+The backend asked for generates and builds the kernel as for kinematics (its M, Q - h, Φ,
+Φ_q, Φ_t, Γ, loads and senses run as compiled code: runtime.dynamics.compiled); the energy
+terms and initial velocities the generated code has no routine for come from the System
+(symbolic.motion_numeric.remainder). A backend that generates no equations of motion (no
+``equations_of_motion`` flag: Octave's) is refused before anything is built.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
-from symkin.errors import BuildError
+from symkin.build.backend import Backend
+from symkin.build.compile import compile as compile_system
+from symkin.codegen import lower
+from symkin.errors import UsageError
+from symkin.runtime.dynamics.compiled import CompiledModel
 from symkin.runtime.dynamics.model import MotionKernel
 from symkin.symbolic import motion_numeric
 from symkin.symbolic.motion import moves_under_forces
 
-BACKEND = "lambdified"
-# what a caller passes who takes whatever runs (the CLI, which then says which ran)
-ANY = "any"
-# the backends whose request a lambdified kernel answers ("auto": whatever runs here)
-ANSWERS = ("auto", "numpy", ANY)
-
-__all__ = ["ANY", "BACKEND", "kernel", "moves_under_forces"]
+__all__ = ["Refused", "kernel", "moves_under_forces"]
 
 
-def kernel(system: Any, backend: str) -> MotionKernel:
-    """The MotionKernel of ``system``; ``backend``: the name asked for."""
-    if backend not in ANSWERS:
-        raise BuildError(f"symkin.solve cannot integrate a mechanism its forces move (fewer "
-                         f"drivers than freedoms) on the {backend!r} backend yet: use the numpy "
-                         "backend (--backend numpy); symkin.generate writes that backend's "
-                         "<prefix>_dynamics_step for a real-time loop")
-    return MotionKernel(motion_numeric.numeric(system), BACKEND)
+class Refused(UsageError):
+    """A backend or option that cannot integrate a mechanism its forces move (the command
+    line names the file before the message)."""
+
+
+def kernel(system: Any, backend: Backend, *, real: str = "double", cse: bool = True,
+           linalg: str = lower.DEFAULT_LINALG, cache_dir: str | Path | None = None
+           ) -> MotionKernel:
+    """The MotionKernel of ``system`` on ``backend`` (options as build.compile's).
+
+    Raises:
+        Refused: the backend generates no equations of motion, or ``real`` is not double
+            (the projection's tolerance is below a float's resolution).
+    """
+    if not getattr(backend, "equations_of_motion", False):
+        raise Refused(f"{system.name} has fewer drivers than freedoms and moves under its "
+                         f"forces, but the {backend.title} backend generates no mass matrix "
+                         "or applied forces to integrate it with: run it with --backend c or "
+                         "--backend numpy (symkin.compile(..., backend='c' or 'numpy'))")
+    if real != "double":
+        raise Refused(f"{system.name} moves under its forces: its motion is integrated in "
+                         f"double (the projection onto the constraints works to 1e-11), not "
+                         f"in {real}. Leave real at double; symkin generate writes the "
+                         "float <prefix>_dynamics_step for a controller")
+    compiled = compile_system(system, backend, real=real, cse=cse, linalg=linalg,
+                              cache_dir=cache_dir)
+    if not compiled.has_mass:  # a plug-in that says so but generates none
+        raise Refused(f"the {backend.title} kernel of {system.name} has no mass matrix: "
+                         "run it with --backend c or --backend numpy")
+    return MotionKernel(CompiledModel(compiled, motion_numeric.remainder(system)),
+                        compiled.backend)

@@ -200,20 +200,18 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def _solve_and_write(args: argparse.Namespace) -> int:
-    from symkin.build import index
+    from symkin.build import index, motion
     from symkin.runtime import driver
 
     options = index.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
-    prepared = index.prepare(args.mechanism, options,
-                             outlines=args.animate is not None or args.html is not None)
+    try:
+        prepared = index.prepare(args.mechanism, options,
+                                 outlines=args.animate is not None or args.html is not None)
+    except motion.Refused as refused:  # a backend that cannot integrate it: name the file
+        return _error(f"{args.mechanism}: {refused}", EXIT_BAD_INPUT)
     kernel = prepared.kernel
     moves = getattr(kernel, "moves_under_forces", False)
-    if moves and kernel.backend != options.backend.name:
-        messages.note(f"the motion is integrated with {kernel.backend} NumPy functions (error "
-                      f"control and projection in Python); the {options.backend.name} "
-                      "backend's generated <prefix>_dynamics_step is reached through "
-                      "symkin generate")
     if moves and args.at is not None:
         return _error(f"{args.mechanism}: --at solves one configuration, but this mechanism "
                       "moves under its forces: its state at a time comes from integrating "

@@ -47,6 +47,10 @@ class _Functions(Protocol):
     # inverse dynamics (kernels of mechanisms with masses or forces only)
     def dynamics_rhs(self, q: Array, dq: Array, ddq: Array, t: float, p: Array) -> Array: ...
     def loads(self, q: Array, lam: Array, t: float, p: Array) -> Array: ...
+    # Forward dynamics: M(q, p) dense and Q - h(q, dq, t, p) (kernels of files with masses
+    # whose backend generates them; else None).
+    mass: Callable[[Array, Array], Array] | None
+    applied: Callable[[Array, Array, float, Array], Array] | None
     # ... with rows removed as redundant too (runtime.indeterminate)
     def removed_q(self, q: Array, t: float, p: Array) -> Array: ...
     def loads_full(self, q: Array, lam: Array, t: float, p: Array) -> Array: ...
@@ -108,6 +112,8 @@ class Kernel:
         self.joint_names: tuple[str, ...] = tuple(meta.get("joint_names", ()))
         # The input drivers (u[] order); their u, du, ddu follow the parameters in p[].
         self.input_names: tuple[str, ...] = tuple(meta.get("input_names", ()))
+        # Forward dynamics: the generated M and Q - h are there (runtime.dynamics.compiled).
+        self.has_mass = getattr(functions, "mass", None) is not None
         self._functions = functions
 
     @property
@@ -211,7 +217,28 @@ class Kernel:
         """The efforts (one per driver row) then Fx, Fy, M of each joint (spatial: Fx, Fy, Fz,
         Mx, My, Mz), from lam."""
         self._require_dynamics()
-        return self._functions.loads(self._q(q), self._q(lam, "lam"), float(t), self._p(p))
+        # one multiplier a row of Phi: as many as coordinates, fewer where forces move it
+        return self._functions.loads(self._q(q), self._vector(lam, len(self.rows), "lam"),
+                                     float(t), self._p(p))
+
+    def mass(self, q: ArrayLike, p: ArrayLike | None = None) -> Array:
+        """The mass matrix M(q) as a dense N x N array (files with masses only)."""
+        evaluate = self._functions.mass
+        if evaluate is None:
+            raise ValueError(f"the kernel of {self.name} has no mass matrix (no masses, or "
+                             f"its backend generates none)")
+        return np.asarray(evaluate(self._q(q), self._p(p)), dtype=float)
+
+    def applied(self, q: ArrayLike, dq: ArrayLike, t: float,
+                p: ArrayLike | None = None) -> Array:
+        """The applied forces less the velocity terms, Q - h at (q, dq, t), shape (N,)
+        (files with masses only)."""
+        evaluate = self._functions.applied
+        if evaluate is None:
+            raise ValueError(f"the kernel of {self.name} has no applied forces (no masses, "
+                             f"or its backend generates none)")
+        return np.asarray(evaluate(self._q(q), self._q(dq, "dq"), float(t), self._p(p)),
+                          dtype=float)
 
     def removed_q(self, q: ArrayLike, t: float, p: ArrayLike | None = None) -> Array:
         """The removed rows' Jacobian, (NREMOVED, N) (dynamics and removed rows only)."""
@@ -256,9 +283,12 @@ class Kernel:
 
     # -- argument checks ----------------------------------------------------------------------
     def _q(self, values: ArrayLike, what: str = "q") -> Array:
+        return self._vector(values, self.nq, what)
+
+    def _vector(self, values: ArrayLike, size: int, what: str) -> Array:
         array = np.ascontiguousarray(values, dtype=float)
-        if array.shape != (self.nq,):
-            raise ValueError(f"{what} must have shape ({self.nq},) for {self.name}, "
+        if array.shape != (size,):
+            raise ValueError(f"{what} must have shape ({size},) for {self.name}, "
                              f"got {array.shape}")
         return array
 

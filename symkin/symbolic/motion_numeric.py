@@ -121,16 +121,52 @@ def functions(system: Any, equations: EquationsOfMotion) -> Functions:
         point_vectors=np.array(vectors, dtype=float).reshape(len(vectors), point_size),
         given=equations.given, rtol=equations.rtol, atol=equations.atol,
         removed=tuple(str(item) for item in system.removed),
-        given_values=_compiled([p], sp.Matrix([item.value for item in equations.given]),
-                               (len(equations.given),)) if equations.given else None,
+        given_values=_given_values(p, equations),
         senses=tuple(label for label, _ in system.senses),
         sense_values=_compiled([q, t, p], sp.Matrix([expr for _, expr in system.senses]),
                                (len(system.senses),)) if system.senses else None)
 
 
-def numeric(system: Any) -> Functions:
-    """The :class:`Functions` of ``system``, a mechanism its forces move."""
+@dataclass(frozen=True)
+class Remainder:
+    """What a generated kernel leaves out of the equations of motion (runtime.dynamics.
+    compiled): V (q, t, p) (), Q_nc (q, dq, t, p) (N,), the given initial velocities with
+    their values at p, and the integrator's tolerances."""
+
+    potential: Callable[..., Array]
+    nonconservative: Callable[..., Array]
+    given: tuple[Given, ...]
+    given_values: Callable[..., Array] | None
+    rtol: float
+    atol: float
+
+
+def remainder(system: Any) -> Remainder:
+    """The :class:`Remainder` of ``system``, a mechanism its forces move."""
+    equations = _equations(system)
+    q, dq, t, p = list(system.q), list(system.dq), system.t, list(system.p)
+    n = len(q)
+    return Remainder(
+        potential=_compiled([q, t, p], equations.potential, ()),
+        nonconservative=_compiled([q, dq, t, p], equations.nonconservative, (n,)),
+        given=equations.given, given_values=_given_values(p, equations),
+        rtol=equations.rtol, atol=equations.atol)
+
+
+def _given_values(p: list[Any], equations: EquationsOfMotion) -> Callable[..., Array] | None:
+    if not equations.given:
+        return None
+    return _compiled([p], sp.Matrix([item.value for item in equations.given]),
+                     (len(equations.given),))
+
+
+def _equations(system: Any) -> EquationsOfMotion:
     equations = derive(system)
     if equations is None:
         raise ValueError("the mechanism's drivers fix its motion: nothing to integrate")
-    return functions(system, equations)
+    return equations
+
+
+def numeric(system: Any) -> Functions:
+    """The :class:`Functions` of ``system``, a mechanism its forces move."""
+    return functions(system, _equations(system))

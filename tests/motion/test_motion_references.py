@@ -25,11 +25,14 @@ def _energy(trajectory: Any) -> tuple[np.ndarray, np.ndarray]:
     return total, scale
 
 
-def test_a_pendulum_swings_with_the_period_of_the_elliptic_integral(tmp_path: Path) -> None:
+@pytest.mark.parametrize("backend", ["numpy", "c"])  # each integrates through its kernel
+def test_a_pendulum_swings_with_the_period_of_the_elliptic_integral(tmp_path: Path,
+                                                                    backend: str) -> None:
     amplitude = 2.0  # rad from the bottom: far from the small-angle period
     start = -math.pi / 2 + amplitude
     kernel = symkin.compile(symkin.derive(write(tmp_path, "p.yaml", PENDULUM.replace(
-        "PHI0", repr(start)))), backend="numpy")
+        "PHI0", repr(start)))), backend=backend)
+    assert kernel.backend == backend
     period = 4 * math.sqrt(1.3 / 9.81) * ellipk(math.sin(amplitude / 2) ** 2)
     # (the small-angle period 2 pi sqrt(L/g) differs by 30 %: the test sees the difference)
     trajectory = symkin.solve(kernel, t=[0, period / 2, period, 3 * period])
@@ -58,8 +61,10 @@ def _minimal_crank_slider() -> Any:
     return sp.lambdify((th, w), accel), sp.lambdify(th, x3)
 
 
-def test_the_crank_slider_follows_its_minimal_coordinate_equation(crank_slider: Any) -> None:
-    trajectory = symkin.solve(crank_slider)
+@pytest.mark.parametrize("fixture", ["crank_slider", "crank_slider_c"])
+def test_the_crank_slider_follows_its_minimal_coordinate_equation(
+        fixture: str, request: pytest.FixtureRequest) -> None:
+    trajectory = symkin.solve(request.getfixturevalue(fixture))
     accel, slider_x = _minimal_crank_slider()
     theta0, omega0 = trajectory.q[0, 2], trajectory.dq[0, 2]
     assert omega0 == pytest.approx(2.0, abs=1e-12)  # the given rate, kept exactly

@@ -1,6 +1,6 @@
 """symkin run and symkin.solve of a mechanism its forces move: the summary, the energy
-columns, located refusals, Ctrl-C with the rows kept; and the generated kernels (NumPy and
-C, compiled and run) agreeing with the equations of motion the integrator uses."""
+columns, located refusals, Ctrl-C with the rows kept (the backends' kernels:
+test_motion_backends)."""
 
 from __future__ import annotations
 
@@ -10,11 +10,10 @@ from typing import Any
 
 import numpy as np
 import pytest
-from motion_support import CRANK_SLIDER, PENDULUM, write
+from motion_support import PENDULUM, write
 
 import symkin
 from symkin import cli
-from symkin.runtime.dynamics.model import kernel_terms
 from symkin.runtime.run_outcome import SolveInterrupted
 
 
@@ -66,11 +65,6 @@ def test_contradicting_initial_velocities_are_refused_at_their_line(
     assert "Traceback" not in err
 
 
-def test_the_c_backend_is_refused_by_the_api_until_its_step_exists(pendulum: Path) -> None:
-    with pytest.raises(symkin.BuildError, match="use the numpy backend"):
-        symkin.compile(symkin.derive(pendulum), backend="c")
-
-
 def test_ctrl_c_keeps_the_rows_solved(crank_slider: Any) -> None:
     def interrupt(done: int, total: int) -> None:
         if done == 5:
@@ -80,26 +74,6 @@ def test_ctrl_c_keeps_the_rows_solved(crank_slider: Any) -> None:
         symkin.solve(crank_slider, progress=interrupt)
     assert caught.value.trajectory.t.size == 5
     assert dict(caught.value.trajectory.outputs)["kinetic_energy"].shape == (5,)
-
-
-@pytest.mark.parametrize("backend", ["numpy", "c"])
-def test_the_generated_kernels_give_the_same_mass_and_forces(
-        crank_slider: Any, tmp_path: Path, backend: str) -> None:
-    # the same bodies and forces, driven: a generated kernel with inverse dynamics
-    driven = CRANK_SLIDER.replace("SPRING", "20.0").replace(
-        "forces:", "drivers:\n  - {type: angle, i: crank, j: ground, theta: 1.8 + t}\nforces:"
-    ).replace("initial: {velocities: {crank.phi: 2.0}}\n", "").replace(
-        "integrator: {rtol: 1e-11, atol: 1e-12}\n", "")
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "driven.yaml", driven)),
-                            backend=backend)
-    assert kernel.backend == backend
-    model, p = crank_slider.model, crank_slider.p_values
-    rng = np.random.default_rng(37)
-    for _ in range(3):
-        q, dq = rng.normal(size=9), rng.normal(size=9)
-        mass, applied = kernel_terms(kernel, q, dq, 0.3, p)
-        assert mass == pytest.approx(model.mass(q, p), abs=1e-9)
-        assert applied == pytest.approx(model.applied(q, dq, 0.3, p), abs=1e-9)
 
 
 def test_generate_writes_the_dynamics_step(pendulum: Path, tmp_path: Path) -> None:

@@ -41,6 +41,8 @@ class CBackend:
     name = "c"
     title = "C"
     real_types: tuple[str, ...] = ("double", "float")
+    # its kernels evaluate the mass matrix and applied forces (build.motion integrates)
+    equations_of_motion = True
     template_folder = "templates"
 
     @property

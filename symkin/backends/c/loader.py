@@ -115,6 +115,19 @@ class _CFunctions:
         # Only the kernel of a file with spatial revolutes or angles has it.
         self.senses: Callable[[Array, float, Array], Array] | None = (
             self._senses if nsenses else None)
+        # Only the kernel of a file with masses has them (forward dynamics).
+        self.mass: Callable[[Array, Array], Array] | None = None
+        self.applied: Callable[[Array, Array, float, Array], Array] | None = None
+        if hasattr(lib, f"{prefix}_mass"):
+            self._mass_c, self._applied_c = (getattr(lib, f"{prefix}_{what}")
+                                             for what in ("mass", "applied"))
+            count = int(getattr(lib, f"{prefix.upper()}_NNZ_M"))
+            # the mass matrix's sparsity pattern, the static arrays of the generated header
+            self._mass_at = tuple(np.array(ffi.unpack(getattr(lib, f"{prefix}_mass_{side}"),
+                                                      count), dtype=np.intp)
+                                  for side in ("row", "col"))
+            self._nq = nq
+            self.mass, self.applied = self._mass, self._applied
 
     def _in(self, array: Array) -> Any:
         if array.size == 0:
@@ -163,6 +176,20 @@ class _CFunctions:
 
     def loads_full(self, q: Array, lam: Array, t: float, p: Array) -> Array:
         return self._call("loads_full", self._in(q), self._in(lam), t, self._in(p))
+
+    def _mass(self, q: Array, p: Array) -> Array:
+        rows, cols = self._mass_at
+        nz = np.zeros(rows.size, dtype=self._dtype)
+        self._mass_c(self._in(q), self._in(p), self._ffi.from_buffer(self._ctype, nz))
+        dense = np.zeros((self._nq, self._nq))
+        dense[rows, cols] = nz
+        return dense
+
+    def _applied(self, q: Array, dq: Array, t: float, p: Array) -> Array:
+        out = np.zeros(self._nq, dtype=self._dtype)
+        self._applied_c(self._in(q), self._in(dq), t, self._in(p),
+                        self._ffi.from_buffer(self._ctype, out))
+        return out.astype(np.float64, copy=False)
 
 
 def load(folder: Path, meta: Mapping[str, Any]) -> CKernel:

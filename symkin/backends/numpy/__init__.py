@@ -27,6 +27,8 @@ class NumPyBackend:
     name = "numpy"
     title = "NumPy"
     real_types: tuple[str, ...] = ("double",)  # NumPy computes in double
+    # its kernels evaluate the mass matrix and applied forces (build.motion integrates)
+    equations_of_motion = True
     template_folder = "templates"
 
     @property

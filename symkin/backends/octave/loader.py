@@ -20,6 +20,10 @@ _SESSIONS: dict[Path, Session] = {}
 class _OctaveFunctions:
     """The Kernel's functions, each a call of the generated <prefix>_<what>.m."""
 
+    # no equations of motion: the backend generates none (build.motion refuses it)
+    mass: Callable[[Array, Array], Array] | None = None
+    applied: Callable[[Array, Array, float, Array], Array] | None = None
+
     def __init__(self, session: Session, name: str, meta: Mapping[str, Any]) -> None:
         self._session, self._name = session, name
         self.removed: Callable[[Array, float, Array], Array] | None = (

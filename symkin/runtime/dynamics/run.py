@@ -67,6 +67,15 @@ def solve(kernel: MotionKernel, t: ArrayLike | None = None, q0: ArrayLike | None
         SolveInterrupted on Ctrl-C; SolveError for bad arguments or initial velocities that
         contradict the constraints (runtime.dynamics.initial).
     """
+    # a load's 1/(t - 0.5) at t = 0.5 is inf in a generated NumPy kernel, as in C: the row
+    # is then flagged (run_outcome.flag_not_finite) or the motion stops, never a warning
+    with np.errstate(all="ignore"):
+        return _solve(kernel, t, q0, params, progress, stop_at_singular)
+
+
+def _solve(kernel: MotionKernel, t: ArrayLike | None, q0: ArrayLike | None,
+           params: Mapping[str, float] | ArrayLike | None, progress: Progress | None,
+           stop_at_singular: bool) -> Trajectory:
     model = kernel.model
     # the shared argument checks read only a kernel's grid, parameters, q0 and coordinates
     checked: Any = kernel
