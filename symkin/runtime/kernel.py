@@ -117,6 +117,13 @@ class Kernel:
         self._functions = functions
 
     @property
+    def unchecked(self) -> _Functions:
+        """The backend's functions without the argument checks: flat float64 arrays of the
+        right sizes, p with the inputs, in and out (runtime.dynamics.compiled checks once
+        and calls them at every stage of the integrator)."""
+        return self._functions
+
+    @property
     def has_grid_solver(self) -> bool:
         """True for a kernel whose generated code runs whole grids (the C solver)."""
         return False

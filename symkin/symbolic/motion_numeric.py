@@ -148,9 +148,17 @@ def remainder(system: Any) -> Remainder:
     n = len(q)
     return Remainder(
         potential=_compiled([q, t, p], equations.potential, ()),
-        nonconservative=_compiled([q, dq, t, p], equations.nonconservative, (n,)),
+        nonconservative=_nonconservative([q, dq, t, p], equations.nonconservative, n),
         given=equations.given, given_values=_given_values(p, equations),
         rtol=equations.rtol, atol=equations.atol)
+
+
+def _nonconservative(arguments: list[Any], expr: Any, n: int) -> Callable[..., Array]:
+    """Q_nc as a function; without damping, forces or torques (a pendulum under gravity) a
+    constant zero, which the integrator asks for at every stage."""
+    if not any(sp.sympify(item) != 0 for item in expr):
+        return lambda *values: np.zeros(n)
+    return _compiled(arguments, expr, (n,))
 
 
 def _given_values(p: list[Any], equations: EquationsOfMotion) -> Callable[..., Array] | None:

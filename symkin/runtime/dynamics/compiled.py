@@ -69,26 +69,34 @@ class CompiledModel:
         self._m = len(kernel.rows)
         # Φ_q is (rows, NQ) here: the pattern's entries all lie in Φ's rows
         self._at = (kernel.pattern_rows, kernel.pattern_cols)
+        # called at every Runge-Kutta stage: the kernel's argument checks are skipped, the
+        # integrator's arrays being flat float64 of the kernel's sizes (symkin.solve's
+        # arguments are checked once: runtime.arguments)
+        self._f = kernel.unchecked
+        if self._f.mass is None or self._f.applied is None:
+            raise ValueError(f"the kernel of {kernel.name} has no mass matrix or applied "
+                             "forces: its backend generates none")
+        self._mass, self._applied = self._f.mass, self._f.applied
 
     def phi(self, q: Array, t: float, p: Array) -> Array:
-        return self.kernel.phi(q, t, p)[:self._m]
+        return self._f.phi(q, t, p)[:self._m]
 
     def phi_q(self, q: Array, t: float, p: Array) -> Array:
         dense = np.zeros((self._m, q.size))
-        dense[self._at] = self.kernel.phi_q_nz(q, t, p)
+        dense[self._at] = self._f.phi_q_nz(q, t, p)
         return dense
 
     def phi_t(self, q: Array, t: float, p: Array) -> Array:
-        return self.kernel.phi_t(q, t, p)[:self._m]
+        return self._f.phi_t(q, t, p)[:self._m]
 
     def gamma(self, q: Array, dq: Array, t: float, p: Array) -> Array:
-        return self.kernel.gamma(q, dq, t, p)[:self._m]
+        return self._f.gamma(q, dq, t, p)[:self._m]
 
     def mass(self, q: Array, p: Array) -> Array:
-        return self.kernel.mass(q, p)
+        return self._mass(q, p)
 
     def applied(self, q: Array, dq: Array, t: float, p: Array) -> Array:
-        return self.kernel.applied(q, dq, t, p)
+        return self._applied(q, dq, t, p)
 
     def loads(self, q: Array, lam: Array, t: float, p: Array) -> Array:
         return self.kernel.loads(q, lam, t, p)
