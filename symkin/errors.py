@@ -93,6 +93,11 @@ class UsageError(SymkinError):
     fit); the command line exits with status 2."""
 
 
+class BackendRefused(UsageError):
+    """A backend or option that cannot serve this mechanism (Octave or float for one its
+    forces move: build.motion); the command line names the file before the message."""
+
+
 class MissingToolError(UsageError, BuildError):
     """A backend asked for by name needs a program this machine lacks (GNU Octave for the
     octave backend; exit status 2)."""

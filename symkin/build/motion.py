@@ -15,18 +15,13 @@ from typing import Any
 from symkin.build.backend import Backend
 from symkin.build.compile import compile as compile_system
 from symkin.codegen import lower
-from symkin.errors import UsageError
+from symkin.errors import BackendRefused
 from symkin.runtime.dynamics.compiled import CompiledModel
 from symkin.runtime.dynamics.model import MotionKernel
 from symkin.symbolic import motion_numeric
 from symkin.symbolic.motion import moves_under_forces
 
-__all__ = ["Refused", "kernel", "moves_under_forces"]
-
-
-class Refused(UsageError):
-    """A backend or option that cannot integrate a mechanism its forces move (the command
-    line names the file before the message)."""
+__all__ = ["kernel", "moves_under_forces"]
 
 
 def kernel(system: Any, backend: Backend, *, real: str = "double", cse: bool = True,
@@ -35,23 +30,23 @@ def kernel(system: Any, backend: Backend, *, real: str = "double", cse: bool = T
     """The MotionKernel of ``system`` on ``backend`` (options as build.compile's).
 
     Raises:
-        Refused: the backend generates no equations of motion, or ``real`` is not double
+        BackendRefused: the backend generates no equations of motion, or ``real`` is not double
             (the projection's tolerance is below a float's resolution).
     """
     if not getattr(backend, "equations_of_motion", False):
-        raise Refused(f"{system.name} has fewer drivers than freedoms and moves under its "
+        raise BackendRefused(f"{system.name} has fewer drivers than freedoms and moves under its "
                          f"forces, but the {backend.title} backend generates no mass matrix "
                          "or applied forces to integrate it with: run it with --backend c or "
                          "--backend numpy (symkin.compile(..., backend='c' or 'numpy'))")
     if real != "double":
-        raise Refused(f"{system.name} moves under its forces: its motion is integrated in "
+        raise BackendRefused(f"{system.name} moves under its forces: its motion is integrated in "
                          f"double (the projection onto the constraints works to 1e-11), not "
                          f"in {real}. Leave real at double; symkin generate writes the "
                          "float <prefix>_dynamics_step for a controller")
     compiled = compile_system(system, backend, real=real, cse=cse, linalg=linalg,
                               cache_dir=cache_dir)
     if not compiled.has_mass:  # a plug-in that says so but generates none
-        raise Refused(f"the {backend.title} kernel of {system.name} has no mass matrix: "
+        raise BackendRefused(f"the {backend.title} kernel of {system.name} has no mass matrix: "
                          "run it with --backend c or --backend numpy")
     return MotionKernel(CompiledModel(compiled, motion_numeric.remainder(system)),
                         compiled.backend)

@@ -22,6 +22,7 @@ from symkin import backends, limits, outfiles
 from symkin.cli import messages, overrides, run_outputs
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 from symkin.cli.run_outputs import CannotWrite, ProgressBar
+from symkin.errors import BackendRefused
 
 SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png", ".svg", ".pdf"), "animate": (".gif",),
             "html": (".html", ".htm")}
@@ -200,7 +201,7 @@ def handle(args: argparse.Namespace) -> int:
 
 
 def _solve_and_write(args: argparse.Namespace) -> int:
-    from symkin.build import index, motion
+    from symkin.build import index
     from symkin.runtime import driver
 
     options = index.Options(backend=backends.resolve(args.backend),
@@ -208,7 +209,7 @@ def _solve_and_write(args: argparse.Namespace) -> int:
     try:
         prepared = index.prepare(args.mechanism, options,
                                  outlines=args.animate is not None or args.html is not None)
-    except motion.Refused as refused:  # a backend that cannot integrate it: name the file
+    except BackendRefused as refused:  # a backend that cannot integrate it: name the file
         return _error(f"{args.mechanism}: {refused}", EXIT_BAD_INPUT)
     kernel = prepared.kernel
     moves = getattr(kernel, "moves_under_forces", False)

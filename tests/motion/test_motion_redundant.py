@@ -48,10 +48,12 @@ def _reference() -> Any:
     return sp.lambdify((th, ps, dth, dps), mass.LUsolve(force))
 
 
-def test_a_parallelogram_with_an_extra_bar_falls_as_by_hand(tmp_path: Path) -> None:
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_a_parallelogram_with_an_extra_bar_falls_as_by_hand(tmp_path: Path,
+                                                            backend: str) -> None:
     text = _falling(EXAMPLE.read_text(encoding="utf-8"))
     kernel = symkin.compile(symkin.derive(write(tmp_path, "falling.yaml", text)),
-                            backend="numpy")
+                            backend=backend)
     trajectory = symkin.solve(kernel, t=np.linspace(0, 1, 11))
     accel = _reference()
     reference = solve_ivp(lambda t, y: [y[2], y[3], *np.ravel(accel(*y))], (0, 1),

@@ -32,9 +32,11 @@ def _rotation(e: np.ndarray) -> np.ndarray:
     return (e0 ** 2 - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * e0 * skew
 
 
-def test_a_free_body_keeps_its_energy_and_angular_momentum(tmp_path: Path) -> None:
+@pytest.mark.parametrize("backend", ["numpy", "c"])
+def test_a_free_body_keeps_its_energy_and_angular_momentum(tmp_path: Path,
+                                                           backend: str) -> None:
     kernel = symkin.compile(symkin.derive(write(tmp_path, "free.yaml", FREE_BODY)),
-                            backend="numpy")
+                            backend=backend)
     trajectory = symkin.solve(kernel)
     omega, _ = trajectory.angular()
     omega = omega[:, 0]

@@ -2,9 +2,10 @@
 one that its forces move.
 
 A :class:`Model` is plain data and functions of flat float64 arrays, in the generated
-kernels' argument order (q, dq, t, p). Today symbolic.motion_numeric supplies it; a
-kernel whose generated code computes M and Q - h (``PREFIX_mass``, ``PREFIX_applied``) can
-supply the same functions without changing the integrator.
+kernels' argument order (q, dq, t, p). A run's model is runtime.dynamics.compiled's, over
+the generated kernel of the backend asked for (``PREFIX_mass``, ``PREFIX_applied``, Φ and
+its derivatives); symbolic.motion_numeric.Functions, lambdified from the System, is the same
+protocol, which the tests compare the kernels with.
 """
 
 from __future__ import annotations
@@ -83,20 +84,6 @@ class MotionKernel:
     def __repr__(self) -> str:
         return (f"<MotionKernel {self.name}: {self.nq} coordinates, {len(self.rows)} "
                 f"constraints, {self.backend}>")
-
-
-def kernel_terms(kernel: Any, q: Array, dq: Array, t: float, p: Array) -> tuple[Array, Array]:
-    """M and Q - h of a generated kernel with inverse dynamics (a mechanism with the same
-    bodies and forces, driven): its multipliers solve Φ_qᵀ λ = Q - M q̈ - h, linear in q̈,
-    so Φ_qᵀ λ at q̈ = 0 is Q - h and the difference at q̈ = e_k is M's column k. The way the
-    kernels' own ``mass`` and ``applied`` can replace the lambdified ones, checked now."""
-    jacobian_t = kernel.phi_q(q, t, p).T
-    n = q.size
-    applied = jacobian_t @ kernel.multipliers(q, dq, np.zeros(n), t, p)
-    mass = np.empty((n, n))
-    for k, unit in enumerate(np.eye(n)):
-        mass[:, k] = applied - jacobian_t @ kernel.multipliers(q, dq, unit, t, p)
-    return mass, applied
 
 
 def refuse_motion(kernel: Any, command: str) -> None:
