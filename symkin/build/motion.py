@@ -30,23 +30,26 @@ def kernel(system: Any, backend: Backend, *, real: str = "double", cse: bool = T
     """The MotionKernel of ``system`` on ``backend`` (options as build.compile's).
 
     Raises:
-        BackendRefused: the backend generates no equations of motion, or ``real`` is not double
-            (the projection's tolerance is below a float's resolution).
+        BackendRefused: the backend generates no equations of motion, or ``real`` is not
+            double (the projection's tolerance is below a float's resolution).
+        MechanismError: an input driver (symbolic.motion), before anything is built.
     """
     if not getattr(backend, "equations_of_motion", False):
-        raise BackendRefused(f"{system.name} has fewer drivers than freedoms and moves under its "
-                         f"forces, but the {backend.title} backend generates no mass matrix "
-                         "or applied forces to integrate it with: run it with --backend c or "
-                         "--backend numpy (symkin.compile(..., backend='c' or 'numpy'))")
+        raise BackendRefused(
+            f"{system.name} has fewer drivers than freedoms and moves under its forces, but "
+            f"the {backend.title} backend generates no mass matrix or applied forces to "
+            "integrate it with: run it with --backend c or --backend numpy "
+            "(symkin.compile(..., backend='c' or 'numpy'))")
     if real != "double":
-        raise BackendRefused(f"{system.name} moves under its forces: its motion is integrated in "
-                         f"double (the projection onto the constraints works to 1e-11), not "
-                         f"in {real}. Leave real at double; symkin generate writes the "
-                         "float <prefix>_dynamics_step for a controller")
+        raise BackendRefused(
+            f"{system.name} moves under its forces: its motion is integrated in double (the "
+            f"projection onto the constraints works to 1e-11), not in {real}. Leave real at "
+            "double; symkin generate writes the float <prefix>_dynamics_step for a controller")
+    # first: it refuses what the motion cannot have (input drivers) before anything is built
+    rest = motion_numeric.remainder(system)
     compiled = compile_system(system, backend, real=real, cse=cse, linalg=linalg,
                               cache_dir=cache_dir)
     if not compiled.has_mass:  # a plug-in that says so but generates none
         raise BackendRefused(f"the {backend.title} kernel of {system.name} has no mass matrix: "
-                         "run it with --backend c or --backend numpy")
-    return MotionKernel(CompiledModel(compiled, motion_numeric.remainder(system)),
-                        compiled.backend)
+                             "run it with --backend c or --backend numpy")
+    return MotionKernel(CompiledModel(compiled, rest), compiled.backend)

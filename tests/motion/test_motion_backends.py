@@ -115,3 +115,36 @@ def test_the_octave_backend_is_refused_with_its_reason(
 def test_a_float_kernel_is_refused_for_the_motion(pendulum: Path) -> None:
     with pytest.raises(UsageError, match="integrated in double"):
         symkin.compile(symkin.derive(pendulum), backend="c", real="float")
+
+
+INPUT_DRIVEN = """\
+name: arm_input
+parameters: {L: 1.0, m: 1.0, g: 9.81}
+bodies:
+  a: {q0: [0, 0, 0], mass: m, inertia: 0.1, com: [0.5, 0], points: {tip: [L, 0]}}
+  b: {q0: [1, 0, 0], mass: m, inertia: 0.1, com: [0.5, 0]}
+joints:
+  - {type: revolute, i: ground, j: a, sA: [0, 0], sB: [0, 0]}
+  - {type: revolute, i: a, j: b, sA: tip, sB: [0, 0]}
+drivers:
+  - {type: angle, i: a, j: ground, theta: input}
+forces:
+  - {type: gravity, g: [0, -g]}
+time: {t0: 0, t1: 1, dt: 0.1}
+"""
+
+
+def test_an_input_driver_is_refused_before_anything_is_built(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str],
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # a double pendulum whose first arm an inputs table would drive: one freedom left free
+    path = write(tmp_path, "arm.yaml", INPUT_DRIVEN)
+
+    def no_build(*arguments: Any, **options: Any) -> None:
+        raise AssertionError("built before the refusal")
+
+    monkeypatch.setattr("symkin.build.motion.compile_system", no_build)
+    assert cli.main(["run", str(path), "--backend", "c"]) == cli.EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"{path}:9: at drivers: a mechanism moved by its forces cannot have input " \
+           "drivers yet" in err and "Traceback" not in err
