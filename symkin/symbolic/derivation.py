@@ -27,6 +27,7 @@ from symkin.spec import validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
 from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
+from symkin.symbolic.derivatives import diff
 from symkin.symbolic.differentiation import parameter_jacobian, row_gamma, row_jacobian
 from symkin.symbolic.planar import TAU, Context, input_slot
 from symkin.symbolic.symbols import Input, Symbols, extra_coordinates, make_symbols
@@ -199,7 +200,7 @@ def derive(mech: Mechanism | str | Path) -> System:
     phi_t, gamma = [], []
     for r, row in enumerate(phi):
         entries = row_jacobian(row, column, symbols.q)
-        row_t = sp.diff(row, symbols.t)
+        row_t = diff(row, symbols.t)
         jacobian.update({(r, k): _at_tau(value, symbols) for k, value in entries.items()})
         phi_t.append(_at_tau(row_t, symbols))
         gamma.append(_at_tau(row_gamma(row, entries, row_t, symbols), symbols))

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from symkin.symbolic.derivatives import diff
 from symkin.symbolic.symbols import Symbols
 
 
@@ -24,7 +25,7 @@ def row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
                  q: tuple[sp.Symbol, ...]) -> dict[int, sp.Expr]:
     """The structural non-zeros of one row of Phi_q, keyed by column."""
     touched = sorted(column[s] for s in row.free_symbols if s in column)
-    derivatives = {k: sp.diff(row, q[k]) for k in touched}
+    derivatives = {k: diff(row, q[k]) for k in touched}
     return {k: value for k, value in derivatives.items() if value != 0}
 
 
@@ -43,8 +44,8 @@ def row_gamma(row: sp.Expr, entries: dict[int, sp.Expr], row_t: sp.Expr,
               symbols: Symbols) -> sp.Expr:
     """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt (2.74)."""
     dq, t = symbols.dq, symbols.t
-    mixed = sp.Add(*(sp.diff(value, t) * dq[k] for k, value in entries.items()))
-    return -convective(row, entries, symbols) - 2 * mixed - sp.diff(row_t, t)
+    mixed = sp.Add(*(diff(value, t) * dq[k] for k, value in entries.items()))
+    return -convective(row, entries, symbols) - 2 * mixed - diff(row_t, t)
 
 
 def convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols) -> sp.Expr:
@@ -54,9 +55,8 @@ def convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols) -> s
     q, dq = symbols.q, symbols.dq
     if not row.has(sp.Piecewise):
         along = sp.Dummy("along", real=True)  # as q and dq: Abs(x + e v) has a sign
-        second = sp.diff(row.xreplace({q[k]: q[k] + along * dq[k] for k in entries}),
-                         along, 2)
+        second = diff(row.xreplace({q[k]: q[k] + along * dq[k] for k in entries}), along, 2)
         if not second.has(sp.Derivative, sp.Subs):
             return second.xreplace({along: 0})
     velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))
-    return sp.Add(*(sp.diff(velocity, q[k]) * dq[k] for k in entries))
+    return sp.Add(*(diff(velocity, q[k]) * dq[k] for k in entries))
