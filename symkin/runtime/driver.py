@@ -211,15 +211,12 @@ def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike 
     return trajectory
 
 
-def _solve(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
-           params: Mapping[str, float] | ArrayLike | None, options: Options,
+def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: Options,
            progress: Progress | None, use_c_solver: bool, out: Out | None) -> Trajectory:
-    """Check the arguments, then the C grid loop over the whole grid; only where it stops
-    (a failed assembly from q0, a singular point, a limit, a failure) or without the C
-    solver, the general loop with the assembly and the edge treatments takes over."""
-    times = time_points(kernel, t)
-    p = parameter_values(kernel, params)
-    q = first_guess(kernel, q0)
+    """The C grid loop over the whole grid; only where it stops (a failed assembly from q0, a
+    singular point, a limit, a failure) or without the C solver, the general loop with the
+    assembly and the edge treatments takes over. The arguments as _solve_in_unit checked
+    them (not checked again: a loop of calls pays for that once a call)."""
     run = allocate(times, q.size, out)
     solver = kernel.grid_solver(options, q, p) if use_c_solver and kernel.has_grid_solver \
         else None

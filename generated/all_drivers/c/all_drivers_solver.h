@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 642 (223 add/sub, 149 mul, 22 div, 0 sqrt, 9 other calls, 132 fabs, 107 compares)
- *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 155
- * Condition at the converged q: 522; an extra iteration there (at most 3): 723
- * Velocity: 127; acceleration: 189; per-point checks: 2174; predictor: 91
- * Step, worst case with the default cap of 25 iterations: 22388 (7973 add/sub, 5502 mul, 787 div, 10 sqrt, 280 other calls, 4354 fabs, 3482 compares)
+ * One Newton iteration: 627 (208 add/sub, 149 mul, 22 div, 0 sqrt, 9 other calls, 132 fabs, 107 compares)
+ *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 140
+ * Condition at the converged q: 522; an extra iteration there (at most 3): 801
+ * Velocity: 112; acceleration: 189; per-point checks: 2176; predictor: 63
+ * Step, worst case with the default cap of 25 iterations: 22245 (7664 add/sub, 5606 mul, 773 div, 10 sqrt, 280 other calls, 4354 fabs, 3558 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130168
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130025
  */
-#define ALL_DRIVERS_OPS_ITERATION 642   /* one Newton iteration */
-#define ALL_DRIVERS_OPS_STEP_FIXED 6338  /* a step without its iterations */
-#define ALL_DRIVERS_OPS_STEP_WORST 22388  /* at the default cap, 25 */
-#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130168  /* every factorization dense */
+#define ALL_DRIVERS_OPS_ITERATION 627   /* one Newton iteration */
+#define ALL_DRIVERS_OPS_STEP_FIXED 6570  /* a step without its iterations */
+#define ALL_DRIVERS_OPS_STEP_WORST 22245  /* at the default cap, 25 */
+#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130025  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     all_drivers_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     all_drivers_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     all_drivers_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    all_drivers_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     all_drivers_real column[ALL_DRIVERS_NQ]; /* options->unit where q_i is a length, else 1 */
     all_drivers_real inverse_column[ALL_DRIVERS_NQ]; /* 1 / column */
     all_drivers_real row[ALL_DRIVERS_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -70,11 +70,10 @@ static int andrews_squeezer_refused(andrews_squeezer_report *report, andrews_squ
 static andrews_squeezer_real andrews_squeezer_max_abs(const andrews_squeezer_real v[])
 {
     andrews_squeezer_real largest = 0, sum = 0;
-    int i;
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        andrews_squeezer_real a = fabs(v[i]);
-        largest = a > largest ? a : largest; /* branch-free max */
-        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
+    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
+     * inf cannot occur) */
+    for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        { const andrews_squeezer_real a = fabs(v[i]); largest = a > largest ? a : largest; sum += a; }
     }
     return sum != sum ? (andrews_squeezer_real)NAN : largest;
 }
@@ -613,26 +612,58 @@ static int andrews_squeezer_misses(const andrews_squeezer_options *options, int 
         || (judged > 1 && e_ddq > options->target_ddq * andrews_squeezer_at_least_1(nddq));
 }
 
+/* The cheap bound of the error model: 1 when no target can be missed at a point whose
+ * max |q| and max |dq| are at most nq and ndq (whatever its max |ddq|), s = ||Phi_q^-1||_1 /
+ * sqrt(NQ) and the residual leaving an error `left` of q; e_q into *e_q. With A = max(1, |dq|)
+ * and x = s (u + e_q), e_dq <= x A and e_ddq <= x (1 + A^2 (1 + 2 s)) max(1, |ddq|), so where
+ * e_q, x and x (1 + A^2 (1 + 2 s)) are within half their targets (the half covers the
+ * rounding of both sides) the model flags nothing. Each quantity grows with nq and ndq, also
+ * as rounded: a bound that holds for some norms holds for smaller ones. A NaN fails it. */
+static int andrews_squeezer_within_bound(const andrews_squeezer_options *options,
+                                     const andrews_squeezer_report *report, andrews_squeezer_real s,
+                                     andrews_squeezer_real left, andrews_squeezer_real nq, andrews_squeezer_real ndq, andrews_squeezer_real *e_q)
+{
+    const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
+    const andrews_squeezer_real rounding = s * u * (1 + nq);
+    const andrews_squeezer_real error = left > rounding ? left : rounding;
+    const andrews_squeezer_real x = s * (u + error), a = andrews_squeezer_at_least_1(ndq);
+    /* all the arithmetic before the tests: its count does not depend on the values */
+    const andrews_squeezer_real margin = 2 * ANDREWS_SQUEEZER_SAFETY, bound_dq = margin * x;
+    const andrews_squeezer_real bound_ddq = bound_dq * (1 + a * a * (1 + 2 * s));
+    *e_q = error;
+    return report->cond < (andrews_squeezer_real)INFINITY && margin * error <= options->target_q
+        && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
+}
+
+/* andrews_squeezer_flagged with s and the residual's error `left` worked out. */
+static int andrews_squeezer_flagged_at(const andrews_squeezer_options *options,
+                                   const andrews_squeezer_report *report, andrews_squeezer_real s, andrews_squeezer_real left,
+                                   andrews_squeezer_real nq, andrews_squeezer_real ndq, andrews_squeezer_real nddq, int judged)
+{
+    const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
+    const andrews_squeezer_real a = andrews_squeezer_at_least_1(ndq);
+    andrews_squeezer_real e_q, e_dq, e_ddq;
+    if (andrews_squeezer_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    if (report->cond - report->cond != 0) return 1;
+    e_dq = s * (u * ndq + e_q * a);
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
+    return andrews_squeezer_misses(options, judged, ANDREWS_SQUEEZER_SAFETY * e_q,
+                               ANDREWS_SQUEEZER_SAFETY * e_dq, ANDREWS_SQUEEZER_SAFETY * e_ddq, nq, ndq,
+                               nddq);
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
- * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
+ * decides first; the model runs where the bound fails. */
 static int andrews_squeezer_flagged(const andrews_squeezer_options *options,
                                 const andrews_squeezer_workspace *work,
                                 const andrews_squeezer_report *report, andrews_squeezer_real nq, andrews_squeezer_real ndq,
                                 andrews_squeezer_real nddq, int judged)
 {
-    const andrews_squeezer_real u = ANDREWS_SQUEEZER_UNIT_ROUNDOFF;
     const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
-    const andrews_squeezer_real rounding = s * u * (1 + nq);
     const andrews_squeezer_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    andrews_squeezer_real e_q, e_dq, e_ddq;
-    if (report->cond - report->cond != 0) return 1;
-    e_q = left > rounding ? left : rounding;
-    e_dq = s * (u * ndq + e_q * andrews_squeezer_at_least_1(ndq));
-    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * andrews_squeezer_at_least_1(ndq));
-    return andrews_squeezer_misses(options, judged, ANDREWS_SQUEEZER_SAFETY * e_q,
-                               ANDREWS_SQUEEZER_SAFETY * e_dq, ANDREWS_SQUEEZER_SAFETY * e_ddq, nq, ndq,
-                               nddq);
+    return andrews_squeezer_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -766,14 +797,26 @@ static int andrews_squeezer_flagged_refined(const andrews_squeezer_options *opti
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
- * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
+ * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
+ * at the end of the step too if the new norms are within those (work->clear; the residual,
+ * condition and correction unchanged), and the model need not run again there. */
 static int andrews_squeezer_would_flag(const andrews_squeezer_options *options,
-                                   const andrews_squeezer_workspace *work,
+                                   andrews_squeezer_workspace *work,
                                    const andrews_squeezer_report *report)
 {
     const andrews_squeezer_real *norms = work->norms;
-    return report->residual > ANDREWS_SQUEEZER_UNIT_ROUNDOFF * (1 + norms[0])
-        && andrews_squeezer_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
+    const andrews_squeezer_real s = report->inv_norm / sqrt((andrews_squeezer_real)ANDREWS_SQUEEZER_NQ);
+    const andrews_squeezer_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const andrews_squeezer_real wide_q = 2 * norms[0] + 1, wide_dq = 2 * norms[1] + 1;
+    andrews_squeezer_real e_q;
+    if (!(report->residual > ANDREWS_SQUEEZER_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
+    if (andrews_squeezer_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
+        work->clear[0] = wide_q;
+        work->clear[1] = wide_dq;
+        return 0;
+    }
+    return andrews_squeezer_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point
@@ -792,6 +835,7 @@ static int andrews_squeezer_converged(const andrews_squeezer_options *options, c
     int i, extra, moved = 0, ill;
     andrews_squeezer_estimate(work, report);
     work->correction = -1;
+    work->clear[0] = work->clear[1] = -1; /* until the model's cheap bound clears the point */
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (andrews_squeezer_real)INFINITY
@@ -821,6 +865,7 @@ static int andrews_squeezer_converged(const andrews_squeezer_options *options, c
         if (moved) {
             andrews_squeezer_estimate(work, report);
         }
+        work->clear[0] = work->clear[1] = -1; /* the model decides at the end */
     }
     return report->cond <= options->max_cond ? ANDREWS_SQUEEZER_OK : ANDREWS_SQUEEZER_SINGULAR;
 }
@@ -831,7 +876,7 @@ static int andrews_squeezer_newton(const andrews_squeezer_options *options, cons
                   andrews_squeezer_workspace *work, andrews_squeezer_report *report)
 {
     andrews_squeezer_real step = 0;
-    int i, iteration;
+    int iteration;
     report->t = t;
     report->pivot = -1;
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
@@ -857,14 +902,12 @@ static int andrews_squeezer_newton(const andrews_squeezer_options *options, cons
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-            work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
-        }
+        /* the step solves Phi_q dq = -Phi in place: solved for Phi, it is subtracted */
         andrews_squeezer_lu_solve(&work->lu, work->phi);
         step = andrews_squeezer_max_abs(work->phi); /* in the run's unit */
         andrews_squeezer_from_unit(work, work->phi);
-        for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-            q[i] += work->phi[i];
+        for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+            q[i] -= work->phi[i];
         }
     }
     return ANDREWS_SQUEEZER_NO_CONVERGENCE;
@@ -872,11 +915,49 @@ static int andrews_squeezer_newton(const andrews_squeezer_options *options, cons
 
 static void andrews_squeezer_predict(andrews_squeezer_real t, andrews_squeezer_state *state)
 {
-    andrews_squeezer_real h = t - state->t;
-    int i;
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
+    const andrews_squeezer_real h = t - state->t, half_h2 = h * h / 2;
+    /* (2.76) */
+    for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        state->q[i] += state->dq[i] * h + state->ddq[i] * half_h2;
     }
+}
+
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+static andrews_squeezer_real andrews_squeezer_rates_pass(const andrews_squeezer_workspace *work, andrews_squeezer_real dq[],
+                                       andrews_squeezer_real *finite)
+{
+    andrews_squeezer_real largest = 0, nan = 0;
+    for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        { const andrews_squeezer_real b = fabs(dq[i]); largest = b > largest ? b : largest; nan += b - b; }
+        dq[i] = -dq[i];
+    }
+    andrews_squeezer_from_unit(work, dq);
+    *finite = nan;
+    return largest;
+}
+
+/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
+ * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
+ * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+static andrews_squeezer_real andrews_squeezer_accelerations_pass(const andrews_squeezer_workspace *work,
+                                               const andrews_squeezer_real q[], andrews_squeezer_real ddq[],
+                                               andrews_squeezer_real *finite, andrews_squeezer_real *nq)
+{
+    andrews_squeezer_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
+    for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+        { const andrews_squeezer_real c = fabs(ddq[i]); largest = c > largest ? c : largest; nan += c - c; }
+        {
+            const andrews_squeezer_real a = fabs(q[i]) * work->inverse_column[i];
+            largest_q = a > largest_q ? a : largest_q;
+            sum_q += a;
+        }
+    }
+    andrews_squeezer_from_unit(work, ddq);
+    *finite = nan;
+    *nq = sum_q != sum_q ? (andrews_squeezer_real)NAN : largest_q;
+    return largest;
 }
 
 /* andrews_squeezer_solve_step with its options already checked. */
@@ -884,8 +965,7 @@ static int andrews_squeezer_step(const andrews_squeezer_options *options, const 
                              andrews_squeezer_real t, andrews_squeezer_state *state,
                              andrews_squeezer_workspace *work, andrews_squeezer_report *report)
 {
-    andrews_squeezer_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
-    int i;
+    andrews_squeezer_real nq, ndq, nddq, finite_dq, finite_ddq;
     report->flagged = 0;
     report->cond = (andrews_squeezer_real)NAN;
     if (state->started) {
@@ -898,41 +978,26 @@ static int andrews_squeezer_step(const andrews_squeezer_options *options, const 
     if (report->status != ANDREWS_SQUEEZER_OK) {
         return report->status;
     }
-    /* Both right-hand sides are formed and solved in place in the state: no copies. Newton
-     * stopped at the q of its last fused call, so the shared sines and cosines are this q's. */
+    /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
+     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
+     * fused call, so the shared sines and cosines are this q's. */
     andrews_squeezer_phi_t_shared(state->q, t, p, work->shared, state->dq);
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        state->dq[i] = -state->dq[i];
-    }
     andrews_squeezer_rows_in_unit(work, state->dq);
-    andrews_squeezer_lu_solve(&work->lu, state->dq); /* (2.73) */
-    andrews_squeezer_from_unit(work, state->dq);
+    andrews_squeezer_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
+    ndq = andrews_squeezer_rates_pass(work, state->dq, &finite_dq);
     andrews_squeezer_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     andrews_squeezer_rows_in_unit(work, state->ddq);
     andrews_squeezer_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    andrews_squeezer_from_unit(work, state->ddq);
-    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
-     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
-    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) { /* in the run's unit: q / column */
-        const andrews_squeezer_real a = fabs(state->q[i]) * work->inverse_column[i];
-        const andrews_squeezer_real b = fabs(state->dq[i]) * work->inverse_column[i];
-        const andrews_squeezer_real c = fabs(state->ddq[i]) * work->inverse_column[i];
-        nq = a > nq ? a : nq;
-        ndq = b > ndq ? b : ndq;
-        nddq = c > nddq ? c : nddq;
-        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
-        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
-        finite_ddq += c - c;
-    }
+    nddq = andrews_squeezer_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
     if (finite_dq != 0 || finite_ddq != 0) {
         report->status = ANDREWS_SQUEEZER_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = andrews_squeezer_flagged_refined(options, work, report,
-                                                   sum_q != sum_q ? (andrews_squeezer_real)NAN : nq, ndq,
-                                                   nddq, state->q, state->dq, state->ddq,
-                                                   t, p);
+    /* where the model's cheap bound cleared this point for norms up to work->clear, in
+     * Newton (the residual, condition and correction as they are now), it is not run again */
+    report->flagged = nq <= work->clear[0] && ndq <= work->clear[1]
+        ? 0 : andrews_squeezer_flagged_refined(options, work, report, nq, ndq, nddq, state->q,
+                                           state->dq, state->ddq, t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -967,8 +1032,13 @@ int andrews_squeezer_solve_grid_checked(const andrews_squeezer_options *options,
 {
     int k;
     report->status = ANDREWS_SQUEEZER_OK;
+    /* the options once per call, not at every step */
+    if (n > 0 && andrews_squeezer_check_options(options) != 0) {
+        andrews_squeezer_refused(report, t[0]);
+        return 0;
+    }
     for (k = 0; k < n; ++k) {
-        if (andrews_squeezer_solve_step(options, p, t[k], state, work, report) != ANDREWS_SQUEEZER_OK) {
+        if (andrews_squeezer_step(options, p, t[k], state, work, report) != ANDREWS_SQUEEZER_OK) {
             return k;
         }
         andrews_squeezer_store(q_out, k, state->q);
@@ -1025,8 +1095,12 @@ int andrews_squeezer_solve_batch(const andrews_squeezer_options *options, const 
         out->iterations = 0;
         out->cond = out->start_cond = (andrews_squeezer_real)NAN;
         set_options.unit = units ? units[j] : options->unit;
-        for (k = 0; k < n; ++k) {
-            if (andrews_squeezer_solve_step(&set_options, p_set, t[k], state, work, &report) != ANDREWS_SQUEEZER_OK) {
+        /* the options (with this set's unit) once per set, not at every step */
+        if (n > 0 && andrews_squeezer_check_options(&set_options) != 0) {
+            andrews_squeezer_refused(&report, t[0]);
+        }
+        for (k = 0; k < n && report.status == ANDREWS_SQUEEZER_OK; ++k) {
+            if (andrews_squeezer_step(&set_options, p_set, t[k], state, work, &report) != ANDREWS_SQUEEZER_OK) {
                 break;
             }
             out->iterations += report.iterations;

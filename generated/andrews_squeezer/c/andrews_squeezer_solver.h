@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 606 (227 add/sub, 121 mul, 28 div, 0 sqrt, 14 other calls, 116 fabs, 100 compares)
- *   Phi, Phi_q, their factorization and tests: 417; the update (a solve): 189
- * Condition at the converged q: 517; an extra iteration there (at most 3): 687
- * Velocity: 125; acceleration: 148; per-point checks: 2530; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 21649 (8269 add/sub, 4538 mul, 1015 div, 10 sqrt, 434 other calls, 4010 fabs, 3373 compares)
+ * One Newton iteration: 585 (206 add/sub, 121 mul, 28 div, 0 sqrt, 14 other calls, 116 fabs, 100 compares)
+ *   Phi, Phi_q, their factorization and tests: 417; the update (a solve): 168
+ * Condition at the converged q: 517; an extra iteration there (at most 3): 765
+ * Velocity: 104; acceleration: 148; per-point checks: 2526; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 21332 (7810 add/sub, 4624 mul, 995 div, 10 sqrt, 434 other calls, 4010 fabs, 3449 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284675
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284358
  */
-#define ANDREWS_SQUEEZER_OPS_ITERATION 606   /* one Newton iteration */
-#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6499  /* a step without its iterations */
-#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21649  /* at the default cap, 25 */
-#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284675  /* every factorization dense */
+#define ANDREWS_SQUEEZER_OPS_ITERATION 585   /* one Newton iteration */
+#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6707  /* a step without its iterations */
+#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21332  /* at the default cap, 25 */
+#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284358  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     andrews_squeezer_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     andrews_squeezer_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     andrews_squeezer_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    andrews_squeezer_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     andrews_squeezer_real column[ANDREWS_SQUEEZER_NQ]; /* options->unit where q_i is a length, else 1 */
     andrews_squeezer_real inverse_column[ANDREWS_SQUEEZER_NQ]; /* 1 / column */
     andrews_squeezer_real row[ANDREWS_SQUEEZER_NQ]; /* options->unit where Phi_i is a length, else 1 */

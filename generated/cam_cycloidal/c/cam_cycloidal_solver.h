@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 409 (149 add/sub, 170 mul, 16 div, 1 sqrt, 18 other calls, 23 fabs, 32 compares)
- *   Phi, Phi_q, their factorization and tests: 353; the update (a solve): 56
- * Condition at the converged q: 46; an extra iteration there (at most 3): 490
- * Velocity: 34; acceleration: 520; per-point checks: 1545; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 14339 (5172 add/sub, 5988 mul, 560 div, 42 sqrt, 576 other calls, 817 fabs, 1184 compares)
+ * One Newton iteration: 402 (142 add/sub, 170 mul, 16 div, 1 sqrt, 18 other calls, 23 fabs, 32 compares)
+ *   Phi, Phi_q, their factorization and tests: 353; the update (a solve): 49
+ * Condition at the converged q: 46; an extra iteration there (at most 3): 568
+ * Velocity: 27; acceleration: 520; per-point checks: 1555; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 14428 (5063 add/sub, 6116 mul, 554 div, 42 sqrt, 576 other calls, 817 fabs, 1260 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31364
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31453
  */
-#define CAM_CYCLOIDAL_OPS_ITERATION 409   /* one Newton iteration */
-#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4114  /* a step without its iterations */
-#define CAM_CYCLOIDAL_OPS_STEP_WORST 14339  /* at the default cap, 25 */
-#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31364  /* every factorization dense */
+#define CAM_CYCLOIDAL_OPS_ITERATION 402   /* one Newton iteration */
+#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4378  /* a step without its iterations */
+#define CAM_CYCLOIDAL_OPS_STEP_WORST 14428  /* at the default cap, 25 */
+#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31453  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CAM_CYCLOIDAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     cam_cycloidal_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     cam_cycloidal_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     cam_cycloidal_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    cam_cycloidal_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     cam_cycloidal_real column[CAM_CYCLOIDAL_NQ]; /* options->unit where q_i is a length, else 1 */
     cam_cycloidal_real inverse_column[CAM_CYCLOIDAL_NQ]; /* 1 / column */
     cam_cycloidal_real row[CAM_CYCLOIDAL_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 1008 (373 add/sub, 312 mul, 23 div, 0 sqrt, 4 other calls, 164 fabs, 132 compares)
- *   Phi, Phi_q, their factorization and tests: 794; the update (a solve): 214
- * Condition at the converged q: 2542; an extra iteration there (at most 3): 1089
- * Velocity: 188; acceleration: 382; per-point checks: 3099; predictor: 85
- * Step, worst case with the default cap of 25 iterations: 38156 (14838 add/sub, 12171 mul, 809 div, 10 sqrt, 266 other calls, 5540 fabs, 4522 compares)
+ * One Newton iteration: 994 (359 add/sub, 312 mul, 23 div, 0 sqrt, 4 other calls, 164 fabs, 132 compares)
+ *   Phi, Phi_q, their factorization and tests: 794; the update (a solve): 200
+ * Condition at the converged q: 2542; an extra iteration there (at most 3): 1167
+ * Velocity: 174; acceleration: 382; per-point checks: 3102; predictor: 59
+ * Step, worst case with the default cap of 25 iterations: 38042 (14554 add/sub, 12278 mul, 796 div, 10 sqrt, 266 other calls, 5540 fabs, 4598 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 122979
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 122865
  */
-#define CARDAN_OPS_ITERATION 1008   /* one Newton iteration */
-#define CARDAN_OPS_STEP_FIXED 12956  /* a step without its iterations */
-#define CARDAN_OPS_STEP_WORST 38156  /* at the default cap, 25 */
-#define CARDAN_OPS_STEP_DENSE_WORST 122979  /* every factorization dense */
+#define CARDAN_OPS_ITERATION 994   /* one Newton iteration */
+#define CARDAN_OPS_STEP_FIXED 13192  /* a step without its iterations */
+#define CARDAN_OPS_STEP_WORST 38042  /* at the default cap, 25 */
+#define CARDAN_OPS_STEP_DENSE_WORST 122865  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CARDAN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     cardan_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     cardan_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     cardan_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    cardan_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     cardan_real column[CARDAN_NQ]; /* options->unit where q_i is a length, else 1 */
     cardan_real inverse_column[CARDAN_NQ]; /* 1 / column */
     cardan_real row[CARDAN_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -70,12 +70,17 @@ static int crank_slider_refused(crank_slider_report *report, crank_slider_real t
 static crank_slider_real crank_slider_max_abs(const crank_slider_real v[])
 {
     crank_slider_real largest = 0, sum = 0;
-    int i;
-    for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
-        crank_slider_real a = fabs(v[i]);
-        largest = a > largest ? a : largest; /* branch-free max */
-        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
-    }
+    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
+     * inf cannot occur) */
+    { const crank_slider_real a = fabs(v[0]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[1]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[2]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[3]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[4]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[5]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[6]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[7]); largest = a > largest ? a : largest; sum += a; }
+    { const crank_slider_real a = fabs(v[8]); largest = a > largest ? a : largest; sum += a; }
     return sum != sum ? (crank_slider_real)NAN : largest;
 }
 
@@ -392,26 +397,58 @@ static int crank_slider_misses(const crank_slider_options *options, int judged, 
         || (judged > 1 && e_ddq > options->target_ddq * crank_slider_at_least_1(nddq));
 }
 
+/* The cheap bound of the error model: 1 when no target can be missed at a point whose
+ * max |q| and max |dq| are at most nq and ndq (whatever its max |ddq|), s = ||Phi_q^-1||_1 /
+ * sqrt(NQ) and the residual leaving an error `left` of q; e_q into *e_q. With A = max(1, |dq|)
+ * and x = s (u + e_q), e_dq <= x A and e_ddq <= x (1 + A^2 (1 + 2 s)) max(1, |ddq|), so where
+ * e_q, x and x (1 + A^2 (1 + 2 s)) are within half their targets (the half covers the
+ * rounding of both sides) the model flags nothing. Each quantity grows with nq and ndq, also
+ * as rounded: a bound that holds for some norms holds for smaller ones. A NaN fails it. */
+static int crank_slider_within_bound(const crank_slider_options *options,
+                                     const crank_slider_report *report, crank_slider_real s,
+                                     crank_slider_real left, crank_slider_real nq, crank_slider_real ndq, crank_slider_real *e_q)
+{
+    const crank_slider_real u = CRANK_SLIDER_UNIT_ROUNDOFF;
+    const crank_slider_real rounding = s * u * (1 + nq);
+    const crank_slider_real error = left > rounding ? left : rounding;
+    const crank_slider_real x = s * (u + error), a = crank_slider_at_least_1(ndq);
+    /* all the arithmetic before the tests: its count does not depend on the values */
+    const crank_slider_real margin = 2 * CRANK_SLIDER_SAFETY, bound_dq = margin * x;
+    const crank_slider_real bound_ddq = bound_dq * (1 + a * a * (1 + 2 * s));
+    *e_q = error;
+    return report->cond < (crank_slider_real)INFINITY && margin * error <= options->target_q
+        && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
+}
+
+/* crank_slider_flagged with s and the residual's error `left` worked out. */
+static int crank_slider_flagged_at(const crank_slider_options *options,
+                                   const crank_slider_report *report, crank_slider_real s, crank_slider_real left,
+                                   crank_slider_real nq, crank_slider_real ndq, crank_slider_real nddq, int judged)
+{
+    const crank_slider_real u = CRANK_SLIDER_UNIT_ROUNDOFF;
+    const crank_slider_real a = crank_slider_at_least_1(ndq);
+    crank_slider_real e_q, e_dq, e_ddq;
+    if (crank_slider_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    if (report->cond - report->cond != 0) return 1;
+    e_dq = s * (u * ndq + e_q * a);
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
+    return crank_slider_misses(options, judged, CRANK_SLIDER_SAFETY * e_q,
+                               CRANK_SLIDER_SAFETY * e_dq, CRANK_SLIDER_SAFETY * e_ddq, nq, ndq,
+                               nddq);
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
- * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
+ * decides first; the model runs where the bound fails. */
 static int crank_slider_flagged(const crank_slider_options *options,
                                 const crank_slider_workspace *work,
                                 const crank_slider_report *report, crank_slider_real nq, crank_slider_real ndq,
                                 crank_slider_real nddq, int judged)
 {
-    const crank_slider_real u = CRANK_SLIDER_UNIT_ROUNDOFF;
     const crank_slider_real s = report->inv_norm / sqrt((crank_slider_real)CRANK_SLIDER_NQ);
-    const crank_slider_real rounding = s * u * (1 + nq);
     const crank_slider_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    crank_slider_real e_q, e_dq, e_ddq;
-    if (report->cond - report->cond != 0) return 1;
-    e_q = left > rounding ? left : rounding;
-    e_dq = s * (u * ndq + e_q * crank_slider_at_least_1(ndq));
-    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * crank_slider_at_least_1(ndq));
-    return crank_slider_misses(options, judged, CRANK_SLIDER_SAFETY * e_q,
-                               CRANK_SLIDER_SAFETY * e_dq, CRANK_SLIDER_SAFETY * e_ddq, nq, ndq,
-                               nddq);
+    return crank_slider_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -545,14 +582,26 @@ static int crank_slider_flagged_refined(const crank_slider_options *options,
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
- * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
+ * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
+ * at the end of the step too if the new norms are within those (work->clear; the residual,
+ * condition and correction unchanged), and the model need not run again there. */
 static int crank_slider_would_flag(const crank_slider_options *options,
-                                   const crank_slider_workspace *work,
+                                   crank_slider_workspace *work,
                                    const crank_slider_report *report)
 {
     const crank_slider_real *norms = work->norms;
-    return report->residual > CRANK_SLIDER_UNIT_ROUNDOFF * (1 + norms[0])
-        && crank_slider_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
+    const crank_slider_real s = report->inv_norm / sqrt((crank_slider_real)CRANK_SLIDER_NQ);
+    const crank_slider_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const crank_slider_real wide_q = 2 * norms[0] + 1, wide_dq = 2 * norms[1] + 1;
+    crank_slider_real e_q;
+    if (!(report->residual > CRANK_SLIDER_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
+    if (crank_slider_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
+        work->clear[0] = wide_q;
+        work->clear[1] = wide_dq;
+        return 0;
+    }
+    return crank_slider_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point
@@ -571,6 +620,7 @@ static int crank_slider_converged(const crank_slider_options *options, const cra
     int i, extra, moved = 0, ill;
     crank_slider_estimate(work, report);
     work->correction = -1;
+    work->clear[0] = work->clear[1] = -1; /* until the model's cheap bound clears the point */
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (crank_slider_real)INFINITY
@@ -600,6 +650,7 @@ static int crank_slider_converged(const crank_slider_options *options, const cra
         if (moved) {
             crank_slider_estimate(work, report);
         }
+        work->clear[0] = work->clear[1] = -1; /* the model decides at the end */
     }
     return report->cond <= options->max_cond ? CRANK_SLIDER_OK : CRANK_SLIDER_SINGULAR;
 }
@@ -610,7 +661,7 @@ static int crank_slider_newton(const crank_slider_options *options, const crank_
                   crank_slider_workspace *work, crank_slider_report *report)
 {
     crank_slider_real step = 0;
-    int i, iteration;
+    int iteration;
     report->t = t;
     report->pivot = -1;
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
@@ -636,26 +687,134 @@ static int crank_slider_newton(const crank_slider_options *options, const crank_
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
-            work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
-        }
+        /* the step solves Phi_q dq = -Phi in place: solved for Phi, it is subtracted */
         crank_slider_lu_solve(&work->lu, work->phi);
         step = crank_slider_max_abs(work->phi); /* in the run's unit */
         crank_slider_from_unit(work, work->phi);
-        for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
-            q[i] += work->phi[i];
-        }
+        q[0] -= work->phi[0];
+        q[1] -= work->phi[1];
+        q[2] -= work->phi[2];
+        q[3] -= work->phi[3];
+        q[4] -= work->phi[4];
+        q[5] -= work->phi[5];
+        q[6] -= work->phi[6];
+        q[7] -= work->phi[7];
+        q[8] -= work->phi[8];
     }
     return CRANK_SLIDER_NO_CONVERGENCE;
 }
 
 static void crank_slider_predict(crank_slider_real t, crank_slider_state *state)
 {
-    crank_slider_real h = t - state->t;
-    int i;
-    for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
-        state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
+    const crank_slider_real h = t - state->t, half_h2 = h * h / 2;
+    /* (2.76) */
+    state->q[0] += state->dq[0] * h + state->ddq[0] * half_h2;
+    state->q[1] += state->dq[1] * h + state->ddq[1] * half_h2;
+    state->q[2] += state->dq[2] * h + state->ddq[2] * half_h2;
+    state->q[3] += state->dq[3] * h + state->ddq[3] * half_h2;
+    state->q[4] += state->dq[4] * h + state->ddq[4] * half_h2;
+    state->q[5] += state->dq[5] * h + state->ddq[5] * half_h2;
+    state->q[6] += state->dq[6] * h + state->ddq[6] * half_h2;
+    state->q[7] += state->dq[7] * h + state->ddq[7] * half_h2;
+    state->q[8] += state->dq[8] * h + state->ddq[8] * half_h2;
+}
+
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+static crank_slider_real crank_slider_rates_pass(const crank_slider_workspace *work, crank_slider_real dq[],
+                                       crank_slider_real *finite)
+{
+    crank_slider_real largest = 0, nan = 0;
+    { const crank_slider_real b = fabs(dq[0]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[0] = -dq[0];
+    { const crank_slider_real b = fabs(dq[1]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[1] = -dq[1];
+    { const crank_slider_real b = fabs(dq[2]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[2] = -dq[2];
+    { const crank_slider_real b = fabs(dq[3]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[3] = -dq[3];
+    { const crank_slider_real b = fabs(dq[4]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[4] = -dq[4];
+    { const crank_slider_real b = fabs(dq[5]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[5] = -dq[5];
+    { const crank_slider_real b = fabs(dq[6]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[6] = -dq[6];
+    { const crank_slider_real b = fabs(dq[7]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[7] = -dq[7];
+    { const crank_slider_real b = fabs(dq[8]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[8] = -dq[8];
+    crank_slider_from_unit(work, dq);
+    *finite = nan;
+    return largest;
+}
+
+/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
+ * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
+ * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+static crank_slider_real crank_slider_accelerations_pass(const crank_slider_workspace *work,
+                                               const crank_slider_real q[], crank_slider_real ddq[],
+                                               crank_slider_real *finite, crank_slider_real *nq)
+{
+    crank_slider_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
+    { const crank_slider_real c = fabs(ddq[0]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[0]) * work->inverse_column[0];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
     }
+    { const crank_slider_real c = fabs(ddq[1]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[1]) * work->inverse_column[1];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const crank_slider_real c = fabs(ddq[2]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[2]) * work->inverse_column[2];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const crank_slider_real c = fabs(ddq[3]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[3]) * work->inverse_column[3];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const crank_slider_real c = fabs(ddq[4]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[4]) * work->inverse_column[4];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const crank_slider_real c = fabs(ddq[5]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[5]) * work->inverse_column[5];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const crank_slider_real c = fabs(ddq[6]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[6]) * work->inverse_column[6];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const crank_slider_real c = fabs(ddq[7]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[7]) * work->inverse_column[7];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const crank_slider_real c = fabs(ddq[8]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const crank_slider_real a = fabs(q[8]) * work->inverse_column[8];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    crank_slider_from_unit(work, ddq);
+    *finite = nan;
+    *nq = sum_q != sum_q ? (crank_slider_real)NAN : largest_q;
+    return largest;
 }
 
 /* crank_slider_solve_step with its options already checked. */
@@ -663,8 +822,7 @@ static int crank_slider_step(const crank_slider_options *options, const crank_sl
                              crank_slider_real t, crank_slider_state *state,
                              crank_slider_workspace *work, crank_slider_report *report)
 {
-    crank_slider_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
-    int i;
+    crank_slider_real nq, ndq, nddq, finite_dq, finite_ddq;
     report->flagged = 0;
     report->cond = (crank_slider_real)NAN;
     if (state->started) {
@@ -677,41 +835,26 @@ static int crank_slider_step(const crank_slider_options *options, const crank_sl
     if (report->status != CRANK_SLIDER_OK) {
         return report->status;
     }
-    /* Both right-hand sides are formed and solved in place in the state: no copies. Newton
-     * stopped at the q of its last fused call, so the shared sines and cosines are this q's. */
+    /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
+     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
+     * fused call, so the shared sines and cosines are this q's. */
     crank_slider_phi_t_shared(state->q, t, p, work->shared, state->dq);
-    for (i = 0; i < CRANK_SLIDER_NQ; ++i) {
-        state->dq[i] = -state->dq[i];
-    }
     crank_slider_rows_in_unit(work, state->dq);
-    crank_slider_lu_solve(&work->lu, state->dq); /* (2.73) */
-    crank_slider_from_unit(work, state->dq);
+    crank_slider_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
+    ndq = crank_slider_rates_pass(work, state->dq, &finite_dq);
     crank_slider_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     crank_slider_rows_in_unit(work, state->ddq);
     crank_slider_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    crank_slider_from_unit(work, state->ddq);
-    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
-     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
-    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < CRANK_SLIDER_NQ; ++i) { /* in the run's unit: q / column */
-        const crank_slider_real a = fabs(state->q[i]) * work->inverse_column[i];
-        const crank_slider_real b = fabs(state->dq[i]) * work->inverse_column[i];
-        const crank_slider_real c = fabs(state->ddq[i]) * work->inverse_column[i];
-        nq = a > nq ? a : nq;
-        ndq = b > ndq ? b : ndq;
-        nddq = c > nddq ? c : nddq;
-        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
-        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
-        finite_ddq += c - c;
-    }
+    nddq = crank_slider_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
     if (finite_dq != 0 || finite_ddq != 0) {
         report->status = CRANK_SLIDER_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = crank_slider_flagged_refined(options, work, report,
-                                                   sum_q != sum_q ? (crank_slider_real)NAN : nq, ndq,
-                                                   nddq, state->q, state->dq, state->ddq,
-                                                   t, p);
+    /* where the model's cheap bound cleared this point for norms up to work->clear, in
+     * Newton (the residual, condition and correction as they are now), it is not run again */
+    report->flagged = nq <= work->clear[0] && ndq <= work->clear[1]
+        ? 0 : crank_slider_flagged_refined(options, work, report, nq, ndq, nddq, state->q,
+                                           state->dq, state->ddq, t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -746,8 +889,13 @@ int crank_slider_solve_grid_checked(const crank_slider_options *options,
 {
     int k;
     report->status = CRANK_SLIDER_OK;
+    /* the options once per call, not at every step */
+    if (n > 0 && crank_slider_check_options(options) != 0) {
+        crank_slider_refused(report, t[0]);
+        return 0;
+    }
     for (k = 0; k < n; ++k) {
-        if (crank_slider_solve_step(options, p, t[k], state, work, report) != CRANK_SLIDER_OK) {
+        if (crank_slider_step(options, p, t[k], state, work, report) != CRANK_SLIDER_OK) {
             return k;
         }
         crank_slider_store(q_out, k, state->q);
@@ -804,8 +952,12 @@ int crank_slider_solve_batch(const crank_slider_options *options, const crank_sl
         out->iterations = 0;
         out->cond = out->start_cond = (crank_slider_real)NAN;
         set_options.unit = units ? units[j] : options->unit;
-        for (k = 0; k < n; ++k) {
-            if (crank_slider_solve_step(&set_options, p_set, t[k], state, work, &report) != CRANK_SLIDER_OK) {
+        /* the options (with this set's unit) once per set, not at every step */
+        if (n > 0 && crank_slider_check_options(&set_options) != 0) {
+            crank_slider_refused(&report, t[0]);
+        }
+        for (k = 0; k < n && report.status == CRANK_SLIDER_OK; ++k) {
+            if (crank_slider_step(&set_options, p_set, t[k], state, work, &report) != CRANK_SLIDER_OK) {
                 break;
             }
             out->iterations += report.iterations;

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 199 (82 add/sub, 41 mul, 11 div, 1 sqrt, 4 other calls, 27 fabs, 33 compares)
- *   Phi, Phi_q, their factorization and tests: 126; the update (a solve): 73
- * Condition at the converged q: 57; an extra iteration there (at most 3): 280
- * Velocity: 46; acceleration: 56; per-point checks: 1031; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 7300 (2915 add/sub, 1596 mul, 414 div, 42 sqrt, 124 other calls, 977 fabs, 1232 compares)
+ * One Newton iteration: 190 (73 add/sub, 41 mul, 11 div, 1 sqrt, 4 other calls, 27 fabs, 33 compares)
+ *   Phi, Phi_q, their factorization and tests: 126; the update (a solve): 64
+ * Condition at the converged q: 57; an extra iteration there (at most 3): 358
+ * Velocity: 37; acceleration: 56; per-point checks: 1039; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 7331 (2756 add/sub, 1718 mul, 406 div, 42 sqrt, 124 other calls, 977 fabs, 1308 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38062
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38093
  */
-#define CRANK_SLIDER_DRAWN_OPS_ITERATION 199   /* one Newton iteration */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2325  /* a step without its iterations */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7300  /* at the default cap, 25 */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38062  /* every factorization dense */
+#define CRANK_SLIDER_DRAWN_OPS_ITERATION 190   /* one Newton iteration */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2581  /* a step without its iterations */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7331  /* at the default cap, 25 */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38093  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     crank_slider_drawn_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     crank_slider_drawn_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_drawn_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    crank_slider_drawn_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     crank_slider_drawn_real column[CRANK_SLIDER_DRAWN_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_drawn_real inverse_column[CRANK_SLIDER_DRAWN_NQ]; /* 1 / column */
     crank_slider_drawn_real row[CRANK_SLIDER_DRAWN_NQ]; /* options->unit where Phi_i is a length, else 1 */

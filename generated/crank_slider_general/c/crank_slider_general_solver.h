@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 375 (136 add/sub, 91 mul, 13 div, 0 sqrt, 6 other calls, 68 fabs, 61 compares)
- *   Phi, Phi_q, their factorization and tests: 285; the update (a solve): 90
- * Condition at the converged q: 211; an extra iteration there (at most 3): 456
- * Velocity: 63; acceleration: 113; per-point checks: 1320; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 13058 (4778 add/sub, 3300 mul, 472 div, 10 sqrt, 186 other calls, 2254 fabs, 2058 compares)
+ * One Newton iteration: 366 (127 add/sub, 91 mul, 13 div, 0 sqrt, 6 other calls, 68 fabs, 61 compares)
+ *   Phi, Phi_q, their factorization and tests: 285; the update (a solve): 81
+ * Condition at the converged q: 211; an extra iteration there (at most 3): 534
+ * Velocity: 54; acceleration: 113; per-point checks: 1328; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 13089 (4619 add/sub, 3422 mul, 464 div, 10 sqrt, 186 other calls, 2254 fabs, 2134 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43253
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43284
  */
-#define CRANK_SLIDER_GENERAL_OPS_ITERATION 375   /* one Newton iteration */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3683  /* a step without its iterations */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13058  /* at the default cap, 25 */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43253  /* every factorization dense */
+#define CRANK_SLIDER_GENERAL_OPS_ITERATION 366   /* one Newton iteration */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3939  /* a step without its iterations */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13089  /* at the default cap, 25 */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43284  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_GENERAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     crank_slider_general_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     crank_slider_general_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_general_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    crank_slider_general_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     crank_slider_general_real column[CRANK_SLIDER_GENERAL_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_general_real inverse_column[CRANK_SLIDER_GENERAL_NQ]; /* 1 / column */
     crank_slider_general_real row[CRANK_SLIDER_GENERAL_NQ]; /* options->unit where Phi_i is a length, else 1 */

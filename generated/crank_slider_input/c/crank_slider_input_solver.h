@@ -56,23 +56,23 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 185 (75 add/sub, 35 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
- *   Phi, Phi_q, their factorization and tests: 112; the update (a solve): 73
- * Condition at the converged q: 57; an extra iteration there (at most 3): 266
- * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 6859 (2696 add/sub, 1406 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1232 compares)
+ * One Newton iteration: 176 (66 add/sub, 35 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
+ *   Phi, Phi_q, their factorization and tests: 112; the update (a solve): 64
+ * Condition at the converged q: 57; an extra iteration there (at most 3): 344
+ * Velocity: 37; acceleration: 44; per-point checks: 1016; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 6890 (2537 add/sub, 1528 mul, 406 div, 10 sqrt, 124 other calls, 977 fabs, 1308 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 7525 (3006 add/sub, 1505 mul, 465 div, 10 sqrt, 148 other calls, 1040 fabs, 1351 compares)
- *   positions only (du, ddu NULL): 7361 (2950 add/sub, 1453 mul, 447 div, 10 sqrt, 148 other calls, 1022 fabs, 1331 compares)
+ * solve_inputs, worst case: 7579 (2838 add/sub, 1653 mul, 465 div, 10 sqrt, 148 other calls, 1040 fabs, 1425 compares)
+ *   positions only (du, ddu NULL): 7424 (2791 add/sub, 1601 mul, 447 div, 10 sqrt, 148 other calls, 1022 fabs, 1405 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 656
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37621
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37652
  */
-#define CRANK_SLIDER_INPUT_OPS_ITERATION 185   /* one Newton iteration */
-#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2234  /* a step without its iterations */
-#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6859  /* at the default cap, 25 */
-#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37621  /* every factorization dense */
-#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7525  /* solve_inputs with du, ddu */
-#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7361  /* solve_inputs, du, ddu NULL */
+#define CRANK_SLIDER_INPUT_OPS_ITERATION 176   /* one Newton iteration */
+#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2490  /* a step without its iterations */
+#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6890  /* at the default cap, 25 */
+#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37652  /* every factorization dense */
+#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7579  /* solve_inputs with du, ddu */
+#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7424  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -110,6 +110,7 @@ typedef struct {
     crank_slider_input_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     crank_slider_input_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_input_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    crank_slider_input_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     crank_slider_input_real column[CRANK_SLIDER_INPUT_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_input_real inverse_column[CRANK_SLIDER_INPUT_NQ]; /* 1 / column */
     crank_slider_input_real row[CRANK_SLIDER_INPUT_NQ]; /* options->unit where Phi_i is a length, else 1 */

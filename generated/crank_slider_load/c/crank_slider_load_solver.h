@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 186 (75 add/sub, 36 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
- *   Phi, Phi_q, their factorization and tests: 113; the update (a solve): 73
- * Condition at the converged q: 57; an extra iteration there (at most 3): 267
- * Velocity: 46; acceleration: 44; per-point checks: 1008; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 6888 (2694 add/sub, 1437 mul, 414 div, 10 sqrt, 124 other calls, 977 fabs, 1232 compares)
+ * One Newton iteration: 177 (66 add/sub, 36 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
+ *   Phi, Phi_q, their factorization and tests: 113; the update (a solve): 64
+ * Condition at the converged q: 57; an extra iteration there (at most 3): 345
+ * Velocity: 37; acceleration: 44; per-point checks: 1016; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 6919 (2535 add/sub, 1559 mul, 406 div, 10 sqrt, 124 other calls, 977 fabs, 1308 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37650
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37681
  */
-#define CRANK_SLIDER_LOAD_OPS_ITERATION 186   /* one Newton iteration */
-#define CRANK_SLIDER_LOAD_OPS_STEP_FIXED 2238  /* a step without its iterations */
-#define CRANK_SLIDER_LOAD_OPS_STEP_WORST 6888  /* at the default cap, 25 */
-#define CRANK_SLIDER_LOAD_OPS_STEP_DENSE_WORST 37650  /* every factorization dense */
+#define CRANK_SLIDER_LOAD_OPS_ITERATION 177   /* one Newton iteration */
+#define CRANK_SLIDER_LOAD_OPS_STEP_FIXED 2494  /* a step without its iterations */
+#define CRANK_SLIDER_LOAD_OPS_STEP_WORST 6919  /* at the default cap, 25 */
+#define CRANK_SLIDER_LOAD_OPS_STEP_DENSE_WORST 37681  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_LOAD_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     crank_slider_load_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     crank_slider_load_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_load_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    crank_slider_load_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     crank_slider_load_real column[CRANK_SLIDER_LOAD_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_load_real inverse_column[CRANK_SLIDER_LOAD_NQ]; /* 1 / column */
     crank_slider_load_real row[CRANK_SLIDER_LOAD_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 229 (90 add/sub, 46 mul, 12 div, 0 sqrt, 7 other calls, 35 fabs, 39 compares)
- *   Phi, Phi_q, their factorization and tests: 151; the update (a solve): 78
- * Condition at the converged q: 104; an extra iteration there (at most 3): 310
- * Velocity: 64; acceleration: 98; per-point checks: 1159; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8447 (3240 add/sub, 1883 mul, 443 div, 10 sqrt, 226 other calls, 1233 fabs, 1412 compares)
+ * One Newton iteration: 220 (81 add/sub, 46 mul, 12 div, 0 sqrt, 7 other calls, 35 fabs, 39 compares)
+ *   Phi, Phi_q, their factorization and tests: 151; the update (a solve): 69
+ * Condition at the converged q: 104; an extra iteration there (at most 3): 388
+ * Velocity: 55; acceleration: 98; per-point checks: 1167; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8478 (3081 add/sub, 2005 mul, 435 div, 10 sqrt, 226 other calls, 1233 fabs, 1488 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38936
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38967
  */
-#define CUSTOM_DRIVER_OPS_ITERATION 229   /* one Newton iteration */
-#define CUSTOM_DRIVER_OPS_STEP_FIXED 2722  /* a step without its iterations */
-#define CUSTOM_DRIVER_OPS_STEP_WORST 8447  /* at the default cap, 25 */
-#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38936  /* every factorization dense */
+#define CUSTOM_DRIVER_OPS_ITERATION 220   /* one Newton iteration */
+#define CUSTOM_DRIVER_OPS_STEP_FIXED 2978  /* a step without its iterations */
+#define CUSTOM_DRIVER_OPS_STEP_WORST 8478  /* at the default cap, 25 */
+#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38967  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     custom_driver_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     custom_driver_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     custom_driver_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    custom_driver_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     custom_driver_real column[CUSTOM_DRIVER_NQ]; /* options->unit where q_i is a length, else 1 */
     custom_driver_real inverse_column[CUSTOM_DRIVER_NQ]; /* 1 / column */
     custom_driver_real row[CUSTOM_DRIVER_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 3630 (1388 add/sub, 1335 mul, 48 div, 0 sqrt, 9 other calls, 485 fabs, 365 compares)
- *   Phi, Phi_q, their factorization and tests: 3199; the update (a solve): 431
- * Condition at the converged q: 5260; an extra iteration there (at most 3): 3711
- * Velocity: 433; acceleration: 2639; per-point checks: 9257; predictor: 169
- * Step, worst case with the default cap of 25 iterations: 128157 (50548 add/sub, 47781 mul, 1660 div, 10 sqrt, 592 other calls, 15757 fabs, 11809 compares)
+ * One Newton iteration: 3602 (1360 add/sub, 1335 mul, 48 div, 0 sqrt, 9 other calls, 485 fabs, 365 compares)
+ *   Phi, Phi_q, their factorization and tests: 3199; the update (a solve): 403
+ * Condition at the converged q: 5260; an extra iteration there (at most 3): 3789
+ * Velocity: 405; acceleration: 2639; per-point checks: 9246; predictor: 115
+ * Step, worst case with the default cap of 25 iterations: 127637 (49914 add/sub, 47846 mul, 1633 div, 10 sqrt, 592 other calls, 15757 fabs, 11885 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689781
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689261
  */
-#define DELTA_OPS_ITERATION 3630   /* one Newton iteration */
-#define DELTA_OPS_STEP_FIXED 37407  /* a step without its iterations */
-#define DELTA_OPS_STEP_WORST 128157  /* at the default cap, 25 */
-#define DELTA_OPS_STEP_DENSE_WORST 689781  /* every factorization dense */
+#define DELTA_OPS_ITERATION 3602   /* one Newton iteration */
+#define DELTA_OPS_STEP_FIXED 37587  /* a step without its iterations */
+#define DELTA_OPS_STEP_WORST 127637  /* at the default cap, 25 */
+#define DELTA_OPS_STEP_DENSE_WORST 689261  /* every factorization dense */
 
 typedef struct {
     int status;                  /* DELTA_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     delta_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     delta_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     delta_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    delta_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     delta_real column[DELTA_NQ]; /* options->unit where q_i is a length, else 1 */
     delta_real inverse_column[DELTA_NQ]; /* 1 / column */
     delta_real row[DELTA_NQ]; /* options->unit where Phi_i is a length, else 1 */

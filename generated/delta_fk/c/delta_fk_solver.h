@@ -56,23 +56,23 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 3619 (1384 add/sub, 1331 mul, 48 div, 0 sqrt, 6 other calls, 485 fabs, 365 compares)
- *   Phi, Phi_q, their factorization and tests: 3188; the update (a solve): 431
- * Condition at the converged q: 5260; an extra iteration there (at most 3): 3700
- * Velocity: 423; acceleration: 2603; per-point checks: 9188; predictor: 169
- * Step, worst case with the default cap of 25 iterations: 127723 (50404 add/sub, 47611 mul, 1660 div, 10 sqrt, 472 other calls, 15757 fabs, 11809 compares)
+ * One Newton iteration: 3591 (1356 add/sub, 1331 mul, 48 div, 0 sqrt, 6 other calls, 485 fabs, 365 compares)
+ *   Phi, Phi_q, their factorization and tests: 3188; the update (a solve): 403
+ * Condition at the converged q: 5260; an extra iteration there (at most 3): 3778
+ * Velocity: 395; acceleration: 2603; per-point checks: 9177; predictor: 115
+ * Step, worst case with the default cap of 25 iterations: 127203 (49770 add/sub, 47676 mul, 1633 div, 10 sqrt, 472 other calls, 15757 fabs, 11885 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 134107 (53292 add/sub, 50420 mul, 1806 div, 10 sqrt, 508 other calls, 15953 fabs, 12118 compares)
- *   positions only (du, ddu NULL): 130855 (51914 add/sub, 48716 mul, 1750 div, 10 sqrt, 508 other calls, 15897 fabs, 12060 compares)
+ * solve_inputs, worst case: 133667 (52630 add/sub, 50568 mul, 1806 div, 10 sqrt, 508 other calls, 15953 fabs, 12192 compares)
+ *   positions only (du, ddu NULL): 130443 (51280 add/sub, 48864 mul, 1750 div, 10 sqrt, 508 other calls, 15897 fabs, 12134 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 6374
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689347
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 688827
  */
-#define DELTA_FK_OPS_ITERATION 3619   /* one Newton iteration */
-#define DELTA_FK_OPS_STEP_FIXED 37248  /* a step without its iterations */
-#define DELTA_FK_OPS_STEP_WORST 127723  /* at the default cap, 25 */
-#define DELTA_FK_OPS_STEP_DENSE_WORST 689347  /* every factorization dense */
-#define DELTA_FK_OPS_INPUTS_WORST 134107  /* solve_inputs with du, ddu */
-#define DELTA_FK_OPS_POSITIONS_WORST 130855  /* solve_inputs, du, ddu NULL */
+#define DELTA_FK_OPS_ITERATION 3591   /* one Newton iteration */
+#define DELTA_FK_OPS_STEP_FIXED 37428  /* a step without its iterations */
+#define DELTA_FK_OPS_STEP_WORST 127203  /* at the default cap, 25 */
+#define DELTA_FK_OPS_STEP_DENSE_WORST 688827  /* every factorization dense */
+#define DELTA_FK_OPS_INPUTS_WORST 133667  /* solve_inputs with du, ddu */
+#define DELTA_FK_OPS_POSITIONS_WORST 130443  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* DELTA_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -110,6 +110,7 @@ typedef struct {
     delta_fk_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     delta_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     delta_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    delta_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     delta_fk_real column[DELTA_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     delta_fk_real inverse_column[DELTA_FK_NQ]; /* 1 / column */
     delta_fk_real row[DELTA_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -70,12 +70,17 @@ static int four_bar_dynamics_refused(four_bar_dynamics_report *report, four_bar_
 static four_bar_dynamics_real four_bar_dynamics_max_abs(const four_bar_dynamics_real v[])
 {
     four_bar_dynamics_real largest = 0, sum = 0;
-    int i;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        four_bar_dynamics_real a = fabs(v[i]);
-        largest = a > largest ? a : largest; /* branch-free max */
-        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
-    }
+    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
+     * inf cannot occur) */
+    { const four_bar_dynamics_real a = fabs(v[0]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[1]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[2]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[3]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[4]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[5]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[6]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[7]); largest = a > largest ? a : largest; sum += a; }
+    { const four_bar_dynamics_real a = fabs(v[8]); largest = a > largest ? a : largest; sum += a; }
     return sum != sum ? (four_bar_dynamics_real)NAN : largest;
 }
 
@@ -407,26 +412,58 @@ static int four_bar_dynamics_misses(const four_bar_dynamics_options *options, in
         || (judged > 1 && e_ddq > options->target_ddq * four_bar_dynamics_at_least_1(nddq));
 }
 
+/* The cheap bound of the error model: 1 when no target can be missed at a point whose
+ * max |q| and max |dq| are at most nq and ndq (whatever its max |ddq|), s = ||Phi_q^-1||_1 /
+ * sqrt(NQ) and the residual leaving an error `left` of q; e_q into *e_q. With A = max(1, |dq|)
+ * and x = s (u + e_q), e_dq <= x A and e_ddq <= x (1 + A^2 (1 + 2 s)) max(1, |ddq|), so where
+ * e_q, x and x (1 + A^2 (1 + 2 s)) are within half their targets (the half covers the
+ * rounding of both sides) the model flags nothing. Each quantity grows with nq and ndq, also
+ * as rounded: a bound that holds for some norms holds for smaller ones. A NaN fails it. */
+static int four_bar_dynamics_within_bound(const four_bar_dynamics_options *options,
+                                     const four_bar_dynamics_report *report, four_bar_dynamics_real s,
+                                     four_bar_dynamics_real left, four_bar_dynamics_real nq, four_bar_dynamics_real ndq, four_bar_dynamics_real *e_q)
+{
+    const four_bar_dynamics_real u = FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF;
+    const four_bar_dynamics_real rounding = s * u * (1 + nq);
+    const four_bar_dynamics_real error = left > rounding ? left : rounding;
+    const four_bar_dynamics_real x = s * (u + error), a = four_bar_dynamics_at_least_1(ndq);
+    /* all the arithmetic before the tests: its count does not depend on the values */
+    const four_bar_dynamics_real margin = 2 * FOUR_BAR_DYNAMICS_SAFETY, bound_dq = margin * x;
+    const four_bar_dynamics_real bound_ddq = bound_dq * (1 + a * a * (1 + 2 * s));
+    *e_q = error;
+    return report->cond < (four_bar_dynamics_real)INFINITY && margin * error <= options->target_q
+        && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
+}
+
+/* four_bar_dynamics_flagged with s and the residual's error `left` worked out. */
+static int four_bar_dynamics_flagged_at(const four_bar_dynamics_options *options,
+                                   const four_bar_dynamics_report *report, four_bar_dynamics_real s, four_bar_dynamics_real left,
+                                   four_bar_dynamics_real nq, four_bar_dynamics_real ndq, four_bar_dynamics_real nddq, int judged)
+{
+    const four_bar_dynamics_real u = FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF;
+    const four_bar_dynamics_real a = four_bar_dynamics_at_least_1(ndq);
+    four_bar_dynamics_real e_q, e_dq, e_ddq;
+    if (four_bar_dynamics_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    if (report->cond - report->cond != 0) return 1;
+    e_dq = s * (u * ndq + e_q * a);
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
+    return four_bar_dynamics_misses(options, judged, FOUR_BAR_DYNAMICS_SAFETY * e_q,
+                               FOUR_BAR_DYNAMICS_SAFETY * e_dq, FOUR_BAR_DYNAMICS_SAFETY * e_ddq, nq, ndq,
+                               nddq);
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
- * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
+ * decides first; the model runs where the bound fails. */
 static int four_bar_dynamics_flagged(const four_bar_dynamics_options *options,
                                 const four_bar_dynamics_workspace *work,
                                 const four_bar_dynamics_report *report, four_bar_dynamics_real nq, four_bar_dynamics_real ndq,
                                 four_bar_dynamics_real nddq, int judged)
 {
-    const four_bar_dynamics_real u = FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF;
     const four_bar_dynamics_real s = report->inv_norm / sqrt((four_bar_dynamics_real)FOUR_BAR_DYNAMICS_NQ);
-    const four_bar_dynamics_real rounding = s * u * (1 + nq);
     const four_bar_dynamics_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    four_bar_dynamics_real e_q, e_dq, e_ddq;
-    if (report->cond - report->cond != 0) return 1;
-    e_q = left > rounding ? left : rounding;
-    e_dq = s * (u * ndq + e_q * four_bar_dynamics_at_least_1(ndq));
-    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * four_bar_dynamics_at_least_1(ndq));
-    return four_bar_dynamics_misses(options, judged, FOUR_BAR_DYNAMICS_SAFETY * e_q,
-                               FOUR_BAR_DYNAMICS_SAFETY * e_dq, FOUR_BAR_DYNAMICS_SAFETY * e_ddq, nq, ndq,
-                               nddq);
+    return four_bar_dynamics_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -560,14 +597,26 @@ static int four_bar_dynamics_flagged_refined(const four_bar_dynamics_options *op
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
- * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
+ * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
+ * at the end of the step too if the new norms are within those (work->clear; the residual,
+ * condition and correction unchanged), and the model need not run again there. */
 static int four_bar_dynamics_would_flag(const four_bar_dynamics_options *options,
-                                   const four_bar_dynamics_workspace *work,
+                                   four_bar_dynamics_workspace *work,
                                    const four_bar_dynamics_report *report)
 {
     const four_bar_dynamics_real *norms = work->norms;
-    return report->residual > FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF * (1 + norms[0])
-        && four_bar_dynamics_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
+    const four_bar_dynamics_real s = report->inv_norm / sqrt((four_bar_dynamics_real)FOUR_BAR_DYNAMICS_NQ);
+    const four_bar_dynamics_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const four_bar_dynamics_real wide_q = 2 * norms[0] + 1, wide_dq = 2 * norms[1] + 1;
+    four_bar_dynamics_real e_q;
+    if (!(report->residual > FOUR_BAR_DYNAMICS_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
+    if (four_bar_dynamics_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
+        work->clear[0] = wide_q;
+        work->clear[1] = wide_dq;
+        return 0;
+    }
+    return four_bar_dynamics_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point
@@ -586,6 +635,7 @@ static int four_bar_dynamics_converged(const four_bar_dynamics_options *options,
     int i, extra, moved = 0, ill;
     four_bar_dynamics_estimate(work, report);
     work->correction = -1;
+    work->clear[0] = work->clear[1] = -1; /* until the model's cheap bound clears the point */
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (four_bar_dynamics_real)INFINITY
@@ -615,6 +665,7 @@ static int four_bar_dynamics_converged(const four_bar_dynamics_options *options,
         if (moved) {
             four_bar_dynamics_estimate(work, report);
         }
+        work->clear[0] = work->clear[1] = -1; /* the model decides at the end */
     }
     return report->cond <= options->max_cond ? FOUR_BAR_DYNAMICS_OK : FOUR_BAR_DYNAMICS_SINGULAR;
 }
@@ -625,7 +676,7 @@ static int four_bar_dynamics_newton(const four_bar_dynamics_options *options, co
                   four_bar_dynamics_workspace *work, four_bar_dynamics_report *report)
 {
     four_bar_dynamics_real step = 0;
-    int i, iteration;
+    int iteration;
     report->t = t;
     report->pivot = -1;
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
@@ -651,26 +702,134 @@ static int four_bar_dynamics_newton(const four_bar_dynamics_options *options, co
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-            work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
-        }
+        /* the step solves Phi_q dq = -Phi in place: solved for Phi, it is subtracted */
         four_bar_dynamics_lu_solve(&work->lu, work->phi);
         step = four_bar_dynamics_max_abs(work->phi); /* in the run's unit */
         four_bar_dynamics_from_unit(work, work->phi);
-        for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-            q[i] += work->phi[i];
-        }
+        q[0] -= work->phi[0];
+        q[1] -= work->phi[1];
+        q[2] -= work->phi[2];
+        q[3] -= work->phi[3];
+        q[4] -= work->phi[4];
+        q[5] -= work->phi[5];
+        q[6] -= work->phi[6];
+        q[7] -= work->phi[7];
+        q[8] -= work->phi[8];
     }
     return FOUR_BAR_DYNAMICS_NO_CONVERGENCE;
 }
 
 static void four_bar_dynamics_predict(four_bar_dynamics_real t, four_bar_dynamics_state *state)
 {
-    four_bar_dynamics_real h = t - state->t;
-    int i;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
+    const four_bar_dynamics_real h = t - state->t, half_h2 = h * h / 2;
+    /* (2.76) */
+    state->q[0] += state->dq[0] * h + state->ddq[0] * half_h2;
+    state->q[1] += state->dq[1] * h + state->ddq[1] * half_h2;
+    state->q[2] += state->dq[2] * h + state->ddq[2] * half_h2;
+    state->q[3] += state->dq[3] * h + state->ddq[3] * half_h2;
+    state->q[4] += state->dq[4] * h + state->ddq[4] * half_h2;
+    state->q[5] += state->dq[5] * h + state->ddq[5] * half_h2;
+    state->q[6] += state->dq[6] * h + state->ddq[6] * half_h2;
+    state->q[7] += state->dq[7] * h + state->ddq[7] * half_h2;
+    state->q[8] += state->dq[8] * h + state->ddq[8] * half_h2;
+}
+
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+static four_bar_dynamics_real four_bar_dynamics_rates_pass(const four_bar_dynamics_workspace *work, four_bar_dynamics_real dq[],
+                                       four_bar_dynamics_real *finite)
+{
+    four_bar_dynamics_real largest = 0, nan = 0;
+    { const four_bar_dynamics_real b = fabs(dq[0]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[0] = -dq[0];
+    { const four_bar_dynamics_real b = fabs(dq[1]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[1] = -dq[1];
+    { const four_bar_dynamics_real b = fabs(dq[2]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[2] = -dq[2];
+    { const four_bar_dynamics_real b = fabs(dq[3]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[3] = -dq[3];
+    { const four_bar_dynamics_real b = fabs(dq[4]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[4] = -dq[4];
+    { const four_bar_dynamics_real b = fabs(dq[5]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[5] = -dq[5];
+    { const four_bar_dynamics_real b = fabs(dq[6]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[6] = -dq[6];
+    { const four_bar_dynamics_real b = fabs(dq[7]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[7] = -dq[7];
+    { const four_bar_dynamics_real b = fabs(dq[8]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[8] = -dq[8];
+    four_bar_dynamics_from_unit(work, dq);
+    *finite = nan;
+    return largest;
+}
+
+/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
+ * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
+ * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+static four_bar_dynamics_real four_bar_dynamics_accelerations_pass(const four_bar_dynamics_workspace *work,
+                                               const four_bar_dynamics_real q[], four_bar_dynamics_real ddq[],
+                                               four_bar_dynamics_real *finite, four_bar_dynamics_real *nq)
+{
+    four_bar_dynamics_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
+    { const four_bar_dynamics_real c = fabs(ddq[0]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[0]) * work->inverse_column[0];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
     }
+    { const four_bar_dynamics_real c = fabs(ddq[1]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[1]) * work->inverse_column[1];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const four_bar_dynamics_real c = fabs(ddq[2]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[2]) * work->inverse_column[2];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const four_bar_dynamics_real c = fabs(ddq[3]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[3]) * work->inverse_column[3];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const four_bar_dynamics_real c = fabs(ddq[4]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[4]) * work->inverse_column[4];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const four_bar_dynamics_real c = fabs(ddq[5]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[5]) * work->inverse_column[5];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const four_bar_dynamics_real c = fabs(ddq[6]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[6]) * work->inverse_column[6];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const four_bar_dynamics_real c = fabs(ddq[7]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[7]) * work->inverse_column[7];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const four_bar_dynamics_real c = fabs(ddq[8]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const four_bar_dynamics_real a = fabs(q[8]) * work->inverse_column[8];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    four_bar_dynamics_from_unit(work, ddq);
+    *finite = nan;
+    *nq = sum_q != sum_q ? (four_bar_dynamics_real)NAN : largest_q;
+    return largest;
 }
 
 /* four_bar_dynamics_solve_step with its options already checked. */
@@ -678,8 +837,7 @@ static int four_bar_dynamics_step(const four_bar_dynamics_options *options, cons
                              four_bar_dynamics_real t, four_bar_dynamics_state *state,
                              four_bar_dynamics_workspace *work, four_bar_dynamics_report *report)
 {
-    four_bar_dynamics_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
-    int i;
+    four_bar_dynamics_real nq, ndq, nddq, finite_dq, finite_ddq;
     report->flagged = 0;
     report->cond = (four_bar_dynamics_real)NAN;
     if (state->started) {
@@ -692,41 +850,26 @@ static int four_bar_dynamics_step(const four_bar_dynamics_options *options, cons
     if (report->status != FOUR_BAR_DYNAMICS_OK) {
         return report->status;
     }
-    /* Both right-hand sides are formed and solved in place in the state: no copies. Newton
-     * stopped at the q of its last fused call, so the shared sines and cosines are this q's. */
+    /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
+     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
+     * fused call, so the shared sines and cosines are this q's. */
     four_bar_dynamics_phi_t_shared(state->q, t, p, work->shared, state->dq);
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        state->dq[i] = -state->dq[i];
-    }
     four_bar_dynamics_rows_in_unit(work, state->dq);
-    four_bar_dynamics_lu_solve(&work->lu, state->dq); /* (2.73) */
-    four_bar_dynamics_from_unit(work, state->dq);
+    four_bar_dynamics_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
+    ndq = four_bar_dynamics_rates_pass(work, state->dq, &finite_dq);
     four_bar_dynamics_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     four_bar_dynamics_rows_in_unit(work, state->ddq);
     four_bar_dynamics_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    four_bar_dynamics_from_unit(work, state->ddq);
-    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
-     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
-    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) { /* in the run's unit: q / column */
-        const four_bar_dynamics_real a = fabs(state->q[i]) * work->inverse_column[i];
-        const four_bar_dynamics_real b = fabs(state->dq[i]) * work->inverse_column[i];
-        const four_bar_dynamics_real c = fabs(state->ddq[i]) * work->inverse_column[i];
-        nq = a > nq ? a : nq;
-        ndq = b > ndq ? b : ndq;
-        nddq = c > nddq ? c : nddq;
-        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
-        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
-        finite_ddq += c - c;
-    }
+    nddq = four_bar_dynamics_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
     if (finite_dq != 0 || finite_ddq != 0) {
         report->status = FOUR_BAR_DYNAMICS_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = four_bar_dynamics_flagged_refined(options, work, report,
-                                                   sum_q != sum_q ? (four_bar_dynamics_real)NAN : nq, ndq,
-                                                   nddq, state->q, state->dq, state->ddq,
-                                                   t, p);
+    /* where the model's cheap bound cleared this point for norms up to work->clear, in
+     * Newton (the residual, condition and correction as they are now), it is not run again */
+    report->flagged = nq <= work->clear[0] && ndq <= work->clear[1]
+        ? 0 : four_bar_dynamics_flagged_refined(options, work, report, nq, ndq, nddq, state->q,
+                                           state->dq, state->ddq, t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -775,8 +918,13 @@ int four_bar_dynamics_solve_grid_checked(const four_bar_dynamics_options *option
 {
     int k;
     report->status = FOUR_BAR_DYNAMICS_OK;
+    /* the options once per call, not at every step */
+    if (n > 0 && four_bar_dynamics_check_options(options) != 0) {
+        four_bar_dynamics_refused(report, t[0]);
+        return 0;
+    }
     for (k = 0; k < n; ++k) {
-        if (four_bar_dynamics_solve_step(options, p, t[k], state, work, report) != FOUR_BAR_DYNAMICS_OK) {
+        if (four_bar_dynamics_step(options, p, t[k], state, work, report) != FOUR_BAR_DYNAMICS_OK) {
             return k;
         }
         four_bar_dynamics_store(q_out, k, state->q);
@@ -841,8 +989,12 @@ int four_bar_dynamics_solve_batch(const four_bar_dynamics_options *options, cons
         out->iterations = 0;
         out->cond = out->start_cond = (four_bar_dynamics_real)NAN;
         set_options.unit = units ? units[j] : options->unit;
-        for (k = 0; k < n; ++k) {
-            if (four_bar_dynamics_solve_step(&set_options, p_set, t[k], state, work, &report) != FOUR_BAR_DYNAMICS_OK) {
+        /* the options (with this set's unit) once per set, not at every step */
+        if (n > 0 && four_bar_dynamics_check_options(&set_options) != 0) {
+            four_bar_dynamics_refused(&report, t[0]);
+        }
+        for (k = 0; k < n && report.status == FOUR_BAR_DYNAMICS_OK; ++k) {
+            if (four_bar_dynamics_step(&set_options, p_set, t[k], state, work, &report) != FOUR_BAR_DYNAMICS_OK) {
                 break;
             }
             out->iterations += report.iterations;

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 234 (85 add/sub, 46 mul, 12 div, 0 sqrt, 6 other calls, 42 fabs, 43 compares)
- *   Phi, Phi_q, their factorization and tests: 159; the update (a solve): 75
- * Condition at the converged q: 83; an extra iteration there (at most 3): 315
- * Velocity: 48; acceleration: 52; per-point checks: 1051; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8383 (3019 add/sub, 1773 mul, 443 div, 10 sqrt, 186 other calls, 1424 fabs, 1528 compares)
+ * One Newton iteration: 225 (76 add/sub, 46 mul, 12 div, 0 sqrt, 6 other calls, 42 fabs, 43 compares)
+ *   Phi, Phi_q, their factorization and tests: 159; the update (a solve): 66
+ * Condition at the converged q: 83; an extra iteration there (at most 3): 393
+ * Velocity: 39; acceleration: 52; per-point checks: 1059; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8414 (2860 add/sub, 1895 mul, 435 div, 10 sqrt, 186 other calls, 1424 fabs, 1604 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39031
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39062
  */
-#define FOUR_BAR_DYNAMICS_OPS_ITERATION 234   /* one Newton iteration */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2533  /* a step without its iterations */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8383  /* at the default cap, 25 */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39031  /* every factorization dense */
+#define FOUR_BAR_DYNAMICS_OPS_ITERATION 225   /* one Newton iteration */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2789  /* a step without its iterations */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8414  /* at the default cap, 25 */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39062  /* every factorization dense */
 
 typedef struct {
     int status;                  /* FOUR_BAR_DYNAMICS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     four_bar_dynamics_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     four_bar_dynamics_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     four_bar_dynamics_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    four_bar_dynamics_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     four_bar_dynamics_real column[FOUR_BAR_DYNAMICS_NQ]; /* options->unit where q_i is a length, else 1 */
     four_bar_dynamics_real inverse_column[FOUR_BAR_DYNAMICS_NQ]; /* 1 / column */
     four_bar_dynamics_real row[FOUR_BAR_DYNAMICS_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 326 (120 add/sub, 71 mul, 16 div, 0 sqrt, 10 other calls, 55 fabs, 54 compares)
- *   Phi, Phi_q, their factorization and tests: 224; the update (a solve): 102
- * Condition at the converged q: 154; an extra iteration there (at most 3): 407
- * Velocity: 65; acceleration: 93; per-point checks: 1431; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 11622 (4280 add/sub, 2651 mul, 586 div, 10 sqrt, 310 other calls, 1889 fabs, 1896 compares)
+ * One Newton iteration: 314 (108 add/sub, 71 mul, 16 div, 0 sqrt, 10 other calls, 55 fabs, 54 compares)
+ *   Phi, Phi_q, their factorization and tests: 224; the update (a solve): 90
+ * Condition at the converged q: 154; an extra iteration there (at most 3): 485
+ * Velocity: 53; acceleration: 93; per-point checks: 1436; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 11566 (4046 add/sub, 2764 mul, 575 div, 10 sqrt, 310 other calls, 1889 fabs, 1972 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73419
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73363
  */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_ITERATION 326   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3472  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11622  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73419  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_ITERATION 314   /* one Newton iteration */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3716  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11566  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73363  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     parallelogram_extra_bar_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     parallelogram_extra_bar_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     parallelogram_extra_bar_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    parallelogram_extra_bar_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     parallelogram_extra_bar_real column[PARALLELOGRAM_EXTRA_BAR_NQ]; /* options->unit where q_i is a length, else 1 */
     parallelogram_extra_bar_real inverse_column[PARALLELOGRAM_EXTRA_BAR_NQ]; /* 1 / column */
     parallelogram_extra_bar_real row[PARALLELOGRAM_EXTRA_BAR_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 396 (153 add/sub, 88 mul, 19 div, 0 sqrt, 11 other calls, 63 fabs, 62 compares)
- *   Phi, Phi_q, their factorization and tests: 267; the update (a solve): 129
- * Condition at the converged q: 231; an extra iteration there (at most 3): 477
- * Velocity: 88; acceleration: 113; per-point checks: 1784; predictor: 91
- * Step, worst case with the default cap of 25 iterations: 14193 (5479 add/sub, 3262 mul, 700 div, 10 sqrt, 342 other calls, 2233 fabs, 2167 compares)
+ * One Newton iteration: 381 (138 add/sub, 88 mul, 19 div, 0 sqrt, 11 other calls, 63 fabs, 62 compares)
+ *   Phi, Phi_q, their factorization and tests: 267; the update (a solve): 114
+ * Condition at the converged q: 231; an extra iteration there (at most 3): 555
+ * Velocity: 73; acceleration: 113; per-point checks: 1786; predictor: 63
+ * Step, worst case with the default cap of 25 iterations: 14050 (5170 add/sub, 3366 mul, 686 div, 10 sqrt, 342 other calls, 2233 fabs, 2243 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123329
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123186
  */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_ITERATION 396   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4293  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 14193  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123329  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_ITERATION 381   /* one Newton iteration */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4525  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 14050  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123186  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_LOADS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     parallelogram_extra_bar_loads_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     parallelogram_extra_bar_loads_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     parallelogram_extra_bar_loads_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    parallelogram_extra_bar_loads_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     parallelogram_extra_bar_loads_real column[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* options->unit where q_i is a length, else 1 */
     parallelogram_extra_bar_loads_real inverse_column[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* 1 / column */
     parallelogram_extra_bar_loads_real row[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* options->unit where Phi_i is a length, else 1 */

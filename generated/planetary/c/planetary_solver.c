@@ -70,12 +70,17 @@ static int planetary_refused(planetary_report *report, planetary_real t)
 static planetary_real planetary_max_abs(const planetary_real v[])
 {
     planetary_real largest = 0, sum = 0;
-    int i;
-    for (i = 0; i < PLANETARY_NQ; ++i) {
-        planetary_real a = fabs(v[i]);
-        largest = a > largest ? a : largest; /* branch-free max */
-        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
-    }
+    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
+     * inf cannot occur) */
+    { const planetary_real a = fabs(v[0]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[1]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[2]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[3]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[4]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[5]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[6]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[7]); largest = a > largest ? a : largest; sum += a; }
+    { const planetary_real a = fabs(v[8]); largest = a > largest ? a : largest; sum += a; }
     return sum != sum ? (planetary_real)NAN : largest;
 }
 
@@ -400,26 +405,58 @@ static int planetary_misses(const planetary_options *options, int judged, planet
         || (judged > 1 && e_ddq > options->target_ddq * planetary_at_least_1(nddq));
 }
 
+/* The cheap bound of the error model: 1 when no target can be missed at a point whose
+ * max |q| and max |dq| are at most nq and ndq (whatever its max |ddq|), s = ||Phi_q^-1||_1 /
+ * sqrt(NQ) and the residual leaving an error `left` of q; e_q into *e_q. With A = max(1, |dq|)
+ * and x = s (u + e_q), e_dq <= x A and e_ddq <= x (1 + A^2 (1 + 2 s)) max(1, |ddq|), so where
+ * e_q, x and x (1 + A^2 (1 + 2 s)) are within half their targets (the half covers the
+ * rounding of both sides) the model flags nothing. Each quantity grows with nq and ndq, also
+ * as rounded: a bound that holds for some norms holds for smaller ones. A NaN fails it. */
+static int planetary_within_bound(const planetary_options *options,
+                                     const planetary_report *report, planetary_real s,
+                                     planetary_real left, planetary_real nq, planetary_real ndq, planetary_real *e_q)
+{
+    const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
+    const planetary_real rounding = s * u * (1 + nq);
+    const planetary_real error = left > rounding ? left : rounding;
+    const planetary_real x = s * (u + error), a = planetary_at_least_1(ndq);
+    /* all the arithmetic before the tests: its count does not depend on the values */
+    const planetary_real margin = 2 * PLANETARY_SAFETY, bound_dq = margin * x;
+    const planetary_real bound_ddq = bound_dq * (1 + a * a * (1 + 2 * s));
+    *e_q = error;
+    return report->cond < (planetary_real)INFINITY && margin * error <= options->target_q
+        && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
+}
+
+/* planetary_flagged with s and the residual's error `left` worked out. */
+static int planetary_flagged_at(const planetary_options *options,
+                                   const planetary_report *report, planetary_real s, planetary_real left,
+                                   planetary_real nq, planetary_real ndq, planetary_real nddq, int judged)
+{
+    const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
+    const planetary_real a = planetary_at_least_1(ndq);
+    planetary_real e_q, e_dq, e_ddq;
+    if (planetary_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    if (report->cond - report->cond != 0) return 1;
+    e_dq = s * (u * ndq + e_q * a);
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
+    return planetary_misses(options, judged, PLANETARY_SAFETY * e_q,
+                               PLANETARY_SAFETY * e_dq, PLANETARY_SAFETY * e_ddq, nq, ndq,
+                               nddq);
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
- * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
+ * decides first; the model runs where the bound fails. */
 static int planetary_flagged(const planetary_options *options,
                                 const planetary_workspace *work,
                                 const planetary_report *report, planetary_real nq, planetary_real ndq,
                                 planetary_real nddq, int judged)
 {
-    const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
     const planetary_real s = report->inv_norm / sqrt((planetary_real)PLANETARY_NQ);
-    const planetary_real rounding = s * u * (1 + nq);
     const planetary_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    planetary_real e_q, e_dq, e_ddq;
-    if (report->cond - report->cond != 0) return 1;
-    e_q = left > rounding ? left : rounding;
-    e_dq = s * (u * ndq + e_q * planetary_at_least_1(ndq));
-    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * planetary_at_least_1(ndq));
-    return planetary_misses(options, judged, PLANETARY_SAFETY * e_q,
-                               PLANETARY_SAFETY * e_dq, PLANETARY_SAFETY * e_ddq, nq, ndq,
-                               nddq);
+    return planetary_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -553,14 +590,26 @@ static int planetary_flagged_refined(const planetary_options *options,
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
- * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
+ * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
+ * at the end of the step too if the new norms are within those (work->clear; the residual,
+ * condition and correction unchanged), and the model need not run again there. */
 static int planetary_would_flag(const planetary_options *options,
-                                   const planetary_workspace *work,
+                                   planetary_workspace *work,
                                    const planetary_report *report)
 {
     const planetary_real *norms = work->norms;
-    return report->residual > PLANETARY_UNIT_ROUNDOFF * (1 + norms[0])
-        && planetary_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
+    const planetary_real s = report->inv_norm / sqrt((planetary_real)PLANETARY_NQ);
+    const planetary_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const planetary_real wide_q = 2 * norms[0] + 1, wide_dq = 2 * norms[1] + 1;
+    planetary_real e_q;
+    if (!(report->residual > PLANETARY_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
+    if (planetary_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
+        work->clear[0] = wide_q;
+        work->clear[1] = wide_dq;
+        return 0;
+    }
+    return planetary_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point
@@ -579,6 +628,7 @@ static int planetary_converged(const planetary_options *options, const planetary
     int i, extra, moved = 0, ill;
     planetary_estimate(work, report);
     work->correction = -1;
+    work->clear[0] = work->clear[1] = -1; /* until the model's cheap bound clears the point */
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (planetary_real)INFINITY
@@ -608,6 +658,7 @@ static int planetary_converged(const planetary_options *options, const planetary
         if (moved) {
             planetary_estimate(work, report);
         }
+        work->clear[0] = work->clear[1] = -1; /* the model decides at the end */
     }
     return report->cond <= options->max_cond ? PLANETARY_OK : PLANETARY_SINGULAR;
 }
@@ -618,7 +669,7 @@ static int planetary_newton(const planetary_options *options, const planetary_re
                   planetary_workspace *work, planetary_report *report)
 {
     planetary_real step = 0;
-    int i, iteration;
+    int iteration;
     report->t = t;
     report->pivot = -1;
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
@@ -644,26 +695,134 @@ static int planetary_newton(const planetary_options *options, const planetary_re
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < PLANETARY_NQ; ++i) {
-            work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
-        }
+        /* the step solves Phi_q dq = -Phi in place: solved for Phi, it is subtracted */
         planetary_lu_solve(&work->lu, work->phi);
         step = planetary_max_abs(work->phi); /* in the run's unit */
         planetary_from_unit(work, work->phi);
-        for (i = 0; i < PLANETARY_NQ; ++i) {
-            q[i] += work->phi[i];
-        }
+        q[0] -= work->phi[0];
+        q[1] -= work->phi[1];
+        q[2] -= work->phi[2];
+        q[3] -= work->phi[3];
+        q[4] -= work->phi[4];
+        q[5] -= work->phi[5];
+        q[6] -= work->phi[6];
+        q[7] -= work->phi[7];
+        q[8] -= work->phi[8];
     }
     return PLANETARY_NO_CONVERGENCE;
 }
 
 static void planetary_predict(planetary_real t, planetary_state *state)
 {
-    planetary_real h = t - state->t;
-    int i;
-    for (i = 0; i < PLANETARY_NQ; ++i) {
-        state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
+    const planetary_real h = t - state->t, half_h2 = h * h / 2;
+    /* (2.76) */
+    state->q[0] += state->dq[0] * h + state->ddq[0] * half_h2;
+    state->q[1] += state->dq[1] * h + state->ddq[1] * half_h2;
+    state->q[2] += state->dq[2] * h + state->ddq[2] * half_h2;
+    state->q[3] += state->dq[3] * h + state->ddq[3] * half_h2;
+    state->q[4] += state->dq[4] * h + state->ddq[4] * half_h2;
+    state->q[5] += state->dq[5] * h + state->ddq[5] * half_h2;
+    state->q[6] += state->dq[6] * h + state->ddq[6] * half_h2;
+    state->q[7] += state->dq[7] * h + state->ddq[7] * half_h2;
+    state->q[8] += state->dq[8] * h + state->ddq[8] * half_h2;
+}
+
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+static planetary_real planetary_rates_pass(const planetary_workspace *work, planetary_real dq[],
+                                       planetary_real *finite)
+{
+    planetary_real largest = 0, nan = 0;
+    { const planetary_real b = fabs(dq[0]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[0] = -dq[0];
+    { const planetary_real b = fabs(dq[1]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[1] = -dq[1];
+    { const planetary_real b = fabs(dq[2]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[2] = -dq[2];
+    { const planetary_real b = fabs(dq[3]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[3] = -dq[3];
+    { const planetary_real b = fabs(dq[4]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[4] = -dq[4];
+    { const planetary_real b = fabs(dq[5]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[5] = -dq[5];
+    { const planetary_real b = fabs(dq[6]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[6] = -dq[6];
+    { const planetary_real b = fabs(dq[7]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[7] = -dq[7];
+    { const planetary_real b = fabs(dq[8]); largest = b > largest ? b : largest; nan += b - b; }
+    dq[8] = -dq[8];
+    planetary_from_unit(work, dq);
+    *finite = nan;
+    return largest;
+}
+
+/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
+ * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
+ * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+static planetary_real planetary_accelerations_pass(const planetary_workspace *work,
+                                               const planetary_real q[], planetary_real ddq[],
+                                               planetary_real *finite, planetary_real *nq)
+{
+    planetary_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
+    { const planetary_real c = fabs(ddq[0]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[0]) * work->inverse_column[0];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
     }
+    { const planetary_real c = fabs(ddq[1]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[1]) * work->inverse_column[1];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const planetary_real c = fabs(ddq[2]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[2]) * work->inverse_column[2];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const planetary_real c = fabs(ddq[3]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[3]) * work->inverse_column[3];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const planetary_real c = fabs(ddq[4]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[4]) * work->inverse_column[4];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const planetary_real c = fabs(ddq[5]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[5]) * work->inverse_column[5];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const planetary_real c = fabs(ddq[6]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[6]) * work->inverse_column[6];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const planetary_real c = fabs(ddq[7]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[7]) * work->inverse_column[7];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    { const planetary_real c = fabs(ddq[8]); largest = c > largest ? c : largest; nan += c - c; }
+    {
+        const planetary_real a = fabs(q[8]) * work->inverse_column[8];
+        largest_q = a > largest_q ? a : largest_q;
+        sum_q += a;
+    }
+    planetary_from_unit(work, ddq);
+    *finite = nan;
+    *nq = sum_q != sum_q ? (planetary_real)NAN : largest_q;
+    return largest;
 }
 
 /* planetary_solve_step with its options already checked. */
@@ -671,8 +830,7 @@ static int planetary_step(const planetary_options *options, const planetary_real
                              planetary_real t, planetary_state *state,
                              planetary_workspace *work, planetary_report *report)
 {
-    planetary_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
-    int i;
+    planetary_real nq, ndq, nddq, finite_dq, finite_ddq;
     report->flagged = 0;
     report->cond = (planetary_real)NAN;
     if (state->started) {
@@ -685,41 +843,26 @@ static int planetary_step(const planetary_options *options, const planetary_real
     if (report->status != PLANETARY_OK) {
         return report->status;
     }
-    /* Both right-hand sides are formed and solved in place in the state: no copies. Newton
-     * stopped at the q of its last fused call, so the shared sines and cosines are this q's. */
+    /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
+     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
+     * fused call, so the shared sines and cosines are this q's. */
     planetary_phi_t_shared(state->q, t, p, work->shared, state->dq);
-    for (i = 0; i < PLANETARY_NQ; ++i) {
-        state->dq[i] = -state->dq[i];
-    }
     planetary_rows_in_unit(work, state->dq);
-    planetary_lu_solve(&work->lu, state->dq); /* (2.73) */
-    planetary_from_unit(work, state->dq);
+    planetary_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
+    ndq = planetary_rates_pass(work, state->dq, &finite_dq);
     planetary_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     planetary_rows_in_unit(work, state->ddq);
     planetary_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    planetary_from_unit(work, state->ddq);
-    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
-     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
-    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < PLANETARY_NQ; ++i) { /* in the run's unit: q / column */
-        const planetary_real a = fabs(state->q[i]) * work->inverse_column[i];
-        const planetary_real b = fabs(state->dq[i]) * work->inverse_column[i];
-        const planetary_real c = fabs(state->ddq[i]) * work->inverse_column[i];
-        nq = a > nq ? a : nq;
-        ndq = b > ndq ? b : ndq;
-        nddq = c > nddq ? c : nddq;
-        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
-        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
-        finite_ddq += c - c;
-    }
+    nddq = planetary_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
     if (finite_dq != 0 || finite_ddq != 0) {
         report->status = PLANETARY_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = planetary_flagged_refined(options, work, report,
-                                                   sum_q != sum_q ? (planetary_real)NAN : nq, ndq,
-                                                   nddq, state->q, state->dq, state->ddq,
-                                                   t, p);
+    /* where the model's cheap bound cleared this point for norms up to work->clear, in
+     * Newton (the residual, condition and correction as they are now), it is not run again */
+    report->flagged = nq <= work->clear[0] && ndq <= work->clear[1]
+        ? 0 : planetary_flagged_refined(options, work, report, nq, ndq, nddq, state->q,
+                                           state->dq, state->ddq, t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -754,8 +897,13 @@ int planetary_solve_grid_checked(const planetary_options *options,
 {
     int k;
     report->status = PLANETARY_OK;
+    /* the options once per call, not at every step */
+    if (n > 0 && planetary_check_options(options) != 0) {
+        planetary_refused(report, t[0]);
+        return 0;
+    }
     for (k = 0; k < n; ++k) {
-        if (planetary_solve_step(options, p, t[k], state, work, report) != PLANETARY_OK) {
+        if (planetary_step(options, p, t[k], state, work, report) != PLANETARY_OK) {
             return k;
         }
         planetary_store(q_out, k, state->q);
@@ -812,8 +960,12 @@ int planetary_solve_batch(const planetary_options *options, const planetary_real
         out->iterations = 0;
         out->cond = out->start_cond = (planetary_real)NAN;
         set_options.unit = units ? units[j] : options->unit;
-        for (k = 0; k < n; ++k) {
-            if (planetary_solve_step(&set_options, p_set, t[k], state, work, &report) != PLANETARY_OK) {
+        /* the options (with this set's unit) once per set, not at every step */
+        if (n > 0 && planetary_check_options(&set_options) != 0) {
+            planetary_refused(&report, t[0]);
+        }
+        for (k = 0; k < n && report.status == PLANETARY_OK; ++k) {
+            if (planetary_step(&set_options, p_set, t[k], state, work, &report) != PLANETARY_OK) {
                 break;
             }
             out->iterations += report.iterations;

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 229 (87 add/sub, 44 mul, 12 div, 0 sqrt, 2 other calls, 41 fabs, 43 compares)
- *   Phi, Phi_q, their factorization and tests: 154; the update (a solve): 75
- * Condition at the converged q: 70; an extra iteration there (at most 3): 310
- * Velocity: 48; acceleration: 43; per-point checks: 1018; predictor: 55
- * Step, worst case with the default cap of 25 iterations: 8170 (3033 add/sub, 1713 mul, 443 div, 10 sqrt, 62 other calls, 1389 fabs, 1520 compares)
+ * One Newton iteration: 220 (78 add/sub, 44 mul, 12 div, 0 sqrt, 2 other calls, 41 fabs, 43 compares)
+ *   Phi, Phi_q, their factorization and tests: 154; the update (a solve): 66
+ * Condition at the converged q: 70; an extra iteration there (at most 3): 388
+ * Velocity: 39; acceleration: 43; per-point checks: 1026; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8201 (2874 add/sub, 1835 mul, 435 div, 10 sqrt, 62 other calls, 1389 fabs, 1596 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38569
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38600
  */
-#define PLANETARY_OPS_ITERATION 229   /* one Newton iteration */
-#define PLANETARY_OPS_STEP_FIXED 2445  /* a step without its iterations */
-#define PLANETARY_OPS_STEP_WORST 8170  /* at the default cap, 25 */
-#define PLANETARY_OPS_STEP_DENSE_WORST 38569  /* every factorization dense */
+#define PLANETARY_OPS_ITERATION 220   /* one Newton iteration */
+#define PLANETARY_OPS_STEP_FIXED 2701  /* a step without its iterations */
+#define PLANETARY_OPS_STEP_WORST 8201  /* at the default cap, 25 */
+#define PLANETARY_OPS_STEP_DENSE_WORST 38600  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PLANETARY_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     planetary_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     planetary_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     planetary_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    planetary_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     planetary_real column[PLANETARY_NQ]; /* options->unit where q_i is a length, else 1 */
     planetary_real inverse_column[PLANETARY_NQ]; /* 1 / column */
     planetary_real row[PLANETARY_NQ]; /* options->unit where Phi_i is a length, else 1 */

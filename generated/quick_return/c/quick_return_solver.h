@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 296 (122 add/sub, 61 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
- *   Phi, Phi_q, their factorization and tests: 192; the update (a solve): 104
- * Condition at the converged q: 179; an extra iteration there (at most 3): 377
- * Velocity: 68; acceleration: 97; per-point checks: 1446; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 10822 (4374 add/sub, 2387 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1724 compares)
+ * One Newton iteration: 284 (110 add/sub, 61 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
+ *   Phi, Phi_q, their factorization and tests: 192; the update (a solve): 92
+ * Condition at the converged q: 179; an extra iteration there (at most 3): 455
+ * Velocity: 56; acceleration: 97; per-point checks: 1451; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 10766 (4140 add/sub, 2500 mul, 546 div, 10 sqrt, 186 other calls, 1584 fabs, 1800 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72681
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72625
  */
-#define QUICK_RETURN_OPS_ITERATION 296   /* one Newton iteration */
-#define QUICK_RETURN_OPS_STEP_FIXED 3422  /* a step without its iterations */
-#define QUICK_RETURN_OPS_STEP_WORST 10822  /* at the default cap, 25 */
-#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72681  /* every factorization dense */
+#define QUICK_RETURN_OPS_ITERATION 284   /* one Newton iteration */
+#define QUICK_RETURN_OPS_STEP_FIXED 3666  /* a step without its iterations */
+#define QUICK_RETURN_OPS_STEP_WORST 10766  /* at the default cap, 25 */
+#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72625  /* every factorization dense */
 
 typedef struct {
     int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     quick_return_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     quick_return_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     quick_return_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    quick_return_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     quick_return_real column[QUICK_RETURN_NQ]; /* options->unit where q_i is a length, else 1 */
     quick_return_real inverse_column[QUICK_RETURN_NQ]; /* 1 / column */
     quick_return_real row[QUICK_RETURN_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 370 (130 add/sub, 75 mul, 16 div, 0 sqrt, 7 other calls, 73 fabs, 69 compares)
- *   Phi, Phi_q, their factorization and tests: 262; the update (a solve): 108
- * Condition at the converged q: 225; an extra iteration there (at most 3): 451
- * Velocity: 73; acceleration: 93; per-point checks: 1486; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 13097 (4662 add/sub, 2849 mul, 586 div, 10 sqrt, 218 other calls, 2431 fabs, 2341 compares)
+ * One Newton iteration: 358 (118 add/sub, 75 mul, 16 div, 0 sqrt, 7 other calls, 73 fabs, 69 compares)
+ *   Phi, Phi_q, their factorization and tests: 262; the update (a solve): 96
+ * Condition at the converged q: 225; an extra iteration there (at most 3): 529
+ * Velocity: 61; acceleration: 93; per-point checks: 1491; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 13041 (4428 add/sub, 2962 mul, 575 div, 10 sqrt, 218 other calls, 2431 fabs, 2417 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74720
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74664
  */
-#define RACK_LINKAGE_OPS_ITERATION 370   /* one Newton iteration */
-#define RACK_LINKAGE_OPS_STEP_FIXED 3847  /* a step without its iterations */
-#define RACK_LINKAGE_OPS_STEP_WORST 13097  /* at the default cap, 25 */
-#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74720  /* every factorization dense */
+#define RACK_LINKAGE_OPS_ITERATION 358   /* one Newton iteration */
+#define RACK_LINKAGE_OPS_STEP_FIXED 4091  /* a step without its iterations */
+#define RACK_LINKAGE_OPS_STEP_WORST 13041  /* at the default cap, 25 */
+#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74664  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     rack_linkage_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     rack_linkage_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     rack_linkage_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    rack_linkage_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     rack_linkage_real column[RACK_LINKAGE_NQ]; /* options->unit where q_i is a length, else 1 */
     rack_linkage_real inverse_column[RACK_LINKAGE_NQ]; /* 1 / column */
     rack_linkage_real row[RACK_LINKAGE_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 928 (320 add/sub, 279 mul, 24 div, 1 sqrt, 2 other calls, 166 fabs, 136 compares)
- *   Phi, Phi_q, their factorization and tests: 761; the update (a solve): 167
- * Condition at the converged q: 628; an extra iteration there (at most 3): 1009
- * Velocity: 141; acceleration: 412; per-point checks: 2671; predictor: 85
- * Step, worst case with the default cap of 25 iterations: 31610 (11134 add/sub, 9911 mul, 839 div, 42 sqrt, 64 other calls, 5294 fabs, 4326 compares)
+ * One Newton iteration: 914 (306 add/sub, 279 mul, 24 div, 1 sqrt, 2 other calls, 166 fabs, 136 compares)
+ *   Phi, Phi_q, their factorization and tests: 761; the update (a solve): 153
+ * Condition at the converged q: 628; an extra iteration there (at most 3): 1087
+ * Velocity: 127; acceleration: 412; per-point checks: 2674; predictor: 59
+ * Step, worst case with the default cap of 25 iterations: 31496 (10850 add/sub, 10018 mul, 826 div, 42 sqrt, 64 other calls, 5294 fabs, 4402 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121153
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121039
  */
-#define RSSR_OPS_ITERATION 928   /* one Newton iteration */
-#define RSSR_OPS_STEP_FIXED 8410  /* a step without its iterations */
-#define RSSR_OPS_STEP_WORST 31610  /* at the default cap, 25 */
-#define RSSR_OPS_STEP_DENSE_WORST 121153  /* every factorization dense */
+#define RSSR_OPS_ITERATION 914   /* one Newton iteration */
+#define RSSR_OPS_STEP_FIXED 8646  /* a step without its iterations */
+#define RSSR_OPS_STEP_WORST 31496  /* at the default cap, 25 */
+#define RSSR_OPS_STEP_DENSE_WORST 121039  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RSSR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     rssr_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     rssr_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     rssr_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    rssr_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     rssr_real column[RSSR_NQ]; /* options->unit where q_i is a length, else 1 */
     rssr_real inverse_column[RSSR_NQ]; /* 1 / column */
     rssr_real row[RSSR_NQ]; /* options->unit where Phi_i is a length, else 1 */

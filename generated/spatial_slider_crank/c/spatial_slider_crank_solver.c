@@ -70,11 +70,10 @@ static int spatial_slider_crank_refused(spatial_slider_crank_report *report, spa
 static spatial_slider_crank_real spatial_slider_crank_max_abs(const spatial_slider_crank_real v[])
 {
     spatial_slider_crank_real largest = 0, sum = 0;
-    int i;
-    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        spatial_slider_crank_real a = fabs(v[i]);
-        largest = a > largest ? a : largest; /* branch-free max */
-        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
+    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
+     * inf cannot occur) */
+    for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+        { const spatial_slider_crank_real a = fabs(v[i]); largest = a > largest ? a : largest; sum += a; }
     }
     return sum != sum ? (spatial_slider_crank_real)NAN : largest;
 }
@@ -393,26 +392,58 @@ static int spatial_slider_crank_misses(const spatial_slider_crank_options *optio
         || (judged > 1 && e_ddq > options->target_ddq * spatial_slider_crank_at_least_1(nddq));
 }
 
+/* The cheap bound of the error model: 1 when no target can be missed at a point whose
+ * max |q| and max |dq| are at most nq and ndq (whatever its max |ddq|), s = ||Phi_q^-1||_1 /
+ * sqrt(NQ) and the residual leaving an error `left` of q; e_q into *e_q. With A = max(1, |dq|)
+ * and x = s (u + e_q), e_dq <= x A and e_ddq <= x (1 + A^2 (1 + 2 s)) max(1, |ddq|), so where
+ * e_q, x and x (1 + A^2 (1 + 2 s)) are within half their targets (the half covers the
+ * rounding of both sides) the model flags nothing. Each quantity grows with nq and ndq, also
+ * as rounded: a bound that holds for some norms holds for smaller ones. A NaN fails it. */
+static int spatial_slider_crank_within_bound(const spatial_slider_crank_options *options,
+                                     const spatial_slider_crank_report *report, spatial_slider_crank_real s,
+                                     spatial_slider_crank_real left, spatial_slider_crank_real nq, spatial_slider_crank_real ndq, spatial_slider_crank_real *e_q)
+{
+    const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
+    const spatial_slider_crank_real rounding = s * u * (1 + nq);
+    const spatial_slider_crank_real error = left > rounding ? left : rounding;
+    const spatial_slider_crank_real x = s * (u + error), a = spatial_slider_crank_at_least_1(ndq);
+    /* all the arithmetic before the tests: its count does not depend on the values */
+    const spatial_slider_crank_real margin = 2 * SPATIAL_SLIDER_CRANK_SAFETY, bound_dq = margin * x;
+    const spatial_slider_crank_real bound_ddq = bound_dq * (1 + a * a * (1 + 2 * s));
+    *e_q = error;
+    return report->cond < (spatial_slider_crank_real)INFINITY && margin * error <= options->target_q
+        && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
+}
+
+/* spatial_slider_crank_flagged with s and the residual's error `left` worked out. */
+static int spatial_slider_crank_flagged_at(const spatial_slider_crank_options *options,
+                                   const spatial_slider_crank_report *report, spatial_slider_crank_real s, spatial_slider_crank_real left,
+                                   spatial_slider_crank_real nq, spatial_slider_crank_real ndq, spatial_slider_crank_real nddq, int judged)
+{
+    const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
+    const spatial_slider_crank_real a = spatial_slider_crank_at_least_1(ndq);
+    spatial_slider_crank_real e_q, e_dq, e_ddq;
+    if (spatial_slider_crank_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    if (report->cond - report->cond != 0) return 1;
+    e_dq = s * (u * ndq + e_q * a);
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
+    return spatial_slider_crank_misses(options, judged, SPATIAL_SLIDER_CRANK_SAFETY * e_q,
+                               SPATIAL_SLIDER_CRANK_SAFETY * e_dq, SPATIAL_SLIDER_CRANK_SAFETY * e_ddq, nq, ndq,
+                               nddq);
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
- * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
+ * decides first; the model runs where the bound fails. */
 static int spatial_slider_crank_flagged(const spatial_slider_crank_options *options,
                                 const spatial_slider_crank_workspace *work,
                                 const spatial_slider_crank_report *report, spatial_slider_crank_real nq, spatial_slider_crank_real ndq,
                                 spatial_slider_crank_real nddq, int judged)
 {
-    const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
     const spatial_slider_crank_real s = report->inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
-    const spatial_slider_crank_real rounding = s * u * (1 + nq);
     const spatial_slider_crank_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    spatial_slider_crank_real e_q, e_dq, e_ddq;
-    if (report->cond - report->cond != 0) return 1;
-    e_q = left > rounding ? left : rounding;
-    e_dq = s * (u * ndq + e_q * spatial_slider_crank_at_least_1(ndq));
-    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * spatial_slider_crank_at_least_1(ndq));
-    return spatial_slider_crank_misses(options, judged, SPATIAL_SLIDER_CRANK_SAFETY * e_q,
-                               SPATIAL_SLIDER_CRANK_SAFETY * e_dq, SPATIAL_SLIDER_CRANK_SAFETY * e_ddq, nq, ndq,
-                               nddq);
+    return spatial_slider_crank_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -546,14 +577,26 @@ static int spatial_slider_crank_flagged_refined(const spatial_slider_crank_optio
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
- * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
+ * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
+ * at the end of the step too if the new norms are within those (work->clear; the residual,
+ * condition and correction unchanged), and the model need not run again there. */
 static int spatial_slider_crank_would_flag(const spatial_slider_crank_options *options,
-                                   const spatial_slider_crank_workspace *work,
+                                   spatial_slider_crank_workspace *work,
                                    const spatial_slider_crank_report *report)
 {
     const spatial_slider_crank_real *norms = work->norms;
-    return report->residual > SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF * (1 + norms[0])
-        && spatial_slider_crank_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
+    const spatial_slider_crank_real s = report->inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
+    const spatial_slider_crank_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const spatial_slider_crank_real wide_q = 2 * norms[0] + 1, wide_dq = 2 * norms[1] + 1;
+    spatial_slider_crank_real e_q;
+    if (!(report->residual > SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
+    if (spatial_slider_crank_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
+        work->clear[0] = wide_q;
+        work->clear[1] = wide_dq;
+        return 0;
+    }
+    return spatial_slider_crank_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point
@@ -572,6 +615,7 @@ static int spatial_slider_crank_converged(const spatial_slider_crank_options *op
     int i, extra, moved = 0, ill;
     spatial_slider_crank_estimate(work, report);
     work->correction = -1;
+    work->clear[0] = work->clear[1] = -1; /* until the model's cheap bound clears the point */
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (spatial_slider_crank_real)INFINITY
@@ -601,6 +645,7 @@ static int spatial_slider_crank_converged(const spatial_slider_crank_options *op
         if (moved) {
             spatial_slider_crank_estimate(work, report);
         }
+        work->clear[0] = work->clear[1] = -1; /* the model decides at the end */
     }
     return report->cond <= options->max_cond ? SPATIAL_SLIDER_CRANK_OK : SPATIAL_SLIDER_CRANK_SINGULAR;
 }
@@ -611,7 +656,7 @@ static int spatial_slider_crank_newton(const spatial_slider_crank_options *optio
                   spatial_slider_crank_workspace *work, spatial_slider_crank_report *report)
 {
     spatial_slider_crank_real step = 0;
-    int i, iteration;
+    int iteration;
     report->t = t;
     report->pivot = -1;
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
@@ -637,14 +682,12 @@ static int spatial_slider_crank_newton(const spatial_slider_crank_options *optio
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-            work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
-        }
+        /* the step solves Phi_q dq = -Phi in place: solved for Phi, it is subtracted */
         spatial_slider_crank_lu_solve(&work->lu, work->phi);
         step = spatial_slider_crank_max_abs(work->phi); /* in the run's unit */
         spatial_slider_crank_from_unit(work, work->phi);
-        for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-            q[i] += work->phi[i];
+        for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+            q[i] -= work->phi[i];
         }
     }
     return SPATIAL_SLIDER_CRANK_NO_CONVERGENCE;
@@ -652,11 +695,49 @@ static int spatial_slider_crank_newton(const spatial_slider_crank_options *optio
 
 static void spatial_slider_crank_predict(spatial_slider_crank_real t, spatial_slider_crank_state *state)
 {
-    spatial_slider_crank_real h = t - state->t;
-    int i;
-    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
+    const spatial_slider_crank_real h = t - state->t, half_h2 = h * h / 2;
+    /* (2.76) */
+    for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+        state->q[i] += state->dq[i] * h + state->ddq[i] * half_h2;
     }
+}
+
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+static spatial_slider_crank_real spatial_slider_crank_rates_pass(const spatial_slider_crank_workspace *work, spatial_slider_crank_real dq[],
+                                       spatial_slider_crank_real *finite)
+{
+    spatial_slider_crank_real largest = 0, nan = 0;
+    for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+        { const spatial_slider_crank_real b = fabs(dq[i]); largest = b > largest ? b : largest; nan += b - b; }
+        dq[i] = -dq[i];
+    }
+    spatial_slider_crank_from_unit(work, dq);
+    *finite = nan;
+    return largest;
+}
+
+/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
+ * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
+ * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+static spatial_slider_crank_real spatial_slider_crank_accelerations_pass(const spatial_slider_crank_workspace *work,
+                                               const spatial_slider_crank_real q[], spatial_slider_crank_real ddq[],
+                                               spatial_slider_crank_real *finite, spatial_slider_crank_real *nq)
+{
+    spatial_slider_crank_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
+    for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+        { const spatial_slider_crank_real c = fabs(ddq[i]); largest = c > largest ? c : largest; nan += c - c; }
+        {
+            const spatial_slider_crank_real a = fabs(q[i]) * work->inverse_column[i];
+            largest_q = a > largest_q ? a : largest_q;
+            sum_q += a;
+        }
+    }
+    spatial_slider_crank_from_unit(work, ddq);
+    *finite = nan;
+    *nq = sum_q != sum_q ? (spatial_slider_crank_real)NAN : largest_q;
+    return largest;
 }
 
 /* spatial_slider_crank_solve_step with its options already checked. */
@@ -664,8 +745,7 @@ static int spatial_slider_crank_step(const spatial_slider_crank_options *options
                              spatial_slider_crank_real t, spatial_slider_crank_state *state,
                              spatial_slider_crank_workspace *work, spatial_slider_crank_report *report)
 {
-    spatial_slider_crank_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
-    int i;
+    spatial_slider_crank_real nq, ndq, nddq, finite_dq, finite_ddq;
     report->flagged = 0;
     report->cond = (spatial_slider_crank_real)NAN;
     if (state->started) {
@@ -678,41 +758,26 @@ static int spatial_slider_crank_step(const spatial_slider_crank_options *options
     if (report->status != SPATIAL_SLIDER_CRANK_OK) {
         return report->status;
     }
-    /* Both right-hand sides are formed and solved in place in the state: no copies. Newton
-     * stopped at the q of its last fused call, so the shared sines and cosines are this q's. */
+    /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
+     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
+     * fused call, so the shared sines and cosines are this q's. */
     spatial_slider_crank_phi_t_shared(state->q, t, p, work->shared, state->dq);
-    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        state->dq[i] = -state->dq[i];
-    }
     spatial_slider_crank_rows_in_unit(work, state->dq);
-    spatial_slider_crank_lu_solve(&work->lu, state->dq); /* (2.73) */
-    spatial_slider_crank_from_unit(work, state->dq);
+    spatial_slider_crank_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
+    ndq = spatial_slider_crank_rates_pass(work, state->dq, &finite_dq);
     spatial_slider_crank_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     spatial_slider_crank_rows_in_unit(work, state->ddq);
     spatial_slider_crank_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    spatial_slider_crank_from_unit(work, state->ddq);
-    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
-     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
-    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) { /* in the run's unit: q / column */
-        const spatial_slider_crank_real a = fabs(state->q[i]) * work->inverse_column[i];
-        const spatial_slider_crank_real b = fabs(state->dq[i]) * work->inverse_column[i];
-        const spatial_slider_crank_real c = fabs(state->ddq[i]) * work->inverse_column[i];
-        nq = a > nq ? a : nq;
-        ndq = b > ndq ? b : ndq;
-        nddq = c > nddq ? c : nddq;
-        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
-        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
-        finite_ddq += c - c;
-    }
+    nddq = spatial_slider_crank_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
     if (finite_dq != 0 || finite_ddq != 0) {
         report->status = SPATIAL_SLIDER_CRANK_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = spatial_slider_crank_flagged_refined(options, work, report,
-                                                   sum_q != sum_q ? (spatial_slider_crank_real)NAN : nq, ndq,
-                                                   nddq, state->q, state->dq, state->ddq,
-                                                   t, p);
+    /* where the model's cheap bound cleared this point for norms up to work->clear, in
+     * Newton (the residual, condition and correction as they are now), it is not run again */
+    report->flagged = nq <= work->clear[0] && ndq <= work->clear[1]
+        ? 0 : spatial_slider_crank_flagged_refined(options, work, report, nq, ndq, nddq, state->q,
+                                           state->dq, state->ddq, t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -747,8 +812,13 @@ int spatial_slider_crank_solve_grid_checked(const spatial_slider_crank_options *
 {
     int k;
     report->status = SPATIAL_SLIDER_CRANK_OK;
+    /* the options once per call, not at every step */
+    if (n > 0 && spatial_slider_crank_check_options(options) != 0) {
+        spatial_slider_crank_refused(report, t[0]);
+        return 0;
+    }
     for (k = 0; k < n; ++k) {
-        if (spatial_slider_crank_solve_step(options, p, t[k], state, work, report) != SPATIAL_SLIDER_CRANK_OK) {
+        if (spatial_slider_crank_step(options, p, t[k], state, work, report) != SPATIAL_SLIDER_CRANK_OK) {
             return k;
         }
         spatial_slider_crank_store(q_out, k, state->q);
@@ -805,8 +875,12 @@ int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options
         out->iterations = 0;
         out->cond = out->start_cond = (spatial_slider_crank_real)NAN;
         set_options.unit = units ? units[j] : options->unit;
-        for (k = 0; k < n; ++k) {
-            if (spatial_slider_crank_solve_step(&set_options, p_set, t[k], state, work, &report) != SPATIAL_SLIDER_CRANK_OK) {
+        /* the options (with this set's unit) once per set, not at every step */
+        if (n > 0 && spatial_slider_crank_check_options(&set_options) != 0) {
+            spatial_slider_crank_refused(&report, t[0]);
+        }
+        for (k = 0; k < n && report.status == SPATIAL_SLIDER_CRANK_OK; ++k) {
+            if (spatial_slider_crank_step(&set_options, p_set, t[k], state, work, &report) != SPATIAL_SLIDER_CRANK_OK) {
                 break;
             }
             out->iterations += report.iterations;

@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 1375 (513 add/sub, 407 mul, 34 div, 1 sqrt, 3 other calls, 232 fabs, 185 compares)
- *   Phi, Phi_q, their factorization and tests: 1085; the update (a solve): 290
- * Condition at the converged q: 3440; an extra iteration there (at most 3): 1456
- * Velocity: 243; acceleration: 532; per-point checks: 4224; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 51891 (20344 add/sub, 15810 mul, 1193 div, 44 sqrt, 304 other calls, 7884 fabs, 6312 compares)
+ * One Newton iteration: 1354 (492 add/sub, 407 mul, 34 div, 1 sqrt, 3 other calls, 232 fabs, 185 compares)
+ *   Phi, Phi_q, their factorization and tests: 1085; the update (a solve): 269
+ * Condition at the converged q: 3440; an extra iteration there (at most 3): 1534
+ * Velocity: 222; acceleration: 532; per-point checks: 4220; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 51574 (19885 add/sub, 15896 mul, 1173 div, 44 sqrt, 304 other calls, 7884 fabs, 6388 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 307246
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 306929
  */
-#define SPATIAL_SLIDER_CRANK_OPS_ITERATION 1375   /* one Newton iteration */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17516  /* a step without its iterations */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51891  /* at the default cap, 25 */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 307246  /* every factorization dense */
+#define SPATIAL_SLIDER_CRANK_OPS_ITERATION 1354   /* one Newton iteration */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17724  /* a step without its iterations */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51574  /* at the default cap, 25 */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 306929  /* every factorization dense */
 
 typedef struct {
     int status;                  /* SPATIAL_SLIDER_CRANK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     spatial_slider_crank_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     spatial_slider_crank_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     spatial_slider_crank_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    spatial_slider_crank_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     spatial_slider_crank_real column[SPATIAL_SLIDER_CRANK_NQ]; /* options->unit where q_i is a length, else 1 */
     spatial_slider_crank_real inverse_column[SPATIAL_SLIDER_CRANK_NQ]; /* 1 / column */
     spatial_slider_crank_real row[SPATIAL_SLIDER_CRANK_NQ]; /* options->unit where Phi_i is a length, else 1 */

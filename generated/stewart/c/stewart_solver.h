@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 1492 (631 add/sub, 586 mul, 21 div, 6 sqrt, 7 other calls, 128 fabs, 113 compares)
- *   Phi, Phi_q, their factorization and tests: 1364; the update (a solve): 128
- * Condition at the converged q: 612; an extra iteration there (at most 3): 1573
- * Velocity: 376; acceleration: 1579; per-point checks: 4041; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 50703 (21626 add/sub, 20370 mul, 704 div, 202 sqrt, 233 other calls, 4028 fabs, 3540 compares)
+ * One Newton iteration: 1485 (624 add/sub, 586 mul, 21 div, 6 sqrt, 7 other calls, 128 fabs, 113 compares)
+ *   Phi, Phi_q, their factorization and tests: 1364; the update (a solve): 121
+ * Condition at the converged q: 612; an extra iteration there (at most 3): 1651
+ * Velocity: 369; acceleration: 1579; per-point checks: 4051; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 50792 (21517 add/sub, 20498 mul, 698 div, 202 sqrt, 233 other calls, 4028 fabs, 3616 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66502
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66591
  */
-#define STEWART_OPS_ITERATION 1492   /* one Newton iteration */
-#define STEWART_OPS_STEP_FIXED 13403  /* a step without its iterations */
-#define STEWART_OPS_STEP_WORST 50703  /* at the default cap, 25 */
-#define STEWART_OPS_STEP_DENSE_WORST 66502  /* every factorization dense */
+#define STEWART_OPS_ITERATION 1485   /* one Newton iteration */
+#define STEWART_OPS_STEP_FIXED 13667  /* a step without its iterations */
+#define STEWART_OPS_STEP_WORST 50792  /* at the default cap, 25 */
+#define STEWART_OPS_STEP_DENSE_WORST 66591  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     stewart_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     stewart_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    stewart_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     stewart_real column[STEWART_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_real inverse_column[STEWART_NQ]; /* 1 / column */
     stewart_real row[STEWART_NQ]; /* options->unit where Phi_i is a length, else 1 */

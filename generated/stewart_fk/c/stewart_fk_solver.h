@@ -56,23 +56,23 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 1402 (545 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 146 fabs, 122 compares)
- *   Phi, Phi_q, their factorization and tests: 1274; the update (a solve): 128
- * Condition at the converged q: 612; an extra iteration there (at most 3): 1483
- * Velocity: 118; acceleration: 996; per-point checks: 3224; predictor: 43
- * Step, worst case with the default cap of 25 iterations: 46435 (18361 add/sub, 19201 mul, 512 div, 10 sqrt, 0 other calls, 4550 fabs, 3801 compares)
+ * One Newton iteration: 1395 (538 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 146 fabs, 122 compares)
+ *   Phi, Phi_q, their factorization and tests: 1274; the update (a solve): 121
+ * Condition at the converged q: 612; an extra iteration there (at most 3): 1561
+ * Velocity: 111; acceleration: 996; per-point checks: 3234; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 46524 (18252 add/sub, 19329 mul, 506 div, 10 sqrt, 0 other calls, 4550 fabs, 3877 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 48799 (19431 add/sub, 20306 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3900 compares)
- *   positions only (du, ddu NULL): 47627 (18879 add/sub, 19730 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3884 compares)
+ * solve_inputs, worst case: 48905 (19315 add/sub, 20454 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3974 compares)
+ *   positions only (du, ddu NULL): 47740 (18770 add/sub, 19878 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3958 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2354
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62234
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62323
  */
-#define STEWART_FK_OPS_ITERATION 1402   /* one Newton iteration */
-#define STEWART_FK_OPS_STEP_FIXED 11385  /* a step without its iterations */
-#define STEWART_FK_OPS_STEP_WORST 46435  /* at the default cap, 25 */
-#define STEWART_FK_OPS_STEP_DENSE_WORST 62234  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 48799  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 47627  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_ITERATION 1395   /* one Newton iteration */
+#define STEWART_FK_OPS_STEP_FIXED 11649  /* a step without its iterations */
+#define STEWART_FK_OPS_STEP_WORST 46524  /* at the default cap, 25 */
+#define STEWART_FK_OPS_STEP_DENSE_WORST 62323  /* every factorization dense */
+#define STEWART_FK_OPS_INPUTS_WORST 48905  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 47740  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -110,6 +110,7 @@ typedef struct {
     stewart_fk_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     stewart_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    stewart_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     stewart_fk_real column[STEWART_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_fk_real inverse_column[STEWART_FK_NQ]; /* 1 / column */
     stewart_fk_real row[STEWART_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -70,11 +70,10 @@ static int stewart_legs_refused(stewart_legs_report *report, stewart_legs_real t
 static stewart_legs_real stewart_legs_max_abs(const stewart_legs_real v[])
 {
     stewart_legs_real largest = 0, sum = 0;
-    int i;
-    for (i = 0; i < STEWART_LEGS_NQ; ++i) {
-        stewart_legs_real a = fabs(v[i]);
-        largest = a > largest ? a : largest; /* branch-free max */
-        sum += a; /* NaN exactly when some a is (no a is negative: inf - inf cannot occur) */
+    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
+     * inf cannot occur) */
+    for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
+        { const stewart_legs_real a = fabs(v[i]); largest = a > largest ? a : largest; sum += a; }
     }
     return sum != sum ? (stewart_legs_real)NAN : largest;
 }
@@ -709,26 +708,58 @@ static int stewart_legs_misses(const stewart_legs_options *options, int judged, 
         || (judged > 1 && e_ddq > options->target_ddq * stewart_legs_at_least_1(nddq));
 }
 
+/* The cheap bound of the error model: 1 when no target can be missed at a point whose
+ * max |q| and max |dq| are at most nq and ndq (whatever its max |ddq|), s = ||Phi_q^-1||_1 /
+ * sqrt(NQ) and the residual leaving an error `left` of q; e_q into *e_q. With A = max(1, |dq|)
+ * and x = s (u + e_q), e_dq <= x A and e_ddq <= x (1 + A^2 (1 + 2 s)) max(1, |ddq|), so where
+ * e_q, x and x (1 + A^2 (1 + 2 s)) are within half their targets (the half covers the
+ * rounding of both sides) the model flags nothing. Each quantity grows with nq and ndq, also
+ * as rounded: a bound that holds for some norms holds for smaller ones. A NaN fails it. */
+static int stewart_legs_within_bound(const stewart_legs_options *options,
+                                     const stewart_legs_report *report, stewart_legs_real s,
+                                     stewart_legs_real left, stewart_legs_real nq, stewart_legs_real ndq, stewart_legs_real *e_q)
+{
+    const stewart_legs_real u = STEWART_LEGS_UNIT_ROUNDOFF;
+    const stewart_legs_real rounding = s * u * (1 + nq);
+    const stewart_legs_real error = left > rounding ? left : rounding;
+    const stewart_legs_real x = s * (u + error), a = stewart_legs_at_least_1(ndq);
+    /* all the arithmetic before the tests: its count does not depend on the values */
+    const stewart_legs_real margin = 2 * STEWART_LEGS_SAFETY, bound_dq = margin * x;
+    const stewart_legs_real bound_ddq = bound_dq * (1 + a * a * (1 + 2 * s));
+    *e_q = error;
+    return report->cond < (stewart_legs_real)INFINITY && margin * error <= options->target_q
+        && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
+}
+
+/* stewart_legs_flagged with s and the residual's error `left` worked out. */
+static int stewart_legs_flagged_at(const stewart_legs_options *options,
+                                   const stewart_legs_report *report, stewart_legs_real s, stewart_legs_real left,
+                                   stewart_legs_real nq, stewart_legs_real ndq, stewart_legs_real nddq, int judged)
+{
+    const stewart_legs_real u = STEWART_LEGS_UNIT_ROUNDOFF;
+    const stewart_legs_real a = stewart_legs_at_least_1(ndq);
+    stewart_legs_real e_q, e_dq, e_ddq;
+    if (stewart_legs_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    if (report->cond - report->cond != 0) return 1;
+    e_dq = s * (u * ndq + e_q * a);
+    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
+    return stewart_legs_misses(options, judged, STEWART_LEGS_SAFETY * e_q,
+                               STEWART_LEGS_SAFETY * e_dq, STEWART_LEGS_SAFETY * e_ddq, nq, ndq,
+                               nddq);
+}
+
 /* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
- * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. */
+ * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
+ * decides first; the model runs where the bound fails. */
 static int stewart_legs_flagged(const stewart_legs_options *options,
                                 const stewart_legs_workspace *work,
                                 const stewart_legs_report *report, stewart_legs_real nq, stewart_legs_real ndq,
                                 stewart_legs_real nddq, int judged)
 {
-    const stewart_legs_real u = STEWART_LEGS_UNIT_ROUNDOFF;
     const stewart_legs_real s = report->inv_norm / sqrt((stewart_legs_real)STEWART_LEGS_NQ);
-    const stewart_legs_real rounding = s * u * (1 + nq);
     const stewart_legs_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    stewart_legs_real e_q, e_dq, e_ddq;
-    if (report->cond - report->cond != 0) return 1;
-    e_q = left > rounding ? left : rounding;
-    e_dq = s * (u * ndq + e_q * stewart_legs_at_least_1(ndq));
-    e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * stewart_legs_at_least_1(ndq));
-    return stewart_legs_misses(options, judged, STEWART_LEGS_SAFETY * e_q,
-                               STEWART_LEGS_SAFETY * e_dq, STEWART_LEGS_SAFETY * e_ddq, nq, ndq,
-                               nddq);
+    return stewart_legs_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -862,14 +893,26 @@ static int stewart_legs_flagged_refined(const stewart_legs_options *options,
 }
 
 /* Whether the error model would flag a point with this report's residual and condition and
- * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help. */
+ * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
+ * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
+ * at the end of the step too if the new norms are within those (work->clear; the residual,
+ * condition and correction unchanged), and the model need not run again there. */
 static int stewart_legs_would_flag(const stewart_legs_options *options,
-                                   const stewart_legs_workspace *work,
+                                   stewart_legs_workspace *work,
                                    const stewart_legs_report *report)
 {
     const stewart_legs_real *norms = work->norms;
-    return report->residual > STEWART_LEGS_UNIT_ROUNDOFF * (1 + norms[0])
-        && stewart_legs_flagged(options, work, report, norms[0], norms[1], norms[2], 2);
+    const stewart_legs_real s = report->inv_norm / sqrt((stewart_legs_real)STEWART_LEGS_NQ);
+    const stewart_legs_real left = work->correction >= 0 ? work->correction : s * report->residual;
+    const stewart_legs_real wide_q = 2 * norms[0] + 1, wide_dq = 2 * norms[1] + 1;
+    stewart_legs_real e_q;
+    if (!(report->residual > STEWART_LEGS_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
+    if (stewart_legs_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
+        work->clear[0] = wide_q;
+        work->clear[1] = wide_dq;
+        return 0;
+    }
+    return stewart_legs_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
 }
 
 /* At a converged point: estimate the condition. Where the error model would flag the point
@@ -888,6 +931,7 @@ static int stewart_legs_converged(const stewart_legs_options *options, const ste
     int i, extra, moved = 0, ill;
     stewart_legs_estimate(work, report);
     work->correction = -1;
+    work->clear[0] = work->clear[1] = -1; /* until the model's cheap bound clears the point */
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (stewart_legs_real)INFINITY
@@ -917,6 +961,7 @@ static int stewart_legs_converged(const stewart_legs_options *options, const ste
         if (moved) {
             stewart_legs_estimate(work, report);
         }
+        work->clear[0] = work->clear[1] = -1; /* the model decides at the end */
     }
     return report->cond <= options->max_cond ? STEWART_LEGS_OK : STEWART_LEGS_SINGULAR;
 }
@@ -927,7 +972,7 @@ static int stewart_legs_newton(const stewart_legs_options *options, const stewar
                   stewart_legs_workspace *work, stewart_legs_report *report)
 {
     stewart_legs_real step = 0;
-    int i, iteration;
+    int iteration;
     report->t = t;
     report->pivot = -1;
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
@@ -953,14 +998,12 @@ static int stewart_legs_newton(const stewart_legs_options *options, const stewar
         if (iteration == options->max_iterations) {
             break;
         }
-        for (i = 0; i < STEWART_LEGS_NQ; ++i) {
-            work->phi[i] = -work->phi[i]; /* the step solves Phi_q dq = -Phi, in place */
-        }
+        /* the step solves Phi_q dq = -Phi in place: solved for Phi, it is subtracted */
         stewart_legs_lu_solve(&work->lu, work->phi);
         step = stewart_legs_max_abs(work->phi); /* in the run's unit */
         stewart_legs_from_unit(work, work->phi);
-        for (i = 0; i < STEWART_LEGS_NQ; ++i) {
-            q[i] += work->phi[i];
+        for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
+            q[i] -= work->phi[i];
         }
     }
     return STEWART_LEGS_NO_CONVERGENCE;
@@ -968,11 +1011,49 @@ static int stewart_legs_newton(const stewart_legs_options *options, const stewar
 
 static void stewart_legs_predict(stewart_legs_real t, stewart_legs_state *state)
 {
-    stewart_legs_real h = t - state->t;
-    int i;
-    for (i = 0; i < STEWART_LEGS_NQ; ++i) {
-        state->q[i] += state->dq[i] * h + state->ddq[i] * (h * h / 2); /* (2.76) */
+    const stewart_legs_real h = t - state->t, half_h2 = h * h / 2;
+    /* (2.76) */
+    for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
+        state->q[i] += state->dq[i] * h + state->ddq[i] * half_h2;
     }
+}
+
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+static stewart_legs_real stewart_legs_rates_pass(const stewart_legs_workspace *work, stewart_legs_real dq[],
+                                       stewart_legs_real *finite)
+{
+    stewart_legs_real largest = 0, nan = 0;
+    for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
+        { const stewart_legs_real b = fabs(dq[i]); largest = b > largest ? b : largest; nan += b - b; }
+        dq[i] = -dq[i];
+    }
+    stewart_legs_from_unit(work, dq);
+    *finite = nan;
+    return largest;
+}
+
+/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
+ * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
+ * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+static stewart_legs_real stewart_legs_accelerations_pass(const stewart_legs_workspace *work,
+                                               const stewart_legs_real q[], stewart_legs_real ddq[],
+                                               stewart_legs_real *finite, stewart_legs_real *nq)
+{
+    stewart_legs_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
+    for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
+        { const stewart_legs_real c = fabs(ddq[i]); largest = c > largest ? c : largest; nan += c - c; }
+        {
+            const stewart_legs_real a = fabs(q[i]) * work->inverse_column[i];
+            largest_q = a > largest_q ? a : largest_q;
+            sum_q += a;
+        }
+    }
+    stewart_legs_from_unit(work, ddq);
+    *finite = nan;
+    *nq = sum_q != sum_q ? (stewart_legs_real)NAN : largest_q;
+    return largest;
 }
 
 /* stewart_legs_solve_step with its options already checked. */
@@ -980,8 +1061,7 @@ static int stewart_legs_step(const stewart_legs_options *options, const stewart_
                              stewart_legs_real t, stewart_legs_state *state,
                              stewart_legs_workspace *work, stewart_legs_report *report)
 {
-    stewart_legs_real nq, ndq, nddq, sum_q, finite_dq, finite_ddq;
-    int i;
+    stewart_legs_real nq, ndq, nddq, finite_dq, finite_ddq;
     report->flagged = 0;
     report->cond = (stewart_legs_real)NAN;
     if (state->started) {
@@ -994,41 +1074,26 @@ static int stewart_legs_step(const stewart_legs_options *options, const stewart_
     if (report->status != STEWART_LEGS_OK) {
         return report->status;
     }
-    /* Both right-hand sides are formed and solved in place in the state: no copies. Newton
-     * stopped at the q of its last fused call, so the shared sines and cosines are this q's. */
+    /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
+     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
+     * fused call, so the shared sines and cosines are this q's. */
     stewart_legs_phi_t_shared(state->q, t, p, work->shared, state->dq);
-    for (i = 0; i < STEWART_LEGS_NQ; ++i) {
-        state->dq[i] = -state->dq[i];
-    }
     stewart_legs_rows_in_unit(work, state->dq);
-    stewart_legs_lu_solve(&work->lu, state->dq); /* (2.73) */
-    stewart_legs_from_unit(work, state->dq);
+    stewart_legs_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
+    ndq = stewart_legs_rates_pass(work, state->dq, &finite_dq);
     stewart_legs_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     stewart_legs_rows_in_unit(work, state->ddq);
     stewart_legs_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    stewart_legs_from_unit(work, state->ddq);
-    /* max |q|, |dq|, |ddq| in one pass (as max_abs: NaN when an entry is); the error model
-     * needs them, and an infinite or NaN one is the test for a non-finite dq or ddq */
-    nq = ndq = nddq = sum_q = finite_dq = finite_ddq = 0;
-    for (i = 0; i < STEWART_LEGS_NQ; ++i) { /* in the run's unit: q / column */
-        const stewart_legs_real a = fabs(state->q[i]) * work->inverse_column[i];
-        const stewart_legs_real b = fabs(state->dq[i]) * work->inverse_column[i];
-        const stewart_legs_real c = fabs(state->ddq[i]) * work->inverse_column[i];
-        nq = a > nq ? a : nq;
-        ndq = b > ndq ? b : ndq;
-        nddq = c > nddq ? c : nddq;
-        sum_q += a;          /* NaN exactly when some q_i is (as in max_abs) */
-        finite_dq += b - b;  /* 0, or NaN when some dq_i is inf or NaN */
-        finite_ddq += c - c;
-    }
+    nddq = stewart_legs_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
     if (finite_dq != 0 || finite_ddq != 0) {
         report->status = STEWART_LEGS_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
-    report->flagged = stewart_legs_flagged_refined(options, work, report,
-                                                   sum_q != sum_q ? (stewart_legs_real)NAN : nq, ndq,
-                                                   nddq, state->q, state->dq, state->ddq,
-                                                   t, p);
+    /* where the model's cheap bound cleared this point for norms up to work->clear, in
+     * Newton (the residual, condition and correction as they are now), it is not run again */
+    report->flagged = nq <= work->clear[0] && ndq <= work->clear[1]
+        ? 0 : stewart_legs_flagged_refined(options, work, report, nq, ndq, nddq, state->q,
+                                           state->dq, state->ddq, t, p);
     work->norms[0] = nq; /* for the next point's Newton (converged) */
     work->norms[1] = ndq;
     work->norms[2] = nddq;
@@ -1063,8 +1128,13 @@ int stewart_legs_solve_grid_checked(const stewart_legs_options *options,
 {
     int k;
     report->status = STEWART_LEGS_OK;
+    /* the options once per call, not at every step */
+    if (n > 0 && stewart_legs_check_options(options) != 0) {
+        stewart_legs_refused(report, t[0]);
+        return 0;
+    }
     for (k = 0; k < n; ++k) {
-        if (stewart_legs_solve_step(options, p, t[k], state, work, report) != STEWART_LEGS_OK) {
+        if (stewart_legs_step(options, p, t[k], state, work, report) != STEWART_LEGS_OK) {
             return k;
         }
         stewart_legs_store(q_out, k, state->q);
@@ -1121,8 +1191,12 @@ int stewart_legs_solve_batch(const stewart_legs_options *options, const stewart_
         out->iterations = 0;
         out->cond = out->start_cond = (stewart_legs_real)NAN;
         set_options.unit = units ? units[j] : options->unit;
-        for (k = 0; k < n; ++k) {
-            if (stewart_legs_solve_step(&set_options, p_set, t[k], state, work, &report) != STEWART_LEGS_OK) {
+        /* the options (with this set's unit) once per set, not at every step */
+        if (n > 0 && stewart_legs_check_options(&set_options) != 0) {
+            stewart_legs_refused(&report, t[0]);
+        }
+        for (k = 0; k < n && report.status == STEWART_LEGS_OK; ++k) {
+            if (stewart_legs_step(&set_options, p_set, t[k], state, work, &report) != STEWART_LEGS_OK) {
                 break;
             }
             out->iterations += report.iterations;

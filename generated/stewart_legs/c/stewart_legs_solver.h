@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 15716 (6153 add/sub, 6101 mul, 165 div, 6 sqrt, 14 other calls, 1901 fabs, 1376 compares)
- *   Phi, Phi_q, their factorization and tests: 13861; the update (a solve): 1855
- * Condition at the converged q: 22622; an extra iteration there (at most 3): 15797
- * Velocity: 1885; acceleration: 10074; per-point checks: 37200; predictor: 547
- * Step, worst case with the default cap of 25 iterations: 549159 (221053 add/sub, 216380 mul, 5656 div, 208 sqrt, 1346 other calls, 61063 fabs, 43453 compares)
+ * One Newton iteration: 15625 (6062 add/sub, 6101 mul, 165 div, 6 sqrt, 14 other calls, 1901 fabs, 1376 compares)
+ *   Phi, Phi_q, their factorization and tests: 13861; the update (a solve): 1764
+ * Condition at the converged q: 22622; an extra iteration there (at most 3): 15875
+ * Velocity: 1794; acceleration: 10074; per-point checks: 37126; predictor: 367
+ * Step, worst case with the default cap of 25 iterations: 546812 (218844 add/sub, 216256 mul, 5566 div, 208 sqrt, 1346 other calls, 61063 fabs, 43529 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16599276
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16596929
  */
-#define STEWART_LEGS_OPS_ITERATION 15716   /* one Newton iteration */
-#define STEWART_LEGS_OPS_STEP_FIXED 156259  /* a step without its iterations */
-#define STEWART_LEGS_OPS_STEP_WORST 549159  /* at the default cap, 25 */
-#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16599276  /* every factorization dense */
+#define STEWART_LEGS_OPS_ITERATION 15625   /* one Newton iteration */
+#define STEWART_LEGS_OPS_STEP_FIXED 156187  /* a step without its iterations */
+#define STEWART_LEGS_OPS_STEP_WORST 546812  /* at the default cap, 25 */
+#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16596929  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     stewart_legs_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     stewart_legs_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_legs_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    stewart_legs_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     stewart_legs_real column[STEWART_LEGS_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_legs_real inverse_column[STEWART_LEGS_NQ]; /* 1 / column */
     stewart_legs_real row[STEWART_LEGS_NQ]; /* options->unit where Phi_i is a length, else 1 */

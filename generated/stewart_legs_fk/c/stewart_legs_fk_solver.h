@@ -56,23 +56,23 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 15452 (6015 add/sub, 5995 mul, 165 div, 0 sqrt, 0 other calls, 1901 fabs, 1376 compares)
- *   Phi, Phi_q, their factorization and tests: 13597; the update (a solve): 1855
- * Condition at the converged q: 22622; an extra iteration there (at most 3): 15533
- * Velocity: 1587; acceleration: 9249; per-point checks: 36090; predictor: 547
- * Step, worst case with the default cap of 25 iterations: 539270 (216193 add/sub, 212021 mul, 5620 div, 10 sqrt, 910 other calls, 61063 fabs, 43453 compares)
+ * One Newton iteration: 15361 (5924 add/sub, 5995 mul, 165 div, 0 sqrt, 0 other calls, 1901 fabs, 1376 compares)
+ *   Phi, Phi_q, their factorization and tests: 13597; the update (a solve): 1764
+ * Condition at the converged q: 22622; an extra iteration there (at most 3): 15611
+ * Velocity: 1496; acceleration: 9249; per-point checks: 36016; predictor: 367
+ * Step, worst case with the default cap of 25 iterations: 536923 (213984 add/sub, 211897 mul, 5530 div, 10 sqrt, 910 other calls, 61063 fabs, 43529 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 572042 (230577 add/sub, 228372 mul, 6081 div, 10 sqrt, 910 other calls, 61700 fabs, 44392 compares)
- *   positions only (du, ddu NULL): 560476 (225849 add/sub, 222082 mul, 5899 div, 10 sqrt, 910 other calls, 61518 fabs, 44208 compares)
+ * solve_inputs, worst case: 569964 (228277 add/sub, 228520 mul, 6081 div, 10 sqrt, 910 other calls, 61700 fabs, 44466 compares)
+ *   positions only (du, ddu NULL): 558489 (223640 add/sub, 222230 mul, 5899 div, 10 sqrt, 910 other calls, 61518 fabs, 44282 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 32762
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16589387
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16587040
  */
-#define STEWART_LEGS_FK_OPS_ITERATION 15452   /* one Newton iteration */
-#define STEWART_LEGS_FK_OPS_STEP_FIXED 152970  /* a step without its iterations */
-#define STEWART_LEGS_FK_OPS_STEP_WORST 539270  /* at the default cap, 25 */
-#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16589387  /* every factorization dense */
-#define STEWART_LEGS_FK_OPS_INPUTS_WORST 572042  /* solve_inputs with du, ddu */
-#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 560476  /* solve_inputs, du, ddu NULL */
+#define STEWART_LEGS_FK_OPS_ITERATION 15361   /* one Newton iteration */
+#define STEWART_LEGS_FK_OPS_STEP_FIXED 152898  /* a step without its iterations */
+#define STEWART_LEGS_FK_OPS_STEP_WORST 536923  /* at the default cap, 25 */
+#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16587040  /* every factorization dense */
+#define STEWART_LEGS_FK_OPS_INPUTS_WORST 569964  /* solve_inputs with du, ddu */
+#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 558489  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -110,6 +110,7 @@ typedef struct {
     stewart_legs_fk_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     stewart_legs_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_legs_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    stewart_legs_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     stewart_legs_fk_real column[STEWART_LEGS_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_legs_fk_real inverse_column[STEWART_LEGS_FK_NQ]; /* 1 / column */
     stewart_legs_fk_real row[STEWART_LEGS_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -56,23 +56,23 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 665 (259 add/sub, 148 mul, 27 div, 0 sqrt, 14 other calls, 115 fabs, 102 compares)
- *   Phi, Phi_q, their factorization and tests: 470; the update (a solve): 195
- * Condition at the converged q: 569; an extra iteration there (at most 3): 746
- * Velocity: 134; acceleration: 198; per-point checks: 2674; predictor: 127
- * Step, worst case with the default cap of 25 iterations: 23661 (9328 add/sub, 5459 mul, 986 div, 10 sqrt, 434 other calls, 4013 fabs, 3431 compares)
+ * One Newton iteration: 644 (238 add/sub, 148 mul, 27 div, 0 sqrt, 14 other calls, 115 fabs, 102 compares)
+ *   Phi, Phi_q, their factorization and tests: 470; the update (a solve): 174
+ * Condition at the converged q: 569; an extra iteration there (at most 3): 824
+ * Velocity: 113; acceleration: 198; per-point checks: 2670; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 23344 (8869 add/sub, 5545 mul, 966 div, 10 sqrt, 434 other calls, 4013 fabs, 3507 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 25665 (10340 add/sub, 5870 mul, 1097 div, 10 sqrt, 518 other calls, 4160 fabs, 3670 compares)
- *   positions only (du, ddu NULL): 25163 (10154 add/sub, 5682 mul, 1055 div, 10 sqrt, 518 other calls, 4118 fabs, 3626 compares)
+ * solve_inputs, worst case: 25407 (9860 add/sub, 6018 mul, 1097 div, 10 sqrt, 518 other calls, 4160 fabs, 3744 compares)
+ *   positions only (du, ddu NULL): 24926 (9695 add/sub, 5830 mul, 1055 div, 10 sqrt, 518 other calls, 4118 fabs, 3700 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 1994
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286515
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286198
  */
-#define THREE_RRR_FK_OPS_ITERATION 665   /* one Newton iteration */
-#define THREE_RRR_FK_OPS_STEP_FIXED 7036  /* a step without its iterations */
-#define THREE_RRR_FK_OPS_STEP_WORST 23661  /* at the default cap, 25 */
-#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286515  /* every factorization dense */
-#define THREE_RRR_FK_OPS_INPUTS_WORST 25665  /* solve_inputs with du, ddu */
-#define THREE_RRR_FK_OPS_POSITIONS_WORST 25163  /* solve_inputs, du, ddu NULL */
+#define THREE_RRR_FK_OPS_ITERATION 644   /* one Newton iteration */
+#define THREE_RRR_FK_OPS_STEP_FIXED 7244  /* a step without its iterations */
+#define THREE_RRR_FK_OPS_STEP_WORST 23344  /* at the default cap, 25 */
+#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286198  /* every factorization dense */
+#define THREE_RRR_FK_OPS_INPUTS_WORST 25407  /* solve_inputs with du, ddu */
+#define THREE_RRR_FK_OPS_POSITIONS_WORST 24926  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -110,6 +110,7 @@ typedef struct {
     three_rrr_fk_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     three_rrr_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     three_rrr_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    three_rrr_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     three_rrr_fk_real column[THREE_RRR_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     three_rrr_fk_real inverse_column[THREE_RRR_FK_NQ]; /* 1 / column */
     three_rrr_fk_real row[THREE_RRR_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

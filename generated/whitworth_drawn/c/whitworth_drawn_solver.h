@@ -54,18 +54,18 @@ typedef struct {
  * below, worst case (every branch that adds work taken, Newton at its cap, the extra
  * iterations and estimates of an ill-conditioned point); each sin, cos, ... is a library
  * call of tens of instructions, each other operation about one.
- * One Newton iteration: 316 (130 add/sub, 73 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
- *   Phi, Phi_q, their factorization and tests: 212; the update (a solve): 104
- * Condition at the converged q: 179; an extra iteration there (at most 3): 397
- * Velocity: 68; acceleration: 117; per-point checks: 1482; predictor: 73
- * Step, worst case with the default cap of 25 iterations: 11458 (4638 add/sub, 2759 mul, 557 div, 10 sqrt, 186 other calls, 1584 fabs, 1724 compares)
+ * One Newton iteration: 304 (118 add/sub, 73 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
+ *   Phi, Phi_q, their factorization and tests: 212; the update (a solve): 92
+ * Condition at the converged q: 179; an extra iteration there (at most 3): 475
+ * Velocity: 56; acceleration: 117; per-point checks: 1487; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 11402 (4404 add/sub, 2872 mul, 546 div, 10 sqrt, 186 other calls, 1584 fabs, 1800 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73317
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73261
  */
-#define WHITWORTH_DRAWN_OPS_ITERATION 316   /* one Newton iteration */
-#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3558  /* a step without its iterations */
-#define WHITWORTH_DRAWN_OPS_STEP_WORST 11458  /* at the default cap, 25 */
-#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73317  /* every factorization dense */
+#define WHITWORTH_DRAWN_OPS_ITERATION 304   /* one Newton iteration */
+#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3802  /* a step without its iterations */
+#define WHITWORTH_DRAWN_OPS_STEP_WORST 11402  /* at the default cap, 25 */
+#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73261  /* every factorization dense */
 
 typedef struct {
     int status;                  /* WHITWORTH_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -101,6 +101,7 @@ typedef struct {
     whitworth_drawn_real estimated_inv_norm; /* ||Phi_q^-1||_1 estimated there; < 0: none yet */
     whitworth_drawn_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     whitworth_drawn_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
+    whitworth_drawn_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
     whitworth_drawn_real column[WHITWORTH_DRAWN_NQ]; /* options->unit where q_i is a length, else 1 */
     whitworth_drawn_real inverse_column[WHITWORTH_DRAWN_NQ]; /* 1 / column */
     whitworth_drawn_real row[WHITWORTH_DRAWN_NQ]; /* options->unit where Phi_i is a length, else 1 */

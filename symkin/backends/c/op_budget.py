@@ -141,11 +141,16 @@ def norm1(context: dict[str, Any] | None, n: int, nnz: int) -> Flops:
 
 # ----- the solver's own work (templates/solver.c.j2, _condition, _error_model, _units) -----
 
-# <prefix>_flagged: s = inv_norm / sqrt(NQ), the rounding floor, the residual's error, e_q,
-# e_dq, e_ddq, and the three comparisons with the targets.
-FLAGGED = Flops(sqrt=1, div=1, mul=18, add=6, cmp=11)
-# <prefix>_would_flag: the residual against the rounding level, then the model.
-WOULD_FLAG = Flops(add=1, mul=1, cmp=1) + FLAGGED
+# <prefix>_within_bound, the model's cheap bound: the rounding floor, e_q, x = s (u + e_q),
+# max(1, |dq|), the three bounds and their four tests.
+BOUND = Flops(mul=10, add=4, cmp=6)
+# <prefix>_flagged: s = inv_norm / sqrt(NQ) and the residual's error, the bound, then (where it
+# fails) e_dq, e_ddq and the three comparisons with the targets.
+FLAGGED = Flops(sqrt=1, div=1, mul=1, cmp=1) + BOUND + Flops(mul=15, add=5, cmp=8)
+# <prefix>_would_flag: the residual against the rounding level, s and the residual's error,
+# the bound at the widened norms (twice the last, plus one), then the model (its own bound
+# again).
+WOULD_FLAG = Flops(add=1, mul=1, cmp=1) + Flops(mul=2, add=2) + BOUND + FLAGGED
 # <prefix>_position_error: s, the residual's error, the rounding floor and their max.
 POSITION_ERROR = Flops(sqrt=1, div=1, mul=3, add=1, cmp=2)
 # <prefix>_flagged_refined around its calls: s, e_dq, e_ddq, the three finite tests and the
@@ -272,19 +277,21 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
     factor = algebra.factor + algebra.pivot_ratio + Flops(cmp=1)  # factor_jacobian
     fused = _routine(code, "phi_phi_q") + in_unit + _max_abs(n)
     evaluation = fused + Flops(add=1, cmp=1) + factor + Flops(cmp=2)
-    negate_solve = Flops(add=n) + algebra.solve
-    update = negate_solve + _max_abs(n) + from_unit + Flops(add=n)
-    tighten = (update + Flops(add=1, cmp=1) + WOULD_FLAG * 2 + Flops(cmp=2, div=1)
+    # Newton's step: Phi_q x = Phi solved in place, its max, q -= x (no negation)
+    update = algebra.solve + _max_abs(n) + from_unit + Flops(add=n)
+    tighten = (update + Flops(add=n) + Flops(add=1, cmp=1) + WOULD_FLAG * 2 + Flops(cmp=2, div=1)
                + fused + factor)
     estimate = _estimate(algebra, norm, n, nnz)
     solve = rows_in_unit + algebra.solve + from_unit
-    velocity = _routine(code, "phi_t_shared") + Flops(add=n) + solve
+    velocity = _routine(code, "phi_t_shared") + solve  # negated in the norms' pass
     acceleration = _routine(code, "gamma_shared") + solve
     if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests
         norms = _max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
-    else:  # one pass: |q|, |dq|, |ddq| scaled, three maxima, the sum and two finite tests
-        norms = Flops(abs=3 * n, mul=3 * n, cmp=3 * n, add=5 * n) + Flops(cmp=3)
-    prediction = Flops(add=1) + Flops(mul=3, div=1, add=2) * n  # (2.76)
+    else:  # a pass over dq as solved (max, finite test, negation) and one over ddq as solved
+        # and q / column (two maxima, ddq's finite test, q's sum)
+        # then whether Newton's bound cleared the point (work->clear)
+        norms = Flops(abs=3 * n, mul=n, cmp=3 * n, add=6 * n) + Flops(cmp=3 + 2)
+    prediction = Flops(add=1, mul=1, div=1) + Flops(mul=2, add=2) * n  # (2.76), h^2 / 2 once
     predictor = chord(code, algebra, units) if inputs else prediction
     return Pieces(evaluation=evaluation, update=update, estimate=estimate,
                   tighten=tighten, velocity=velocity, acceleration=acceleration,

@@ -1,0 +1,110 @@
+"""The error model's cheap bound in the generated C (``<prefix>_within_bound``): where it
+clears a point the model could not have flagged it. The generated ``<prefix>_flagged`` (its
+bound first, then the model) is compiled into a small program and run on many random points
+-- near the targets as well as far from them -- and compared with the runtime's own model,
+``runtime.accuracy.flagged_norms``, written in Python: the same answer at every point. Also
+a point whose condition is not finite is flagged."""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import symkin
+from symkin.contract import options as contract
+from symkin.contract import tuning
+from symkin.runtime import accuracy
+
+pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is not installed")
+
+HARNESS = r"""
+#include <stdio.h>
+#include "@P@_solver.c"
+/* one point a line: inv_norm cond residual correction nq ndq nddq target_q target_dq
+   target_ddq; prints the generated model's flag */
+int main(void)
+{
+    @P@_options o;
+    static @P@_workspace w;
+    @P@_report r;
+    double v[10];
+    @P@_default_options(&o);
+    while (scanf("%lf %lf %lf %lf %lf %lf %lf %lf %lf %lf", &v[0], &v[1], &v[2], &v[3],
+                 &v[4], &v[5], &v[6], &v[7], &v[8], &v[9]) == 10) {
+        r.inv_norm = v[0];
+        r.cond = v[1];
+        r.residual = v[2];
+        w.correction = v[3];
+        o.target_q = v[7];
+        o.target_dq = v[8];
+        o.target_ddq = v[9];
+        printf("%d\n", @P@_flagged(&o, &w, &r, v[4], v[5], v[6], 2));
+    }
+    return 0;
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def model_program(crank_slider_system, tmp_path_factory) -> tuple[Path, int]:
+    folder = tmp_path_factory.mktemp("flag_bound")
+    symkin.generate(crank_slider_system, backend="c", out_dir=folder)
+    prefix = crank_slider_system.name
+    (folder / "main.c").write_text(HARNESS.replace("@P@", prefix))
+    program = folder / "main"
+    sources = [str(p) for p in sorted(folder.glob("*.c"))
+               if p.name not in ("main.c", f"{prefix}_solver.c")]
+    subprocess.run(["gcc", "-std=c99", "-O2", f"-I{folder}", "-o", str(program),
+                    str(folder / "main.c"), *sources, "-lm"], check=True)
+    return program, len(crank_slider_system.q)
+
+
+def _points(count: int, seed: int) -> np.ndarray:
+    """Random points, log-uniform over wide ranges so that the targets are met by some and
+    missed by others, and a share right at the edge (residuals near target / s)."""
+    rng = np.random.default_rng(seed)
+    inv_norm = 10.0 ** rng.uniform(-1, 7, count)
+    norm_a = 10.0 ** rng.uniform(-1, 2, count)
+    residual = 10.0 ** rng.uniform(-18, -8, count)
+    correction = np.where(rng.random(count) < 0.5, -1.0, 10.0 ** rng.uniform(-16, -7, count))
+    nq, ndq = 10.0 ** rng.uniform(-3, 4, count), 10.0 ** rng.uniform(-3, 4, count)
+    nddq = 10.0 ** rng.uniform(-3, 6, count)
+    targets = 10.0 ** rng.uniform(-12, -4, (count, 3))
+    return np.column_stack([inv_norm, inv_norm * norm_a, residual, correction, nq, ndq, nddq,
+                            targets])
+
+
+def test_the_generated_model_flags_as_the_runtime_model(model_program) -> None:
+    """At 20,000 random points the generated flag equals runtime.accuracy's: the bound
+    never clears a point the model flags (nor does anything else)."""
+    program, n = model_program
+    points = _points(20000, 38)
+    text = "\n".join(" ".join(repr(float(x)) for x in row) for row in points)
+    out = subprocess.run([str(program)], input=text, capture_output=True, text=True,
+                         check=True).stdout.split()
+    generated = np.array([int(v) for v in out], dtype=bool)
+    assert generated.size == len(points)
+    expected = np.empty(len(points), dtype=bool)
+    for k, row in enumerate(points):
+        inv_norm, cond, residual, correction, nq, ndq, nddq, tq, tdq, tddq = map(float, row)
+        options = contract.Options(target_q=tq, target_dq=tdq, target_ddq=tddq)
+        expected[k] = accuracy.flagged_norms(
+            inv_norm, cond / inv_norm, residual, n, nq, ndq, nddq, options,
+            tuning.UNIT_ROUNDOFF["double"], math.nan if correction < 0 else correction)
+    assert 0.2 < expected.mean() < 0.8  # both answers well represented
+    wrong = np.flatnonzero(generated != expected)
+    assert wrong.size == 0, f"{wrong.size} points differ, the first: {points[wrong[0]]}"
+
+
+def test_a_non_finite_condition_is_flagged(model_program) -> None:
+    program, _ = model_program
+    line = "1 {cond} 1e-15 -1 1 1 1 1e-8 1e-7 1e-6"
+    text = "\n".join(line.format(cond=c) for c in ("inf", "nan"))
+    out = subprocess.run([str(program)], input=text, capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["1", "1"]
