@@ -163,19 +163,10 @@ def _input_table(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None
                       "input drivers (a "
                       "driver function written `input`); leave out --inputs")
     try:
-        return input_table.read(args.inputs, names, _length_inputs(args)), None
+        lengths = tuple(getattr(kernel, "input_lengths", ()))
+        return input_table.read(args.inputs, names, lengths), None
     except input_table.TableError as error:
         return None, str(error)
-
-
-def _length_inputs(args: argparse.Namespace) -> tuple[str, ...]:
-    """The inputs that are lengths, read from the mechanism file (only a run with --inputs
-    reads it again; a table of a file changed since the kernel was built is checked by the
-    file as it is now)."""
-    from symkin.spec import name_checks, validate
-
-    mech = validate.load(args.mechanism, overrides.parse(args.overrides))
-    return name_checks.length_inputs(mech)
 
 
 def _size(count: float) -> str:

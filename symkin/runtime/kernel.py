@@ -108,6 +108,8 @@ class Kernel:
         self.joint_names: tuple[str, ...] = tuple(meta.get("joint_names", ()))
         # The input drivers (u[] order); their u, du, ddu follow the parameters in p[].
         self.input_names: tuple[str, ...] = tuple(meta.get("input_names", ()))
+        # Those that are a length (a distance driver's f): runtime.inputs refuses them < 0.
+        self.input_lengths: tuple[str, ...] = tuple(meta.get("input_lengths", ()))
         self._functions = functions
 
     @property

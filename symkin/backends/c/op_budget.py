@@ -280,8 +280,10 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
     solve = rows_in_unit + algebra.solve + from_unit
     velocity = _routine(code, "phi_t_shared") + Flops(add=n) + solve
     acceleration = _routine(code, "gamma_shared") + solve
-    if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests
-        norms = _max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
+    if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests;
+        # solve_inputs' first test: no length input below zero
+        norms = (_max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
+                 + Flops(cmp=len(getattr(code, "input_lengths", ()))))
     else:  # one pass: |q|, |dq|, |ddq| scaled, three maxima, the sum and two finite tests
         norms = Flops(abs=3 * n, mul=3 * n, cmp=3 * n, add=5 * n) + Flops(cmp=3)
     prediction = Flops(add=1) + Flops(mul=3, div=1, add=2) * n  # (2.76)
