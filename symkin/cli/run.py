@@ -272,7 +272,8 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     solved = stop.trajectory.t.size
     message = f"{args.mechanism}: {why}"
     if status == EXIT_INTERRUPTED:
-        message += f" at t = {stop.t:g}."
+        during = getattr(stop, "during", "")
+        message += f" while {during}, after the solve." if during else f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     _warn_flagged(stop.trajectory)  # after the error: a singular start flags its one row too
     try:
