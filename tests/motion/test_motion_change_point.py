@@ -8,8 +8,6 @@ its own branch (the rocker parallel to the crank), never a silent jump to the ot
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from motion_support import write
