@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from symkin import limits
 from symkin.contract.columns import RATE_SUFFIXES
+from symkin.runtime.inputs import negative_length
 
 Array = NDArray[np.float64]
 SUFFIXES = ("", *RATE_SUFFIXES)  # a value's column, its rate's and its acceleration's
@@ -72,16 +73,13 @@ def read(path: Path, names: tuple[str, ...], lengths: tuple[str, ...] = ()) -> I
 
 def _not_negative(path: Path, values: Array, lines: list[int], header: list[str],
                   lengths: tuple[str, ...]) -> None:
-    """A length's column (an actuator's |B - A|) has no negative value: its equation holds
-    the square, so -1 would be solved, silently, as 1."""
-    for name in lengths:
-        column = header.index(name)
-        negative = np.flatnonzero(values[:, column] < 0)
-        if negative.size:
-            k = int(negative[0])
-            raise TableError(f"{path}:{lines[k]}: column {name}: {values[k, column]:.10g} is "
-                             f"negative, but {name} is a distance driver's length |B - A| "
-                             f"({negative.size} negative value(s) in all); give lengths >= 0")
+    """A length's column (an actuator's |B - A|) has no negative value (the rule and its
+    words are runtime.inputs', which symkin.solve applies too)."""
+    names = tuple(header)
+    negative = negative_length(values, names, lengths)
+    if negative is not None:
+        k, name, message = negative
+        raise TableError(f"{path}:{lines[k]}: column {name}: {message}")
 
 
 def expected(names: tuple[str, ...]) -> str:

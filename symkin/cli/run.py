@@ -164,19 +164,10 @@ def _input_table(kernel: Any, args: argparse.Namespace) -> tuple[Any, str | None
                       "input drivers (a "
                       "driver function written `input`); leave out --inputs")
     try:
-        return input_table.read(args.inputs, names, _length_inputs(args)), None
+        lengths = tuple(getattr(kernel, "input_lengths", ()))
+        return input_table.read(args.inputs, names, lengths), None
     except input_table.TableError as error:
         return None, str(error)
-
-
-def _length_inputs(args: argparse.Namespace) -> tuple[str, ...]:
-    """The inputs that are lengths, read from the mechanism file (only a run with --inputs
-    reads it again; a table of a file changed since the kernel was built is checked by the
-    file as it is now)."""
-    from symkin.spec import name_checks, validate
-
-    mech = validate.load(args.mechanism, overrides.parse(args.overrides))
-    return name_checks.length_inputs(mech)
 
 
 def _size(count: float) -> str:
@@ -280,7 +271,8 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
     solved = stop.trajectory.t.size
     message = f"{args.mechanism}: {why}"
     if status == EXIT_INTERRUPTED:
-        message += f" at t = {stop.t:g}."
+        during = getattr(stop, "during", "")
+        message += f" while {during}, after the solve." if during else f" at t = {stop.t:g}."
     _error(f"{message} Solved {solved} of {total} time points.", status)
     _warn_flagged(stop.trajectory)  # after the error: a singular start flags its one row too
     try:

@@ -180,6 +180,8 @@ class Code:
     """The inputs' values in the file's q0 (codegen.sample.input_values)."""
     input_places: tuple[str, ...] = ()
     """Where each input is in the file (System.input_places)."""
+    input_lengths: tuple[int, ...] = ()
+    """The inputs (indices into u[]) that are lengths, never negative (System.input_lengths)."""
     nonlinear: tuple[int, ...] = ()
     """The coordinates that enter Phi_q or Phi_t (angles, Euler parameters, the positions of
     a prismatic pair's bodies): only their errors move Phi_q (runtime.accuracy)."""
@@ -288,7 +290,8 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         driver_names=system.dynamics.driver_names if system.dynamics else (),
         joint_names=system.dynamics.joint_names if system.dynamics else (),
         input_names=system.input_names, input_values=sample.input_values(system),
-        input_places=system.input_places, nonlinear=nonlinear_coordinates(system),
+        input_places=system.input_places, input_lengths=system.input_lengths,
+        nonlinear=nonlinear_coordinates(system),
         mass_rows=tuple(r for r, _ in m_pattern), mass_cols=tuple(c for _, c in m_pattern),
     )
 

@@ -244,6 +244,8 @@ def metadata(code: Code) -> Metadata:
         data["joint_names"] = list(code.joint_names)
     if code.input_names:  # only then: the other mechanisms' manifests stay the same
         data["input_names"] = list(code.input_names)
+    if code.input_lengths:  # likewise
+        data["input_lengths"] = [code.input_names[k] for k in code.input_lengths]
     if code.ranges:  # likewise
         data["ranges"] = [list(entry) for entry in code.ranges]
     return data
@@ -281,6 +283,8 @@ def template_context(code: Code) -> dict[str, Any]:
         "input_comments": [f"u[{k}] {lower.comment(n)}: {lower.comment(place)}" for k, (n, place)
                            in enumerate(zip(code.input_names, code.input_places))],
         "input_literals": [repr(n) for n in code.input_names],
+        "input_lengths": list(code.input_lengths),
+        "input_length_literals": [repr(code.input_names[k]) for k in code.input_lengths],
         "input_value_literals": [literal(v) for v in code.input_values],
         "routines": [_routine_context(code, r) for r in code.routines],
         # Python string literals: repr() of a str is always a valid, inert literal.
@@ -318,7 +322,7 @@ def template_context(code: Code) -> dict[str, Any]:
         "newton_defaults": _newton_defaults(code, literal),
         "option_fields": list(options.C_FIELDS),
         "option_rules": dict(options.RULES),
-        "status": dict(status.CODES),
+        "status": {**status.CODES, **status.INPUT_CODES},
         "shared_constants": {name: _c_number(value)
                              for name, value in {**tuning.SHARED, **tuning.INPUTS}.items()},
         **code.backend.template_context(code),

@@ -58,6 +58,9 @@ class Metadata(_Dynamics):
     absent for a planar one."""
     input_names: NotRequired[list[str]]
     """The input drivers, in the order of u[] (only a mechanism that has them)."""
+    input_lengths: NotRequired[list[str]]
+    """Those of the input drivers that are a length, never negative (a distance driver's f;
+    only a mechanism that has one)."""
     ranges: NotRequired[list[list[str | float]]]
     """[coordinate, a, b, owner] for each range a file gives a pair's own coordinate (only a
     mechanism that has one), at the nominal parameter values."""
@@ -84,7 +87,8 @@ KEYS = frozenset(Manifest.__annotations__)
 DYNAMICS_KEYS = frozenset(_Dynamics.__annotations__)
 """The keys only a mechanism with masses or forces has."""
 
-OPTIONAL_KEYS = frozenset({"removed", "senses", "space", "input_names", "ranges"}) | DYNAMICS_KEYS
+OPTIONAL_KEYS = frozenset({"removed", "senses", "space", "input_names",
+                           "input_lengths", "ranges"}) | DYNAMICS_KEYS
 """The keys only some manifests have (``removed``: an over-constrained file's; ``senses``: one
 with spatial revolutes, cylindricals or angle drivers; ``space``: a
 spatial one's; ``input_names``: one with input drivers; the dynamics keys). Written out:

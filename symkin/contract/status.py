@@ -18,6 +18,15 @@ BAD_OPTIONS = 4
 target <= 0, unit <= 0, ...); nothing was solved and the state is as it was. The runtime never
 meets it: Options refuses such values when it is made."""
 
+BAD_INPUT = 5
+"""Generated C ``solve_inputs`` only: an input breaks its rule (a length, a distance driver's
+f, is negative: its row holds the square, so it would be solved as its absolute value);
+nothing was solved and the state is as it was. The runtime refuses such inputs before any
+call (runtime.inputs.negative_length)."""
+
+INPUT_CODES = {"BAD_INPUT": BAD_INPUT}
+"""The status only a mechanism with length inputs can return (its header alone defines it)."""
+
 CODES = {"OK": OK, "NO_CONVERGENCE": NO_CONVERGENCE, "SINGULAR": SINGULAR,
          "NOT_FINITE": NOT_FINITE, "BAD_OPTIONS": BAD_OPTIONS}
 """Every status by its name (the C macro is ``<PREFIX>_`` + the name)."""

@@ -7,7 +7,8 @@ every moving point stays in the view. The HTML report is a rotatable plotly scen
 frame per shown time and a slider; the GIF is an isometric projection of the same lines.
 With masses or forces, each joint's reaction force (body i on body j) is an arrow at its point
 on body i, the largest of the run VECTOR_SHARE of the scene long, as in the planar pictures,
-and the HTML report has the planar report's column of efforts and reactions beside its scene.
+and the HTML report has the planar report's column of efforts and reactions beside its scene;
+a run its forces move (runtime.dynamics) has the planar report's energy column too.
 
 Names in the figure come from a validated file and reach the browser as JSON data only.
 """
@@ -168,7 +169,7 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
             marker={"size": [0, 9], "color": REACTION, "symbol": "diamond",
                     "line": {"width": 1, "color": "black"}}))
         moving.append(len(figure.data) - 1)
-    cursors = _force_column(go, figure, trajectory, units)
+    cursors = _columns(go, figure, trajectory, units)
     built = [go.Frame(name=f"{float(trajectory.t[k]):.6g}", traces=moving + list(cursors),
                       data=[*(_at(go, shape[k]) for shape in lines.values()),
                             *_arrows(go, points[k], forces[k], scale),
@@ -184,29 +185,47 @@ def report(trajectory: Trajectory, path: str | Path, units: Units = DEFAULT_UNIT
     return page.write(figure, path)
 
 
+def _side_columns(trajectory: Trajectory) -> tuple[str, ...]:
+    """The columns of panels beside the scene: ``forces`` (with masses or forces,
+    :mod:`symkin.present.html_forces`), then ``energy`` (a run its forces move,
+    :mod:`symkin.present.html_energy`)."""
+    from symkin.present import html_energy
+
+    return tuple(name for name, shown in (("forces", trajectory.forces is not None),
+                                          ("energy", html_energy.energies(trajectory)
+                                           is not None)) if shown)
+
+
 def _figure(go: Any, trajectory: Trajectory) -> Any:
-    """The empty figure: the scene alone, or with masses or forces the scene beside the
-    column of efforts and reactions (:mod:`symkin.present.html_forces`)."""
-    if trajectory.forces is None:
+    """The empty figure: the scene alone, or the scene beside its side columns (three panels
+    each, sharing the time axis)."""
+    side = _side_columns(trajectory)
+    if not side:
         return go.Figure()
     from plotly.subplots import make_subplots
 
-    specs = [[{"type": "scene", "rowspan": 3}, {}], [None, {}], [None, {}]]
-    return make_subplots(rows=3, cols=2, specs=specs, shared_xaxes=True,
-                         column_widths=[0.62, 0.38], horizontal_spacing=0.08,
+    panels: list[dict[str, Any]] = [{} for _ in side]
+    specs = [[{"type": "scene", "rowspan": 3}, *panels], [None, *panels], [None, *panels]]
+    widths = [0.62, 0.38] if len(side) == 1 else [0.5, 0.25, 0.25]
+    return make_subplots(rows=3, cols=1 + len(side), specs=specs, shared_xaxes=True,
+                         column_widths=widths, horizontal_spacing=0.08,
                          vertical_spacing=0.06)
 
 
-def _force_column(go: Any, figure: Any, trajectory: Trajectory, units: Units
-                  ) -> dict[int, tuple[float, float]]:
-    """The efforts' and reactions' curves in column 2; returns each time cursor's trace
-    index and the y range it spans (none without forces)."""
-    if trajectory.forces is None:
-        return {}
-    from symkin.present import html_forces
+def _columns(go: Any, figure: Any, trajectory: Trajectory, units: Units
+             ) -> dict[int, tuple[float, float]]:
+    """The side columns' curves (columns 2 on); returns each time cursor's trace index and
+    the y range it spans (none without side columns)."""
+    from symkin.present import html_energy, html_forces
 
-    cursors = html_forces.plot(go, figure, trajectory, column=2)
-    html_forces.label(figure, 2, units, spatial=True)
+    cursors = []
+    for column, name in enumerate(_side_columns(trajectory), start=2):
+        if name == "forces":
+            cursors += html_forces.plot(go, figure, trajectory, column=column)
+            html_forces.label(figure, column, units, spatial=True)
+        else:
+            cursors += html_energy.plot(go, figure, trajectory, column)
+            html_energy.label(figure, column, units)
     return {index: html_forces.panel_range(figure, index) for index, _, _ in cursors}
 
 

@@ -24,8 +24,10 @@ better q0 will do).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,6 +35,7 @@ from numpy.typing import NDArray
 from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.options import Options
 from symkin.contract.status import OK, SINGULAR
+from symkin.errors import SymkinWarning
 from symkin.runtime.newton import Newton, newton
 from symkin.runtime.protocol import KinematicsKernel
 
@@ -105,6 +108,49 @@ def reversed_senses(kernel: KinematicsKernel, q: Array, t: float, p: Array
         values = np.asarray(kernel.sense_values(q, t, p),  # type: ignore[attr-defined]
                             dtype=np.float64)
     return tuple(label for label, value in zip(labels, values) if not value > 0.0)
+
+
+def reversed_rows(kernel: KinematicsKernel, t: Array, q: Array, p: Array) -> NDArray[np.bool_]:
+    """(T, NSENSES): where each sense of the kernel is not positive along a run's rows (p:
+    the kernel's p[], or (T, NP) one per row). A sense cannot change sign along a continuous
+    motion (its value is +1 or -1 wherever Phi = 0 holds), so a row where one is negative is
+    a jump to a solution of Phi = 0 that is no assembly of the mechanism: a step too large for
+    Newton to follow. One evaluation per row; nothing at all without senses."""
+    count = len(getattr(kernel, "senses", ()))
+    if not count or not t.size:
+        return np.zeros((t.size, count), dtype=bool)
+    with np.errstate(all="ignore"):
+        batched = getattr(kernel, "sense_rows", None)  # a Kernel's: one crossing into C
+        if batched is not None:
+            values = np.asarray(batched(q, t, p), dtype=np.float64)
+        else:  # a stand-in (the motion's model): one call per row
+            rows = np.broadcast_to(p, (t.size, np.shape(p)[-1])) if np.ndim(p) == 1 else p
+            values = np.array([kernel.sense_values(  # type: ignore[attr-defined]
+                q[k], float(t[k]), rows[k]) for k in range(t.size)], dtype=np.float64)
+    return ~(values.reshape(t.size, count) > 0.0)
+
+
+def flip_message(kernel: KinematicsKernel, t: Array, wrong: NDArray[np.bool_]) -> str:
+    """One sentence locating the first row where a sense flipped (reversed_rows): its time
+    and the joints or drivers, and how many rows in all."""
+    labels = tuple(getattr(kernel, "senses", ()))
+    rows = np.flatnonzero(wrong.any(axis=1))
+    k = int(rows[0])
+    named = [label for label, bad in zip(labels, wrong[k]) if bad]
+    shown = ", ".join(named[:10]) + (f" and {len(named) - 10} more" if len(named) > 10 else "")
+    return (f"the motion left the mechanism's assembly at row {k} (t = {float(t[k]):.10g}): "
+            f"{shown} reversed (a revolute's axis, or an angle half a turn away; "
+            f"{rows.size} row(s) in all, flagged): the step before it was too large for Newton "
+            "to follow; use a smaller dt there")
+
+
+def flag_flips(kernel: KinematicsKernel, trajectory: Any, p: Array) -> None:
+    """Flag the rows of a solved run where a sense is not positive (reversed_rows), with a
+    SymkinWarning that locates the first; nothing when every row is as meant."""
+    wrong = reversed_rows(kernel, trajectory.t, trajectory.q, p)
+    if wrong.any():
+        trajectory.flagged[wrong.any(axis=1)] = True
+        warnings.warn(flip_message(kernel, trajectory.t, wrong), SymkinWarning, stacklevel=3)
 
 
 def _evidence(residuals: list[float]) -> str:

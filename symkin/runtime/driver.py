@@ -41,7 +41,7 @@ from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
-from symkin.runtime.assembly import assemble, genuine
+from symkin.runtime.assembly import assemble, flag_flips, genuine
 from symkin.runtime.c_loop import _c_loop, _c_outcome, _c_run
 from symkin.runtime.edges import Resolution, resolve
 from symkin.runtime.inputs import InputValues
@@ -52,7 +52,7 @@ from symkin.runtime.result_arrays import Run as _Run
 from symkin.runtime.results import Trajectory
 from symkin.runtime.run_outcome import SolveFailure as SolveFailure
 from symkin.runtime.run_outcome import SolveInterrupted as SolveInterrupted
-from symkin.runtime.run_outcome import _fail, _point_size, refuse_reversed
+from symkin.runtime.run_outcome import _fail, _point_size, refuse_reversed, rows_kept
 from symkin.runtime.run_outcome import _trajectory as _trajectory
 from symkin.runtime.start import singular_start
 
@@ -150,12 +150,15 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     except SolveFailure as failure:  # past a curve's range first: that is the cause to name
         _stop_outside_range(kernel, failure.trajectory)
         raise
-    _stop_outside_range(kernel, trajectory)
-    trajectory = redundant.check(kernel, trajectory, options)
+    with rows_kept(trajectory, "the solved rows were checked"):
+        _stop_outside_range(kernel, trajectory)
+        trajectory = redundant.check(kernel, trajectory, options)
+        flag_flips(kernel, trajectory, trajectory.params)  # a jump off the assembly
     if sensitivities:
         from symkin.runtime.sensitivity import with_sensitivities
 
-        return with_sensitivities(kernel, trajectory)
+        with rows_kept(trajectory, "the sensitivities were computed"):
+            return with_sensitivities(kernel, trajectory)
     return trajectory
 
 

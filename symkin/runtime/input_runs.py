@@ -19,10 +19,17 @@ from symkin.contract.status import OK
 from symkin.errors import SymkinWarning
 from symkin.runtime import branch, units
 from symkin.runtime.arguments import first_guess, parameter_values, time_points
+from symkin.runtime.assembly import flag_flips
 from symkin.runtime.inputs import Inputs, InputValues, check_inputs, solve_points
 from symkin.runtime.result_arrays import Out, allocate
 from symkin.runtime.results import Trajectory
-from symkin.runtime.run_outcome import SolveFailure, SolveInterrupted, _fail, _trajectory
+from symkin.runtime.run_outcome import (
+    SolveFailure,
+    SolveInterrupted,
+    _fail,
+    _trajectory,
+    rows_kept,
+)
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -80,9 +87,10 @@ def _inputs_run(kernel: Any, times: Array, table: Inputs, q: Array, p: Array,
     # each row's efforts and reactions at its own inputs (an actuator's depend on them)
     rows = _input_rows(kernel, table, p, run.done)
     trajectory = _trajectory(kernel, run, p, loads_p=rows)
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"), rows_kept(trajectory, "the solved rows were checked"):
         trajectory.__dict__["branch_jumps"] = branch.jump_rows(kernel, trajectory.t,
                                                                trajectory.q, rows)
+        flag_flips(kernel, trajectory, rows)  # a jump off the assembly
     return trajectory
 
 

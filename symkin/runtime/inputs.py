@@ -111,9 +111,31 @@ def check_inputs(kernel: InputKernel, times: Array, inputs: InputValues | None,
     if accels is not None and rates is None:
         raise SolveError("input_accels= needs input_rates= too (the accelerations of the "
                          "mechanism depend on both)")
-    return Inputs(*(None if values is None else _table(values, what, names, times)
-                    for values, what in ((inputs, "inputs"), (rates, "input_rates"),
-                                         (accels, "input_accels"))))  # type: ignore[arg-type]
+    checked = Inputs(*(None if values is None else _table(values, what, names, times)
+                       for values, what in ((inputs, "inputs"), (rates, "input_rates"),
+                                            (accels, "input_accels"))))  # type: ignore[arg-type]
+    negative = negative_length(checked.u, names, tuple(getattr(kernel, "input_lengths", ())))
+    if negative is not None:
+        k, name, message = negative
+        raise SolveError(f"inputs[{name!r}] at point {k} (t = {times[k]:.10g}): {message}")
+    return checked
+
+
+def negative_length(u: Array, names: tuple[str, ...], lengths: tuple[str, ...]
+                    ) -> tuple[int, str, str] | None:
+    """The first point k and input whose value in u (T, NU) is a negative length, with the
+    message's end (what is wrong and how to fix it), or None. A length (a distance driver's
+    f, Kernel.input_lengths) is never negative: its row holds the square, so -1 would be
+    solved, silently, as 1. The CLI's inputs table and symkin.solve both ask here."""
+    for name in lengths:
+        column = u[:, names.index(name)]
+        negative = np.flatnonzero(column < 0)
+        if negative.size:
+            k = int(negative[0])
+            return k, name, (f"{column[k]:.10g} is negative, but {name} is a distance driver's "
+                             f"length |B - A| ({negative.size} negative value(s) in all); "
+                             "give lengths >= 0")
+    return None
 
 
 def _table(values: InputValues, what: str, names: tuple[str, ...], times: Array) -> Array:

@@ -114,6 +114,8 @@ class Kernel:
         self.input_names: tuple[str, ...] = tuple(meta.get("input_names", ()))
         # Forward dynamics: the generated M and Q - h are there (runtime.dynamics.compiled).
         self.has_mass = getattr(functions, "mass", None) is not None
+        # Those that are a length (a distance driver's f): runtime.inputs refuses them < 0.
+        self.input_lengths: tuple[str, ...] = tuple(meta.get("input_lengths", ()))
         self._functions = functions
 
     @property
@@ -208,6 +210,22 @@ class Kernel:
             raise ValueError(f"the kernel of {self.name} names senses but has no routine "
                              "for them; rebuild it with symkin.compile")
         return np.asarray(evaluate(self._q(q), float(t), self._p(p)), dtype=float)
+
+    def sense_rows(self, q: ArrayLike, t: ArrayLike, p: ArrayLike | None = None) -> Array:
+        """The senses at every row of a run, (T, NSENSES): q (T, NQ) at t (T,), p the
+        kernel's p[] or one per row (T, NP + 3 NU, an input run's). The C extension loops
+        over the rows without a Python call each; other functions are called per row."""
+        rows_q, times = np.asarray(q, dtype=float), np.asarray(t, dtype=float)
+        if not self.senses or not times.size:
+            return np.zeros((times.size, len(self.senses)))
+        given = np.asarray(self.p_values if p is None else p, dtype=float)
+        params = given if given.ndim == 2 else self._p(given)
+        batched = getattr(self._functions, "sense_rows", None)
+        if batched is not None:
+            return np.asarray(batched(rows_q, times, params), dtype=float)
+        return np.array([self.sense_values(rows_q[k], float(times[k]),
+                                           params[k] if params.ndim == 2 else params)
+                         for k in range(times.size)], dtype=float)
 
     # -- inverse dynamics ---------------------------------------------------------------------
     def multipliers(self, q: ArrayLike, dq: ArrayLike, ddq: ArrayLike, t: float,

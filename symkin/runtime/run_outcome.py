@@ -7,7 +7,8 @@ Imports NumPy only: part of the runtime.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -29,13 +30,17 @@ class SolveInterrupted(SolveError):
 
     Attributes:
         trajectory: the time points solved before the interrupt.
-        t: the first time point not solved.
+        t: the first time point not solved (the last one when all were).
+        during: the work after the loop that was interrupted ("" within the loop): every
+            time point was solved, what ``during`` would have added is missing.
     """
 
-    def __init__(self, trajectory: Trajectory, t: float) -> None:
-        super().__init__(f"interrupted at t = {t:g} after {trajectory.t.size} time points")
+    def __init__(self, trajectory: Trajectory, t: float, during: str = "") -> None:
+        where = f"while {during}, " if during else f"at t = {t:g} "
+        super().__init__(f"interrupted {where}after {trajectory.t.size} time points")
         self.trajectory = trajectory
         self.t = t
+        self.during = during
 
 
 class SolveFailure(SolveError):
@@ -93,12 +98,33 @@ def _trajectory(kernel: KinematicsKernel, run: _Run, p: Array,
     # inverse dynamics (a kernel with masses or forces): efforts and reactions of the rows
     given = None if run.forces_out is None else tuple(a[:done] for a in run.forces_out)
     if getattr(kernel, "nu", 0):
-        trajectory.__dict__["forces"] = (None if loads_p is None else
-                                         forces.compute(kernel, t, q, dq, d2q, loads_p))
+        attach_forces(trajectory, lambda: None if loads_p is None else
+                      forces.compute(kernel, t, q, dq, d2q, loads_p))
     else:
-        trajectory.__dict__["forces"] = forces.compute(kernel, t, q, dq, d2q, p, given)
-    flag_not_finite(trajectory)
+        attach_forces(trajectory, lambda: forces.compute(kernel, t, q, dq, d2q, p, given))
     return trajectory
+
+
+@contextmanager
+def rows_kept(trajectory: Trajectory, during: str) -> Iterator[None]:
+    """Work after the loop on rows all solved (efforts, removed rows, ranges): a Ctrl-C in
+    it hands on ``trajectory`` (SolveInterrupted, ``during`` saying what was cut short), so
+    that the rows solved are written as after an interrupt in the loop, never lost to a bare
+    KeyboardInterrupt."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        last = float(trajectory.t[-1]) if trajectory.t.size else math.nan
+        raise SolveInterrupted(trajectory, last, during) from None
+
+
+def attach_forces(trajectory: Trajectory, compute: Callable[[], forces.Forces | None]) -> None:
+    """The efforts and reactions ``compute()`` gives, on the trajectory, their non-finite
+    rows flagged; none (and SolveInterrupted) where a Ctrl-C cuts their computation short."""
+    trajectory.__dict__["forces"] = None
+    with rows_kept(trajectory, "the efforts and reactions were computed"):
+        trajectory.__dict__["forces"] = compute()
+    flag_not_finite(trajectory)
 
 
 def flag_not_finite(trajectory: Trajectory) -> None:

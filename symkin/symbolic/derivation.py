@@ -23,7 +23,7 @@ import sympy as sp
 from symkin import pairs
 from symkin.errors import ExpressionError, MechanismError
 from symkin.spec import motion as motion_spec
-from symkin.spec import validate
+from symkin.spec import name_checks, validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
 from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
@@ -138,6 +138,13 @@ class System:
     @property
     def input_names(self) -> tuple[str, ...]:
         return tuple(item.name for item in self.inputs)
+
+    @property
+    def input_lengths(self) -> tuple[int, ...]:
+        """The inputs (indices into u[]) that are a length (PairType.lengths: a distance
+        driver's f), never negative: the row holds its square."""
+        lengths = name_checks.length_inputs(self.mechanism)
+        return tuple(k for k, name in enumerate(self.input_names) if name in lengths)
 
     @property
     def input_places(self) -> tuple[str, ...]:

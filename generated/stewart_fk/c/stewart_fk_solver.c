@@ -1404,6 +1404,12 @@ int stewart_fk_solve_inputs(const stewart_fk_options *options, const stewart_fk_
                               stewart_fk_report *report)
 {
     if (stewart_fk_check_options(options) != 0) return stewart_fk_refused(report, state->t);
+    /* A length's row holds its square: -1 would be solved, silently, as 1. */
+    if (u[0] < 0 || u[1] < 0 || u[2] < 0 || u[3] < 0 || u[4] < 0 || u[5] < 0) {
+        stewart_fk_refused(report, state->t);
+        report->status = STEWART_FK_BAD_INPUT;
+        return report->status;
+    }
     return stewart_fk_inputs_step(options, p, u, du, ddu, state, work, report);
 }
 

@@ -24,6 +24,7 @@
 #define STEWART_FK_SINGULAR 2       /* Phi_q singular or ill-conditioned */
 #define STEWART_FK_NOT_FINITE 3     /* Phi at the prediction, dq or ddq is inf or NaN */
 #define STEWART_FK_BAD_OPTIONS 4    /* an option breaks its rule: see stewart_fk_check_options */
+#define STEWART_FK_BAD_INPUT 5      /* solve_inputs: a length input u[0], u[1], u[2], u[3], u[4], u[5] is negative */
 
 typedef struct {
     stewart_fk_real tol_phi;         /* converged when max|Phi| <= tol_phi ...        */
@@ -62,8 +63,8 @@ typedef struct {
  * Velocity: 111; acceleration: 996; per-point checks: 3234; predictor: 31
  * Step, worst case with the default cap of 25 iterations: 46524 (18252 add/sub, 19329 mul, 506 div, 10 sqrt, 0 other calls, 4550 fabs, 3877 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 48905 (19315 add/sub, 20454 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3974 compares)
- *   positions only (du, ddu NULL): 47740 (18770 add/sub, 19878 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3958 compares)
+ * solve_inputs, worst case: 48911 (19315 add/sub, 20454 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3980 compares)
+ *   positions only (du, ddu NULL): 47746 (18770 add/sub, 19878 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3964 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2354
  * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62323
  */
@@ -71,8 +72,8 @@ typedef struct {
 #define STEWART_FK_OPS_STEP_FIXED 11649  /* a step without its iterations */
 #define STEWART_FK_OPS_STEP_WORST 46524  /* at the default cap, 25 */
 #define STEWART_FK_OPS_STEP_DENSE_WORST 62323  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 48905  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 47740  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_INPUTS_WORST 48911  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 47746  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -177,7 +178,10 @@ int stewart_fk_solve_grid_checked(const stewart_fk_options *options,
  * since the last solution (a singular configuration lies between the two), or the solution is
  * farther from Newton's first step from the last solution than its region of quadratic
  * convergence allows (|q - (q_last + s)| > 0.5 |s| and > 1e-08 (1 + |q|), max-norms).
- * The call's result stands; give inputs closer together there, or check the assembly. */
+ * The call's result stands; give inputs closer together there, or check the assembly.
+ * u[0], u[1], u[2], u[3], u[4], u[5] are lengths (a distance driver's |B - A|): one that is negative is
+ * refused, STEWART_FK_BAD_INPUT with nothing solved and the state as it was (its row holds
+ * the square, so it would be solved as its absolute value). */
 int stewart_fk_solve_inputs(const stewart_fk_options *options, const stewart_fk_real p[],
                               const stewart_fk_real u[], const stewart_fk_real du[],
                               const stewart_fk_real ddu[], stewart_fk_state *state,

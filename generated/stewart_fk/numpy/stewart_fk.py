@@ -26,6 +26,15 @@ INPUT_NAMES = (
     'leg5',
     'leg6',
 )
+# The inputs that are a length (a distance driver's f): never negative, the row holds f^2.
+INPUT_LENGTHS = (
+    'leg1',
+    'leg2',
+    'leg3',
+    'leg4',
+    'leg5',
+    'leg6',
+)
 NNZ = 46
 NPOINTS = 6
 NSHARED = 0

@@ -285,8 +285,10 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
     solve = rows_in_unit + algebra.solve + from_unit
     velocity = _routine(code, "phi_t_shared") + solve  # negated in the norms' pass
     acceleration = _routine(code, "gamma_shared") + solve
-    if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests
-        norms = _max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
+    if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests;
+        # solve_inputs' first test: no length input below zero
+        norms = (_max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
+                 + Flops(cmp=len(getattr(code, "input_lengths", ()))))
     else:  # a pass over dq as solved (max, finite test, negation) and one over ddq as solved
         # and q / column (two maxima, ddq's finite test, q's sum)
         # then whether Newton's bound cleared the point (work->clear)

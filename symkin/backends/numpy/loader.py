@@ -65,6 +65,7 @@ def from_module(module: ModuleType, backend: str, folder: Path | None = None) ->
         **({"driver_names": module.DRIVER_NAMES, "joint_names": module.JOINT_NAMES}
            if hasattr(module, "JOINT_NAMES") else {}),
         "input_names": getattr(module, "INPUT_NAMES", ()),
+        "input_lengths": getattr(module, "INPUT_LENGTHS", ()),
         **({"nonlinear": [k for k, entered in enumerate(module.NONLINEAR) if entered]}
            if hasattr(module, "NONLINEAR") else {}),
     }

@@ -23,13 +23,18 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.loads import reaction_parts
 from symkin.runtime import failures
 from symkin.runtime.arguments import first_guess, parameter_values, time_points
-from symkin.runtime.assembly import reversed_senses
+from symkin.runtime.assembly import flag_flips, reversed_senses
 from symkin.runtime.dynamics import equations, initial
 from symkin.runtime.dynamics.integrator import State, StepFailure, Stepper
 from symkin.runtime.dynamics.model import Model, MotionKernel
 from symkin.runtime.forces import Forces
 from symkin.runtime.results import Trajectory
-from symkin.runtime.run_outcome import SolveFailure, SolveInterrupted, flag_not_finite
+from symkin.runtime.run_outcome import (
+    SolveFailure,
+    SolveInterrupted,
+    attach_forces,
+    rows_kept,
+)
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -111,7 +116,10 @@ def _solve(kernel: MotionKernel, t: ArrayLike | None, q0: ArrayLike | None,
         raise SolveFailure(f"the motion stops at t = {at:.6g}: {reason}. {kept}",
                            _trajectory(model, rows, p), at, math.nan, 0,
                            reason="singular") from None
-    return _trajectory(model, rows, p)
+    trajectory = _trajectory(model, rows, p)
+    with rows_kept(trajectory, "the solved rows were checked"):
+        flag_flips(model, trajectory, p)  # type: ignore[arg-type]  # a jump off the assembly
+    return trajectory
 
 
 def _refuse_reversed(model: Model, rows: _Rows, q: Array, p: Array) -> None:
@@ -163,8 +171,8 @@ def _trajectory(model: Model, rows: _Rows, p: Array) -> Trajectory:
     outputs = [(name, rows.energy[:done, j].copy()) for j, name in enumerate(ENERGY)]
     outputs.append(("constraint_residual", rows.residual[:done].copy()))
     trajectory.__dict__["outputs"] = tuple(outputs)
-    trajectory.__dict__["forces"] = _forces(model, t, q, rows.lam[:done], p, rows.redundant)
-    flag_not_finite(trajectory)  # an infinite or undefined load: flagged, never silent
+    # an infinite or undefined load is flagged, never silent; a Ctrl-C keeps the rows
+    attach_forces(trajectory, lambda: _forces(model, t, q, rows.lam[:done], p, rows.redundant))
     return trajectory
 
 
