@@ -16,7 +16,7 @@ from symkin.runtime.kernel import Kernel
 from symkin.symbolic.derivation import System
 
 
-def generate(system: System, backend: str = "c", out_dir: str | Path = "generated",
+def generate(system: System, backend: str = "c", out_dir: str | Path = "generated", *,
              cse: bool = True, force: bool = False, **options: str) -> list[Path]:
     """Generate the source files of one backend into ``out_dir`` (``codegen.render.generate``).
 
