@@ -32,13 +32,17 @@ def test_no_module_is_too_long() -> None:
 
 
 def test_partial_templates_are_included_not_rendered() -> None:
+    import symkin
     from symkin import backends
-    from symkin.codegen import render
+    from symkin.codegen import lower, render
 
+    derived = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
     for name in backends.names():
-        for linalg in ("dense", "sparse"):
-            rendered = render.template_names(backends.get(name), linalg)
-            assert rendered and not [name for name in rendered if name.startswith("_")]
+        for option in backends.get(name).options:
+            for value in option.choices:
+                code = lower.lower(derived, backends.get(name), {option.name: value})
+                rendered = render.template_names(code)
+                assert rendered and not [name for name in rendered if name.startswith("_")]
         # each backend's templates live in its own folder and include each other there
         root = backends.get(name).template_root
         folder = root / backends.get(name).template_folder
@@ -65,15 +69,18 @@ def test_package_is_mypy_strict_clean() -> None:
 
 
 def test_every_subpackage_ships_in_the_wheel() -> None:
-    """pyproject lists the packages explicitly (templates are mapped in as symkin.templates):
-    a new stage folder that is not listed would be missing from an installed symkin."""
+    """pyproject finds the packages (a new backend's folder is not named there): every folder
+    of modules must then be a package, or it would be missing from an installed symkin."""
     import tomllib
 
-    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
-                 ["packages"])
-    found = {".".join(init.parent.relative_to(ROOT).parts)
-             for init in (ROOT / "symkin").rglob("__init__.py")}
-    assert found <= listed, f"add to [tool.setuptools] packages: {sorted(found - listed)}"
+    from setuptools import find_packages
+
+    found = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    shipped = set(find_packages(str(ROOT), include=found["packages"]["find"]["include"]))
+    folders = {".".join(module.parent.relative_to(ROOT).parts)
+               for module in (ROOT / "symkin").rglob("*.py")
+               if "templates" not in module.parts}
+    assert folders <= shipped, f"add an __init__.py to: {sorted(folders - shipped)}"
 
 
 def test_architecture_names_every_module() -> None:

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from symkin.backends import c, numpy, octave
 from symkin.build.backend import Backend
+from symkin.codegen.target import Option
 from symkin.errors import BuildError, SymkinWarning
 
 if TYPE_CHECKING:  # the CLI imports the registry for --backend: no NumPy at start-up
@@ -38,6 +39,20 @@ def names() -> tuple[str, ...]:
 def choices() -> tuple[str, ...]:
     """What ``backend=`` and ``--backend`` accept: ``"auto"`` and every registered name."""
     return (AUTO, *_REGISTERED)
+
+
+def declared_options() -> tuple[Option, ...]:
+    """Every option some registered backend declares, once by name (for the CLI's flags): the
+    choices of all that declare it, the help and default of the first (in order of
+    preference). Which backend takes which value is still checked by each backend
+    (``codegen.target.chosen_options``)."""
+    merged: dict[str, Option] = {}
+    for backend in _REGISTERED.values():
+        for option in backend.options:
+            first = merged.get(option.name, option)
+            choices = (*first.choices, *(c for c in option.choices if c not in first.choices))
+            merged[option.name] = Option(option.name, choices, first.default, first.help)
+    return tuple(merged.values())
 
 
 def get(name: str) -> Backend:

@@ -23,11 +23,12 @@ class Backend(Target, Protocol):
     """A code-generation target that can also be built and loaded."""
 
     def unavailable(self) -> str | None:
-        """Why it cannot build on this machine (e.g. no C compiler), or None when it can."""
+        """Why it cannot build on this machine (e.g. no compiler), or None when it can."""
         ...
 
     def require(self) -> None:
-        """Raise the error that says how to make it available (``NoCompilerError`` for C);
+        """Raise the error that says how to make it available (``NoCompilerError`` where it
+        needs a compiler);
         nothing when :meth:`unavailable` is None."""
         ...
 

@@ -1,15 +1,16 @@
 """The kernel index: from a mechanism file straight to its built kernel, without SymPy.
 
-The build cache (symkin/build/cache.py) is keyed by the generated source, so finding a kernel there
+The build cache (symkin.build.cache) is keyed by the generated source, so finding a kernel there
 needs the derivation, and with it SymPy, pydantic and jinja2. This index sits in front of it:
 
-    sha256(file bytes, file format, backend, real, cse, linalg, symkin's code and templates,
-           interpreter and compiler)  ->  index/<key>.json  ->  the cache folder of the kernel
+    sha256(file bytes, file format, backend, cse, the backend's options, symkin's code and
+           templates, interpreter and compiler)
+        ->  index/<key>.json  ->  the cache folder of the kernel
 
 Keying on the raw bytes, not on the validated spec, is what lets a warm run skip validation
 too: the same bytes read by the same symkin code validate and derive to the same kernel, so
 a file that was accepted once needs no second check. Anything else misses: an edited file,
-another backend or real type, a new symkin version or an edited template.
+another backend or option, a new symkin version or an edited template.
 
 An entry records the sha256 of every file a warm run loads. An entry that does not parse,
 does not match its key, or points at files whose hash changed is deleted (with the kernel
@@ -35,6 +36,7 @@ from numpy.typing import NDArray
 
 from symkin.build.backend import Backend
 from symkin.build.cache import discard, open_cache, sha256_of
+from symkin.codegen.target import chosen_options
 from symkin.contract.manifest import MANIFEST_SUFFIX
 from symkin.runtime.kernel import Kernel, read_manifest
 
@@ -55,9 +57,10 @@ class Options:
     """
 
     backend: Backend
-    real: str = "double"
     cse: bool = True
-    linalg: str = "sparse"  # codegen.DEFAULT_LINALG (not imported: it would load SymPy)
+    # The backend's own options as (name, value) pairs (codegen.target.Option): the ones
+    # given; the backend's defaults stand for the rest.
+    choices: tuple[tuple[str, str], ...] = ()
     # Parameter values replacing the file's (``--set``), as (name, text) pairs: they change
     # the nominal values (and the first guess q0) recorded with the kernel.
     parameters: tuple[tuple[str, str], ...] = ()
@@ -86,7 +89,7 @@ def prepare(mechanism: str | Path, options: Options, *, outlines: bool = False,
 
     Args:
         mechanism: the mechanism file (.yaml or .toml).
-        options: backend, real type, CSE and LU choice.
+        options: backend, CSE and the backend's own options.
         outlines: also return the body outlines for an animation (recorded in the entry, so
             a warm run can draw without SymPy).
         cache_dir: the cache folder; default ``$SYMKIN_CACHE_DIR`` or the user cache.
@@ -102,10 +105,10 @@ def prepare(mechanism: str | Path, options: Options, *, outlines: bool = False,
         if found is not None:
             return found
     prepared = _full_pipeline(Path(mechanism), options, cache, outlines)
-    # Not recorded: a C request that fell back to NumPy (no compiler; the next run must try,
-    # and warn, again), a file that changed while it was derived (the kernel may be of
-    # other bytes than the key's), and a mechanism its forces move (build.motion: its energy
-    # terms need the System).
+    # Not recorded: a request that fell back to another backend (no compiler; the next run
+    # must try, and warn, again), a file that changed while it was derived (the kernel may
+    # be of other bytes than the key's), and a mechanism its forces move (build.motion: its
+    # energy terms need the System).
     if (key is not None and prepared.kernel.backend == options.backend.name
             and not getattr(prepared.kernel, "moves_under_forces", False)
             and index_key(Path(mechanism), options) == key):
@@ -124,8 +127,8 @@ def _full_pipeline(mechanism: Path, options: Options, cache: Path,
     # Forward dynamics is not recorded in the index (record skips it): its energy terms come
     # from the System (build.motion), so a run derives; the kernel itself is cached.
     build = motion.kernel if motion.moves_under_forces(system) else compile_system
-    kernel = build(system, options.backend, real=options.real, cse=options.cse,
-                   linalg=options.linalg, cache_dir=cache)
+    kernel = build(system, options.backend, dict(options.choices), cse=options.cse,
+                   cache_dir=cache)
     return Prepared(kernel, hit=False, outlines=_drawn_outlines(system, want_outlines),
                     system=system)
 
@@ -152,7 +155,7 @@ def index_key(mechanism: Path, options: Options) -> str | None:
         "format": FORMAT, "file_sha256": hashlib.sha256(raw).hexdigest(),
         # The loader picks TOML or YAML by suffix: the same bytes may mean different things.
         "file_format": "toml" if mechanism.suffix.lower() == ".toml" else "yaml",
-        "options": [options.backend.name, options.real, options.cse, options.linalg,
+        "options": [options.backend.name, options.cse, _chosen(options),
                     [list(pair) for pair in options.parameters]],
         "code": code_version(), **options.backend.fingerprint(),
     }
@@ -234,10 +237,17 @@ def _matching_manifest(folder: Path, options: Options) -> dict[str, Any] | None:
         meta = read_manifest(folder)
     except (OSError, ValueError):
         return None
-    wanted = {"backend": options.backend.name, "cse": options.cse, "real": options.real}
+    wanted = {"backend": options.backend.name, "cse": options.cse,
+              "real": options.backend.precision(_chosen(options))}
     if isinstance(meta, dict) and all(meta.get(k) == v for k, v in wanted.items()):
         return meta
     return None
+
+
+def _chosen(options: Options) -> dict[str, str]:
+    """The backend's options with its defaults filled in: a default given or left out is the
+    same kernel, so the same key."""
+    return chosen_options(options.backend, dict(options.choices))
 
 
 def _named_folder(cache: Path, entry: Any) -> Path | None:

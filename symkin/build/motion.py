@@ -10,11 +10,12 @@ terms and initial velocities the generated code has no routine for come from the
 from __future__ import annotations
 
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any
 
 from symkin.build.backend import Backend
 from symkin.build.compile import compile as compile_system
-from symkin.codegen import lower
+from symkin.codegen.target import chosen_options
 from symkin.errors import BackendRefused
 from symkin.runtime.dynamics.compiled import CompiledModel
 from symkin.runtime.dynamics.model import MotionKernel
@@ -24,10 +25,10 @@ from symkin.symbolic.motion import moves_under_forces
 __all__ = ["kernel", "moves_under_forces"]
 
 
-def kernel(system: Any, backend: Backend, *, real: str = "double", cse: bool = True,
-           linalg: str = lower.DEFAULT_LINALG, cache_dir: str | Path | None = None
-           ) -> MotionKernel:
-    """The MotionKernel of ``system`` on ``backend`` (options as build.compile's).
+def kernel(system: Any, backend: Backend, options: Mapping[str, str] | None = None, *,
+           cse: bool = True, cache_dir: str | Path | None = None) -> MotionKernel:
+    """The MotionKernel of ``system`` on ``backend`` (``options``, ``cse``, ``cache_dir`` as
+    build.compile's).
 
     Raises:
         BackendRefused: the backend generates no equations of motion, or ``real`` is not
@@ -40,6 +41,7 @@ def kernel(system: Any, backend: Backend, *, real: str = "double", cse: bool = T
             f"the {backend.title} backend generates no mass matrix or applied forces to "
             "integrate it with: run it with --backend c or --backend numpy "
             "(symkin.compile(..., backend='c' or 'numpy'))")
+    real = chosen_options(backend, options).get("real", "double")
     if real != "double":
         raise BackendRefused(
             f"{system.name} moves under its forces: its motion is integrated in double (the "
@@ -47,8 +49,7 @@ def kernel(system: Any, backend: Backend, *, real: str = "double", cse: bool = T
             "double; symkin generate writes the float <prefix>_dynamics_step for a controller")
     # first: it refuses what the motion cannot have (input drivers) before anything is built
     rest = motion_numeric.remainder(system)
-    compiled = compile_system(system, backend, real=real, cse=cse, linalg=linalg,
-                              cache_dir=cache_dir)
+    compiled = compile_system(system, backend, options, cse=cse, cache_dir=cache_dir)
     if not compiled.has_mass:  # a plug-in that says so but generates none
         raise BackendRefused(f"the {backend.title} kernel of {system.name} has no mass matrix: "
                              "run it with --backend c or --backend numpy")

@@ -17,7 +17,8 @@ from typing import Any, TextIO
 from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
-from symkin.errors import MechanismError, SymkinError, UsageError
+from symkin.codegen.target import chosen_options
+from symkin.errors import BuildError, MechanismError, SymkinError, UsageError
 
 
 def _load(args: argparse.Namespace) -> Any:
@@ -80,29 +81,35 @@ def _add_verify(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -
                             "and/or gamma(q, dq, t, p) in the order `symkin show` prints")
     check.add_argument("--samples", type=int, default=50, help="random states (default 50)")
     check.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    check.add_argument("--spread", type=float, default=0.3,
+    check.add_argument("--spread", type=float, default=None,
                        help="relative spread of parameters around the nominal design "
-                            "(default 0.3; 0 keeps them nominal)")
+                            "(default 0.3; 0 keeps them nominal; .m hand files take no "
+                            "parameters and are checked at the nominal design only)")
     check.add_argument("--tolerance", type=float, default=1e-8,
                        help="largest accepted relative error (default 1e-8)")
     check.set_defaults(handler=_verify)
 
 
 # Each entry adds one subcommand; its handler returns the exit status.
+_OPTION_DEST = "backend_option_"  # a backend's option never shadows one of the command's own
+
+
 def _generate(args: argparse.Namespace) -> int:
     from symkin.codegen import render
     from symkin.symbolic import derivation
 
-    # Writing C source needs no compiler: only "auto" asks whether one can be built.
+    # Writing source needs no compiler: only "auto" asks whether one can be built.
     backend = (backends.resolve(args.backend) if args.backend == backends.AUTO
                else backends.get(args.backend))
-    if args.real not in backend.real_types:
-        return messages.error(f"--real {args.real} is not for the {backend.title} backend, which "
-                              f"computes in {' or '.join(backend.real_types)} precision",
-                              EXIT_BAD_INPUT)
+    given = {option.name: value for option in backends.declared_options()
+             if (value := getattr(args, _OPTION_DEST + option.name)) is not None}
+    try:  # before the derivation: a wrong flag is said at once
+        chosen_options(backend, given, flags=True)
+    except BuildError as error:
+        return messages.error(str(error), EXIT_BAD_INPUT)
     system = derivation.derive(_load(args))
-    paths = render.generate(system, backend=backend, out_dir=args.output, real=args.real,
-                            cse=not args.no_cse, linalg=args.linalg, force=args.force)
+    paths = render.generate(system, backend, args.output, given, cse=not args.no_cse,
+                            force=args.force)
     print("\n".join(str(path) for path in paths))
     return EXIT_OK
 
@@ -114,16 +121,14 @@ def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser])
                           help="source to write (default auto, as for run: C when a C compiler "
                                "is found, else NumPy with a note)")
     generate.add_argument("-o", "--output", type=Path, required=True, help="output folder")
-    generate.add_argument("--real", choices=("double", "float"), default="double",
-                          help="C real type (default double)")
+    for option in backends.declared_options():  # the backends' own options, as they declare
+        generate.add_argument(f"--{option.name}", choices=option.choices, default=None,
+                              dest=_OPTION_DEST + option.name, help=option.help)
     generate.add_argument("--force", action="store_true",
                           help="write into a folder that also holds files symkin did not "
                                "write (they are left alone)")
     generate.add_argument("--no-cse", action="store_true",
                           help="do not eliminate common subexpressions")
-    generate.add_argument("--linalg", choices=("sparse", "dense"), default="sparse",
-                          help="LU behind the C solver: generated sparse LU with run-time pivot "
-                          "checks and a dense fall-back (default), or dense partial pivoting")
     overrides.add_argument(generate)
     generate.set_defaults(handler=_generate)
 

@@ -21,15 +21,17 @@ from symkin.verify.numeric import (
 
 
 def command(mechanism: str | Path, against: str | Path, *, samples: int = DEFAULT_SAMPLES,
-            seed: int = 0, spread: float = DEFAULT_SPREAD,
+            seed: int = 0, spread: float | None = None,
             tolerance: float = DEFAULT_TOLERANCE) -> int:
     """``symkin verify MECH --against HAND.py``: print the report, return the exit status.
 
     0 when every entry matches, 1 when some differ, 2 for bad input (the hand file is missing,
     fails to run, raises, or returns the wrong shape; bad options). Errors in the mechanism
-    file are raised as MechanismError for the CLI to report.
+    file are raised as MechanismError for the CLI to report. ``spread`` None is the default
+    spread for Python hand files; .m hand files take none (see :func:`_matlab_spread`).
     """
-    problem = _option_problem(samples, spread, tolerance)
+    problem = (_option_problem(samples, DEFAULT_SPREAD if spread is None else spread, tolerance)
+               or _matlab_spread(against, spread))
     if problem:
         print(f"symkin verify: error: {printable(problem)}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -39,13 +41,26 @@ def command(mechanism: str | Path, against: str | Path, *, samples: int = DEFAUL
             report = verify_matlab(derived_functions(system), against, samples=samples,
                                    seed=seed, tolerance=tolerance)
         else:
-            report = verify(system, against, samples=samples, seed=seed, spread=spread,
+            report = verify(system, against, samples=samples, seed=seed,
+                            spread=DEFAULT_SPREAD if spread is None else spread,
                             tolerance=tolerance)
     except HandModuleError as error:
         print(f"symkin verify: error: {printable(str(error))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     print(report.text(), end="")
     return EXIT_OK if report.ok else EXIT_FAILED
+
+
+def _matlab_spread(against: str | Path, spread: float | None) -> str | None:
+    """.m hand functions take no parameters (their data is fixed in the files, as the chapter's
+    Dane.m does), so they are compared at the nominal design only: a spread asked for could not
+    be applied, and is refused rather than ignored."""
+    if not spread or not is_matlab(against):
+        return None
+    shown = str(against)[:200]
+    return (f"--spread {spread:g}: the MATLAB/Octave hand functions of {shown} take no "
+            f"parameters (their data is fixed in the files, as the chapter's Dane.m), so they "
+            f"are compared at the nominal design only; leave out --spread, or give --spread 0")
 
 
 def _option_problem(samples: int, spread: float, tolerance: float) -> str | None:

@@ -11,7 +11,7 @@ user's name can never collide with a temporary (``w0``...) or reach the generate
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,12 +29,10 @@ from symkin.codegen.system_facts import (
     point_names,
     routine_expressions,
 )
-from symkin.codegen.target import Target, check_options
+from symkin.codegen.target import Target, chosen_options
 from symkin.errors import BuildError
 from symkin.symbolic.derivation import System
 from symkin.symbolic.ranges import Range, coordinate_ranges
-
-DEFAULT_LINALG = "sparse"
 
 # The routines every backend emits, in output order, and the arguments each one takes.
 ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
@@ -49,7 +47,7 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "senses": ("q", "t", "p"),
     # Fused evaluation (see _fused_expressions): one call per Newton iterate evaluates Phi, the
     # non-zeros of Phi_q and the shared sines and cosines; Phi_t and Gamma at the converged q
-    # read those instead of calling libm again.
+    # read those instead of evaluating them again.
     "phi_phi_q": ("q", "t", "p"),
     "phi_t_shared": ("q", "t", "p", "shared"),
     "gamma_shared": ("q", "dq", "t", "p", "shared"),
@@ -78,7 +76,7 @@ _COMMENT_UNSAFE = re.compile(r"[^A-Za-z0-9_.,:;()\[\] +=-]")
 
 PART_OUTPUTS = 200
 """Outputs per generated function: a larger routine is split into parts of this many outputs,
-each with its own CSE, so that neither SymPy's CSE nor the C compiler (both superlinear in
+each with its own CSE, so that neither SymPy's CSE nor a compiler (both superlinear in
 the size of one function) sees more than a bounded piece; the parts are consecutive outputs
 (rows of a chain stay together, so little sharing is lost between parts)."""
 
@@ -100,7 +98,7 @@ class Routine:
         name: ``phi``, ``phi_q`` (the non-zeros in pattern order), ``phi_t``, ``gamma``,
             ``points``.
         arguments: the argument names, in order.
-        unused: the arguments its body does not read (C marks them ``(void)``).
+        unused: the arguments its body does not read (a backend may have to mark them).
         temporaries: ``(name, expression)`` pairs, in evaluation order.
         outputs: one expression per output slot.
         ops: operation count after CSE (SymPy's ``count_ops``).
@@ -125,7 +123,9 @@ class Code:
     """Everything the templates of one backend need, as plain data."""
 
     backend: Target
-    real: str
+    options: Mapping[str, str]
+    """The backend's options, checked and completed (codegen.target.chosen_options); only
+    the backend reads them."""
     cse: bool
     name: str
     spec_sha256: str
@@ -142,9 +142,9 @@ class Code:
     points: tuple[tuple[str, str], ...]
     routines: tuple[Routine, ...]
     ops_before_cse: dict[str, int]
-    linalg: str = DEFAULT_LINALG
     lu_plan: LUPlan | None = None
-    """The sparse LU's pivot order and steps (C with sparse linear algebra only)."""
+    """The sparse LU's pivot order and steps (for a backend that plans_lu, and a mechanism
+    with a kinematic solve)."""
     phi_p_rows: tuple[int, ...] = ()
     phi_p_cols: tuple[int, ...] = ()
     """The structural non-zeros of Phi_p (row, parameter), row-major."""
@@ -222,22 +222,22 @@ class Code:
 
 # ----- lowering ------------------------------------------------------------------------------
 
-def lower(system: System, backend: Target, real: str = "double", cse: bool = True,
-          linalg: str = DEFAULT_LINALG) -> Code:
+def lower(system: System, backend: Target, options: Mapping[str, str] | None = None,
+          cse: bool = True) -> Code:
     """Turn a System into the plain data the templates of ``backend`` render.
 
     Args:
         system: the derived kinematics.
         backend: the target (``symkin.backends.get`` finds one by name).
-        real: one of ``backend.real_types`` (``"double"`` or ``"float"`` for C).
+        options: the backend's options (``backend.options`` declares them; defaults for the
+            rest).
         cse: eliminate common subexpressions within each routine.
-        linalg: ``"sparse"`` (default) or ``"dense"``, the LU behind the C solver.
 
     Raises:
-        BuildError: an unknown real type, or an expression the printer cannot print, or a
-            mechanism with fewer driving equations than freedoms and no masses.
+        BuildError: an option the backend does not take, or an expression the printer cannot
+            print, or a mechanism with fewer driving equations than freedoms and no masses.
     """
-    check_options(backend, real, linalg)
+    chosen = chosen_options(backend, options)
     # A mechanism its forces move (fewer rows than coordinates) has no kinematic solve: its
     # code is the kernel and the dynamics step; the solver's Phi_q has no LU plan then.
     free = system.phi_q.shape[0] < len(system.q)
@@ -249,7 +249,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
     p_pattern = parameter_pattern(system)
     m_pattern = mass_pattern(system)
     expressions = routine_expressions(system, pattern, p_pattern, m_pattern)
-    printer: CodePrinter = backend.printer(real)
+    printer: CodePrinter = backend.printer(chosen)
     prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
     prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
     fused, shared = _fused_expressions(prepared)
@@ -270,7 +270,7 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         _assemble(name, _lowered_parts(name, exprs, printer, cse), len(exprs))
         for name, exprs in {**prepared, **fused}.items())
     return Code(
-        backend=backend, real=real, cse=cse, name=system.name,
+        backend=backend, options=chosen, cse=cse, name=system.name,
         space="3d" if system.mechanism.is_spatial else "2d",
         spec_sha256=system.mechanism.spec_hash(), nq=len(system.q), n_params=len(system.p),
         coordinates=system.coordinates, parameter_names=system.parameter_names,
@@ -279,10 +279,9 @@ def lower(system: System, backend: Target, real: str = "double", cse: bool = Tru
         pattern_rows=tuple(r for r, _ in pattern), pattern_cols=tuple(c for _, c in pattern),
         points=point_names(system), routines=routines,
         ops_before_cse=_ops_before_cse(expressions, fused, shared),
-        linalg="dense" if free else linalg,
         phi_p_rows=tuple(r for r, _ in p_pattern), phi_p_cols=tuple(c for _, c in p_pattern),
         lu_plan=(sample.sparse_lu_plan(system, pattern)
-                 if backend.plans_lu(linalg) and not free else None),
+                 if backend.plans_lu(chosen) and not free else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
         removed=tuple(str(removed) for removed in system.removed),
@@ -442,5 +441,6 @@ def _print(printer: Any, expr: sp.Expr) -> str:
 
 
 def comment(text: str) -> str:
-    """Text from a mechanism file made safe for a C or Python comment (one line, no ``*/``)."""
+    """Text from a mechanism file made safe for a comment of every backend's language (one
+    line, none of the characters that could end a comment, such as ``*/``)."""
     return _COMMENT_UNSAFE.sub("?", text)[:120]

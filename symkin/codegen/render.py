@@ -1,11 +1,11 @@
 """Stage 4 — render: jinja2 templates turn the plain data of codegen into files.
 
 Every template the backend (a ``codegen.target.Target``) lists becomes one file of the
-generated folder, named by the backend: ``kernel.h.j2 -> <prefix>.h``, ``kernel.c.j2 ->
-<prefix>.c``, ``kernel.py.j2 -> <prefix>.py`` and any other ``X.Y.j2 -> <prefix>_X.Y`` (the
-solver runtime of the C backend). Templates whose name starts with ``_`` are partials and are
-not written out. The folder also gets ``<prefix>_manifest.json`` (symkin.contract.manifest):
-the files with their sha256, the op counts and the metadata a runtime needs. The output
+generated folder, named by the backend (``Target.output_name``); the templates, their file
+names and whatever they need of the language (signatures, literals, the real type) are the
+backend's. Templates whose name starts with ``_`` are partials and are not written out. The
+folder also gets ``<prefix>_manifest.json`` (symkin.contract.manifest): the files with their
+sha256, the op counts and the metadata a runtime needs. The output
 depends only on the input: the same mechanism gives the same bytes on every run and machine.
 """
 
@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,7 @@ import jinja2
 from symkin.codegen import lower
 from symkin.codegen.lower import Code, Routine
 from symkin.codegen.target import Target
-from symkin.contract import options, status, tuning
+from symkin.contract import status
 from symkin.contract.loads import load_count, reaction_parts
 from symkin.contract.manifest import GENERATOR, MANIFEST_SUFFIX, Manifest, Metadata, manifest_name
 from symkin.errors import BuildError, UsageError
@@ -30,37 +31,14 @@ from symkin.symbolic.derivation import System
 
 # Templates rendered only for a file with masses (Code.forward_dynamics).
 DYNAMICS_TEMPLATES = ("dynamics",)
-_C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "points": "out",
-             "phi_p": "nz", "phi_t_shared": "out", "gamma_shared": "out", "removed": "out",
-             "senses": "out",
-             "dynamics_rhs": "out", "loads": "out", "dynamics_rhs_shared": "out",
-             "loads_shared": "out", "removed_q": "out", "loads_full": "out",
-             "mass": "nz", "applied": "out"}
-# The output arrays of a routine with several (Routine.sizes), in order.
-_C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
-_PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
-                "phi_phi_q": "phi_phi_q_nz", "mass": "mass_nz"}
-_PYTHON_DOC = {
-    "phi": "Phi(q, t), shape (NQ,).",
-    "phi_q": "The non-zeros of Phi_q in pattern order, shape (NNZ,).",
-    "phi_t": "Phi_t(q, t), shape (NQ,).",
-    "gamma": "Gamma(q, dq, t), the right-hand side of Phi_q ddq = Gamma, shape (NQ,).",
-    "points": "Local vectors of the named points, flat (x, y) pairs in POINTS order.",
-    "phi_p": "The non-zeros of Phi_p (d Phi / d p) in PHI_P_ROWS/COLS order, shape (NNZ_P,).",
-    "removed": "The rows removed as dependent at t0, in REMOVED order, shape (NREMOVED,).",
-    "senses": "Positive at a genuine assembly, in SENSES order, shape (NSENSES,).",
-    "phi_phi_q": "(Phi, the non-zeros of Phi_q, the shared values) with one CSE: each sine "
-                 "and cosine once.",
-    "phi_t_shared": "Phi_t(q, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
-    "gamma_shared": "Gamma(q, dq, t) from the shared values of phi_phi_q_nz at the same q, t, p.",
-    "dynamics_rhs": "Q - M ddq - h(q, dq), the right-hand side of Phi_q^T lam = rhs, (NQ,).",
-    "loads": "The efforts (DRIVER_NAMES) then Fx, Fy, M of each joint (JOINT_NAMES) from lam.",
-    "dynamics_rhs_shared": "dynamics_rhs from the shared values of phi_phi_q_nz at the same q.",
-    "loads_shared": "loads from the shared values of phi_phi_q_nz at the same q, t, p.",
-    "removed_q": "The removed rows' Jacobian, row-major, shape (NREMOVED * NQ,).",
-    "loads_full": "loads from lam of every row: the kept rows' (NQ), then the removed rows'.",
-    "mass": "The non-zeros of the mass matrix M(q) in MASS_ROWS/COLS order, shape (NNZ_M,).",
-    "applied": "The applied forces less the velocity terms, Q(q, dq, t) - h(q, dq), (NQ,).",
+# The output arrays of each routine, as every backend's templates name them: values ("out")
+# or the non-zeros of a sparse matrix ("nz"); the fused routine writes three, in order
+# (Routine.sizes). How a backend spells a routine's name and signature is its own
+# (Target.routine_context).
+OUTPUT_ARRAYS: dict[str, tuple[str, ...]] = {
+    **{name: ("out",) for name in lower.ROUTINE_ARGUMENTS},
+    "phi_q": ("nz",), "phi_p": ("nz",), "mass": ("nz",),
+    "phi_phi_q": ("out", "nz", "shared"),
 }
 
 
@@ -73,9 +51,9 @@ def environment(root: str) -> jinja2.Environment:
         lstrip_blocks=True, autoescape=False)
 
 
-def template_names(backend: Target, linalg: str = lower.DEFAULT_LINALG) -> list[str]:
-    """The templates of ``backend`` that each render to one file, sorted."""
-    return backend.templates(linalg)
+def template_names(code: Code) -> list[str]:
+    """The templates of ``code.backend`` that each render to one file, sorted."""
+    return code.backend.templates(code)
 
 
 def render_sources(code: Code) -> dict[str, str]:
@@ -83,7 +61,7 @@ def render_sources(code: Code) -> dict[str, str]:
     context = template_context(code)
     files = {}
     backend = code.backend
-    for template in template_names(backend, code.linalg):
+    for template in template_names(code):
         if template.split(".")[0] in DYNAMICS_TEMPLATES and not code.forward_dynamics:
             continue  # the dynamics step is for a file with masses only
         name = backend.output_name(template, code.name)
@@ -107,21 +85,20 @@ def _render(backend: Target, name: str, context: dict[str, Any]) -> str:
 
 
 def generate(system: System, backend: Target, out_dir: str | Path = "generated",
-             real: str = "double", cse: bool = True,
-             linalg: str = lower.DEFAULT_LINALG, force: bool = False) -> list[Path]:
+             options: Mapping[str, str] | None = None, cse: bool = True,
+             force: bool = False) -> list[Path]:
     """Generate the source files of one backend into ``out_dir``.
 
     Args:
         system: the derived kinematics.
-        backend: the target (``symkin.generate`` takes its name: ``"c"``, a self-contained
-            C99 folder, or ``"numpy"``, one Python module).
+        backend: the target (``symkin.generate`` takes its name; ``symkin.backends``
+            lists them).
         out_dir: the folder to write; created when missing. It may hold earlier output of
             symkin (this mechanism's is replaced, other mechanisms' is left alone); any other
             file makes it refuse, unless ``force``.
-        real: the C real type, ``"double"`` or ``"float"``.
+        options: the backend's own options, by name (``backend.options`` declares them;
+            the rest take their defaults).
         cse: eliminate common subexpressions.
-        linalg: the LU behind the C solver, ``"sparse"`` (default: the generated sparse LU
-            with run-time pivot checks and a dense fall-back) or ``"dense"``.
         force: write even where files symkin did not write are present (they are never
             deleted; one with the name of a generated file is replaced: a symlink itself,
             never the file it points to).
@@ -130,10 +107,11 @@ def generate(system: System, backend: Target, out_dir: str | Path = "generated",
         The paths written, sorted, the manifest last.
 
     Raises:
+        BuildError: an option the backend does not take.
         UsageError: the folder holds files symkin did not write (and not ``force``), or it
             cannot be written.
     """
-    code = lower.lower(system, backend, real, cse, linalg)
+    code = lower.lower(system, backend, options, cse)
     return write(code, Path(out_dir), force=force)
 
 
@@ -213,7 +191,8 @@ def _sha256_file(path: Path) -> str | None:
 def manifest(code: Code, files: dict[str, str]) -> str:
     """The manifest: file hashes, op counts and the metadata a runtime needs, as JSON."""
     data = Manifest(
-        generator=GENERATOR, backend=code.backend.name, real=code.real, cse=code.cse,
+        generator=GENERATOR, backend=code.backend.name,
+        real=code.backend.precision(code.options), cse=code.cse,
         name=code.name, spec_sha256=code.spec_sha256,
         files={name: hashlib.sha256(text.encode()).hexdigest() for name, text in files.items()},
         ops=code.ops, ops_before_cse=code.ops_before_cse, **metadata(code),
@@ -255,13 +234,13 @@ def metadata(code: Code) -> Metadata:
 
 def template_context(code: Code) -> dict[str, Any]:
     """The plain data every template of ``code.backend`` receives."""
-    literal = code.backend.literal(code.real)
+    literal = code.backend.literal(code.options)
     return {
         "prefix": code.name, "PREFIX": code.name.upper(),
         "name_comment": lower.comment(code.name),
         "nq": code.nq, "n_params": code.n_params, "nnz": code.nnz, "npoints": code.npoints,
         "nshared": len(code.shared),
-        "real": code.real, "cse": code.cse, "spec_sha256": code.spec_sha256,
+        "cse": code.cse, "spec_sha256": code.spec_sha256,
         "pattern_rows": list(code.pattern_rows), "pattern_cols": list(code.pattern_cols),
         "nonlinear_mask": [int(k in code.nonlinear) for k in range(code.nq)],
         "nnz_p": code.nnz_p,
@@ -287,22 +266,12 @@ def template_context(code: Code) -> dict[str, Any]:
         "input_length_literals": [repr(code.input_names[k]) for k in code.input_lengths],
         "input_value_literals": [literal(v) for v in code.input_values],
         "routines": [_routine_context(code, r) for r in code.routines],
-        # Python string literals: repr() of a str is always a valid, inert literal.
-        "name_literal": repr(code.name),
-        "coordinate_literals": [repr(n) for n in code.coordinates],
-        "parameter_literals": [repr(n) for n in code.parameter_names],
-        "row_literals": [repr(r) for r in code.rows],
         "nremoved": len(code.removed),
         "removed_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.removed)],
-        "removed_literals": [repr(r) for r in code.removed],
         "nsenses": len(code.senses),
         "sense_comments": [f"{k}: {lower.comment(r)}" for k, r in enumerate(code.senses)],
-        "sense_literals": [repr(r) for r in code.senses],
-        "range_literals": [repr(tuple(entry)) for entry in code.ranges],
-        "point_literals": [repr(tuple(p)) for p in code.points],
         "point_size": len(code.point_axes),
         "point_tuples": "(x, y, z) triples" if code.space == "3d" else "(x, y) pairs",
-        "linalg": code.linalg,
         # Inverse dynamics (only when the file has masses or forces).
         "dynamics": code.dynamics, "n_efforts": len(code.driver_names),
         "n_joints": len(code.joint_names),
@@ -312,19 +281,12 @@ def template_context(code: Code) -> dict[str, Any]:
                           else "Fx, Fy (global) and M"),
         # a spatial driver's effort is conjugate to its function (symbolic.dynamics3d)
         "effort_text": "lam dPhi/df" if code.space == "3d" else "-lam",
-        "driver_literals": [repr(n) for n in code.driver_names],
         # Forward dynamics (only when the file gives masses).
         "forward_dynamics": code.forward_dynamics, "nrows": code.nrows,
         "nnz_m": len(code.mass_rows), "mass_rows": list(code.mass_rows),
         "mass_cols": list(code.mass_cols),
-        "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
-        "newton_defaults": _newton_defaults(code, literal),
-        "option_fields": list(options.C_FIELDS),
-        "option_rules": dict(options.RULES),
         "status": {**status.CODES, **status.INPUT_CODES},
-        "shared_constants": {name: _c_number(value)
-                             for name, value in {**tuning.SHARED, **tuning.INPUTS}.items()},
         **code.backend.template_context(code),
     }
 
@@ -336,8 +298,7 @@ def _body_index(code: Code, body: str) -> int:
 
 
 def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
-    real = f"{code.name}_real"
-    names = _C_OUTPUTS.get(routine.name) or (_C_OUTPUT[routine.name],)
+    names = OUTPUT_ARRAYS[routine.name]
     sizes = routine.sizes or (len(routine.outputs),)
     labels = _labels(code, routine.name)
     arrays, start, place = [], 0, []
@@ -356,31 +317,13 @@ def _routine_context(code: Code, routine: Routine) -> dict[str, Any]:
             "unwritten": [n for n in names if n not in written],
             "slots": [(*place[k], routine.outputs[k], labels[k] if labels else "")
                       for k in part.slots]})
-    arguments = [f"{real} t" if a == "t" else f"const {real} {a}[]" for a in routine.arguments]
-    python_arguments = [a for a in routine.arguments if a != "p"] + ["p=None"]
-    return {
+    common = {
         "name": routine.name, "arguments": list(routine.arguments),
         "unused": list(routine.unused), "output": names[0], "arrays": arrays, "parts": parts,
-        "call": ", ".join([*routine.arguments, *names]),
         "temporaries": list(routine.temporaries), "outputs": list(routine.outputs),
-        # C99 restrict on the outputs (definitions only; the header keeps plain []): they never
-        # overlap the inputs, and knowing so lets the compiler keep q[i] in a register across
-        # the stores, e.g. to merge sin(q[i]) and cos(q[i]) into one sincos call.
-        "signature": ", ".join([*arguments, *(f"{real} *restrict {n}" for n in names)]),
-        "labels": labels,
-        "python_name": _PYTHON_NAME.get(routine.name, routine.name),
-        "python_signature": ", ".join(python_arguments), "doc": _doc(code, routine.name),
-        "size": len(routine.outputs),
+        "labels": labels, "size": len(routine.outputs),
     }
-
-
-def _doc(code: Code, routine: str) -> str:
-    """The generated function's docstring; a spatial mechanism's points are triples, its
-    reactions six components."""
-    doc = _PYTHON_DOC[routine]
-    if code.space != "3d":
-        return doc
-    return doc.replace("(x, y) pairs", "(x, y, z) triples").replace("Fx, Fy, M", "Fx ... Mz")
+    return {**common, **code.backend.routine_context(code, common)}
 
 
 def _labels(code: Code, routine: str) -> list[str]:
@@ -416,17 +359,6 @@ def _labels(code: Code, routine: str) -> list[str]:
     return [lower.comment(row) for row in code.rows]
 
 
-def _newton_defaults(code: Code, literal: Any) -> dict[str, str]:
-    """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
-    return {name: str(value) if isinstance(value, (int, bool)) else literal(value)
-            for name, value in options.c_defaults(code.real).items()}
-
-
-def _c_number(value: float) -> str:
-    """The shortest text that reads back as ``value``: ``10``, ``0.05`` (cast where used)."""
-    return str(int(value)) if float(value).is_integer() else repr(float(value))
-
-
 def header_lines(code: Code, template: str, file_name: str) -> list[str]:
     """The header every generated file starts with, in one style for every template: what the
     file is, which template made it, the spec's sha256, the real type and op counts; never a
@@ -434,8 +366,9 @@ def header_lines(code: Code, template: str, file_name: str) -> list[str]:
     purpose = code.backend.purpose(template).format(
         name=lower.comment(code.name))
     ops = ", ".join(f"{name} {count}" for name, count in sorted(code.ops.items()))
+    precision = code.backend.precision(code.options)
     after = ", after CSE" if code.cse else ""
     return [f"{file_name}: {purpose}",
             f"Generated by symkin from the template {template}. Do not edit: regenerate instead.",
             f"Mechanism spec sha256: {code.spec_sha256}",
-            f"Real type: {code.real}. Operations (SymPy count_ops{after}): {ops}"]
+            f"Real type: {precision}. Operations (SymPy count_ops{after}): {ops}"]

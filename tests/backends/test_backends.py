@@ -20,8 +20,9 @@ from codegen_support import ROOT, system
 
 import symkin
 from symkin import backends, cli
+from symkin.backends.numpy import naming
 from symkin.build.cache import build_unless_verified, content_key
-from symkin.codegen.target import rendered_templates
+from symkin.codegen.target import Option, rendered_templates
 from symkin.runtime.kernel import Kernel, import_file
 
 # The whole template of the test backend: a module with META (what the runtime Kernel needs)
@@ -62,7 +63,7 @@ class TinyBackend:
 
     name = "tiny"
     title = "Tiny"
-    real_types: tuple[str, ...] = ("double",)
+    options: tuple[Option, ...] = (Option("real", ("double",), "double", "double only"),)
     template_folder = "tiny"
 
     def __init__(self, root: Path) -> None:
@@ -72,13 +73,16 @@ class TinyBackend:
     def template_root(self) -> Path:
         return self._root
 
-    def printer(self, real: str) -> Any:
-        return backends.get("numpy").printer(real)
+    def printer(self, options: Mapping[str, str]) -> Any:
+        return backends.get("numpy").printer(options)
 
-    def literal(self, real: str) -> Callable[[float], str]:
+    def literal(self, options: Mapping[str, str]) -> Callable[[float], str]:
         return repr
 
-    def templates(self, linalg: str) -> list[str]:
+    def precision(self, options: Mapping[str, str]) -> str:
+        return options["real"]
+
+    def templates(self, code: Any) -> list[str]:
         return rendered_templates(self._root / self.template_folder)
 
     def output_name(self, template: str, prefix: str) -> str:
@@ -87,10 +91,14 @@ class TinyBackend:
     def purpose(self, template: str) -> str:
         return "the tiny backend's kernel of {name}"
 
-    def plans_lu(self, linalg: str) -> bool:
+    def plans_lu(self, options: Mapping[str, str]) -> bool:
         return False
 
     def template_context(self, code: Any) -> dict[str, Any]:
+        # Python string literals of the names: what NumPy's template also needs
+        return naming.template_context(code)
+
+    def routine_context(self, code: Any, routine: dict[str, Any]) -> dict[str, Any]:
         return {}
 
     def unavailable(self) -> str | None:

@@ -37,7 +37,7 @@ def _defines(source: str, prefix: str) -> dict[str, str]:
 
 @pytest.fixture(scope="module", params=["double", "float"])
 def rendered(request: pytest.FixtureRequest) -> tuple[str, dict[str, str]]:
-    code = lower(system("crank_slider"), backends.get("c"), request.param)
+    code = lower(system("crank_slider"), backends.get("c"), {"real": request.param})
     return request.param, render.render_sources(code)
 
 

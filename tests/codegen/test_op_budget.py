@@ -202,7 +202,7 @@ def _measure(folder: Path, code: lower.Code, steps: int, dt: float, cap: int) ->
     assert typedef in text
     header.write_text(text.replace(typedef, f"typedef R {prefix}_real;"))
     (folder / "counted.hpp").write_text(COUNTED)
-    linalg = f"{prefix}_sparse_lu.c" if code.linalg == "sparse" else f"{prefix}_linalg.c"
+    linalg = f"{prefix}_sparse_lu.c" if code.lu_plan is not None else f"{prefix}_linalg.c"
     u0 = ", ".join(repr(float(v)) for v in code.input_values) or "0"
     source = (MAIN.replace("@P@", prefix).replace("@U@", prefix.upper())
               .replace("@STEPS@", str(steps)).replace("@DT@", repr(dt))
@@ -318,7 +318,7 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
         monkeypatch.setattr(lu_code, "TABLE_FLOPS", 0)
         linalg = "sparse"
     symkin.generate(system, backend="c", out_dir=tmp_path, linalg=linalg)
-    code = lower.lower(system, get_backend("c"), linalg=linalg)
+    code = lower.lower(system, get_backend("c"), {"linalg": linalg})
     extra = context.template_context(code)
     if name == "stewart_fk":  # its file's q0 is the home pose; the inputs start there
         assert np.allclose(code.input_values, _home_legs(), rtol=1e-12, atol=0)

@@ -112,3 +112,18 @@ def test_a_file_of_another_name_is_refused(tmp_path: Path) -> None:
     empty.mkdir()
     status, text = _run(empty)
     assert status == EXIT_BAD_INPUT and "holds none of" in text
+
+
+def test_a_spread_is_refused_for_m_files_not_ignored(capsys: pytest.CaptureFixture) -> None:
+    """.m hand functions take no parameters: a spread could not be applied, so --spread is
+    refused (exit 2, before anything is derived); --spread 0 and no --spread check the
+    nominal design."""
+    from symkin import cli
+
+    base = ["verify", str(CRANK_SLIDER), "--against", str(CHAPTER), "--samples", "3"]
+    assert cli.main([*base, "--spread", "0.3"]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "--spread 0.3" in err and "nominal design only" in err and "Traceback" not in err
+    assert cli.main([*base, "--spread", "0"]) == EXIT_OK
+    assert cli.main(base) == EXIT_OK
+    assert "at the nominal" not in capsys.readouterr().err

@@ -5,7 +5,7 @@ Its pieces, each imported only when needed (loading a built kernel never imports
 solver's template data), ``cdef`` (cffi declarations from the headers), ``toolchain`` (the
 compiler), ``cffi_build`` (the build), ``loader`` (the CKernel), ``csolver`` and ``batch``
 (the generated grid and batch solvers through cffi). Templates: ``templates/`` beside this
-module.
+module. Its options (:data:`OPTIONS`): the real type and the LU behind the solver.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from symkin.codegen.target import file_name, rendered_templates
+from symkin.codegen.target import Option, file_name, rendered_templates
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 
 if TYPE_CHECKING:
@@ -34,13 +34,19 @@ PURPOSES = {
 # one is rendered; dense_lu.*.j2, which both use, always is.
 _LINALG_TEMPLATES = {"dense": "linalg", "sparse": "sparse_lu"}
 
+REAL = Option("real", ("double", "float"), "double", "C real type (default double)")
+LINALG = Option("linalg", ("sparse", "dense"), "sparse",
+                "LU behind the C solver: generated sparse LU with run-time pivot checks and a "
+                "dense fall-back (default), or dense partial pivoting")
+OPTIONS = (REAL, LINALG)
+
 
 class CBackend:
     """The C99 backend (see the module docstring)."""
 
     name = "c"
     title = "C"
-    real_types: tuple[str, ...] = ("double", "float")
+    options: tuple[Option, ...] = OPTIONS
     # its kernels evaluate the mass matrix and applied forces (build.motion integrates)
     equations_of_motion = True
     template_folder = "templates"
@@ -50,18 +56,21 @@ class CBackend:
         # The backend's own folder: its templates ship inside it, with the package.
         return Path(__file__).resolve().parent
 
-    def printer(self, real: str) -> Any:
+    def printer(self, options: Mapping[str, str]) -> Any:
         from symkin.backends.c.printer import CPrinter
 
-        return CPrinter(real)
+        return CPrinter(options[REAL.name])
 
-    def literal(self, real: str) -> Callable[[float], str]:
+    def literal(self, options: Mapping[str, str]) -> Callable[[float], str]:
         from symkin.backends.c.printer import literal
 
-        return literal(real)
+        return literal(options[REAL.name])
 
-    def templates(self, linalg: str) -> list[str]:
-        left_out = _LINALG_TEMPLATES["sparse" if linalg == "dense" else "dense"]
+    def precision(self, options: Mapping[str, str]) -> str:
+        return options[REAL.name]
+
+    def templates(self, code: Code) -> list[str]:
+        left_out = _LINALG_TEMPLATES["sparse" if linalg(code) == "dense" else "dense"]
         return [name for name in rendered_templates(self.template_root / self.template_folder)
                 if name.split(".")[0] != left_out]
 
@@ -71,13 +80,18 @@ class CBackend:
     def purpose(self, template: str) -> str:
         return PURPOSES[template.split(".")[0]]
 
-    def plans_lu(self, linalg: str) -> bool:
-        return linalg == "sparse"
+    def plans_lu(self, options: Mapping[str, str]) -> bool:
+        return options[LINALG.name] == "sparse"
 
     def template_context(self, code: Code) -> dict[str, Any]:
         from symkin.backends.c import context
 
         return context.template_context(code)
+
+    def routine_context(self, code: Code, routine: dict[str, Any]) -> dict[str, Any]:
+        from symkin.backends.c import context
+
+        return context.routine_context(code, routine)
 
     def unavailable(self) -> str | None:
         from symkin.backends.c import toolchain
@@ -113,6 +127,17 @@ class CBackend:
         from symkin.backends.c import loader
 
         return [manifest_name(name), loader.extension_file(folder).name]
+
+
+def real(code: Code) -> str:
+    """The real type ``code`` is generated in (its ``real`` option)."""
+    return code.options[REAL.name]
+
+
+def linalg(code: Code) -> str:
+    """The LU the solver of ``code`` runs on: the sparse one where lowering planned it (the
+    ``linalg`` option, for a mechanism with a kinematic solve), else the dense one."""
+    return "sparse" if code.lu_plan is not None else "dense"
 
 
 BACKEND = CBackend()

@@ -1,32 +1,41 @@
-"""What the C templates need beyond the common context: the sparse LU as statements or
-tables (lu_code), ||Phi_q||_1 as column sums (norm_code) and the libm and literal suffixes of
-the real type."""
+"""What the C templates need beyond the common context: the real type and its libm and literal
+suffixes, the Newton defaults and option rules of symkin.contract as C literals, the sparse LU
+as statements or tables (lu_code), ||Phi_q||_1 as column sums (norm_code), and each routine's
+C signature."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from symkin.backends.c import dynamics_budget, lu_code, norm_code, op_budget
+from symkin.backends.c import dynamics_budget, linalg, lu_code, norm_code, op_budget, real
 from symkin.backends.c.printer import literal
 from symkin.codegen.lower import Code
-from symkin.contract import lengths, options
+from symkin.contract import lengths, options, tuning
 
 
 def template_context(code: Code) -> dict[str, Any]:
     """The C-only entries of the template context of ``code``."""
-    lu = (lu_code.template_context(code.lu_plan, constants=code.constant_nz, real=code.real,
+    kind = real(code)
+    lu = (lu_code.template_context(code.lu_plan, constants=code.constant_nz, real=kind,
                                    prefix=code.name) if code.lu_plan else None)
     norm1 = (norm_code.norm1_context(code.pattern_cols, code.nq, code.constant_nz,
-                                     literal(code.real), code.real)
+                                     literal(kind), kind)
              if not (lu and lu["style"] == "tables") else None)
     scale_free = lengths.scale_free_constants(code.constant_nz, code.pattern_rows,
                                               code.pattern_cols, code.coordinates)
-    cap = int(options.c_defaults(code.real)["max_iterations"])
+    cap = int(options.c_defaults(kind)["max_iterations"])
     budget = op_budget.budget(code, lu, norm1, bool(scale_free), cap)
     return {
+        "real": kind, "linalg": linalg(code),
         # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
-        "libm_suffix": "f" if code.real == "float" else "",
-        "literal_suffix": "F" if code.real == "float" else "",
+        "libm_suffix": "f" if kind == "float" else "",
+        "literal_suffix": "F" if kind == "float" else "",
+        # What must equal the runtime's, rendered from symkin.contract (never copied):
+        "newton_defaults": _newton_defaults(kind),
+        "option_fields": list(options.C_FIELDS),
+        "option_rules": dict(options.RULES),
+        "shared_constants": {name: _c_number(value)
+                             for name, value in {**tuning.SHARED, **tuning.INPUTS}.items()},
         **({"lu": lu} if lu else {}),
         # ||Phi_q||_1 straight-line, or a loop where the LU itself is table-driven
         "norm1": norm1,
@@ -45,3 +54,30 @@ def template_context(code: Code) -> dict[str, Any]:
         **({"dynamics_budget": dynamics_budget.template_context(code, cap)}
            if code.forward_dynamics else {}),
     }
+
+
+def routine_context(code: Code, routine: dict[str, Any]) -> dict[str, Any]:
+    """A routine's C signature (definition) and the argument list of a call to it."""
+    kind = f"{code.name}_real"
+    names = [array["name"] for array in routine["arrays"]]
+    arguments = [f"{kind} t" if a == "t" else f"const {kind} {a}[]"
+                 for a in routine["arguments"]]
+    return {
+        "call": ", ".join([*routine["arguments"], *names]),
+        # C99 restrict on the outputs (definitions only; the header keeps plain []): they never
+        # overlap the inputs, and knowing so lets the compiler keep q[i] in a register across
+        # the stores, e.g. to merge sin(q[i]) and cos(q[i]) into one sincos call.
+        "signature": ", ".join([*arguments, *(f"{kind} *restrict {n}" for n in names)]),
+    }
+
+
+def _newton_defaults(kind: str) -> dict[str, str]:
+    """The runtime's Newton defaults for this real type, as literals (one source of truth)."""
+    text = literal(kind)
+    return {name: str(value) if isinstance(value, (int, bool)) else text(value)
+            for name, value in options.c_defaults(kind).items()}
+
+
+def _c_number(value: float) -> str:
+    """The shortest text that reads back as ``value``: ``10``, ``0.05`` (cast where used)."""
+    return str(int(value)) if float(value).is_integer() else repr(float(value))

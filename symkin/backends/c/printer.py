@@ -11,6 +11,7 @@ from sympy.codegen.ast import real as real_type
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
+from symkin.codegen.printing import heaviside_at_zero
 from symkin.codegen.symbol_printing import symbol_text
 from symkin.errors import BuildError
 
@@ -53,7 +54,7 @@ class CPrinter(C99CodePrinter):
         # The step with H(0) = 1/2, the value the parser gives every Heaviside; a NaN argument
         # stays NaN (as numpy.heaviside gives), so a non-real argument is seen, not hidden.
         x = self._print(expr.args[0])
-        at_zero = self._literal(float(expr.args[1]) if len(expr.args) > 1 else 0.5)
+        at_zero = self._literal(heaviside_at_zero(expr))
         one, zero = self._literal(1.0), self._literal(0.0)
         return (f"(({x}) > 0 ? {one} : (({x}) < 0 ? {zero} : "
                 f"(({x}) == 0 ? {at_zero} : ({x}))))")

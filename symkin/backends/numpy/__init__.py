@@ -1,6 +1,7 @@
 """The NumPy backend: one Python module per mechanism, imported from the build cache; needs
-no compiler. Its pieces: ``printer`` (NumPy text; imported only when generating) and
-``loader`` (the Kernel over the module). Templates: ``templates/`` beside this
+no compiler. Its pieces: ``printer`` (NumPy text; imported only when generating), ``naming``
+(the Python names, signatures and literals of the template) and ``loader`` (the Kernel over
+the module). Templates: ``templates/`` beside this
 module.
 """
 
@@ -13,7 +14,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from symkin.codegen.target import file_name, rendered_templates
+from symkin.codegen.target import Option, file_name, rendered_templates
 from symkin.contract.manifest import MANIFEST_SUFFIX, manifest_name
 
 if TYPE_CHECKING:
@@ -26,7 +27,8 @@ class NumPyBackend:
 
     name = "numpy"
     title = "NumPy"
-    real_types: tuple[str, ...] = ("double",)  # NumPy computes in double
+    options: tuple[Option, ...] = (
+        Option("real", ("double",), "double", "NumPy computes in double"),)
     # its kernels evaluate the mass matrix and applied forces (build.motion integrates)
     equations_of_motion = True
     template_folder = "templates"
@@ -36,18 +38,21 @@ class NumPyBackend:
         # The backend's own folder: its templates ship inside it, with the package.
         return Path(__file__).resolve().parent
 
-    def printer(self, real: str) -> Any:
+    def printer(self, options: Mapping[str, str]) -> Any:
         from symkin.backends.numpy.printer import PythonPrinter
 
-        del real  # double only (real_types)
+        del options  # double only
         return PythonPrinter()
 
-    def literal(self, real: str) -> Callable[[float], str]:
-        del real
+    def literal(self, options: Mapping[str, str]) -> Callable[[float], str]:
+        del options
         return repr
 
-    def templates(self, linalg: str) -> list[str]:
-        del linalg  # the Python driver does the linear algebra
+    def precision(self, options: Mapping[str, str]) -> str:
+        return options["real"]
+
+    def templates(self, code: Code) -> list[str]:
+        del code  # one module; the Python driver does the linear algebra
         return rendered_templates(self.template_root / self.template_folder)
 
     def output_name(self, template: str, prefix: str) -> str:
@@ -57,13 +62,19 @@ class NumPyBackend:
         del template  # one file
         return "kinematic kernel of the mechanism {name}"
 
-    def plans_lu(self, linalg: str) -> bool:
-        del linalg
+    def plans_lu(self, options: Mapping[str, str]) -> bool:
+        del options
         return False
 
     def template_context(self, code: Code) -> dict[str, Any]:
-        del code
-        return {}
+        from symkin.backends.numpy import naming
+
+        return naming.template_context(code)
+
+    def routine_context(self, code: Code, routine: dict[str, Any]) -> dict[str, Any]:
+        from symkin.backends.numpy import naming
+
+        return naming.routine_context(code, routine)
 
     def unavailable(self) -> str | None:
         return None

@@ -6,11 +6,16 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
 
+from symkin.codegen.printing import PairwiseMinMax, heaviside_at_zero
 from symkin.codegen.symbol_printing import symbol_text
 
 
-class PythonPrinter(NumPyPrinter):
+class PythonPrinter(PairwiseMinMax, NumPyPrinter):
     """NumPy printer for the generated module: array arguments, ``numpy.`` functions."""
+
+    # fmin/fmax, as in C: the generated code of both backends treats NaN alike.
+    MIN_FUNCTION = "numpy.fmin"
+    MAX_FUNCTION = "numpy.fmax"
 
     def __init__(self) -> None:
         super().__init__({"strict": True})
@@ -22,21 +27,7 @@ class PythonPrinter(NumPyPrinter):
         return repr(float(expr))
 
     def _print_Heaviside(self, expr: sp.Heaviside) -> str:
-        at_zero = float(expr.args[1]) if len(expr.args) > 1 else 0.5
-        return f"numpy.heaviside({self._print(expr.args[0])}, {at_zero!r})"
-
-    def _print_Min(self, expr: sp.Min) -> str:
-        return self._nested("numpy.fmin", expr.args)
-
-    def _print_Max(self, expr: sp.Max) -> str:
-        return self._nested("numpy.fmax", expr.args)
-
-    def _nested(self, function: str, args: tuple[sp.Expr, ...]) -> str:
-        # fmin/fmax, as in C: the generated code of both backends treats NaN alike.
-        text = str(self._print(args[-1]))
-        for arg in reversed(args[:-1]):
-            text = f"{function}({self._print(arg)}, {text})"
-        return text
+        return f"numpy.heaviside({self._print(expr.args[0])}, {heaviside_at_zero(expr)!r})"
 
     def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
         if expr.exp == 2:

@@ -15,7 +15,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from symkin.codegen.target import rendered_templates
+from symkin.codegen.target import Option, rendered_templates
 from symkin.errors import MissingToolError
 
 if TYPE_CHECKING:
@@ -52,7 +52,8 @@ class OctaveBackend:
 
     name = "octave"
     title = "MATLAB/Octave"
-    real_types: tuple[str, ...] = ("double",)  # MATLAB computes in double
+    options: tuple[Option, ...] = (
+        Option("real", ("double",), "double", "MATLAB and Octave compute in double"),)
     template_folder = "templates"
 
     @property
@@ -60,20 +61,23 @@ class OctaveBackend:
         # The backend's own folder: its templates ship inside it, with the package.
         return Path(__file__).resolve().parent
 
-    def printer(self, real: str) -> Any:
+    def printer(self, options: Mapping[str, str]) -> Any:
         from symkin.backends.octave.printer import MatlabPrinter
 
-        del real  # double only (real_types)
+        del options  # double only
         return MatlabPrinter()
 
-    def literal(self, real: str) -> Callable[[float], str]:
+    def literal(self, options: Mapping[str, str]) -> Callable[[float], str]:
         from symkin.octave_process import number
 
-        del real
+        del options
         return number
 
-    def templates(self, linalg: str) -> list[str]:
-        del linalg  # MATLAB's backslash does the linear algebra
+    def precision(self, options: Mapping[str, str]) -> str:
+        return options["real"]
+
+    def templates(self, code: Code) -> list[str]:
+        del code  # MATLAB's backslash does the linear algebra
         return rendered_templates(self.template_root / self.template_folder)
 
     def output_name(self, template: str, prefix: str) -> str:
@@ -85,14 +89,18 @@ class OctaveBackend:
     def purpose(self, template: str) -> str:
         return PURPOSES[template.split(".")[0]]
 
-    def plans_lu(self, linalg: str) -> bool:
-        del linalg
+    def plans_lu(self, options: Mapping[str, str]) -> bool:
+        del options
         return False
 
     def template_context(self, code: Code) -> dict[str, Any]:
         from symkin.backends.octave.context import template_context
 
         return template_context(code)
+
+    def routine_context(self, code: Code, routine: dict[str, Any]) -> dict[str, Any]:
+        del code, routine  # the templates name each function after its file
+        return {}
 
     def unavailable(self) -> str | None:
         if shutil.which(OCTAVE) is None:

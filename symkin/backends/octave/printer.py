@@ -9,15 +9,20 @@ import sympy as sp
 from sympy.printing.octave import OctaveCodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
+from symkin.codegen.printing import PairwiseMinMax, heaviside_at_zero
 from symkin.codegen.symbol_printing import symbol_text
 from symkin.octave_process import number as literal
 
 _ELEMENT = re.compile(r"(\w+)\[(\d+)\]\Z")
 
 
-class MatlabPrinter(OctaveCodePrinter):
+class MatlabPrinter(PairwiseMinMax, OctaveCodePrinter):
     """SymPy's Octave printer held to the subset MATLAB shares: the arguments' elements are
     ``q(k+1)``, a step function is a comparison (MATLAB's ``heaviside`` needs a toolbox)."""
+
+    # min/max of two, as C's fmin/fmax: a NaN argument gives the other one.
+    MIN_FUNCTION = "min"
+    MAX_FUNCTION = "max"
 
     def __init__(self) -> None:
         super().__init__({"strict": True, "inline": True})
@@ -32,22 +37,9 @@ class MatlabPrinter(OctaveCodePrinter):
         return literal(float(expr))
 
     def _print_Heaviside(self, expr: sp.Heaviside) -> str:
-        at_zero = float(expr.args[1]) if len(expr.args) > 1 else 0.5
         argument = self._print(expr.args[0])
-        return f"((({argument}) > 0) + {literal(at_zero)}*(({argument}) == 0))"
-
-    def _print_Min(self, expr: sp.Min) -> str:
-        return self._nested("min", expr.args)
-
-    def _print_Max(self, expr: sp.Max) -> str:
-        return self._nested("max", expr.args)
-
-    def _nested(self, function: str, args: tuple[sp.Expr, ...]) -> str:
-        # min/max of two, as C's fmin/fmax: a NaN argument gives the other one.
-        text = str(self._print(args[-1]))
-        for arg in reversed(args[:-1]):
-            text = f"{function}({self._print(arg)}, {text})"
-        return text
+        return (f"((({argument}) > 0) + {literal(heaviside_at_zero(expr))}"
+                f"*(({argument}) == 0))")
 
     def _print_Pow(self, expr: sp.Pow) -> str:
         if expr.exp == 2:

@@ -143,7 +143,7 @@ def test_numpy_step_equals_the_c_step(pendulum: Any, pendulum_c: Any,
 
 
 def test_float_step_runs_to_its_precision(pendulum: Any) -> None:
-    kernel = build_compile(pendulum, backends.get("c"), real="float")
+    kernel = build_compile(pendulum, backends.get("c"), {"real": "float"})
     motion = _stepper(kernel).run(options.defaults("float"), np.array([LENGTH, MASS]), 0.0,
                                   np.array([0.5, 0.0, 0.0]), np.zeros(3), 1e-2, 100)
     assert motion.status == OK

@@ -48,7 +48,7 @@ def test_sample_configuration_falls_back_to_q0_when_assembly_fails() -> None:
     system = symkin.derive(model.from_dict(data))
     assert codegen_sample.sample_configuration(system) == tuple(system.q0)
     code = codegen.lower(system, backends.get("c"))  # the plan is still made (at q0), generation goes on
-    assert code.linalg == "sparse" and code.lu_plan is not None and code.lu_plan.n_lu >= code.nnz
+    assert code.options["linalg"] == "sparse" and code.lu_plan is not None and code.lu_plan.n_lu >= code.nnz
 
 
 def test_sparse_lu_is_the_default(crank_slider_system, tmp_path) -> None:
