@@ -199,7 +199,7 @@ def derive(mech: Mechanism | str | Path) -> System:
     q0 = _initial_guess(mech, ctx, nominal)
     time_grid = _time_grid(mech, ctx, nominal)
     phi, rows, removed, mobility = _remove_redundant(phi, rows, symbols, p_values, q0,
-                                                     time_grid)
+                                                     time_grid, motion_spec.has_masses(mech))
     # the rank decides whether the forces move it (symbolic.motion.moves_under_forces)
     motion_spec.refuse_keys(mech, motion_spec.moves(len(phi), len(symbols.q)))
     column = {q: k for k, q in enumerate(symbols.q)}
@@ -249,13 +249,16 @@ def _dynamics(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: tuple
 
 def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbols,
                       p_values: tuple[float, ...], q0: tuple[float, ...],
-                      grid: tuple[float, float, float]
+                      grid: tuple[float, float, float], masses: bool = False
                       ) -> tuple[list[sp.Expr], tuple[Row, ...], tuple[Removed, ...],
                                  int | None]:
     """A file with more equations than coordinates: the rows dependent at the assembled t0
     removed (symbolic.redundancy), joint rows before the others, later before earlier. A file
-    with as many (the DOF count passed) is left as it is, untouched."""
-    if len(phi) <= len(symbols.q):
+    with as many (the DOF count passed) is left as it is, untouched, unless its bodies have
+    ``masses`` and one of its rows is dependent: Bricard's linkage has as many equations as
+    coordinates, one of them dependent, and moves under its forces."""
+    square = len(phi) == len(symbols.q)
+    if len(phi) < len(symbols.q) or (square and (not masses or symbols.inputs)):
         return phi, rows, (), None
     if symbols.inputs:
         # the rank is judged at an assembled t0, which inputs known only at run time lack
@@ -274,13 +277,17 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
         # A rank short at t0 is checked again half a step later (t0 singular, or a freedom).
         t0, t1, dt = grid
         found = redundancy.analyse(phi, symbols.q, symbols.t, symbols.p, p_values, q0, t0,
-                                   priority, t0 + 0.5 * min(dt, t1 - t0), subject)
+                                   priority, t0 + 0.5 * min(dt, t1 - t0), subject, masses)
     except redundancy.Refusal as refusal:
+        if square:  # judged by the run, as any square file's start is
+            return phi, rows, (), None
         row = None if refusal.row is None else rows[refusal.row]
         where = (row.section, row.index) if row else ("joints",)
         named = f" ({row})" if row else ""
         raise MechanismError(f"over-constrained: {refusal.message}{named}", where,
                              refusal.hint) from None
+    if square and not found.removed:
+        return phi, rows, (), None
     removed = tuple(Removed(rows[k], phi[k], k, d)
                     for k, d in zip(found.removed, found.dependency))
     return ([phi[k] for k in found.kept], tuple(rows[k] for k in found.kept), removed,

@@ -119,7 +119,7 @@ class _Equations:
 def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
             p: Sequence[sp.Symbol], p_values: Sequence[float], q0: Sequence[float],
             t0: float, priority: Sequence[int], t_near: float | None = None,
-            joints: Sequence[int] = ()) -> Finding:
+            joints: Sequence[int] = (), freedoms: bool = False) -> Finding:
     """Assemble all rows at t0, find their rank and which rows to remove.
 
     Args:
@@ -131,6 +131,8 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
             count (default t0: moved in configuration only).
         joints: the rows a coordinate is subject to without the drivers (the joints' and a
             spatial body's normalisation), whose rank gives the mobility at t0.
+        freedoms: a rank below the number of coordinates that a nearby assembly keeps is
+            a motion the forces decide (a file with masses), not refused.
 
     Raises:
         Refusal: the rows contradict each other at t0 (no assembly), the rank is below the
@@ -152,8 +154,10 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
                       f"relative tolerance {RANK_TOLERANCE:g})",
                       "Move t0 away from a singular configuration, or remove the nearly "
                       "repeated joint.")
-    if rank < equations.size:
-        raise _short_rank(equations, assembled, t0, rank, t0 if t_near is None else t_near)
+    near = t0 if t_near is None else t_near
+    if rank < equations.size and not (
+            freedoms and _perturbed_rank(equations, assembled, near) == rank):
+        raise _short_rank(equations, assembled, t0, rank, near)
     removed = tuple(k for k in range(equations.rows) if k not in kept)
     joint_rank = numerical_rank(scaled[list(joints)]) if joints else 0
     return Finding(kept=tuple(sorted(kept)), removed=removed, rank=rank,

@@ -103,3 +103,31 @@ def test_its_initial_velocities_and_tolerances_are_the_motions(
     assert err.startswith(f"symkin: error: {driven}:{example.count(chr(10)) + 1}: ")
     assert err.count("\n") == 1
     assert "'initial' applies to a mechanism that moves under its forces" in err
+
+
+TWICE = """\
+name: twice_hinged
+parameters: {L: 1.0, m: 1.0}
+bodies:
+  bar: {q0: [0.5, 0, 0], mass: m, inertia: m*L**2/12}
+joints:
+  - {type: revolute, name: O, i: ground, j: bar, sA: [0, 0], sB: [-L/2, 0]}
+  - {type: revolute, name: O_again, i: ground, j: bar, sA: [0, 0], sB: [-L/2, 0]}
+forces:
+  - {type: gravity, g: [0, -9.81]}
+time: {t0: 0, t1: 1, dt: 0.05}
+"""
+
+
+def test_an_over_constrained_file_with_masses_and_a_free_motion_moves(tmp_path: Path) -> None:
+    """The hinge written twice and no driver: 4 rows on 3 coordinates, rank 2 at t0 and
+    nearby. Without masses that freedom is refused (tests/symbolic/test_redundancy.py); with
+    them the forces move it: the repeated rows are removed and the bar swings as a pendulum,
+    J_O theta'' = -m g (L/2) cos(theta) with J_O = m L^2/3, released horizontal."""
+    system = symkin.derive(write(tmp_path, "twice.yaml", TWICE))
+    assert len(system.removed) == 2
+    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    reference = solve_ivp(lambda t, y: [y[1], -9.81 / 2 * math.cos(y[0]) * 3], (0, 1),
+                          [0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12,
+                          t_eval=trajectory.t)
+    assert trajectory.q[:, 2] == pytest.approx(reference.y[0], abs=1e-7)
