@@ -37,7 +37,7 @@ _C_OUTPUT = {"phi": "out", "phi_q": "nz", "phi_t": "out", "gamma": "out", "point
              "loads_shared": "out", "removed_q": "out", "loads_full": "out",
              "mass": "nz", "applied": "out"}
 # The output arrays of a routine with several (Routine.sizes), in order.
-_C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared")}
+_C_OUTPUTS = {"phi_phi_q": ("out", "nz", "shared"), "motion": ("mass", "nz", "rhs", "gamma")}
 _PYTHON_NAME = {"phi_q": "phi_q_nz", "points": "_points", "phi_p": "phi_p_nz",
                 "phi_phi_q": "phi_phi_q_nz", "mass": "mass_nz"}
 _PYTHON_DOC = {
@@ -61,6 +61,8 @@ _PYTHON_DOC = {
     "loads_full": "loads from lam of every row: the kept rows' (NQ), then the removed rows'.",
     "mass": "The non-zeros of the mass matrix M(q) in MASS_ROWS/COLS order, shape (NNZ_M,).",
     "applied": "The applied forces less the velocity terms, Q(q, dq, t) - h(q, dq), (NQ,).",
+    "motion": "(the non-zeros of M, of Phi_q, Q - h, Gamma) at q, dq, t with one CSE: each "
+              "sine and cosine once.",
 }
 
 
@@ -312,6 +314,7 @@ def template_context(code: Code) -> dict[str, Any]:
         # Forward dynamics (only when the file gives masses).
         "forward_dynamics": code.forward_dynamics, "nrows": code.nrows,
         "nnz_m": len(code.mass_rows), "mass_rows": list(code.mass_rows),
+        "kept": list(code.augmented.kept) if code.augmented else [],
         "mass_cols": list(code.mass_cols),
         "joint_literals": [repr(n) for n in code.joint_names],
         # What must equal the runtime's, rendered from symkin.contract (never copied):
@@ -399,6 +402,9 @@ def _labels(code: Code, routine: str) -> list[str]:
         return [lower.comment(name) for name in code.coordinates]
     if routine == "mass":
         return [f"({r}, {c})" for r, c in zip(code.mass_rows, code.mass_cols)]
+    if routine == "motion":
+        return [label for part in ("mass", "phi_q", "applied", "gamma")
+                for label in _labels(code, part)]
     if routine == "removed_q":
         return [lower.comment(f"({row}, {name})") for row in code.removed
                 for name in code.coordinates]

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from symkin.backends.c import dynamics_budget, lu_code, norm_code, op_budget
+from symkin.backends.c import dynamics_budget, dynamics_lu, lu_code, norm_code, op_budget
 from symkin.backends.c.printer import literal
 from symkin.codegen.lower import Code
 from symkin.contract import lengths, options
@@ -42,6 +42,11 @@ def template_context(code: Code) -> dict[str, Any]:
                        "positions": budget.positions.total if budget.positions else None,
                        "inputs": budget.inputs.total if budget.inputs else None},
         # the same for <prefix>_dynamics_step, in a file with masses only
-        **({"dynamics_budget": dynamics_budget.template_context(code, cap)}
-           if code.forward_dynamics else {}),
+        **(_dynamics(code, cap) if code.forward_dynamics else {}),
     }
+
+
+def _dynamics(code: Code, cap: int) -> dict[str, Any]:
+    """The dynamics step's sparse LU (dynamics_lu) and its worst-case operation count."""
+    dyn = dynamics_lu.template_context(code)
+    return {"dyn": dyn, "dynamics_budget": dynamics_budget.template_context(code, dyn, cap)}
