@@ -43,15 +43,15 @@
 /* Operations of one crank_slider_load_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of crank_slider_load_dynamics.c, every branch that adds work
  * taken, the position corrections at their cap); each sin, cos, ... is a library call.
- * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 295
- * Runge-Kutta, three stages: 1140; one position correction: 142; the factorization at the corrected q, velocity correction and accelerations: 559
- * Step, worst case with the default cap of 25 corrections: 5617 (2751 add/sub, 1444 mul, 18 div, 0 sqrt, 128 other calls, 686 fabs, 590 compares)
+ * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 228
+ * Runge-Kutta, three stages: 939; one position correction: 142; the factorization at the corrected q, velocity correction and accelerations: 492
+ * Step, worst case with the default cap of 25 corrections: 5282 (2581 add/sub, 1444 mul, 18 div, 0 sqrt, 128 other calls, 601 fabs, 510 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
- * On the dense fall-back at every factorization, worst case: 44847
+ * On the dense fall-back at every factorization, worst case: 44512
  */
 #define CRANK_SLIDER_LOAD_OPS_DYNAMICS_ITERATION 142  /* one position correction */
-#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_FIXED 2067  /* a step without its corrections */
-#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_STEP_WORST 5617  /* at the default cap, 25 */
+#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_FIXED 1732  /* a step without its corrections */
+#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_STEP_WORST 5282  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */

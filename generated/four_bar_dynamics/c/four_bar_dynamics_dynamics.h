@@ -43,15 +43,15 @@
 /* Operations of one four_bar_dynamics_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of four_bar_dynamics_dynamics.c, every branch that adds work
  * taken, the position corrections at their cap); each sin, cos, ... is a library call.
- * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 495
- * Runge-Kutta, three stages: 1740; one position correction: 165; the factorization at the corrected q, velocity correction and accelerations: 869
- * Step, worst case with the default cap of 25 corrections: 7311 (3356 add/sub, 2146 mul, 34 div, 6 sqrt, 198 other calls, 846 fabs, 725 compares)
+ * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 412
+ * Runge-Kutta, three stages: 1491; one position correction: 165; the factorization at the corrected q, velocity correction and accelerations: 786
+ * Step, worst case with the default cap of 25 corrections: 6896 (3146 add/sub, 2146 mul, 34 div, 6 sqrt, 198 other calls, 741 fabs, 625 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
- * On the dense fall-back at every factorization, worst case: 46227
+ * On the dense fall-back at every factorization, worst case: 45812
  */
 #define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_ITERATION 165  /* one position correction */
-#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_FIXED 3186  /* a step without its corrections */
-#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_STEP_WORST 7311  /* at the default cap, 25 */
+#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_FIXED 2771  /* a step without its corrections */
+#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_STEP_WORST 6896  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */

@@ -43,15 +43,15 @@
 /* Operations of one parallelogram_extra_bar_loads_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of parallelogram_extra_bar_loads_dynamics.c, every branch that adds work
  * taken, the position corrections at their cap); each sin, cos, ... is a library call.
- * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 779
- * Runge-Kutta, three stages: 2760; one position correction: 299; the factorization at the corrected q, velocity correction and accelerations: 1371
- * Step, worst case with the default cap of 25 corrections: 12523 (5885 add/sub, 3690 mul, 38 div, 0 sqrt, 401 other calls, 1400 fabs, 1109 compares)
+ * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 640
+ * Runge-Kutta, three stages: 2343; one position correction: 299; the factorization at the corrected q, velocity correction and accelerations: 1232
+ * Step, worst case with the default cap of 25 corrections: 11828 (5535 add/sub, 3690 mul, 38 div, 0 sqrt, 401 other calls, 1225 fabs, 939 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
- * On the dense fall-back at every factorization, worst case: 158813
+ * On the dense fall-back at every factorization, worst case: 158118
  */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_ITERATION 299  /* one position correction */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_FIXED 5048  /* a step without its corrections */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_STEP_WORST 12523  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_FIXED 4353  /* a step without its corrections */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_STEP_WORST 11828  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */

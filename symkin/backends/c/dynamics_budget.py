@@ -53,9 +53,10 @@ def sparse(code: Any, dyn: dict[str, Any]) -> Algebra:
     straight-line parts) and <prefix>_dyn_solve's straight-line substitutions."""
     lu = dyn["lu"]
     scaled = sum(1 for entry in dyn["loads"] if entry["scaled"])
-    load = (Flops(abs=1, cmp=1, add=1) * len(code.mass_rows) + Flops(cmp=1, div=1)  # s, 1/s
-            + Flops(abs=1, cmp=1, add=2) * len(dyn["loads"]) + Flops(mul=scaled)
-            + Flops(mul=1, add=1))
+    load = (Flops(abs=1, cmp=1, add=1) * len(code.mass_rows)  # max |M_ij| and its NaN test
+            + Flops(cmp=2, div=1) + Flops(mul=scaled)  # s, 1 / s, amax of M / s, M / s
+            + Flops(abs=1, cmp=1, add=2) * (len(dyn["loads"]) - scaled)
+            + Flops(mul=1, add=1))  # the tiny bound
     lines = [line for part in lu["factor_parts"] for s in part["steps"] for line in s["factor"]]
     factor = (load + Flops(cmp=1 if lu["tiny_check"] else 0)
               + count_all(lines, _amax_helpers(dynamics_lu.prefix(code.name))))
