@@ -18,7 +18,7 @@ from typing import Any
 import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
-from symkin.codegen import sample, symbol_printing
+from symkin.codegen import dynamics_plan, sample, symbol_printing
 from symkin.codegen.cse_tidy import _count_ops, _inline_trivial, _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
@@ -66,6 +66,8 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     # order) and the applied forces less the velocity terms, Q - h(q, dq, t).
     "mass": ("q", "p"),
     "applied": ("q", "dq", "t", "p"),
+    # M, Phi_q, Q - h and Gamma at one (q, dq, t) with one CSE (the dynamics step's stages)
+    "motion": ("q", "dq", "t", "p"),
 }
 DYNAMICS = ("dynamics_rhs", "loads")
 FUSED = ("phi_phi_q", "phi_t_shared", "gamma_shared")
@@ -188,6 +190,8 @@ class Code:
     mass_rows: tuple[int, ...] = ()
     mass_cols: tuple[int, ...] = ()
     """Forward dynamics (a file with masses): the structural non-zeros of M, row-major."""
+    augmented: dynamics_plan.AugmentedPlan | None = None
+    """Forward dynamics: the rows and the sparse LU of the step's matrix (codegen.dynamics_plan)."""
 
     @property
     def forward_dynamics(self) -> bool:
@@ -265,6 +269,12 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
            "phi_q": _select("phi_q", fused_parts, {nphi + e: e for e in range(nnz)}, nnz),
            "phi_phi_q": _assemble("phi_phi_q", fused_parts, len(fused["phi_phi_q"]),
                                   sizes["phi_phi_q"])}
+    if m_pattern:  # the dynamics step's stages: each sine and cosine once for all four
+        fused["motion"] = [e for name in ("mass", "phi_q", "applied", "gamma")
+                           for e in prepared[name]]
+        own["motion"] = _assemble("motion", _lowered_parts("motion", fused["motion"], printer,
+                                                           cse), len(fused["motion"]),
+                                  (len(m_pattern), nnz, len(system.q), nphi))
     routines = tuple(
         own[name] if name in own else
         _assemble(name, _lowered_parts(name, exprs, printer, cse), len(exprs))
@@ -292,6 +302,7 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
         input_places=system.input_places, input_lengths=system.input_lengths,
         nonlinear=nonlinear_coordinates(system),
         mass_rows=tuple(r for r, _ in m_pattern), mass_cols=tuple(c for _, c in m_pattern),
+        augmented=dynamics_plan.analyse(system, pattern, m_pattern) if m_pattern else None,
     )
 
 

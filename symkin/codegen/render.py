@@ -39,6 +39,7 @@ OUTPUT_ARRAYS: dict[str, tuple[str, ...]] = {
     **{name: ("out",) for name in lower.ROUTINE_ARGUMENTS},
     "phi_q": ("nz",), "phi_p": ("nz",), "mass": ("nz",),
     "phi_phi_q": ("out", "nz", "shared"),
+    "motion": ("mass", "nz", "rhs", "gamma"),
 }
 
 
@@ -284,6 +285,7 @@ def template_context(code: Code) -> dict[str, Any]:
         # Forward dynamics (only when the file gives masses).
         "forward_dynamics": code.forward_dynamics, "nrows": code.nrows,
         "nnz_m": len(code.mass_rows), "mass_rows": list(code.mass_rows),
+        "kept": list(code.augmented.kept) if code.augmented else [],
         "mass_cols": list(code.mass_cols),
         # What must equal the runtime's, rendered from symkin.contract (never copied):
         "status": {**status.CODES, **status.INPUT_CODES},
@@ -346,6 +348,9 @@ def _labels(code: Code, routine: str) -> list[str]:
         return [lower.comment(name) for name in code.coordinates]
     if routine == "mass":
         return [f"({r}, {c})" for r, c in zip(code.mass_rows, code.mass_cols)]
+    if routine == "motion":
+        return [label for part in ("mass", "phi_q", "applied", "gamma")
+                for label in _labels(code, part)]
     if routine == "removed_q":
         return [lower.comment(f"({row}, {name})") for row in code.removed
                 for name in code.coordinates]

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from symkin.backends.c import dynamics_budget, linalg, lu_code, norm_code, op_budget, real
+from symkin.backends.c import (dynamics_budget, dynamics_lu, linalg, lu_code, norm_code,
+                               op_budget, real)
 from symkin.backends.c.printer import literal
 from symkin.codegen.lower import Code
 from symkin.contract import lengths, options, tuning
@@ -51,8 +52,7 @@ def template_context(code: Code) -> dict[str, Any]:
                        "positions": budget.positions.total if budget.positions else None,
                        "inputs": budget.inputs.total if budget.inputs else None},
         # the same for <prefix>_dynamics_step, in a file with masses only
-        **({"dynamics_budget": dynamics_budget.template_context(code, cap)}
-           if code.forward_dynamics else {}),
+        **(_dynamics(code, cap) if code.forward_dynamics else {}),
     }
 
 
@@ -81,3 +81,9 @@ def _newton_defaults(kind: str) -> dict[str, str]:
 def _c_number(value: float) -> str:
     """The shortest text that reads back as ``value``: ``10``, ``0.05`` (cast where used)."""
     return str(int(value)) if float(value).is_integer() else repr(float(value))
+
+
+def _dynamics(code: Code, cap: int) -> dict[str, Any]:
+    """The dynamics step's sparse LU (dynamics_lu) and its worst-case operation count."""
+    dyn = dynamics_lu.template_context(code)
+    return {"dyn": dyn, "dynamics_budget": dynamics_budget.template_context(code, dyn, cap)}

@@ -28,7 +28,8 @@ def available(lib: Any, name: str) -> bool:
 @dataclass(frozen=True)
 class Motion:
     """Rows of a run of fixed steps: t (T,), q, dq, ddq (T, NQ), lam (T, NR); ``status`` of
-    the step that ended the run (OK when all were taken); each step's report residuals."""
+    the step that ended the run (OK when all were taken); each step's report residuals;
+    ``fallbacks``: the factorizations of the run that took the dense path."""
 
     t: Array
     q: Array
@@ -38,6 +39,7 @@ class Motion:
     status: int
     residual: Array
     velocity_residual: Array
+    fallbacks: int = 0
 
 
 class DynamicsStepper:
@@ -67,10 +69,11 @@ class DynamicsStepper:
         values = np.ascontiguousarray(p, dtype=self._dtype)
         buffer = self._ffi.from_buffer(self._real, values) if values.size else self._ffi.NULL
         rows: list[tuple[Any, ...]] = []
-        status = OK
+        status, fallbacks = OK, 0
         for _ in range(steps):
             status = int(self._step(self._options, buffer, h, state, self._work,
                                     self._report))
+            fallbacks += int(self._report.fallbacks)
             if status != OK:
                 break
             rows.append(self._row())
@@ -79,7 +82,7 @@ class DynamicsStepper:
         t, q, dq, ddq, lam, residual, velocity = (
             column if rows else np.zeros(shape) for column, shape in zip(columns, shapes))
         return Motion(t=t, q=q, dq=dq, ddq=ddq, lam=lam, status=status, residual=residual,
-                      velocity_residual=velocity)
+                      velocity_residual=velocity, fallbacks=fallbacks)
 
     def _row(self) -> tuple[Any, ...]:
         state, unpack, report = self._state, self._ffi.unpack, self._report

@@ -333,12 +333,7 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
                          "the straight-line style for a plan with swaps")
     fabs = "fabsf" if real == "float" else "fabs"
     code = statements(plan, constants if real == "double" else None, literal(real), prefix, fabs)
-    steps = [{"k": s.k, "row": s.row, "col": s.col, "pivot": s.pivot,
-              "lower": [list(x) for x in s.lower], "upper": [list(x) for x in s.upper],
-              "updates": [list(x) for x in s.updates], "factor": code.factor[s.k],
-              "cmax": code.uses_cmax[s.k], "forward": code.forward[s.k],
-              "backward": code.backward[plan.n - 1 - s.k], "upper_t": code.upper_t[s.k],
-              "lower_t": code.lower_t[plan.n - 1 - s.k]} for s in plan.steps]
+    steps = step_dicts(plan, code)
     backward = list(reversed(steps))
     return {
         "n_lu": plan.n_lu,
@@ -375,15 +370,15 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
                                                 or plan.n > part_ops),
         "pivot_ok": code.uses_pivot_ok or style == "tables",
         "constant_pivots": code.constant_pivots if style == "straight" else 0,
-        "factor_parts": _parts(steps, lambda s: len(s["factor"]), part_ops),
-        "forward_parts": _parts([s for s in steps if s["forward"]], lambda s: len(s["forward"]),
-                                part_ops),
-        "backward_parts": _parts([s for s in backward if s["backward"]],
-                                 lambda s: len(s["backward"]), part_ops),
-        "upper_t_parts": _parts([s for s in steps if s["upper_t"]], lambda s: len(s["upper_t"]),
-                                part_ops),
-        "lower_t_parts": _parts([s for s in backward if s["lower_t"]],
-                                lambda s: len(s["lower_t"]), part_ops),
+        "factor_parts": split_parts(steps, lambda s: len(s["factor"]), part_ops),
+        "forward_parts": split_parts([s for s in steps if s["forward"]],
+                                     lambda s: len(s["forward"]), part_ops),
+        "backward_parts": split_parts([s for s in backward if s["backward"]],
+                                      lambda s: len(s["backward"]), part_ops),
+        "upper_t_parts": split_parts([s for s in steps if s["upper_t"]],
+                                     lambda s: len(s["upper_t"]), part_ops),
+        "lower_t_parts": split_parts([s for s in backward if s["lower_t"]],
+                                     lambda s: len(s["lower_t"]), part_ops),
         "style": style,
         "tables": _tables(plan),
         # ||Phi_q^-1||_1 exactly, where the straight-line code for it is short
@@ -391,6 +386,16 @@ def template_context(plan: LUPlan, part_ops: int = PART_OPS,
                                                f"{prefix}_real", fabs)
                     if style == "straight" else None),
     }
+
+
+def step_dicts(plan: LUPlan, code: Statements) -> list[dict[str, Any]]:
+    """Per step (pivot order) its plan entries and its statements in every routine."""
+    return [{"k": s.k, "row": s.row, "col": s.col, "pivot": s.pivot,
+             "lower": [list(x) for x in s.lower], "upper": [list(x) for x in s.upper],
+             "updates": [list(x) for x in s.updates], "factor": code.factor[s.k],
+             "cmax": code.uses_cmax[s.k], "forward": code.forward[s.k],
+             "backward": code.backward[plan.n - 1 - s.k], "upper_t": code.upper_t[s.k],
+             "lower_t": code.lower_t[plan.n - 1 - s.k]} for s in plan.steps]
 
 
 def _odd(perm: Sequence[int]) -> bool:
@@ -424,8 +429,8 @@ def _tables(plan: LUPlan) -> dict[str, list[int]]:
     return tables
 
 
-def _parts(steps: list[dict[str, Any]], size: Callable[[dict[str, Any]], int],
-           limit: int) -> list[dict[str, Any]]:
+def split_parts(steps: list[dict[str, Any]], size: Callable[[dict[str, Any]], int],
+                limit: int) -> list[dict[str, Any]]:
     """Consecutive runs of steps of at most ``limit`` operations each (at least one step);
     ``checks`` says whether a run has a ratio test (and so needs its column maximum)."""
     runs: list[list[dict[str, Any]]] = []

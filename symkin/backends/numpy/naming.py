@@ -32,6 +32,8 @@ _DOC = {
     "loads_full": "loads from lam of every row: the kept rows' (NQ), then the removed rows'.",
     "mass": "The non-zeros of the mass matrix M(q) in MASS_ROWS/COLS order, shape (NNZ_M,).",
     "applied": "The applied forces less the velocity terms, Q(q, dq, t) - h(q, dq), (NQ,).",
+    "motion": "(the non-zeros of M, of Phi_q, Q - h, Gamma) at q, dq, t with one CSE: each "
+              "sine and cosine once.",
 }
 
 

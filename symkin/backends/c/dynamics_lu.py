@@ -1,0 +1,85 @@
+"""The forward-dynamics step's sparse LU as data for ``templates/dynamics.c.j2``: the
+straight-line factor and solves of the augmented matrix's plan (codegen.dynamics_plan), made
+by the statements of the kinematic LU (lu_code) with this matrix's known numbers folded in,
+and the loads of M's and Phi_q's varying non-zeros into their slots.
+
+The statements call their helpers under the prefix ``<prefix>_dyn`` (``<prefix>_dyn_lu_amax``,
+``<prefix>_dyn_lu_pivot_ok``, ``<PREFIX>_DYN_LU_TAU``), defined in the dynamics source, so the
+step compiles with or without the kinematic solver's sparse LU beside it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from symkin.backends.c import lu_code
+from symkin.backends.c.printer import literal
+from symkin.codegen.dynamics_plan import AugmentedPlan
+from symkin.codegen.lower import comment
+from symkin.codegen.lu_plan import LUPlan
+
+SOURCES = {"m": "mass", "j": "nz"}
+"""Where a slot's value is read from: the work struct's M and Phi_q non-zeros."""
+
+
+def prefix(name: str) -> str:
+    """The prefix of the dynamics LU's helpers."""
+    return f"{name}_dyn"
+
+
+def straight(plan: LUPlan, constants: Sequence[float | None] | None, real: str, name: str,
+             part_ops: int = lu_code.PART_OPS) -> dict[str, Any]:
+    """The straight-line factor and solve of ``plan``, in parts (lu_code's statements).
+    Constants fold in double only, as for the kinematic LU. The statements never read a known
+    slot nor the reciprocal of a constant pivot (literals there): nothing to initialise."""
+    fabs = "fabsf" if real == "float" else "fabs"
+    code = lu_code.statements(plan, constants if real == "double" else None, literal(real),
+                              prefix(name), fabs)
+    steps = lu_code.step_dicts(plan, code)
+    backward = list(reversed(steps))
+    return {
+        "n_lu": plan.n_lu, "n_fill": plan.n_lu - plan.nnz, "tau": repr(float(plan.tau)),
+        "flops": plan.flops, "solve_flops": plan.solve_flops,
+        "row_perm": list(plan.row_perm), "col_perm": list(plan.col_perm),
+        "loaded": code.loaded, "known_max": code.known_max, "tiny_check": code.tiny_check,
+        "constant_pivots": code.constant_pivots, "pivot_ok": code.uses_pivot_ok,
+        "amax": code.ratio_tests > 0,
+        "factor_parts": lu_code.split_parts(steps, lambda s: len(s["factor"]), part_ops),
+        "forward_parts": lu_code.split_parts([s for s in steps if s["forward"]],
+                                             lambda s: len(s["forward"]), part_ops),
+        "backward_parts": lu_code.split_parts([s for s in backward if s["backward"]],
+                                              lambda s: len(s["backward"]), part_ops),
+    }
+
+
+def loads(augmented: AugmentedPlan, loaded: Sequence[int]) -> list[dict[str, Any]]:
+    """Per varying non-zero of M or Phi_q (in slot order of its first slot): the array it is
+    read from, its index there, the slots it fills (a Phi_q entry fills two: below M and
+    transposed beside it) and whether it is divided by the mass scale (M's)."""
+    wanted = set(loaded)
+    found: dict[tuple[str, int], list[int]] = {}
+    for slot, source in enumerate(augmented.sources):
+        if slot in wanted:
+            found.setdefault(source, []).append(slot)
+    return [{"array": SOURCES[kind], "index": index, "slots": slots, "scaled": kind == "m"}
+            for (kind, index), slots in found.items()]
+
+
+def template_context(code: Any) -> dict[str, Any]:
+    """The ``dyn`` entry of the C template context (a file with masses only)."""
+    augmented: AugmentedPlan = code.augmented
+    lu = straight(augmented.plan, augmented.constants, code.real, code.name)
+    position = {row: k for k, row in enumerate(augmented.kept)}
+    return {
+        "lu": lu,
+        "loads": loads(augmented, lu["loaded"]),
+        "nkept": len(augmented.kept),
+        "kept": list(augmented.kept),
+        "removed": list(augmented.removed),
+        "removed_rows": [(r, comment(code.rows[r])) for r in augmented.removed],
+        # the dense fall-back's scatter: each non-zero of Phi_q's row in the matrix, or -1
+        # where its row is left out
+        "kept_row": [code.nq + position[r] if r in position else -1
+                     for r in code.pattern_rows],
+    }
