@@ -61,7 +61,7 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "dynamics_rhs_shared": ("q", "dq", "ddq", "t", "p", "shared"),
     "loads_shared": ("q", "lam", "t", "p", "shared"),
     # Dynamics with removed rows: their Jacobian (dense) and the loads of lam of every row
-    # (kept, then removed), for the runtime's minimum-norm loads (runtime.indeterminate).
+    # (kept, then removed), for the runtime's minimum-norm loads (runtime.loads.indeterminate).
     "removed_q": ("q", "t", "p"),
     "loads_full": ("q", "lam", "t", "p"),
     # Forward dynamics, only for a file with masses: the non-zeros of M(q) (mass_rows/_cols
@@ -182,7 +182,7 @@ class Code:
     """Where each input is in the file (System.input_places)."""
     nonlinear: tuple[int, ...] = ()
     """The coordinates that enter Phi_q or Phi_t (angles, Euler parameters, the positions of
-    a prismatic pair's bodies): only their errors move Phi_q (runtime.accuracy)."""
+    a prismatic pair's bodies): only their errors move Phi_q (runtime.solving.accuracy)."""
     mass_rows: tuple[int, ...] = ()
     mass_cols: tuple[int, ...] = ()
     """Forward dynamics (a file with masses): the structural non-zeros of M, row-major."""

@@ -15,7 +15,7 @@ from motion_support import CRANK_SLIDER, PENDULUM, write
 import symkin
 from symkin import cli
 from symkin.runtime.dynamics.model import kernel_terms
-from symkin.runtime.run_outcome import SolveInterrupted
+from symkin.runtime.solving.run_outcome import SolveInterrupted
 
 
 @pytest.fixture

@@ -33,7 +33,7 @@ class _ModuleFunctions:
         # inverse dynamics, generated only for a mechanism with masses or forces
         self.dynamics_rhs: Callable[..., Array] = getattr(module, "dynamics_rhs", _no_dynamics)
         self.loads: Callable[..., Array] = getattr(module, "loads", _no_dynamics)
-        # with dynamics and removed rows only (runtime.indeterminate)
+        # with dynamics and removed rows only (runtime.loads.indeterminate)
         self.removed_q: Callable[..., Array] = getattr(module, "removed_q", _no_dynamics)
         self.loads_full: Callable[..., Array] = getattr(module, "loads_full", _no_dynamics)
 
