@@ -1,5 +1,5 @@
 """Cost of the minimum-norm completion of the reactions where rows were removed as redundant
-(runtime.indeterminate), per row, against the kinematic step of the same run.
+(runtime.loads.indeterminate), per row, against the kinematic step of the same run.
 
     python3 bench/redundant_forces.py [--steps 2000] [--repeat 5]
 
@@ -8,7 +8,7 @@ file's interval), best of --repeat, CPU time of this process:
 
 - ``kinematic``: the generated grid loop with NULL multiplier outputs (as bench/forces.py);
 - ``kept rows``: the generated ``multipliers_grid`` (the kept rows' multipliers and loads);
-- ``completion``: runtime.indeterminate.complete on them (NumPy, per row: Phi_q and the
+- ``completion``: runtime.loads.indeterminate.complete on them (NumPy, per row: Phi_q and the
   removed rows' Jacobian from the generated code, one batched solve and QR for all rows,
   the loads of the null vectors, the minimum-norm loads and which are determinate).
 """
@@ -26,8 +26,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import symkin  # noqa: E402
-from symkin.runtime import indeterminate  # noqa: E402
 from symkin.runtime.driver import default_options  # noqa: E402
+from symkin.runtime.loads import indeterminate  # noqa: E402
 
 NAME = "parallelogram_extra_bar_loads"
 

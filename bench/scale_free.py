@@ -4,7 +4,7 @@ size, solved by symkin.solve on the C backend, microseconds per time step.
     python3 bench/scale_free.py [--points 20001] [--repeat 10]
 
 A mechanism whose length scale lies outside 0.01..100 is solved in the unit 10^k that brings it
-near 1 (runtime.units); the generated C grid loop itself decides in that unit (its options'
+near 1 (runtime.solving.units); the generated C grid loop itself decides in that unit (its options'
 ``unit``), so a millimetre drawing runs at the speed of one in metres. For comparison, the same
 runs through the Python grid loop over the generated functions (what a scaled run took
 before), on a grid 100 times shorter. Best of --repeat, CPU time of this process.

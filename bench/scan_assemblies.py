@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import symkin  # noqa: E402
-from symkin.runtime.scan import scan  # noqa: E402
+from symkin.runtime.scanning.scan import scan  # noqa: E402
 
 
 def main() -> None:

@@ -36,7 +36,7 @@ _EXPORTS = {
     "generate": ("symkin.public", "generate"),
     "compile": ("symkin.public", "compile"),
     "solve": ("symkin.runtime.driver", "solve"),
-    "scan": ("symkin.runtime.scan", "scan"),
+    "scan": ("symkin.runtime.scanning.scan", "scan"),
     "sweep": ("symkin.sweeps.api", "sweep"),
     "with_outputs": ("symkin.symbolic.outputs", "with_outputs"),
     "SymkinError": ("symkin.errors", "SymkinError"),

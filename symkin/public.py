@@ -10,7 +10,6 @@ from symkin import backends
 from symkin.build import motion
 from symkin.build.compile import compile as compile_system
 from symkin.codegen import render
-from symkin.errors import BuildError
 from symkin.runtime.dynamics.model import MotionKernel
 from symkin.runtime.kernel import Kernel
 from symkin.symbolic.derivation import System

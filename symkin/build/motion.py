@@ -9,8 +9,8 @@ terms and initial velocities the generated code has no routine for come from the
 
 from __future__ import annotations
 
-from pathlib import Path
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 from symkin.build.backend import Backend

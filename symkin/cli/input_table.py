@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from symkin import limits
 from symkin.contract.columns import RATE_SUFFIXES
-from symkin.runtime.inputs import negative_length
+from symkin.runtime.input_driven.inputs import negative_length
 
 Array = NDArray[np.float64]
 SUFFIXES = ("", *RATE_SUFFIXES)  # a value's column, its rate's and its acceleration's
@@ -74,7 +74,7 @@ def read(path: Path, names: tuple[str, ...], lengths: tuple[str, ...] = ()) -> I
 def _not_negative(path: Path, values: Array, lines: list[int], header: list[str],
                   lengths: tuple[str, ...]) -> None:
     """A length's column (an actuator's |B - A|) has no negative value (the rule and its
-    words are runtime.inputs', which symkin.solve applies too)."""
+    words are runtime.input_driven.inputs', which symkin.solve applies too)."""
     names = tuple(header)
     negative = negative_length(values, names, lengths)
     if negative is not None:

@@ -289,10 +289,10 @@ def _stopped(args: argparse.Namespace, prepared: Any, stop: Any, total: int, why
 
 
 def _note_far_start(kernel: Any, trajectory: Any) -> None:
-    """A note when the start was assembled far from the file's q0 (runtime.start)."""
+    """A note when the start was assembled far from the file's q0 (runtime.solving.start)."""
     import numpy as np
 
-    from symkin.runtime.start import far_from_guess
+    from symkin.runtime.solving.start import far_from_guess
 
     moved, scale = far_from_guess(kernel, np.asarray(kernel.q0, dtype=float), trajectory.q[0],
                                   float(trajectory.t[0]), trajectory.params)

@@ -19,7 +19,7 @@ from symkin.limits import listed
 # parser and must not pay for them.
 if TYPE_CHECKING:
     from symkin.present.series import Units
-    from symkin.runtime.start import Moved
+    from symkin.runtime.solving.start import Moved
 
 
 class CannotWrite(Exception):
@@ -183,7 +183,7 @@ def fallback_note(count: int, points: int, verbose: bool = False) -> str:
 
 
 def far_start_note(moved: Sequence[Moved], scale: float) -> str:
-    """A line on bodies assembled far from their q0 (runtime.start.far_from_guess)."""
+    """A line on bodies assembled far from their q0 (runtime.solving.start.far_from_guess)."""
     said = listed(f"{m.body} (moved {m.distance:.3g}, turned {m.turn:.3g} rad)"
                   for m in moved)
     return (f"the assembled start is far from q0 (the mechanism's length scale is "
@@ -305,7 +305,7 @@ def _broken_removed(trajectory: Any, k: int, end: int, target: float) -> str:
     residual = getattr(trajectory, "removed_residual", None)
     if residual is None or not trajectory.removed:
         return ""
-    from symkin.runtime import redundant
+    from symkin.runtime.outputs import redundant
 
     stretch = residual[k:end + 1]
     broken: Any = redundant.exceeded(stretch, trajectory.q[k:end + 1], target).any(axis=0)

@@ -1,6 +1,6 @@
 """``symkin scan``: the assembly branches at t0, then the singular configurations, limit
-positions and flagged stretches over the driver range (symkin.runtime.scan), as a short report;
-with ``--input NAME=VALUE`` (a mechanism with input drivers) every assembly at those inputs.
+positions and flagged stretches over the driver range (symkin.runtime.scanning.scan), as a short
+report; with ``--input NAME=VALUE`` (a mechanism with input drivers) every assembly at those inputs.
 
 Exit status 0 when the scan ran, whatever it found (a limit position is a finding, not a
 failure); 2 for bad input; 1 when the kernel cannot be built or cached; 130 on Ctrl-C.
@@ -45,7 +45,7 @@ def handle(args: argparse.Namespace) -> int:
     from symkin.build import index
     from symkin.errors import SolveError
     from symkin.runtime import driver
-    from symkin.runtime.scan import scan
+    from symkin.runtime.scanning.scan import scan
 
     for option in ("t0", "t1", "dt"):
         value = getattr(args, option)
@@ -107,7 +107,7 @@ def _inputs(pairs: list[str]) -> dict[str, float] | str | None:
 
 def text(report: Any, name: str, grid: str) -> str:
     """The report as a person reads it."""
-    from symkin.runtime.scan import distinguishing, printed
+    from symkin.runtime.scanning.scan import distinguishing, printed
 
     lines = [f"{name}: scan over {grid}"]
     shown = distinguishing(report)

@@ -68,7 +68,7 @@ def handle(args: argparse.Namespace) -> int:
     options = index.Options(backend=backends.resolve(args.backend),
                             parameters=overrides.pairs(args.overrides))
     kernel = index.prepare(args.mechanism, options).kernel
-    from symkin.runtime.inputs import refuse_inputs
+    from symkin.runtime.input_driven.inputs import refuse_inputs
 
     try:
         refuse_inputs(kernel, "a sweep")  # the user's file, not a failed design: exit 2

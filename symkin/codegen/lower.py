@@ -18,7 +18,7 @@ from typing import Any
 import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
-from symkin.codegen import dynamics_plan, sample, symbol_printing
+from symkin.codegen import dynamics_plan, fusion, sample, symbol_printing
 from symkin.codegen.cse_tidy import _count_ops, _inline_trivial, _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
@@ -45,7 +45,7 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     # Only when there are some: System.removed (checked along the motion), System.senses.
     "removed": ("q", "t", "p"),
     "senses": ("q", "t", "p"),
-    # Fused evaluation (see _fused_expressions): one call per Newton iterate evaluates Phi, the
+    # Fused evaluation (see codegen.fusion): one call per Newton iterate evaluates Phi, the
     # non-zeros of Phi_q and the shared sines and cosines; Phi_t and Gamma at the converged q
     # read those instead of evaluating them again.
     "phi_phi_q": ("q", "t", "p"),
@@ -59,7 +59,7 @@ ROUTINE_ARGUMENTS: dict[str, tuple[str, ...]] = {
     "dynamics_rhs_shared": ("q", "dq", "ddq", "t", "p", "shared"),
     "loads_shared": ("q", "lam", "t", "p", "shared"),
     # Dynamics with removed rows: their Jacobian (dense) and the loads of lam of every row
-    # (kept, then removed), for the runtime's minimum-norm loads (runtime.indeterminate).
+    # (kept, then removed), for the runtime's minimum-norm loads (runtime.loads.indeterminate).
     "removed_q": ("q", "t", "p"),
     "loads_full": ("q", "lam", "t", "p"),
     # Forward dynamics, only for a file with masses: the non-zeros of M(q) (mass_rows/_cols
@@ -186,7 +186,7 @@ class Code:
     """The inputs (indices into u[]) that are lengths, never negative (System.input_lengths)."""
     nonlinear: tuple[int, ...] = ()
     """The coordinates that enter Phi_q or Phi_t (angles, Euler parameters, the positions of
-    a prismatic pair's bodies): only their errors move Phi_q (runtime.accuracy)."""
+    a prismatic pair's bodies): only their errors move Phi_q (runtime.solving.accuracy)."""
     mass_rows: tuple[int, ...] = ()
     mass_cols: tuple[int, ...] = ()
     """Forward dynamics (a file with masses): the structural non-zeros of M, row-major."""
@@ -256,11 +256,11 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
     printer: CodePrinter = backend.printer(chosen)
     prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
     prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
-    fused, shared = _fused_expressions(prepared)
+    fused, shared = fusion.fused_expressions(prepared, DYNAMICS)
     # Phi's rows: as many as coordinates, or fewer where the dynamics moves the rest
     nphi = len(system.phi)
     sizes = {"phi_phi_q": (nphi, len(pattern), len(shared))}
-    orders = {"phi_phi_q": _fused_order(prepared, pattern, shared)}
+    orders = {"phi_phi_q": fusion.fused_order(prepared, pattern, shared)}
     # Phi and Phi_q alone are the fused routine's pieces: its CSE and printing serve all three.
     fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse,
                                  orders["phi_phi_q"])
@@ -304,58 +304,6 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
         mass_rows=tuple(r for r, _ in m_pattern), mass_cols=tuple(c for _, c in m_pattern),
         augmented=dynamics_plan.analyse(system, pattern, m_pattern) if m_pattern else None,
     )
-
-
-def _fused_expressions(prepared: dict[str, list[sp.Expr]]
-                       ) -> tuple[dict[str, list[sp.Expr]], list[sp.Expr]]:
-    """The fused routines' expressions, and the values they share.
-
-    ``phi_phi_q`` outputs Phi, the non-zeros of Phi_q and every sine or cosine that Phi or
-    Phi_q and also Phi_t or Gamma use, with one CSE over all of them (so each is evaluated
-    once); ``phi_t_shared`` and ``gamma_shared`` read those values (``shared[k]``) instead of
-    calling sin and cos again. They are evaluated at the same q, t and p, so the values are
-    the same numbers bit for bit.
-    """
-    def trig(names: tuple[str, ...]) -> set[sp.Expr]:
-        found: set[sp.Expr] = set()
-        for name in names:
-            for e in prepared[name]:
-                found |= e.atoms(sp.sin, sp.cos)
-        return found
-
-    # With inverse dynamics, also those the multipliers' routines use (a file without masses
-    # or forces shares exactly what it did before).
-    dynamics = tuple(name for name in DYNAMICS if name in prepared)
-    shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma", *dynamics)),
-                    key=sp.default_sort_key)
-    # one memory of rebuilt subtrees: Gamma repeats Phi_t's piecewise parts
-    mapped = symbol_printing.Substitution({f: sp.Symbol(f"_shared{k}", real=True)
-                                           for k, f in enumerate(shared)})
-    return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
-            "phi_t_shared": [mapped(e) for e in prepared["phi_t"]],
-            "gamma_shared": [mapped(e) for e in prepared["gamma"]],
-            **{f"{name}_shared": [mapped(e) for e in prepared[name]]
-               for name in dynamics}}, shared
-
-
-def _fused_order(prepared: dict[str, list[sp.Expr]], pattern: Sequence[tuple[int, int]],
-                 shared: list[sp.Expr]) -> list[int]:
-    """The fused routine's outputs row by row: Phi's row, that row's non-zeros of Phi_q, then
-    the shared values it first uses; so a part keeps a row's sines and cosines together."""
-    nq, nnz = len(prepared["phi"]), len(pattern)
-    by_row: dict[int, list[int]] = {}
-    for e, (r, _) in enumerate(pattern):
-        by_row.setdefault(r, []).append(e)
-    where = {f: nq + nnz + k for k, f in enumerate(shared)}
-    order: list[int] = []
-    for r in range(nq):
-        row = [r, *(nq + e for e in by_row.get(r, []))]
-        order += row
-        exprs = [prepared["phi"][r], *(prepared["phi_q"][e] for e in by_row.get(r, []))]
-        for e in exprs:
-            for f in sorted(e.atoms(sp.sin, sp.cos) & where.keys(), key=sp.default_sort_key):
-                order.append(where.pop(f))
-    return order + sorted(where.values())
 
 
 @dataclass

@@ -1,5 +1,5 @@
 """Which coordinates and which rows of Phi are lengths: the split the scale-free solve rests on
-(runtime.units scales them in Python, the generated C solver from the tables codegen renders
+(runtime.solving.units scales them in Python, the generated C solver from the tables codegen renders
 from the same rules, so both backends scale the same entries)."""
 
 from __future__ import annotations

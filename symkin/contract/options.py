@@ -60,7 +60,7 @@ class Options:
             model's test alone gave the same accuracy on the test mechanisms for less work).
             ``inf``: no extra iterations at all (the same work at every step).
         target_q, target_dq, target_ddq: a point is flagged when the estimated error of q, dq
-            or ddq exceeds this times max(1, max |x|) (runtime.accuracy).
+            or ddq exceeds this times max(1, max |x|) (runtime.solving.accuracy).
         stop_at_singular: stop at the first singular point (the behaviour before singular
             points were passed through); also no bisection of limit positions.
     """
@@ -118,9 +118,9 @@ grid loop stops)."""
 
 LENGTH_UNIT = "unit"
 """The C solver's option beyond :data:`SOLVER_FIELDS`: the length unit its decisions are made
-in (runtime.units chooses it from the mechanism's length scale; 1, the default, is the
+in (runtime.solving.units chooses it from the mechanism's length scale; 1, the default, is the
 mechanism's own unit). The Python loop applies the same unit by solving a scaled view of the
-kernel (runtime.units.ScaledKernel), so it is no field of :class:`Options`."""
+kernel (runtime.solving.units.ScaledKernel), so it is no field of :class:`Options`."""
 
 C_FIELDS = (*SOLVER_FIELDS, LENGTH_UNIT)
 """The fields of the generated ``<prefix>_options`` struct, in order."""

@@ -22,7 +22,7 @@ BAD_INPUT = 5
 """Generated C ``solve_inputs`` only: an input breaks its rule (a length, a distance driver's
 f, is negative: its row holds the square, so it would be solved as its absolute value);
 nothing was solved and the state is as it was. The runtime refuses such inputs before any
-call (runtime.inputs.negative_length)."""
+call (runtime.input_driven.inputs.negative_length)."""
 
 INPUT_CODES = {"BAD_INPUT": BAD_INPUT}
 """The status only a mechanism with length inputs can return (its header alone defines it)."""

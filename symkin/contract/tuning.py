@@ -1,5 +1,5 @@
 """The fixed numbers of the condition estimator, the error model and Newton's extra steps,
-which the runtime (runtime.accuracy, runtime.newton) and the generated C solver
+which the runtime (runtime.solving.accuracy, runtime.solving.newton) and the generated C solver
 (``<prefix>_solver.c``, its ``#define``s rendered from :data:`SHARED`) both use."""
 
 from __future__ import annotations
@@ -8,7 +8,8 @@ UNIT_ROUNDOFF = {"double": 2.0**-52, "float": 2.0**-23}
 """The unit roundoff of each real type (C's DBL_EPSILON and FLT_EPSILON)."""
 
 ESTIMATOR_STEPS = 5
-"""Steps of Hager's ascent in the estimate of ||Phi_q^-1||_1 (runtime.accuracy.inverse_norm1)."""
+"""Steps of Hager's ascent in the estimate of ||Phi_q^-1||_1
+(runtime.solving.accuracy.inverse_norm1)."""
 
 SAFETY = 10.0
 """The error model's estimates are multiplied by this before they are compared with the
@@ -38,7 +39,7 @@ BRANCH_REGION = 0.5
 """A solve from the last solution q_prev may have left its assembly when the converged q differs
 from q_prev + s, s Newton's first step from q_prev, by more than this fraction of s: in Newton's
 region of quadratic convergence the remainder is second order in the step, far below half of
-it (runtime.branch for a run, the generated C solve_inputs for one call)."""
+it (runtime.input_driven.branch for a run, the generated C solve_inputs for one call)."""
 
 BRANCH_FLOOR = 1e-8
 """Remainders below BRANCH_FLOOR (1 + max |q|) are never a jump: the inputs barely moved, and
@@ -46,9 +47,9 @@ the rounding of two solves would otherwise count as one."""
 
 EDGE_SUBSTEPS = 1000
 """The substeps (each one Newton solve of at most max_iter iterations) that the edge treatment
-of one grid point may take in all, over every march it makes (runtime.edges and the generated
-C's solve_edge): Newton's total work per time point is bounded, so no driver can keep a run
-spinning. Passing a singular configuration or bisecting to a limit position takes some 100;
+of one grid point may take in all, over every march it makes (runtime.solving.edges and the
+generated C's solve_edge): Newton's total work per time point is bounded, so no driver can keep a
+run spinning. Passing a singular configuration or bisecting to a limit position takes some 100;
 a driver so fast that each grid step spans thousands of turns is what meets the bound."""
 
 

@@ -29,7 +29,7 @@ from symkin.present.placement import (
     global_vectors,
     joint_points,
 )
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]

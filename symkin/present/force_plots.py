@@ -14,7 +14,7 @@ import numpy as np
 
 from symkin.present.plots import _pyplot, _save
 from symkin.present.series import DEFAULT_UNITS, Units
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 
 def forces_path(path: str | Path) -> Path:

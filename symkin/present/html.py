@@ -31,7 +31,7 @@ from symkin.present.animation import (
 )
 from symkin.present.placement import Outlines, joint_points
 from symkin.present.series import DEFAULT_UNITS, LENGTH, Units
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 Array = NDArray[np.float64]
 VECTOR_SHARE = 0.15  # the longest vector of the run drawn this long, relative to the picture

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from symkin.present.html_forces import cursor_traces
 from symkin.present.series import Units
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 Array = NDArray[np.float64]
 TITLES = ("energy", "work W", "T + V - W")

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from symkin.present import series
 from symkin.present.series import Units
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 Array = NDArray[np.float64]
 MOMENT_FLOOR = 1e-9

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 
 from symkin import outfiles
 from symkin.present.series import Units
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 
 def time_controls(trajectory: Trajectory, frames: NDArray[np.float64], units: Units, *,

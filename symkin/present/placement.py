@@ -11,8 +11,8 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.runtime import spatial
-from symkin.runtime.results import Trajectory, rotation
+from symkin.runtime.outputs import spatial
+from symkin.runtime.outputs.results import Trajectory, rotation
 
 Array = NDArray[np.float64]
 Outlines = Mapping[str, Array]

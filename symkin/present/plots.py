@@ -19,7 +19,7 @@ from symkin import outfiles
 from symkin.errors import UsageError
 from symkin.present import series
 from symkin.present.series import DEFAULT_UNITS, Units
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 FORMATS = (".png", ".svg", ".pdf")
 _STYLES: dict[str, Any] = {"": "-", "x": "-", "y": "--", "z": ":"}

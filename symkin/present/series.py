@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from symkin.errors import UsageError
 from symkin.limits import listed
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 Array = NDArray[np.float64]
 LENGTH, ANGLE = "length", "angle"

@@ -27,7 +27,7 @@ from symkin.errors import SymkinError, UsageError
 from symkin.present import page, series
 from symkin.present.placement import REACTION, VECTOR_SHARE, Outlines, joint_points
 from symkin.present.series import DEFAULT_UNITS, Units
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]

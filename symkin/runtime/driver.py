@@ -8,17 +8,17 @@ The chapter's algorithm (Example 2.6, section 2.7) on any compiled kernel:
     Phi_q ddq = Gamma                            acceleration                     (2.74)
 
 One LU factorization (partial pivoting) of the converged Phi_q serves both linear solves, and
-the condition estimate of each point (runtime.accuracy) that decides whether it is flagged.
+the condition estimate of each point (runtime.solving.accuracy) that decides whether it is flagged.
 The first point is assembled from the file's q0, which may be poor (the chapter starts from
-q = 0): plain Newton first, then damped Newton from several starts (runtime.assembly). Where
+q = 0): plain Newton first, then damped Newton from several starts (runtime.solving.assembly). Where
 several assemblies exist, the one reached from q0 is taken. A grid point the plain step cannot
-solve goes to runtime.edges: a too-large step is subdivided, a singular configuration is
+solve goes to runtime.solving.edges: a too-large step is subdivided, a singular configuration is
 passed on the predicted branch, a limit position is bisected and reported.
 
 With a C kernel that carries the generated solver, the grid loop runs in C: one call per
-trajectory, written straight into the result arrays (runtime.result_arrays: fresh, or the caller's
-``out=``). When it solves the whole grid, the usual case, the Trajectory is returned at once;
-only where it stops does the general path above take over, from that point. Imports NumPy and
+trajectory, written straight into the result arrays (runtime.solving.result_arrays: fresh, or the
+caller's ``out=``). When it solves the whole grid, the usual case, the Trajectory is returned at
+once; only where it stops does the general path above take over, from that point. Imports NumPy and
 SciPy only: it is part of the runtime.
 """
 
@@ -36,25 +36,28 @@ from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime import failures, forces, input_runs, ranges, redundant, units
 from symkin.runtime.arguments import first_guess as first_guess
 from symkin.runtime.arguments import grid as grid
 from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
-from symkin.runtime.assembly import assemble, flag_flips, genuine
-from symkin.runtime.c_loop import _c_loop, _c_outcome, _c_run
-from symkin.runtime.edges import Resolution, resolve
-from symkin.runtime.inputs import InputValues
-from symkin.runtime.newton import Newton, kinematics, newton
+from symkin.runtime.input_driven import input_runs
+from symkin.runtime.input_driven.inputs import InputValues
+from symkin.runtime.loads import forces
+from symkin.runtime.outputs import ranges, redundant
+from symkin.runtime.outputs.results import Trajectory
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
-from symkin.runtime.result_arrays import Out, allocate
-from symkin.runtime.result_arrays import Run as _Run
-from symkin.runtime.results import Trajectory
-from symkin.runtime.run_outcome import SolveFailure as SolveFailure
-from symkin.runtime.run_outcome import SolveInterrupted as SolveInterrupted
-from symkin.runtime.run_outcome import _fail, _point_size, refuse_reversed, rows_kept
-from symkin.runtime.run_outcome import _trajectory as _trajectory
-from symkin.runtime.start import singular_start
+from symkin.runtime.solving import failures, units
+from symkin.runtime.solving.assembly import assemble, flag_flips, genuine
+from symkin.runtime.solving.c_loop import _c_loop, _c_outcome, _c_run
+from symkin.runtime.solving.edges import Resolution, resolve
+from symkin.runtime.solving.newton import Newton, kinematics, newton
+from symkin.runtime.solving.result_arrays import Out, allocate
+from symkin.runtime.solving.result_arrays import Run as _Run
+from symkin.runtime.solving.run_outcome import SolveFailure as SolveFailure
+from symkin.runtime.solving.run_outcome import SolveInterrupted as SolveInterrupted
+from symkin.runtime.solving.run_outcome import _fail, _point_size, refuse_reversed, rows_kept
+from symkin.runtime.solving.run_outcome import _trajectory as _trajectory
+from symkin.runtime.solving.start import singular_start
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -121,7 +124,7 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         inputs: for a mechanism with input drivers (a driver function written ``input``),
             their values at every t: an array (T, NU) in ``kernel.input_names`` order or a
             dict by driver name of arrays (T,). Each point is then solved from the last
-            solution (runtime.inputs); t defaults to the file's grid as above.
+            solution (runtime.input_driven.inputs); t defaults to the file's grid as above.
         input_rates, input_accels: the inputs' rates and accelerations, the same shapes;
             without them dq (and d2q) are NaN: positions only.
 
@@ -155,7 +158,7 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         trajectory = redundant.check(kernel, trajectory, options)
         flag_flips(kernel, trajectory, trajectory.params)  # a jump off the assembly
     if sensitivities:
-        from symkin.runtime.sensitivity import with_sensitivities
+        from symkin.runtime.outputs.sensitivity import with_sensitivities
 
         with rows_kept(trajectory, "the sensitivities were computed"):
             return with_sensitivities(kernel, trajectory)
@@ -194,7 +197,7 @@ def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike 
                    params: Mapping[str, float] | ArrayLike | None, options: Options,
                    progress: Progress | None, use_c_solver: bool, out: Out | None
                    ) -> Trajectory:
-    """_solve in the unit that brings the mechanism's length scale near 1 (runtime.units),
+    """_solve in the unit that brings the mechanism's length scale near 1 (runtime.solving.units),
     the rows converted back to the kernel's unit (also those a failure or an interrupt
     carries)."""
     times = time_points(kernel, t)
@@ -311,7 +314,7 @@ def _resume(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None, q: A
 def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options,
                  assembled: Array | None = None) -> None:
     """Raise SolveFailure (reason "singular") when the start is a singular or limit
-    configuration (runtime.start): the first point solved, keeping only that point (the rows
+    configuration (runtime.solving.start): the first point solved, keeping only that point (the rows
     stepped from it are not trusted), or the ``assembled`` q that Newton found singular (no
     row). Nothing to check before the first point is solved."""
     if assembled is None and run.done == 0:

@@ -51,7 +51,7 @@ class _Functions(Protocol):
     # whose backend generates them; else None).
     mass: Callable[[Array, Array], Array] | None
     applied: Callable[[Array, Array, float, Array], Array] | None
-    # ... with rows removed as redundant too (runtime.indeterminate)
+    # ... with rows removed as redundant too (runtime.loads.indeterminate)
     def removed_q(self, q: Array, t: float, p: Array) -> Array: ...
     def loads_full(self, q: Array, lam: Array, t: float, p: Array) -> Array: ...
 
@@ -86,8 +86,8 @@ class Kernel:
         self.rows: tuple[str, ...] = tuple(meta["rows"])
         self.pattern_rows = np.array(meta["pattern_rows"], dtype=np.intp)
         self.pattern_cols = np.array(meta["pattern_cols"], dtype=np.intp)
-        # The coordinates that enter Phi_q or Phi_t (runtime.accuracy's refined model); every
-        # coordinate for a kernel generated before it.
+        # The coordinates that enter Phi_q or Phi_t (runtime.solving.accuracy's refined model);
+        # every coordinate for a kernel generated before it.
         self.nonlinear = np.zeros(len(self.coordinates), dtype=bool)
         self.nonlinear[list(meta.get("nonlinear", range(len(self.coordinates))))] = True
         self.points: tuple[tuple[str, str], ...] = tuple(tuple(p) for p in meta["points"])
@@ -104,7 +104,7 @@ class Kernel:
         # assembly search counts no solution of Phi = 0 where one is not.
         self.senses: tuple[str, ...] = tuple(meta.get("senses", ()))
         # A pair's coordinate and the range its file gives it, (name, a, b, owner): the
-        # driver stops the motion where it is left (runtime.ranges).
+        # driver stops the motion where it is left (runtime.outputs.ranges).
         self.ranges = tuple(tuple(entry) for entry in meta.get("ranges", ()))
         # Inverse dynamics: present when the file has masses or forces.
         self.has_dynamics = "joint_names" in meta
@@ -114,7 +114,8 @@ class Kernel:
         self.input_names: tuple[str, ...] = tuple(meta.get("input_names", ()))
         # Forward dynamics: the generated M and Q - h are there (runtime.dynamics.compiled).
         self.has_mass = getattr(functions, "mass", None) is not None
-        # Those that are a length (a distance driver's f): runtime.inputs refuses them < 0.
+        # Those that are a length (a distance driver's f): runtime.input_driven.inputs refuses
+        # them below zero.
         self.input_lengths: tuple[str, ...] = tuple(meta.get("input_lengths", ()))
         self._functions = functions
 
@@ -133,13 +134,13 @@ class Kernel:
     def grid_solver(self, options: Options, q: Array, p: Array, unit: float = 1.0
                     ) -> GridSolver | None:
         """A fresh run of the generated grid loop from q (its decisions made in the length
-        unit ``unit``, runtime.units), or None without one."""
+        unit ``unit``, runtime.solving.units), or None without one."""
         del options, q, p, unit
         return None
 
     def input_stepper(self) -> Any:
-        """A backend's generated one-point solve at given inputs (runtime.inputs), or None:
-        then the runtime's Newton solves each point."""
+        """A backend's generated one-point solve at given inputs (runtime.input_driven.inputs), or
+        None: then the runtime's Newton solves each point."""
         return None
 
     @property

@@ -101,8 +101,8 @@ class BatchSolver(Protocol):
                  q: Array, dq: Array, d2q: Array, units: Array) -> BatchStatus: ...
 
     def length_scales(self, params: Array, q: Array, t: float) -> Array:
-        """Per set, the largest lever arm in Phi_q at (q, t) (runtime.start.length_scale, raw:
-        0 where there is none, NaN where Phi_q is not finite); q (N,) or (m, N)."""
+        """Per set, the largest lever arm in Phi_q at (q, t) (runtime.solving.start.length_scale,
+        raw: 0 where there is none, NaN where Phi_q is not finite); q (N,) or (m, N)."""
         ...
 
 
@@ -113,7 +113,7 @@ EDGE_REACHED, EDGE_PASSABLE, EDGE_STOPPED = 0, 1, 2
 
 @dataclass(frozen=True)
 class EdgeFound:
-    """What a backend's edge treatment found (runtime.edges.resolve up to its decision):
+    """What a backend's edge treatment found (runtime.solving.edges.resolve up to its decision):
     outcome (EDGE_*), the step that failed from the last point reached, that point's condition
     estimate, time, q, dq and ddq; the substeps taken (contract.tuning.EDGE_SUBSTEPS when that
     bound stopped the motion)."""
@@ -131,7 +131,7 @@ class EdgeFound:
 class EdgeSolver(Protocol):
     """A backend's substeps from a solved point towards a grid point it could not reach (the
     generated ``<prefix>_solve_edge``): start = (t, q, dq, ddq) with its condition ``cond``,
-    decided in the length unit ``unit`` (runtime.units; the rows stay in the kernel's)."""
+    decided in the length unit ``unit`` (runtime.solving.units; the rows stay in the kernel's)."""
 
     def __call__(self, options: Options, p: Array, start: tuple[float, Array, Array, Array],
                  cond: float, t: float, h_min: float, delta: float, unit: float = 1.0

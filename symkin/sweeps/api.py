@@ -21,10 +21,12 @@ from symkin import limits
 from symkin.contract.options import Options
 from symkin.errors import SolveError
 from symkin.limits import listed
-from symkin.runtime import driver, forces, redundant
+from symkin.runtime import driver
 from symkin.runtime.dynamics.model import refuse_motion
-from symkin.runtime.inputs import refuse_inputs
+from symkin.runtime.input_driven.inputs import refuse_inputs
 from symkin.runtime.kernel import Kernel
+from symkin.runtime.loads import forces
+from symkin.runtime.outputs import redundant
 from symkin.sweeps import parallel
 from symkin.sweeps.batch import Chunk, empty_chunk, solve_chunk
 from symkin.sweeps.result import SweepResult

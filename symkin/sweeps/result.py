@@ -15,7 +15,7 @@ from symkin import outfiles
 from symkin.contract.loads import reaction_parts
 from symkin.errors import SymkinError
 from symkin.limits import listed
-from symkin.runtime import spatial
+from symkin.runtime.outputs import spatial
 
 Array = NDArray[np.float64]
 
@@ -68,7 +68,7 @@ class SweepResult:
                                                             compare=False)
     # An over-constrained file's rows removed as dependent at t0 (their labels), and per set
     # whether the solved motion breaks one of them beyond the position target
-    # (runtime.redundant); () and None for every other file.
+    # (runtime.outputs.redundant); () and None for every other file.
     removed: tuple[str, ...] = ()
     removed_broken: NDArray[np.bool_] | None = None
     # Inverse dynamics (a kernel with masses or forces): the kernel's multipliers_grid, and

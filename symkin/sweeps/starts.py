@@ -1,8 +1,8 @@
 """The unit and the start of every set of a sweep, decided as ``symkin.solve`` decides them
-(runtime.units, runtime.start) without a Python call per set.
+(runtime.solving.units, runtime.solving.start) without a Python call per set.
 
 The unit: the generated ``<prefix>_length_scales`` gives each set's length scale at its first
-guess in one C call, and runtime.units.units_for turns them into units; the C batch then
+guess in one C call, and runtime.solving.units.units_for turns them into units; the C batch then
 solves each set in its own unit (a mechanism drawn in millimetres stays in the C loop).
 
 The start: symkin.solve refuses to step from a singular or limit configuration at t0 (runtime.
@@ -13,11 +13,11 @@ length columns and rows by s = L / u, which change the 1-norm condition by at mo
 max(s, 1/s)^2. A set whose estimate, so bounded and times SAFETY (the estimator's lower
 bound can fall short of the true norm), stays under the threshold cannot be a singular start;
 only the others, few where a sweep does not start near a singular position, are checked by
-runtime.start itself on their first row, in the set's unit as symkin.solve checks it.
+runtime.solving.start itself on their first row, in the set's unit as symkin.solve checks it.
 
 The senses: a first row that solves Phi = 0 with a spatial revolute's axes reversed (or an
-angle driver half a turn away) is no assembly (runtime.assembly); symkin.solve refuses to run
-from it. Only kernels with senses (spatial files) pay a call per set for that check; such a
+angle driver half a turn away) is no assembly (runtime.solving.assembly); symkin.solve refuses to
+run from it. Only kernels with senses (spatial files) pay a call per set for that check; such a
 set is handed to symkin.solve, which searches further or stops with "no assembly".
 """
 
@@ -27,15 +27,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.contract.options import Options
-from symkin.runtime.assembly import reversed_senses
 from symkin.runtime.protocol import BatchSolver, KinematicsKernel
-from symkin.runtime.start import SAFETY, singular_start, start_threshold
-from symkin.runtime.units import ScaledKernel, units_for
+from symkin.runtime.solving.assembly import reversed_senses
+from symkin.runtime.solving.start import SAFETY, singular_start, start_threshold
+from symkin.runtime.solving.units import ScaledKernel, units_for
 
 Array = NDArray[np.float64]
 
 def set_units(batch: BatchSolver, params: Array, t0: float, q0: Array) -> Array:
-    """The unit each set is solved in (runtime.units.unit_for at its first guess q0, (N,) or
+    """The unit each set is solved in (runtime.solving.units.unit_for at its first guess q0, (N,) or
     (m, N))."""
     return units_for(batch.length_scales(params, q0, t0))
 

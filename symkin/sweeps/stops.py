@@ -4,18 +4,19 @@ treatment decides it as ``symkin.solve`` would.
 The C batch reports where a set stopped (the grid index k of the first point its plain step
 could not solve), the condition estimate at its last row, and has written the rows before it.
 A per-set ``symkin.solve`` goes on from the same rows (the same generated grid loop) into
-``runtime.edges``: substeps halved on failure down to about 1e-9 of the grid step, then a step
-over the blocked time, some 1,400 Newton iterations in Python (700 times the cost of a solved
+``runtime.solving.edges``: substeps halved on failure down to about 1e-9 of the grid step, then a
+step over the blocked time, some 1,400 Newton iterations in Python (700 times the cost of a solved
 set). Here the generated ``<prefix>_solve_edge`` takes those substeps in C, from the batch's
 last row; where they stop (no step over the blocked time converges), the set ends as
-``symkin.solve`` ends it: a limit position or no convergence (runtime.edges.stopped_at), at the
-grid point t[k], with the same bisected time and message (runtime.failures.explain_stop).
+``symkin.solve`` ends it: a limit position or no convergence (runtime.solving.edges.stopped_at), at
+the grid point t[k], with the same bisected time and message
+(runtime.solving.failures.explain_stop).
 
 Left to ``symkin.solve`` (None here): a set whose substeps reach t[k] or find a position the
 motion passes (it goes on), one stopped at its first point (the assembly) or on a value that
 is not finite (no edge treatment there), and stop_at_singular runs. A set solved in another
-length unit (runtime.units) is treated in it, as symkin.solve treats it; the caller hands only
-sets whose start is not singular (sweeps.starts decided both for the chunk).
+length unit (runtime.solving.units) is treated in it, as symkin.solve treats it; the caller hands
+only sets whose start is not singular (sweeps.starts decided both for the chunk).
 Imports NumPy and the runtime only.
 """
 
@@ -29,10 +30,10 @@ from numpy.typing import NDArray
 from symkin.contract.options import Options
 from symkin.contract.status import NOT_FINITE, OK
 from symkin.contract.tuning import EDGE_SUBSTEPS
-from symkin.runtime import edges, failures
-from symkin.runtime.newton import Point
 from symkin.runtime.protocol import EDGE_STOPPED, EdgeSolver, KinematicsKernel
-from symkin.runtime.units import ScaledKernel
+from symkin.runtime.solving import edges, failures
+from symkin.runtime.solving.newton import Point
+from symkin.runtime.solving.units import ScaledKernel
 
 Array = NDArray[np.float64]
 
@@ -51,7 +52,7 @@ class Stop:
 class Stopped:
     """How the batch left one set: its rows (q, dq, ddq, each (T, N)), the rows solved, its
     status, the condition estimate at its last row, and the length unit it was decided in
-    (runtime.units; the rows are in the kernel's own)."""
+    (runtime.solving.units; the rows are in the kernel's own)."""
 
     rows: tuple[Array, Array, Array]
     solved: int

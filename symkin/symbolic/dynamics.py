@@ -26,7 +26,7 @@ Where rows were removed as redundant (symbolic.redundancy) the loads are derived
 multipliers of every row the file writes: lam holds the kept rows' then the removed rows',
 ``loads`` reads the kept ones only (the removed rows' multipliers taken as zero, one of the
 many solutions) and ``loads_full`` all of them, with ``removed_q`` the removed rows' Jacobian:
-the runtime (runtime.indeterminate) finds from these which loads are determinate and the
+the runtime (runtime.loads.indeterminate) finds from these which loads are determinate and the
 minimum-norm multipliers.
 """
 

@@ -39,7 +39,7 @@ class Functions:
             (G,): the given velocities at the parameters p (a run's own, not only nominal).
         removed: the rows removed as redundant (their loads are then not unique).
         senses, sense_values(q, t, p) (S,): what the rows leave ambiguous, positive at a
-            genuine assembly (the kernels' ``senses``; runtime.assembly checks the start).
+            genuine assembly (the kernels' ``senses``; runtime.solving.assembly checks the start).
     """
 
     name: str

@@ -23,7 +23,7 @@ import pytest
 import yaml
 
 import symkin
-from symkin.runtime.scan import scan
+from symkin.runtime.scanning.scan import scan
 from tests.assemblies.test_every_assembly import _rotation
 
 HERE = Path(__file__).resolve().parent

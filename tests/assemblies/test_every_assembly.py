@@ -25,7 +25,7 @@ import pytest
 
 import symkin
 from symkin.errors import SolveError
-from symkin.runtime.scan import scan
+from symkin.runtime.scanning.scan import scan
 
 SWEEP = 200_000
 ROOT = Path(__file__).resolve().parents[2]

@@ -19,7 +19,7 @@ import yaml
 
 import symkin
 from symkin.runtime.protocol import KinematicsKernel
-from symkin.runtime.scan import scan
+from symkin.runtime.scanning.scan import scan
 from tests.assemblies.planar_six import Platform, assemblies
 from tests.assemblies.test_every_assembly import _rotation
 

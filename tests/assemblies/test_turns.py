@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import symkin
-from symkin.runtime.assemblies import Shape
+from symkin.runtime.scanning.assemblies import Shape
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -204,7 +204,7 @@ def test_at_columns_never_run_together() -> None:
     import numpy as np
 
     from symkin.cli import run_outputs
-    from symkin.runtime.results import Trajectory
+    from symkin.runtime.outputs.results import Trajectory
 
     widest = np.array([[-1.23456789012e-100, -9.87654321098e-200, -1.1e-16]])
     trajectory = Trajectory(t=np.zeros(1), q=widest, dq=widest, d2q=widest,

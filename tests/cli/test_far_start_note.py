@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import symkin
-from symkin.runtime.start import FAR, far_from_guess
+from symkin.runtime.solving.start import FAR, far_from_guess
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -13,9 +13,10 @@ import pytest
 
 import symkin
 from symkin import cli
-from symkin.runtime import forces, redundant
 from symkin.runtime.dynamics import run as motion_run
-from symkin.runtime.run_outcome import SolveInterrupted
+from symkin.runtime.loads import forces
+from symkin.runtime.outputs import redundant
+from symkin.runtime.solving.run_outcome import SolveInterrupted
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"

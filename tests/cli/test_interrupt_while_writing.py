@@ -10,7 +10,7 @@ import numpy as np
 
 import symkin
 from symkin.cli.run_outputs import interrupts_held
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 
 def test_a_second_interrupt_while_writing_is_held_off(tmp_path, crank_slider_path):

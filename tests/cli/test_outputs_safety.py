@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from symkin import cli, outfiles
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 ROOT = Path(__file__).resolve().parents[2]
 CRANK_SLIDER = ROOT / "examples" / "crank_slider.yaml"

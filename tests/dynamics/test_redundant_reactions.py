@@ -284,7 +284,7 @@ class _StubKernel:
 def test_completion_is_lstsq_and_a_singular_row_stays_nan() -> None:
     """Rows with finite multipliers: the minimum-norm solution of [Phi_q; removed]^T lam =
     rhs, as lstsq finds it; the singular row (NaN multipliers) stays NaN."""
-    from symkin.runtime import indeterminate
+    from symkin.runtime.loads import indeterminate
 
     rng = np.random.default_rng(7)
     kernel = _StubKernel(rng, singular_at=2)
@@ -310,7 +310,7 @@ def test_completion_is_lstsq_and_a_singular_row_stays_nan() -> None:
 def test_an_exactly_singular_row_is_nan_and_the_others_still_complete() -> None:
     """A Phi_q with a zero row (exactly singular) in the batch: that row has no unique
     completion and stays NaN, the others are completed one by one."""
-    from symkin.runtime import indeterminate
+    from symkin.runtime.loads import indeterminate
 
     rng = np.random.default_rng(3)
     kernel = _StubKernel(rng, singular_at=1)

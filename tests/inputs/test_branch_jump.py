@@ -1,5 +1,5 @@
-"""Branch jumps of an input-driven run (runtime.branch): where the crank-slider driven by its
-crank angle passes its singular configuration (the rod at right angles to the slider's line)
+"""Branch jumps of an input-driven run (runtime.input_driven.branch): where the crank-slider driven
+by its crank angle passes its singular configuration (the rod at right angles to the slider's line)
 Newton goes on along the other assembly; the rows where that happens, by the closed form of
 both assemblies, are exactly the rows flagged, on both backends alike, with a warning naming
 them. A smooth path along one assembly flags nothing."""

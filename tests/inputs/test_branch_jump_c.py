@@ -3,7 +3,7 @@ controller sees it: its sign of det(Phi_q), read from the sparse LU's factors (t
 order's parity, the run-time interchanges taken, the pivots) or from the dense LU's, equals
 NumPy's determinant; and along input paths its flags are the rows where the closed form
 changes assembly (the crank-slider through its singular configuration), none on a smooth
-path, and the rows runtime.branch flags after a run of large input steps (the Stewart
+path, and the rows runtime.input_driven.branch flags after a run of large input steps (the Stewart
 platform).
 """
 
@@ -18,7 +18,7 @@ import pytest
 import symkin
 from symkin.contract.options import Options
 from symkin.errors import SymkinWarning
-from symkin.runtime import branch
+from symkin.runtime.input_driven import branch
 from tests.inputs.test_branch_jump import _assembly
 from tests.spatial.test_stewart_fk import _legs, _poses
 
@@ -95,7 +95,7 @@ def crank_slider(request: pytest.FixtureRequest):
 def test_c_flags_the_rows_that_change_assembly(crank_slider) -> None:
     """Through the crank-slider's singular configuration at theta = -pi/2 (the path of
     tests/inputs/test_branch_jump.py): the rows where the closed form switches assembly, the
-    rows runtime.branch flags."""
+    rows runtime.input_driven.branch flags."""
     theta = np.linspace(np.pi / 2, -np.pi / 2 - 1.0, 41)
     t = np.arange(theta.size) * 0.05
     with pytest.warns(SymkinWarning, match="another assembly"):

@@ -16,7 +16,7 @@ import pytest
 
 import symkin
 from symkin.errors import MechanismError, SolveError
-from symkin.runtime.scan import scan
+from symkin.runtime.scanning.scan import scan
 
 ROOT = Path(__file__).resolve().parents[2]
 BACKENDS = ("c", "numpy")

@@ -1,5 +1,5 @@
 """An input-driven mechanism drawn far from unit size solves as the same mechanism at unit size:
-the runs in Python decide in the unit runtime.units picks (as a run over t does), and the
+the runs in Python decide in the unit runtime.solving.units picks (as a run over t does), and the
 generated C solve_inputs in its options' unit. Before, the crank-slider drawn in millimetres
 could not be assembled on either backend (its condition 1.4e7 read as singular), and the C
 solver ignored options.unit.

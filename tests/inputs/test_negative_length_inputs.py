@@ -1,6 +1,6 @@
 """A length input (a distance driver's f written ``input``) is never negative: its row holds
 f squared, so -1 was solved, silently, as 1. ``symkin.solve(inputs=...)`` refuses it as the
-CLI's inputs table does (one rule, runtime.inputs.negative_length), and the generated C
+CLI's inputs table does (one rule, runtime.input_driven.inputs.negative_length), and the generated C
 ``solve_inputs`` returns ``<PREFIX>_BAD_INPUT`` with nothing solved. The mechanism is a ram
 on a guide along x pushed by a leg from one unit off the guide: its x is sqrt(leg^2 - 1)."""
 

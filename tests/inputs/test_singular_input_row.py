@@ -107,8 +107,8 @@ def test_a_first_row_on_the_dead_centre_and_a_failure_alike_on_both_backends(sys
 
 
 def test_an_interrupt_while_assembling_hands_on_no_rows(system, monkeypatch) -> None:
-    from symkin.runtime import inputs
     from symkin.runtime.driver import SolveInterrupted
+    from symkin.runtime.input_driven import inputs
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt

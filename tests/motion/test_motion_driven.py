@@ -31,7 +31,8 @@ time: {t0: 0, t1: 3, dt: 0.05}
 
 
 @pytest.fixture(scope="module")
-def trajectory(tmp_path_factory: pytest.TempPathFactory) -> symkin.runtime.results.Trajectory:
+def trajectory(
+        tmp_path_factory: pytest.TempPathFactory) -> symkin.runtime.outputs.results.Trajectory:
     path = write(tmp_path_factory.mktemp("shaken"), "shaken.yaml",
                  SHAKEN.replace("PHI0", repr(-math.pi / 2 + 0.5)))
     return symkin.solve(symkin.compile(symkin.derive(path), backend="numpy"))

@@ -14,7 +14,7 @@ from motion_support import PENDULUM, write
 
 import symkin
 from symkin import cli
-from symkin.runtime.run_outcome import SolveInterrupted
+from symkin.runtime.solving.run_outcome import SolveInterrupted
 
 
 @pytest.fixture

@@ -1,8 +1,8 @@
-"""A curve or cam profile written for s in [a, b] (`range: [a, b]`, symkin/runtime/ranges.py):
-a piecewise formula has values past its range (its last piece extended), so a contact that
-runs past the end would be solved on a curve the file does not describe. The motion stops
-at the first point past the range, naming the pair; the rows before it are kept and
-exact. Both backends, the C one compiled and run.
+"""A curve or cam profile written for s in [a, b] (`range: [a, b]`,
+symkin/runtime/outputs/ranges.py): a piecewise formula has values past its range (its last piece
+extended), so a contact that runs past the end would be solved on a curve the file does not
+describe. The motion stops at the first point past the range, naming the pair; the rows before it
+are kept and exact. Both backends, the C one compiled and run.
 """
 
 from __future__ import annotations

@@ -247,8 +247,8 @@ def test_report_arrows_show_over_a_body_line_and_say_their_unit(forces_run) -> N
 def test_force_figure_axes_give_the_units(units, force, moment, monkeypatch, tmp_path) -> None:
     from symkin.present import force_plots
     from symkin.present.series import Units
-    from symkin.runtime.forces import Forces
-    from symkin.runtime.results import Trajectory
+    from symkin.runtime.loads.forces import Forces
+    from symkin.runtime.outputs.results import Trajectory
 
     saved = []
     monkeypatch.setattr(force_plots, "_save", lambda figure, plt, path: saved.append(figure))

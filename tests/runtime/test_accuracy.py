@@ -8,7 +8,8 @@ import pytest
 from driver_support import derive, kernel_for
 
 import symkin
-from symkin.runtime import accuracy, driver
+from symkin.runtime import driver
+from symkin.runtime.solving import accuracy
 
 
 def test_estimate_is_a_lower_bound_and_usually_exact() -> None:

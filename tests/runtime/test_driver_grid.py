@@ -78,7 +78,7 @@ def test_runtime_imports_no_sympy() -> None:
     import sys
     from pathlib import Path
 
-    code = ("import sys, symkin.runtime.driver, symkin.runtime.results; "
+    code = ("import sys, symkin.runtime.driver, symkin.runtime.outputs.results; "
             "assert 'sympy' not in sys.modules and 'jinja2' not in sys.modules")
     root = Path(__file__).resolve().parents[2]
     subprocess.run([sys.executable, "-c", code], cwd=root, check=True)

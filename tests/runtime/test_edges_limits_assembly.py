@@ -17,7 +17,8 @@ import symkin
 from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.options import Options
 from symkin.errors import SolveError
-from symkin.runtime import driver, newton
+from symkin.runtime import driver
+from symkin.runtime.solving import newton
 
 ROOT = Path(__file__).resolve().parents[2]
 T_LIMIT = math.acos(-0.25)  # non_grashof.yaml: a = b = c = 2, d = 3; cos(theta*) = -1/4

@@ -21,7 +21,8 @@ from test_edges_singular import TARGETS, chain_reference
 from test_tightening import closed_form
 
 import symkin
-from symkin.runtime import accuracy, driver, linalg, newton
+from symkin.runtime import driver
+from symkin.runtime.solving import accuracy, linalg, newton
 from symkin.spec import validate as model
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))

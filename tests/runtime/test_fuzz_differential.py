@@ -23,7 +23,7 @@ import pytest
 import symkin
 from symkin.errors import SolveError
 from symkin.runtime import driver
-from symkin.runtime.start import positions
+from symkin.runtime.solving.start import positions
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 NAMES = ("crank_slider.yaml", "four_bar.yaml", "quick_return.yaml", "custom_driver.yaml",

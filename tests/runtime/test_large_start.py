@@ -24,7 +24,7 @@ import pytest
 import symkin
 from symkin.contract.options import Options
 from symkin.limits import MAX_LISTED, listed
-from symkin.runtime import edges, failures, start
+from symkin.runtime.solving import edges, failures, start
 from symkin.spec import validate
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))

@@ -18,7 +18,8 @@ from driver_support import BACKENDS
 
 import symkin
 from symkin.errors import SolveError
-from symkin.runtime import driver, units
+from symkin.runtime import driver
+from symkin.runtime.solving import units
 
 SCALES = (1e-9, 1e-6, 1e-3, 1.0, 1e3, 1e4, 1e5, 1e6)
 
@@ -160,7 +161,7 @@ def test_the_unit_is_one_for_a_mechanism_of_ordinary_size():
 def test_scan_finds_the_same_branches_at_any_scale(tmp_path, s):
     """Two assemblies at t0 (slider right and left of the crank): slider.x = +-sqrt(b^2 - (c -
     a)^2) = +-4 s, the rod at atan(3/4) or pi - atan(3/4)."""
-    from symkin.runtime.scan import scan
+    from symkin.runtime.scanning.scan import scan
 
     kernel = _kernel(tmp_path, CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s), "numpy")
     report = scan(kernel)

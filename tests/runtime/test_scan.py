@@ -19,7 +19,7 @@ import pytest
 
 import symkin
 from symkin.runtime import driver
-from symkin.runtime.scan import scan
+from symkin.runtime.scanning.scan import scan
 
 ROOT = Path(__file__).resolve().parents[2]
 MECHANISMS = ROOT / "tests" / "mechanisms"
@@ -146,9 +146,9 @@ def test_cli_set_moves_the_limit_position() -> None:
 @pytest.mark.parametrize("stop", ["keyboard", "solve"])
 def test_cli_ctrl_c_exits_130(stop: str, monkeypatch: pytest.MonkeyPatch,
                               capsys: pytest.CaptureFixture[str]) -> None:
-    import symkin.runtime.scan as module
+    import symkin.runtime.scanning.scan as module
     from symkin.cli import main
-    from symkin.runtime.results import Trajectory
+    from symkin.runtime.outputs.results import Trajectory
 
     def interrupted(*args, **kwargs):
         if stop == "keyboard":

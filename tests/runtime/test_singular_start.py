@@ -21,7 +21,8 @@ from driver_support import BACKENDS
 
 import symkin
 from symkin.errors import SolveError
-from symkin.runtime import driver, start
+from symkin.runtime import driver
+from symkin.runtime.solving import start
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -258,7 +259,7 @@ time: {t0: 0, t1: 0.5, dt: 0.05}
 @pytest.mark.parametrize("drawing", ["textbook", "exact"])
 def test_crank_slider_drawn_at_its_dead_centre_is_refused_error_first(tmp_path, backend,
                                                                       drawing):
-    """Refused at the start whatever size a larger mechanism is allowed (runtime.start: 9
+    """Refused at the start whatever size a larger mechanism is allowed (runtime.solving.start: 9
     coordinates keep the small threshold), and the error is the first thing said: the
     warning about the one row solved (the exact drawing's is flagged) comes after it."""
     path = tmp_path / "dead_centre.yaml"

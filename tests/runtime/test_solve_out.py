@@ -18,8 +18,8 @@ from driver_support import BACKENDS, derive, kernel_for
 import symkin
 from symkin.errors import SolveError
 from symkin.runtime import driver
-from symkin.runtime.result_arrays import allocate
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
+from symkin.runtime.solving.result_arrays import allocate
 
 ARRAYS = ("t", "q", "dq", "d2q", "cond", "flagged")
 TIMES = np.linspace(0.0, 1.5, 31)

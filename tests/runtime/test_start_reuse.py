@@ -16,7 +16,7 @@ import pytest
 
 import symkin
 from symkin.contract.options import Options
-from symkin.runtime import start
+from symkin.runtime.solving import start
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import sympy as sp
 
-from symkin.runtime.results import point_kinematics
+from symkin.runtime.outputs.results import point_kinematics
 
 ROOT_2PI = math.sqrt(2 * math.pi)
 # Example 2.5 data

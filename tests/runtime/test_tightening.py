@@ -21,7 +21,7 @@ import pytest
 import symkin
 from symkin.contract.options import defaults
 from symkin.contract.tuning import REESTIMATE_SHIFT, UNIT_ROUNDOFF
-from symkin.runtime import accuracy, linalg, newton
+from symkin.runtime.solving import accuracy, linalg, newton
 from symkin.spec import validate as model
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))

@@ -13,9 +13,9 @@ import pytest
 
 import symkin
 from symkin.contract.tuning import EDGE_SUBSTEPS
-from symkin.runtime import edges
 from symkin.runtime.driver import SolveFailure
 from symkin.runtime.protocol import EDGE_STOPPED
+from symkin.runtime.solving import edges
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import symkin
-from symkin.runtime.spatial import rotation
+from symkin.runtime.outputs.spatial import rotation
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 BACKENDS = ["c", "numpy"]

@@ -120,7 +120,7 @@ def test_a_tumble_through_plus_minus_90_degrees_of_pitch(backend: str) -> None:
     theta, dtheta = 2 * np.pi * t, 2 * np.pi
     assert theta[-1] > 2 * np.pi + np.pi / 2  # through +90, -90 (as 270) and a full turn
     q, _, _ = result.body("rotor")
-    from symkin.runtime.spatial import rotation
+    from symkin.runtime.outputs.spatial import rotation
 
     expected = _rz(psi) @ _ry(theta)
     assert np.abs(rotation(q[:, 3:]) - expected).max() < 1e-10

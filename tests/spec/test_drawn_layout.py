@@ -29,7 +29,7 @@ MECHANISMS = Path(__file__).resolve().parents[1] / "mechanisms"
 Positions = Callable[[np.ndarray], dict[str, np.ndarray]]  # t -> {"body.point": (T, 2)}
 
 
-def _solve(name: str, backend: str) -> symkin.runtime.results.Trajectory:  # type: ignore[name-defined]
+def _solve(name: str, backend: str) -> symkin.runtime.outputs.results.Trajectory:  # type: ignore[name-defined]
     path = MECHANISMS / f"{name}.yaml" if (MECHANISMS / f"{name}.yaml").exists() \
         else ROOT / "examples" / f"{name}.yaml"
     kernel = symkin.compile(symkin.derive(symkin.load(path)), backend=backend)

@@ -83,7 +83,7 @@ def test_sets_drawn_at_a_dead_centre_are_singular_starts_as_per_set_solve(crank_
 
 def test_the_start_check_costs_no_python_per_set_away_from_a_dead_centre(
         crank_slider_system, monkeypatch) -> None:
-    """Regular starts are cleared by the batch's condition estimate, in C: runtime.start's
+    """Regular starts are cleared by the batch's condition estimate, in C: runtime.solving.start's
     check (a Phi_q evaluation and an inverse per set) never runs for them."""
     kernel = symkin.compile(crank_slider_system, backend="c")
     checked: list[int] = []
@@ -149,7 +149,7 @@ def test_length_scales_in_c_are_the_largest_lever_arm(crank_slider_system) -> No
     a cos theta; the slide's rows no lever. At q = 0 the largest arm is b. At the assembled
     start the crank is vertical (theta = pi/2: arm a) and the rod climbs from its tip (0, a) to
     the guide y = c, sin phi = (c - a) / b: arms |c - a| and sqrt(b^2 - (c - a)^2). A NaN
-    coordinate gives NaN; the units follow as runtime.units decides."""
+    coordinate gives NaN; the units follow as runtime.solving.units decides."""
     kernel = symkin.compile(crank_slider_system, backend="c")
     designs = np.outer(SCALES, [1.0, 5.0, 4.0])
     a, b, c = designs.T

@@ -4,8 +4,8 @@ time in C), with no re-run, and ends as its own ``symkin.solve`` ends it: the sa
 point, bisected time (SolveFailure.reached, in the message) and rows; every other failed set is
 re-run as before.
 
-References: each set's own ``symkin.solve`` (the substeps in Python, runtime.edges), and for the
-crank-slider the closed form of its limit position. The slider's point lies on the line y = c;
+References: each set's own ``symkin.solve`` (the substeps in Python, runtime.solving.edges), and for
+the crank-slider the closed form of its limit position. The slider's point lies on the line y = c;
 the rod (length b) reaches it from the crank tip (a cos theta, a sin theta) while
 |c - a sin theta| <= b. With theta = t^2 + pi/2, sin theta = cos t^2, so (c - b <= a always for
 these designs) the motion stops where cos t^2 = (c - b) / a: t_limit = sqrt(arccos((c - b) /

@@ -21,7 +21,7 @@ import yaml
 import symkin
 from symkin import cli
 from symkin.errors import MechanismError
-from symkin.runtime import redundant
+from symkin.runtime.outputs import redundant
 from symkin.spec.validate import from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -364,7 +364,7 @@ def test_scan_lists_only_assemblies_that_keep_the_removed_row() -> None:
     """With the crank pinned at t0, the parallelogram's rocker has two places (parallel or
     crossed); the extra bar fits only the parallel one, and the bar's own mirror image meets
     C's x but not its y. So the file has exactly one assembly at t0."""
-    from symkin.runtime.scan import scan
+    from symkin.runtime.scanning.scan import scan
 
     kernel = symkin.compile(symkin.derive(EXAMPLE), backend="numpy")
     report = scan(kernel, t=np.array([0.0, 0.01]))

@@ -18,7 +18,7 @@ import sympy as sp
 
 import symkin
 from symkin import cli
-from symkin.runtime.spatial import rotation
+from symkin.runtime.outputs.spatial import rotation
 from symkin.spec import constants
 
 HERE = Path(__file__).resolve().parent

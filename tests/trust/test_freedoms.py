@@ -17,7 +17,7 @@ import pytest
 
 import symkin
 from symkin import cli
-from symkin.runtime.spatial import rotation
+from symkin.runtime.outputs.spatial import rotation
 
 HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parents[1] / "examples"

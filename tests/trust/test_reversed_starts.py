@@ -1,6 +1,6 @@
 """No path runs from a solution of Phi = 0 that is no assembly: an input-driven run, a sweep's
 batch and a forward-dynamics run refuse such a start (reason "no assembly"), as the time loop
-and scan do (runtime.assembly.reversed_senses).
+and scan do (runtime.solving.assembly.reversed_senses).
 
 References, derived here, on the RSSR of the examples (crank about z at A0 = 0 with A =
 (a, 0, 0), rocker about x at B0 with B = B0 + R (0, c, 0), a rod from A to B):

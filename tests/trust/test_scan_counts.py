@@ -26,7 +26,7 @@ import pytest
 import symkin
 from symkin.cli.scan import text
 from symkin.runtime.driver import SolveFailure
-from symkin.runtime.scan import Branch, ScanReport, distinguishing, scan
+from symkin.runtime.scanning.scan import Branch, ScanReport, distinguishing, scan
 
 HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parents[1] / "examples"

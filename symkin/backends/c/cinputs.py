@@ -1,6 +1,6 @@
 """The generated C ``<prefix>_solve_inputs`` called through cffi, one time point a call
-(the C backend's ``runtime.inputs.InputStepper``): the state is carried in C from point to
-point, so each point starts from the last solution as in a controller loop."""
+(the C backend's ``runtime.input_driven.inputs.InputStepper``): the state is carried in C from point
+to point, so each point starts from the last solution as in a controller loop."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from symkin.backends.c.csolver import fill_options
 from symkin.contract.options import Options
 from symkin.contract.status import OK
-from symkin.runtime.newton import Newton, Point
+from symkin.runtime.solving.newton import Newton, Point
 
 Array = NDArray[np.float64]
 
@@ -32,11 +32,12 @@ class InputStepper:
         self._np = int(getattr(lib, f"{name.upper()}_NP"))
         self._nu = int(getattr(lib, f"{name.upper()}_NU"))
         self.fallbacks = 0
-        self.branch_jump = False  # the last call's report.branch_jump (runtime.branch's tests)
+        # the last call's report.branch_jump (runtime.input_driven.branch's tests)
+        self.branch_jump = False
 
     def start(self, options: Options, q: Array, unit: float = 1.0) -> None:
         """Begin from q (in the kernel's unit), the decisions made in the length unit ``unit``
-        (runtime.units): the first call initialises the workspace."""
+        (runtime.solving.units): the first call initialises the workspace."""
         fill_options(self._lib, self._name, self._options, options, unit)
         self._state.q[0:self._n] = [float(v) for v in q]
         self._state.started = 0

@@ -7,8 +7,15 @@ from __future__ import annotations
 
 from typing import Any
 
-from symkin.backends.c import (dynamics_budget, dynamics_lu, linalg, lu_code, norm_code,
-                               op_budget, real)
+from symkin.backends.c import (
+    dynamics_budget,
+    dynamics_lu,
+    linalg,
+    lu_code,
+    norm_code,
+    op_budget,
+    real,
+)
 from symkin.backends.c.printer import literal
 from symkin.codegen.lower import Code
 from symkin.contract import lengths, options, tuning

@@ -28,7 +28,7 @@ Array = NDArray[np.float64]
 def fill_options(lib: Any, name: str, target: Any, options: Options, unit: float = 1.0
                  ) -> None:
     """The C options struct ``target`` set from the runtime's Options and the length unit the
-    decisions are made in (runtime.units)."""
+    decisions are made in (runtime.solving.units)."""
     getattr(lib, f"{name}_default_options")(target)
     target.tol_phi, target.tol_dq = options.tol_phi, options.tol_dq
     target.max_iterations = options.max_iterations

@@ -59,7 +59,7 @@ class CKernel(Kernel):
     def grid_solver(self, options: Options, q: Array, p: Array, unit: float = 1.0
                     ) -> GridSolver | None:
         """A fresh run of the generated C grid loop from q, its decisions made in the length
-        unit ``unit`` (runtime.units), or None without a C solver (or, for a unit other than
+        unit ``unit`` (runtime.solving.units), or None without a C solver (or, for a unit other than
         1, one that cannot honour it)."""
         if unit != 1.0 and not self.scale_free:
             return None

@@ -3,8 +3,8 @@
 The generated solver needs the 1-norm of Phi_q at every solved point (the condition estimate).
 A loop over the non-zeros that adds into column sums through an index table costs a load, an
 indexed read-modify-write and a branch per entry; here each column's sum is one expression in
-the order of the non-zeros (the order of the loop and of runtime.accuracy.norm1), so the bits
-are the same. An entry that is a number at every state contributes its known |value|: a run of
+the order of the non-zeros (the order of the loop and of runtime.solving.accuracy.norm1), so the
+bits are the same. An entry that is a number at every state contributes its known |value|: a run of
 them at the start of a column is added here in IEEE double (the operations C would do), the
 others are literals in place; a column of numbers only is known outright and joins the starting
 value of the maximum.

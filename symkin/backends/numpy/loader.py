@@ -36,7 +36,7 @@ class _ModuleFunctions:
         # forward dynamics, generated only for a mechanism with masses
         self.mass: Callable[..., Array] | None = getattr(module, "mass", None)
         self.applied: Callable[..., Array] | None = getattr(module, "applied", None)
-        # with dynamics and removed rows only (runtime.indeterminate)
+        # with dynamics and removed rows only (runtime.loads.indeterminate)
         self.removed_q: Callable[..., Array] = getattr(module, "removed_q", _no_dynamics)
         self.loads_full: Callable[..., Array] = getattr(module, "loads_full", _no_dynamics)
 

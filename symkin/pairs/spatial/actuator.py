@@ -29,7 +29,7 @@ def check(c: Actuator, checks: Any, path: kit.Path) -> None:
     holds f squared, so a negative f would be solved silently as its absolute value (and the
     leg's force would change sign)."""
     distance.apart(c, checks, path)
-    if is_input(c.f):  # its values come from the caller (runtime.inputs checks them)
+    if is_input(c.f):  # its values come from the caller (runtime.input_driven.inputs checks them)
         return
     f = checks.expression(c.f, path + ("f",), time=True)
     samples = checks.over_time(f)

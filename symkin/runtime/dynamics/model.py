@@ -49,7 +49,7 @@ class Model(Protocol):
     given_values: Any
     rtol: float
     atol: float
-    senses: tuple[str, ...]  # with sense_values(q, t, p): runtime.assembly.reversed_senses
+    senses: tuple[str, ...]  # with sense_values(q, t, p): runtime.solving.assembly.reversed_senses
     sense_values: Any
 
 

@@ -21,15 +21,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.loads import reaction_parts
-from symkin.runtime import failures
 from symkin.runtime.arguments import first_guess, parameter_values, time_points
-from symkin.runtime.assembly import flag_flips, reversed_senses
 from symkin.runtime.dynamics import equations, initial
 from symkin.runtime.dynamics.integrator import State, StepFailure, Stepper
 from symkin.runtime.dynamics.model import Model, MotionKernel
-from symkin.runtime.forces import Forces
-from symkin.runtime.results import Trajectory
-from symkin.runtime.run_outcome import (
+from symkin.runtime.loads.forces import Forces
+from symkin.runtime.outputs.results import Trajectory
+from symkin.runtime.solving import failures
+from symkin.runtime.solving.assembly import flag_flips, reversed_senses
+from symkin.runtime.solving.run_outcome import (
     SolveFailure,
     SolveInterrupted,
     attach_forces,
@@ -125,7 +125,7 @@ def _solve(kernel: MotionKernel, t: ArrayLike | None, q0: ArrayLike | None,
 def _refuse_reversed(model: Model, rows: _Rows, q: Array, p: Array) -> None:
     """SolveFailure (reason "no assembly", no row) when the assembled q solves Φ = 0 with a
     spatial revolute's axes reversed or an angle driver half a turn away, as a kinematic run
-    refuses to start there (runtime.run_outcome.refuse_reversed)."""
+    refuses to start there (runtime.solving.run_outcome.refuse_reversed)."""
     t0 = float(rows.t[0])
     wrong = reversed_senses(model, q, t0, p)  # type: ignore[arg-type]
     if not wrong:
@@ -193,7 +193,7 @@ def _forces(model: Model, t: Array, q: Array, lam: Array, p: Array,
 
 
 # A load is determinate where the multipliers' free directions move it by less than this
-# share of the largest such effect (rounding), as in runtime.indeterminate.
+# share of the largest such effect (rounding), as in runtime.loads.indeterminate.
 DETERMINATE = 1e-8
 
 

@@ -3,8 +3,8 @@ straight-line column sums, Phi_q's numbers folded in) equals the largest column 
 ||Phi_q^-1||_1 is exact where the generated code computes the inverse's columns
 (backends.c.inverse_code: every example here) and equals the largest column sum of
 numpy.linalg.inv; where that code would be too long, the solver runs the Hager-Higham estimate
-of runtime.accuracy instead, a lower bound that is usually exact (carried from point to point
-by the Banach lemma while Phi_q moves little)."""
+of runtime.solving.accuracy instead, a lower bound that is usually exact (carried from point to
+point by the Banach lemma while Phi_q moves little)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,8 @@ import symkin
 from symkin import backends
 from symkin.backends.c import inverse_code
 from symkin.contract import tuning
-from symkin.runtime import accuracy, driver, linalg
+from symkin.runtime import driver
+from symkin.runtime.solving import accuracy, linalg
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[3] / "examples"
 

@@ -2,7 +2,7 @@
 clears a point the model could not have flagged it. The generated ``<prefix>_flagged`` (its
 bound first, then the model) is compiled into a small program and run on many random points
 -- near the targets as well as far from them -- and compared with the runtime's own model,
-``runtime.accuracy.flagged_norms``, written in Python: the same answer at every point. Also
+``runtime.solving.accuracy.flagged_norms``, written in Python: the same answer at every point. Also
 a point whose condition is not finite is flagged."""
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pytest
 import symkin
 from symkin.contract import options as contract
 from symkin.contract import tuning
-from symkin.runtime import accuracy
+from symkin.runtime.solving import accuracy
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is not installed")
 
@@ -80,7 +80,7 @@ def _points(count: int, seed: int) -> np.ndarray:
 
 
 def test_the_generated_model_flags_as_the_runtime_model(model_program) -> None:
-    """At 20,000 random points the generated flag equals runtime.accuracy's: the bound
+    """At 20,000 random points the generated flag equals runtime.solving.accuracy's: the bound
     never clears a point the model flags (nor does anything else)."""
     program, n = model_program
     points = _points(20000, 38)

@@ -17,7 +17,8 @@ import pytest
 from driver_support import derive, kernel_for
 
 import symkin
-from symkin.runtime import driver, newton
+from symkin.runtime import driver
+from symkin.runtime.solving import newton
 
 MECHANISMS = ("four_bar_test", "offset_crank_slider", "slide_driven", "point_trajectory")
 WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]

@@ -21,7 +21,8 @@ from symkin import backends
 from symkin.cli import run_outputs
 from symkin.codegen import lower as codegen
 from symkin.codegen import sample as codegen_sample
-from symkin.runtime import driver, linalg
+from symkin.runtime import driver
+from symkin.runtime.solving import linalg
 from symkin.spec import validate as model
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"

@@ -14,9 +14,9 @@ from numpy.typing import NDArray
 from symkin.contract.options import Options
 from symkin.contract.status import NO_CONVERGENCE, NOT_FINITE, OK, SINGULAR
 from symkin.contract.tuning import REESTIMATE_SHIFT, TIGHTEN_STEPS, UNIT_ROUNDOFF
-from symkin.runtime import accuracy
-from symkin.runtime.linalg import Factors, SparseFactors, distance1, factor_at
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.solving import accuracy
+from symkin.runtime.solving.linalg import Factors, SparseFactors, distance1, factor_at
 
 Array = NDArray[np.float64]
 
@@ -24,7 +24,7 @@ Array = NDArray[np.float64]
 class Newton:
     """The outcome of Newton-Raphson at one time point; at a converged point also the estimate
     of ||Phi_q^-1||_1 and ||Phi_q||_1 and, where it was solved for, max |Phi_q^-1 Phi| at q
-    (runtime.accuracy)."""
+    (runtime.solving.accuracy)."""
 
     q: Array
     status: int
@@ -96,8 +96,8 @@ def _converged(kernel: KinematicsKernel, result: Newton, t: float, p: Array, opt
     point as Newton left it (with the last point's max |q|, |dq|, |ddq|: ``previous``), solve
     for the Newton correction: its size is the error of q the residual leaves (to first
     order), which judges the point instead of the model's bound from the residual
-    (runtime.accuracy). Where the point would still be flagged, iterate on until it would not
-    (or the step stalls): a point is flagged only for what iterations cannot fix. Where the
+    (runtime.solving.accuracy). Where the point would still be flagged, iterate on until it would
+    not (or the step stalls): a point is flagged only for what iterations cannot fix. Where the
     condition is above options.tighten_cond, iterate on while the step still shrinks (each at
     most half the one before: once it stalls it is rounding noise, which a nearly singular
     Phi_q would only amplify along its null direction): q as exact as rounding allows.
@@ -178,7 +178,7 @@ def _propagation(kernel: KinematicsKernel, factors: Factors | SparseFactors,
                  solved: tuple[Array, Array, Array], t: float, p: Array, unit: float
                  ) -> accuracy.Propagate:
     """The errors of dq and ddq that a position error of a given size causes at the solved
-    point, along the worst direction (runtime.accuracy.propagated, forward differences of
+    point, along the worst direction (runtime.solving.accuracy.propagated, forward differences of
     length sqrt(u) (1 + max |q|), as the generated C takes them)."""
     q, dq, ddq = solved
     rows, cols = (np.asarray(a, dtype=np.intp) for a in (kernel.pattern_rows, kernel.pattern_cols))

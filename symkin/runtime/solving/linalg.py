@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.runtime import accuracy
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.solving import accuracy
 
 Array = NDArray[np.float64]
 

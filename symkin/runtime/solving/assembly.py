@@ -36,8 +36,8 @@ from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.options import Options
 from symkin.contract.status import OK, SINGULAR
 from symkin.errors import SymkinWarning
-from symkin.runtime.newton import Newton, newton
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.solving.newton import Newton, newton
 
 Array = NDArray[np.float64]
 
@@ -99,7 +99,7 @@ def genuine(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> bool:
 def reversed_senses(kernel: KinematicsKernel, q: Array, t: float, p: Array
                     ) -> tuple[str, ...]:
     """The labels of the kernel's senses that are not positive at q (none: q is genuine).
-    The senses hold no lengths, so a kernel in another length unit (runtime.units) answers
+    The senses hold no lengths, so a kernel in another length unit (runtime.solving.units) answers
     the same."""
     labels = tuple(getattr(kernel, "senses", ()))
     if not labels:

@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import SolveError
+from symkin.runtime.outputs.results import Trajectory
 from symkin.runtime.protocol import KinematicsKernel
-from symkin.runtime.results import Trajectory
 
 Array = NDArray[np.float64]
 

@@ -14,12 +14,12 @@ from symkin.contract.options import defaults
 from symkin.contract.status import NO_CONVERGENCE, NOT_FINITE, SINGULAR
 from symkin.contract.tuning import EDGE_SUBSTEPS
 from symkin.limits import listed
-from symkin.runtime.assembly import Assembly
-from symkin.runtime.edges import Resolution
-from symkin.runtime.linalg import dependencies
-from symkin.runtime.newton import Newton
 from symkin.runtime.protocol import KinematicsKernel
-from symkin.runtime.start import Singular
+from symkin.runtime.solving.assembly import Assembly
+from symkin.runtime.solving.edges import Resolution
+from symkin.runtime.solving.linalg import dependencies
+from symkin.runtime.solving.newton import Newton
+from symkin.runtime.solving.start import Singular
 
 Array = NDArray[np.float64]
 
@@ -152,8 +152,8 @@ def explain_start(start: Singular, t: float) -> str:
 
 
 def explain_reversed(labels: tuple[str, ...], t: float) -> str:
-    """Why a solution of Phi = 0 at t is not run from: the senses (runtime.assembly) that are
-    not positive there, at most ten named."""
+    """Why a solution of Phi = 0 at t is not run from: the senses (runtime.solving.assembly) that
+    are not positive there, at most ten named."""
     named = listed(labels, "; ")
     return (f"at t = {t:.10g} the equations are solved where the mechanism is not assembled "
             f"as meant: {named} - a revolute's (or cylindrical's) axes reversed, or an angle "

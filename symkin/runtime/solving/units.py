@@ -5,8 +5,8 @@ Newton's tolerances, the singularity test and the error model's targets are abso
 (symkin.contract.options); Phi_q mixes lengths and angles, so its condition grows with the
 square of the unit (a crank-slider drawn in millimetres looked singular at t0, in
 micrometres it could not be assembled; in nanometres every point was flagged). When the
-mechanism's length scale L (runtime.start: the largest lever arm in Phi_q, at the first guess)
-lies outside NATURAL, the driver solves it in the unit u = 10^k that brings L into [1, 10):
+mechanism's length scale L (runtime.solving.start: the largest lever arm in Phi_q, at the first
+guess) lies outside NATURAL, the driver solves it in the unit u = 10^k that brings L into [1, 10):
 lengths (x, y of each body; the rows of Phi that are lengths) are divided by u, angles kept,
 and the results are converted back. Inside NATURAL nothing changes (u = 1). The same
 mechanism at 10^-9, 10^-3, 1, 10^3 or 10^6 times its size is then solved on numbers that
@@ -32,9 +32,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.options import Options
-from symkin.runtime.newton import Newton, Point
 from symkin.runtime.protocol import ChunkResult, GridSolver, KinematicsKernel
-from symkin.runtime.start import length_rows, lever_arm, positions
+from symkin.runtime.solving.newton import Newton, Point
+from symkin.runtime.solving.start import length_rows, lever_arm, positions
 
 Array = NDArray[np.float64]
 
@@ -74,7 +74,7 @@ class ScaledKernel:
         self.kernel = kernel
         self.unit = unit
         # Not the kernel's batch solver: it works in the kernel's unit, not in this view's
-        # (runtime.start.lever_arm would read its L in the wrong unit).
+        # (runtime.solving.start.lever_arm would read its L in the wrong unit).
         self.batch_solver = None
         self.column = np.where(positions(kernel), unit, 1.0)
         self.row = np.where(length_rows(kernel), unit, 1.0)
@@ -102,7 +102,8 @@ class ScaledKernel:
         """The kernel's generated input solve deciding in this unit, seen in it (None where
         the kernel has none, or one that cannot rescale, as grid_solver: the runtime's Newton
         then solves this view)."""
-        make = getattr(self.kernel, "input_stepper", None)  # (an input kernel's, runtime.inputs)
+        # (an input kernel's, runtime.input_driven.inputs)
+        make = getattr(self.kernel, "input_stepper", None)
         if make is None or not getattr(self.kernel, "scale_free", True):
             return None
         inner = make()
@@ -111,7 +112,7 @@ class ScaledKernel:
     def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array, p: Array
                          ) -> tuple[Array, Array]:
         """The kernel's multipliers and loads of rows given in this unit (in its own unit)."""
-        kernel: Any = self.kernel  # a kernel with dynamics (runtime.forces asks only those)
+        kernel: Any = self.kernel  # a kernel with dynamics (runtime.loads.forces asks only those)
         result: tuple[Array, Array] = kernel.multipliers_grid(
             t, self.to_length(q), self.to_length(dq), self.to_length(d2q), p)
         return result
@@ -201,8 +202,8 @@ class ScaledGridSolver:
 
 
 class ScaledInputStepper:
-    """A kernel's generated input solve (runtime.inputs.InputStepper) run in the unit u, shown
-    in that unit like ScaledKernel: q handed to it is multiplied back, the q, dq, ddq it
+    """A kernel's generated input solve (runtime.input_driven.inputs.InputStepper) run in the unit
+    u, shown in that unit like ScaledKernel: q handed to it is multiplied back, the q, dq, ddq it
     returns (in the kernel's unit) are divided by the column scales."""
 
     def __init__(self, stepper: Any, scaled: ScaledKernel) -> None:

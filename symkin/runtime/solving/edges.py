@@ -29,9 +29,9 @@ from numpy.typing import NDArray
 from symkin.contract.options import Options
 from symkin.contract.status import OK
 from symkin.contract.tuning import EDGE_SUBSTEPS
-from symkin.runtime.linalg import dependencies
-from symkin.runtime.newton import Point, kinematics, newton
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.solving.linalg import dependencies
+from symkin.runtime.solving.newton import Point, kinematics, newton
 
 Array = NDArray[np.float64]
 

@@ -15,9 +15,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import SolveError
-from symkin.runtime.edges import Passage, State
-from symkin.runtime.newton import Point
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
+from symkin.runtime.solving.edges import Passage, State
+from symkin.runtime.solving.newton import Point
 
 Array = NDArray[np.float64]
 Out = Trajectory | Sequence[Array]

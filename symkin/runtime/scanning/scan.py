@@ -1,10 +1,11 @@
 """A first look at a mechanism over its driver range: what a designer asks before anything else.
 
 At t0 (and at given values of the input drivers), the assembly branches: the damped assembly
-(runtime.assembly) from q0, then the deflated multi-start search (runtime.assemblies: seeded,
-so scans repeat) for the others, each distinct (angles modulo 2 pi, Euler parameters up to
-their sign) and genuine (no spatial revolute's axes reversed, no angle driver half a turn
-away: runtime.assembly.genuine). The branch a run takes is the one reached from q0.
+(runtime.solving.assembly) from q0, then the deflated multi-start search
+(runtime.scanning.assemblies: seeded, so scans repeat) for the others, each distinct (angles modulo
+2 pi, Euler parameters up to their sign) and genuine (no spatial revolute's axes reversed, no angle
+driver half a turn away: runtime.solving.assembly.genuine). The branch a run takes is the one
+reached from q0.
 
 Over the time grid, the motion on that branch (and, on request, on every other): the singular
 configurations passed, the stretches of flagged points, and where the motion stops, a limit
@@ -24,12 +25,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from symkin.contract.status import OK
 from symkin.errors import SolveError
-from symkin.runtime import driver, redundant, units
-from symkin.runtime.assemblies import SAME, Shape, search
-from symkin.runtime.assembly import assemble, genuine
+from symkin.runtime import driver
 from symkin.runtime.dynamics.model import refuse_motion
-from symkin.runtime.edges import LIMIT_COND
+from symkin.runtime.outputs import redundant
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.scanning.assemblies import SAME, Shape, search
+from symkin.runtime.solving import units
+from symkin.runtime.solving.assembly import assemble, genuine
+from symkin.runtime.solving.edges import LIMIT_COND
 
 Array = NDArray[np.float64]
 
@@ -123,8 +126,8 @@ def scan(kernel: KinematicsKernel, t: ArrayLike | None = None,
         p = kernel.with_inputs(p, list(values.values()))  # type: ignore[attr-defined]
     t0 = float(times[0])
     with np.errstate(all="ignore"):
-        # In the unit that brings the mechanism near unit size (runtime.units), as solve does;
-        # the branches' q back in the kernel's unit.
+        # In the unit that brings the mechanism near unit size (runtime.solving.units), as solve
+        # does; the branches' q back in the kernel's unit.
         unit = units.unit_for(kernel, np.array(kernel.q0, dtype=float), t0, p)
         if unit == 1.0:
             branches = _branches(kernel, t0, p)
@@ -185,14 +188,14 @@ def input_point(kernel: KinematicsKernel, inputs: InputPoint | None) -> dict[str
 
 def _branches(kernel: KinematicsKernel, t0: float, p: Array) -> list[Branch]:
     """The distinct assemblies at t0, the one reached from q0 first (when there is one): the
-    deflated multi-start search of runtime.assemblies."""
+    deflated multi-start search of runtime.scanning.assemblies."""
     options = driver.default_options(kernel)
     shape = Shape(tuple(kernel.coordinates))
     q0 = np.array(kernel.q0, dtype=float)
     found: list[Branch] = []
     first = assemble(kernel, q0, t0, p, options).result
     # An over-constrained file's rows removed at t0 must hold too: elsewhere the kept rows
-    # alone are assembled, which is no assembly of the file (runtime.redundant).
+    # alone are assembled, which is no assembly of the file (runtime.outputs.redundant).
     if (first.status == OK and redundant.holds(kernel, first.q, t0, p, options.target_q)
             and genuine(kernel, first.q, t0, p)):
         found.append(Branch(shape.canonical(first.q), first.cond, True))

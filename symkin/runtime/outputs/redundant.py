@@ -5,8 +5,8 @@ off, two drivers that agree at t0 only), the solved motion breaks them, and thos
 flagged.
 
 A removed row's residual is compared with the position accuracy target, as the flag model of
-runtime.accuracy compares the estimated error of q: |Phi_removed| > target_q max(1, max |q|).
-Imports NumPy only: part of the runtime.
+runtime.solving.accuracy compares the estimated error of q: |Phi_removed| > target_q max(1, max
+|q|). Imports NumPy only: part of the runtime.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.contract.options import Options
+from symkin.runtime.outputs.results import Trajectory
 from symkin.runtime.protocol import KinematicsKernel
-from symkin.runtime.results import Trajectory
 
 
 def check(kernel: KinematicsKernel, trajectory: Trajectory, options: Options) -> Trajectory:

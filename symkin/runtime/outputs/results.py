@@ -17,8 +17,8 @@ from symkin import outfiles
 from symkin.contract.columns import ENERGY_COLUMNS, RATE_SUFFIXES
 from symkin.errors import SymkinError
 from symkin.limits import listed
-from symkin.runtime import spatial
-from symkin.runtime.forces import Forces
+from symkin.runtime.loads.forces import Forces
+from symkin.runtime.outputs import spatial
 
 SAVE_FORMATS = (".npz", ".csv")
 
@@ -78,7 +78,7 @@ class Trajectory:
         removed: the rows of an over-constrained file removed as dependent at t0 (their
             labels); empty for every other file.
         removed_residual: (T, len(removed)) their Phi along the motion, or None; a point
-            where one exceeds the position target is flagged (runtime.redundant).
+            where one exceeds the position target is flagged (runtime.outputs.redundant).
         space: ``3d`` for a spatial mechanism: 7 coordinates per body (x, y, z, e0..e3),
             points of 3 components, and each body's angular velocity and acceleration.
         outputs: what pairs report beyond the coordinates, as (name, values of shape (T,)):
@@ -104,11 +104,11 @@ class Trajectory:
     removed_residual: NDArray[np.float64] | None = None
     space: str = "2d"
     forces: Forces | None = None
-    """Efforts and reactions (runtime.forces) when the mechanism has masses or forces."""
+    """Efforts and reactions (runtime.loads.forces) when the mechanism has masses or forces."""
     outputs: tuple[tuple[str, NDArray[np.float64]], ...] = ()
     branch_jumps: NDArray[np.bool_] | None = None
     """(T,) True where an input-driven run may have jumped to another assembly than the row
-    before (runtime.branch); None for a run over t."""
+    before (runtime.input_driven.branch); None for a run over t."""
 
     def __post_init__(self) -> None:
         # A Trajectory built without them (by hand, or from older code) is unflagged.

@@ -16,7 +16,7 @@ needs the equations as polynomials, which the kernel (Phi and Phi_q at points) d
 deflation needs only what Newton needs.
 
 The starts decide which basins are reached at all. After q0 and the damped assembly's first
-starts (runtime.assembly), they are the points of a low-discrepancy sequence (Roberts' R_d):
+starts (runtime.solving.assembly), they are the points of a low-discrepancy sequence (Roberts' R_d):
 each planar angle spread over [-pi, pi) with the positions placed along the joints; each
 spatial body at an orientation spread uniformly over SO(3) (Shoemake's map from the unit cube
 to unit quaternions) and its origin spread over a box about q0's origin wide enough to hold
@@ -27,9 +27,10 @@ is assumed. The search runs in batches of BATCH starts and ends after PATIENCE b
 row that found nothing new, or after STARTS starts. The sequence has no seed: a scan repeats
 exactly. Each root of the deflated Newton is polished by the runtime's Newton (the same test
 as a run), which gives its condition; a root where a sense of the kernel is not positive (a
-spatial revolute's axes anti-parallel, an angle driver at theta + pi: runtime.assembly.genuine)
-is no assembly and not counted; two roots are one assembly when they agree to SAME (angles
-modulo 2 pi, Euler parameters up to their sign). Imports NumPy only: part of the runtime.
+spatial revolute's axes anti-parallel, an angle driver at theta + pi:
+runtime.solving.assembly.genuine) is no assembly and not counted; two roots are one assembly when
+they agree to SAME (angles modulo 2 pi, Euler parameters up to their sign). Imports NumPy only: part
+of the runtime.
 """
 
 from __future__ import annotations
@@ -43,11 +44,11 @@ from numpy.typing import NDArray
 from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.options import Options
 from symkin.contract.status import OK
-from symkin.runtime import redundant
-from symkin.runtime.assembly import genuine, placed
-from symkin.runtime.assembly import starts as assembly_starts
-from symkin.runtime.newton import Newton, newton
+from symkin.runtime.outputs import redundant
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.solving.assembly import genuine, placed
+from symkin.runtime.solving.assembly import starts as assembly_starts
+from symkin.runtime.solving.newton import Newton, newton
 
 Array = NDArray[np.float64]
 
@@ -76,7 +77,7 @@ DEFLATED_ITERATIONS = 50
 
 STEP_CAP = 0.5
 """The longest deflated Newton step (max-norm: radians, Euler parameters, and lengths in the
-unit near the mechanism's size that a scan solves in, runtime.units)."""
+unit near the mechanism's size that a scan solves in, runtime.solving.units)."""
 
 FOUND = 1e-8
 """The deflated Newton stops at max |Phi| below this; the runtime's Newton then polishes."""
@@ -269,7 +270,7 @@ def _log_gradient(shape: Shape, q: Array, roots: list[Array]) -> Array:
 
 def _starts(kernel: KinematicsKernel, shape: Shape, q0: Array, t0: float, p: Array,
             centre: Array) -> Iterator[Array]:
-    """q0 and the damped assembly's other first starts (runtime.assembly: the bodies placed
+    """q0 and the damped assembly's other first starts (runtime.solving.assembly: the bodies placed
     along their joints, q0 perturbed), then the points of a low-discrepancy sequence
     (_sequence): each planar angle uniform over one turn, [-pi, pi) shifted by the whole
     turns of its value in ``centre`` (an angle driven to 30 rad, an encoder's count of turns,

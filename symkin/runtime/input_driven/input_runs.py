@@ -1,8 +1,8 @@
-"""The loop over input rows (runtime.inputs: drivers whose functions are ``input``), as
+"""The loop over input rows (runtime.input_driven.inputs: drivers whose functions are ``input``), as
 ``symkin.solve(kernel, inputs=...)`` runs it: decided in the unit that brings the mechanism
-near unit size (runtime.units), as a run over t is; each row's inputs in the generated
-functions' p[]; Ctrl-C and failures raised with the rows solved (runtime.run_outcome); the
-branch test of runtime.branch over the rows. Imports NumPy only: part of the runtime.
+near unit size (runtime.solving.units), as a run over t is; each row's inputs in the generated
+functions' p[]; Ctrl-C and failures raised with the rows solved (runtime.solving.run_outcome); the
+branch test of runtime.input_driven.branch over the rows. Imports NumPy only: part of the runtime.
 """
 
 from __future__ import annotations
@@ -17,13 +17,14 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.options import Options
 from symkin.contract.status import OK
 from symkin.errors import SymkinWarning
-from symkin.runtime import branch, units
 from symkin.runtime.arguments import first_guess, parameter_values, time_points
-from symkin.runtime.assembly import flag_flips
-from symkin.runtime.inputs import Inputs, InputValues, check_inputs, solve_points
-from symkin.runtime.result_arrays import Out, allocate
-from symkin.runtime.results import Trajectory
-from symkin.runtime.run_outcome import (
+from symkin.runtime.input_driven import branch
+from symkin.runtime.input_driven.inputs import Inputs, InputValues, check_inputs, solve_points
+from symkin.runtime.outputs.results import Trajectory
+from symkin.runtime.solving import units
+from symkin.runtime.solving.assembly import flag_flips
+from symkin.runtime.solving.result_arrays import Out, allocate
+from symkin.runtime.solving.run_outcome import (
     SolveFailure,
     SolveInterrupted,
     _fail,
@@ -39,9 +40,9 @@ def solve_inputs(kernel: Any, t: ArrayLike | None, q0: ArrayLike | None,
                  params: Mapping[str, float] | ArrayLike | None, options: Options,
                  out: Out | None, progress: Progress | None,
                  given: tuple[InputValues | None, ...]) -> Trajectory:
-    """A run driven by inputs (runtime.inputs), failures raised as by the time loop; decided
-    in the unit that brings the mechanism near unit size (runtime.units), as runtime.driver
-    decides a run over t, the rows converted back to the kernel's unit."""
+    """A run driven by inputs (runtime.input_driven.inputs), failures raised as by the time loop;
+    decided in the unit that brings the mechanism near unit size (runtime.solving.units), as
+    runtime.driver decides a run over t, the rows converted back to the kernel's unit."""
     times = time_points(kernel, t)
     table = check_inputs(kernel, times, *given)
     p = parameter_values(kernel, params)

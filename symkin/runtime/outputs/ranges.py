@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from symkin.runtime.results import Trajectory
+from symkin.runtime.outputs.results import Trajectory
 
 SLACK = 1e-9
 """How far past a bound (relative to the range's length) still counts as on it."""

@@ -10,7 +10,7 @@ revolute; a prismatic pair: about A, carried by i). A spatial mechanism's ``reac
 (:mod:`symkin.contract.loads`). Rows where Φ_q is exactly singular are NaN.
 
 Where rows were removed as redundant, the loads are those of the minimum-norm multipliers of
-every row the file writes, and ``determinate`` says which are unique (runtime.indeterminate).
+every row the file writes, and ``determinate`` says which are unique (runtime.loads.indeterminate).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.contract.loads import load_count, reaction_parts
-from symkin.runtime import indeterminate
+from symkin.runtime.loads import indeterminate
 
 Array = NDArray[np.float64]
 REACTION_PARTS = reaction_parts("2d")

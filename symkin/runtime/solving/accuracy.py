@@ -34,7 +34,7 @@ actual position error gives the actual errors of dq and ddq: the errors there ar
 position error carried through the solves.
 SAFETY, u and the estimator's steps are symkin.contract.tuning's, which the C solver shares.
 c is the error of q the residual r leaves: max |Phi_q^-1 Phi|, the size of the Newton
-correction, where it was solved for (runtime.newton does so before it iterates on to avoid a
+correction, where it was solved for (runtime.solving.newton does so before it iterates on to avoid a
 flag), else the bound s r. The correction is the actual error where the bound is the worst
 case: on the 301-body chain of loops of bench/scaling_limit.py it is a tenth of s r (median).
 """

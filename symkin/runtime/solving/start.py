@@ -31,10 +31,10 @@ from numpy.typing import NDArray
 
 from symkin.contract.lengths import POSITION_SUFFIXES
 from symkin.contract.options import Options
-from symkin.runtime import accuracy
-from symkin.runtime.edges import LIMIT_COND, limit_motion
-from symkin.runtime.linalg import SPARSE_FROM, dependencies, factor_sparse
 from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.solving import accuracy
+from symkin.runtime.solving.edges import LIMIT_COND, limit_motion
+from symkin.runtime.solving.linalg import SPARSE_FROM, dependencies, factor_sparse
 
 Array = NDArray[np.float64]
 
@@ -53,14 +53,14 @@ class Singular:
 
 
 SIZE_FROM = 100
-"""Coordinates up to which the start's threshold is the limit positions' (runtime.edges); a
+"""Coordinates up to which the start's threshold is the limit positions' (runtime.solving.edges); a
 larger mechanism's grows with the square of its size (start_threshold)."""
 
 
 def start_threshold(options: Options, size: int = 0) -> float:
     """The scaled condition above which the start of a mechanism of ``size`` coordinates
     counts as singular: up to SIZE_FROM the one that makes a stop a limit position
-    (runtime.edges), so the start and the motion are judged alike.
+    (runtime.solving.edges), so the start and the motion are judged alike.
 
     Beyond, it grows as (size / SIZE_FROM)^2, because the condition of a regular mechanism
     does too: Phi_q^-1 carries a residual of one joint through every body beyond it, each
@@ -213,7 +213,7 @@ def scaled_nonzeros(kernel: KinematicsKernel, nz: Array) -> tuple[Array, float]:
 def scaled_cond(kernel: KinematicsKernel, scaled: Array) -> float:
     """The 1-norm condition number of the scaled Phi_q from its non-zeros (inf when it is
     singular): exact from NumPy's inverse below SPARSE_FROM coordinates (a warm C run never
-    imports SciPy), estimated with the sparse LU (runtime.linalg) from there on."""
+    imports SciPy), estimated with the sparse LU (runtime.solving.linalg) from there on."""
     if not np.all(np.isfinite(scaled)):
         return math.inf
     n = len(kernel.coordinates)

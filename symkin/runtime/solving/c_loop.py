@@ -9,10 +9,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.contract.status import OK, SINGULAR
-from symkin.runtime.linalg import factor_at
-from symkin.runtime.newton import Newton
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
-from symkin.runtime.result_arrays import Run as _Run
+from symkin.runtime.solving.linalg import factor_at
+from symkin.runtime.solving.newton import Newton
+from symkin.runtime.solving.result_arrays import Run as _Run
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]

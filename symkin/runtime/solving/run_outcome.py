@@ -1,7 +1,7 @@
 """What a run hands back or raises: the Trajectory of the rows it solved (with their efforts
 and reactions), and SolveInterrupted and SolveFailure, which carry those rows. Shared by the
-loop over a time grid (runtime.driver) and the loop over input rows (runtime.input_runs).
-Imports NumPy only: part of the runtime.
+loop over a time grid (runtime.driver) and the loop over input rows
+(runtime.input_driven.input_runs). Imports NumPy only: part of the runtime.
 """
 
 from __future__ import annotations
@@ -15,12 +15,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from symkin.errors import SolveError
-from symkin.runtime import failures, forces
-from symkin.runtime.assembly import Assembly, reversed_senses
-from symkin.runtime.newton import Newton
+from symkin.runtime.loads import forces
+from symkin.runtime.outputs.results import Trajectory
 from symkin.runtime.protocol import KinematicsKernel
-from symkin.runtime.result_arrays import Run as _Run
-from symkin.runtime.results import Trajectory
+from symkin.runtime.solving import failures
+from symkin.runtime.solving.assembly import Assembly, reversed_senses
+from symkin.runtime.solving.newton import Newton
+from symkin.runtime.solving.result_arrays import Run as _Run
 
 Array = NDArray[np.float64]
 
@@ -148,7 +149,7 @@ def _point_size(kernel: KinematicsKernel) -> int:
 def refuse_reversed(kernel: KinematicsKernel, run: _Run, q: Array, t: float, p: Array,
                     params: Array | None = None) -> None:
     """Raise SolveFailure (reason "no assembly", no row kept) when q, a solution of Phi = 0
-    at the first time point t, has a sense of the kernel not positive (runtime.assembly): a
+    at the first time point t, has a sense of the kernel not positive (runtime.solving.assembly): a
     spatial revolute's axes reversed, an angle driver half a turn away. Every run checks its
     first row so (p: the kernel's p[] at t; params: the parameters, when p holds inputs)."""
     wrong = reversed_senses(kernel, q, t, p)

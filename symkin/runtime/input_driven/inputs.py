@@ -20,12 +20,12 @@ from numpy.typing import ArrayLike, NDArray
 from symkin.contract.options import Options
 from symkin.contract.status import NOT_FINITE, OK, SINGULAR
 from symkin.errors import SolveError
-from symkin.runtime.assembly import Assembly, assemble
-from symkin.runtime.edges import Passage
-from symkin.runtime.linalg import dependencies
-from symkin.runtime.newton import Newton, Point, kinematics, newton
-from symkin.runtime.result_arrays import Run
-from symkin.runtime.run_outcome import refuse_reversed
+from symkin.runtime.solving.assembly import Assembly, assemble
+from symkin.runtime.solving.edges import Passage
+from symkin.runtime.solving.linalg import dependencies
+from symkin.runtime.solving.newton import Newton, Point, kinematics, newton
+from symkin.runtime.solving.result_arrays import Run
+from symkin.runtime.solving.run_outcome import refuse_reversed
 
 Array = NDArray[np.float64]
 InputValues = Mapping[str, ArrayLike] | ArrayLike
@@ -39,11 +39,11 @@ class InputStepper(Protocol):
 
     branch_jump: bool
     """Whether the last step's solution may lie on another assembly than the step before's
-    (the generated solve's own form of runtime.branch's tests)."""
+    (the generated solve's own form of runtime.input_driven.branch's tests)."""
 
     def start(self, options: Options, q: Array, unit: float = 1.0) -> None:
         """Begin from q (the assembled first point, in the kernel's unit), deciding in the
-        length unit ``unit`` (runtime.units)."""
+        length unit ``unit`` (runtime.solving.units)."""
 
     def step(self, t: float, pu: Array, rates: int) -> Point | Newton:
         """Solve at time t (for drivers that are functions of t) with the generated
