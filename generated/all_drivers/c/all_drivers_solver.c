@@ -60,10 +60,10 @@ static int all_drivers_refused(all_drivers_report *report, all_drivers_real t)
 }
 
 #define ALL_DRIVERS_UNIT_ROUNDOFF DBL_EPSILON
-#define ALL_DRIVERS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define ALL_DRIVERS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define ALL_DRIVERS_SAFETY ((all_drivers_real)10) /* as runtime.accuracy.SAFETY */
-#define ALL_DRIVERS_REESTIMATE_SHIFT ((all_drivers_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define ALL_DRIVERS_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define ALL_DRIVERS_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define ALL_DRIVERS_SAFETY ((all_drivers_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define ALL_DRIVERS_REESTIMATE_SHIFT ((all_drivers_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define ALL_DRIVERS_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -112,7 +112,7 @@ static const unsigned char all_drivers_length_row[ALL_DRIVERS_NQ] = { 1, 1, 1, 1
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void all_drivers_prepare(all_drivers_real unit, all_drivers_workspace *work)
 {
     int i, e;
@@ -191,7 +191,7 @@ void all_drivers_length_scales(int m, const all_drivers_real p[], const all_driv
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const all_drivers_real all_drivers_uniform[ALL_DRIVERS_NQ] = {
     (all_drivers_real)1 / 15,
@@ -229,7 +229,7 @@ static const all_drivers_real all_drivers_alternating[ALL_DRIVERS_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static all_drivers_real all_drivers_inverse_norm1_rows(const all_drivers_lu *lu, const all_drivers_real rows[])
@@ -272,7 +272,7 @@ static all_drivers_real all_drivers_inverse_norm1_rows(const all_drivers_lu *lu,
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -607,7 +607,7 @@ static all_drivers_real all_drivers_at_least_1(all_drivers_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int all_drivers_misses(const all_drivers_options *options, int judged, all_drivers_real e_q,
                                all_drivers_real e_dq, all_drivers_real e_ddq, all_drivers_real nq, all_drivers_real ndq,
@@ -658,7 +658,7 @@ static int all_drivers_flagged_at(const all_drivers_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -672,7 +672,7 @@ static int all_drivers_flagged(const all_drivers_options *options,
     return all_drivers_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static all_drivers_real all_drivers_position_error(const all_drivers_workspace *work,
                                           const all_drivers_report *report, all_drivers_real nq)
@@ -693,7 +693,7 @@ static all_drivers_real all_drivers_sum_abs(const all_drivers_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void all_drivers_worst_column(const all_drivers_lu *lu, all_drivers_real y[])
 {
     all_drivers_real z[ALL_DRIVERS_NQ], candidate[ALL_DRIVERS_NQ], norm, candidate_norm;
@@ -733,7 +733,7 @@ static void all_drivers_jacobian_times(const all_drivers_real nz[], const all_dr
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void all_drivers_propagated(const all_drivers_workspace *work, all_drivers_real size, all_drivers_real nq,
                                     const all_drivers_real q[], const all_drivers_real dq[], const all_drivers_real ddq[],
@@ -776,7 +776,7 @@ static void all_drivers_propagated(const all_drivers_workspace *work, all_driver
     errors[1] = all_drivers_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1260,7 +1260,7 @@ int all_drivers_solve_batch(const all_drivers_options *options, const all_driver
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int cam_cycloidal_refused(cam_cycloidal_report *report, cam_cycloidal_rea
 }
 
 #define CAM_CYCLOIDAL_UNIT_ROUNDOFF DBL_EPSILON
-#define CAM_CYCLOIDAL_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define CAM_CYCLOIDAL_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define CAM_CYCLOIDAL_SAFETY ((cam_cycloidal_real)10) /* as runtime.accuracy.SAFETY */
-#define CAM_CYCLOIDAL_REESTIMATE_SHIFT ((cam_cycloidal_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CAM_CYCLOIDAL_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define CAM_CYCLOIDAL_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define CAM_CYCLOIDAL_SAFETY ((cam_cycloidal_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define CAM_CYCLOIDAL_REESTIMATE_SHIFT ((cam_cycloidal_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define CAM_CYCLOIDAL_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -104,7 +104,7 @@ static const unsigned char cam_cycloidal_length_row[CAM_CYCLOIDAL_NQ] = { 1, 1, 
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void cam_cycloidal_prepare(cam_cycloidal_real unit, cam_cycloidal_workspace *work)
 {
     int i, e;
@@ -183,7 +183,7 @@ void cam_cycloidal_length_scales(int m, const cam_cycloidal_real p[], const cam_
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const cam_cycloidal_real cam_cycloidal_uniform[CAM_CYCLOIDAL_NQ] = {
     (cam_cycloidal_real)1 / 7,
@@ -205,7 +205,7 @@ static const cam_cycloidal_real cam_cycloidal_alternating[CAM_CYCLOIDAL_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static cam_cycloidal_real cam_cycloidal_inverse_norm1_rows(const cam_cycloidal_lu *lu, const cam_cycloidal_real rows[])
@@ -248,7 +248,7 @@ static cam_cycloidal_real cam_cycloidal_inverse_norm1_rows(const cam_cycloidal_l
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -377,7 +377,7 @@ static cam_cycloidal_real cam_cycloidal_at_least_1(cam_cycloidal_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int cam_cycloidal_misses(const cam_cycloidal_options *options, int judged, cam_cycloidal_real e_q,
                                cam_cycloidal_real e_dq, cam_cycloidal_real e_ddq, cam_cycloidal_real nq, cam_cycloidal_real ndq,
@@ -428,7 +428,7 @@ static int cam_cycloidal_flagged_at(const cam_cycloidal_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -442,7 +442,7 @@ static int cam_cycloidal_flagged(const cam_cycloidal_options *options,
     return cam_cycloidal_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static cam_cycloidal_real cam_cycloidal_position_error(const cam_cycloidal_workspace *work,
                                           const cam_cycloidal_report *report, cam_cycloidal_real nq)
@@ -463,7 +463,7 @@ static cam_cycloidal_real cam_cycloidal_sum_abs(const cam_cycloidal_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void cam_cycloidal_worst_column(const cam_cycloidal_lu *lu, cam_cycloidal_real y[])
 {
     cam_cycloidal_real z[CAM_CYCLOIDAL_NQ], candidate[CAM_CYCLOIDAL_NQ], norm, candidate_norm;
@@ -503,7 +503,7 @@ static void cam_cycloidal_jacobian_times(const cam_cycloidal_real nz[], const ca
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void cam_cycloidal_propagated(const cam_cycloidal_workspace *work, cam_cycloidal_real size, cam_cycloidal_real nq,
                                     const cam_cycloidal_real q[], const cam_cycloidal_real dq[], const cam_cycloidal_real ddq[],
@@ -546,7 +546,7 @@ static void cam_cycloidal_propagated(const cam_cycloidal_workspace *work, cam_cy
     errors[1] = cam_cycloidal_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -950,7 +950,7 @@ int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, const cam_cy
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

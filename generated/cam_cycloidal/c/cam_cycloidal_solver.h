@@ -11,7 +11,7 @@
  * At each converged point the 1-norm condition of Phi_q is estimated from those factors
  * (Hager-Higham: a few solves, one of them transposed); where it is high Newton goes on while
  * its step still halves, and the point is flagged when an error model says q, dq or ddq may
- * miss the targets of the options (the same model as the Python driver's runtime.accuracy).
+ * miss the targets of the options (the same model as the Python driver's runtime.solving.accuracy).
  * No malloc, no stdio, no mutable statics: the caller owns every buffer.
  */
 #ifndef CAM_CYCLOIDAL_SOLVER_H
@@ -176,7 +176,7 @@ int cam_cycloidal_solve_batch(const cam_cycloidal_options *options, const cam_cy
 /* The length scale of m configurations: per set j (parameters p[j*NP ...], coordinates
  * q[j*q_stride ...], at time t), the largest lever arm in Phi_q, max |dPhi_i/dphi_k| /
  * max |dPhi_i/dx_k| over the rows i with an entry in a length column (symkin's
- * runtime.start.length_scale): 0 where there is none, NaN where an entry of Phi_q is not
+ * runtime.solving.start.length_scale): 0 where there is none, NaN where an entry of Phi_q is not
  * finite. The unit a run is decided in, and how far its condition estimate may be from the
  * one in units of this scale, follow from it. */
 void cam_cycloidal_length_scales(int m, const cam_cycloidal_real p[], const cam_cycloidal_real q[],
@@ -197,7 +197,7 @@ typedef struct {
 
 /* A time t that the plain step from a solved state could not reach (the point where
  * cam_cycloidal_solve_grid stopped), treated as symkin's runtime does before it decides (its
- * runtime.edges.resolve): substeps from state towards t, halved on failure and doubled on
+ * runtime.solving.edges.resolve): substeps from state towards t, halved on failure and doubled on
  * success (at most t - state->t), until t is reached or a step of at most h_min fails at the
  * blocked time b; then, from the last point reached substepping towards b - delta, steps to
  * b + delta, b + 2 delta, ... (up to t - state->t past b): one that converges makes the

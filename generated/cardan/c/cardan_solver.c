@@ -60,10 +60,10 @@ static int cardan_refused(cardan_report *report, cardan_real t)
 }
 
 #define CARDAN_UNIT_ROUNDOFF DBL_EPSILON
-#define CARDAN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define CARDAN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define CARDAN_SAFETY ((cardan_real)10) /* as runtime.accuracy.SAFETY */
-#define CARDAN_REESTIMATE_SHIFT ((cardan_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CARDAN_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define CARDAN_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define CARDAN_SAFETY ((cardan_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define CARDAN_REESTIMATE_SHIFT ((cardan_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define CARDAN_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -111,7 +111,7 @@ static const unsigned char cardan_length_row[CARDAN_NQ] = { 1, 1, 1, 0, 0, 1, 1,
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void cardan_prepare(cardan_real unit, cardan_workspace *work)
 {
     int i, e;
@@ -190,7 +190,7 @@ void cardan_length_scales(int m, const cardan_real p[], const cardan_real q[],
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const cardan_real cardan_uniform[CARDAN_NQ] = {
     (cardan_real)1 / 14,
@@ -226,7 +226,7 @@ static const cardan_real cardan_alternating[CARDAN_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static cardan_real cardan_inverse_norm1_rows(const cardan_lu *lu, const cardan_real rows[])
@@ -269,7 +269,7 @@ static cardan_real cardan_inverse_norm1_rows(const cardan_lu *lu, const cardan_r
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -370,7 +370,7 @@ static cardan_real cardan_at_least_1(cardan_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int cardan_misses(const cardan_options *options, int judged, cardan_real e_q,
                                cardan_real e_dq, cardan_real e_ddq, cardan_real nq, cardan_real ndq,
@@ -421,7 +421,7 @@ static int cardan_flagged_at(const cardan_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -435,7 +435,7 @@ static int cardan_flagged(const cardan_options *options,
     return cardan_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static cardan_real cardan_position_error(const cardan_workspace *work,
                                           const cardan_report *report, cardan_real nq)
@@ -456,7 +456,7 @@ static cardan_real cardan_sum_abs(const cardan_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void cardan_worst_column(const cardan_lu *lu, cardan_real y[])
 {
     cardan_real z[CARDAN_NQ], candidate[CARDAN_NQ], norm, candidate_norm;
@@ -496,7 +496,7 @@ static void cardan_jacobian_times(const cardan_real nz[], const cardan_real v[],
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void cardan_propagated(const cardan_workspace *work, cardan_real size, cardan_real nq,
                                     const cardan_real q[], const cardan_real dq[], const cardan_real ddq[],
@@ -539,7 +539,7 @@ static void cardan_propagated(const cardan_workspace *work, cardan_real size, ca
     errors[1] = cardan_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1013,7 +1013,7 @@ int cardan_solve_batch(const cardan_options *options, const cardan_real units[],
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int crank_slider_refused(crank_slider_report *report, crank_slider_real t
 }
 
 #define CRANK_SLIDER_UNIT_ROUNDOFF DBL_EPSILON
-#define CRANK_SLIDER_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define CRANK_SLIDER_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define CRANK_SLIDER_SAFETY ((crank_slider_real)10) /* as runtime.accuracy.SAFETY */
-#define CRANK_SLIDER_REESTIMATE_SHIFT ((crank_slider_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CRANK_SLIDER_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define CRANK_SLIDER_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define CRANK_SLIDER_SAFETY ((crank_slider_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define CRANK_SLIDER_REESTIMATE_SHIFT ((crank_slider_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define CRANK_SLIDER_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -106,7 +106,7 @@ static const unsigned char crank_slider_length_row[CRANK_SLIDER_NQ] = { 1, 1, 1,
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void crank_slider_prepare(crank_slider_real unit, crank_slider_workspace *work)
 {
     int i, e;
@@ -185,7 +185,7 @@ void crank_slider_length_scales(int m, const crank_slider_real p[], const crank_
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const crank_slider_real crank_slider_uniform[CRANK_SLIDER_NQ] = {
     (crank_slider_real)1 / 9,
@@ -211,7 +211,7 @@ static const crank_slider_real crank_slider_alternating[CRANK_SLIDER_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static crank_slider_real crank_slider_inverse_norm1_rows(const crank_slider_lu *lu, const crank_slider_real rows[])
@@ -254,7 +254,7 @@ static crank_slider_real crank_slider_inverse_norm1_rows(const crank_slider_lu *
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -386,7 +386,7 @@ static crank_slider_real crank_slider_at_least_1(crank_slider_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int crank_slider_misses(const crank_slider_options *options, int judged, crank_slider_real e_q,
                                crank_slider_real e_dq, crank_slider_real e_ddq, crank_slider_real nq, crank_slider_real ndq,
@@ -437,7 +437,7 @@ static int crank_slider_flagged_at(const crank_slider_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -451,7 +451,7 @@ static int crank_slider_flagged(const crank_slider_options *options,
     return crank_slider_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static crank_slider_real crank_slider_position_error(const crank_slider_workspace *work,
                                           const crank_slider_report *report, crank_slider_real nq)
@@ -472,7 +472,7 @@ static crank_slider_real crank_slider_sum_abs(const crank_slider_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void crank_slider_worst_column(const crank_slider_lu *lu, crank_slider_real y[])
 {
     crank_slider_real z[CRANK_SLIDER_NQ], candidate[CRANK_SLIDER_NQ], norm, candidate_norm;
@@ -512,7 +512,7 @@ static void crank_slider_jacobian_times(const crank_slider_real nz[], const cran
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void crank_slider_propagated(const crank_slider_workspace *work, crank_slider_real size, crank_slider_real nq,
                                     const crank_slider_real q[], const crank_slider_real dq[], const crank_slider_real ddq[],
@@ -555,7 +555,7 @@ static void crank_slider_propagated(const crank_slider_workspace *work, crank_sl
     errors[1] = crank_slider_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -979,7 +979,7 @@ int crank_slider_solve_batch(const crank_slider_options *options, const crank_sl
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -61,10 +61,10 @@ static int crank_slider_input_refused(crank_slider_input_report *report, crank_s
 }
 
 #define CRANK_SLIDER_INPUT_UNIT_ROUNDOFF DBL_EPSILON
-#define CRANK_SLIDER_INPUT_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define CRANK_SLIDER_INPUT_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define CRANK_SLIDER_INPUT_SAFETY ((crank_slider_input_real)10) /* as runtime.accuracy.SAFETY */
-#define CRANK_SLIDER_INPUT_REESTIMATE_SHIFT ((crank_slider_input_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define CRANK_SLIDER_INPUT_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define CRANK_SLIDER_INPUT_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define CRANK_SLIDER_INPUT_SAFETY ((crank_slider_input_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define CRANK_SLIDER_INPUT_REESTIMATE_SHIFT ((crank_slider_input_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define CRANK_SLIDER_INPUT_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -107,7 +107,7 @@ static const unsigned char crank_slider_input_length_row[CRANK_SLIDER_INPUT_NQ] 
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void crank_slider_input_prepare(crank_slider_input_real unit, crank_slider_input_workspace *work)
 {
     int i, e;
@@ -187,7 +187,7 @@ void crank_slider_input_length_scales(int m, const crank_slider_input_real p[], 
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const crank_slider_input_real crank_slider_input_uniform[CRANK_SLIDER_INPUT_NQ] = {
     (crank_slider_input_real)1 / 9,
@@ -213,7 +213,7 @@ static const crank_slider_input_real crank_slider_input_alternating[CRANK_SLIDER
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static crank_slider_input_real crank_slider_input_inverse_norm1_rows(const crank_slider_input_lu *lu, const crank_slider_input_real rows[])
@@ -256,7 +256,7 @@ static crank_slider_input_real crank_slider_input_inverse_norm1_rows(const crank
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -388,7 +388,7 @@ static crank_slider_input_real crank_slider_input_at_least_1(crank_slider_input_
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int crank_slider_input_misses(const crank_slider_input_options *options, int judged, crank_slider_input_real e_q,
                                crank_slider_input_real e_dq, crank_slider_input_real e_ddq, crank_slider_input_real nq, crank_slider_input_real ndq,
@@ -439,7 +439,7 @@ static int crank_slider_input_flagged_at(const crank_slider_input_options *optio
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -453,7 +453,7 @@ static int crank_slider_input_flagged(const crank_slider_input_options *options,
     return crank_slider_input_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static crank_slider_input_real crank_slider_input_position_error(const crank_slider_input_workspace *work,
                                           const crank_slider_input_report *report, crank_slider_input_real nq)
@@ -474,7 +474,7 @@ static crank_slider_input_real crank_slider_input_sum_abs(const crank_slider_inp
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void crank_slider_input_worst_column(const crank_slider_input_lu *lu, crank_slider_input_real y[])
 {
     crank_slider_input_real z[CRANK_SLIDER_INPUT_NQ], candidate[CRANK_SLIDER_INPUT_NQ], norm, candidate_norm;
@@ -514,7 +514,7 @@ static void crank_slider_input_jacobian_times(const crank_slider_input_real nz[]
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void crank_slider_input_propagated(const crank_slider_input_workspace *work, crank_slider_input_real size, crank_slider_input_real nq,
                                     const crank_slider_input_real q[], const crank_slider_input_real dq[], const crank_slider_input_real ddq[],
@@ -557,7 +557,7 @@ static void crank_slider_input_propagated(const crank_slider_input_workspace *wo
     errors[1] = crank_slider_input_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -962,7 +962,7 @@ static int crank_slider_input_chord(const crank_slider_input_real p[], crank_sli
     return k;
 }
 
-/* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
+/* report->branch_jump of a converged call (runtime.input_driven.branch's two tests, one call at a time):
  * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
  * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
  * none was solved: the first call, or after a failed one); nq: max |q|; both in the run's
@@ -1181,7 +1181,7 @@ int crank_slider_input_solve_batch(const crank_slider_input_options *options, co
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

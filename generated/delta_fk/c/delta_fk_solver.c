@@ -61,10 +61,10 @@ static int delta_fk_refused(delta_fk_report *report, delta_fk_real t)
 }
 
 #define DELTA_FK_UNIT_ROUNDOFF DBL_EPSILON
-#define DELTA_FK_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define DELTA_FK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define DELTA_FK_SAFETY ((delta_fk_real)10) /* as runtime.accuracy.SAFETY */
-#define DELTA_FK_REESTIMATE_SHIFT ((delta_fk_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define DELTA_FK_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define DELTA_FK_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define DELTA_FK_SAFETY ((delta_fk_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define DELTA_FK_REESTIMATE_SHIFT ((delta_fk_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define DELTA_FK_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -101,7 +101,7 @@ static const unsigned char delta_fk_length_row[DELTA_FK_NQ] = { 1, 1, 1, 0, 0, 1
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void delta_fk_prepare(delta_fk_real unit, delta_fk_workspace *work)
 {
     int i, e;
@@ -181,7 +181,7 @@ void delta_fk_length_scales(int m, const delta_fk_real p[], const delta_fk_real 
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const delta_fk_real delta_fk_uniform[DELTA_FK_NQ] = {
     (delta_fk_real)1 / 28,
@@ -245,7 +245,7 @@ static const delta_fk_real delta_fk_alternating[DELTA_FK_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static delta_fk_real delta_fk_inverse_norm1_rows(const delta_fk_lu *lu, const delta_fk_real rows[])
@@ -288,7 +288,7 @@ static delta_fk_real delta_fk_inverse_norm1_rows(const delta_fk_lu *lu, const de
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -429,7 +429,7 @@ static delta_fk_real delta_fk_at_least_1(delta_fk_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int delta_fk_misses(const delta_fk_options *options, int judged, delta_fk_real e_q,
                                delta_fk_real e_dq, delta_fk_real e_ddq, delta_fk_real nq, delta_fk_real ndq,
@@ -480,7 +480,7 @@ static int delta_fk_flagged_at(const delta_fk_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -494,7 +494,7 @@ static int delta_fk_flagged(const delta_fk_options *options,
     return delta_fk_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static delta_fk_real delta_fk_position_error(const delta_fk_workspace *work,
                                           const delta_fk_report *report, delta_fk_real nq)
@@ -515,7 +515,7 @@ static delta_fk_real delta_fk_sum_abs(const delta_fk_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void delta_fk_worst_column(const delta_fk_lu *lu, delta_fk_real y[])
 {
     delta_fk_real z[DELTA_FK_NQ], candidate[DELTA_FK_NQ], norm, candidate_norm;
@@ -555,7 +555,7 @@ static void delta_fk_jacobian_times(const delta_fk_real nz[], const delta_fk_rea
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void delta_fk_propagated(const delta_fk_workspace *work, delta_fk_real size, delta_fk_real nq,
                                     const delta_fk_real q[], const delta_fk_real dq[], const delta_fk_real ddq[],
@@ -598,7 +598,7 @@ static void delta_fk_propagated(const delta_fk_workspace *work, delta_fk_real si
     errors[1] = delta_fk_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -931,7 +931,7 @@ static int delta_fk_chord(const delta_fk_real p[], delta_fk_real t, delta_fk_rea
     return k;
 }
 
-/* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
+/* report->branch_jump of a converged call (runtime.input_driven.branch's two tests, one call at a time):
  * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
  * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
  * none was solved: the first call, or after a failed one); nq: max |q|; both in the run's
@@ -1150,7 +1150,7 @@ int delta_fk_solve_batch(const delta_fk_options *options, const delta_fk_real un
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int four_bar_refused(four_bar_report *report, four_bar_real t)
 }
 
 #define FOUR_BAR_UNIT_ROUNDOFF DBL_EPSILON
-#define FOUR_BAR_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define FOUR_BAR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define FOUR_BAR_SAFETY ((four_bar_real)10) /* as runtime.accuracy.SAFETY */
-#define FOUR_BAR_REESTIMATE_SHIFT ((four_bar_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define FOUR_BAR_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define FOUR_BAR_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define FOUR_BAR_SAFETY ((four_bar_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define FOUR_BAR_REESTIMATE_SHIFT ((four_bar_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define FOUR_BAR_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -106,7 +106,7 @@ static const unsigned char four_bar_length_row[FOUR_BAR_NQ] = { 1, 1, 1, 1, 1, 1
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void four_bar_prepare(four_bar_real unit, four_bar_workspace *work)
 {
     int i, e;
@@ -185,7 +185,7 @@ void four_bar_length_scales(int m, const four_bar_real p[], const four_bar_real 
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const four_bar_real four_bar_uniform[FOUR_BAR_NQ] = {
     (four_bar_real)1 / 9,
@@ -211,7 +211,7 @@ static const four_bar_real four_bar_alternating[FOUR_BAR_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static four_bar_real four_bar_inverse_norm1_rows(const four_bar_lu *lu, const four_bar_real rows[])
@@ -254,7 +254,7 @@ static four_bar_real four_bar_inverse_norm1_rows(const four_bar_lu *lu, const fo
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -401,7 +401,7 @@ static four_bar_real four_bar_at_least_1(four_bar_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int four_bar_misses(const four_bar_options *options, int judged, four_bar_real e_q,
                                four_bar_real e_dq, four_bar_real e_ddq, four_bar_real nq, four_bar_real ndq,
@@ -452,7 +452,7 @@ static int four_bar_flagged_at(const four_bar_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -466,7 +466,7 @@ static int four_bar_flagged(const four_bar_options *options,
     return four_bar_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static four_bar_real four_bar_position_error(const four_bar_workspace *work,
                                           const four_bar_report *report, four_bar_real nq)
@@ -487,7 +487,7 @@ static four_bar_real four_bar_sum_abs(const four_bar_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void four_bar_worst_column(const four_bar_lu *lu, four_bar_real y[])
 {
     four_bar_real z[FOUR_BAR_NQ], candidate[FOUR_BAR_NQ], norm, candidate_norm;
@@ -527,7 +527,7 @@ static void four_bar_jacobian_times(const four_bar_real nz[], const four_bar_rea
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void four_bar_propagated(const four_bar_workspace *work, four_bar_real size, four_bar_real nq,
                                     const four_bar_real q[], const four_bar_real dq[], const four_bar_real ddq[],
@@ -570,7 +570,7 @@ static void four_bar_propagated(const four_bar_workspace *work, four_bar_real si
     errors[1] = four_bar_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -994,7 +994,7 @@ int four_bar_solve_batch(const four_bar_options *options, const four_bar_real un
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int parallelogram_extra_bar_refused(parallelogram_extra_bar_report *repor
 }
 
 #define PARALLELOGRAM_EXTRA_BAR_UNIT_ROUNDOFF DBL_EPSILON
-#define PARALLELOGRAM_EXTRA_BAR_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define PARALLELOGRAM_EXTRA_BAR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define PARALLELOGRAM_EXTRA_BAR_SAFETY ((parallelogram_extra_bar_real)10) /* as runtime.accuracy.SAFETY */
-#define PARALLELOGRAM_EXTRA_BAR_REESTIMATE_SHIFT ((parallelogram_extra_bar_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define PARALLELOGRAM_EXTRA_BAR_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define PARALLELOGRAM_EXTRA_BAR_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define PARALLELOGRAM_EXTRA_BAR_SAFETY ((parallelogram_extra_bar_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define PARALLELOGRAM_EXTRA_BAR_REESTIMATE_SHIFT ((parallelogram_extra_bar_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define PARALLELOGRAM_EXTRA_BAR_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -109,7 +109,7 @@ static const unsigned char parallelogram_extra_bar_length_row[PARALLELOGRAM_EXTR
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void parallelogram_extra_bar_prepare(parallelogram_extra_bar_real unit, parallelogram_extra_bar_workspace *work)
 {
     int i, e;
@@ -188,7 +188,7 @@ void parallelogram_extra_bar_length_scales(int m, const parallelogram_extra_bar_
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const parallelogram_extra_bar_real parallelogram_extra_bar_uniform[PARALLELOGRAM_EXTRA_BAR_NQ] = {
     (parallelogram_extra_bar_real)1 / 12,
@@ -220,7 +220,7 @@ static const parallelogram_extra_bar_real parallelogram_extra_bar_alternating[PA
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1_rows(const parallelogram_extra_bar_lu *lu, const parallelogram_extra_bar_real rows[])
@@ -263,7 +263,7 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_inverse_norm1_rows(c
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -443,7 +443,7 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_at_least_1(parallelo
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int parallelogram_extra_bar_misses(const parallelogram_extra_bar_options *options, int judged, parallelogram_extra_bar_real e_q,
                                parallelogram_extra_bar_real e_dq, parallelogram_extra_bar_real e_ddq, parallelogram_extra_bar_real nq, parallelogram_extra_bar_real ndq,
@@ -494,7 +494,7 @@ static int parallelogram_extra_bar_flagged_at(const parallelogram_extra_bar_opti
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -508,7 +508,7 @@ static int parallelogram_extra_bar_flagged(const parallelogram_extra_bar_options
     return parallelogram_extra_bar_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static parallelogram_extra_bar_real parallelogram_extra_bar_position_error(const parallelogram_extra_bar_workspace *work,
                                           const parallelogram_extra_bar_report *report, parallelogram_extra_bar_real nq)
@@ -529,7 +529,7 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_sum_abs(const parall
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void parallelogram_extra_bar_worst_column(const parallelogram_extra_bar_lu *lu, parallelogram_extra_bar_real y[])
 {
     parallelogram_extra_bar_real z[PARALLELOGRAM_EXTRA_BAR_NQ], candidate[PARALLELOGRAM_EXTRA_BAR_NQ], norm, candidate_norm;
@@ -569,7 +569,7 @@ static void parallelogram_extra_bar_jacobian_times(const parallelogram_extra_bar
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void parallelogram_extra_bar_propagated(const parallelogram_extra_bar_workspace *work, parallelogram_extra_bar_real size, parallelogram_extra_bar_real nq,
                                     const parallelogram_extra_bar_real q[], const parallelogram_extra_bar_real dq[], const parallelogram_extra_bar_real ddq[],
@@ -612,7 +612,7 @@ static void parallelogram_extra_bar_propagated(const parallelogram_extra_bar_wor
     errors[1] = parallelogram_extra_bar_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1066,7 +1066,7 @@ int parallelogram_extra_bar_solve_batch(const parallelogram_extra_bar_options *o
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int parallelogram_extra_bar_loads_refused(parallelogram_extra_bar_loads_r
 }
 
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_UNIT_ROUNDOFF DBL_EPSILON
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY ((parallelogram_extra_bar_loads_real)10) /* as runtime.accuracy.SAFETY */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_REESTIMATE_SHIFT ((parallelogram_extra_bar_loads_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_SAFETY ((parallelogram_extra_bar_loads_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_REESTIMATE_SHIFT ((parallelogram_extra_bar_loads_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -112,7 +112,7 @@ static const unsigned char parallelogram_extra_bar_loads_length_row[PARALLELOGRA
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void parallelogram_extra_bar_loads_prepare(parallelogram_extra_bar_loads_real unit, parallelogram_extra_bar_loads_workspace *work)
 {
     int i, e;
@@ -191,7 +191,7 @@ void parallelogram_extra_bar_loads_length_scales(int m, const parallelogram_extr
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_uniform[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ] = {
     (parallelogram_extra_bar_loads_real)1 / 15,
@@ -229,7 +229,7 @@ static const parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_al
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_norm1_rows(const parallelogram_extra_bar_loads_lu *lu, const parallelogram_extra_bar_loads_real rows[])
@@ -272,7 +272,7 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_inverse_
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -466,7 +466,7 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_at_least
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int parallelogram_extra_bar_loads_misses(const parallelogram_extra_bar_loads_options *options, int judged, parallelogram_extra_bar_loads_real e_q,
                                parallelogram_extra_bar_loads_real e_dq, parallelogram_extra_bar_loads_real e_ddq, parallelogram_extra_bar_loads_real nq, parallelogram_extra_bar_loads_real ndq,
@@ -517,7 +517,7 @@ static int parallelogram_extra_bar_loads_flagged_at(const parallelogram_extra_ba
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -531,7 +531,7 @@ static int parallelogram_extra_bar_loads_flagged(const parallelogram_extra_bar_l
     return parallelogram_extra_bar_loads_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_position_error(const parallelogram_extra_bar_loads_workspace *work,
                                           const parallelogram_extra_bar_loads_report *report, parallelogram_extra_bar_loads_real nq)
@@ -552,7 +552,7 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_sum_abs(
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void parallelogram_extra_bar_loads_worst_column(const parallelogram_extra_bar_loads_lu *lu, parallelogram_extra_bar_loads_real y[])
 {
     parallelogram_extra_bar_loads_real z[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], candidate[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ], norm, candidate_norm;
@@ -592,7 +592,7 @@ static void parallelogram_extra_bar_loads_jacobian_times(const parallelogram_ext
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void parallelogram_extra_bar_loads_propagated(const parallelogram_extra_bar_loads_workspace *work, parallelogram_extra_bar_loads_real size, parallelogram_extra_bar_loads_real nq,
                                     const parallelogram_extra_bar_loads_real q[], const parallelogram_extra_bar_loads_real dq[], const parallelogram_extra_bar_loads_real ddq[],
@@ -635,7 +635,7 @@ static void parallelogram_extra_bar_loads_propagated(const parallelogram_extra_b
     errors[1] = parallelogram_extra_bar_loads_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1141,7 +1141,7 @@ int parallelogram_extra_bar_loads_solve_batch(const parallelogram_extra_bar_load
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int rack_linkage_refused(rack_linkage_report *report, rack_linkage_real t
 }
 
 #define RACK_LINKAGE_UNIT_ROUNDOFF DBL_EPSILON
-#define RACK_LINKAGE_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define RACK_LINKAGE_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define RACK_LINKAGE_SAFETY ((rack_linkage_real)10) /* as runtime.accuracy.SAFETY */
-#define RACK_LINKAGE_REESTIMATE_SHIFT ((rack_linkage_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define RACK_LINKAGE_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define RACK_LINKAGE_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define RACK_LINKAGE_SAFETY ((rack_linkage_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define RACK_LINKAGE_REESTIMATE_SHIFT ((rack_linkage_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define RACK_LINKAGE_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -109,7 +109,7 @@ static const unsigned char rack_linkage_length_row[RACK_LINKAGE_NQ] = { 1, 1, 0,
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void rack_linkage_prepare(rack_linkage_real unit, rack_linkage_workspace *work)
 {
     int i, e;
@@ -188,7 +188,7 @@ void rack_linkage_length_scales(int m, const rack_linkage_real p[], const rack_l
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const rack_linkage_real rack_linkage_uniform[RACK_LINKAGE_NQ] = {
     (rack_linkage_real)1 / 12,
@@ -220,7 +220,7 @@ static const rack_linkage_real rack_linkage_alternating[RACK_LINKAGE_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static rack_linkage_real rack_linkage_inverse_norm1_rows(const rack_linkage_lu *lu, const rack_linkage_real rows[])
@@ -263,7 +263,7 @@ static rack_linkage_real rack_linkage_inverse_norm1_rows(const rack_linkage_lu *
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -478,7 +478,7 @@ static rack_linkage_real rack_linkage_at_least_1(rack_linkage_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int rack_linkage_misses(const rack_linkage_options *options, int judged, rack_linkage_real e_q,
                                rack_linkage_real e_dq, rack_linkage_real e_ddq, rack_linkage_real nq, rack_linkage_real ndq,
@@ -529,7 +529,7 @@ static int rack_linkage_flagged_at(const rack_linkage_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -543,7 +543,7 @@ static int rack_linkage_flagged(const rack_linkage_options *options,
     return rack_linkage_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static rack_linkage_real rack_linkage_position_error(const rack_linkage_workspace *work,
                                           const rack_linkage_report *report, rack_linkage_real nq)
@@ -564,7 +564,7 @@ static rack_linkage_real rack_linkage_sum_abs(const rack_linkage_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void rack_linkage_worst_column(const rack_linkage_lu *lu, rack_linkage_real y[])
 {
     rack_linkage_real z[RACK_LINKAGE_NQ], candidate[RACK_LINKAGE_NQ], norm, candidate_norm;
@@ -604,7 +604,7 @@ static void rack_linkage_jacobian_times(const rack_linkage_real nz[], const rack
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void rack_linkage_propagated(const rack_linkage_workspace *work, rack_linkage_real size, rack_linkage_real nq,
                                     const rack_linkage_real q[], const rack_linkage_real dq[], const rack_linkage_real ddq[],
@@ -647,7 +647,7 @@ static void rack_linkage_propagated(const rack_linkage_workspace *work, rack_lin
     errors[1] = rack_linkage_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1101,7 +1101,7 @@ int rack_linkage_solve_batch(const rack_linkage_options *options, const rack_lin
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

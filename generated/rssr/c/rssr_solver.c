@@ -60,10 +60,10 @@ static int rssr_refused(rssr_report *report, rssr_real t)
 }
 
 #define RSSR_UNIT_ROUNDOFF DBL_EPSILON
-#define RSSR_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define RSSR_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define RSSR_SAFETY ((rssr_real)10) /* as runtime.accuracy.SAFETY */
-#define RSSR_REESTIMATE_SHIFT ((rssr_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define RSSR_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define RSSR_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define RSSR_SAFETY ((rssr_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define RSSR_REESTIMATE_SHIFT ((rssr_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define RSSR_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -111,7 +111,7 @@ static const unsigned char rssr_length_row[RSSR_NQ] = { 1, 1, 1, 0, 0, 1, 1, 1, 
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void rssr_prepare(rssr_real unit, rssr_workspace *work)
 {
     int i, e;
@@ -190,7 +190,7 @@ void rssr_length_scales(int m, const rssr_real p[], const rssr_real q[],
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const rssr_real rssr_uniform[RSSR_NQ] = {
     (rssr_real)1 / 14,
@@ -226,7 +226,7 @@ static const rssr_real rssr_alternating[RSSR_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static rssr_real rssr_inverse_norm1_rows(const rssr_lu *lu, const rssr_real rows[])
@@ -269,7 +269,7 @@ static rssr_real rssr_inverse_norm1_rows(const rssr_lu *lu, const rssr_real rows
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -735,7 +735,7 @@ static rssr_real rssr_at_least_1(rssr_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int rssr_misses(const rssr_options *options, int judged, rssr_real e_q,
                                rssr_real e_dq, rssr_real e_ddq, rssr_real nq, rssr_real ndq,
@@ -786,7 +786,7 @@ static int rssr_flagged_at(const rssr_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -800,7 +800,7 @@ static int rssr_flagged(const rssr_options *options,
     return rssr_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static rssr_real rssr_position_error(const rssr_workspace *work,
                                           const rssr_report *report, rssr_real nq)
@@ -821,7 +821,7 @@ static rssr_real rssr_sum_abs(const rssr_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void rssr_worst_column(const rssr_lu *lu, rssr_real y[])
 {
     rssr_real z[RSSR_NQ], candidate[RSSR_NQ], norm, candidate_norm;
@@ -861,7 +861,7 @@ static void rssr_jacobian_times(const rssr_real nz[], const rssr_real v[], rssr_
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void rssr_propagated(const rssr_workspace *work, rssr_real size, rssr_real nq,
                                     const rssr_real q[], const rssr_real dq[], const rssr_real ddq[],
@@ -904,7 +904,7 @@ static void rssr_propagated(const rssr_workspace *work, rssr_real size, rssr_rea
     errors[1] = rssr_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1378,7 +1378,7 @@ int rssr_solve_batch(const rssr_options *options, const rssr_real units[],
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int spatial_slider_crank_refused(spatial_slider_crank_report *report, spa
 }
 
 #define SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF DBL_EPSILON
-#define SPATIAL_SLIDER_CRANK_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define SPATIAL_SLIDER_CRANK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define SPATIAL_SLIDER_CRANK_SAFETY ((spatial_slider_crank_real)10) /* as runtime.accuracy.SAFETY */
-#define SPATIAL_SLIDER_CRANK_REESTIMATE_SHIFT ((spatial_slider_crank_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define SPATIAL_SLIDER_CRANK_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define SPATIAL_SLIDER_CRANK_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define SPATIAL_SLIDER_CRANK_SAFETY ((spatial_slider_crank_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define SPATIAL_SLIDER_CRANK_REESTIMATE_SHIFT ((spatial_slider_crank_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define SPATIAL_SLIDER_CRANK_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -100,7 +100,7 @@ static const unsigned char spatial_slider_crank_length_row[SPATIAL_SLIDER_CRANK_
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void spatial_slider_crank_prepare(spatial_slider_crank_real unit, spatial_slider_crank_workspace *work)
 {
     int i, e;
@@ -179,7 +179,7 @@ void spatial_slider_crank_length_scales(int m, const spatial_slider_crank_real p
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const spatial_slider_crank_real spatial_slider_crank_uniform[SPATIAL_SLIDER_CRANK_NQ] = {
     (spatial_slider_crank_real)1 / 21,
@@ -229,7 +229,7 @@ static const spatial_slider_crank_real spatial_slider_crank_alternating[SPATIAL_
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static spatial_slider_crank_real spatial_slider_crank_inverse_norm1_rows(const spatial_slider_crank_lu *lu, const spatial_slider_crank_real rows[])
@@ -272,7 +272,7 @@ static spatial_slider_crank_real spatial_slider_crank_inverse_norm1_rows(const s
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -381,7 +381,7 @@ static spatial_slider_crank_real spatial_slider_crank_at_least_1(spatial_slider_
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int spatial_slider_crank_misses(const spatial_slider_crank_options *options, int judged, spatial_slider_crank_real e_q,
                                spatial_slider_crank_real e_dq, spatial_slider_crank_real e_ddq, spatial_slider_crank_real nq, spatial_slider_crank_real ndq,
@@ -432,7 +432,7 @@ static int spatial_slider_crank_flagged_at(const spatial_slider_crank_options *o
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -446,7 +446,7 @@ static int spatial_slider_crank_flagged(const spatial_slider_crank_options *opti
     return spatial_slider_crank_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static spatial_slider_crank_real spatial_slider_crank_position_error(const spatial_slider_crank_workspace *work,
                                           const spatial_slider_crank_report *report, spatial_slider_crank_real nq)
@@ -467,7 +467,7 @@ static spatial_slider_crank_real spatial_slider_crank_sum_abs(const spatial_slid
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void spatial_slider_crank_worst_column(const spatial_slider_crank_lu *lu, spatial_slider_crank_real y[])
 {
     spatial_slider_crank_real z[SPATIAL_SLIDER_CRANK_NQ], candidate[SPATIAL_SLIDER_CRANK_NQ], norm, candidate_norm;
@@ -507,7 +507,7 @@ static void spatial_slider_crank_jacobian_times(const spatial_slider_crank_real 
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void spatial_slider_crank_propagated(const spatial_slider_crank_workspace *work, spatial_slider_crank_real size, spatial_slider_crank_real nq,
                                     const spatial_slider_crank_real q[], const spatial_slider_crank_real dq[], const spatial_slider_crank_real ddq[],
@@ -550,7 +550,7 @@ static void spatial_slider_crank_propagated(const spatial_slider_crank_workspace
     errors[1] = spatial_slider_crank_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -902,7 +902,7 @@ int spatial_slider_crank_solve_batch(const spatial_slider_crank_options *options
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int stewart_refused(stewart_report *report, stewart_real t)
 }
 
 #define STEWART_UNIT_ROUNDOFF DBL_EPSILON
-#define STEWART_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define STEWART_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define STEWART_SAFETY ((stewart_real)10) /* as runtime.accuracy.SAFETY */
-#define STEWART_REESTIMATE_SHIFT ((stewart_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define STEWART_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define STEWART_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define STEWART_SAFETY ((stewart_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define STEWART_REESTIMATE_SHIFT ((stewart_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define STEWART_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -104,7 +104,7 @@ static const unsigned char stewart_length_row[STEWART_NQ] = { 1, 1, 1, 1, 1, 1, 
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void stewart_prepare(stewart_real unit, stewart_workspace *work)
 {
     int i, e;
@@ -183,7 +183,7 @@ void stewart_length_scales(int m, const stewart_real p[], const stewart_real q[]
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const stewart_real stewart_uniform[STEWART_NQ] = {
     (stewart_real)1 / 7,
@@ -205,7 +205,7 @@ static const stewart_real stewart_alternating[STEWART_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static stewart_real stewart_inverse_norm1_rows(const stewart_lu *lu, const stewart_real rows[])
@@ -248,7 +248,7 @@ static stewart_real stewart_inverse_norm1_rows(const stewart_lu *lu, const stewa
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -740,7 +740,7 @@ static stewart_real stewart_at_least_1(stewart_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int stewart_misses(const stewart_options *options, int judged, stewart_real e_q,
                                stewart_real e_dq, stewart_real e_ddq, stewart_real nq, stewart_real ndq,
@@ -791,7 +791,7 @@ static int stewart_flagged_at(const stewart_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -805,7 +805,7 @@ static int stewart_flagged(const stewart_options *options,
     return stewart_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static stewart_real stewart_position_error(const stewart_workspace *work,
                                           const stewart_report *report, stewart_real nq)
@@ -826,7 +826,7 @@ static stewart_real stewart_sum_abs(const stewart_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void stewart_worst_column(const stewart_lu *lu, stewart_real y[])
 {
     stewart_real z[STEWART_NQ], candidate[STEWART_NQ], norm, candidate_norm;
@@ -866,7 +866,7 @@ static void stewart_jacobian_times(const stewart_real nz[], const stewart_real v
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void stewart_propagated(const stewart_workspace *work, stewart_real size, stewart_real nq,
                                     const stewart_real q[], const stewart_real dq[], const stewart_real ddq[],
@@ -909,7 +909,7 @@ static void stewart_propagated(const stewart_workspace *work, stewart_real size,
     errors[1] = stewart_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1313,7 +1313,7 @@ int stewart_solve_batch(const stewart_options *options, const stewart_real units
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

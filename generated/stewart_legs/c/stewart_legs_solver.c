@@ -60,10 +60,10 @@ static int stewart_legs_refused(stewart_legs_report *report, stewart_legs_real t
 }
 
 #define STEWART_LEGS_UNIT_ROUNDOFF DBL_EPSILON
-#define STEWART_LEGS_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define STEWART_LEGS_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define STEWART_LEGS_SAFETY ((stewart_legs_real)10) /* as runtime.accuracy.SAFETY */
-#define STEWART_LEGS_REESTIMATE_SHIFT ((stewart_legs_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define STEWART_LEGS_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define STEWART_LEGS_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define STEWART_LEGS_SAFETY ((stewart_legs_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define STEWART_LEGS_REESTIMATE_SHIFT ((stewart_legs_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define STEWART_LEGS_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -106,7 +106,7 @@ static const unsigned char stewart_legs_length_row[STEWART_LEGS_NQ] = { 1, 1, 1,
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void stewart_legs_prepare(stewart_legs_real unit, stewart_legs_workspace *work)
 {
     int i, e;
@@ -185,7 +185,7 @@ void stewart_legs_length_scales(int m, const stewart_legs_real p[], const stewar
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const stewart_legs_real stewart_legs_uniform[STEWART_LEGS_NQ] = {
     (stewart_legs_real)1 / 91,
@@ -375,7 +375,7 @@ static const stewart_legs_real stewart_legs_alternating[STEWART_LEGS_NQ] = {
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static stewart_legs_real stewart_legs_inverse_norm1_rows(const stewart_legs_lu *lu, const stewart_legs_real rows[])
@@ -418,7 +418,7 @@ static stewart_legs_real stewart_legs_inverse_norm1_rows(const stewart_legs_lu *
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -697,7 +697,7 @@ static stewart_legs_real stewart_legs_at_least_1(stewart_legs_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int stewart_legs_misses(const stewart_legs_options *options, int judged, stewart_legs_real e_q,
                                stewart_legs_real e_dq, stewart_legs_real e_ddq, stewart_legs_real nq, stewart_legs_real ndq,
@@ -748,7 +748,7 @@ static int stewart_legs_flagged_at(const stewart_legs_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -762,7 +762,7 @@ static int stewart_legs_flagged(const stewart_legs_options *options,
     return stewart_legs_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static stewart_legs_real stewart_legs_position_error(const stewart_legs_workspace *work,
                                           const stewart_legs_report *report, stewart_legs_real nq)
@@ -783,7 +783,7 @@ static stewart_legs_real stewart_legs_sum_abs(const stewart_legs_real v[])
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void stewart_legs_worst_column(const stewart_legs_lu *lu, stewart_legs_real y[])
 {
     stewart_legs_real z[STEWART_LEGS_NQ], candidate[STEWART_LEGS_NQ], norm, candidate_norm;
@@ -823,7 +823,7 @@ static void stewart_legs_jacobian_times(const stewart_legs_real nz[], const stew
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void stewart_legs_propagated(const stewart_legs_workspace *work, stewart_legs_real size, stewart_legs_real nq,
                                     const stewart_legs_real q[], const stewart_legs_real dq[], const stewart_legs_real ddq[],
@@ -866,7 +866,7 @@ static void stewart_legs_propagated(const stewart_legs_workspace *work, stewart_
     errors[1] = stewart_legs_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1218,7 +1218,7 @@ int stewart_legs_solve_batch(const stewart_legs_options *options, const stewart_
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

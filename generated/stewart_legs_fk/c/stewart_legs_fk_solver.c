@@ -61,10 +61,10 @@ static int stewart_legs_fk_refused(stewart_legs_fk_report *report, stewart_legs_
 }
 
 #define STEWART_LEGS_FK_UNIT_ROUNDOFF DBL_EPSILON
-#define STEWART_LEGS_FK_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define STEWART_LEGS_FK_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define STEWART_LEGS_FK_SAFETY ((stewart_legs_fk_real)10) /* as runtime.accuracy.SAFETY */
-#define STEWART_LEGS_FK_REESTIMATE_SHIFT ((stewart_legs_fk_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define STEWART_LEGS_FK_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define STEWART_LEGS_FK_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define STEWART_LEGS_FK_SAFETY ((stewart_legs_fk_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define STEWART_LEGS_FK_REESTIMATE_SHIFT ((stewart_legs_fk_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define STEWART_LEGS_FK_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -107,7 +107,7 @@ static const unsigned char stewart_legs_fk_length_row[STEWART_LEGS_FK_NQ] = { 1,
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void stewart_legs_fk_prepare(stewart_legs_fk_real unit, stewart_legs_fk_workspace *work)
 {
     int i, e;
@@ -187,7 +187,7 @@ void stewart_legs_fk_length_scales(int m, const stewart_legs_fk_real p[], const 
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const stewart_legs_fk_real stewart_legs_fk_uniform[STEWART_LEGS_FK_NQ] = {
     (stewart_legs_fk_real)1 / 91,
@@ -377,7 +377,7 @@ static const stewart_legs_fk_real stewart_legs_fk_alternating[STEWART_LEGS_FK_NQ
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static stewart_legs_fk_real stewart_legs_fk_inverse_norm1_rows(const stewart_legs_fk_lu *lu, const stewart_legs_fk_real rows[])
@@ -420,7 +420,7 @@ static stewart_legs_fk_real stewart_legs_fk_inverse_norm1_rows(const stewart_leg
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -699,7 +699,7 @@ static stewart_legs_fk_real stewart_legs_fk_at_least_1(stewart_legs_fk_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int stewart_legs_fk_misses(const stewart_legs_fk_options *options, int judged, stewart_legs_fk_real e_q,
                                stewart_legs_fk_real e_dq, stewart_legs_fk_real e_ddq, stewart_legs_fk_real nq, stewart_legs_fk_real ndq,
@@ -750,7 +750,7 @@ static int stewart_legs_fk_flagged_at(const stewart_legs_fk_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -764,7 +764,7 @@ static int stewart_legs_fk_flagged(const stewart_legs_fk_options *options,
     return stewart_legs_fk_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static stewart_legs_fk_real stewart_legs_fk_position_error(const stewart_legs_fk_workspace *work,
                                           const stewart_legs_fk_report *report, stewart_legs_fk_real nq)
@@ -785,7 +785,7 @@ static stewart_legs_fk_real stewart_legs_fk_sum_abs(const stewart_legs_fk_real v
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void stewart_legs_fk_worst_column(const stewart_legs_fk_lu *lu, stewart_legs_fk_real y[])
 {
     stewart_legs_fk_real z[STEWART_LEGS_FK_NQ], candidate[STEWART_LEGS_FK_NQ], norm, candidate_norm;
@@ -825,7 +825,7 @@ static void stewart_legs_fk_jacobian_times(const stewart_legs_fk_real nz[], cons
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void stewart_legs_fk_propagated(const stewart_legs_fk_workspace *work, stewart_legs_fk_real size, stewart_legs_fk_real nq,
                                     const stewart_legs_fk_real q[], const stewart_legs_fk_real dq[], const stewart_legs_fk_real ddq[],
@@ -868,7 +868,7 @@ static void stewart_legs_fk_propagated(const stewart_legs_fk_workspace *work, st
     errors[1] = stewart_legs_fk_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1201,7 +1201,7 @@ static int stewart_legs_fk_chord(const stewart_legs_fk_real p[], stewart_legs_fk
     return k;
 }
 
-/* report->branch_jump of a converged call (runtime.branch's two tests, one call at a time):
+/* report->branch_jump of a converged call (runtime.input_driven.branch's two tests, one call at a time):
  * det(Phi_q) changed sign since the last solution, or q lies farther from the end of Newton's
  * first step from it than quadratic convergence allows. first: max |s| of that step (NaN when
  * none was solved: the first call, or after a failed one); nq: max |q|; both in the run's
@@ -1420,7 +1420,7 @@ int stewart_legs_fk_solve_batch(const stewart_legs_fk_options *options, const st
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -60,10 +60,10 @@ static int whitworth_drawn_refused(whitworth_drawn_report *report, whitworth_dra
 }
 
 #define WHITWORTH_DRAWN_UNIT_ROUNDOFF DBL_EPSILON
-#define WHITWORTH_DRAWN_ESTIMATOR_STEPS 5 /* as runtime.accuracy.ESTIMATOR_STEPS */
-#define WHITWORTH_DRAWN_TIGHTEN_STEPS 3   /* as runtime.newton.TIGHTEN_STEPS */
-#define WHITWORTH_DRAWN_SAFETY ((whitworth_drawn_real)10) /* as runtime.accuracy.SAFETY */
-#define WHITWORTH_DRAWN_REESTIMATE_SHIFT ((whitworth_drawn_real)0.05) /* as runtime.newton.REESTIMATE_SHIFT */
+#define WHITWORTH_DRAWN_ESTIMATOR_STEPS 5 /* as runtime.solving.accuracy.ESTIMATOR_STEPS */
+#define WHITWORTH_DRAWN_TIGHTEN_STEPS 3   /* as runtime.solving.newton.TIGHTEN_STEPS */
+#define WHITWORTH_DRAWN_SAFETY ((whitworth_drawn_real)10) /* as runtime.solving.accuracy.SAFETY */
+#define WHITWORTH_DRAWN_REESTIMATE_SHIFT ((whitworth_drawn_real)0.05) /* as runtime.solving.newton.REESTIMATE_SHIFT */
 #define WHITWORTH_DRAWN_EDGE_SUBSTEPS 1000 /* as contract.tuning.EDGE_SUBSTEPS */
 
 /* max |v_i|; NaN when some v_i is NaN, so that it is reported. */
@@ -109,7 +109,7 @@ static const unsigned char whitworth_drawn_length_row[WHITWORTH_DRAWN_NQ] = { 1,
 
 /* Set up the workspace for a run whose decisions are made in the length unit `unit`: the
  * solver then sees Phi~(q~) = Phi(q) / row with q~ = q / column (the scaled view of
- * runtime.units), so Phi~_q = Phi_q column / row. */
+ * runtime.solving.units), so Phi~_q = Phi_q column / row. */
 static void whitworth_drawn_prepare(whitworth_drawn_real unit, whitworth_drawn_workspace *work)
 {
     int i, e;
@@ -188,7 +188,7 @@ void whitworth_drawn_length_scales(int m, const whitworth_drawn_real p[], const 
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
- * real type, the same operations as runtime.accuracy.inverse_norm1): the start x = 1/NQ and
+ * real type, the same operations as runtime.solving.accuracy.inverse_norm1): the start x = 1/NQ and
  * Higham's alternating-sign test vector (-1)^i (1 + i / (NQ - 1)). */
 static const whitworth_drawn_real whitworth_drawn_uniform[WHITWORTH_DRAWN_NQ] = {
     (whitworth_drawn_real)1 / 12,
@@ -220,7 +220,7 @@ static const whitworth_drawn_real whitworth_drawn_alternating[WHITWORTH_DRAWN_NQ
 };
 
 /* Hager's estimate of ||Phi_q^-1||_1 with Higham's refinements (LAPACK's xLACN2), from the
- * factors in work->lu: the steps of runtime.accuracy.inverse_norm1, so both backends agree.
+ * factors in work->lu: the steps of runtime.solving.accuracy.inverse_norm1, so both backends agree.
  * With rows (1 or 0 per coordinate, else NULL): of ||P Phi_q^-1||_1, P those rows.
  * After the first step x is the unit vector e_j, kept as its index j only. */
 static whitworth_drawn_real whitworth_drawn_inverse_norm1_rows(const whitworth_drawn_lu *lu, const whitworth_drawn_real rows[])
@@ -263,7 +263,7 @@ static whitworth_drawn_real whitworth_drawn_inverse_norm1_rows(const whitworth_d
         }
         if (step > 0) {
             /* y . x with x = e_j: y_j when every y_i is finite, else the full sum (NaN from
-             * 0 * inf), so that the test is the one runtime.accuracy makes */
+             * 0 * inf), so that the test is the one runtime.solving.accuracy makes */
             if (finite == 0) {
                 dot = y[j];
             } else {
@@ -451,7 +451,7 @@ static whitworth_drawn_real whitworth_drawn_at_least_1(whitworth_drawn_real x)
     return x > 1 ? x : 1;
 }
 
-/* runtime.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
+/* runtime.solving.accuracy._misses: 1 when e_q, or one of the first `judged` of e_dq, e_ddq, exceeds
  * its target (an input-driven point's rates or accelerations not solved for are not judged). */
 static int whitworth_drawn_misses(const whitworth_drawn_options *options, int judged, whitworth_drawn_real e_q,
                                whitworth_drawn_real e_dq, whitworth_drawn_real e_ddq, whitworth_drawn_real nq, whitworth_drawn_real ndq,
@@ -502,7 +502,7 @@ static int whitworth_drawn_flagged_at(const whitworth_drawn_options *options,
                                nddq);
 }
 
-/* The error model of runtime.accuracy: 1 when q, dq or ddq may miss its target. The error of q
+/* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
  * decides first; the model runs where the bound fails. */
@@ -516,7 +516,7 @@ static int whitworth_drawn_flagged(const whitworth_drawn_options *options,
     return whitworth_drawn_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
 }
 
-/* e_q of runtime.accuracy.position_error: the error of q the residual leaves (the Newton
+/* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
  * correction where it was solved for), or the rounding of Phi. */
 static whitworth_drawn_real whitworth_drawn_position_error(const whitworth_drawn_workspace *work,
                                           const whitworth_drawn_report *report, whitworth_drawn_real nq)
@@ -537,7 +537,7 @@ static whitworth_drawn_real whitworth_drawn_sum_abs(const whitworth_drawn_real v
 }
 
 /* The column of Phi_q^-1 of largest 1-norm that Hager's ascent finds, into y: the steps of
- * runtime.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
+ * runtime.solving.accuracy.worst_column (x = 1/NQ first, then the unit vectors e_at). */
 static void whitworth_drawn_worst_column(const whitworth_drawn_lu *lu, whitworth_drawn_real y[])
 {
     whitworth_drawn_real z[WHITWORTH_DRAWN_NQ], candidate[WHITWORTH_DRAWN_NQ], norm, candidate_norm;
@@ -577,7 +577,7 @@ static void whitworth_drawn_jacobian_times(const whitworth_drawn_real nz[], cons
 }
 
 /* The errors of dq and ddq (max norms, errors[0..1]) that a position error of max norm `size`
- * along the worst column causes: runtime.accuracy.propagated, in the run's unit (the rows
+ * along the worst column causes: runtime.solving.accuracy.propagated, in the run's unit (the rows
  * divided by row, the solutions read as q / column), the kernel evaluated in its own. */
 static void whitworth_drawn_propagated(const whitworth_drawn_workspace *work, whitworth_drawn_real size, whitworth_drawn_real nq,
                                     const whitworth_drawn_real q[], const whitworth_drawn_real dq[], const whitworth_drawn_real ddq[],
@@ -620,7 +620,7 @@ static void whitworth_drawn_propagated(const whitworth_drawn_workspace *work, wh
     errors[1] = whitworth_drawn_max_abs(rows);
 }
 
-/* The flag of runtime.accuracy.flagged: where the norm bound flags the point, the propagated
+/* The flag of runtime.solving.accuracy.flagged: where the norm bound flags the point, the propagated
  * model decides: e_q, and the errors of dq and ddq it causes along the worst column plus the
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
@@ -1074,7 +1074,7 @@ int whitworth_drawn_solve_batch(const whitworth_drawn_options *options, const wh
     return solved_sets;
 }
 
-/* Substeps from state towards target (runtime.edges.march): halved on failure, doubled on
+/* Substeps from state towards target (runtime.solving.edges.march): halved on failure, doubled on
  * success up to h0. Returns the step that failed from the last point reached (state), 0 when
  * target was reached; *cond: the condition estimate at that point. Each substep spends one
  * of *left; with none left the next step counts as failed (the bound on Newton's work at one

@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from symkin.backends.c import lu_code
+from symkin.backends.c import lu_code, real
 from symkin.backends.c.printer import literal
 from symkin.codegen.dynamics_plan import AugmentedPlan
 from symkin.codegen.lower import comment
@@ -69,7 +69,7 @@ def loads(augmented: AugmentedPlan, loaded: Sequence[int]) -> list[dict[str, Any
 def template_context(code: Any) -> dict[str, Any]:
     """The ``dyn`` entry of the C template context (a file with masses only)."""
     augmented: AugmentedPlan = code.augmented
-    lu = straight(augmented.plan, augmented.constants, code.real, code.name)
+    lu = straight(augmented.plan, augmented.constants, real(code), code.name)
     position = {row: k for k, row in enumerate(augmented.kept)}
     return {
         "lu": lu,
