@@ -620,3 +620,14 @@ void cardan_point_kinematics(const cardan_real q[], const cardan_real dq[],
         }
     }
 }
+
+void cardan_senses_rows(int n, const cardan_real q[], const cardan_real t[], const cardan_real p[], int p_stride, cardan_real out[])
+{
+    int k;
+    for (k = 0; k < n; ++k) { /* each row's arrays follow the last's */
+        cardan_senses(q, t[k], p, out);
+        q += CARDAN_NQ;
+        out += CARDAN_NSENSES;
+        if (p) p += p_stride;
+    }
+}

@@ -127,6 +127,11 @@ void cardan_removed(const cardan_real q[], cardan_real t, const cardan_real p[],
 /* The senses at (q, t): out[NSENSES]. */
 void cardan_senses(const cardan_real q[], cardan_real t, const cardan_real p[], cardan_real out[]);
 
+/* The senses at n rows of a run: row k's q at q + k NQ and t[k], its p[] at p + k p_stride
+ * (p_stride 0: one p[] for every row; p may be NULL when there are no parameters);
+ * out[n NSENSES], row by row. One call for a whole run (the runtime's check along the motion). */
+void cardan_senses_rows(int n, const cardan_real q[], const cardan_real t[], const cardan_real p[], int p_stride, cardan_real out[]);
+
 /* Fused evaluation, for a Newton iterate: Phi (out[NQ]) and the non-zeros of Phi_q (nz[NNZ])
  * with their common subexpressions computed once, and the sines and cosines that Phi_t and
  * Gamma also need (shared[NSHARED]; may be NULL when NSHARED is 0). */

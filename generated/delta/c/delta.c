@@ -1909,3 +1909,14 @@ void delta_point_kinematics(const delta_real q[], const delta_real dq[],
         }
     }
 }
+
+void delta_senses_rows(int n, const delta_real q[], const delta_real t[], const delta_real p[], int p_stride, delta_real out[])
+{
+    int k;
+    for (k = 0; k < n; ++k) { /* each row's arrays follow the last's */
+        delta_senses(q, t[k], p, out);
+        q += DELTA_NQ;
+        out += DELTA_NSENSES;
+        if (p) p += p_stride;
+    }
+}

@@ -1850,3 +1850,14 @@ void delta_fk_point_kinematics(const delta_fk_real q[], const delta_fk_real dq[]
         }
     }
 }
+
+void delta_fk_senses_rows(int n, const delta_fk_real q[], const delta_fk_real t[], const delta_fk_real p[], int p_stride, delta_fk_real out[])
+{
+    int k;
+    for (k = 0; k < n; ++k) { /* each row's arrays follow the last's */
+        delta_fk_senses(q, t[k], p, out);
+        q += DELTA_FK_NQ;
+        out += DELTA_FK_NSENSES;
+        if (p) p += p_stride;
+    }
+}

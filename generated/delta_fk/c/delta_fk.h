@@ -158,6 +158,11 @@ void delta_fk_phi_p(const delta_fk_real q[], delta_fk_real t, const delta_fk_rea
 /* The senses at (q, t): out[NSENSES]. */
 void delta_fk_senses(const delta_fk_real q[], delta_fk_real t, const delta_fk_real p[], delta_fk_real out[]);
 
+/* The senses at n rows of a run: row k's q at q + k NQ and t[k], its p[] at p + k p_stride
+ * (p_stride 0: one p[] for every row; p may be NULL when there are no parameters);
+ * out[n NSENSES], row by row. One call for a whole run (the runtime's check along the motion). */
+void delta_fk_senses_rows(int n, const delta_fk_real q[], const delta_fk_real t[], const delta_fk_real p[], int p_stride, delta_fk_real out[]);
+
 /* Fused evaluation, for a Newton iterate: Phi (out[NQ]) and the non-zeros of Phi_q (nz[NNZ])
  * with their common subexpressions computed once, and the sines and cosines that Phi_t and
  * Gamma also need (shared[NSHARED]; may be NULL when NSHARED is 0). */

@@ -550,3 +550,14 @@ void rssr_point_kinematics(const rssr_real q[], const rssr_real dq[],
         }
     }
 }
+
+void rssr_senses_rows(int n, const rssr_real q[], const rssr_real t[], const rssr_real p[], int p_stride, rssr_real out[])
+{
+    int k;
+    for (k = 0; k < n; ++k) { /* each row's arrays follow the last's */
+        rssr_senses(q, t[k], p, out);
+        q += RSSR_NQ;
+        out += RSSR_NSENSES;
+        if (p) p += p_stride;
+    }
+}

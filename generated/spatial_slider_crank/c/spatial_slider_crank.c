@@ -852,3 +852,14 @@ void spatial_slider_crank_point_kinematics(const spatial_slider_crank_real q[], 
         }
     }
 }
+
+void spatial_slider_crank_senses_rows(int n, const spatial_slider_crank_real q[], const spatial_slider_crank_real t[], const spatial_slider_crank_real p[], int p_stride, spatial_slider_crank_real out[])
+{
+    int k;
+    for (k = 0; k < n; ++k) { /* each row's arrays follow the last's */
+        spatial_slider_crank_senses(q, t[k], p, out);
+        q += SPATIAL_SLIDER_CRANK_NQ;
+        out += SPATIAL_SLIDER_CRANK_NSENSES;
+        if (p) p += p_stride;
+    }
+}

@@ -131,6 +131,11 @@ void spatial_slider_crank_phi_p(const spatial_slider_crank_real q[], spatial_sli
 /* The senses at (q, t): out[NSENSES]. */
 void spatial_slider_crank_senses(const spatial_slider_crank_real q[], spatial_slider_crank_real t, const spatial_slider_crank_real p[], spatial_slider_crank_real out[]);
 
+/* The senses at n rows of a run: row k's q at q + k NQ and t[k], its p[] at p + k p_stride
+ * (p_stride 0: one p[] for every row; p may be NULL when there are no parameters);
+ * out[n NSENSES], row by row. One call for a whole run (the runtime's check along the motion). */
+void spatial_slider_crank_senses_rows(int n, const spatial_slider_crank_real q[], const spatial_slider_crank_real t[], const spatial_slider_crank_real p[], int p_stride, spatial_slider_crank_real out[]);
+
 /* Fused evaluation, for a Newton iterate: Phi (out[NQ]) and the non-zeros of Phi_q (nz[NNZ])
  * with their common subexpressions computed once, and the sines and cosines that Phi_t and
  * Gamma also need (shared[NSHARED]; may be NULL when NSHARED is 0). */

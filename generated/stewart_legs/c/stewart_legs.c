@@ -6731,3 +6731,14 @@ void stewart_legs_point_kinematics(const stewart_legs_real q[], const stewart_le
         }
     }
 }
+
+void stewart_legs_senses_rows(int n, const stewart_legs_real q[], const stewart_legs_real t[], const stewart_legs_real p[], int p_stride, stewart_legs_real out[])
+{
+    int k;
+    for (k = 0; k < n; ++k) { /* each row's arrays follow the last's */
+        stewart_legs_senses(q, t[k], p, out);
+        q += STEWART_LEGS_NQ;
+        out += STEWART_LEGS_NSENSES;
+        if (p) p += p_stride;
+    }
+}

@@ -6392,3 +6392,14 @@ void stewart_legs_fk_point_kinematics(const stewart_legs_fk_real q[], const stew
         }
     }
 }
+
+void stewart_legs_fk_senses_rows(int n, const stewart_legs_fk_real q[], const stewart_legs_fk_real t[], const stewart_legs_fk_real p[], int p_stride, stewart_legs_fk_real out[])
+{
+    int k;
+    for (k = 0; k < n; ++k) { /* each row's arrays follow the last's */
+        stewart_legs_fk_senses(q, t[k], p, out);
+        q += STEWART_LEGS_FK_NQ;
+        out += STEWART_LEGS_FK_NSENSES;
+        if (p) p += p_stride;
+    }
+}

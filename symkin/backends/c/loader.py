@@ -109,6 +109,7 @@ class _CFunctions:
         # getattr with a default: a kernel folder built before phi_p existed has none.
         self._c: dict[str, Any] = {name: getattr(lib, f"{prefix}_{name}", None)
                                    for name in self._sizes}
+        self._c["senses_rows"] = getattr(lib, f"{prefix}_senses_rows", None)
         # Only an over-constrained file's kernel has it (Kernel.removed_phi).
         self.removed: Callable[[Array, float, Array], Array] | None = (
             self._removed if nremoved else None)
@@ -166,22 +167,19 @@ class _CFunctions:
 
     def sense_rows(self, q: Array, t: Array, p: Array) -> Array:
         """The senses at every row (T, NSENSES) of q (T, NQ) at t (T,), p[] (NP,) or one
-        per row (T, NP): the arrays cross into C once, each row's call points into them (a
-        call per row through _senses costs several times the row's own solve)."""
+        per row (T, NP): one call of the generated senses_rows for the whole run (a call
+        per row through _senses costs several times the row's own solve)."""
         count, size = self._sizes["senses"], t.size
         out = np.zeros((size, count), dtype=self._dtype)
         rows = np.ascontiguousarray(q, self._dtype)
         params = np.ascontiguousarray(p, self._dtype)
-        pointer = f"{self._ctype[:-2]} *"
-        base_q = self._ffi.cast(pointer, self._ffi.from_buffer(self._ctype, rows))
-        base_p = self._ffi.cast(pointer, self._ffi.from_buffer(self._ctype, params)) \
-            if params.size else self._ffi.NULL
-        base_out = self._ffi.cast(pointer, self._ffi.from_buffer(self._ctype, out))
-        width_q, width_p = rows.shape[-1], params.shape[-1] if params.ndim == 2 else 0
-        evaluate = self._c["senses"]
-        for k in range(size):
-            evaluate(base_q + k * width_q, float(t[k]),
-                     base_p + k * width_p if width_p else base_p, base_out + k * count)
+        times = np.ascontiguousarray(t, self._dtype)
+        stride = params.shape[-1] if params.ndim == 2 else 0
+        self._c["senses_rows"](size, self._ffi.from_buffer(self._ctype, rows),
+                               self._ffi.from_buffer(self._ctype, times),
+                               self._ffi.from_buffer(self._ctype, params) if params.size
+                               else self._ffi.NULL, stride,
+                               self._ffi.from_buffer(self._ctype, out))
         return out.astype(np.float64, copy=False)
 
     def dynamics_rhs(self, q: Array, dq: Array, ddq: Array, t: float, p: Array) -> Array:
