@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from codegen_support import derived
 from driver_support import BACKENDS, kernel_for
 
 import symkin
@@ -181,7 +182,7 @@ def _cycloidal(theta: sp.Expr) -> sp.Expr:
 
 @pytest.fixture(scope="module")
 def cam():
-    return symkin.derive(EXAMPLES / "cam_cycloidal.yaml")
+    return derived(EXAMPLES / "cam_cycloidal.yaml")  # shared with the goldens' in a worker
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
