@@ -41,8 +41,16 @@ def example_ids() -> list[str]:
 
 
 @functools.cache
+def derived(path: Path):
+    """The System of a mechanism file, derived once per test process: a System is plain data
+    that compile, generate and solve only read, and the heavy examples (stewart_legs_fk's 91
+    coordinates) take SymPy a minute or more each. Tests that build from an example file take
+    it from here, so the files a worker runs share one derivation."""
+    return symkin.derive(Path(path).resolve())
+
+
 def system(name: str):
-    return symkin.derive(ROOT / "examples" / f"{name}.yaml")
+    return derived(ROOT / "examples" / f"{name}.yaml")
 
 
 def golden_folder(name: str, backend: str) -> Path:

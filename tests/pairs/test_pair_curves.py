@@ -8,6 +8,7 @@ range, a missing or clashing name."""
 from __future__ import annotations
 
 import csv
+import functools
 import json
 import math
 import os
@@ -18,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from codegen_support import derived
 from driver_support import BACKENDS, kernel_for
 
 import symkin
@@ -181,15 +183,23 @@ def _cycloidal(theta: sp.Expr) -> sp.Expr:
 
 @pytest.fixture(scope="module")
 def cam():
-    return symkin.derive(EXAMPLES / "cam_cycloidal.yaml")
+    return derived(EXAMPLES / "cam_cycloidal.yaml")  # shared with the goldens' in a worker
+
+
+@pytest.fixture(scope="module")
+def cam_kernel(cam):
+    """The cam's kernel of a backend, built once for the tests here (lowering its 600-character
+    profile takes many seconds)."""
+    return functools.cache(lambda backend: kernel_for(cam, backend))
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-def test_cam_follower_rises_dwells_and_returns_on_the_cycloidal_law(cam, backend: str) -> None:
+def test_cam_follower_rises_dwells_and_returns_on_the_cycloidal_law(cam, cam_kernel,
+                                                                   backend: str) -> None:
     """The cam turns clockwise at 1 rad/s, so the follower on the x axis meets the profile
     at the cam angle theta = t: x = R0 + y(t), its velocity y'(t) and acceleration y''(t);
     the contact parameter is s = t."""
-    kernel = kernel_for(cam, backend)
+    kernel = cam_kernel(backend)
     assert kernel.backend == backend
     run = symkin.solve(kernel)
     law = R0 + _cycloidal(T)
@@ -306,13 +316,14 @@ def test_drawn_cam_polar_profile_turns_with_its_frame() -> None:
     assert not math.isclose(runs[0].min(), runs[0].max())
 
 
-def test_cam_pressure_angle_and_curvature_radius_follow_the_law(cam, tmp_path: Path) -> None:
+def test_cam_pressure_angle_and_curvature_radius_follow_the_law(cam, cam_kernel,
+                                                               tmp_path: Path) -> None:
     """For a radial roller follower, tan(pressure angle) = y'(theta) / (R0 + y(theta)) (the
     pitch curve's normal against the follower's axis), undefined (NaN) in the dwells where
     the follower rests; the profile's radius of curvature is the pitch curve's, of the polar
     curve R = R0 + y: (R^2 + R'^2)^(3/2) / (R^2 + 2 R'^2 - R R''), less the roller's radius.
     Written as CSV columns and NPZ arrays k1.pressure_angle and k1.curvature_radius."""
-    run = symkin.with_outputs(cam, symkin.solve(kernel_for(cam, "numpy")))
+    run = symkin.with_outputs(cam, symkin.solve(cam_kernel("numpy")))
     outputs = dict(run.outputs)
     y, dy, d2y = _derivatives(_cycloidal(T), run.t)
     moving = np.abs(dy) > 1e-6

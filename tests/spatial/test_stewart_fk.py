@@ -14,12 +14,15 @@ legs and pose alike).
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 
 import mpmath
 import numpy as np
 import pytest
+from codegen_support import derived
+from octave_support import assert_octave_equals_numpy, needs_octave
 
 import symkin
 
@@ -72,12 +75,27 @@ def _euler_rotation(e: np.ndarray) -> np.ndarray:
         [e1 * e3 - e0 * e2, e2 * e3 + e0 * e1, e0 * e0 + e3 * e3 - 0.5]])
 
 
+@functools.cache
+def _compiled(name: str, backend: str):
+    # one derivation per file for both backends and the Octave check (stewart_legs_fk's
+    # takes a minute), one kernel per backend for every test here
+    return symkin.compile(derived(ROOT / "examples" / f"{name}.yaml"), backend=backend)
+
+
 @pytest.fixture(scope="module", params=[(f, b) for f in FILES for b in BACKENDS],
                 ids=lambda p: f"{p[0]}-{p[1]}")
 def kernel(request: pytest.FixtureRequest):
     name, backend = request.param
-    return name, symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"),
-                                backend=backend)
+    return name, _compiled(name, backend)
+
+
+@needs_octave
+@pytest.mark.slow
+def test_octave_runs_equal_numpy() -> None:
+    """stewart_legs_fk's part of tests/backends/octave's check on every example, here where
+    its derivation and NumPy kernel are built anyway."""
+    assert_octave_equals_numpy(derived(ROOT / "examples" / "stewart_legs_fk.yaml"),
+                               _compiled("stewart_legs_fk", "numpy"), "stewart_legs_fk")
 
 
 @pytest.mark.parametrize("tilt", [0.05, 0.5])

@@ -6,22 +6,17 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import derived
+from octave_support import assert_octave_equals_numpy, needs_octave
 
 import symkin
 from symkin.backends import get
-from symkin.codegen import sample
-
-# Without Octave the tests that run .m files skip (under CI, which installs it,
-# tests/conftest.py makes its absence an error instead).
-needs_octave = pytest.mark.skipif(shutil.which("octave-cli") is None,
-                                  reason="GNU Octave (octave-cli) is not on PATH")
 
 ROOT = Path(__file__).resolve().parents[3]
 EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
@@ -55,7 +50,7 @@ def generated(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     folders = {}
     for name in LINTED:
         folder = tmp_path_factory.mktemp(name)
-        symkin.generate(symkin.derive(ROOT / "examples" / f"{name}.yaml"), "octave", folder)
+        symkin.generate(derived(ROOT / "examples" / f"{name}.yaml"), "octave", folder)
         folders[name] = folder
     return folders
 
@@ -96,47 +91,28 @@ def test_row_comments_name_the_joint_or_driver(generated: dict[str, Path]) -> No
     assert re.search(r"% \(9, 3\) drivers\[0\] angle crank-ground \(angle\), crank\.phi", phi_q)
 
 
-def _inputs(system: symkin.System, times: np.ndarray) -> dict[str, np.ndarray]:
-    """For a file with input drivers: their nominal values moved a little each step, and
-    those rates."""
-    if not system.input_names:
-        return {}
-    start = np.array(sample.input_values(system), dtype=float)
-    steps = np.arange(len(times))[:, None] + 0 * start
-    return {"inputs": start + 1e-3 * steps,
-            "input_rates": 1e-3 / (times[1] - times[0]) + 0 * steps,
-            "input_accels": 0 * steps}
-
-
 # Deriving and lowering these takes SymPy a minute or more (each, twice lowered): slow.
 HEAVY = {"cam_cycloidal", "delta", "delta_fk", "stewart", "stewart_legs", "stewart_legs_fk"}
+# Checked where its derivation and NumPy kernel are built anyway:
+# tests/spatial/test_stewart_fk.py::test_octave_runs_equal_numpy.
+ELSEWHERE = {"stewart_legs_fk"}
 
 
 @needs_octave
 @pytest.mark.parametrize("path", [pytest.param(p, id=p.stem, marks=[pytest.mark.slow]
-                                               if p.stem in HEAVY else []) for p in EXAMPLES])
+                                               if p.stem in HEAVY else [])
+                                  for p in EXAMPLES if p.stem not in ELSEWHERE])
 def test_octave_runs_equal_numpy(path: Path) -> None:
-    """symkin.solve with the octave kernel gives NumPy's rows to 1e-12 (the first steps of
-    each example's grid: Octave evaluates each call in a running process)."""
-    system = symkin.derive(path)
-    octave, numpy = (symkin.compile(system, backend=b) for b in ("octave", "numpy"))
-    assert octave.backend == "octave"
-    t0, t1, dt = system.time_grid
-    times = t0 + dt * np.arange(min(6, round((t1 - t0) / dt) + 1))
-    runs = [symkin.solve(k, t=times, **_inputs(system, times)) for k in (octave, numpy)]
-    for field in ("q", "dq", "d2q"):
-        ours, theirs = (np.asarray(getattr(run, field)) for run in runs)
-        assert ours.shape == theirs.shape
-        assert np.isfinite(theirs).all(), (path.stem, field)
-        scale = 1 + np.max(np.abs(theirs))
-        assert np.max(np.abs(ours - theirs)) <= 1e-12 * scale, (path.stem, field)
+    """symkin.solve with the octave kernel gives NumPy's rows to 1e-12 on every example."""
+    system = derived(path)
+    assert_octave_equals_numpy(system, symkin.compile(system, backend="numpy"), path.stem)
 
 
 @needs_octave
 def test_parameters_are_an_argument(generated: dict[str, Path]) -> None:
     """Phi at other parameters than the nominal ones, in Octave, equals NumPy's there: the
     parameters are p, never constants baked into the files."""
-    system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
+    system = derived(ROOT / "examples" / "crank_slider.yaml")
     numpy = symkin.compile(system, backend="numpy")
     octave = get("octave").load(generated["crank_slider"],
                                 {**_manifest(generated["crank_slider"]), "backend": "octave"})
@@ -163,7 +139,7 @@ def test_the_generated_driver_solves_as_numpy(generated: dict[str, Path], name: 
     script = (f"[T, Q, DQ, D2Q] = {name}_solve(); fprintf('%.17g\\n', [T; Q; DQ; D2Q]);")
     result = subprocess.run(["octave-cli", "--norc", "--quiet", "--eval", script], cwd=folder,
                             capture_output=True, text=True, timeout=120, check=True)
-    numpy = symkin.solve(symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"),
+    numpy = symkin.solve(symkin.compile(derived(ROOT / "examples" / f"{name}.yaml"),
                                         backend="numpy"))
     values = np.array(result.stdout.split(), dtype=float)
     nq = numpy.q.shape[1]
@@ -180,7 +156,7 @@ def test_the_generated_driver_solves_as_numpy(generated: dict[str, Path], name: 
 def test_point_kinematics_equal_the_trajectorys(generated: dict[str, Path], name: str) -> None:
     """<prefix>_point_kinematics (r + R s and its derivatives; spatial: R from the Euler
     parameters) equals the runtime's points at a row of a NumPy run."""
-    numpy = symkin.solve(symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"),
+    numpy = symkin.solve(symkin.compile(derived(ROOT / "examples" / f"{name}.yaml"),
                                         backend="numpy"))
     expected = numpy.point_arrays()
     row = 7
