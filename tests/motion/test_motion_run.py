@@ -121,3 +121,23 @@ def test_a_free_freedom_without_mass_stops_with_a_message(
     err = capsys.readouterr().err
     assert "the kinetic energy does not decide the freedoms" in err
     assert "Traceback" not in err and err.count("\n") <= 2
+
+
+def test_a_stiff_spring_stops_at_the_work_bound_with_the_rows_kept(
+        crank_slider_c: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A spring of 1e9 N/m on the free crank-slider: the explicit integrator needs steps of
+    about 1e-5 s. It ran for minutes with no word before the bound (integrator.
+    MAX_STEPS_PER_ROW); now it stops at the first row the bound cannot reach, saying why and
+    what to do, with the rows before it kept. (The bound lowered tenfold here, to keep the
+    test short: the full one stops the same run after some 7 s of CPU.)"""
+    from symkin.runtime.dynamics import integrator
+
+    monkeypatch.setattr(integrator, "MAX_STEPS_PER_ROW", integrator.MAX_STEPS_PER_ROW // 10)
+    with pytest.raises(symkin.SolveError) as stop:
+        symkin.solve(crank_slider_c, params={"k": 1e9})
+    message = str(stop.value)
+    assert "2000 steps did not reach the next output time" in message and "--dt" in message
+    assert "stiff" in message and len(message) < 400
+    assert stop.value.reason == "too many substeps"  # type: ignore[attr-defined]
+    trajectory = stop.value.trajectory  # type: ignore[attr-defined]
+    assert trajectory.t.size >= 1 and np.isfinite(trajectory.q).all()

@@ -50,16 +50,21 @@ E = B - np.array([5179 / 57600, 0.0, 7571 / 16695, 393 / 640, -92097 / 339200, 1
 ORDER = 5
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 5.0
 MIN_STEP_FRACTION = 1e-12  # of the interval: below it the step is refused (a stiff lock-up)
+# Steps tried between two output rows before the run stops: a bound on the work one row may
+# take (a stiff spring makes an explicit method take steps of 1/omega; unbounded, a run of a
+# spring of 1e9 N/m went on for minutes with no word). A finer output grid allows more.
+MAX_STEPS_PER_ROW = 20_000
 PROJECTION_ITERATIONS = 10
 
 
 class StepFailure(Exception):
     """The integration cannot go on: ``reason`` and the time reached."""
 
-    def __init__(self, reason: str, t: float) -> None:
+    def __init__(self, reason: str, t: float, kind: str = "singular") -> None:
         super().__init__(reason)
         self.reason = reason
         self.t = t
+        self.kind = kind  # SolveFailure.reason: "singular", or "too many substeps" (the bound)
 
 
 @dataclass
@@ -100,8 +105,16 @@ class Stepper:
         t = state.t
         if self.step <= 0.0:
             self.step = self._first_step(t, y, t_end)
+        tried = 0
         while t < t_end:
             interrupted()
+            tried += 1
+            if tried > MAX_STEPS_PER_ROW:
+                raise StepFailure(
+                    f"{MAX_STEPS_PER_ROW} steps did not reach the next output time "
+                    f"{t_end:.6g} (the step was {self.step:.3g} s): the motion is too fast or "
+                    "stiff for this explicit integrator (a stiff spring, a large force?); a "
+                    "finer output grid (--dt) allows more steps", t, "too many substeps")
             h = min(self.step, t_end - t)
             if h <= MIN_STEP_FRACTION * max(1.0, abs(t_end)):
                 raise StepFailure(self.singular or "the step size fell below its minimum: "

@@ -115,7 +115,7 @@ def _solve(kernel: MotionKernel, t: ArrayLike | None, q0: ArrayLike | None,
                 else "No row was solved.")
         raise SolveFailure(f"the motion stops at t = {at:.6g}: {reason}. {kept}",
                            _trajectory(model, rows, p), at, math.nan, 0,
-                           reason="singular") from None
+                           reason=getattr(stop, "kind", "singular")) from None
     trajectory = _trajectory(model, rows, p)
     with rows_kept(trajectory, "the solved rows were checked"):
         flag_flips(model, trajectory, p)  # type: ignore[arg-type]  # a jump off the assembly
