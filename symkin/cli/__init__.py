@@ -115,7 +115,8 @@ def _generate(args: argparse.Namespace) -> int:
 
 
 def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    generate = commands.add_parser("generate", help="write the C or NumPy source of a mechanism")
+    generate = commands.add_parser(
+        "generate", help="write the source of a mechanism in a backend's language (--backend)")
     generate.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
     generate.add_argument("--backend", choices=backends.choices(), default="auto",
                           help="source to write (default auto, as for run: C when a C compiler "
