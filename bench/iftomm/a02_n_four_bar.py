@@ -40,7 +40,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from harness import Row, Run, SymkinC, SymkinNumPy, at_step, print_table, to_accuracy  # noqa: E402
+from harness import (  # noqa: E402
+    Row, Run, SymkinC, SymkinNumPy, at_step, exudyn_settings, print_table, to_accuracy)
 
 import symkin  # noqa: E402
 
@@ -150,12 +151,7 @@ def exudyn_run(n: int, h: float, repeat: int) -> Run:
                                             outputVariableType=exu.OutputVariableType.Position))
                    for c in cranks]
         mbs.Assemble()
-        settings = exu.SimulationSettings()
-        settings.timeIntegration.numberOfSteps = round(T_END / h)
-        settings.timeIntegration.endTime = T_END
-        settings.timeIntegration.verboseMode = 0
-        settings.solution.file.write = False
-        settings.solution.sensors.writePeriod = SAMPLE
+        settings = exudyn_settings(exu, T_END, h, SAMPLE)
         start = time.process_time()
         try:
             exu.SolveDynamic(mbs, settings)

@@ -39,7 +39,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from harness import Row, Run, SymkinC, SymkinNumPy, at_step, print_table, to_accuracy  # noqa: E402
+from harness import (  # noqa: E402
+    Row, Run, SymkinC, SymkinNumPy, at_step, exudyn_settings, print_table, to_accuracy)
 
 import symkin  # noqa: E402
 
@@ -144,12 +145,7 @@ def exudyn_run(q0: np.ndarray, h: float, repeat: int) -> Run:
                                             outputVariableType=exu.OutputVariableType.Rotation))
                    for node in nodes]
         mbs.Assemble()
-        settings = exu.SimulationSettings()
-        settings.timeIntegration.numberOfSteps = round(T_END / h)
-        settings.timeIntegration.endTime = T_END
-        settings.timeIntegration.verboseMode = 0
-        settings.solution.file.write = False
-        settings.solution.sensors.writePeriod = SAMPLE
+        settings = exudyn_settings(exu, T_END, h, SAMPLE)
         # its default Newton tolerance (relative 1e-8) leaves errors of 3e-6 rad whatever
         # the step: tightened so that the step decides the error
         settings.timeIntegration.newton.relativeTolerance = NEWTON_TOLERANCE

@@ -38,7 +38,8 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from harness import Row, Run, SymkinC, SymkinNumPy, at_step, print_table, to_accuracy  # noqa: E402
+from harness import (  # noqa: E402
+    Row, Run, SymkinC, SymkinNumPy, at_step, exudyn_settings, print_table, to_accuracy)
 
 import symkin  # noqa: E402
 
@@ -117,12 +118,7 @@ def exudyn_run(h: float, repeat: int) -> Run:
                                           storeInternal=True,
                                           outputVariableType=exu.OutputVariableType.Position))
         mbs.Assemble()
-        settings = exu.SimulationSettings()
-        settings.timeIntegration.numberOfSteps = round(T_END / h)
-        settings.timeIntegration.endTime = T_END
-        settings.timeIntegration.verboseMode = 0
-        settings.solution.file.write = False
-        settings.solution.sensors.writePeriod = SAMPLE
+        settings = exudyn_settings(exu, T_END, h, SAMPLE)
         settings.linearSolver.solverType = exu.LinearSolverType.EigenDense
         settings.linearSolverSettings.ignoreSingularJacobian = True
         start = time.process_time()

@@ -219,3 +219,15 @@ def print_table(title: str, rows: list[Row]) -> None:
     for row in rows:
         print(f"{row.solver:34} {row.h:11.3e} {row.seconds:9.4f} {row.error:9.2e}"
               f" {row.energy:9.2e}  {row.note}")
+
+
+def exudyn_settings(exu: ModuleType, end: float, h: float, sample: float) -> object:
+    """Exudyn's settings for a fixed step h to ``end``, the sensors stored every ``sample``,
+    no solution file and no console output: the same in every script (each adds its own)."""
+    settings = exu.SimulationSettings()
+    settings.timeIntegration.numberOfSteps = round(end / h)
+    settings.timeIntegration.endTime = end
+    settings.timeIntegration.verboseMode = 0
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = sample
+    return settings
