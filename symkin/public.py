@@ -56,8 +56,8 @@ def compile(system: System, backend: str = backends.AUTO, *, cse: bool = True,
 
     A mechanism its forces move (fewer drivers than freedoms, symbolic.motion) gives a
     MotionKernel: the integrator of runtime.dynamics evaluating the equations of motion
-    through this backend's compiled kernel (C or NumPy; Octave is refused with a
-    UsageError).
+    through this backend's compiled kernel (a backend whose generated code has no equations
+    of motion is refused with a BackendRefused).
     """
     chosen = backends.resolve(backend)
     if motion.moves_under_forces(system):

@@ -179,7 +179,7 @@ def test_redundant_parallelogram_falls_as_by_hand(falling: Any, falling_c: Any) 
 
 
 def test_redundant_parallelogram_in_float(falling: Any) -> None:
-    kernel = build_compile(falling, backends.get("c"), real="float")
+    kernel = build_compile(falling, backends.get("c"), {"real": "float"})
     q0, dq0 = _consistent_start(falling)
     motion = _stepper(kernel).run(options.defaults("float"),
                                   np.asarray(falling.p_values, float), 0.0, q0, dq0, 1e-2, 50)
