@@ -40,6 +40,8 @@ from scipy.integrate import solve_ivp  # noqa: E402
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
+from harness import exudyn_settings  # noqa: E402  (beside this script)
+
 import symkin  # noqa: E402
 
 G, L, T_END, SAMPLE = 9.81, 1.0, 10.0, 0.01
@@ -190,12 +192,7 @@ def exudyn_run(h: float, repeat: int) -> tuple[float, float]:
         sensor = mbs.AddSensor(SensorNode(nodeNumber=node, storeInternal=True,
                                           outputVariableType=exu.OutputVariableType.Position))
         mbs.Assemble()
-        settings = exu.SimulationSettings()
-        settings.timeIntegration.numberOfSteps = round(T_END / h)
-        settings.timeIntegration.endTime = T_END
-        settings.timeIntegration.verboseMode = 0
-        settings.solution.file.write = False
-        settings.solution.sensors.writePeriod = SAMPLE
+        settings = exudyn_settings(exu, T_END, h, SAMPLE)
         start = time.process_time()
         exu.SolveDynamic(mbs, settings)
         best = min(best, time.process_time() - start)

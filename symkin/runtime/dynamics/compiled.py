@@ -63,6 +63,8 @@ class CompiledModel:
         self.points, self.point_vectors = kernel.points, kernel.point_vectors()
         self.removed, self.senses = kernel.removed, kernel.senses
         self.sense_values = kernel.sense_values if kernel.senses else None
+        # a run's rows in one call (the C kernel's senses_rows): the check along the motion
+        self.sense_rows = kernel.sense_rows if kernel.senses else None
         self.given, self.rtol, self.atol = rest.given, rest.rtol, rest.atol
         self.given_values = rest.given_values
         self.potential, self.nonconservative = rest.potential, rest.nonconservative
