@@ -145,19 +145,20 @@ def _body_terms(ctx: SpatialContext, body: str, spec: Any, ddq: tuple[sp.Symbol,
     arm = (pose.A * _com(ctx, body, spec)).jacobian(e)
     arm_rate = arm.xreplace(dict(zip(pose.e, rates[3:])))
     G, G_rate = body_frame_rates(pose.e), body_frame_rates(tuple(rates[3:]))
-    inertia_G = inertia * G
-    spin = 2 * G * de
-    spin_momentum = inertia * spin
+    # the factors 4 and 8 go into J' (numbers or parameters) before it meets G: a number
+    # times a sum is distributed over its terms, so outside it would multiply each one
+    inertia_G = (4 * inertia) * G  # 4 J' G
+    rate_G = G * de  # ω' / 2
+    spin_momentum = (8 * inertia) * rate_G  # 4 J' ω'
     drift = arm_rate * de  # Ḃ ṗ: the centre's acceleration at p̈ = 0, r̈ = 0
     force = m * (accelerations[:3, :] + arm * accelerations[3:, :] + drift)
-    turning = inertia_G * accelerations[3:, :]  # J' alpha' / 2
-    inertial = sp.Matrix.vstack(
-        force, arm.T * force + 4 * (G.T * turning) + 4 * (G_rate.T * spin_momentum))
+    turning = inertia_G * accelerations[3:, :]  # 2 J' alpha'
+    inertial = sp.Matrix.vstack(force, arm.T * force + G.T * turning + G_rate.T * spin_momentum)
     mass = sp.BlockMatrix([[m * sp.eye(3), m * arm],
-                           [m * arm.T, m * (arm.T * arm) + 4 * (G.T * inertia_G)]]).as_explicit()
-    velocity = sp.Matrix.vstack(m * drift, m * (arm.T * drift) + 4 * (G_rate.T * spin_momentum))
+                           [m * arm.T, m * (arm.T * arm) + G.T * inertia_G]]).as_explicit()
+    velocity = sp.Matrix.vstack(m * drift, m * (arm.T * drift) + G_rate.T * spin_momentum)
     speed = v + arm * de
-    kinetic = m * (speed.T * speed)[0, 0] / 2 + (spin.T * spin_momentum)[0, 0] / 2
+    kinetic = m * (speed.T * speed)[0, 0] / 2 + (rate_G.T * spin_momentum)[0, 0] / 4
     return _BodyTerms(mass, velocity, inertial, kinetic)
 
 
