@@ -75,13 +75,20 @@ def derive(mech: Mechanism, ctx: SpatialContext, phi_q: sp.SparseMatrix, rows: A
     ddq = tuple(sp.Symbol(name + "_tt", real=True) for name in symbols.coordinates)
     lam = tuple(sp.Symbol(f"lambda{k}", real=True) for k in range(n + len(removed)))
     kinetic, applied = sp.Integer(0), sp.zeros(n, 1)
-    mass, velocity_terms = sp.zeros(n, n), sp.zeros(n, 1)
+    mass, velocity_terms, inertial = sp.zeros(n, n), sp.zeros(n, 1), sp.zeros(n, 1)
     for body, spec in mech.bodies.items():
-        kinetic += _body_terms(ctx, body, spec, mass, velocity_terms)
+        terms = _body_terms(ctx, body, spec, ddq)
+        columns = _columns(ctx, body)
+        for a, row in enumerate(columns):
+            velocity_terms[row] += terms.velocity[a]
+            inertial[row] += terms.inertial[a]
+            for b, column in enumerate(columns):
+                mass[row, column] += terms.mass[a, b]
+        kinetic += terms.kinetic
     for load in mech.forces:
         applied += (_torque(ctx, load) if load.type == "torque"
                     else dynamics.generalized_force(mech, ctx, load))
-    rhs = applied - mass * sp.Matrix(ddq) - velocity_terms
+    rhs = applied - inertial  # Q - (M q̈ + h), M q̈ + h as Newton-Euler (_body_terms)
     every_label = (*rows, *(label for label, _ in removed))
     return dynamics.assemble(
         mech, ctx, phi_q, rows, placed, removed, lam, _reaction,
@@ -99,20 +106,38 @@ def _com(ctx: SpatialContext, body: str, spec: Any) -> sp.Matrix:
     return ctx.local(body, spec.com) if spec.com is not None else sp.zeros(3, 1)
 
 
-def _body_terms(ctx: SpatialContext, body: str, spec: Any, mass: sp.Matrix,
-                velocity_terms: sp.Matrix) -> sp.Expr:
-    """Add one body's mass matrix and velocity terms (its own columns), return its T.
+@dataclass(frozen=True)
+class _BodyTerms:
+    """One body's share of the equations of motion, on its own seven columns."""
+
+    mass: sp.Matrix  # 7 x 7
+    velocity: sp.Matrix  # h, 7 x 1
+    inertial: sp.Matrix  # M q̈ + h, 7 x 1, written as Newton-Euler (see _body_terms)
+    kinetic: sp.Expr
+
+
+def _body_terms(ctx: SpatialContext, body: str, spec: Any, ddq: tuple[sp.Symbol, ...]
+                ) -> _BodyTerms:
+    """One body's mass matrix, velocity terms and M q̈ + h on its own columns, and its T.
 
     With B(p) = ∂(A c)/∂p (3 x 4, linear in p, so Ḃ = B(ṗ)) the velocity of the centre is
     ṙ + B ṗ and Lagrange's equations of T (module docstring) give, worked out once by hand
     (∂(B ṗ)/∂p = B(ṗ) and ∂(G ṗ)/∂p = -G(ṗ) = -Ġ, Ġ ṗ = 0):
 
         M = [[m I, m B], [m Bᵀ, m BᵀB + 4 GᵀJ'G]],   h = [m Ḃ ṗ; m Bᵀ Ḃ ṗ + 8 ĠᵀJ'G ṗ].
+
+    M q̈ + h is not formed from M (a 7 x 7 block of quadratics in p times q̈, which common
+    subexpressions cannot undo) but grouped as Newton-Euler per body, the same terms for
+    any p: the centre's acceleration a = r̈ + B p̈ + Ḃ ṗ and the force f = m a, the body-frame
+    ω' = 2 G ṗ and alpha' = 2 G p̈ (Ġ ṗ = 0), then [f; Bᵀ f + 2 Gᵀ J' alpha' + 4 Ġᵀ J' ω']. M and h
+    are grouped the same way (Bᵀ B, Gᵀ (J' G)), so each of B, Ḃ ṗ, ω', J' ω' appears once
+    for the code's common subexpressions to share.
     """
     pose = ctx.pose(body)
     columns = _columns(ctx, body)
     rates = [ctx.symbols.dq[k] for k in columns]
     v, de = sp.Matrix(rates[:3]), sp.Matrix(rates[3:])
+    accelerations = sp.Matrix([ddq[k] for k in columns])
     m = ctx.expr(spec.mass or 0)
     inertia = sp.Matrix([[ctx.expr(item) for item in row]
                          for row in forces3d.matrix(spec.inertia or 0)])
@@ -120,16 +145,21 @@ def _body_terms(ctx: SpatialContext, body: str, spec: Any, mass: sp.Matrix,
     arm = (pose.A * _com(ctx, body, spec)).jacobian(e)
     arm_rate = arm.xreplace(dict(zip(pose.e, rates[3:])))
     G, G_rate = body_frame_rates(pose.e), body_frame_rates(tuple(rates[3:]))
-    block = sp.BlockMatrix([[m * sp.eye(3), m * arm],
-                            [m * arm.T, m * arm.T * arm + 4 * G.T * inertia * G]]).as_explicit()
-    terms = sp.Matrix.vstack(m * arm_rate * de,
-                             m * arm.T * arm_rate * de + 8 * G_rate.T * inertia * G * de)
-    for a, row in enumerate(columns):
-        velocity_terms[row] += terms[a]
-        for b, column in enumerate(columns):
-            mass[row, column] += block[a, b]
-    speed, spin = v + arm * de, 2 * G * de
-    return m * (speed.T * speed)[0, 0] / 2 + (spin.T * inertia * spin)[0, 0] / 2
+    # the factors 4 and 8 go into J' (numbers or parameters) before it meets G: a number
+    # times a sum is distributed over its terms, so outside it would multiply each one
+    inertia_G = (4 * inertia) * G  # 4 J' G
+    rate_G = G * de  # ω' / 2
+    spin_momentum = (8 * inertia) * rate_G  # 4 J' ω'
+    drift = arm_rate * de  # Ḃ ṗ: the centre's acceleration at p̈ = 0, r̈ = 0
+    force = m * (accelerations[:3, :] + arm * accelerations[3:, :] + drift)
+    turning = inertia_G * accelerations[3:, :]  # 2 J' alpha'
+    inertial = sp.Matrix.vstack(force, arm.T * force + G.T * turning + G_rate.T * spin_momentum)
+    mass = sp.BlockMatrix([[m * sp.eye(3), m * arm],
+                           [m * arm.T, m * (arm.T * arm) + G.T * inertia_G]]).as_explicit()
+    velocity = sp.Matrix.vstack(m * drift, m * (arm.T * drift) + G_rate.T * spin_momentum)
+    speed = v + arm * de
+    kinetic = m * (speed.T * speed)[0, 0] / 2 + (rate_G.T * spin_momentum)[0, 0] / 4
+    return _BodyTerms(mass, velocity, inertial, kinetic)
 
 
 def _torque(ctx: SpatialContext, load: Any) -> sp.Matrix:
