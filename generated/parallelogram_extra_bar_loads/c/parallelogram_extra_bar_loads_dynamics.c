@@ -261,33 +261,33 @@ static int parallelogram_extra_bar_loads_dyn_factor_0(parallelogram_extra_bar_lo
     inv[19] = 1 / v[101];
     v[91] *= inv[19];
     v[27] -= v[91] * v[58];
-    /* pivot 20: row 5, column 21 */
-    cmax = fabs(v[79]);
-    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[81]);
-    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[79], cmax, tiny)) return 21;
-    inv[20] = 1 / v[79];
-    v[81] *= inv[20];
-    v[102] = -(v[81] * v[13]);
-    v[85] -= v[81] * v[83];
-    /* pivot 21: row 11, column 22 */
-    if (!(fabs(v[85]) > tiny)) return 22;
-    inv[21] = 1 / v[85];
+    /* pivot 20: row 5, column 22 */
+    cmax = fabs(v[83]);
+    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[85]);
+    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[83], cmax, tiny)) return 21;
+    inv[20] = 1 / v[83];
+    v[85] *= inv[20];
+    v[102] = -(v[85] * v[13]);
+    v[81] -= v[85] * v[79];
+    /* pivot 21: row 11, column 21 */
+    if (!(fabs(v[81]) > tiny)) return 22;
+    inv[21] = 1 / v[81];
     /* pivot 22: row 12, column 26 */
     /* pivot 23: row 13, column 27 */
     /* pivot 24: row 14, column 29 */
     /* pivot 25: row 26, column 12 */
     /* pivot 26: row 27, column 13 */
     /* pivot 27: row 29, column 14 */
-    /* pivot 28: row 21, column 5 */
-    cmax = fabs(v[46]);
-    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[50]);
-    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[46], cmax, tiny)) return 29;
-    inv[28] = 1 / v[46];
-    v[50] *= inv[28];
-    v[52] -= v[50] * v[48];
-    /* pivot 29: row 22, column 11 */
-    if (!(fabs(v[52]) > tiny)) return 30;
-    inv[29] = 1 / v[52];
+    /* pivot 28: row 22, column 5 */
+    cmax = fabs(v[50]);
+    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[46]);
+    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[50], cmax, tiny)) return 29;
+    inv[28] = 1 / v[50];
+    v[46] *= inv[28];
+    v[48] -= v[46] * v[52];
+    /* pivot 29: row 21, column 11 */
+    if (!(fabs(v[48]) > tiny)) return 30;
+    inv[29] = 1 / v[48];
     return 0;
 }
 
@@ -373,9 +373,9 @@ static void parallelogram_extra_bar_loads_dyn_forward_0(const parallelogram_extr
     x[16] += x[9];
     x[17] += x[10];
     x[20] -= v[11] * x[11];
-    x[28] -= x[11];
+    x[29] -= x[11];
     x[20] -= v[12] * x[12];
-    x[29] -= x[12];
+    x[28] -= x[12];
     x[18] -= v[18] * x[13];
     x[19] += x[13];
     x[18] -= v[19] * x[14];
@@ -384,14 +384,14 @@ static void parallelogram_extra_bar_loads_dyn_forward_0(const parallelogram_extr
     x[19] -= x[16];
     x[21] -= v[25] * x[16];
     x[25] += x[16];
-    x[28] += x[16];
+    x[29] += x[16];
     x[21] -= v[26] * x[17];
     x[26] += x[17];
-    x[29] += x[17];
+    x[28] += x[17];
     x[19] -= v[56] * x[18];
     x[21] -= v[91] * x[19];
-    x[21] -= v[81] * x[20];
-    x[29] -= v[50] * x[28];
+    x[21] -= v[85] * x[20];
+    x[29] -= v[46] * x[28];
 }
 
 /* U z = y, rows 29..0 */
@@ -400,7 +400,7 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     (void)v;
     (void)inv;
     x[29] *= inv[29];
-    x[28] -= v[48] * x[29];
+    x[28] -= v[52] * x[29];
     x[28] *= inv[28];
     x[27] += x[29];
     x[26] -= v[63] * x[29];
@@ -422,7 +422,7 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     x[21] -= v[102] * x[28];
     x[21] -= v[27] * x[29];
     x[21] *= inv[21];
-    x[20] -= v[83] * x[21];
+    x[20] -= v[79] * x[21];
     x[20] -= v[13] * x[28];
     x[20] *= inv[20];
     x[19] -= v[58] * x[29];
@@ -438,13 +438,13 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     x[10] = -x[10];
     x[9] = -x[9];
     x[8] -= v[23] * x[17];
-    x[8] -= x[21];
+    x[8] -= x[20];
     x[8] -= x[23];
     x[8] -= v[24] * x[29];
     x[8] = -x[8];
     x[7] -= v[21] * x[16];
     x[7] += x[19];
-    x[7] -= x[20];
+    x[7] -= x[21];
     x[7] -= x[22];
     x[7] -= v[22] * x[29];
     x[7] = -x[7];
@@ -461,11 +461,11 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     x[4] -= x[19];
     x[4] = -x[4];
     x[3] -= v[9] * x[12];
-    x[3] += x[21];
+    x[3] += x[20];
     x[3] -= v[10] * x[28];
     x[3] = -x[3];
     x[2] -= v[7] * x[11];
-    x[2] += x[20];
+    x[2] += x[21];
     x[2] -= v[8] * x[28];
     x[2] = -x[2];
     x[1] -= x[8];
@@ -543,8 +543,8 @@ static void parallelogram_extra_bar_loads_dyn_solve_motion(parallelogram_extra_b
         x[25] = work->phi[11];
         x[26] = work->phi[12];
         x[27] = work->phi[14];
-        x[28] = work->phi[6];
-        x[29] = work->phi[7];
+        x[28] = work->phi[7];
+        x[29] = work->phi[6];
         parallelogram_extra_bar_loads_dyn_forward_0(work->v, x);
         parallelogram_extra_bar_loads_dyn_backward_0(work->v, work->inv, x);
         lam[0] = x[0] * work->scale;
@@ -567,8 +567,8 @@ static void parallelogram_extra_bar_loads_dyn_solve_motion(parallelogram_extra_b
         ddq[10] = x[17];
         ddq[8] = x[18];
         lam[10] = x[19] * work->scale;
-        lam[6] = x[20] * work->scale;
-        lam[7] = x[21] * work->scale;
+        lam[7] = x[20] * work->scale;
+        lam[6] = x[21] * work->scale;
         lam[11] = x[22] * work->scale;
         lam[12] = x[23] * work->scale;
         lam[14] = x[24] * work->scale;
@@ -619,8 +619,8 @@ static void parallelogram_extra_bar_loads_dyn_correct_positions(parallelogram_ex
         x[25] = -work->phi[11];
         x[26] = -work->phi[12];
         x[27] = -work->phi[14];
-        x[28] = -work->phi[6];
-        x[29] = -work->phi[7];
+        x[28] = -work->phi[7];
+        x[29] = -work->phi[6];
         parallelogram_extra_bar_loads_dyn_forward_0(work->v, x);
         parallelogram_extra_bar_loads_dyn_backward_0(work->v, work->inv, x);
         work->q[0] += x[9];
@@ -679,8 +679,8 @@ static void parallelogram_extra_bar_loads_dyn_correct_velocities(parallelogram_e
         x[25] = -work->lam[11];
         x[26] = -work->lam[12];
         x[27] = -work->lam[14];
-        x[28] = -work->lam[6];
-        x[29] = -work->lam[7];
+        x[28] = -work->lam[7];
+        x[29] = -work->lam[6];
         parallelogram_extra_bar_loads_dyn_forward_0(work->v, x);
         parallelogram_extra_bar_loads_dyn_backward_0(work->v, work->inv, x);
         work->dq[0] += x[9];

@@ -43,6 +43,7 @@ def straight(plan: LUPlan, constants: Sequence[float | None] | None, real: str, 
     return {
         "n_lu": plan.n_lu, "n_fill": plan.n_lu - plan.nnz, "tau": repr(float(plan.tau)),
         "flops": plan.flops, "solve_flops": plan.solve_flops,
+        "swaps": [[swap.k, swap.p] for swap in plan.swaps],
         "row_perm": list(plan.row_perm), "col_perm": list(plan.col_perm),
         "loaded": code.loaded, "known_max": code.known_max, "tiny_check": code.tiny_check,
         "constant_pivots": code.constant_pivots, "pivot_ok": code.uses_pivot_ok,
