@@ -9,6 +9,8 @@ kinematic step, then takes K kinematic steps of the file's dt and K dynamics ste
 from there; the count per step is (instructions at K = 1 + --steps minus at K = 1) / --steps,
 so set-up, the first assembly and the dynamics step's first evaluation cancel. Instruction
 counts do not depend on the load of a shared machine, unlike the times of step_ratio.py.
+The dynamics steps of both default examples are guarded by tests/test_performance_budget.py
+against bench/budgets.json.
 """
 
 from __future__ import annotations
@@ -70,8 +72,8 @@ def _instructions(program: Path, steps: int, kind: str) -> int:
     return int(found.group(1))
 
 
-def per_step(example: str, steps: int, scratch: Path) -> tuple[float, float]:
-    """(kinematic, dynamics) instructions per step of ``example``."""
+def program(example: str, scratch: Path) -> Path:
+    """The example's generated folder compiled with MAIN (gcc -O2) in ``scratch``."""
     system = symkin.derive(ROOT / "examples" / f"{example}.yaml")
     folder = scratch / example
     symkin.generate(system, "c", folder)
@@ -79,12 +81,21 @@ def per_step(example: str, steps: int, scratch: Path) -> tuple[float, float]:
     source = (MAIN.replace("@P@", example).replace("@U@", example.upper())
               .replace("@T0@", repr(float(t0))).replace("@DT@", repr(float(dt))))
     (folder / "main.c").write_text(source)
-    program = folder / "main"
-    subprocess.run(["gcc", "-std=c99", "-O2", f"-I{folder}", "-o", str(program),
+    built = folder / "main"
+    subprocess.run(["gcc", "-std=c99", "-O2", f"-I{folder}", "-o", str(built),
                     *sorted(str(p) for p in folder.glob("*.c")), "-lm"], check=True)
-    counts = {kind: (_instructions(program, 1 + steps, kind) - _instructions(program, 1, kind))
-              / steps for kind in ("kinematic", "dynamics")}
-    return counts["kinematic"], counts["dynamics"]
+    return built
+
+
+def count(built: Path, steps: int, kind: str) -> float:
+    """Instructions per step of ``kind`` ("kinematic" or "dynamics") of a built program."""
+    return (_instructions(built, 1 + steps, kind) - _instructions(built, 1, kind)) / steps
+
+
+def per_step(example: str, steps: int, scratch: Path) -> tuple[float, float]:
+    """(kinematic, dynamics) instructions per step of ``example``."""
+    built = program(example, scratch)
+    return count(built, steps, "kinematic"), count(built, steps, "dynamics")
 
 
 def main() -> None:

@@ -1,5 +1,6 @@
 """A performance guard: instruction counts (callgrind; they do not move with the machine's
-load, unlike times) of the crank-slider's generated step and of one ``symkin.solve`` call,
+load, unlike times) of the crank-slider's generated step, of one ``symkin.solve`` call and of
+the generated ``<prefix>_dynamics_step`` of the two examples with masses and drivers,
 against the budgets committed in bench/budgets.json with their margins. A change that costs
 more fails here and says so in its diff by raising the budget.
 
@@ -16,6 +17,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "bench"))
+import dynamics_instructions  # noqa: E402
 import instructions  # noqa: E402
 
 BUDGETS = json.loads((ROOT / "bench" / "budgets.json").read_text())
@@ -42,3 +44,11 @@ def test_the_crank_slider_step_keeps_its_budget():
 
 def test_one_solve_call_keeps_its_budget(tmp_path):
     _within("crank_slider_solve_call", instructions.per_solve_call("crank_slider", tmp_path))
+
+
+@pytest.mark.parametrize(("example", "name"), [
+    ("four_bar_dynamics", "four_bar_dynamics_step"),
+    ("crank_slider_load", "crank_slider_load_dynamics_step")])
+def test_the_dynamics_step_keeps_its_budget(example: str, name: str, tmp_path: Path) -> None:
+    built = dynamics_instructions.program(example, tmp_path)
+    _within(name, dynamics_instructions.count(built, 100, "dynamics"))

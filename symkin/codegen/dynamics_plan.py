@@ -12,8 +12,12 @@ its factorization are fixed once, by the same analysis as the kinematic solver's
 (codegen.lu_plan: Markowitz's rule on the structure, checked on a numeric sample, threshold
 pivoting on the sample where the structure's order fails it; the run-time pivot test sends a
 factorization that fails it to the dense fall-back). The samples are the mechanism at the
-file's q0 assembled at t0 (codegen.sample) and configurations spread about it (SPREAD), M
-and Phi_q evaluated there.
+file's q0 assembled at t0 (codegen.sample), configurations spread about it (SPREAD), the
+start turned to the quarter turns (ALIGNED) and mechanisms assembled anywhere on the turn
+(TURNS), M and Phi_q evaluated there. Where no fixed
+order holds at all of them, rows of one pattern trade places at run time when the larger
+entry asks for it (codegen.lu_interchange, as for the kinematic LU), so that the dense
+fall-back stays for what no interchange mends.
 
 Units. The threshold tests compare entries of one column, M's (a mass, an inertia) with
 Phi_q's (numbers, lengths): with masses in tonnes or grams no fixed order would pass them for
@@ -36,13 +40,13 @@ residual, so a dependency that stops holding is seen.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 
-from symkin.codegen import lu_plan, sample, symbol_printing
+from symkin.codegen import lu_interchange, lu_plan, sample, symbol_printing
 from symkin.errors import BuildError, SolveError
 from symkin.symbolic import redundancy
 from symkin.symbolic.derivation import System
@@ -88,6 +92,69 @@ another (a free body's Euler parameters at another orientation). The order that 
 all of them, or fails at the fewest, is taken (lu_plan.analyse_over)."""
 
 
+ALIGNED = 4
+"""Samples of the start with every planar angle (``.phi``) at j quarter turns and every body's
+Euler parameters (``.e0`` .. ``.e3``) at the j-th unit vector, j < ALIGNED: the orientations
+where the entries of Phi_q and M that are sines, cosines or parameters vanish (a free body at
+the identity has Phi_q's normalisation row 2 (1, 0, 0, 0)), which seeded samples never meet
+and a body its forces turn meets at every quarter turn."""
+
+
+def aligned(names: Sequence[str], start: np.ndarray) -> list[np.ndarray]:
+    """The ALIGNED samples of ``start`` (coordinates named as ``names``)."""
+    found = []
+    for j in range(ALIGNED):
+        q = start.copy()
+        for i, name in enumerate(names):
+            suffix = name.rsplit(".", 1)[-1]
+            if suffix == "phi":
+                q[i] = j * np.pi / 2
+            elif suffix in ("e0", "e1", "e2", "e3"):
+                q[i] = 1.0 if suffix == f"e{j}" else 0.0
+        found.append(q)
+    return found if any(n.rsplit(".", 1)[-1] in ("phi", "e0") for n in names) else []
+
+
+TURNS = 16
+"""Seeded configurations with every planar angle anywhere on the turn (the others moved by up
+to SPREAD), each taken onto Phi(q, t0) = 0 by minimum-norm Newton (those that do not get
+there in TURN_ITERATIONS are left out): where a mechanism its forces move goes. A pivot can
+shrink at a configuration the loops' closure alone reaches, which no unassembled sample meets
+(Andrews' squeezer: about 2 % of its factorizations before these samples, none after)."""
+
+TURN_ITERATIONS = 30
+
+
+def turned(names: Sequence[str], start: np.ndarray, generator: np.random.Generator,
+           closure: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> list[np.ndarray]:
+    """The TURNS samples about ``start``: ``closure(q)`` gives Phi and the dense Phi_q at q
+    (at t0); the assembled ones, in the order drawn."""
+    angles = [i for i, name in enumerate(names) if name.endswith(".phi")]
+    found = []
+    for _ in range(TURNS):
+        q = start + generator.uniform(-SPREAD, SPREAD, start.size)
+        q[angles] = generator.uniform(-np.pi, np.pi, len(angles))
+        assembled = _onto_constraints(q, closure)
+        if assembled is not None:
+            found.append(assembled)
+    return found
+
+
+def _onto_constraints(q: np.ndarray, closure: Callable[[np.ndarray], tuple[np.ndarray,
+                                                                              np.ndarray]]
+                      ) -> np.ndarray | None:
+    """Minimum-norm Newton from q onto Phi = 0 (Phi_q has fewer rows than columns where the
+    forces move the mechanism): the q reached, or None."""
+    for _ in range(TURN_ITERATIONS):
+        phi, jacobian = closure(q)
+        if not (np.all(np.isfinite(phi)) and np.all(np.isfinite(jacobian))):
+            return None
+        if np.max(np.abs(phi), initial=0.0) <= sample.NEWTON.tol_phi:
+            return q
+        q = q - np.linalg.lstsq(jacobian, phi, rcond=None)[0]
+    return None
+
+
 def analyse(system: System, pattern: Sequence[tuple[int, int]],
             m_pattern: Sequence[tuple[int, int]]) -> AugmentedPlan:
     """The kept rows and the sparse LU of the step's matrix (module docstring).
@@ -107,8 +174,8 @@ def analyse(system: System, pattern: Sequence[tuple[int, int]],
     values = [[float(mass[e]) / _mass_scale(mass) if kind == "m" else float(jacobian[e])
                for _, _, (kind, e) in entries] for mass, jacobian in samples]
     try:
-        plan = lu_plan.analyse_over(nq + len(kept), [r for r, _, _ in entries],
-                                    [c for _, c, _ in entries], values)
+        plan = lu_interchange.analyse_over(nq + len(kept), [r for r, _, _ in entries],
+                                           [c for _, c, _ in entries], values)
     except SolveError as error:
         raise BuildError(f"cannot plan the sparse LU of the equations of motion: {error}. "
                          "A coordinate that no mass and no constraint reaches has no "
@@ -139,7 +206,8 @@ def _numbers(matrix: sp.MatrixBase, pattern: Sequence[tuple[int, int]]
 def _samples(system: System, pattern: Sequence[tuple[int, int]],
              m_pattern: Sequence[tuple[int, int]]) -> list[tuple[np.ndarray, np.ndarray]]:
     """M's and Phi_q's non-zeros at the file's q0 assembled at t0 (codegen.sample), then at
-    SPREAD_SAMPLES configurations about it (every coordinate moved by up to SPREAD, seeded);
+    SPREAD_SAMPLES configurations about it (every coordinate moved by up to SPREAD, seeded),
+    at the ALIGNED ones and the TURNS;
     those with an entry that is not finite left out, seeded values on the patterns where
     none is left (the run-time test guards it)."""
     internal = symbol_printing.internal_symbols(system)
@@ -150,7 +218,8 @@ def _samples(system: System, pattern: Sequence[tuple[int, int]],
     functions = (sp.lambdify(arguments, [prepare(mass[r, c]) for r, c in m_pattern],
                              modules="numpy"),
                  sp.lambdify(arguments, [prepare(system.phi_q[r, c]) for r, c in pattern],
-                             modules="numpy"))
+                             modules="numpy"),
+                 sp.lambdify(arguments, [prepare(e) for e in system.phi], modules="numpy"))
     t0, p = np.float64(system.time_grid[0]), np.array(system.code_p_values, dtype=float)
     generator = np.random.default_rng(sample.STRUCTURE_SEED)
     with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -158,9 +227,18 @@ def _samples(system: System, pattern: Sequence[tuple[int, int]],
         start = np.array(sample.sample_configuration(system), dtype=float)
         spread = SPREAD_SAMPLES if start.size <= sample.MAX_SAMPLED_NQ else 0
         moved = [start + generator.uniform(-SPREAD, SPREAD, start.size) for _ in range(spread)]
+        rows, cols = [r for r, _ in pattern], [c for _, c in pattern]
+
+        def closure(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            jacobian = np.zeros((len(system.phi), start.size))
+            jacobian[rows, cols] = np.array(functions[1](q, t0, p), dtype=float).reshape(-1)
+            return np.array(functions[2](q, t0, p), dtype=float).reshape(-1), jacobian
+
+        extra = ([*aligned(system.coordinates, start),
+                  *turned(system.coordinates, start, generator, closure)] if spread else [])
         found = [(np.array(functions[0](q, t0, p), dtype=float).reshape(-1),
                   np.array(functions[1](q, t0, p), dtype=float).reshape(-1))
-                 for q in [start, *moved]]
+                 for q in [start, *moved, *extra]]
     finite = [values for values in found if all(np.all(np.isfinite(v)) for v in values)]
     return finite or [(generator.uniform(0.5, 1.5, len(m_pattern)),
                        generator.uniform(0.5, 1.5, len(pattern)))]

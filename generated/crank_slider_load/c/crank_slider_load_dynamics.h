@@ -24,10 +24,14 @@
  *              stage's factors (simplified Newton: the correction closest to q in the metric
  *              of M), repeated until max|Phi| <= options->tol_phi over every row, at most
  *              options->max_iterations corrections;
- *   velocities dq += dv with the matrix factored at the corrected q and the right-hand side
- *              [0; -(Phi_k dq + Phi_t,k)], so that Phi_q dq = -Phi_t;
- *   then ddq and lam at the new (q, dq) on the same factors, which also start the next step.
- * Four factorizations a step (five on the first call).
+ *   velocities dq += dv with the matrix of Phi_q at the corrected q (from the position
+ *              check's fused call) and the last stage's M factored, and the right-hand side
+ *              [0; -(Phi_k dq + Phi_t,k)], so that Phi_q dq = -Phi_t (M, the metric of the
+ *              correction, from a q within h |dq|: the kernel's M, Q - h and Gamma run once
+ *              at the corrected q, not twice);
+ *   then ddq and lam at the new (q, dq), which also start the next step.
+ * Five factorizations and four evaluations of M, Q - h and Gamma a step (one more of each on
+ * the first call).
  * No malloc, no stdio, no mutable statics: the caller owns every buffer.
  */
 #ifndef CRANK_SLIDER_LOAD_DYNAMICS_H
@@ -43,15 +47,15 @@
 /* Operations of one crank_slider_load_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of crank_slider_load_dynamics.c, every branch that adds work
  * taken, the position corrections at their cap); each sin, cos, ... is a library call.
- * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 228
- * Runge-Kutta, three stages: 939; one position correction: 142; the factorization at the corrected q, velocity correction and accelerations: 492
- * Step, worst case with the default cap of 25 corrections: 5282 (2581 add/sub, 1444 mul, 18 div, 0 sqrt, 128 other calls, 601 fabs, 510 compares)
+ * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 204
+ * Runge-Kutta, three stages: 867; one position correction: 144; the velocity correction (a factorization) and the accelerations at the corrected q, dq: 471
+ * Step, worst case with the default cap of 25 corrections: 5217 (2622 add/sub, 1403 mul, 21 div, 0 sqrt, 124 other calls, 576 fabs, 471 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
- * On the dense fall-back at every factorization, worst case: 44512
+ * On the dense fall-back at every factorization, worst case: 48821
  */
-#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_ITERATION 142  /* one position correction */
-#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_FIXED 1732  /* a step without its corrections */
-#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_STEP_WORST 5282  /* at the default cap, 25 */
+#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_ITERATION 144  /* one position correction */
+#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_FIXED 1617  /* a step without its corrections */
+#define CRANK_SLIDER_LOAD_OPS_DYNAMICS_STEP_WORST 5217  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */
@@ -76,6 +80,7 @@ typedef struct {
     crank_slider_load_real mass[CRANK_SLIDER_LOAD_NNZ_M];
     crank_slider_load_real nz[CRANK_SLIDER_LOAD_NNZ];
     crank_slider_load_real phi[CRANK_SLIDER_LOAD_NR];
+    crank_slider_load_real shared[4]; /* sin, cos of the position check's q (crank_slider_load_phi_phi_q) */
     crank_slider_load_real q[CRANK_SLIDER_LOAD_NQ];  /* a stage's point */
     crank_slider_load_real dq[CRANK_SLIDER_LOAD_NQ];
     crank_slider_load_real sum_q[CRANK_SLIDER_LOAD_NQ];  /* the stages' weighted sums */

@@ -51,19 +51,24 @@ static four_bar_dynamics_real four_bar_dynamics_dyn_lu_amax(four_bar_dynamics_re
 
 /* The entries of M and Phi_q that vary into their slots of the sparse factors (the numbers
  * among them, and the fill-in's first value, are folded into the code), M's divided by its
- * scale s = max |M_ij| (work->scale: the threshold tests then hold for any unit of mass);
- * returns the tiny-pivot bound, NaN when an entry is not finite so that every pivot test
- * fails. */
+ * scale s = max |M_ij| (work->scale: the threshold tests then hold for any unit of mass),
+ * found on M's diagonal (M is positive semi-definite: |M_ij| <= sqrt(M_ii M_jj));
+ * returns the tiny-pivot bound, NaN when an entry of M's diagonal or of Phi_q is not finite
+ * so that every pivot test fails (another entry of M that is not finite fails a pivot it
+ * reaches, or ends the step at its test of ddq). */
 static four_bar_dynamics_real four_bar_dynamics_dyn_load(four_bar_dynamics_dynamics_work *work)
 {
     four_bar_dynamics_real *v = work->v;
     four_bar_dynamics_real amax = 1.0, finite = 0, mmax = 0, a, x;
-    int e;
-    for (e = 0; e < FOUR_BAR_DYNAMICS_NNZ_M; ++e) {
-        a = fabs(work->mass[e]);
-        mmax = a > mmax ? a : mmax;
-        finite += a - a;
-    }
+    a = fabs(work->mass[0]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[2]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[6]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[7]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[9]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[13]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[14]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[16]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[20]); mmax = a > mmax ? a : mmax; finite += a - a;
     work->scale = mmax > 0 ? mmax : 1;
     work->inverse_scale = 1 / work->scale;
     amax = amax > 1 ? amax : 1; /* M / s: its largest entry is 1 (0 where M is) */
@@ -343,53 +348,11 @@ static void four_bar_dynamics_dyn_backward_0(const four_bar_dynamics_real *v, co
     x[0] = -x[0];
 }
 
-/* Solve A x = b in place with the last factorization, whichever path it took. */
-static void four_bar_dynamics_dyn_solve(const four_bar_dynamics_dynamics_work *work, four_bar_dynamics_real b[])
+/* Solve A x = b in place on the dense fall-back's factors. */
+static void four_bar_dynamics_dyn_solve_dense(const four_bar_dynamics_dynamics_work *work, four_bar_dynamics_real b[])
 {
     const int n = FOUR_BAR_DYNAMICS_NA;
-    four_bar_dynamics_real x[FOUR_BAR_DYNAMICS_NA];
     int i, j;
-    if (!work->dense) { /* 60 operations, the permutations baked in */
-        x[0] = b[0];
-        x[1] = b[1];
-        x[2] = b[6];
-        x[3] = b[7];
-        x[4] = b[2];
-        x[5] = b[3];
-        x[6] = b[4];
-        x[7] = b[9];
-        x[8] = b[10];
-        x[9] = b[15];
-        x[10] = b[16];
-        x[11] = b[17];
-        x[12] = b[11];
-        x[13] = b[12];
-        x[14] = b[5];
-        x[15] = b[8];
-        x[16] = b[13];
-        x[17] = b[14];
-        four_bar_dynamics_dyn_forward_0(work->v, x);
-        four_bar_dynamics_dyn_backward_0(work->v, work->inv, x);
-        b[9] = x[0];
-        b[10] = x[1];
-        b[15] = x[2];
-        b[16] = x[3];
-        b[17] = x[4];
-        b[11] = x[5];
-        b[12] = x[6];
-        b[0] = x[7];
-        b[1] = x[8];
-        b[6] = x[9];
-        b[7] = x[10];
-        b[2] = x[11];
-        b[3] = x[12];
-        b[4] = x[13];
-        b[13] = x[14];
-        b[14] = x[15];
-        b[5] = x[16];
-        b[8] = x[17];
-        return;
-    }
     for (i = 0; i < n; ++i) { /* the row interchanges, in the order they were made */
         const int r = work->perm[i];
         const four_bar_dynamics_real swap = b[i];
@@ -405,17 +368,151 @@ static void four_bar_dynamics_dyn_solve(const four_bar_dynamics_dynamics_work *w
     }
 }
 
+/* On the dense path: the right-hand side [M's rows from work->b; kept rows of Phi's from
+ * rows[]] (negated when sign < 0) solved in work->b. */
+static void four_bar_dynamics_dyn_dense_rhs(four_bar_dynamics_dynamics_work *work, const four_bar_dynamics_real rows[], four_bar_dynamics_real sign)
+{
+    int i;
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) work->b[FOUR_BAR_DYNAMICS_NQ + i] = sign * rows[i];
+    four_bar_dynamics_dyn_solve_dense(work, work->b);
+}
+
 /* ddq and lam from Q - h in work->b[0..NQ) and Gamma in work->phi, with the factors of the
  * same state: [M/s Phi_k^T; Phi_k 0] [ddq; lam/s] = [(Q - h)/s; Gamma_k] solved (the rows
- * left out get lam 0). */
+ * left out get lam 0). The sparse path reads and writes in place (60 operations). */
 static void four_bar_dynamics_dyn_solve_motion(four_bar_dynamics_dynamics_work *work, four_bar_dynamics_real ddq[], four_bar_dynamics_real lam[])
 {
     int i;
+    if (!work->dense) {
+        four_bar_dynamics_real x[FOUR_BAR_DYNAMICS_NA];
+        x[0] = work->b[0] * work->inverse_scale;
+        x[1] = work->b[1] * work->inverse_scale;
+        x[2] = work->b[6] * work->inverse_scale;
+        x[3] = work->b[7] * work->inverse_scale;
+        x[4] = work->b[2] * work->inverse_scale;
+        x[5] = work->b[3] * work->inverse_scale;
+        x[6] = work->b[4] * work->inverse_scale;
+        x[7] = work->phi[0];
+        x[8] = work->phi[1];
+        x[9] = work->phi[6];
+        x[10] = work->phi[7];
+        x[11] = work->phi[8];
+        x[12] = work->phi[2];
+        x[13] = work->phi[3];
+        x[14] = work->b[5] * work->inverse_scale;
+        x[15] = work->b[8] * work->inverse_scale;
+        x[16] = work->phi[4];
+        x[17] = work->phi[5];
+        four_bar_dynamics_dyn_forward_0(work->v, x);
+        four_bar_dynamics_dyn_backward_0(work->v, work->inv, x);
+        lam[0] = x[0] * work->scale;
+        lam[1] = x[1] * work->scale;
+        lam[6] = x[2] * work->scale;
+        lam[7] = x[3] * work->scale;
+        lam[8] = x[4] * work->scale;
+        lam[2] = x[5] * work->scale;
+        lam[3] = x[6] * work->scale;
+        ddq[0] = x[7];
+        ddq[1] = x[8];
+        ddq[6] = x[9];
+        ddq[7] = x[10];
+        ddq[2] = x[11];
+        ddq[3] = x[12];
+        ddq[4] = x[13];
+        lam[4] = x[14] * work->scale;
+        lam[5] = x[15] * work->scale;
+        ddq[5] = x[16];
+        ddq[8] = x[17];
+        return;
+    }
     for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->b[i] *= work->inverse_scale;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) work->b[FOUR_BAR_DYNAMICS_NQ + i] = work->phi[i];
-    four_bar_dynamics_dyn_solve(work, work->b);
+    four_bar_dynamics_dyn_dense_rhs(work, work->phi, 1);
     for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) ddq[i] = work->b[i];
     for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) lam[i] = work->b[FOUR_BAR_DYNAMICS_NQ + i] * work->scale;
+}
+
+/* q += dx, [M/s Phi_k^T; Phi_k 0] [dx; mu] = [0; -Phi_k] with Phi in work->phi. */
+static void four_bar_dynamics_dyn_correct_positions(four_bar_dynamics_dynamics_work *work)
+{
+    int i;
+    if (!work->dense) {
+        four_bar_dynamics_real x[FOUR_BAR_DYNAMICS_NA];
+        x[0] = 0;
+        x[1] = 0;
+        x[2] = 0;
+        x[3] = 0;
+        x[4] = 0;
+        x[5] = 0;
+        x[6] = 0;
+        x[7] = -work->phi[0];
+        x[8] = -work->phi[1];
+        x[9] = -work->phi[6];
+        x[10] = -work->phi[7];
+        x[11] = -work->phi[8];
+        x[12] = -work->phi[2];
+        x[13] = -work->phi[3];
+        x[14] = 0;
+        x[15] = 0;
+        x[16] = -work->phi[4];
+        x[17] = -work->phi[5];
+        four_bar_dynamics_dyn_forward_0(work->v, x);
+        four_bar_dynamics_dyn_backward_0(work->v, work->inv, x);
+        work->q[0] += x[7];
+        work->q[1] += x[8];
+        work->q[6] += x[9];
+        work->q[7] += x[10];
+        work->q[2] += x[11];
+        work->q[3] += x[12];
+        work->q[4] += x[13];
+        work->q[5] += x[16];
+        work->q[8] += x[17];
+        return;
+    }
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->b[i] = 0;
+    four_bar_dynamics_dyn_dense_rhs(work, work->phi, -1);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->q[i] += work->b[i];
+}
+
+/* dq += dv, [M/s Phi_k^T; Phi_k 0] [dv; mu] = [0; -v] with the violation v in work->lam. */
+static void four_bar_dynamics_dyn_correct_velocities(four_bar_dynamics_dynamics_work *work)
+{
+    int i;
+    if (!work->dense) {
+        four_bar_dynamics_real x[FOUR_BAR_DYNAMICS_NA];
+        x[0] = 0;
+        x[1] = 0;
+        x[2] = 0;
+        x[3] = 0;
+        x[4] = 0;
+        x[5] = 0;
+        x[6] = 0;
+        x[7] = -work->lam[0];
+        x[8] = -work->lam[1];
+        x[9] = -work->lam[6];
+        x[10] = -work->lam[7];
+        x[11] = -work->lam[8];
+        x[12] = -work->lam[2];
+        x[13] = -work->lam[3];
+        x[14] = 0;
+        x[15] = 0;
+        x[16] = -work->lam[4];
+        x[17] = -work->lam[5];
+        four_bar_dynamics_dyn_forward_0(work->v, x);
+        four_bar_dynamics_dyn_backward_0(work->v, work->inv, x);
+        work->dq[0] += x[7];
+        work->dq[1] += x[8];
+        work->dq[6] += x[9];
+        work->dq[7] += x[10];
+        work->dq[2] += x[11];
+        work->dq[3] += x[12];
+        work->dq[4] += x[13];
+        work->dq[5] += x[16];
+        work->dq[8] += x[17];
+        return;
+    }
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->b[i] = 0;
+    four_bar_dynamics_dyn_dense_rhs(work, work->lam, -1);
+    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->dq[i] += work->b[i];
 }
 
 /* An evaluation at (q, dq, t): M, Phi_q, Q - h and Gamma in one call (each sine and cosine
@@ -436,27 +533,34 @@ static int four_bar_dynamics_dyn_evaluate(const four_bar_dynamics_real q[], cons
 static int four_bar_dynamics_dyn_stage(four_bar_dynamics_real t, const four_bar_dynamics_real p[], four_bar_dynamics_real weight,
                           four_bar_dynamics_dynamics_work *work, four_bar_dynamics_dynamics_report *report)
 {
-    int i, pivot = four_bar_dynamics_dyn_evaluate(work->q, work->dq, t, p, work, report, work->ddq,
-                                     work->lam);
+    int pivot = four_bar_dynamics_dyn_evaluate(work->q, work->dq, t, p, work, report, work->ddq, work->lam);
     if (pivot) return pivot;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        work->sum_q[i] += weight * work->dq[i];
-        work->sum_dq[i] += weight * work->ddq[i];
-    }
-    return 0;
+    work->sum_q[0] += weight * work->dq[0];
+    work->sum_dq[0] += weight * work->ddq[0];    work->sum_q[1] += weight * work->dq[1];
+    work->sum_dq[1] += weight * work->ddq[1];    work->sum_q[2] += weight * work->dq[2];
+    work->sum_dq[2] += weight * work->ddq[2];    work->sum_q[3] += weight * work->dq[3];
+    work->sum_dq[3] += weight * work->ddq[3];    work->sum_q[4] += weight * work->dq[4];
+    work->sum_dq[4] += weight * work->ddq[4];    work->sum_q[5] += weight * work->dq[5];
+    work->sum_dq[5] += weight * work->ddq[5];    work->sum_q[6] += weight * work->dq[6];
+    work->sum_dq[6] += weight * work->ddq[6];    work->sum_q[7] += weight * work->dq[7];
+    work->sum_dq[7] += weight * work->ddq[7];    work->sum_q[8] += weight * work->dq[8];
+    work->sum_dq[8] += weight * work->ddq[8];    return 0;
 }
 
 /* The next stage's point: (q, dq) + c h (its dq, its ddq) of the stage just taken. */
 static void four_bar_dynamics_dyn_point(const four_bar_dynamics_dynamics_state *state, four_bar_dynamics_real ch,
                            four_bar_dynamics_dynamics_work *work)
 {
-    int i;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        const four_bar_dynamics_real rate = work->dq[i];
-        work->q[i] = state->q[i] + ch * rate;
-        work->dq[i] = state->dq[i] + ch * work->ddq[i];
-    }
-}
+    work->q[0] = state->q[0] + ch * work->dq[0];
+    work->dq[0] = state->dq[0] + ch * work->ddq[0];    work->q[1] = state->q[1] + ch * work->dq[1];
+    work->dq[1] = state->dq[1] + ch * work->ddq[1];    work->q[2] = state->q[2] + ch * work->dq[2];
+    work->dq[2] = state->dq[2] + ch * work->ddq[2];    work->q[3] = state->q[3] + ch * work->dq[3];
+    work->dq[3] = state->dq[3] + ch * work->ddq[3];    work->q[4] = state->q[4] + ch * work->dq[4];
+    work->dq[4] = state->dq[4] + ch * work->ddq[4];    work->q[5] = state->q[5] + ch * work->dq[5];
+    work->dq[5] = state->dq[5] + ch * work->ddq[5];    work->q[6] = state->q[6] + ch * work->dq[6];
+    work->dq[6] = state->dq[6] + ch * work->ddq[6];    work->q[7] = state->q[7] + ch * work->dq[7];
+    work->dq[7] = state->dq[7] + ch * work->ddq[7];    work->q[8] = state->q[8] + ch * work->dq[8];
+    work->dq[8] = state->dq[8] + ch * work->ddq[8];}
 
 static int four_bar_dynamics_dyn_stop(four_bar_dynamics_dynamics_report *report, int status, int pivot)
 {
@@ -473,66 +577,107 @@ static int four_bar_dynamics_dyn_runge_kutta(const four_bar_dynamics_real p[], f
                                 four_bar_dynamics_dynamics_report *report)
 {
     const four_bar_dynamics_real half = h / 2, sixth = h / 6, third = h / 3;
-    int i, pivot;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) { /* the first stage: the state's own rates */
-        work->dq[i] = state->dq[i];
-        work->ddq[i] = state->ddq[i];
-        work->sum_q[i] = sixth * state->dq[i];
-        work->sum_dq[i] = sixth * state->ddq[i];
-    }
-    four_bar_dynamics_dyn_point(state, half, work);
+    int pivot;
+    /* the first stage: the state's own rates */
+    work->dq[0] = state->dq[0];
+    work->ddq[0] = state->ddq[0];
+    work->sum_q[0] = sixth * state->dq[0];
+    work->sum_dq[0] = sixth * state->ddq[0];    work->dq[1] = state->dq[1];
+    work->ddq[1] = state->ddq[1];
+    work->sum_q[1] = sixth * state->dq[1];
+    work->sum_dq[1] = sixth * state->ddq[1];    work->dq[2] = state->dq[2];
+    work->ddq[2] = state->ddq[2];
+    work->sum_q[2] = sixth * state->dq[2];
+    work->sum_dq[2] = sixth * state->ddq[2];    work->dq[3] = state->dq[3];
+    work->ddq[3] = state->ddq[3];
+    work->sum_q[3] = sixth * state->dq[3];
+    work->sum_dq[3] = sixth * state->ddq[3];    work->dq[4] = state->dq[4];
+    work->ddq[4] = state->ddq[4];
+    work->sum_q[4] = sixth * state->dq[4];
+    work->sum_dq[4] = sixth * state->ddq[4];    work->dq[5] = state->dq[5];
+    work->ddq[5] = state->ddq[5];
+    work->sum_q[5] = sixth * state->dq[5];
+    work->sum_dq[5] = sixth * state->ddq[5];    work->dq[6] = state->dq[6];
+    work->ddq[6] = state->ddq[6];
+    work->sum_q[6] = sixth * state->dq[6];
+    work->sum_dq[6] = sixth * state->ddq[6];    work->dq[7] = state->dq[7];
+    work->ddq[7] = state->ddq[7];
+    work->sum_q[7] = sixth * state->dq[7];
+    work->sum_dq[7] = sixth * state->ddq[7];    work->dq[8] = state->dq[8];
+    work->ddq[8] = state->ddq[8];
+    work->sum_q[8] = sixth * state->dq[8];
+    work->sum_dq[8] = sixth * state->ddq[8];    four_bar_dynamics_dyn_point(state, half, work);
     if ((pivot = four_bar_dynamics_dyn_stage(state->t + half, p, third, work, report))) return pivot;
     four_bar_dynamics_dyn_point(state, half, work);
     if ((pivot = four_bar_dynamics_dyn_stage(state->t + half, p, third, work, report))) return pivot;
     four_bar_dynamics_dyn_point(state, h, work);
     if ((pivot = four_bar_dynamics_dyn_stage(state->t + h, p, sixth, work, report))) return pivot;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        work->q[i] = state->q[i] + work->sum_q[i];
-        work->dq[i] = state->dq[i] + work->sum_dq[i];
-    }
-    return 0;
+    work->q[0] = state->q[0] + work->sum_q[0];
+    work->dq[0] = state->dq[0] + work->sum_dq[0];    work->q[1] = state->q[1] + work->sum_q[1];
+    work->dq[1] = state->dq[1] + work->sum_dq[1];    work->q[2] = state->q[2] + work->sum_q[2];
+    work->dq[2] = state->dq[2] + work->sum_dq[2];    work->q[3] = state->q[3] + work->sum_q[3];
+    work->dq[3] = state->dq[3] + work->sum_dq[3];    work->q[4] = state->q[4] + work->sum_q[4];
+    work->dq[4] = state->dq[4] + work->sum_dq[4];    work->q[5] = state->q[5] + work->sum_q[5];
+    work->dq[5] = state->dq[5] + work->sum_dq[5];    work->q[6] = state->q[6] + work->sum_q[6];
+    work->dq[6] = state->dq[6] + work->sum_dq[6];    work->q[7] = state->q[7] + work->sum_q[7];
+    work->dq[7] = state->dq[7] + work->sum_dq[7];    work->q[8] = state->q[8] + work->sum_q[8];
+    work->dq[8] = state->dq[8] + work->sum_dq[8];    return 0;
 }
 
 /* Simplified Newton corrections of work->q onto Phi(q, t) = 0 on the factors in the work
  * (the last stage's, at a q within h |dq| of this one: each correction shrinks the residual
  * by a factor of that order, and the residual left by the integration is its local error).
- * Every row of Phi is checked, the kept ones corrected. Returns a status. */
+ * Every row of Phi is checked, the kept ones corrected. Phi and Phi_q in one fused call:
+ * Phi_q (work->nz) and the sines and cosines (work->shared) are those of the corrected q
+ * when it returns OK. Returns a status. */
 static int four_bar_dynamics_dyn_positions(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[],
                               four_bar_dynamics_real t, four_bar_dynamics_dynamics_work *work,
                               four_bar_dynamics_dynamics_report *report)
 {
-    int i;
     for (report->iterations = 0; ; ++report->iterations) {
-        four_bar_dynamics_phi(work->q, t, p, work->phi);
+        four_bar_dynamics_phi_phi_q(work->q, t, p, work->phi, work->nz, work->shared);
         report->residual = four_bar_dynamics_dyn_max_abs(work->phi, FOUR_BAR_DYNAMICS_NR);
         if (report->residual != report->residual || report->residual - report->residual != 0)
             return FOUR_BAR_DYNAMICS_NOT_FINITE;
         if (report->residual <= options->tol_phi) return FOUR_BAR_DYNAMICS_OK;
         if (report->iterations == options->max_iterations) return FOUR_BAR_DYNAMICS_NO_CONVERGENCE;
-        for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->b[i] = 0;
-        for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) work->b[FOUR_BAR_DYNAMICS_NQ + i] = -work->phi[i];
-        four_bar_dynamics_dyn_solve(work, work->b);
-        for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->q[i] += work->b[i];
+        four_bar_dynamics_dyn_correct_positions(work);
     }
 }
 
-/* dq corrected onto Phi_q dq = -Phi_t with the factors at the corrected q (work->nz is that
- * Phi_q); returns max|Phi_q dq + Phi_t| over every row after the correction. */
-static four_bar_dynamics_real four_bar_dynamics_dyn_velocities(const four_bar_dynamics_real p[], four_bar_dynamics_real t,
-                                    four_bar_dynamics_dynamics_work *work)
+/* dq corrected onto Phi_q dq = -Phi_t at the corrected q: Phi_q (work->nz) and the sines
+ * and cosines (work->shared) are the position check's, M the last stage's (in work->mass,
+ * at a q within h |dq| of this one: the metric of the correction, not its constraint); the
+ * matrix factored anew. Returns as four_bar_dynamics_dyn_factor; report->velocity_residual is
+ * max|Phi_q dq + Phi_t| over every row after the correction. */
+static int four_bar_dynamics_dyn_velocities(const four_bar_dynamics_real p[], four_bar_dynamics_real t, four_bar_dynamics_dynamics_work *work,
+                               four_bar_dynamics_dynamics_report *report)
 {
-    int i, e;
-    four_bar_dynamics_phi_t(work->q, t, p, work->phi);
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) work->lam[i] = work->phi[i];
-    for (e = 0; e < FOUR_BAR_DYNAMICS_NNZ; ++e) /* the violation, in work->lam */
-        work->lam[four_bar_dynamics_phi_q_row[e]] += work->nz[e] * work->dq[four_bar_dynamics_phi_q_col[e]];
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->b[i] = 0;
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) work->b[FOUR_BAR_DYNAMICS_NQ + i] = -work->lam[i];
-    four_bar_dynamics_dyn_solve(work, work->b);
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) work->dq[i] += work->b[i];
-    for (e = 0; e < FOUR_BAR_DYNAMICS_NNZ; ++e)
-        work->phi[four_bar_dynamics_phi_q_row[e]] += work->nz[e] * work->dq[four_bar_dynamics_phi_q_col[e]];
-    return four_bar_dynamics_dyn_max_abs(work->phi, FOUR_BAR_DYNAMICS_NR);
+    int pivot;
+    if ((pivot = four_bar_dynamics_dyn_factor(work, report))) return pivot;
+    four_bar_dynamics_phi_t_shared(work->q, t, p, work->shared, work->phi);
+    /* the violation Phi_t + Phi_q dq, in work->lam */
+    work->lam[0] = work->phi[0] - work->dq[0];
+    work->lam[1] = work->phi[1] - work->dq[1];
+    work->lam[2] = work->phi[2] + work->dq[0] + work->nz[3] * work->dq[2] - work->dq[3];
+    work->lam[3] = work->phi[3] + work->dq[1] + work->nz[6] * work->dq[2] - work->dq[4];
+    work->lam[4] = work->phi[4] + work->dq[3] + work->nz[9] * work->dq[5] - work->dq[6] + work->nz[11] * work->dq[8];
+    work->lam[5] = work->phi[5] + work->dq[4] + work->nz[13] * work->dq[5] - work->dq[7] + work->nz[15] * work->dq[8];
+    work->lam[6] = work->phi[6] + work->dq[6];
+    work->lam[7] = work->phi[7] + work->dq[7];
+    work->lam[8] = work->phi[8] + work->dq[2];
+    four_bar_dynamics_dyn_correct_velocities(work);
+    work->phi[0] = work->phi[0] - work->dq[0];
+    work->phi[1] = work->phi[1] - work->dq[1];
+    work->phi[2] = work->phi[2] + work->dq[0] + work->nz[3] * work->dq[2] - work->dq[3];
+    work->phi[3] = work->phi[3] + work->dq[1] + work->nz[6] * work->dq[2] - work->dq[4];
+    work->phi[4] = work->phi[4] + work->dq[3] + work->nz[9] * work->dq[5] - work->dq[6] + work->nz[11] * work->dq[8];
+    work->phi[5] = work->phi[5] + work->dq[4] + work->nz[13] * work->dq[5] - work->dq[7] + work->nz[15] * work->dq[8];
+    work->phi[6] = work->phi[6] + work->dq[6];
+    work->phi[7] = work->phi[7] + work->dq[7];
+    work->phi[8] = work->phi[8] + work->dq[2];
+    report->velocity_residual = four_bar_dynamics_dyn_max_abs(work->phi, FOUR_BAR_DYNAMICS_NR);
+    return 0;
 }
 
 int four_bar_dynamics_dynamics_step(const four_bar_dynamics_options *options, const four_bar_dynamics_real p[],
@@ -541,6 +686,7 @@ int four_bar_dynamics_dynamics_step(const four_bar_dynamics_options *options, co
                                four_bar_dynamics_dynamics_report *report)
 {
     const four_bar_dynamics_real t1 = state->t + h;
+    four_bar_dynamics_real finite = 0;
     int i, pivot, status;
     report->t = state->t;
     report->residual = report->velocity_residual = 0;
@@ -560,25 +706,33 @@ int four_bar_dynamics_dynamics_step(const four_bar_dynamics_options *options, co
     report->t = t1;
     status = four_bar_dynamics_dyn_positions(options, p, t1, work, report);
     if (status != FOUR_BAR_DYNAMICS_OK) return four_bar_dynamics_dyn_stop(report, status, 0);
-    /* M and Phi_q at the corrected q (the fused call: its sines and cosines once, its
-     * Q - h and Gamma at the uncorrected dq not used) */
-    four_bar_dynamics_motion(work->q, work->dq, t1, p, work->mass, work->nz, work->b, work->phi);
-    if ((pivot = four_bar_dynamics_dyn_factor(work, report)))
+    if ((pivot = four_bar_dynamics_dyn_velocities(p, t1, work, report)))
         return four_bar_dynamics_dyn_stop(report, FOUR_BAR_DYNAMICS_SINGULAR, pivot);
-    report->velocity_residual = four_bar_dynamics_dyn_velocities(p, t1, work);
-    /* Q - h and Gamma at the corrected dq, solved on the factors at this q */
-    four_bar_dynamics_motion(work->q, work->dq, t1, p, work->mass, work->nz, work->b, work->phi);
-    four_bar_dynamics_dyn_solve_motion(work, work->ddq, work->lam);
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) { /* a NaN or an infinity anywhere ends here */
-        if (work->dq[i] - work->dq[i] != 0 || work->ddq[i] - work->ddq[i] != 0)
-            return four_bar_dynamics_dyn_stop(report, FOUR_BAR_DYNAMICS_NOT_FINITE, 0);
-    }
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NQ; ++i) {
-        state->q[i] = work->q[i];
-        state->dq[i] = work->dq[i];
-        state->ddq[i] = work->ddq[i];
-    }
-    for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) state->lam[i] = work->lam[i];
+    /* ddq and lam at the corrected (q, dq): the next step's first stage */
+    if ((pivot = four_bar_dynamics_dyn_evaluate(work->q, work->dq, t1, p, work, report, work->ddq,
+                                   work->lam)))
+        return four_bar_dynamics_dyn_stop(report, FOUR_BAR_DYNAMICS_SINGULAR, pivot);
+    /* a NaN or an infinity anywhere ends here (x - x is 0 for every finite x) */
+    finite += (work->dq[0] - work->dq[0]) + (work->ddq[0] - work->ddq[0]);    finite += (work->dq[1] - work->dq[1]) + (work->ddq[1] - work->ddq[1]);    finite += (work->dq[2] - work->dq[2]) + (work->ddq[2] - work->ddq[2]);    finite += (work->dq[3] - work->dq[3]) + (work->ddq[3] - work->ddq[3]);    finite += (work->dq[4] - work->dq[4]) + (work->ddq[4] - work->ddq[4]);    finite += (work->dq[5] - work->dq[5]) + (work->ddq[5] - work->ddq[5]);    finite += (work->dq[6] - work->dq[6]) + (work->ddq[6] - work->ddq[6]);    finite += (work->dq[7] - work->dq[7]) + (work->ddq[7] - work->ddq[7]);    finite += (work->dq[8] - work->dq[8]) + (work->ddq[8] - work->ddq[8]);    if (finite != 0) return four_bar_dynamics_dyn_stop(report, FOUR_BAR_DYNAMICS_NOT_FINITE, 0);
+    state->q[0] = work->q[0];
+    state->dq[0] = work->dq[0];
+    state->ddq[0] = work->ddq[0];    state->q[1] = work->q[1];
+    state->dq[1] = work->dq[1];
+    state->ddq[1] = work->ddq[1];    state->q[2] = work->q[2];
+    state->dq[2] = work->dq[2];
+    state->ddq[2] = work->ddq[2];    state->q[3] = work->q[3];
+    state->dq[3] = work->dq[3];
+    state->ddq[3] = work->ddq[3];    state->q[4] = work->q[4];
+    state->dq[4] = work->dq[4];
+    state->ddq[4] = work->ddq[4];    state->q[5] = work->q[5];
+    state->dq[5] = work->dq[5];
+    state->ddq[5] = work->ddq[5];    state->q[6] = work->q[6];
+    state->dq[6] = work->dq[6];
+    state->ddq[6] = work->ddq[6];    state->q[7] = work->q[7];
+    state->dq[7] = work->dq[7];
+    state->ddq[7] = work->ddq[7];    state->q[8] = work->q[8];
+    state->dq[8] = work->dq[8];
+    state->ddq[8] = work->ddq[8];    for (i = 0; i < FOUR_BAR_DYNAMICS_NR; ++i) state->lam[i] = work->lam[i];
     state->t = t1;
     report->status = FOUR_BAR_DYNAMICS_OK;
     return FOUR_BAR_DYNAMICS_OK;

@@ -24,10 +24,14 @@
  *              stage's factors (simplified Newton: the correction closest to q in the metric
  *              of M), repeated until max|Phi| <= options->tol_phi over every row, at most
  *              options->max_iterations corrections;
- *   velocities dq += dv with the matrix factored at the corrected q and the right-hand side
- *              [0; -(Phi_k dq + Phi_t,k)], so that Phi_q dq = -Phi_t;
- *   then ddq and lam at the new (q, dq) on the same factors, which also start the next step.
- * Four factorizations a step (five on the first call).
+ *   velocities dq += dv with the matrix of Phi_q at the corrected q (from the position
+ *              check's fused call) and the last stage's M factored, and the right-hand side
+ *              [0; -(Phi_k dq + Phi_t,k)], so that Phi_q dq = -Phi_t (M, the metric of the
+ *              correction, from a q within h |dq|: the kernel's M, Q - h and Gamma run once
+ *              at the corrected q, not twice);
+ *   then ddq and lam at the new (q, dq), which also start the next step.
+ * Five factorizations and four evaluations of M, Q - h and Gamma a step (one more of each on
+ * the first call).
  * No malloc, no stdio, no mutable statics: the caller owns every buffer.
  */
 #ifndef FOUR_BAR_DYNAMICS_DYNAMICS_H
@@ -43,15 +47,15 @@
 /* Operations of one four_bar_dynamics_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of four_bar_dynamics_dynamics.c, every branch that adds work
  * taken, the position corrections at their cap); each sin, cos, ... is a library call.
- * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 412
- * Runge-Kutta, three stages: 1491; one position correction: 165; the factorization at the corrected q, velocity correction and accelerations: 786
- * Step, worst case with the default cap of 25 corrections: 6896 (3146 add/sub, 2146 mul, 34 div, 6 sqrt, 198 other calls, 741 fabs, 625 compares)
+ * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 376
+ * Runge-Kutta, three stages: 1383; one position correction: 167; the velocity correction (a factorization) and the accelerations at the corrected q, dq: 735
+ * Step, worst case with the default cap of 25 corrections: 6753 (3141 add/sub, 2073 mul, 38 div, 5 sqrt, 191 other calls, 720 fabs, 585 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
- * On the dense fall-back at every factorization, worst case: 45812
+ * On the dense fall-back at every factorization, worst case: 50067
  */
-#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_ITERATION 165  /* one position correction */
-#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_FIXED 2771  /* a step without its corrections */
-#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_STEP_WORST 6896  /* at the default cap, 25 */
+#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_ITERATION 167  /* one position correction */
+#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_FIXED 2578  /* a step without its corrections */
+#define FOUR_BAR_DYNAMICS_OPS_DYNAMICS_STEP_WORST 6753  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */
@@ -76,6 +80,7 @@ typedef struct {
     four_bar_dynamics_real mass[FOUR_BAR_DYNAMICS_NNZ_M];
     four_bar_dynamics_real nz[FOUR_BAR_DYNAMICS_NNZ];
     four_bar_dynamics_real phi[FOUR_BAR_DYNAMICS_NR];
+    four_bar_dynamics_real shared[6]; /* sin, cos of the position check's q (four_bar_dynamics_phi_phi_q) */
     four_bar_dynamics_real q[FOUR_BAR_DYNAMICS_NQ];  /* a stage's point */
     four_bar_dynamics_real dq[FOUR_BAR_DYNAMICS_NQ];
     four_bar_dynamics_real sum_q[FOUR_BAR_DYNAMICS_NQ];  /* the stages' weighted sums */

@@ -52,19 +52,30 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_dyn_lu_a
 
 /* The entries of M and Phi_q that vary into their slots of the sparse factors (the numbers
  * among them, and the fill-in's first value, are folded into the code), M's divided by its
- * scale s = max |M_ij| (work->scale: the threshold tests then hold for any unit of mass);
- * returns the tiny-pivot bound, NaN when an entry is not finite so that every pivot test
- * fails. */
+ * scale s = max |M_ij| (work->scale: the threshold tests then hold for any unit of mass),
+ * found on M's diagonal (M is positive semi-definite: |M_ij| <= sqrt(M_ii M_jj));
+ * returns the tiny-pivot bound, NaN when an entry of M's diagonal or of Phi_q is not finite
+ * so that every pivot test fails (another entry of M that is not finite fails a pivot it
+ * reaches, or ends the step at its test of ddq). */
 static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_dyn_load(parallelogram_extra_bar_loads_dynamics_work *work)
 {
     parallelogram_extra_bar_loads_real *v = work->v;
     parallelogram_extra_bar_loads_real amax = 1.0, finite = 0, mmax = 0, a, x;
-    int e;
-    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ_M; ++e) {
-        a = fabs(work->mass[e]);
-        mmax = a > mmax ? a : mmax;
-        finite += a - a;
-    }
+    a = fabs(work->mass[0]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[2]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[6]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[7]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[9]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[13]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[14]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[16]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[20]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[21]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[23]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[27]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[28]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[30]); mmax = a > mmax ? a : mmax; finite += a - a;
+    a = fabs(work->mass[34]); mmax = a > mmax ? a : mmax; finite += a - a;
     work->scale = mmax > 0 ? mmax : 1;
     work->inverse_scale = 1 / work->scale;
     amax = amax > 1 ? amax : 1; /* M / s: its largest entry is 1 (0 where M is) */
@@ -250,33 +261,33 @@ static int parallelogram_extra_bar_loads_dyn_factor_0(parallelogram_extra_bar_lo
     inv[19] = 1 / v[101];
     v[91] *= inv[19];
     v[27] -= v[91] * v[58];
-    /* pivot 20: row 5, column 21 */
-    cmax = fabs(v[79]);
-    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[81]);
-    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[79], cmax, tiny)) return 21;
-    inv[20] = 1 / v[79];
-    v[81] *= inv[20];
-    v[102] = -(v[81] * v[13]);
-    v[85] -= v[81] * v[83];
-    /* pivot 21: row 11, column 22 */
-    if (!(fabs(v[85]) > tiny)) return 22;
-    inv[21] = 1 / v[85];
+    /* pivot 20: row 5, column 22 */
+    cmax = fabs(v[83]);
+    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[85]);
+    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[83], cmax, tiny)) return 21;
+    inv[20] = 1 / v[83];
+    v[85] *= inv[20];
+    v[102] = -(v[85] * v[13]);
+    v[81] -= v[85] * v[79];
+    /* pivot 21: row 11, column 21 */
+    if (!(fabs(v[81]) > tiny)) return 22;
+    inv[21] = 1 / v[81];
     /* pivot 22: row 12, column 26 */
     /* pivot 23: row 13, column 27 */
     /* pivot 24: row 14, column 29 */
     /* pivot 25: row 26, column 12 */
     /* pivot 26: row 27, column 13 */
     /* pivot 27: row 29, column 14 */
-    /* pivot 28: row 21, column 5 */
-    cmax = fabs(v[46]);
-    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[50]);
-    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[46], cmax, tiny)) return 29;
-    inv[28] = 1 / v[46];
-    v[50] *= inv[28];
-    v[52] -= v[50] * v[48];
-    /* pivot 29: row 22, column 11 */
-    if (!(fabs(v[52]) > tiny)) return 30;
-    inv[29] = 1 / v[52];
+    /* pivot 28: row 22, column 5 */
+    cmax = fabs(v[50]);
+    cmax = parallelogram_extra_bar_loads_dyn_lu_amax(cmax, v[46]);
+    if (!parallelogram_extra_bar_loads_dyn_lu_pivot_ok(v[50], cmax, tiny)) return 29;
+    inv[28] = 1 / v[50];
+    v[46] *= inv[28];
+    v[48] -= v[46] * v[52];
+    /* pivot 29: row 21, column 11 */
+    if (!(fabs(v[48]) > tiny)) return 30;
+    inv[29] = 1 / v[48];
     return 0;
 }
 
@@ -362,9 +373,9 @@ static void parallelogram_extra_bar_loads_dyn_forward_0(const parallelogram_extr
     x[16] += x[9];
     x[17] += x[10];
     x[20] -= v[11] * x[11];
-    x[28] -= x[11];
+    x[29] -= x[11];
     x[20] -= v[12] * x[12];
-    x[29] -= x[12];
+    x[28] -= x[12];
     x[18] -= v[18] * x[13];
     x[19] += x[13];
     x[18] -= v[19] * x[14];
@@ -373,14 +384,14 @@ static void parallelogram_extra_bar_loads_dyn_forward_0(const parallelogram_extr
     x[19] -= x[16];
     x[21] -= v[25] * x[16];
     x[25] += x[16];
-    x[28] += x[16];
+    x[29] += x[16];
     x[21] -= v[26] * x[17];
     x[26] += x[17];
-    x[29] += x[17];
+    x[28] += x[17];
     x[19] -= v[56] * x[18];
     x[21] -= v[91] * x[19];
-    x[21] -= v[81] * x[20];
-    x[29] -= v[50] * x[28];
+    x[21] -= v[85] * x[20];
+    x[29] -= v[46] * x[28];
 }
 
 /* U z = y, rows 29..0 */
@@ -389,7 +400,7 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     (void)v;
     (void)inv;
     x[29] *= inv[29];
-    x[28] -= v[48] * x[29];
+    x[28] -= v[52] * x[29];
     x[28] *= inv[28];
     x[27] += x[29];
     x[26] -= v[63] * x[29];
@@ -411,7 +422,7 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     x[21] -= v[102] * x[28];
     x[21] -= v[27] * x[29];
     x[21] *= inv[21];
-    x[20] -= v[83] * x[21];
+    x[20] -= v[79] * x[21];
     x[20] -= v[13] * x[28];
     x[20] *= inv[20];
     x[19] -= v[58] * x[29];
@@ -427,13 +438,13 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     x[10] = -x[10];
     x[9] = -x[9];
     x[8] -= v[23] * x[17];
-    x[8] -= x[21];
+    x[8] -= x[20];
     x[8] -= x[23];
     x[8] -= v[24] * x[29];
     x[8] = -x[8];
     x[7] -= v[21] * x[16];
     x[7] += x[19];
-    x[7] -= x[20];
+    x[7] -= x[21];
     x[7] -= x[22];
     x[7] -= v[22] * x[29];
     x[7] = -x[7];
@@ -450,11 +461,11 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     x[4] -= x[19];
     x[4] = -x[4];
     x[3] -= v[9] * x[12];
-    x[3] += x[21];
+    x[3] += x[20];
     x[3] -= v[10] * x[28];
     x[3] = -x[3];
     x[2] -= v[7] * x[11];
-    x[2] += x[20];
+    x[2] += x[21];
     x[2] -= v[8] * x[28];
     x[2] = -x[2];
     x[1] -= x[8];
@@ -467,77 +478,11 @@ static void parallelogram_extra_bar_loads_dyn_backward_0(const parallelogram_ext
     x[0] = -x[0];
 }
 
-/* Solve A x = b in place with the last factorization, whichever path it took. */
-static void parallelogram_extra_bar_loads_dyn_solve(const parallelogram_extra_bar_loads_dynamics_work *work, parallelogram_extra_bar_loads_real b[])
+/* Solve A x = b in place on the dense fall-back's factors. */
+static void parallelogram_extra_bar_loads_dyn_solve_dense(const parallelogram_extra_bar_loads_dynamics_work *work, parallelogram_extra_bar_loads_real b[])
 {
     const int n = PARALLELOGRAM_EXTRA_BAR_LOADS_NA;
-    parallelogram_extra_bar_loads_real x[PARALLELOGRAM_EXTRA_BAR_LOADS_NA];
     int i, j;
-    if (!work->dense) { /* 103 operations, the permutations baked in */
-        x[0] = b[0];
-        x[1] = b[1];
-        x[2] = b[3];
-        x[3] = b[4];
-        x[4] = b[6];
-        x[5] = b[7];
-        x[6] = b[2];
-        x[7] = b[9];
-        x[8] = b[10];
-        x[9] = b[15];
-        x[10] = b[16];
-        x[11] = b[17];
-        x[12] = b[18];
-        x[13] = b[23];
-        x[14] = b[24];
-        x[15] = b[28];
-        x[16] = b[19];
-        x[17] = b[20];
-        x[18] = b[8];
-        x[19] = b[25];
-        x[20] = b[5];
-        x[21] = b[11];
-        x[22] = b[12];
-        x[23] = b[13];
-        x[24] = b[14];
-        x[25] = b[26];
-        x[26] = b[27];
-        x[27] = b[29];
-        x[28] = b[21];
-        x[29] = b[22];
-        parallelogram_extra_bar_loads_dyn_forward_0(work->v, x);
-        parallelogram_extra_bar_loads_dyn_backward_0(work->v, work->inv, x);
-        b[15] = x[0];
-        b[16] = x[1];
-        b[17] = x[2];
-        b[18] = x[3];
-        b[23] = x[4];
-        b[24] = x[5];
-        b[28] = x[6];
-        b[19] = x[7];
-        b[20] = x[8];
-        b[0] = x[9];
-        b[1] = x[10];
-        b[3] = x[11];
-        b[4] = x[12];
-        b[6] = x[13];
-        b[7] = x[14];
-        b[2] = x[15];
-        b[9] = x[16];
-        b[10] = x[17];
-        b[8] = x[18];
-        b[25] = x[19];
-        b[21] = x[20];
-        b[22] = x[21];
-        b[26] = x[22];
-        b[27] = x[23];
-        b[29] = x[24];
-        b[12] = x[25];
-        b[13] = x[26];
-        b[14] = x[27];
-        b[5] = x[28];
-        b[11] = x[29];
-        return;
-    }
     for (i = 0; i < n; ++i) { /* the row interchanges, in the order they were made */
         const int r = work->perm[i];
         const parallelogram_extra_bar_loads_real swap = b[i];
@@ -553,17 +498,211 @@ static void parallelogram_extra_bar_loads_dyn_solve(const parallelogram_extra_ba
     }
 }
 
+/* On the dense path: the right-hand side [M's rows from work->b; kept rows of Phi's from
+ * rows[]] (negated when sign < 0) solved in work->b. */
+static void parallelogram_extra_bar_loads_dyn_dense_rhs(parallelogram_extra_bar_loads_dynamics_work *work, const parallelogram_extra_bar_loads_real rows[], parallelogram_extra_bar_loads_real sign)
+{
+    int i;
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) work->b[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ + i] = sign * rows[i];
+    parallelogram_extra_bar_loads_dyn_solve_dense(work, work->b);
+}
+
 /* ddq and lam from Q - h in work->b[0..NQ) and Gamma in work->phi, with the factors of the
  * same state: [M/s Phi_k^T; Phi_k 0] [ddq; lam/s] = [(Q - h)/s; Gamma_k] solved (the rows
- * left out get lam 0). */
+ * left out get lam 0). The sparse path reads and writes in place (103 operations). */
 static void parallelogram_extra_bar_loads_dyn_solve_motion(parallelogram_extra_bar_loads_dynamics_work *work, parallelogram_extra_bar_loads_real ddq[], parallelogram_extra_bar_loads_real lam[])
 {
     int i;
+    if (!work->dense) {
+        parallelogram_extra_bar_loads_real x[PARALLELOGRAM_EXTRA_BAR_LOADS_NA];
+        x[0] = work->b[0] * work->inverse_scale;
+        x[1] = work->b[1] * work->inverse_scale;
+        x[2] = work->b[3] * work->inverse_scale;
+        x[3] = work->b[4] * work->inverse_scale;
+        x[4] = work->b[6] * work->inverse_scale;
+        x[5] = work->b[7] * work->inverse_scale;
+        x[6] = work->b[2] * work->inverse_scale;
+        x[7] = work->b[9] * work->inverse_scale;
+        x[8] = work->b[10] * work->inverse_scale;
+        x[9] = work->phi[0];
+        x[10] = work->phi[1];
+        x[11] = work->phi[2];
+        x[12] = work->phi[3];
+        x[13] = work->phi[8];
+        x[14] = work->phi[9];
+        x[15] = work->phi[13];
+        x[16] = work->phi[4];
+        x[17] = work->phi[5];
+        x[18] = work->b[8] * work->inverse_scale;
+        x[19] = work->phi[10];
+        x[20] = work->b[5] * work->inverse_scale;
+        x[21] = work->b[11] * work->inverse_scale;
+        x[22] = work->b[12] * work->inverse_scale;
+        x[23] = work->b[13] * work->inverse_scale;
+        x[24] = work->b[14] * work->inverse_scale;
+        x[25] = work->phi[11];
+        x[26] = work->phi[12];
+        x[27] = work->phi[14];
+        x[28] = work->phi[7];
+        x[29] = work->phi[6];
+        parallelogram_extra_bar_loads_dyn_forward_0(work->v, x);
+        parallelogram_extra_bar_loads_dyn_backward_0(work->v, work->inv, x);
+        lam[0] = x[0] * work->scale;
+        lam[1] = x[1] * work->scale;
+        lam[2] = x[2] * work->scale;
+        lam[3] = x[3] * work->scale;
+        lam[8] = x[4] * work->scale;
+        lam[9] = x[5] * work->scale;
+        lam[13] = x[6] * work->scale;
+        lam[4] = x[7] * work->scale;
+        lam[5] = x[8] * work->scale;
+        ddq[0] = x[9];
+        ddq[1] = x[10];
+        ddq[3] = x[11];
+        ddq[4] = x[12];
+        ddq[6] = x[13];
+        ddq[7] = x[14];
+        ddq[2] = x[15];
+        ddq[9] = x[16];
+        ddq[10] = x[17];
+        ddq[8] = x[18];
+        lam[10] = x[19] * work->scale;
+        lam[7] = x[20] * work->scale;
+        lam[6] = x[21] * work->scale;
+        lam[11] = x[22] * work->scale;
+        lam[12] = x[23] * work->scale;
+        lam[14] = x[24] * work->scale;
+        ddq[12] = x[25];
+        ddq[13] = x[26];
+        ddq[14] = x[27];
+        ddq[5] = x[28];
+        ddq[11] = x[29];
+        return;
+    }
     for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->b[i] *= work->inverse_scale;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) work->b[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ + i] = work->phi[i];
-    parallelogram_extra_bar_loads_dyn_solve(work, work->b);
+    parallelogram_extra_bar_loads_dyn_dense_rhs(work, work->phi, 1);
     for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) ddq[i] = work->b[i];
     for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) lam[i] = work->b[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ + i] * work->scale;
+}
+
+/* q += dx, [M/s Phi_k^T; Phi_k 0] [dx; mu] = [0; -Phi_k] with Phi in work->phi. */
+static void parallelogram_extra_bar_loads_dyn_correct_positions(parallelogram_extra_bar_loads_dynamics_work *work)
+{
+    int i;
+    if (!work->dense) {
+        parallelogram_extra_bar_loads_real x[PARALLELOGRAM_EXTRA_BAR_LOADS_NA];
+        x[0] = 0;
+        x[1] = 0;
+        x[2] = 0;
+        x[3] = 0;
+        x[4] = 0;
+        x[5] = 0;
+        x[6] = 0;
+        x[7] = 0;
+        x[8] = 0;
+        x[9] = -work->phi[0];
+        x[10] = -work->phi[1];
+        x[11] = -work->phi[2];
+        x[12] = -work->phi[3];
+        x[13] = -work->phi[8];
+        x[14] = -work->phi[9];
+        x[15] = -work->phi[13];
+        x[16] = -work->phi[4];
+        x[17] = -work->phi[5];
+        x[18] = 0;
+        x[19] = -work->phi[10];
+        x[20] = 0;
+        x[21] = 0;
+        x[22] = 0;
+        x[23] = 0;
+        x[24] = 0;
+        x[25] = -work->phi[11];
+        x[26] = -work->phi[12];
+        x[27] = -work->phi[14];
+        x[28] = -work->phi[7];
+        x[29] = -work->phi[6];
+        parallelogram_extra_bar_loads_dyn_forward_0(work->v, x);
+        parallelogram_extra_bar_loads_dyn_backward_0(work->v, work->inv, x);
+        work->q[0] += x[9];
+        work->q[1] += x[10];
+        work->q[3] += x[11];
+        work->q[4] += x[12];
+        work->q[6] += x[13];
+        work->q[7] += x[14];
+        work->q[2] += x[15];
+        work->q[9] += x[16];
+        work->q[10] += x[17];
+        work->q[8] += x[18];
+        work->q[12] += x[25];
+        work->q[13] += x[26];
+        work->q[14] += x[27];
+        work->q[5] += x[28];
+        work->q[11] += x[29];
+        return;
+    }
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->b[i] = 0;
+    parallelogram_extra_bar_loads_dyn_dense_rhs(work, work->phi, -1);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->q[i] += work->b[i];
+}
+
+/* dq += dv, [M/s Phi_k^T; Phi_k 0] [dv; mu] = [0; -v] with the violation v in work->lam. */
+static void parallelogram_extra_bar_loads_dyn_correct_velocities(parallelogram_extra_bar_loads_dynamics_work *work)
+{
+    int i;
+    if (!work->dense) {
+        parallelogram_extra_bar_loads_real x[PARALLELOGRAM_EXTRA_BAR_LOADS_NA];
+        x[0] = 0;
+        x[1] = 0;
+        x[2] = 0;
+        x[3] = 0;
+        x[4] = 0;
+        x[5] = 0;
+        x[6] = 0;
+        x[7] = 0;
+        x[8] = 0;
+        x[9] = -work->lam[0];
+        x[10] = -work->lam[1];
+        x[11] = -work->lam[2];
+        x[12] = -work->lam[3];
+        x[13] = -work->lam[8];
+        x[14] = -work->lam[9];
+        x[15] = -work->lam[13];
+        x[16] = -work->lam[4];
+        x[17] = -work->lam[5];
+        x[18] = 0;
+        x[19] = -work->lam[10];
+        x[20] = 0;
+        x[21] = 0;
+        x[22] = 0;
+        x[23] = 0;
+        x[24] = 0;
+        x[25] = -work->lam[11];
+        x[26] = -work->lam[12];
+        x[27] = -work->lam[14];
+        x[28] = -work->lam[7];
+        x[29] = -work->lam[6];
+        parallelogram_extra_bar_loads_dyn_forward_0(work->v, x);
+        parallelogram_extra_bar_loads_dyn_backward_0(work->v, work->inv, x);
+        work->dq[0] += x[9];
+        work->dq[1] += x[10];
+        work->dq[3] += x[11];
+        work->dq[4] += x[12];
+        work->dq[6] += x[13];
+        work->dq[7] += x[14];
+        work->dq[2] += x[15];
+        work->dq[9] += x[16];
+        work->dq[10] += x[17];
+        work->dq[8] += x[18];
+        work->dq[12] += x[25];
+        work->dq[13] += x[26];
+        work->dq[14] += x[27];
+        work->dq[5] += x[28];
+        work->dq[11] += x[29];
+        return;
+    }
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->b[i] = 0;
+    parallelogram_extra_bar_loads_dyn_dense_rhs(work, work->lam, -1);
+    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->dq[i] += work->b[i];
 }
 
 /* An evaluation at (q, dq, t): M, Phi_q, Q - h and Gamma in one call (each sine and cosine
@@ -584,27 +723,46 @@ static int parallelogram_extra_bar_loads_dyn_evaluate(const parallelogram_extra_
 static int parallelogram_extra_bar_loads_dyn_stage(parallelogram_extra_bar_loads_real t, const parallelogram_extra_bar_loads_real p[], parallelogram_extra_bar_loads_real weight,
                           parallelogram_extra_bar_loads_dynamics_work *work, parallelogram_extra_bar_loads_dynamics_report *report)
 {
-    int i, pivot = parallelogram_extra_bar_loads_dyn_evaluate(work->q, work->dq, t, p, work, report, work->ddq,
-                                     work->lam);
+    int pivot = parallelogram_extra_bar_loads_dyn_evaluate(work->q, work->dq, t, p, work, report, work->ddq, work->lam);
     if (pivot) return pivot;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
-        work->sum_q[i] += weight * work->dq[i];
-        work->sum_dq[i] += weight * work->ddq[i];
-    }
-    return 0;
+    work->sum_q[0] += weight * work->dq[0];
+    work->sum_dq[0] += weight * work->ddq[0];    work->sum_q[1] += weight * work->dq[1];
+    work->sum_dq[1] += weight * work->ddq[1];    work->sum_q[2] += weight * work->dq[2];
+    work->sum_dq[2] += weight * work->ddq[2];    work->sum_q[3] += weight * work->dq[3];
+    work->sum_dq[3] += weight * work->ddq[3];    work->sum_q[4] += weight * work->dq[4];
+    work->sum_dq[4] += weight * work->ddq[4];    work->sum_q[5] += weight * work->dq[5];
+    work->sum_dq[5] += weight * work->ddq[5];    work->sum_q[6] += weight * work->dq[6];
+    work->sum_dq[6] += weight * work->ddq[6];    work->sum_q[7] += weight * work->dq[7];
+    work->sum_dq[7] += weight * work->ddq[7];    work->sum_q[8] += weight * work->dq[8];
+    work->sum_dq[8] += weight * work->ddq[8];    work->sum_q[9] += weight * work->dq[9];
+    work->sum_dq[9] += weight * work->ddq[9];    work->sum_q[10] += weight * work->dq[10];
+    work->sum_dq[10] += weight * work->ddq[10];    work->sum_q[11] += weight * work->dq[11];
+    work->sum_dq[11] += weight * work->ddq[11];    work->sum_q[12] += weight * work->dq[12];
+    work->sum_dq[12] += weight * work->ddq[12];    work->sum_q[13] += weight * work->dq[13];
+    work->sum_dq[13] += weight * work->ddq[13];    work->sum_q[14] += weight * work->dq[14];
+    work->sum_dq[14] += weight * work->ddq[14];    return 0;
 }
 
 /* The next stage's point: (q, dq) + c h (its dq, its ddq) of the stage just taken. */
 static void parallelogram_extra_bar_loads_dyn_point(const parallelogram_extra_bar_loads_dynamics_state *state, parallelogram_extra_bar_loads_real ch,
                            parallelogram_extra_bar_loads_dynamics_work *work)
 {
-    int i;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
-        const parallelogram_extra_bar_loads_real rate = work->dq[i];
-        work->q[i] = state->q[i] + ch * rate;
-        work->dq[i] = state->dq[i] + ch * work->ddq[i];
-    }
-}
+    work->q[0] = state->q[0] + ch * work->dq[0];
+    work->dq[0] = state->dq[0] + ch * work->ddq[0];    work->q[1] = state->q[1] + ch * work->dq[1];
+    work->dq[1] = state->dq[1] + ch * work->ddq[1];    work->q[2] = state->q[2] + ch * work->dq[2];
+    work->dq[2] = state->dq[2] + ch * work->ddq[2];    work->q[3] = state->q[3] + ch * work->dq[3];
+    work->dq[3] = state->dq[3] + ch * work->ddq[3];    work->q[4] = state->q[4] + ch * work->dq[4];
+    work->dq[4] = state->dq[4] + ch * work->ddq[4];    work->q[5] = state->q[5] + ch * work->dq[5];
+    work->dq[5] = state->dq[5] + ch * work->ddq[5];    work->q[6] = state->q[6] + ch * work->dq[6];
+    work->dq[6] = state->dq[6] + ch * work->ddq[6];    work->q[7] = state->q[7] + ch * work->dq[7];
+    work->dq[7] = state->dq[7] + ch * work->ddq[7];    work->q[8] = state->q[8] + ch * work->dq[8];
+    work->dq[8] = state->dq[8] + ch * work->ddq[8];    work->q[9] = state->q[9] + ch * work->dq[9];
+    work->dq[9] = state->dq[9] + ch * work->ddq[9];    work->q[10] = state->q[10] + ch * work->dq[10];
+    work->dq[10] = state->dq[10] + ch * work->ddq[10];    work->q[11] = state->q[11] + ch * work->dq[11];
+    work->dq[11] = state->dq[11] + ch * work->ddq[11];    work->q[12] = state->q[12] + ch * work->dq[12];
+    work->dq[12] = state->dq[12] + ch * work->ddq[12];    work->q[13] = state->q[13] + ch * work->dq[13];
+    work->dq[13] = state->dq[13] + ch * work->ddq[13];    work->q[14] = state->q[14] + ch * work->dq[14];
+    work->dq[14] = state->dq[14] + ch * work->ddq[14];}
 
 static int parallelogram_extra_bar_loads_dyn_stop(parallelogram_extra_bar_loads_dynamics_report *report, int status, int pivot)
 {
@@ -621,66 +779,143 @@ static int parallelogram_extra_bar_loads_dyn_runge_kutta(const parallelogram_ext
                                 parallelogram_extra_bar_loads_dynamics_report *report)
 {
     const parallelogram_extra_bar_loads_real half = h / 2, sixth = h / 6, third = h / 3;
-    int i, pivot;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) { /* the first stage: the state's own rates */
-        work->dq[i] = state->dq[i];
-        work->ddq[i] = state->ddq[i];
-        work->sum_q[i] = sixth * state->dq[i];
-        work->sum_dq[i] = sixth * state->ddq[i];
-    }
-    parallelogram_extra_bar_loads_dyn_point(state, half, work);
+    int pivot;
+    /* the first stage: the state's own rates */
+    work->dq[0] = state->dq[0];
+    work->ddq[0] = state->ddq[0];
+    work->sum_q[0] = sixth * state->dq[0];
+    work->sum_dq[0] = sixth * state->ddq[0];    work->dq[1] = state->dq[1];
+    work->ddq[1] = state->ddq[1];
+    work->sum_q[1] = sixth * state->dq[1];
+    work->sum_dq[1] = sixth * state->ddq[1];    work->dq[2] = state->dq[2];
+    work->ddq[2] = state->ddq[2];
+    work->sum_q[2] = sixth * state->dq[2];
+    work->sum_dq[2] = sixth * state->ddq[2];    work->dq[3] = state->dq[3];
+    work->ddq[3] = state->ddq[3];
+    work->sum_q[3] = sixth * state->dq[3];
+    work->sum_dq[3] = sixth * state->ddq[3];    work->dq[4] = state->dq[4];
+    work->ddq[4] = state->ddq[4];
+    work->sum_q[4] = sixth * state->dq[4];
+    work->sum_dq[4] = sixth * state->ddq[4];    work->dq[5] = state->dq[5];
+    work->ddq[5] = state->ddq[5];
+    work->sum_q[5] = sixth * state->dq[5];
+    work->sum_dq[5] = sixth * state->ddq[5];    work->dq[6] = state->dq[6];
+    work->ddq[6] = state->ddq[6];
+    work->sum_q[6] = sixth * state->dq[6];
+    work->sum_dq[6] = sixth * state->ddq[6];    work->dq[7] = state->dq[7];
+    work->ddq[7] = state->ddq[7];
+    work->sum_q[7] = sixth * state->dq[7];
+    work->sum_dq[7] = sixth * state->ddq[7];    work->dq[8] = state->dq[8];
+    work->ddq[8] = state->ddq[8];
+    work->sum_q[8] = sixth * state->dq[8];
+    work->sum_dq[8] = sixth * state->ddq[8];    work->dq[9] = state->dq[9];
+    work->ddq[9] = state->ddq[9];
+    work->sum_q[9] = sixth * state->dq[9];
+    work->sum_dq[9] = sixth * state->ddq[9];    work->dq[10] = state->dq[10];
+    work->ddq[10] = state->ddq[10];
+    work->sum_q[10] = sixth * state->dq[10];
+    work->sum_dq[10] = sixth * state->ddq[10];    work->dq[11] = state->dq[11];
+    work->ddq[11] = state->ddq[11];
+    work->sum_q[11] = sixth * state->dq[11];
+    work->sum_dq[11] = sixth * state->ddq[11];    work->dq[12] = state->dq[12];
+    work->ddq[12] = state->ddq[12];
+    work->sum_q[12] = sixth * state->dq[12];
+    work->sum_dq[12] = sixth * state->ddq[12];    work->dq[13] = state->dq[13];
+    work->ddq[13] = state->ddq[13];
+    work->sum_q[13] = sixth * state->dq[13];
+    work->sum_dq[13] = sixth * state->ddq[13];    work->dq[14] = state->dq[14];
+    work->ddq[14] = state->ddq[14];
+    work->sum_q[14] = sixth * state->dq[14];
+    work->sum_dq[14] = sixth * state->ddq[14];    parallelogram_extra_bar_loads_dyn_point(state, half, work);
     if ((pivot = parallelogram_extra_bar_loads_dyn_stage(state->t + half, p, third, work, report))) return pivot;
     parallelogram_extra_bar_loads_dyn_point(state, half, work);
     if ((pivot = parallelogram_extra_bar_loads_dyn_stage(state->t + half, p, third, work, report))) return pivot;
     parallelogram_extra_bar_loads_dyn_point(state, h, work);
     if ((pivot = parallelogram_extra_bar_loads_dyn_stage(state->t + h, p, sixth, work, report))) return pivot;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
-        work->q[i] = state->q[i] + work->sum_q[i];
-        work->dq[i] = state->dq[i] + work->sum_dq[i];
-    }
-    return 0;
+    work->q[0] = state->q[0] + work->sum_q[0];
+    work->dq[0] = state->dq[0] + work->sum_dq[0];    work->q[1] = state->q[1] + work->sum_q[1];
+    work->dq[1] = state->dq[1] + work->sum_dq[1];    work->q[2] = state->q[2] + work->sum_q[2];
+    work->dq[2] = state->dq[2] + work->sum_dq[2];    work->q[3] = state->q[3] + work->sum_q[3];
+    work->dq[3] = state->dq[3] + work->sum_dq[3];    work->q[4] = state->q[4] + work->sum_q[4];
+    work->dq[4] = state->dq[4] + work->sum_dq[4];    work->q[5] = state->q[5] + work->sum_q[5];
+    work->dq[5] = state->dq[5] + work->sum_dq[5];    work->q[6] = state->q[6] + work->sum_q[6];
+    work->dq[6] = state->dq[6] + work->sum_dq[6];    work->q[7] = state->q[7] + work->sum_q[7];
+    work->dq[7] = state->dq[7] + work->sum_dq[7];    work->q[8] = state->q[8] + work->sum_q[8];
+    work->dq[8] = state->dq[8] + work->sum_dq[8];    work->q[9] = state->q[9] + work->sum_q[9];
+    work->dq[9] = state->dq[9] + work->sum_dq[9];    work->q[10] = state->q[10] + work->sum_q[10];
+    work->dq[10] = state->dq[10] + work->sum_dq[10];    work->q[11] = state->q[11] + work->sum_q[11];
+    work->dq[11] = state->dq[11] + work->sum_dq[11];    work->q[12] = state->q[12] + work->sum_q[12];
+    work->dq[12] = state->dq[12] + work->sum_dq[12];    work->q[13] = state->q[13] + work->sum_q[13];
+    work->dq[13] = state->dq[13] + work->sum_dq[13];    work->q[14] = state->q[14] + work->sum_q[14];
+    work->dq[14] = state->dq[14] + work->sum_dq[14];    return 0;
 }
 
 /* Simplified Newton corrections of work->q onto Phi(q, t) = 0 on the factors in the work
  * (the last stage's, at a q within h |dq| of this one: each correction shrinks the residual
  * by a factor of that order, and the residual left by the integration is its local error).
- * Every row of Phi is checked, the kept ones corrected. Returns a status. */
+ * Every row of Phi is checked, the kept ones corrected. Phi and Phi_q in one fused call:
+ * Phi_q (work->nz) and the sines and cosines (work->shared) are those of the corrected q
+ * when it returns OK. Returns a status. */
 static int parallelogram_extra_bar_loads_dyn_positions(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
                               parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_dynamics_work *work,
                               parallelogram_extra_bar_loads_dynamics_report *report)
 {
-    int i;
     for (report->iterations = 0; ; ++report->iterations) {
-        parallelogram_extra_bar_loads_phi(work->q, t, p, work->phi);
+        parallelogram_extra_bar_loads_phi_phi_q(work->q, t, p, work->phi, work->nz, work->shared);
         report->residual = parallelogram_extra_bar_loads_dyn_max_abs(work->phi, PARALLELOGRAM_EXTRA_BAR_LOADS_NR);
         if (report->residual != report->residual || report->residual - report->residual != 0)
             return PARALLELOGRAM_EXTRA_BAR_LOADS_NOT_FINITE;
         if (report->residual <= options->tol_phi) return PARALLELOGRAM_EXTRA_BAR_LOADS_OK;
         if (report->iterations == options->max_iterations) return PARALLELOGRAM_EXTRA_BAR_LOADS_NO_CONVERGENCE;
-        for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->b[i] = 0;
-        for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) work->b[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ + i] = -work->phi[i];
-        parallelogram_extra_bar_loads_dyn_solve(work, work->b);
-        for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->q[i] += work->b[i];
+        parallelogram_extra_bar_loads_dyn_correct_positions(work);
     }
 }
 
-/* dq corrected onto Phi_q dq = -Phi_t with the factors at the corrected q (work->nz is that
- * Phi_q); returns max|Phi_q dq + Phi_t| over every row after the correction. */
-static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_dyn_velocities(const parallelogram_extra_bar_loads_real p[], parallelogram_extra_bar_loads_real t,
-                                    parallelogram_extra_bar_loads_dynamics_work *work)
+/* dq corrected onto Phi_q dq = -Phi_t at the corrected q: Phi_q (work->nz) and the sines
+ * and cosines (work->shared) are the position check's, M the last stage's (in work->mass,
+ * at a q within h |dq| of this one: the metric of the correction, not its constraint); the
+ * matrix factored anew. Returns as parallelogram_extra_bar_loads_dyn_factor; report->velocity_residual is
+ * max|Phi_q dq + Phi_t| over every row after the correction. */
+static int parallelogram_extra_bar_loads_dyn_velocities(const parallelogram_extra_bar_loads_real p[], parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_dynamics_work *work,
+                               parallelogram_extra_bar_loads_dynamics_report *report)
 {
-    int i, e;
-    parallelogram_extra_bar_loads_phi_t(work->q, t, p, work->phi);
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) work->lam[i] = work->phi[i];
-    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e) /* the violation, in work->lam */
-        work->lam[parallelogram_extra_bar_loads_phi_q_row[e]] += work->nz[e] * work->dq[parallelogram_extra_bar_loads_phi_q_col[e]];
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->b[i] = 0;
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) work->b[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ + i] = -work->lam[i];
-    parallelogram_extra_bar_loads_dyn_solve(work, work->b);
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) work->dq[i] += work->b[i];
-    for (e = 0; e < PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ; ++e)
-        work->phi[parallelogram_extra_bar_loads_phi_q_row[e]] += work->nz[e] * work->dq[parallelogram_extra_bar_loads_phi_q_col[e]];
-    return parallelogram_extra_bar_loads_dyn_max_abs(work->phi, PARALLELOGRAM_EXTRA_BAR_LOADS_NR);
+    int pivot;
+    if ((pivot = parallelogram_extra_bar_loads_dyn_factor(work, report))) return pivot;
+    parallelogram_extra_bar_loads_phi_t_shared(work->q, t, p, work->shared, work->phi);
+    /* the violation Phi_t + Phi_q dq, in work->lam */
+    work->lam[0] = work->phi[0] - work->dq[0];
+    work->lam[1] = work->phi[1] - work->dq[1];
+    work->lam[2] = work->phi[2] - work->dq[3];
+    work->lam[3] = work->phi[3] - work->dq[4];
+    work->lam[4] = work->phi[4] + work->dq[0] + work->nz[5] * work->dq[2] - work->dq[9];
+    work->lam[5] = work->phi[5] + work->dq[1] + work->nz[8] * work->dq[2] - work->dq[10];
+    work->lam[6] = work->phi[6] - work->dq[3] + work->nz[11] * work->dq[5] + work->dq[9] + work->nz[13] * work->dq[11];
+    work->lam[7] = work->phi[7] - work->dq[4] + work->nz[15] * work->dq[5] + work->dq[10] + work->nz[17] * work->dq[11];
+    work->lam[8] = work->phi[8] - work->dq[6];
+    work->lam[9] = work->phi[9] - work->dq[7];
+    work->lam[10] = work->phi[10] + work->dq[6] + work->nz[21] * work->dq[8] - work->dq[9] + work->nz[23] * work->dq[11];
+    work->lam[11] = work->phi[11] + work->dq[9] + work->nz[25] * work->dq[11] - work->dq[12];
+    work->lam[12] = work->phi[12] + work->dq[10] + work->nz[28] * work->dq[11] - work->dq[13];
+    work->lam[13] = work->phi[13] + work->dq[2];
+    work->lam[14] = work->phi[14] - work->dq[11] + work->dq[14];
+    parallelogram_extra_bar_loads_dyn_correct_velocities(work);
+    work->phi[0] = work->phi[0] - work->dq[0];
+    work->phi[1] = work->phi[1] - work->dq[1];
+    work->phi[2] = work->phi[2] - work->dq[3];
+    work->phi[3] = work->phi[3] - work->dq[4];
+    work->phi[4] = work->phi[4] + work->dq[0] + work->nz[5] * work->dq[2] - work->dq[9];
+    work->phi[5] = work->phi[5] + work->dq[1] + work->nz[8] * work->dq[2] - work->dq[10];
+    work->phi[6] = work->phi[6] - work->dq[3] + work->nz[11] * work->dq[5] + work->dq[9] + work->nz[13] * work->dq[11];
+    work->phi[7] = work->phi[7] - work->dq[4] + work->nz[15] * work->dq[5] + work->dq[10] + work->nz[17] * work->dq[11];
+    work->phi[8] = work->phi[8] - work->dq[6];
+    work->phi[9] = work->phi[9] - work->dq[7];
+    work->phi[10] = work->phi[10] + work->dq[6] + work->nz[21] * work->dq[8] - work->dq[9] + work->nz[23] * work->dq[11];
+    work->phi[11] = work->phi[11] + work->dq[9] + work->nz[25] * work->dq[11] - work->dq[12];
+    work->phi[12] = work->phi[12] + work->dq[10] + work->nz[28] * work->dq[11] - work->dq[13];
+    work->phi[13] = work->phi[13] + work->dq[2];
+    work->phi[14] = work->phi[14] - work->dq[11] + work->dq[14];
+    report->velocity_residual = parallelogram_extra_bar_loads_dyn_max_abs(work->phi, PARALLELOGRAM_EXTRA_BAR_LOADS_NR);
+    return 0;
 }
 
 int parallelogram_extra_bar_loads_dynamics_step(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[],
@@ -689,6 +924,7 @@ int parallelogram_extra_bar_loads_dynamics_step(const parallelogram_extra_bar_lo
                                parallelogram_extra_bar_loads_dynamics_report *report)
 {
     const parallelogram_extra_bar_loads_real t1 = state->t + h;
+    parallelogram_extra_bar_loads_real finite = 0;
     int i, pivot, status;
     report->t = state->t;
     report->residual = report->velocity_residual = 0;
@@ -708,25 +944,45 @@ int parallelogram_extra_bar_loads_dynamics_step(const parallelogram_extra_bar_lo
     report->t = t1;
     status = parallelogram_extra_bar_loads_dyn_positions(options, p, t1, work, report);
     if (status != PARALLELOGRAM_EXTRA_BAR_LOADS_OK) return parallelogram_extra_bar_loads_dyn_stop(report, status, 0);
-    /* M and Phi_q at the corrected q (the fused call: its sines and cosines once, its
-     * Q - h and Gamma at the uncorrected dq not used) */
-    parallelogram_extra_bar_loads_motion(work->q, work->dq, t1, p, work->mass, work->nz, work->b, work->phi);
-    if ((pivot = parallelogram_extra_bar_loads_dyn_factor(work, report)))
+    if ((pivot = parallelogram_extra_bar_loads_dyn_velocities(p, t1, work, report)))
         return parallelogram_extra_bar_loads_dyn_stop(report, PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR, pivot);
-    report->velocity_residual = parallelogram_extra_bar_loads_dyn_velocities(p, t1, work);
-    /* Q - h and Gamma at the corrected dq, solved on the factors at this q */
-    parallelogram_extra_bar_loads_motion(work->q, work->dq, t1, p, work->mass, work->nz, work->b, work->phi);
-    parallelogram_extra_bar_loads_dyn_solve_motion(work, work->ddq, work->lam);
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) { /* a NaN or an infinity anywhere ends here */
-        if (work->dq[i] - work->dq[i] != 0 || work->ddq[i] - work->ddq[i] != 0)
-            return parallelogram_extra_bar_loads_dyn_stop(report, PARALLELOGRAM_EXTRA_BAR_LOADS_NOT_FINITE, 0);
-    }
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NQ; ++i) {
-        state->q[i] = work->q[i];
-        state->dq[i] = work->dq[i];
-        state->ddq[i] = work->ddq[i];
-    }
-    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) state->lam[i] = work->lam[i];
+    /* ddq and lam at the corrected (q, dq): the next step's first stage */
+    if ((pivot = parallelogram_extra_bar_loads_dyn_evaluate(work->q, work->dq, t1, p, work, report, work->ddq,
+                                   work->lam)))
+        return parallelogram_extra_bar_loads_dyn_stop(report, PARALLELOGRAM_EXTRA_BAR_LOADS_SINGULAR, pivot);
+    /* a NaN or an infinity anywhere ends here (x - x is 0 for every finite x) */
+    finite += (work->dq[0] - work->dq[0]) + (work->ddq[0] - work->ddq[0]);    finite += (work->dq[1] - work->dq[1]) + (work->ddq[1] - work->ddq[1]);    finite += (work->dq[2] - work->dq[2]) + (work->ddq[2] - work->ddq[2]);    finite += (work->dq[3] - work->dq[3]) + (work->ddq[3] - work->ddq[3]);    finite += (work->dq[4] - work->dq[4]) + (work->ddq[4] - work->ddq[4]);    finite += (work->dq[5] - work->dq[5]) + (work->ddq[5] - work->ddq[5]);    finite += (work->dq[6] - work->dq[6]) + (work->ddq[6] - work->ddq[6]);    finite += (work->dq[7] - work->dq[7]) + (work->ddq[7] - work->ddq[7]);    finite += (work->dq[8] - work->dq[8]) + (work->ddq[8] - work->ddq[8]);    finite += (work->dq[9] - work->dq[9]) + (work->ddq[9] - work->ddq[9]);    finite += (work->dq[10] - work->dq[10]) + (work->ddq[10] - work->ddq[10]);    finite += (work->dq[11] - work->dq[11]) + (work->ddq[11] - work->ddq[11]);    finite += (work->dq[12] - work->dq[12]) + (work->ddq[12] - work->ddq[12]);    finite += (work->dq[13] - work->dq[13]) + (work->ddq[13] - work->ddq[13]);    finite += (work->dq[14] - work->dq[14]) + (work->ddq[14] - work->ddq[14]);    if (finite != 0) return parallelogram_extra_bar_loads_dyn_stop(report, PARALLELOGRAM_EXTRA_BAR_LOADS_NOT_FINITE, 0);
+    state->q[0] = work->q[0];
+    state->dq[0] = work->dq[0];
+    state->ddq[0] = work->ddq[0];    state->q[1] = work->q[1];
+    state->dq[1] = work->dq[1];
+    state->ddq[1] = work->ddq[1];    state->q[2] = work->q[2];
+    state->dq[2] = work->dq[2];
+    state->ddq[2] = work->ddq[2];    state->q[3] = work->q[3];
+    state->dq[3] = work->dq[3];
+    state->ddq[3] = work->ddq[3];    state->q[4] = work->q[4];
+    state->dq[4] = work->dq[4];
+    state->ddq[4] = work->ddq[4];    state->q[5] = work->q[5];
+    state->dq[5] = work->dq[5];
+    state->ddq[5] = work->ddq[5];    state->q[6] = work->q[6];
+    state->dq[6] = work->dq[6];
+    state->ddq[6] = work->ddq[6];    state->q[7] = work->q[7];
+    state->dq[7] = work->dq[7];
+    state->ddq[7] = work->ddq[7];    state->q[8] = work->q[8];
+    state->dq[8] = work->dq[8];
+    state->ddq[8] = work->ddq[8];    state->q[9] = work->q[9];
+    state->dq[9] = work->dq[9];
+    state->ddq[9] = work->ddq[9];    state->q[10] = work->q[10];
+    state->dq[10] = work->dq[10];
+    state->ddq[10] = work->ddq[10];    state->q[11] = work->q[11];
+    state->dq[11] = work->dq[11];
+    state->ddq[11] = work->ddq[11];    state->q[12] = work->q[12];
+    state->dq[12] = work->dq[12];
+    state->ddq[12] = work->ddq[12];    state->q[13] = work->q[13];
+    state->dq[13] = work->dq[13];
+    state->ddq[13] = work->ddq[13];    state->q[14] = work->q[14];
+    state->dq[14] = work->dq[14];
+    state->ddq[14] = work->ddq[14];    for (i = 0; i < PARALLELOGRAM_EXTRA_BAR_LOADS_NR; ++i) state->lam[i] = work->lam[i];
     state->t = t1;
     report->status = PARALLELOGRAM_EXTRA_BAR_LOADS_OK;
     return PARALLELOGRAM_EXTRA_BAR_LOADS_OK;

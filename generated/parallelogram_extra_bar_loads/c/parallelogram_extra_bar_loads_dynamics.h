@@ -24,10 +24,14 @@
  *              stage's factors (simplified Newton: the correction closest to q in the metric
  *              of M), repeated until max|Phi| <= options->tol_phi over every row, at most
  *              options->max_iterations corrections;
- *   velocities dq += dv with the matrix factored at the corrected q and the right-hand side
- *              [0; -(Phi_k dq + Phi_t,k)], so that Phi_q dq = -Phi_t;
- *   then ddq and lam at the new (q, dq) on the same factors, which also start the next step.
- * Four factorizations a step (five on the first call).
+ *   velocities dq += dv with the matrix of Phi_q at the corrected q (from the position
+ *              check's fused call) and the last stage's M factored, and the right-hand side
+ *              [0; -(Phi_k dq + Phi_t,k)], so that Phi_q dq = -Phi_t (M, the metric of the
+ *              correction, from a q within h |dq|: the kernel's M, Q - h and Gamma run once
+ *              at the corrected q, not twice);
+ *   then ddq and lam at the new (q, dq), which also start the next step.
+ * Five factorizations and four evaluations of M, Q - h and Gamma a step (one more of each on
+ * the first call).
  * No malloc, no stdio, no mutable statics: the caller owns every buffer.
  */
 #ifndef PARALLELOGRAM_EXTRA_BAR_LOADS_DYNAMICS_H
@@ -43,15 +47,15 @@
 /* Operations of one parallelogram_extra_bar_loads_dynamics_step, worst case (counted at generation from the
  * kernel's statements and the loops of parallelogram_extra_bar_loads_dynamics.c, every branch that adds work
  * taken, the position corrections at their cap); each sin, cos, ... is a library call.
- * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 640
- * Runge-Kutta, three stages: 2343; one position correction: 299; the factorization at the corrected q, velocity correction and accelerations: 1232
- * Step, worst case with the default cap of 25 corrections: 11828 (5535 add/sub, 3690 mul, 38 div, 0 sqrt, 401 other calls, 1225 fabs, 939 compares)
+ * One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): 580
+ * Runge-Kutta, three stages: 2163; one position correction: 308; the velocity correction (a factorization) and the accelerations at the corrected q, dq: 1187
+ * Step, worst case with the default cap of 25 corrections: 11777 (5624 add/sub, 3671 mul, 45 div, 0 sqrt, 382 other calls, 1188 fabs, 867 compares)
  *   (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)
- * On the dense fall-back at every factorization, worst case: 158118
+ * On the dense fall-back at every factorization, worst case: 177281
  */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_ITERATION 299  /* one position correction */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_FIXED 4353  /* a step without its corrections */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_STEP_WORST 11828  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_ITERATION 308  /* one position correction */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_FIXED 4077  /* a step without its corrections */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_DYNAMICS_STEP_WORST 11777  /* at the default cap, 25 */
 
 /* The motion carried from step to step. Set q, dq (consistent: Phi = 0, Phi_q dq = -Phi_t)
  * and t, and started to 0, before the first step; the first step computes ddq and lam. */
@@ -76,6 +80,7 @@ typedef struct {
     parallelogram_extra_bar_loads_real mass[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ_M];
     parallelogram_extra_bar_loads_real nz[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ];
     parallelogram_extra_bar_loads_real phi[PARALLELOGRAM_EXTRA_BAR_LOADS_NR];
+    parallelogram_extra_bar_loads_real shared[11]; /* sin, cos of the position check's q (parallelogram_extra_bar_loads_phi_phi_q) */
     parallelogram_extra_bar_loads_real q[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];  /* a stage's point */
     parallelogram_extra_bar_loads_real dq[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];
     parallelogram_extra_bar_loads_real sum_q[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];  /* the stages' weighted sums */

@@ -8,10 +8,11 @@ kinematic step. Composition, as the step runs:
     options check + first-step evaluation (M, Phi_q, Q - h, Gamma in one call, a
       factorization and a solve at the start)
     + Runge-Kutta (3 stages, each such an evaluation)
-    + (cap + 1) x position check + cap x position correction (a solve on the last stage's
-      factors)
-    + M, Phi_q (the fused call) and their factorization at the corrected q + velocity
-    correction + Q - h, Gamma (the fused call again) and a solve (the accelerations).
+    + (cap + 1) x position check (Phi and Phi_q in one call) + cap x position correction (a
+      solve on the last stage's factors)
+    + velocity correction (a factorization of the last stage's M and the checked Phi_q,
+      Phi_t on the check's sines and cosines, a solve) + an evaluation at the corrected
+      (q, dq) (the accelerations, the next step's first stage).
 
 The first step's evaluation is counted in every step: a budget holds for any call. The
 header also states the worst case on the dense fall-back (every factorization a sparse attempt
@@ -53,7 +54,7 @@ def sparse(code: Any, dyn: dict[str, Any]) -> Algebra:
     straight-line parts) and <prefix>_dyn_solve's straight-line substitutions."""
     lu = dyn["lu"]
     scaled = sum(1 for entry in dyn["loads"] if entry["scaled"])
-    load = (Flops(abs=1, cmp=1, add=1) * len(code.mass_rows)  # max |M_ij| and its NaN test
+    load = (Flops(abs=1, cmp=1, add=1) * len(dyn["mass_diagonal"])  # max |M_ii|, NaN test
             + Flops(cmp=2, div=1) + Flops(mul=scaled)  # s, 1 / s, amax of M / s, M / s
             + Flops(abs=1, cmp=1, add=2) * (len(dyn["loads"]) - scaled)
             + Flops(mul=1, add=1))  # the tiny bound
@@ -97,7 +98,13 @@ class DynamicsBudget:
         return self.step + self.iteration * -self.cap
 
 
-def _pieces(code: Any, algebra: Algebra, cap: int) -> tuple[Flops, ...]:
+def _lines(lines: list[str]) -> Flops:
+    """The operations of written-out statements on the work struct (``->`` is no minus)."""
+    return count_all(line.replace("->", "_") for line in lines)
+
+
+def _pieces(code: Any, dyn: dict[str, Any], algebra: Algebra, cap: int
+            ) -> tuple[Flops, ...]:
     """(evaluation, Runge-Kutta, one iteration, final, step) on ``algebra``."""
     nq, nr = code.nq, code.nrows
     # <prefix>_dyn_solve_motion: (Q - h) / s, the solve, lam * s
@@ -107,13 +114,13 @@ def _pieces(code: Any, algebra: Algebra, cap: int) -> tuple[Flops, ...]:
     point = Flops(mul=2 * nq, add=2 * nq)  # <prefix>_dyn_point
     runge_kutta = (Flops(div=3, mul=2 * nq) + (point + stage) * 3
                    + Flops(add=2 * nq))  # <prefix>_dyn_runge_kutta
-    check = _routine(code, "phi") + max_abs(nr) + Flops(add=1, cmp=4)
-    correction = algebra.solve + Flops(add=nr + nq)  # <prefix>_dyn_positions
+    check = _routine(code, "phi_phi_q") + max_abs(nr) + Flops(add=1, cmp=4)
+    correction = algebra.solve + Flops(add=nr + nq)  # <prefix>_dyn_correct_positions
     iteration = check + correction
-    velocity = (_routine(code, "phi_t") + Flops(add=nr + nq) + algebra.solve
-                + Flops(mul=2 * code.nnz, add=2 * code.nnz) + max_abs(nr))
-    final = (_routine(code, "motion") * 2 + algebra.factor + velocity + motion_solve
-             + Flops(add=2 * nq, cmp=2 * nq))
+    # <prefix>_dyn_velocities: its factorization, Phi_t, the violation before and after
+    velocity = (algebra.factor + _routine(code, "phi_t_shared") + _lines(dyn["violation"])
+                + Flops(add=nr + nq) + algebra.solve + _lines(dyn["residual"]) + max_abs(nr))
+    final = velocity + evaluation + Flops(add=4 * nq, cmp=1)  # and the NaN test
     step = (OPTIONS_CHECK + Flops(cmp=3, add=2) + evaluation + runge_kutta
             + check * (cap + 1) + correction * cap + final)
     return evaluation, runge_kutta, iteration, final, step
@@ -123,8 +130,9 @@ def budget(code: Any, cap: int, dyn: dict[str, Any] | None = None) -> DynamicsBu
     """The worst case of one step of ``code``'s dynamics with ``cap`` position corrections
     (``dyn``: the step's sparse LU, dynamics_lu.template_context, made here when not given)."""
     dyn = dynamics_lu.template_context(code) if dyn is None else dyn
-    evaluation, runge_kutta, iteration, final, step = _pieces(code, sparse(code, dyn), cap)
-    dense_step = _pieces(code, dense(code, dyn), cap)[-1]
+    evaluation, runge_kutta, iteration, final, step = _pieces(code, dyn, sparse(code, dyn),
+                                                              cap)
+    dense_step = _pieces(code, dyn, dense(code, dyn), cap)[-1]
     return DynamicsBudget(cap=cap, evaluation=evaluation, runge_kutta=runge_kutta,
                           iteration=iteration, final=final, step=step, dense_step=dense_step)
 
@@ -139,8 +147,8 @@ def header_lines(plan: DynamicsBudget) -> list[str]:
         f"One evaluation (M, Phi_q, Q - h, Gamma, the sparse LU, a solve): "
         f"{plan.evaluation.total}",
         f"Runge-Kutta, three stages: {plan.runge_kutta.total}; one position correction: "
-        f"{plan.iteration.total}; the factorization at the corrected q, velocity correction "
-        f"and accelerations: {plan.final.total}",
+        f"{plan.iteration.total}; the velocity correction (a factorization) and the "
+        f"accelerations at the corrected q, dq: {plan.final.total}",
         f"Step, worst case with the default cap of {plan.cap} corrections: {kinds(plan.step)}",
         "  (another cap c: OPS_DYNAMICS_FIXED + c * OPS_DYNAMICS_ITERATION)",
         f"On the dense fall-back at every factorization, worst case: {plan.dense_step.total}",
