@@ -8,7 +8,8 @@ its motion stays smooth: every crank turns by the angle theta of the one-coordin
   its minimum"; rtol 1e-10 with atol 1e-12 still stops at t = 0.714);
 - each passage is reported where theta crosses a multiple of pi (the reference's own
   roots), flagged on the row after it, and warned about by the command line;
-- --stop-at-singular stops at the first with a located message and the rows before it.
+- --stop-at-singular stops at the first with a located message and the rows before it;
+- a driven crank reaching its limit position (a lock-up) stops there, named, rows kept.
 """
 
 from __future__ import annotations
@@ -128,3 +129,42 @@ def test_cli_warns_of_each_passage_and_stops_at_the_first_when_asked(tmp_path: P
     data = np.load(tmp_path / "out.npz")
     assert data["t"].size == int(np.searchsorted(np.linspace(0, 1.5, 151), first))
     assert not data["flagged"].any()
+
+
+# tests/mechanisms/non_grashof.yaml with masses and a free pendulum beside it (so that it
+# has fewer drivers than freedoms): the driven crank reaches its limit position at
+# t* = acos(-1/4), where the coupler and the rocker line up and the motion cannot go on.
+LOCKUP = """\
+name: lockup
+parameters: {a: 2.0, b: 2.0, c: 2.0, d: 3.0, m: 1.0}
+bodies:
+  crank:   {q0: [0, 0, 0], points: {A: [a, 0]}, mass: m, inertia: m*a**2/12, com: [a/2, 0]}
+  coupler: {q0: [2, 0, 1.3], points: {B: [b, 0]}, mass: m, inertia: m*b**2/12, com: [b/2, 0]}
+  rocker:  {q0: [3, 0, 1.8], points: {B: [c, 0]}, mass: m, inertia: m*c**2/12, com: [c/2, 0]}
+  bob:     {q0: [0, -1, 0], mass: m, inertia: m/12, com: [0, 0]}
+joints:
+  - {type: revolute, name: O2, i: ground,  j: crank,   sA: [0, 0], sB: [0, 0]}
+  - {type: revolute, name: A,  i: crank,   j: coupler, sA: A,      sB: [0, 0]}
+  - {type: revolute, name: B,  i: coupler, j: rocker,  sA: B,      sB: B}
+  - {type: revolute, name: O4, i: rocker,  j: ground,  sA: [0, 0], sB: [d, 0]}
+  - {type: revolute, name: P,  i: ground,  j: bob,     sA: [0, 0], sB: [0, 1]}
+drivers:
+  - {type: angle, name: input, i: crank, j: ground, theta: "t"}
+forces:
+  - {type: gravity, g: [0, -9.81]}
+initial: {velocities: {bob.phi: 0.5}}
+time: {t0: 0, t1: 2.5, dt: 0.05}
+"""
+
+
+def test_a_lock_up_stops_at_the_limit_position_naming_it(tmp_path: Path) -> None:
+    (tmp_path / "lockup.yaml").write_text(LOCKUP, encoding="utf-8")
+    result = _cli("lockup.yaml", "--backend", "numpy", "-o", "out.npz", cwd=tmp_path)
+    assert result.returncode == 1
+    said = re.search(r"the motion stops at t = ([0-9.]+): a lock-up: Phi_q loses rank 1",
+                     result.stderr)
+    assert said is not None and abs(float(said.group(1)) - math.acos(-0.25)) < 1e-6
+    assert "O4 revolute rocker-ground" in result.stderr
+    data = np.load(tmp_path / "out.npz")
+    assert data["t"][-1] == pytest.approx(1.8)  # the rows before it, the crank as driven
+    np.testing.assert_allclose(data["q"][:, 2], data["t"], rtol=0, atol=1e-9)

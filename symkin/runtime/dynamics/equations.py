@@ -10,9 +10,11 @@ freedoms Φ_q leaves open (a body without mass in a free direction makes it sing
 condition number is what flags a row, as Φ_q's does in kinematics.
 
 Redundant constraints (a parallelogram's extra bar, Bricard's linkage) leave Φ_q short of
-row rank by ``deficiency`` everywhere: q̈ is still unique, λ is not. Such a mechanism is
-solved by least squares, which gives the unique q̈ and the minimum-norm λ (the reactions'
-determinacy: runtime.dynamics.run), and its condition number is taken over the rank it has.
+row rank by ``deficiency`` everywhere, and a singular configuration (a change point) near
+a state makes it nearly so: q̈ is still unique, λ is not. Such states are solved through
+the singular value decomposition of Φ_q (:func:`revealed`), its rank judged at every
+call, which gives the unique q̈ and the minimum-norm λ (the reactions' determinacy:
+runtime.dynamics.run); the condition number is taken over the rank Φ_q has at t0.
 """
 
 from __future__ import annotations
@@ -93,13 +95,13 @@ def accelerations(model: Model, q: Array, dq: Array, t: float, p: Array,
 
 
 # The floor, as a share of Φ_q's largest singular value, below which the rank-revealing
-# solve damps a direction of Φ_q instead of inverting it: Σ⁺ becomes sigma / (sigma² + floor²).
-# Why: the index-1 equations keep Φ(q) at the small value δ the last projection left, and
-# near a change point the level set Φ = δ turns from one branch to the other; following
-# that turn, the IFToMM A02 chain took steps of 1e-11 s at sigma_min = 4e-8 and stopped. The
-# size was chosen by trial on that chain (10 passages in 10 s, rtol 1e-6, 1e-8 and 1e-10):
-# 1e-9 to 3e-9 passed all within 2e-8 of the crank's one-coordinate equation; 3e-10 and
-# 1e-8 stopped at rtol 1e-10; 3e-8 and above jumped branch or lost 1e-5 in energy.
+# solve damps a direction of Φ_q rather than inverting it (Σ⁺ becomes sigma / (sigma² +
+# floor²)), and which the projections leave out. The SVD solve is what passes the A02
+# chain's change points at rtol 1e-8; with this floor and the projections' cut it also
+# passes them at rtol = atol = 1e-10 (without, it stopped at t = 8.998). The size is from
+# trials on that chain: 1e-9 to 3e-9 passed rtol 1e-6, 1e-8 and 1e-10 within 2e-8 of the
+# crank's one-coordinate equation; 3e-10 and 1e-8 stopped at 1e-10; 3e-8 and above jumped
+# to the other branch. At rtol 1e-10 with atol 1e-12 the chain still stops at t = 0.714.
 TRUNCATION = 2e-9
 # A dropped direction of Φ_q whose row of Γ is larger than this share of the kept rows'
 # scale asks an acceleration Φ_q cannot give there: a lock-up, not a passage.
@@ -107,8 +109,15 @@ LOCKUP = 1e-2
 
 
 def revealed(model: Model, q: Array, dq: Array, t: float, p: Array) -> tuple[Array, Array]:
-    """q̈ and λ by the singular value decomposition Φ_q = U Σ Vᵀ, directions of Φ_q below
-    TRUNCATION dropped.
+    """q̈ and λ by the singular value decomposition Φ_q = U Σ Vᵀ, the directions of Φ_q
+    below RANK_TOLERANCE (dependent rows) dropped, those below TRUNCATION damped.
+
+    Why near a singular configuration: the augmented matrix's condition grows as
+    1/sigma_min² there (its multiplier block is Φ_q M⁻¹ Φ_qᵀ), so an LU solve of it loses
+    every digit at sigma_min = 1e-8, and that noise in q̈ drove the error control's steps
+    down to 1e-11 s: the IFToMM A02 chain stopped at t = 6.54 (rtol 1e-8) with "the step
+    size fell below its minimum". Through Φ_q's orthonormal bases the error grows as
+    1/sigma_min only, and the chain passes (tests/motion/test_dynamics_singular.py).
 
     q̈ = Y Σ⁻¹ Uᵀ Γ + Z z, Y the kept right singular vectors, Z the rest (the freedoms, with
     the directions a singular configuration adds); (Zᵀ M Z) z = Zᵀ (Q - h - M Y Σ⁻¹ Uᵀ Γ)
@@ -124,15 +133,12 @@ def revealed(model: Model, q: Array, dq: Array, t: float, p: Array) -> tuple[Arr
     kept = int(np.count_nonzero(s > RANK_TOLERANCE * s[0])) if s.size else 0
     sk = s[:kept]
     floor = TRUNCATION * (s[0] if s.size else 0.0)
-    # Σ⁺ filtered: 1/sigma above the floor, tending smoothly to 0 below it (no jump in q̈
-    # for the error control to miss)
-    inverse = sk / (sk * sk + floor * floor)
+    inverse = sk / (sk * sk + floor * floor)  # smooth: no jump in q̈ for the error control
     given = u[:, :kept].T @ gamma
-    weak = sk < floor
-    if np.any(weak):
+    if kept < jacobian.shape[0]:
         scale = float(np.abs(given * inverse).max(initial=0.0)) * s[0] + float(
             np.abs(gamma).max())
-        asked = float(np.abs(given[weak]).max())
+        asked = float(np.abs(u[:, kept:].T @ gamma).max())
         if asked > LOCKUP * scale and asked > 0.0:
             raise Singular("a lock-up: the constraints ask an acceleration they cannot give")
     d2q = vt[:kept].T @ (given * inverse)
@@ -144,16 +150,6 @@ def revealed(model: Model, q: Array, dq: Array, t: float, p: Array) -> tuple[Arr
         raise Singular("a free direction without mass") from None
     lam = u[:, :kept] @ (vt[:kept] @ (force - mass @ d2q) * inverse)
     return d2q, lam
-
-
-def ratio(model: Model, q: Array, t: float, p: Array) -> float:
-    """sigma_min / sigma_max of Φ_q over its rows (1 without rows): how near a singular
-    configuration (q, t) is."""
-    jacobian = model.phi_q(q, t, p)
-    if jacobian.size == 0:
-        return 1.0
-    values = np.linalg.svd(jacobian, compute_uv=False)
-    return float(values[-1] / values[0]) if values[0] > 0 else 0.0
 
 
 def condition(model: Model, q: Array, dq: Array, t: float, p: Array,

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from symkin.limits import listed
 from symkin.runtime.dynamics import passages
 from symkin.runtime.dynamics.equations import TRUNCATION, Singular, accelerations
 from symkin.runtime.dynamics.model import Model
@@ -142,8 +143,7 @@ class Stepper:
                     "finer output grid (--dt) allows more steps", t, "too many substeps")
             h = min(self.step, t_end - t)
             if h <= MIN_STEP_FRACTION * max(1.0, abs(t_end)):
-                raise StepFailure(self.singular or "the step size fell below its minimum: "
-                                  "the motion is too fast or stiff to follow", t)
+                raise StepFailure(self.singular or self._stuck(t, y[:n]), t)
             y_new, error = self._try(t, y, h, n)
             factor = MAX_FACTOR if error == 0 else SAFETY * error ** (-1 / ORDER)
             if error <= 1.0:
@@ -156,6 +156,18 @@ class Stepper:
             else:
                 self.step = h * max(MIN_FACTOR, factor)
         return State(t, y[:n], y[n:2 * n], float(y[2 * n]))
+
+    def _stuck(self, t: float, q: Array) -> str:
+        """Why the steps shrank to nothing at (t, q): a lock-up where Phi_q is singular
+        there (the motion cannot go on: a limit position of a driver), else stiffness."""
+        lost = passages.lost_rank(self.model, q, t, self.p)
+        if lost is None:
+            return "the step size fell below its minimum: the motion is too fast or stiff to follow"
+        rank, groups = lost
+        return (f"a lock-up: Phi_q loses rank {rank} there (dependent rows: "
+                f"{listed(('{' + listed(g) + '}' for g in groups), '; ')}) and the motion "
+                "cannot continue through it (a limit position of a driver, or a mechanism "
+                "that jams); the steps shrank to nothing")
 
     def _try(self, t: float, y: Array, h: float, n: int) -> tuple[Array, float]:
         """One Dormand-Prince step: the 5th-order result and its scaled error norm."""
@@ -184,14 +196,13 @@ class Stepper:
         """q onto Φ(q, t) = 0, then q̇ onto Φ_q q̇ = -Φ_t (module docstring)."""
         q, dq = y[:n].copy(), y[n:2 * n].copy()
         model, p = self.model, self.p
-        # Φ_q's directions below TRUNCATION are left out of the corrections: near a change
-        # point a residual of 1e-11 along one would move q by 1e-11 / sigma_min along the
-        # other branch (a jump of 1e-3 was seen at sigma_min = 1e-8); what they leave is of
-        # the size of the residual itself
         for _ in range(PROJECTION_ITERATIONS):
             residual = model.phi(q, t, p)
             if np.max(np.abs(residual), initial=0.0) <= self.position_tolerance:
                 break
+            # Φ_q's directions below TRUNCATION are left out (equations.TRUNCATION): near a
+            # change point a residual along one moves q by residual / sigma_min; once the
+            # correction is below the tolerance, what is left is rounding
             correction = np.linalg.lstsq(model.phi_q(q, t, p), residual, rcond=TRUNCATION)[0]
             q -= correction
             if np.max(np.abs(correction), initial=0.0) <= self.position_tolerance:

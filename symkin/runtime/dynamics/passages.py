@@ -129,3 +129,18 @@ def _on_branch(model: Model, p: Array, trail: tuple[Watched, Watched, Watched],
             break
         q = q - np.linalg.lstsq(model.phi_q(q, t, p), residual, rcond=None)[0]
     return np.asarray(q, dtype=np.float64)
+
+
+def lost_rank(model: Model, q: Array, t: float, p: Array
+              ) -> tuple[int, tuple[tuple[str, ...], ...]] | None:
+    """The rank Φ_q loses at (q, t) beyond its structural dependence and its groups of
+    dependent rows, when its ratio is below SUSPECT (None otherwise)."""
+    state = watched(model, t, q, np.zeros_like(q), p)
+    if state.ratio >= SUSPECT:
+        return None
+    jacobian = model.phi_q(q, t, p)
+    values = np.linalg.svd(jacobian, compute_uv=False)
+    rcond = max(PASSAGE, 2.0 * state.ratio)
+    _, groups = dependencies(jacobian, list(model.rows), rcond=rcond)
+    count = int(np.count_nonzero(values <= rcond * values[0]))
+    return max(count - state.structural, 1), tuple(tuple(g) for g in groups)
