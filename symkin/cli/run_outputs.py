@@ -267,6 +267,10 @@ def flag_warnings(trajectory: Any) -> list[str]:
                          "'flagged'); check the dimensions of the joints named")
             k = end + 1
             continue
+        if passed and _moves_under_forces(trajectory):
+            lines.append(_dynamics_passage(count, where, worst, passed))
+            k = end + 1
+            continue
         detail = "".join(
             f"; a singular configuration is passed at t = {t:.10g} (Phi_q loses rank {rank}; "
             f"dependent rows: {listed(('{' + listed(g) + '}' for g in groups), '; ')}), its "
@@ -277,6 +281,24 @@ def flag_warnings(trajectory: Any) -> list[str]:
                      f"up to {worst:.3g}; column 'flagged'){detail}")
         k = end + 1
     return lines
+
+
+def _moves_under_forces(trajectory: Any) -> bool:
+    """A forward-dynamics run (its energy outputs), whose rows are integrated, not solved
+    point by point."""
+    return any(name == "kinetic_energy" for name, _ in trajectory.outputs)
+
+
+def _dynamics_passage(count: int, where: str, worst: float, passed: list[Any]) -> str:
+    """The warning of a forward-dynamics run that went through a singular configuration:
+    the motion is determinate there (its rows are integrated), only Phi_q is singular."""
+    detail = "; ".join(
+        f"t = {t:.10g} (Phi_q loses rank {rank}; dependent rows: "
+        f"{listed(('{' + listed(g) + '}' for g in groups), '; ')})" for t, rank, groups in passed)
+    return (f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: the motion "
+            f"passes a singular configuration at {detail}; it went on through it on its "
+            "branch, the rows integrated as any other (the equations of motion's condition "
+            f"up to {worst:.3g}; column 'flagged'); --stop-at-singular stops there")
 
 
 def removed_note(trajectory: Any) -> str:

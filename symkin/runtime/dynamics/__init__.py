@@ -7,6 +7,7 @@
   [Q - h; Γ];
 - initial: the assembled position at t0 and the consistent initial velocity (least kinetic
   energy in the freedoms the given components leave open);
+- passages: singular configurations passed through between steps (found, reported);
 - integrator: an embedded Runge-Kutta pair (Dormand-Prince 5(4)) with error control and a
   projection onto Φ = 0, Φ_q q̇ = -Φ_t after every accepted step;
 - run: ``symkin.solve`` of such a mechanism over a time grid, the Trajectory with efforts,

@@ -22,12 +22,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.runtime.dynamics.equations import Singular, accelerations
+from symkin.limits import listed
+from symkin.runtime.dynamics import passages
+from symkin.runtime.dynamics.equations import TRUNCATION, Singular, accelerations
 from symkin.runtime.dynamics.model import Model
 
 Array = NDArray[np.float64]
@@ -55,6 +57,9 @@ MIN_STEP_FRACTION = 1e-12  # of the interval: below it the step is refused (a st
 # spring of 1e9 N/m went on for minutes with no word). A finer output grid allows more.
 MAX_STEPS_PER_ROW = 20_000
 PROJECTION_ITERATIONS = 10
+# Below this sigma_min / sigma_max of Φ_q at a step's start, its stages take the rank-revealing
+# solve (runtime.dynamics.equations.revealed), which costs about three LU solves.
+NEAR = 1e-3
 
 
 class StepFailure(Exception):
@@ -87,16 +92,37 @@ class Stepper:
     rtol: float
     atol: float
     position_tolerance: float
-    redundant: int = 0
-    """Rows of Φ_q that depend on the others (runtime.dynamics.equations)."""
+    stop_at_singular: bool = False
+    """Stop at the first singular configuration passed (StepFailure) instead of going on."""
     step: float = 0.0
     singular: str = ""
     """Why the last rejected stage failed, when the equations of motion were singular."""
+    trail: list[passages.Watched] = field(default_factory=list)
+    """The last three accepted states (runtime.dynamics.passages)."""
+    found: list[passages.Passage] = field(default_factory=list)
+    """The singular configurations passed so far."""
 
     def _derivative(self, t: float, y: Array) -> Array:
         n = len(self.model.coordinates)
-        found = accelerations(self.model, y[:n], y[n:2 * n], t, self.p, self.redundant)
+        near = bool(self.trail) and (self.trail[-1].ratio < NEAR or self.trail[-1].structural > 0)
+        found = accelerations(self.model, y[:n], y[n:2 * n], t, self.p, revealing=near)
         return np.concatenate([y[n:2 * n], found.d2q, [found.power]])
+
+    def watch(self, t: float, q: Array, dq: Array) -> None:
+        """Note an accepted state; a singular configuration passed just before it is
+        recorded, or with ``stop_at_singular`` stops the run there (StepFailure)."""
+        self.trail = [*self.trail[-2:], passages.watched(self.model, t, q, dq, self.p)]
+        if len(self.trail) < 3:
+            return
+        passage = passages.search(self.model, self.p, (self.trail[0], self.trail[1],
+                                                       self.trail[2]))
+        if passage is None:
+            return
+        self.found.append(passage)
+        if self.stop_at_singular:
+            raise StepFailure(f"a singular configuration is reached at t = {passage.t:.10g} "
+                              f"(Phi_q loses rank {passage.rank_loss}) and --stop-at-singular "
+                              "was given", passage.t, "singular")
 
     def advance(self, state: State, t_end: float, interrupted: Callable[[], None]) -> State:
         """The state at ``t_end``, by accepted steps each followed by the projection."""
@@ -117,19 +143,31 @@ class Stepper:
                     "finer output grid (--dt) allows more steps", t, "too many substeps")
             h = min(self.step, t_end - t)
             if h <= MIN_STEP_FRACTION * max(1.0, abs(t_end)):
-                raise StepFailure(self.singular or "the step size fell below its minimum: "
-                                  "the motion is too fast or stiff to follow", t)
+                raise StepFailure(self.singular or self._stuck(t, y[:n]), t)
             y_new, error = self._try(t, y, h, n)
             factor = MAX_FACTOR if error == 0 else SAFETY * error ** (-1 / ORDER)
             if error <= 1.0:
                 t = t_end if h == t_end - t else t + h
                 y = self._project(t, y_new, n)
+                self.watch(t, y[:n], y[n:2 * n])
                 proposal = h * min(MAX_FACTOR, max(MIN_FACTOR, factor))
                 # a step cut short to end on the output time says little about the next one
                 self.step = max(proposal, self.step) if h < self.step else proposal
             else:
                 self.step = h * max(MIN_FACTOR, factor)
         return State(t, y[:n], y[n:2 * n], float(y[2 * n]))
+
+    def _stuck(self, t: float, q: Array) -> str:
+        """Why the steps shrank to nothing at (t, q): a lock-up where Phi_q is singular
+        there (the motion cannot go on: a limit position of a driver), else stiffness."""
+        lost = passages.lost_rank(self.model, q, t, self.p)
+        if lost is None:
+            return "the step size fell below its minimum: the motion is too fast or stiff to follow"
+        rank, groups = lost
+        return (f"a lock-up: Phi_q loses rank {rank} there (dependent rows: "
+                f"{listed(('{' + listed(g) + '}' for g in groups), '; ')}) and the motion "
+                "cannot continue through it (a limit position of a driver, or a mechanism "
+                "that jams); the steps shrank to nothing")
 
     def _try(self, t: float, y: Array, h: float, n: int) -> tuple[Array, float]:
         """One Dormand-Prince step: the 5th-order result and its scaled error norm."""
@@ -139,12 +177,12 @@ class Stepper:
             y_i = y + h * (np.asarray(A[i]) @ stages[:i]) if i else y
             try:
                 stages[i] = self._derivative(t + C[i] * h, y_i)
-            except Singular:
+            except Singular as why:
                 # rejected like a large error: a smaller step may pass by; if none does, the
                 # singular configuration is the reason given
                 self.singular = (f"the equations of motion are singular near t = "
-                                 f"{t + C[i] * h:.6g}: [M Phi_q^T; Phi_q 0] has no inverse (a "
-                                 "lock-up, dependent constraints or a free body without mass)")
+                                 f"{t + C[i] * h:.10g}: {why or 'no unique acceleration'} (a "
+                                 "lock-up, a limit position or a free body without mass)")
                 return y, math.inf
         y_new = y + h * (B @ stages)
         estimate = h * (E @ stages)
@@ -162,12 +200,19 @@ class Stepper:
             residual = model.phi(q, t, p)
             if np.max(np.abs(residual), initial=0.0) <= self.position_tolerance:
                 break
-            q -= np.linalg.lstsq(model.phi_q(q, t, p), residual, rcond=None)[0]
+            # Φ_q's directions below TRUNCATION are left out (equations.TRUNCATION): near a
+            # change point a residual along one moves q by residual / sigma_min; once the
+            # correction is below the tolerance, what is left is rounding
+            correction = np.linalg.lstsq(model.phi_q(q, t, p), residual, rcond=TRUNCATION)[0]
+            q -= correction
+            if np.max(np.abs(correction), initial=0.0) <= self.position_tolerance:
+                break
         else:
             raise StepFailure("the projection onto the constraints did not converge: the "
                               "configuration is singular there", t)
         jacobian = model.phi_q(q, t, p)
-        dq -= np.linalg.lstsq(jacobian, jacobian @ dq + model.phi_t(q, t, p), rcond=None)[0]
+        dq -= np.linalg.lstsq(jacobian, jacobian @ dq + model.phi_t(q, t, p),
+                              rcond=TRUNCATION)[0]
         return np.concatenate([q, dq, y[2 * n:]])
 
     def _first_step(self, t: float, y: Array, t_end: float) -> float:

@@ -13,7 +13,7 @@ number); where the equations of motion are singular the run stops with the rows 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,6 +25,7 @@ from symkin.runtime.arguments import first_guess, parameter_values, time_points
 from symkin.runtime.dynamics import equations, initial
 from symkin.runtime.dynamics.integrator import State, StepFailure, Stepper
 from symkin.runtime.dynamics.model import Model, MotionKernel
+from symkin.runtime.dynamics.passages import Passage
 from symkin.runtime.loads.forces import Forces
 from symkin.runtime.outputs.results import Trajectory
 from symkin.runtime.solving import failures
@@ -93,8 +94,10 @@ def _solve(kernel: MotionKernel, t: ArrayLike | None, q0: ArrayLike | None,
                   initial.velocity(model, q, float(times[0]), p, redundant), 0.0)
     rows = _allocate(times, q.size, len(model.rows), redundant)
     _refuse_reversed(model, rows, q, p)
-    stepper = Stepper(model, p, model.rtol, model.atol, POSITION_TOLERANCE, redundant)
+    stepper = Stepper(model, p, model.rtol, model.atol, POSITION_TOLERANCE,
+                      stop_at_singular=stop_at_singular)
     try:
+        stepper.watch(state.t, state.q, state.dq)
         _record(model, rows, state, p)
         for k in range(1, times.size):
             state = stepper.advance(state, float(times[k]), _no_interrupt)
@@ -110,13 +113,15 @@ def _solve(kernel: MotionKernel, t: ArrayLike | None, q0: ArrayLike | None,
         raise SolveInterrupted(_trajectory(model, rows, p), at) from None
     except (StepFailure, equations.Singular) as stop:
         at = getattr(stop, "t", float(times[rows.done]))
+        # a passage is seen a step after it: rows past it are not the run's to keep
+        rows.done = int(np.searchsorted(rows.t[:rows.done], at, side="left"))
         reason = getattr(stop, "reason", "the equations of motion are singular")
         kept = (f"The rows up to t = {times[rows.done - 1]:.6g} are kept." if rows.done
                 else "No row was solved.")
-        raise SolveFailure(f"the motion stops at t = {at:.6g}: {reason}. {kept}",
-                           _trajectory(model, rows, p), at, math.nan, 0,
+        raise SolveFailure(f"the motion stops at t = {at:.10g}: {reason}. {kept}",
+                           _trajectory(model, rows, p, stepper.found), at, math.nan, 0,
                            reason=getattr(stop, "kind", "singular")) from None
-    trajectory = _trajectory(model, rows, p)
+    trajectory = _trajectory(model, rows, p, stepper.found)
     with rows_kept(trajectory, "the solved rows were checked"):
         flag_flips(model, trajectory, p)  # type: ignore[arg-type]  # a jump off the assembly
     return trajectory
@@ -150,7 +155,9 @@ def _allocate(times: Array, n: int, m: int, redundant: int) -> _Rows:
 def _record(model: Model, rows: _Rows, state: State, p: Array) -> None:
     """One output row: the state, its accelerations and multipliers, energies, residual."""
     k = rows.done
-    found = equations.accelerations(model, state.q, state.dq, state.t, p, rows.redundant)
+    # the rank-revealing solve at every row: the same numbers as LU away from a singular
+    # configuration, and the determinate q̈ near one (runtime.dynamics.equations.revealed)
+    found = equations.accelerations(model, state.q, state.dq, state.t, p, revealing=True)
     rows.q[k], rows.dq[k], rows.d2q[k], rows.lam[k] = state.q, state.dq, found.d2q, found.lam
     kinetic = 0.5 * state.dq @ model.mass(state.q, p) @ state.dq
     rows.energy[k] = (kinetic, float(model.potential(state.q, state.t, p)), state.work)
@@ -159,14 +166,21 @@ def _record(model: Model, rows: _Rows, state: State, p: Array) -> None:
     rows.done = k + 1
 
 
-def _trajectory(model: Model, rows: _Rows, p: Array) -> Trajectory:
-    """The Trajectory of the rows done, with forces and the energy outputs."""
+def _trajectory(model: Model, rows: _Rows, p: Array,
+                passed: Sequence[Passage] = ()) -> Trajectory:
+    """The Trajectory of the rows done, with forces and the energy outputs; the first row
+    at or after each singular configuration ``passed`` is flagged, as kinematics flags the
+    points around one (the motion through it is determinate: only the flag tells)."""
     done = rows.done
     t, q, dq, d2q = (a[:done].copy() for a in (rows.t, rows.q, rows.dq, rows.d2q))
     cond = rows.cond[:done].copy()
     flagged = ~(cond <= equations.FLAG_CONDITION)
+    singular = tuple((s.t, s.rank_loss, s.groups) for s in passed
+                     if done and s.t <= t[-1])
+    for s in singular:
+        flagged[min(int(np.searchsorted(t, s[0], side="left")), done - 1)] = True
     trajectory = Trajectory.solved(t, q, dq, d2q, model.coordinates, model.points,
-                                   model.point_vectors, p, 0, flagged, cond,
+                                   model.point_vectors, p, 0, flagged, cond, singular,
                                    space=model.space)
     outputs = [(name, rows.energy[:done, j].copy()) for j, name in enumerate(ENERGY)]
     outputs.append(("constraint_residual", rows.residual[:done].copy()))
