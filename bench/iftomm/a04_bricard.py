@@ -39,7 +39,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from harness import (  # noqa: E402
-    Row, Run, SymkinC, SymkinNumPy, at_step, exudyn_settings, print_table, to_accuracy)
+    Row, Run, SymkinC, SymkinNumPy, at_step, exudyn_settings, print_table, rotation,
+    to_accuracy)
 
 import symkin  # noqa: E402
 
@@ -50,13 +51,6 @@ CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, -1, 0], [1, -1, 1], [0, -1, 1], [0
                    dtype=float)
 AXES = np.array([[0, 1, 0], [0, 0, 1], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 0, 0]],
                 dtype=float)
-
-
-def rotation(e: np.ndarray) -> np.ndarray:
-    """The rotation matrix of Euler parameters (e0, e1, e2, e3)."""
-    e0, v = e[0], e[1:]
-    skew = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return (e0 ** 2 - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * e0 * skew
 
 
 def body_point(q: np.ndarray, body: int, drawn: np.ndarray) -> np.ndarray:

@@ -221,6 +221,13 @@ def print_table(title: str, rows: list[Row]) -> None:
               f" {row.energy:9.2e}  {row.note}")
 
 
+def rotation(e: Array) -> Array:
+    """The rotation matrix of Euler parameters (e0, e1, e2, e3)."""
+    e0, v = e[0], e[1:]
+    skew = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    return (e0 ** 2 - v @ v) * np.eye(3) + 2 * np.outer(v, v) + 2 * e0 * skew
+
+
 def exudyn_settings(exu: ModuleType, end: float, h: float, sample: float) -> object:
     """Exudyn's settings for a fixed step h to ``end``, the sensors stored every ``sample``,
     no solution file and no console output: the same in every script (each adds its own)."""
