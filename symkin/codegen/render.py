@@ -23,6 +23,7 @@ import jinja2
 from symkin.codegen import lower
 from symkin.codegen.lower import Code, Routine
 from symkin.codegen.target import Target
+from symkin.codegen.template_cache import TemplateCache
 from symkin.contract import status
 from symkin.contract.loads import load_count, reaction_parts
 from symkin.contract.manifest import GENERATOR, MANIFEST_SUFFIX, Manifest, Metadata, manifest_name
@@ -49,7 +50,7 @@ def environment(root: str) -> jinja2.Environment:
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(root),
         undefined=jinja2.StrictUndefined, keep_trailing_newline=True, trim_blocks=True,
-        lstrip_blocks=True, autoescape=False)
+        lstrip_blocks=True, autoescape=False, bytecode_cache=TemplateCache(root))
 
 
 def template_names(code: Code) -> list[str]:

@@ -264,9 +264,14 @@ def fold(expr: sp.Expr) -> sp.Expr:
         ExpressionError: a constant part has no value (see :func:`value`).
     """
     replacements: dict[sp.Basic, sp.Basic] = {}
+    symbolic: dict[sp.Basic, bool] = {}
+    seen: set[sp.Basic] = set()
 
     def visit(node: sp.Basic) -> None:
-        if isinstance(node, sp.Expr) and not node.free_symbols:
+        if node in seen:  # a shared subtree: its replacements are made
+            return
+        seen.add(node)
+        if isinstance(node, sp.Expr) and not _has_symbols(node, symbolic):
             if not is_plain_number(node):
                 replacements[node] = sp.Float(value(node), 17)
             return
@@ -275,6 +280,34 @@ def fold(expr: sp.Expr) -> sp.Expr:
 
     visit(expr)
     return expr.xreplace(replacements) if replacements else expr
+
+
+_UNION_OF_ARGS: dict[type, bool] = {}
+
+
+def _union_of_args(kind: type) -> bool:
+    """The class takes free_symbols from Basic (the union over its args). Looked up in the
+    classes' own dictionaries: a function class's metaclass has a free_symbols of its own."""
+    found = _UNION_OF_ARGS.get(kind)
+    if found is None:
+        owner = next(k for k in kind.__mro__ if "free_symbols" in k.__dict__)
+        found = _UNION_OF_ARGS[kind] = owner is sp.Basic
+    return found
+
+
+def _has_symbols(node: sp.Basic, known: dict[sp.Basic, bool]) -> bool:
+    """``bool(node.free_symbols)``, remembered per subtree: SymPy recomputes free_symbols
+    over the whole subtree at every call, so asking it at each node of a tree costs its size
+    times its depth. A class with its own free_symbols (a symbol, a Derivative's bound
+    variables) is asked itself."""
+    found = known.get(node)
+    if found is None:
+        if _union_of_args(type(node)):
+            found = any(_has_symbols(arg, known) for arg in node.args)
+        else:
+            found = bool(node.free_symbols)
+        known[node] = found
+    return found
 
 
 def lambdify_floats(arguments: Any, expressions: Any, modules: str = "numpy",
@@ -297,9 +330,42 @@ def lambdify_floats(arguments: Any, expressions: Any, modules: str = "numpy",
         folded = fold(expressions)
     else:
         folded = [fold(sp.sympify(e)) for e in expressions]
+    if dummify:
+        arguments, folded, dummify = _renamed(arguments, folded)
     function: Callable[..., Any] = sp.lambdify(arguments, folded, modules=modules,
                                                dummify=dummify, cse=cse)
     return function
+
+
+def _renamed(arguments: Any, folded: Any) -> tuple[Any, Any, bool]:
+    """The argument symbols replaced by plain identifiers ``_a0``, ``_a1``, ... in one pass
+    over the expressions, which is what ``dummify`` asks of lambdify: lambdify itself walks
+    the whole expression once per argument (quadratic in a file's size). Where a name could
+    collide with another symbol of the expressions, lambdify dummifies as before."""
+
+    def leaves(item: Any) -> list[Any]:
+        if isinstance(item, (list, tuple)):
+            return [leaf for part in item for leaf in leaves(part)]
+        return [item]
+
+    symbols = leaves(arguments)
+    if not all(isinstance(s, sp.Symbol) for s in symbols) or len(set(symbols)) < len(symbols):
+        return arguments, folded, True
+    names = {s: sp.Symbol(f"_a{k}") for k, s in enumerate(symbols)}
+    whole = isinstance(folded, (sp.Basic, sp.MatrixBase))
+    others = (folded.free_symbols if whole else
+              set().union(set(), *(sp.sympify(e).free_symbols for e in folded)))
+    if any(s.name.startswith("_a") for s in others if s not in names):
+        return arguments, folded, True
+
+    def rename(item: Any) -> Any:
+        if isinstance(item, (list, tuple)):
+            return type(item)(rename(part) for part in item)
+        return names[item]
+
+    renamed = (folded.xreplace(names) if whole
+               else [sp.sympify(e).xreplace(names) for e in folded])
+    return rename(arguments), renamed, False
 
 
 def check_constants(expr: sp.Expr) -> None:

@@ -28,7 +28,8 @@ from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
 from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
 from symkin.symbolic.derivatives import diff
-from symkin.symbolic.differentiation import parameter_jacobian, row_gamma, row_jacobian
+from symkin.symbolic.differentiation import (Memory, parameter_jacobian, row_gamma,
+                                              row_jacobian)
 from symkin.symbolic.planar import TAU, Context, input_slot
 from symkin.symbolic.symbols import Input, Symbols, extra_coordinates, make_symbols
 
@@ -198,19 +199,24 @@ def derive(mech: Mechanism | str | Path) -> System:
     nominal = dict(zip(symbols.p, p_values))
     q0 = _initial_guess(mech, ctx, nominal)
     time_grid = _time_grid(mech, ctx, nominal)
+    column = {q: k for k, q in enumerate(symbols.q)}
+    # each row's non-zeros of Phi_q, taken once: the redundancy analysis evaluates them, the
+    # rows kept keep them (a row's derivatives are its expression's, whatever its place)
+    nonzeros = {row: row_jacobian(row, column, symbols.q) for row in phi}
     phi, rows, removed, mobility = _remove_redundant(phi, rows, symbols, p_values, q0,
-                                                     time_grid, motion_spec.has_masses(mech))
+                                                     time_grid, motion_spec.has_masses(mech),
+                                                     [nonzeros[row] for row in phi])
     # the rank decides whether the forces move it (symbolic.motion.moves_under_forces)
     motion_spec.refuse_keys(mech, motion_spec.moves(len(phi), len(symbols.q)))
-    column = {q: k for k, q in enumerate(symbols.q)}
     jacobian: dict[tuple[int, int], sp.Expr] = {}
     phi_t, gamma = [], []
+    memory = Memory()
     for r, row in enumerate(phi):
-        entries = row_jacobian(row, column, symbols.q)
+        entries = nonzeros[row]
         row_t = diff(row, symbols.t)
         jacobian.update({(r, k): _at_tau(value, symbols) for k, value in entries.items()})
         phi_t.append(_at_tau(row_t, symbols))
-        gamma.append(_at_tau(row_gamma(row, entries, row_t, symbols), symbols))
+        gamma.append(_at_tau(row_gamma(row, entries, row_t, symbols, memory), symbols))
     phi = [_at_tau(row, symbols) for row in phi]
     size = len(symbols.q)
     # as many rows as equations: fewer than columns where the forces move free freedoms
@@ -249,7 +255,8 @@ def _dynamics(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: tuple
 
 def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbols,
                       p_values: tuple[float, ...], q0: tuple[float, ...],
-                      grid: tuple[float, float, float], masses: bool = False
+                      grid: tuple[float, float, float], masses: bool = False,
+                      entries: list[dict[int, sp.Expr]] | None = None
                       ) -> tuple[list[sp.Expr], tuple[Row, ...], tuple[Removed, ...],
                                  int | None]:
     """A file with more equations than coordinates: the rows dependent at the assembled t0
@@ -277,7 +284,8 @@ def _remove_redundant(phi: list[sp.Expr], rows: tuple[Row, ...], symbols: Symbol
         # A rank short at t0 is checked again half a step later (t0 singular, or a freedom).
         t0, t1, dt = grid
         found = redundancy.analyse(phi, symbols.q, symbols.t, symbols.p, p_values, q0, t0,
-                                   priority, t0 + 0.5 * min(dt, t1 - t0), subject, masses)
+                                   priority, t0 + 0.5 * min(dt, t1 - t0), subject, masses,
+                                   entries=entries)
     except redundancy.Refusal as refusal:
         if square:  # judged by the run, as any square file's start is
             return phi, rows, (), None

@@ -33,10 +33,16 @@ class Unsupported(Exception):
     """A node whose class differentiates itself by a rule of its own: use ``sympy.diff``."""
 
 
-def diff(expr: sp.Expr, symbol: sp.Symbol, order: int = 1) -> sp.Expr:
-    """``sympy.diff(expr, symbol, order)``, the same expression, made faster where it can be."""
+def diff(expr: sp.Expr, symbol: sp.Symbol, order: int = 1,
+         shared: dict[sp.Symbol, Differentiator] | None = None) -> sp.Expr:
+    """``sympy.diff(expr, symbol, order)``, the same expression, made faster where it can be.
+
+    ``shared`` keeps each symbol's :class:`Differentiator` from call to call, so that a
+    sub-expression met in many rows (a body's rotation matrix) is differentiated once."""
+    differentiator = (Differentiator(symbol) if shared is None
+                      else shared.setdefault(symbol, Differentiator(symbol)))
     try:
-        found = Differentiator(symbol).diff(expr, order)
+        found = differentiator.diff(expr, order)
     except Unsupported:
         return sp.diff(expr, symbol, order)
     if found.has(sp.Derivative, sp.Subs):  # SymPy puts those in a canonical form of its own

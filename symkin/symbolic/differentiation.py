@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from symkin.symbolic.derivatives import diff
+from symkin.symbolic.derivatives import Differentiator, diff
 from symkin.symbolic.symbols import Symbols
 
 
@@ -40,22 +40,37 @@ def parameter_jacobian(phi: list[sp.Expr], p: tuple[sp.Symbol, ...]
     return sp.ImmutableSparseMatrix(len(phi), len(p), entries)
 
 
+class Memory:
+    """What the rows of one derivation share: the derivatives of sub-expressions met in
+    several rows (a spatial body's rotation matrix in each of its joints' rows), kept per
+    symbol, and the one symbol e of the derivatives along dq. One e serves every row: it
+    is the only dummy of its kind in a row, so no ordering of terms depends on which it is."""
+
+    def __init__(self) -> None:
+        self.along = sp.Dummy("along", real=True)  # as q and dq: Abs(x + e v) has a sign
+        self.differentiators: dict[sp.Symbol, Differentiator] = {}
+
+
 def row_gamma(row: sp.Expr, entries: dict[int, sp.Expr], row_t: sp.Expr,
-              symbols: Symbols) -> sp.Expr:
+              symbols: Symbols, memory: Memory | None = None) -> sp.Expr:
     """One row of Gamma = -(Phi_q dq)_q dq - 2 Phi_qt dq - Phi_tt (2.74)."""
     dq, t = symbols.dq, symbols.t
     mixed = sp.Add(*(diff(value, t) * dq[k] for k, value in entries.items()))
-    return -convective(row, entries, symbols) - 2 * mixed - diff(row_t, t)
+    return -convective(row, entries, symbols, memory) - 2 * mixed - diff(row_t, t)
 
 
-def convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols) -> sp.Expr:
+def convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols,
+               memory: Memory | None = None) -> sp.Expr:
     """(Phi_q dq)_q dq of one row: its second derivative along dq at fixed t,
     d^2/de^2 Phi(q + e dq, t) at e = 0, where SymPy gives it in closed form (module
-    docstring); else, and for a row with a piecewise function, the sum over its columns."""
+    docstring); else, and for a row with a piecewise function, the sum over its columns.
+    ``memory`` shares the derivatives of sub-expressions with the derivation's other rows."""
     q, dq = symbols.q, symbols.dq
     if not row.has(sp.Piecewise):
-        along = sp.Dummy("along", real=True)  # as q and dq: Abs(x + e v) has a sign
-        second = diff(row.xreplace({q[k]: q[k] + along * dq[k] for k in entries}), along, 2)
+        memory = memory or Memory()
+        along = memory.along
+        second = diff(row.xreplace({q[k]: q[k] + along * dq[k] for k in entries}), along, 2,
+                      memory.differentiators)
         if not second.has(sp.Derivative, sp.Subs):
             return second.xreplace({along: 0})
     velocity = sp.Add(*(value * dq[k] for k, value in entries.items()))

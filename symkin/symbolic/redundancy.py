@@ -38,7 +38,7 @@ Needs NumPy and SciPy besides SymPy (lambdify), and the dense solvers of symkin.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,6 +48,7 @@ import sympy as sp
 from symkin.contract import dense_solvers
 from symkin.contract.options import defaults
 from symkin.spec import constants
+from symkin.symbolic.differentiation import row_jacobian
 
 RANK_TOLERANCE = 1e-8
 """Relative size (of the equilibrated Phi_q) below which a row counts as dependent."""
@@ -95,15 +96,23 @@ class Refusal(Exception):
 
 class _Equations:
     """Phi and the dense Phi_q of all rows as NumPy functions (dummy symbols: names from the
-    file never become Python identifiers)."""
+    file never become Python identifiers). Phi_q is lambdified from each row's structural
+    non-zeros (differentiation.row_jacobian, the derivatives the derivation keeps for the rows
+    it keeps), not from a dense symbolic Jacobian: its zeros cost nothing to print."""
 
     def __init__(self, phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
-                 p: Sequence[sp.Symbol], p_values: Sequence[float]) -> None:
-        matrix = sp.Matrix(list(phi))
+                 p: Sequence[sp.Symbol], p_values: Sequence[float],
+                 entries: Sequence[Mapping[int, sp.Expr]] | None = None) -> None:
+        if entries is None:
+            column = {symbol: k for k, symbol in enumerate(q)}
+            entries = [row_jacobian(row, column, tuple(q)) for row in phi]
+        at = [(r, k) for r, row in enumerate(entries) for k in sorted(row)]
         arguments = (list(q), t, list(p))
-        self._phi = constants.lambdify_floats(arguments, list(matrix), dummify=True)
-        self._jacobian = constants.lambdify_floats(arguments, matrix.jacobian(list(q)),
-                                                   dummify=True)
+        self._phi = constants.lambdify_floats(arguments, list(phi), dummify=True)
+        self._nonzeros = constants.lambdify_floats(
+            arguments, [entries[r][k] for r, k in at], dummify=True)
+        self._rows = np.array([r for r, _ in at], dtype=np.intp)
+        self._columns = np.array([k for _, k in at], dtype=np.intp)
         self.rows, self.size = len(phi), len(q)
         self.p = np.array(p_values, dtype=float)
 
@@ -112,14 +121,17 @@ class _Equations:
         return np.array(values, dtype=float).reshape(self.rows)
 
     def phi_q(self, q: Any, t: float, p: Any = None) -> np.ndarray:
-        values = self._jacobian(q, np.float64(t), self.p if p is None else p)
-        return np.array(values, dtype=float).reshape(self.rows, self.size)
+        values = self._nonzeros(q, np.float64(t), self.p if p is None else p)
+        dense = np.zeros((self.rows, self.size))
+        dense[self._rows, self._columns] = np.array(values, dtype=float).reshape(-1)
+        return dense
 
 
 def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
             p: Sequence[sp.Symbol], p_values: Sequence[float], q0: Sequence[float],
             t0: float, priority: Sequence[int], t_near: float | None = None,
-            joints: Sequence[int] = (), freedoms: bool = False) -> Finding:
+            joints: Sequence[int] = (), freedoms: bool = False,
+            entries: Sequence[Mapping[int, sp.Expr]] | None = None) -> Finding:
     """Assemble all rows at t0, find their rank and which rows to remove.
 
     Args:
@@ -133,12 +145,14 @@ def analyse(phi: Sequence[sp.Expr], q: Sequence[sp.Symbol], t: sp.Symbol,
             spatial body's normalisation), whose rank gives the mobility at t0.
         freedoms: a rank below the number of coordinates that a nearby assembly keeps is
             a motion the forces decide (a file with masses), not refused.
+        entries: each row's structural non-zeros of Phi_q by column, where the caller has
+            them (differentiation.row_jacobian); else taken here.
 
     Raises:
         Refusal: the rows contradict each other at t0 (no assembly), the rank is below the
             number of coordinates, or it cannot be decided.
     """
-    equations = _Equations(phi, q, t, p, p_values)
+    equations = _Equations(phi, q, t, p, p_values, entries)
     with np.errstate(all="ignore"):
         assembled = _assemble(equations, np.array(q0, dtype=float), t0)
         jacobian = equations.phi_q(assembled, t0)
