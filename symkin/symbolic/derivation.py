@@ -13,7 +13,6 @@ Gamma's convective part: :mod:`symkin.symbolic.differentiation`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -28,9 +27,9 @@ from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
 from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
 from symkin.symbolic.derivatives import diff
-from symkin.symbolic.differentiation import (Memory, parameter_jacobian, row_gamma,
-                                              row_jacobian)
-from symkin.symbolic.planar import TAU, Context, input_slot
+from symkin.symbolic.differentiation import Memory, parameter_jacobian, row_gamma, row_jacobian
+from symkin.symbolic.input_rows import at_tau, input_values, with_inputs
+from symkin.symbolic.planar import Context
 from symkin.symbolic.symbols import Input, Symbols, extra_coordinates, make_symbols
 
 # A spatial body's own row: its Euler parameters' normalisation (section, part).
@@ -214,10 +213,10 @@ def derive(mech: Mechanism | str | Path) -> System:
     for r, row in enumerate(phi):
         entries = nonzeros[row]
         row_t = diff(row, symbols.t)
-        jacobian.update({(r, k): _at_tau(value, symbols) for k, value in entries.items()})
-        phi_t.append(_at_tau(row_t, symbols))
-        gamma.append(_at_tau(row_gamma(row, entries, row_t, symbols, memory), symbols))
-    phi = [_at_tau(row, symbols) for row in phi]
+        jacobian.update({(r, k): at_tau(value, symbols) for k, value in entries.items()})
+        phi_t.append(at_tau(row_t, symbols))
+        gamma.append(at_tau(row_gamma(row, entries, row_t, symbols, memory), symbols))
+    phi = [at_tau(row, symbols) for row in phi]
     size = len(symbols.q)
     # as many rows as equations: fewer than columns where the forces move free freedoms
     phi_q = sp.ImmutableSparseMatrix(len(phi), size, jacobian)
@@ -236,7 +235,7 @@ def derive(mech: Mechanism | str | Path) -> System:
                             _removed_jacobians(removed, column, symbols))
                   if has_dynamics(mech) else None),
         inputs=symbols.inputs, senses=_senses(mech, ctx),
-        input_values=_input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
+        input_values=input_values(phi, symbols, {**dict(zip(symbols.q, q0)), **nominal,
                                                   symbols.t: time_grid[0]}),
     )
 
@@ -248,7 +247,7 @@ def _dynamics(mech: Mechanism, ctx: Context, phi_q: sp.SparseMatrix, rows: tuple
     written, to find each row's driven function)."""
     if not mech.is_spatial:
         return dynamics.derive(mech, ctx, phi_q, rows, placed, removed)
-    drivers = [_with_inputs(c, ctx.symbols, k) for k, c in enumerate(mech.drivers)]
+    drivers = [with_inputs(c, ctx.symbols, k) for k, c in enumerate(mech.drivers)]
     return dynamics3d.derive(mech, ctx, phi_q, rows, placed, drivers,  # type: ignore[arg-type]
                              removed)
 
@@ -314,48 +313,6 @@ def _removed_jacobians(removed: tuple[Removed, ...], column: dict[sp.Symbol, int
     return tuple(found)
 
 
-def _at_tau(expr: sp.Expr, symbols: Symbols) -> sp.Expr:
-    """An expression derived from inputs' Taylor polynomials, taken at tau = t."""
-    return expr.xreplace({TAU: symbols.t}) if symbols.inputs else expr
-
-
-def _with_inputs(constraint: Any, symbols: Symbols, index: int) -> Any:
-    """The driver with each ``input`` function replaced by its slot (planar.input_slot)."""
-    update: dict[str, Any] = {}
-    for item in symbols.inputs:
-        if item.driver != index:
-            continue
-        slot = input_slot(item.u, item.du, item.ddu, symbols.t)
-        if item.component is None:
-            update[item.key] = slot
-        else:
-            value = list(update.get(item.key, getattr(constraint, item.key)))
-            value[item.component] = slot
-            update[item.key] = value
-    return constraint.model_copy(update=update) if update else constraint
-
-
-def _input_values(phi: list[sp.Expr], symbols: Symbols,
-                  at_start: dict[sp.Symbol, float]) -> tuple[float, ...]:
-    """Each input's value at the file's q0 and t0 (``at_start``, rates zero): its row, linear
-    in u, solved for u; 0 where that has no finite value. Only generation-time samples use
-    it."""
-    if not symbols.inputs:
-        return ()
-    at_q0: dict[sp.Symbol, Any] = dict(at_start)
-    for item in symbols.inputs:
-        at_q0.update({item.u: 0, item.du: 0, item.ddu: 0})
-    values = []
-    for item in symbols.inputs:
-        row = next(row for row in phi if item.u in row.free_symbols)
-        try:
-            value = float(-row.subs(at_q0) / sp.diff(row, item.u).subs(at_q0))
-        except (TypeError, ValueError, ZeroDivisionError):
-            value = 0.0
-        values.append(value if math.isfinite(value) else 0.0)
-    return tuple(values)
-
-
 def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tuple[Row, ...]]:
     """Phi and its row labels: joints in file order, then drivers (README, "Row order")."""
     phi: list[sp.Expr] = []
@@ -364,7 +321,7 @@ def _constraint_rows(mech: Mechanism, ctx: Context) -> tuple[list[sp.Expr], tupl
         for index, constraint in enumerate(getattr(mech, section)):
             kind = pairs.of(constraint)
             if section == "drivers":
-                constraint = _with_inputs(constraint, ctx.symbols, index)
+                constraint = with_inputs(constraint, ctx.symbols, index)
             equations = _equations(kind, constraint, ctx, (section, index))
             parts = kind.rows or tuple(f"equation {k}" for k in range(len(equations)))
             bodies = kind.joined_bodies(constraint) or _bodies_touched(equations, ctx)
@@ -384,10 +341,10 @@ def _senses(mech: Mechanism, ctx: Context) -> tuple[tuple[str, sp.Expr], ...]:
             if kind.senses is None:
                 continue
             if section == "drivers":
-                constraint = _with_inputs(constraint, ctx.symbols, index)
+                constraint = with_inputs(constraint, ctx.symbols, index)
             owner = Row(section, index, constraint.type,
                         kind.joined_bodies(constraint) or (), "sense", constraint.name)
-            found.extend((str(owner), _at_tau(expr, ctx.symbols))
+            found.extend((str(owner), at_tau(expr, ctx.symbols))
                          for expr in kind.senses(constraint, ctx))
     return tuple(found)
 
