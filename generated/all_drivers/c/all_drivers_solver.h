@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 627 (208 add/sub, 149 mul, 22 div, 0 sqrt, 9 other calls, 132 fabs, 107 compares)
  *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 140
- * Condition at the converged q: 522; an extra iteration there (at most 3): 801
- * Velocity: 112; acceleration: 189; per-point checks: 2176; predictor: 63
- * Step, worst case with the default cap of 25 iterations: 22245 (7664 add/sub, 5606 mul, 773 div, 10 sqrt, 280 other calls, 4354 fabs, 3558 compares)
+ * Condition at the converged q: 470; an extra iteration there (at most 3): 801
+ * Velocity: 112; acceleration: 189; per-point checks: 2145; predictor: 63
+ * Step, worst case with the default cap of 25 iterations: 22110 (7584 add/sub, 5601 mul, 773 div, 10 sqrt, 280 other calls, 4306 fabs, 3556 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130025
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 129994
  */
 #define ALL_DRIVERS_OPS_ITERATION 627   /* one Newton iteration */
-#define ALL_DRIVERS_OPS_STEP_FIXED 6570  /* a step without its iterations */
-#define ALL_DRIVERS_OPS_STEP_WORST 22245  /* at the default cap, 25 */
-#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130025  /* every factorization dense */
+#define ALL_DRIVERS_OPS_STEP_FIXED 6435  /* a step without its iterations */
+#define ALL_DRIVERS_OPS_STEP_WORST 22110  /* at the default cap, 25 */
+#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 129994  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

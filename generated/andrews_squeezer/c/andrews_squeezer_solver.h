@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 585 (206 add/sub, 121 mul, 28 div, 0 sqrt, 14 other calls, 116 fabs, 100 compares)
  *   Phi, Phi_q, their factorization and tests: 417; the update (a solve): 168
- * Condition at the converged q: 517; an extra iteration there (at most 3): 765
- * Velocity: 104; acceleration: 148; per-point checks: 2526; predictor: 87
- * Step, worst case with the default cap of 25 iterations: 21332 (7810 add/sub, 4624 mul, 995 div, 10 sqrt, 434 other calls, 4010 fabs, 3449 compares)
+ * Condition at the converged q: 447; an extra iteration there (at most 3): 765
+ * Velocity: 104; acceleration: 148; per-point checks: 2488; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 21154 (7698 add/sub, 4624 mul, 995 div, 10 sqrt, 434 other calls, 3954 fabs, 3439 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284358
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284320
  */
 #define ANDREWS_SQUEEZER_OPS_ITERATION 585   /* one Newton iteration */
-#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6707  /* a step without its iterations */
-#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21332  /* at the default cap, 25 */
-#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284358  /* every factorization dense */
+#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6529  /* a step without its iterations */
+#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21154  /* at the default cap, 25 */
+#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284320  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

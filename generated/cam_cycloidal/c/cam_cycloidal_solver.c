@@ -305,16 +305,13 @@ static cam_cycloidal_real cam_cycloidal_inverse_norm1_exact(const cam_cycloidal_
     cam_cycloidal_real largest = 2.0, finite = 0, s;
     (void)v;
     (void)inv;
-    s = fabs(w0) + fabs(inv[3]);
+    s = fabs(w0) + fabs(inv[3]) + 1.0;
     finite += s - s;
     largest = s > largest ? s : largest;
     s = fabs(w1) + fabs(inv[3]) + 1.0;
     finite += s - s;
     largest = s > largest ? s : largest;
     s = fabs(w4) + fabs(w2) + 1.0;
-    finite += s - s;
-    largest = s > largest ? s : largest;
-    s = fabs(w0) + fabs(inv[3]) + 1.0;
     finite += s - s;
     largest = s > largest ? s : largest;
     return finite == 0 ? largest : (cam_cycloidal_real)INFINITY;
@@ -343,23 +340,19 @@ static cam_cycloidal_real cam_cycloidal_difference_norm1(const cam_cycloidal_rea
     return finite == 0 ? largest : (cam_cycloidal_real)NAN;
 }
 
-/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
- * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
- * or where the exact code would be long) is a chain of four or more solves, most of a dense
- * step: it is made afresh only when Phi_q has moved too far from where the last one was made
- * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz by Hager's estimate, where the
+ * exact norm is not generated or not usable (on the dense LU: --linalg dense or the sparse
+ * LU's fall-back; or where the exact code would be long). The estimate is a chain of four
+ * or more solves, most of a dense step: it is made afresh only when Phi_q has moved too far
+ * from where the last one was made (work->nz_estimated, estimate work->estimated_inv_norm,
+ * at this point or an earlier one).
  * With theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
  * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
  * a few per cent above the old one (it errs towards flagging), for one pass over the
  * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
-static void cam_cycloidal_estimate(cam_cycloidal_workspace *work, cam_cycloidal_report *report)
+static void cam_cycloidal_estimate_again(cam_cycloidal_workspace *work, cam_cycloidal_report *report)
 {
     cam_cycloidal_real theta;
-    if (cam_cycloidal_exact_estimate(work)) {
-        report->inv_norm = cam_cycloidal_inverse_norm1_exact(work->lu.v, work->lu.inv);
-        report->cond = report->inv_norm * cam_cycloidal_norm1(work->nz);
-        return;
-    }
     /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
     theta = work->estimated_inv_norm * cam_cycloidal_difference_norm1(work->nz, work->nz_estimated);
     if (work->estimated_inv_norm >= 0 && theta <= CAM_CYCLOIDAL_REESTIMATE_SHIFT) {
@@ -370,6 +363,20 @@ static void cam_cycloidal_estimate(cam_cycloidal_workspace *work, cam_cycloidal_
         memcpy(work->nz_estimated, work->nz, sizeof work->nz);
     }
     report->cond = report->inv_norm * cam_cycloidal_norm1(work->nz);
+}
+
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz: exact where the code is
+ * generated, computed every time. Hager's path is a function of its own so that this one
+ * stays small enough for the compiler to take into its caller (16 instructions fewer in the
+ * crank-slider's step: no call, fewer registers saved). */
+static void cam_cycloidal_estimate(cam_cycloidal_workspace *work, cam_cycloidal_report *report)
+{
+    if (cam_cycloidal_exact_estimate(work)) {
+        report->inv_norm = cam_cycloidal_inverse_norm1_exact(work->lu.v, work->lu.inv);
+        report->cond = report->inv_norm * cam_cycloidal_norm1(work->nz);
+        return;
+    }
+    cam_cycloidal_estimate_again(work, report);
 }
 
 static cam_cycloidal_real cam_cycloidal_at_least_1(cam_cycloidal_real x)
@@ -707,27 +714,29 @@ static void cam_cycloidal_predict(cam_cycloidal_real t, cam_cycloidal_state *sta
 }
 
 /* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
- * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. The
+ * test is one addition an entry: the sum of |.| is NaN exactly when some entry is (none is
+ * negative: inf - inf cannot occur), and an infinite entry is the largest. */
 static cam_cycloidal_real cam_cycloidal_rates_pass(const cam_cycloidal_workspace *work, cam_cycloidal_real dq[],
                                        cam_cycloidal_real *finite)
 {
-    cam_cycloidal_real largest = 0, nan = 0;
-    { const cam_cycloidal_real b = fabs(dq[0]); largest = b > largest ? b : largest; nan += b - b; }
+    cam_cycloidal_real largest = 0, sum = 0;
+    { const cam_cycloidal_real b = fabs(dq[0]); largest = b > largest ? b : largest; sum += b; }
     dq[0] = -dq[0];
-    { const cam_cycloidal_real b = fabs(dq[1]); largest = b > largest ? b : largest; nan += b - b; }
+    { const cam_cycloidal_real b = fabs(dq[1]); largest = b > largest ? b : largest; sum += b; }
     dq[1] = -dq[1];
-    { const cam_cycloidal_real b = fabs(dq[2]); largest = b > largest ? b : largest; nan += b - b; }
+    { const cam_cycloidal_real b = fabs(dq[2]); largest = b > largest ? b : largest; sum += b; }
     dq[2] = -dq[2];
-    { const cam_cycloidal_real b = fabs(dq[3]); largest = b > largest ? b : largest; nan += b - b; }
+    { const cam_cycloidal_real b = fabs(dq[3]); largest = b > largest ? b : largest; sum += b; }
     dq[3] = -dq[3];
-    { const cam_cycloidal_real b = fabs(dq[4]); largest = b > largest ? b : largest; nan += b - b; }
+    { const cam_cycloidal_real b = fabs(dq[4]); largest = b > largest ? b : largest; sum += b; }
     dq[4] = -dq[4];
-    { const cam_cycloidal_real b = fabs(dq[5]); largest = b > largest ? b : largest; nan += b - b; }
+    { const cam_cycloidal_real b = fabs(dq[5]); largest = b > largest ? b : largest; sum += b; }
     dq[5] = -dq[5];
-    { const cam_cycloidal_real b = fabs(dq[6]); largest = b > largest ? b : largest; nan += b - b; }
+    { const cam_cycloidal_real b = fabs(dq[6]); largest = b > largest ? b : largest; sum += b; }
     dq[6] = -dq[6];
     cam_cycloidal_from_unit(work, dq);
-    *finite = nan;
+    *finite = sum != sum ? (cam_cycloidal_real)NAN : largest - largest;
     return largest;
 }
 
@@ -738,52 +747,53 @@ static cam_cycloidal_real cam_cycloidal_accelerations_pass(const cam_cycloidal_w
                                                const cam_cycloidal_real q[], cam_cycloidal_real ddq[],
                                                cam_cycloidal_real *finite, cam_cycloidal_real *nq)
 {
-    cam_cycloidal_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
-    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
-    { const cam_cycloidal_real c = fabs(ddq[0]); largest = c > largest ? c : largest; nan += c - c; }
+    cam_cycloidal_real largest = 0, sum = 0, largest_q = 0, sum_q = 0;
+    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
+     * a coordinate that is no length is the same in every unit (no division) */
+    { const cam_cycloidal_real c = fabs(ddq[0]); largest = c > largest ? c : largest; sum += c; }
     {
         const cam_cycloidal_real a = fabs(q[0]) * work->inverse_column[0];
         largest_q = a > largest_q ? a : largest_q;
         sum_q += a;
     }
-    { const cam_cycloidal_real c = fabs(ddq[1]); largest = c > largest ? c : largest; nan += c - c; }
+    { const cam_cycloidal_real c = fabs(ddq[1]); largest = c > largest ? c : largest; sum += c; }
     {
         const cam_cycloidal_real a = fabs(q[1]) * work->inverse_column[1];
         largest_q = a > largest_q ? a : largest_q;
         sum_q += a;
     }
-    { const cam_cycloidal_real c = fabs(ddq[2]); largest = c > largest ? c : largest; nan += c - c; }
+    { const cam_cycloidal_real c = fabs(ddq[2]); largest = c > largest ? c : largest; sum += c; }
     {
-        const cam_cycloidal_real a = fabs(q[2]) * work->inverse_column[2];
+        const cam_cycloidal_real a = fabs(q[2]);
         largest_q = a > largest_q ? a : largest_q;
         sum_q += a;
     }
-    { const cam_cycloidal_real c = fabs(ddq[3]); largest = c > largest ? c : largest; nan += c - c; }
+    { const cam_cycloidal_real c = fabs(ddq[3]); largest = c > largest ? c : largest; sum += c; }
     {
         const cam_cycloidal_real a = fabs(q[3]) * work->inverse_column[3];
         largest_q = a > largest_q ? a : largest_q;
         sum_q += a;
     }
-    { const cam_cycloidal_real c = fabs(ddq[4]); largest = c > largest ? c : largest; nan += c - c; }
+    { const cam_cycloidal_real c = fabs(ddq[4]); largest = c > largest ? c : largest; sum += c; }
     {
         const cam_cycloidal_real a = fabs(q[4]) * work->inverse_column[4];
         largest_q = a > largest_q ? a : largest_q;
         sum_q += a;
     }
-    { const cam_cycloidal_real c = fabs(ddq[5]); largest = c > largest ? c : largest; nan += c - c; }
+    { const cam_cycloidal_real c = fabs(ddq[5]); largest = c > largest ? c : largest; sum += c; }
     {
-        const cam_cycloidal_real a = fabs(q[5]) * work->inverse_column[5];
+        const cam_cycloidal_real a = fabs(q[5]);
         largest_q = a > largest_q ? a : largest_q;
         sum_q += a;
     }
-    { const cam_cycloidal_real c = fabs(ddq[6]); largest = c > largest ? c : largest; nan += c - c; }
+    { const cam_cycloidal_real c = fabs(ddq[6]); largest = c > largest ? c : largest; sum += c; }
     {
-        const cam_cycloidal_real a = fabs(q[6]) * work->inverse_column[6];
+        const cam_cycloidal_real a = fabs(q[6]);
         largest_q = a > largest_q ? a : largest_q;
         sum_q += a;
     }
     cam_cycloidal_from_unit(work, ddq);
-    *finite = nan;
+    *finite = sum != sum ? (cam_cycloidal_real)NAN : largest - largest;
     *nq = sum_q != sum_q ? (cam_cycloidal_real)NAN : largest_q;
     return largest;
 }

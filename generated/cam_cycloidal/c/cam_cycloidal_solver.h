@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 402 (142 add/sub, 170 mul, 16 div, 1 sqrt, 18 other calls, 23 fabs, 32 compares)
  *   Phi, Phi_q, their factorization and tests: 353; the update (a solve): 49
- * Condition at the converged q: 46; an extra iteration there (at most 3): 568
- * Velocity: 27; acceleration: 520; per-point checks: 1555; predictor: 31
- * Step, worst case with the default cap of 25 iterations: 14428 (5063 add/sub, 6116 mul, 554 div, 42 sqrt, 576 other calls, 817 fabs, 1260 compares)
+ * Condition at the converged q: 40; an extra iteration there (at most 3): 568
+ * Velocity: 27; acceleration: 520; per-point checks: 1542; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 14403 (5045 add/sub, 6113 mul, 554 div, 42 sqrt, 576 other calls, 813 fabs, 1260 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31453
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31440
  */
 #define CAM_CYCLOIDAL_OPS_ITERATION 402   /* one Newton iteration */
-#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4378  /* a step without its iterations */
-#define CAM_CYCLOIDAL_OPS_STEP_WORST 14428  /* at the default cap, 25 */
-#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31453  /* every factorization dense */
+#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4353  /* a step without its iterations */
+#define CAM_CYCLOIDAL_OPS_STEP_WORST 14403  /* at the default cap, 25 */
+#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31440  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CAM_CYCLOIDAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 994 (359 add/sub, 312 mul, 23 div, 0 sqrt, 4 other calls, 164 fabs, 132 compares)
  *   Phi, Phi_q, their factorization and tests: 794; the update (a solve): 200
  * Condition at the converged q: 2542; an extra iteration there (at most 3): 1167
- * Velocity: 174; acceleration: 382; per-point checks: 3102; predictor: 59
- * Step, worst case with the default cap of 25 iterations: 38042 (14554 add/sub, 12278 mul, 796 div, 10 sqrt, 266 other calls, 5540 fabs, 4598 compares)
+ * Velocity: 174; acceleration: 382; per-point checks: 3070; predictor: 59
+ * Step, worst case with the default cap of 25 iterations: 38010 (14528 add/sub, 12270 mul, 796 div, 10 sqrt, 266 other calls, 5540 fabs, 4600 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 122865
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 122833
  */
 #define CARDAN_OPS_ITERATION 994   /* one Newton iteration */
-#define CARDAN_OPS_STEP_FIXED 13192  /* a step without its iterations */
-#define CARDAN_OPS_STEP_WORST 38042  /* at the default cap, 25 */
-#define CARDAN_OPS_STEP_DENSE_WORST 122865  /* every factorization dense */
+#define CARDAN_OPS_STEP_FIXED 13160  /* a step without its iterations */
+#define CARDAN_OPS_STEP_WORST 38010  /* at the default cap, 25 */
+#define CARDAN_OPS_STEP_DENSE_WORST 122833  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CARDAN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 177 (66 add/sub, 36 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 113; the update (a solve): 64
- * Condition at the converged q: 57; an extra iteration there (at most 3): 345
- * Velocity: 37; acceleration: 44; per-point checks: 1016; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 6919 (2535 add/sub, 1559 mul, 406 div, 10 sqrt, 124 other calls, 977 fabs, 1308 compares)
+ * Condition at the converged q: 44; an extra iteration there (at most 3): 345
+ * Velocity: 37; acceleration: 44; per-point checks: 999; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 6876 (2505 add/sub, 1556 mul, 406 div, 10 sqrt, 124 other calls, 969 fabs, 1306 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37681
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37664
  */
 #define CRANK_SLIDER_OPS_ITERATION 177   /* one Newton iteration */
-#define CRANK_SLIDER_OPS_STEP_FIXED 2494  /* a step without its iterations */
-#define CRANK_SLIDER_OPS_STEP_WORST 6919  /* at the default cap, 25 */
-#define CRANK_SLIDER_OPS_STEP_DENSE_WORST 37681  /* every factorization dense */
+#define CRANK_SLIDER_OPS_STEP_FIXED 2451  /* a step without its iterations */
+#define CRANK_SLIDER_OPS_STEP_WORST 6876  /* at the default cap, 25 */
+#define CRANK_SLIDER_OPS_STEP_DENSE_WORST 37664  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 190 (73 add/sub, 41 mul, 11 div, 1 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 126; the update (a solve): 64
- * Condition at the converged q: 57; an extra iteration there (at most 3): 358
- * Velocity: 37; acceleration: 56; per-point checks: 1039; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 7331 (2756 add/sub, 1718 mul, 406 div, 42 sqrt, 124 other calls, 977 fabs, 1308 compares)
+ * Condition at the converged q: 44; an extra iteration there (at most 3): 358
+ * Velocity: 37; acceleration: 56; per-point checks: 1022; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 7288 (2726 add/sub, 1715 mul, 406 div, 42 sqrt, 124 other calls, 969 fabs, 1306 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38093
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38076
  */
 #define CRANK_SLIDER_DRAWN_OPS_ITERATION 190   /* one Newton iteration */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2581  /* a step without its iterations */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7331  /* at the default cap, 25 */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38093  /* every factorization dense */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2538  /* a step without its iterations */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7288  /* at the default cap, 25 */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38076  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 366 (127 add/sub, 91 mul, 13 div, 0 sqrt, 6 other calls, 68 fabs, 61 compares)
  *   Phi, Phi_q, their factorization and tests: 285; the update (a solve): 81
- * Condition at the converged q: 211; an extra iteration there (at most 3): 534
- * Velocity: 54; acceleration: 113; per-point checks: 1328; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 13089 (4619 add/sub, 3422 mul, 464 div, 10 sqrt, 186 other calls, 2254 fabs, 2134 compares)
+ * Condition at the converged q: 187; an extra iteration there (at most 3): 534
+ * Velocity: 54; acceleration: 113; per-point checks: 1311; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 13024 (4579 add/sub, 3419 mul, 464 div, 10 sqrt, 186 other calls, 2234 fabs, 2132 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43284
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43267
  */
 #define CRANK_SLIDER_GENERAL_OPS_ITERATION 366   /* one Newton iteration */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3939  /* a step without its iterations */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13089  /* at the default cap, 25 */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43284  /* every factorization dense */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3874  /* a step without its iterations */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13024  /* at the default cap, 25 */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43267  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_GENERAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -58,21 +58,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 176 (66 add/sub, 35 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 112; the update (a solve): 64
- * Condition at the converged q: 57; an extra iteration there (at most 3): 344
- * Velocity: 37; acceleration: 44; per-point checks: 1016; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 6890 (2537 add/sub, 1528 mul, 406 div, 10 sqrt, 124 other calls, 977 fabs, 1308 compares)
+ * Condition at the converged q: 44; an extra iteration there (at most 3): 344
+ * Velocity: 37; acceleration: 44; per-point checks: 999; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 6847 (2507 add/sub, 1525 mul, 406 div, 10 sqrt, 124 other calls, 969 fabs, 1306 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 7579 (2838 add/sub, 1653 mul, 465 div, 10 sqrt, 148 other calls, 1040 fabs, 1425 compares)
- *   positions only (du, ddu NULL): 7424 (2791 add/sub, 1601 mul, 447 div, 10 sqrt, 148 other calls, 1022 fabs, 1405 compares)
+ * solve_inputs, worst case: 7553 (2824 add/sub, 1653 mul, 465 div, 10 sqrt, 148 other calls, 1032 fabs, 1421 compares)
+ *   positions only (du, ddu NULL): 7398 (2777 add/sub, 1601 mul, 447 div, 10 sqrt, 148 other calls, 1014 fabs, 1401 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 656
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37652
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37635
  */
 #define CRANK_SLIDER_INPUT_OPS_ITERATION 176   /* one Newton iteration */
-#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2490  /* a step without its iterations */
-#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6890  /* at the default cap, 25 */
-#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37652  /* every factorization dense */
-#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7579  /* solve_inputs with du, ddu */
-#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7424  /* solve_inputs, du, ddu NULL */
+#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2447  /* a step without its iterations */
+#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6847  /* at the default cap, 25 */
+#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37635  /* every factorization dense */
+#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7553  /* solve_inputs with du, ddu */
+#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7398  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

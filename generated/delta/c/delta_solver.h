@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 3602 (1360 add/sub, 1335 mul, 48 div, 0 sqrt, 9 other calls, 485 fabs, 365 compares)
  *   Phi, Phi_q, their factorization and tests: 3199; the update (a solve): 403
  * Condition at the converged q: 5260; an extra iteration there (at most 3): 3789
- * Velocity: 405; acceleration: 2639; per-point checks: 9246; predictor: 115
- * Step, worst case with the default cap of 25 iterations: 127637 (49914 add/sub, 47846 mul, 1633 div, 10 sqrt, 592 other calls, 15757 fabs, 11885 compares)
+ * Velocity: 405; acceleration: 2639; per-point checks: 9194; predictor: 115
+ * Step, worst case with the default cap of 25 iterations: 127585 (49860 add/sub, 47846 mul, 1633 div, 10 sqrt, 592 other calls, 15757 fabs, 11887 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689261
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689209
  */
 #define DELTA_OPS_ITERATION 3602   /* one Newton iteration */
-#define DELTA_OPS_STEP_FIXED 37587  /* a step without its iterations */
-#define DELTA_OPS_STEP_WORST 127637  /* at the default cap, 25 */
-#define DELTA_OPS_STEP_DENSE_WORST 689261  /* every factorization dense */
+#define DELTA_OPS_STEP_FIXED 37535  /* a step without its iterations */
+#define DELTA_OPS_STEP_WORST 127585  /* at the default cap, 25 */
+#define DELTA_OPS_STEP_DENSE_WORST 689209  /* every factorization dense */
 
 typedef struct {
     int status;                  /* DELTA_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -59,18 +59,18 @@ typedef struct {
  * One Newton iteration: 3591 (1356 add/sub, 1331 mul, 48 div, 0 sqrt, 6 other calls, 485 fabs, 365 compares)
  *   Phi, Phi_q, their factorization and tests: 3188; the update (a solve): 403
  * Condition at the converged q: 5260; an extra iteration there (at most 3): 3778
- * Velocity: 395; acceleration: 2603; per-point checks: 9177; predictor: 115
- * Step, worst case with the default cap of 25 iterations: 127203 (49770 add/sub, 47676 mul, 1633 div, 10 sqrt, 472 other calls, 15757 fabs, 11885 compares)
+ * Velocity: 395; acceleration: 2603; per-point checks: 9125; predictor: 115
+ * Step, worst case with the default cap of 25 iterations: 127151 (49716 add/sub, 47676 mul, 1633 div, 10 sqrt, 472 other calls, 15757 fabs, 11887 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
  * solve_inputs, worst case: 133667 (52630 add/sub, 50568 mul, 1806 div, 10 sqrt, 508 other calls, 15953 fabs, 12192 compares)
  *   positions only (du, ddu NULL): 130443 (51280 add/sub, 48864 mul, 1750 div, 10 sqrt, 508 other calls, 15897 fabs, 12134 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 6374
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 688827
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 688775
  */
 #define DELTA_FK_OPS_ITERATION 3591   /* one Newton iteration */
-#define DELTA_FK_OPS_STEP_FIXED 37428  /* a step without its iterations */
-#define DELTA_FK_OPS_STEP_WORST 127203  /* at the default cap, 25 */
-#define DELTA_FK_OPS_STEP_DENSE_WORST 688827  /* every factorization dense */
+#define DELTA_FK_OPS_STEP_FIXED 37376  /* a step without its iterations */
+#define DELTA_FK_OPS_STEP_WORST 127151  /* at the default cap, 25 */
+#define DELTA_FK_OPS_STEP_DENSE_WORST 688775  /* every factorization dense */
 #define DELTA_FK_OPS_INPUTS_WORST 133667  /* solve_inputs with du, ddu */
 #define DELTA_FK_OPS_POSITIONS_WORST 130443  /* solve_inputs, du, ddu NULL */
 

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 225 (76 add/sub, 46 mul, 12 div, 0 sqrt, 6 other calls, 42 fabs, 43 compares)
  *   Phi, Phi_q, their factorization and tests: 159; the update (a solve): 66
- * Condition at the converged q: 83; an extra iteration there (at most 3): 393
- * Velocity: 39; acceleration: 52; per-point checks: 1059; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 8414 (2860 add/sub, 1895 mul, 435 div, 10 sqrt, 186 other calls, 1424 fabs, 1604 compares)
+ * Condition at the converged q: 57; an extra iteration there (at most 3): 393
+ * Velocity: 39; acceleration: 52; per-point checks: 1042; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8345 (2816 add/sub, 1892 mul, 435 div, 10 sqrt, 186 other calls, 1408 fabs, 1598 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39062
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39045
  */
 #define FOUR_BAR_DYNAMICS_OPS_ITERATION 225   /* one Newton iteration */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2789  /* a step without its iterations */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8414  /* at the default cap, 25 */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39062  /* every factorization dense */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2720  /* a step without its iterations */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8345  /* at the default cap, 25 */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39045  /* every factorization dense */
 
 typedef struct {
     int status;                  /* FOUR_BAR_DYNAMICS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

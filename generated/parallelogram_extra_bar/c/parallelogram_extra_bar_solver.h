@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 314 (108 add/sub, 71 mul, 16 div, 0 sqrt, 10 other calls, 55 fabs, 54 compares)
  *   Phi, Phi_q, their factorization and tests: 224; the update (a solve): 90
- * Condition at the converged q: 154; an extra iteration there (at most 3): 485
- * Velocity: 53; acceleration: 93; per-point checks: 1436; predictor: 51
- * Step, worst case with the default cap of 25 iterations: 11566 (4046 add/sub, 2764 mul, 575 div, 10 sqrt, 310 other calls, 1889 fabs, 1972 compares)
+ * Condition at the converged q: 124; an extra iteration there (at most 3): 485
+ * Velocity: 53; acceleration: 93; per-point checks: 1412; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 11482 (3992 add/sub, 2760 mul, 575 div, 10 sqrt, 310 other calls, 1869 fabs, 1966 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73363
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73339
  */
 #define PARALLELOGRAM_EXTRA_BAR_OPS_ITERATION 314   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3716  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11566  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73363  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3632  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11482  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73339  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 381 (138 add/sub, 88 mul, 19 div, 0 sqrt, 11 other calls, 63 fabs, 62 compares)
  *   Phi, Phi_q, their factorization and tests: 267; the update (a solve): 114
- * Condition at the converged q: 231; an extra iteration there (at most 3): 555
- * Velocity: 73; acceleration: 113; per-point checks: 1786; predictor: 63
- * Step, worst case with the default cap of 25 iterations: 14050 (5170 add/sub, 3366 mul, 686 div, 10 sqrt, 342 other calls, 2233 fabs, 2243 compares)
+ * Condition at the converged q: 197; an extra iteration there (at most 3): 555
+ * Velocity: 73; acceleration: 113; per-point checks: 1755; predictor: 63
+ * Step, worst case with the default cap of 25 iterations: 13951 (5106 add/sub, 3361 mul, 686 div, 10 sqrt, 342 other calls, 2207 fabs, 2239 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123186
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123155
  */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_ITERATION 381   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4525  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 14050  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123186  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4426  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 13951  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123155  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_LOADS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

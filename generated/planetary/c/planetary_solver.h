@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 220 (78 add/sub, 44 mul, 12 div, 0 sqrt, 2 other calls, 41 fabs, 43 compares)
  *   Phi, Phi_q, their factorization and tests: 154; the update (a solve): 66
  * Condition at the converged q: 70; an extra iteration there (at most 3): 388
- * Velocity: 39; acceleration: 43; per-point checks: 1026; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 8201 (2874 add/sub, 1835 mul, 435 div, 10 sqrt, 62 other calls, 1389 fabs, 1596 compares)
+ * Velocity: 39; acceleration: 43; per-point checks: 1009; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8184 (2858 add/sub, 1832 mul, 435 div, 10 sqrt, 62 other calls, 1389 fabs, 1598 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38600
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38583
  */
 #define PLANETARY_OPS_ITERATION 220   /* one Newton iteration */
-#define PLANETARY_OPS_STEP_FIXED 2701  /* a step without its iterations */
-#define PLANETARY_OPS_STEP_WORST 8201  /* at the default cap, 25 */
-#define PLANETARY_OPS_STEP_DENSE_WORST 38600  /* every factorization dense */
+#define PLANETARY_OPS_STEP_FIXED 2684  /* a step without its iterations */
+#define PLANETARY_OPS_STEP_WORST 8184  /* at the default cap, 25 */
+#define PLANETARY_OPS_STEP_DENSE_WORST 38583  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PLANETARY_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 358 (118 add/sub, 75 mul, 16 div, 0 sqrt, 7 other calls, 73 fabs, 69 compares)
  *   Phi, Phi_q, their factorization and tests: 262; the update (a solve): 96
- * Condition at the converged q: 225; an extra iteration there (at most 3): 529
- * Velocity: 61; acceleration: 93; per-point checks: 1491; predictor: 51
- * Step, worst case with the default cap of 25 iterations: 13041 (4428 add/sub, 2962 mul, 575 div, 10 sqrt, 218 other calls, 2431 fabs, 2417 compares)
+ * Condition at the converged q: 213; an extra iteration there (at most 3): 529
+ * Velocity: 61; acceleration: 93; per-point checks: 1467; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 12993 (4394 add/sub, 2958 mul, 575 div, 10 sqrt, 218 other calls, 2423 fabs, 2415 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74664
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74640
  */
 #define RACK_LINKAGE_OPS_ITERATION 358   /* one Newton iteration */
-#define RACK_LINKAGE_OPS_STEP_FIXED 4091  /* a step without its iterations */
-#define RACK_LINKAGE_OPS_STEP_WORST 13041  /* at the default cap, 25 */
-#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74664  /* every factorization dense */
+#define RACK_LINKAGE_OPS_STEP_FIXED 4043  /* a step without its iterations */
+#define RACK_LINKAGE_OPS_STEP_WORST 12993  /* at the default cap, 25 */
+#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74640  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 1354 (492 add/sub, 407 mul, 34 div, 1 sqrt, 3 other calls, 232 fabs, 185 compares)
  *   Phi, Phi_q, their factorization and tests: 1085; the update (a solve): 269
  * Condition at the converged q: 3440; an extra iteration there (at most 3): 1534
- * Velocity: 222; acceleration: 532; per-point checks: 4220; predictor: 87
- * Step, worst case with the default cap of 25 iterations: 51574 (19885 add/sub, 15896 mul, 1173 div, 44 sqrt, 304 other calls, 7884 fabs, 6388 compares)
+ * Velocity: 222; acceleration: 532; per-point checks: 4182; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 51536 (19845 add/sub, 15896 mul, 1173 div, 44 sqrt, 304 other calls, 7884 fabs, 6390 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 306929
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 306891
  */
 #define SPATIAL_SLIDER_CRANK_OPS_ITERATION 1354   /* one Newton iteration */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17724  /* a step without its iterations */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51574  /* at the default cap, 25 */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 306929  /* every factorization dense */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17686  /* a step without its iterations */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51536  /* at the default cap, 25 */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 306891  /* every factorization dense */
 
 typedef struct {
     int status;                  /* SPATIAL_SLIDER_CRANK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 1485 (624 add/sub, 586 mul, 21 div, 6 sqrt, 7 other calls, 128 fabs, 113 compares)
  *   Phi, Phi_q, their factorization and tests: 1364; the update (a solve): 121
  * Condition at the converged q: 612; an extra iteration there (at most 3): 1651
- * Velocity: 369; acceleration: 1579; per-point checks: 4051; predictor: 31
- * Step, worst case with the default cap of 25 iterations: 50792 (21517 add/sub, 20498 mul, 698 div, 202 sqrt, 233 other calls, 4028 fabs, 3616 compares)
+ * Velocity: 369; acceleration: 1579; per-point checks: 4037; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 50778 (21505 add/sub, 20494 mul, 698 div, 202 sqrt, 233 other calls, 4028 fabs, 3618 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66591
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66577
  */
 #define STEWART_OPS_ITERATION 1485   /* one Newton iteration */
-#define STEWART_OPS_STEP_FIXED 13667  /* a step without its iterations */
-#define STEWART_OPS_STEP_WORST 50792  /* at the default cap, 25 */
-#define STEWART_OPS_STEP_DENSE_WORST 66591  /* every factorization dense */
+#define STEWART_OPS_STEP_FIXED 13653  /* a step without its iterations */
+#define STEWART_OPS_STEP_WORST 50778  /* at the default cap, 25 */
+#define STEWART_OPS_STEP_DENSE_WORST 66577  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

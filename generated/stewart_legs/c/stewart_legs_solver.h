@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 15625 (6062 add/sub, 6101 mul, 165 div, 6 sqrt, 14 other calls, 1901 fabs, 1376 compares)
  *   Phi, Phi_q, their factorization and tests: 13861; the update (a solve): 1764
  * Condition at the converged q: 22622; an extra iteration there (at most 3): 15875
- * Velocity: 1794; acceleration: 10074; per-point checks: 37126; predictor: 367
- * Step, worst case with the default cap of 25 iterations: 546812 (218844 add/sub, 216256 mul, 5566 div, 208 sqrt, 1346 other calls, 61063 fabs, 43529 compares)
+ * Velocity: 1794; acceleration: 10074; per-point checks: 36948; predictor: 367
+ * Step, worst case with the default cap of 25 iterations: 546634 (218664 add/sub, 216256 mul, 5566 div, 208 sqrt, 1346 other calls, 61063 fabs, 43531 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16596929
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16596751
  */
 #define STEWART_LEGS_OPS_ITERATION 15625   /* one Newton iteration */
-#define STEWART_LEGS_OPS_STEP_FIXED 156187  /* a step without its iterations */
-#define STEWART_LEGS_OPS_STEP_WORST 546812  /* at the default cap, 25 */
-#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16596929  /* every factorization dense */
+#define STEWART_LEGS_OPS_STEP_FIXED 156009  /* a step without its iterations */
+#define STEWART_LEGS_OPS_STEP_WORST 546634  /* at the default cap, 25 */
+#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16596751  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

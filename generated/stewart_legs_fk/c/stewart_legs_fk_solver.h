@@ -59,18 +59,18 @@ typedef struct {
  * One Newton iteration: 15361 (5924 add/sub, 5995 mul, 165 div, 0 sqrt, 0 other calls, 1901 fabs, 1376 compares)
  *   Phi, Phi_q, their factorization and tests: 13597; the update (a solve): 1764
  * Condition at the converged q: 22622; an extra iteration there (at most 3): 15611
- * Velocity: 1496; acceleration: 9249; per-point checks: 36016; predictor: 367
- * Step, worst case with the default cap of 25 iterations: 536923 (213984 add/sub, 211897 mul, 5530 div, 10 sqrt, 910 other calls, 61063 fabs, 43529 compares)
+ * Velocity: 1496; acceleration: 9249; per-point checks: 35838; predictor: 367
+ * Step, worst case with the default cap of 25 iterations: 536745 (213804 add/sub, 211897 mul, 5530 div, 10 sqrt, 910 other calls, 61063 fabs, 43531 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
  * solve_inputs, worst case: 569964 (228277 add/sub, 228520 mul, 6081 div, 10 sqrt, 910 other calls, 61700 fabs, 44466 compares)
  *   positions only (du, ddu NULL): 558489 (223640 add/sub, 222230 mul, 5899 div, 10 sqrt, 910 other calls, 61518 fabs, 44282 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 32762
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16587040
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16586862
  */
 #define STEWART_LEGS_FK_OPS_ITERATION 15361   /* one Newton iteration */
-#define STEWART_LEGS_FK_OPS_STEP_FIXED 152898  /* a step without its iterations */
-#define STEWART_LEGS_FK_OPS_STEP_WORST 536923  /* at the default cap, 25 */
-#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16587040  /* every factorization dense */
+#define STEWART_LEGS_FK_OPS_STEP_FIXED 152720  /* a step without its iterations */
+#define STEWART_LEGS_FK_OPS_STEP_WORST 536745  /* at the default cap, 25 */
+#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16586862  /* every factorization dense */
 #define STEWART_LEGS_FK_OPS_INPUTS_WORST 569964  /* solve_inputs with du, ddu */
 #define STEWART_LEGS_FK_OPS_POSITIONS_WORST 558489  /* solve_inputs, du, ddu NULL */
 

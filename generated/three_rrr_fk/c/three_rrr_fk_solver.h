@@ -58,21 +58,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 644 (238 add/sub, 148 mul, 27 div, 0 sqrt, 14 other calls, 115 fabs, 102 compares)
  *   Phi, Phi_q, their factorization and tests: 470; the update (a solve): 174
- * Condition at the converged q: 569; an extra iteration there (at most 3): 824
- * Velocity: 113; acceleration: 198; per-point checks: 2670; predictor: 87
- * Step, worst case with the default cap of 25 iterations: 23344 (8869 add/sub, 5545 mul, 966 div, 10 sqrt, 434 other calls, 4013 fabs, 3507 compares)
+ * Condition at the converged q: 395; an extra iteration there (at most 3): 824
+ * Velocity: 113; acceleration: 198; per-point checks: 2632; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 22958 (8649 add/sub, 5545 mul, 966 div, 10 sqrt, 434 other calls, 3869 fabs, 3485 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 25407 (9860 add/sub, 6018 mul, 1097 div, 10 sqrt, 518 other calls, 4160 fabs, 3744 compares)
- *   positions only (du, ddu NULL): 24926 (9695 add/sub, 5830 mul, 1055 div, 10 sqrt, 518 other calls, 4118 fabs, 3700 compares)
+ * solve_inputs, worst case: 25059 (9680 add/sub, 6018 mul, 1097 div, 10 sqrt, 518 other calls, 4016 fabs, 3720 compares)
+ *   positions only (du, ddu NULL): 24578 (9515 add/sub, 5830 mul, 1055 div, 10 sqrt, 518 other calls, 3974 fabs, 3676 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 1994
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286198
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286160
  */
 #define THREE_RRR_FK_OPS_ITERATION 644   /* one Newton iteration */
-#define THREE_RRR_FK_OPS_STEP_FIXED 7244  /* a step without its iterations */
-#define THREE_RRR_FK_OPS_STEP_WORST 23344  /* at the default cap, 25 */
-#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286198  /* every factorization dense */
-#define THREE_RRR_FK_OPS_INPUTS_WORST 25407  /* solve_inputs with du, ddu */
-#define THREE_RRR_FK_OPS_POSITIONS_WORST 24926  /* solve_inputs, du, ddu NULL */
+#define THREE_RRR_FK_OPS_STEP_FIXED 6858  /* a step without its iterations */
+#define THREE_RRR_FK_OPS_STEP_WORST 22958  /* at the default cap, 25 */
+#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286160  /* every factorization dense */
+#define THREE_RRR_FK_OPS_INPUTS_WORST 25059  /* solve_inputs with du, ddu */
+#define THREE_RRR_FK_OPS_POSITIONS_WORST 24578  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

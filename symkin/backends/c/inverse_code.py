@@ -130,19 +130,23 @@ def exact_context(plan: LUPlan, values: Sequence[float | None], inverses: dict[i
         return float(inverses[k]) if k in inverses else f"inv[{k}]"
 
     start = 0.0
-    sums: list[str] = []
+    # the columns' terms -> the largest known part added to them: columns with the same
+    # terms (a pair's x and y rows, or columns apart in their numbers only) need one sum, the
+    # one of the largest number, since fl(x + a) <= fl(x + b) for a <= b (and a column not
+    # finite makes that one not finite too)
+    columns: dict[tuple[str, ...], float] = {}
     for unit in range(plan.n):
         entries = _solve_unit(plan, unit, slot, inverse, code)
         known = sum(abs(x) for x in entries if isinstance(x, float))
-        terms = [f"{fabs}({x.lstrip('-')})" for x in entries if isinstance(x, str)]
+        terms = tuple(f"{fabs}({x.lstrip('-')})" for x in entries if isinstance(x, str))
         code.ops += len(terms)
         if code.ops > limit:
             return None
         if terms:
-            total = " + ".join(terms + ([literal(known)] if known else []))
-            if total not in sums:  # two columns alike (a pair's x and y rows): one test
-                sums.append(total)
+            columns[terms] = max(columns.get(terms, 0.0), known)
         else:
             start = max(start, known)
+    sums = [" + ".join(terms + ((literal(known),) if known else ()))
+            for terms, known in columns.items()]
     return {"lines": code.lines, "sums": sums,
             "start": literal(start), "ops": code.ops}

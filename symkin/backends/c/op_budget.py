@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from symkin.codegen.op_count import ZERO, Flops, count, count_all
-from symkin.contract import options, tuning
+from symkin.contract import lengths, options, tuning
 
 
 def _routine(code: Any, name: str) -> Flops:
@@ -140,6 +140,10 @@ def norm1(context: dict[str, Any] | None, n: int, nnz: int) -> Flops:
 
 
 # ----- the solver's own work (templates/solver.c.j2, _condition, _error_model, _units) -----
+
+UNROLLED = 16
+"""Coordinates up to which the solver's element-wise passes are written out
+(templates/_each.j2): there a coordinate that is no length is not divided by its unit."""
 
 # <prefix>_within_bound, the model's cheap bound: the rounding floor, e_q, x = s (u + e_q),
 # max(1, |dq|), the three bounds and their four tests.
@@ -289,10 +293,15 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
         # solve_inputs' first test: no length input below zero
         norms = (_max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
                  + Flops(cmp=len(getattr(code, "input_lengths", ()))))
-    else:  # a pass over dq as solved (max, finite test, negation) and one over ddq as solved
-        # and q / column (two maxima, ddq's finite test, q's sum)
-        # then whether Newton's bound cleared the point (work->clear)
-        norms = Flops(abs=3 * n, mul=n, cmp=3 * n, add=6 * n) + Flops(cmp=3 + 2)
+    else:  # a pass over dq as solved (max, sum, negation) and one over ddq as solved and
+        # q / column where q_i is a length (two maxima, two sums), the three sums' NaN tests
+        # and the two infinity tests; then whether Newton's bound cleared the point
+        # (work->clear)
+        divided = sum(1 for c in lengths.length_columns(code.coordinates) if c)
+        if n > UNROLLED:  # the loop divides every q_i
+            divided = n
+        norms = (Flops(abs=3 * n, mul=divided, cmp=3 * n, add=4 * n) + Flops(cmp=2, add=2)
+                 + Flops(cmp=3 + 2))
     prediction = Flops(add=1, mul=1, div=1) + Flops(mul=2, add=2) * n  # (2.76), h^2 / 2 once
     predictor = chord(code, algebra, units) if inputs else prediction
     return Pieces(evaluation=evaluation, update=update, estimate=estimate,
