@@ -108,9 +108,14 @@ def first_guess(kernel: KinematicsKernel, q0: ArrayLike | None) -> Array:
     return q
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
 def _floats(value: ArrayLike, what: str) -> Array:
     """value as float64 (no copy of a float64 array); text or complex numbers are a SolveError
     that names the argument, not a ValueError from NumPy or a silently dropped imaginary part."""
+    if type(value) is np.ndarray and value.dtype is _FLOAT64:  # the usual case, as it is
+        return value
     if np.iscomplexobj(value):
         raise SolveError(f"{what} must be real numbers, not complex")
     try:
