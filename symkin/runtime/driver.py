@@ -49,7 +49,7 @@ from symkin.runtime.protocol import GridSolver, KinematicsKernel
 from symkin.runtime.solving import call_plan, failures, units
 from symkin.runtime.solving.assembly import assemble, flag_flips, genuine
 from symkin.runtime.solving.c_loop import _c_loop, _c_outcome, _c_run
-from symkin.runtime.solving.call_plan import Plan, start_key
+from symkin.runtime.solving.call_plan import Plan
 from symkin.runtime.solving.edges import Resolution, resolve
 from symkin.runtime.solving.newton import Newton, kinematics, newton
 from symkin.runtime.solving.result_arrays import Out, allocate
@@ -242,13 +242,16 @@ def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: 
         else None
     try:
         if solver is not None:
-            run.forces_out = forces.allocate(kernel, times.size)
+            if plan.has_dynamics:
+                run.forces_out = forces.allocate(kernel, times.size)
             solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
             solved = _c_run(run, solver, progress)
-            key = start_key(unit, run.q[0], float(times[0]), p_bytes, float(run.cond[0])) \
+            # What the start check's verdict depends on besides the options (call_plan).
+            key = (unit, run.q[0].tobytes(), times.item(0), p_bytes, run.cond.item(0)) \
                 if run.done else None
             judged = key is not None and plan.judged_regular(key, options)
-            if run.done and not judged and not genuine(kernel, run.q[0], float(times[0]), p):
+            if run.done and not judged and plan.has_senses and \
+                    not genuine(kernel, run.q[0], times.item(0), p):
                 # Plain Newton in C found Phi = 0 where the mechanism is not assembled as
                 # meant (a revolute's axes reversed): the damped assembly looks for the one
                 # meant, as without C, and the grid is run again from it.
@@ -259,9 +262,7 @@ def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: 
                     plan.remember_regular(key, options)
                 if run.done == times.size:  # the usual case: nothing left to treat
                     run.fallbacks = solver.fallbacks
-                    vectors = plan.point_vectors(p, p_bytes, lambda _: solver.point_vectors(
-                        len(plan.points), plan.point_size))
-                    return _whole(kernel, plan, run, p, vectors)
+                    return _whole(kernel, plan, run, p, plan.point_vectors(p_bytes, solver))
                 first = _c_outcome(kernel, run, solver, p, solved)
         else:
             first = None

@@ -108,3 +108,17 @@ def test_a_result_is_its_own(kernel):
     assert np.array_equal(again.point_vectors, kept.point_vectors)
     assert np.array_equal(again.q, kept.q)
     assert not np.shares_memory(again.point_vectors, kept.point_vectors)
+
+
+def test_a_grid_changed_in_place_is_checked_again(kernel):
+    """The same array, valid on one call, then written into: refused as any bad grid is."""
+    t = T.copy()
+    symkin.solve(kernel, t=t)
+    t[5] = t[4]
+    with pytest.raises(symkin.SolveError, match="strictly increasing"):
+        symkin.solve(kernel, t=t)
+    t[5] = math.nan
+    with pytest.raises(symkin.SolveError, match="finite"):
+        symkin.solve(kernel, t=t)
+    t[5] = T[5]
+    assert np.array_equal(symkin.solve(kernel, t=t).t, T)

@@ -16,14 +16,13 @@ from __future__ import annotations
 
 import contextlib
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
-from symkin.runtime.protocol import KinematicsKernel
+from symkin.runtime.protocol import GridSolver, KinematicsKernel
 from symkin.runtime.solving import units
 
 Array = NDArray[np.float64]
@@ -32,7 +31,11 @@ RECENT = 8
 """Parameter sets and starts a plan remembers: a loop over a few sets hits, a sweep-like loop
 over many sets misses at the cost of one dictionary look-up."""
 
-StartKey = tuple[float, int, bytes, float, bytes, float]
+StartKey = tuple[float, bytes, float, bytes, float]
+"""What the start check's verdict depends on besides the options: the unit the first row was
+solved in, the row's exact bytes, t0, the parameters' bytes and the solver's condition estimate
+at the row (runtime.solving.start.singular_start and assembly.genuine are functions of these
+alone)."""
 
 
 @dataclass
@@ -44,6 +47,7 @@ class Plan:
         has_inputs: input drivers: the input room (runtime.input_driven).
         after_rows: ranges, removed rows or senses: the checks after the loop apply.
         has_dynamics: efforts and reactions are computed for a run's rows.
+        has_senses: a first row may solve Phi = 0 and be no assembly (solving.assembly).
         coordinates, points, space, point_size: what every Trajectory carries.
         options: the Newton options of the kernel's real type (symkin.solve's default).
     """
@@ -52,6 +56,7 @@ class Plan:
     has_inputs: bool
     after_rows: bool
     has_dynamics: bool
+    has_senses: bool
     coordinates: tuple[str, ...]
     points: tuple[tuple[str, str], ...]
     space: str
@@ -65,16 +70,20 @@ class Plan:
     # they were judged under.
     _regular: dict[StartKey, Options] = field(default_factory=dict)
 
-    def point_vectors(self, p: Array, p_bytes: bytes, compute: Any) -> Array:
-        """A fresh copy of the named points' vectors at p, ``compute(p)`` on a miss."""
+    def point_vectors(self, p_bytes: bytes, solver: GridSolver) -> Array:
+        """The named points' vectors at the parameters of ``p_bytes``, an array of the
+        caller's own: on a miss, those of the grid ``solver`` run with them."""
         found = self._point_vectors.get(p_bytes)
-        if found is None:
-            found = np.array(compute(p), dtype=np.float64).reshape(-1, self.point_size)
-            found.flags.writeable = False
-            if len(self._point_vectors) >= RECENT:
-                self._point_vectors.clear()
-            self._point_vectors[p_bytes] = found
-        return found.copy()
+        if found is not None:
+            return found.copy()
+        fresh = np.asarray(solver.point_vectors(len(self.points), self.point_size),
+                           dtype=np.float64).reshape(-1, self.point_size)
+        kept = fresh.copy()
+        kept.flags.writeable = False
+        if len(self._point_vectors) >= RECENT:
+            self._point_vectors.clear()
+        self._point_vectors[p_bytes] = kept
+        return fresh
 
     def unit(self, kernel: KinematicsKernel, q0: Array, t0: float, p: Array, p_bytes: bytes
              ) -> float:
@@ -98,14 +107,6 @@ class Plan:
         self._regular[key] = options
 
 
-def start_key(unit: float, q: Array, t: float, p_bytes: bytes, estimate: float) -> StartKey:
-    """What the start check's verdict depends on besides the options: the unit the row was
-    solved in, the row q (its exact bytes), t, the parameters' bytes and the solver's
-    condition estimate at the row. (The row's size is part of the key for safety: bytes of
-    different lengths never collide anyway.)"""
-    return (unit, q.size, q.tobytes(), t, p_bytes, estimate)
-
-
 def of(kernel: KinematicsKernel) -> Plan:
     """The kernel's plan: made on the first call and kept on the kernel (``call_plan``);
     made afresh each call for a stand-in kernel that cannot keep one."""
@@ -125,6 +126,7 @@ def _make(kernel: KinematicsKernel) -> Plan:
         after_rows=bool(getattr(kernel, "ranges", ()) or getattr(kernel, "removed", ())
                         or getattr(kernel, "senses", ())),
         has_dynamics=bool(getattr(kernel, "has_dynamics", False)),
+        has_senses=bool(getattr(kernel, "senses", ())),
         coordinates=tuple(getattr(kernel, "coordinates", ())),
         points=tuple(getattr(kernel, "points", ())),
         space=space,
