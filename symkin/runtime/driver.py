@@ -137,7 +137,7 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         assembled at t[0], Newton does not converge, or Phi_q is singular. SolveError for a
         bad t, q0, params or out.
     """
-    plan = call_plan.of(kernel)
+    plan = getattr(kernel, "call_plan", None) or call_plan.of(kernel)
     if plan.moves_under_forces:  # forward dynamics: runtime.dynamics
         from symkin.runtime.dynamics import run as motion
 
@@ -209,7 +209,7 @@ def _solve_in_unit(kernel: KinematicsKernel, plan: Plan, t: ArrayLike | None,
     p = parameter_values(kernel, params)
     q = first_guess(kernel, q0)
     p_bytes = p.tobytes()
-    unit = plan.unit(kernel, q, float(times[0]), p, p_bytes)
+    unit = plan.unit(kernel, q, times.item(0), p, p_bytes)
     if unit == 1.0:
         return _solve(kernel, times, q, p, options, progress, use_c_solver, out,
                       (plan, unit, p_bytes))
