@@ -48,7 +48,25 @@ def time_points(kernel: KinematicsKernel, t: ArrayLike | None) -> Array:
     """
     if t is None:
         return _file_grid(*kernel.time_grid).copy()
-    times = _floats(t, "t")
+    if type(t) is np.ndarray and t.dtype is _FLOAT64 and t.ndim == 1 \
+            and 0 < t.size <= _CHECKED_SIZE:
+        key = t.tobytes()  # a grid passed again and again: the same bytes, the same verdict
+        if key not in _CHECKED:
+            _check_times(t)
+            if len(_CHECKED) >= 16:
+                _CHECKED.clear()
+            _CHECKED.add(key)
+        return t
+    return _check_times(_floats(t, "t"))
+
+
+_CHECKED: set[bytes] = set()
+"""Short grids (up to _CHECKED_SIZE points) time_points has found valid, by their bytes."""
+_CHECKED_SIZE = 256
+
+
+def _check_times(times: Array) -> Array:
+    """times as time_points returns them (finite, increasing, 1-D), or a SolveError."""
     if times.ndim != 1:
         times = np.atleast_1d(times)
     # Finite ends as Python floats (their sum overflows to inf without a NumPy warning).
@@ -108,9 +126,14 @@ def first_guess(kernel: KinematicsKernel, q0: ArrayLike | None) -> Array:
     return q
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
 def _floats(value: ArrayLike, what: str) -> Array:
     """value as float64 (no copy of a float64 array); text or complex numbers are a SolveError
     that names the argument, not a ValueError from NumPy or a silently dropped imaginary part."""
+    if type(value) is np.ndarray and value.dtype is _FLOAT64:  # the usual case, as it is
+        return value
     if np.iscomplexobj(value):
         raise SolveError(f"{what} must be real numbers, not complex")
     try:

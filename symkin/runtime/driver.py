@@ -46,16 +46,17 @@ from symkin.runtime.loads import forces
 from symkin.runtime.outputs import ranges, redundant
 from symkin.runtime.outputs.results import Trajectory
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
-from symkin.runtime.solving import failures, units
+from symkin.runtime.solving import call_plan, failures, units
 from symkin.runtime.solving.assembly import assemble, flag_flips, genuine
 from symkin.runtime.solving.c_loop import _c_loop, _c_outcome, _c_run
+from symkin.runtime.solving.call_plan import Plan
 from symkin.runtime.solving.edges import Resolution, resolve
 from symkin.runtime.solving.newton import Newton, kinematics, newton
 from symkin.runtime.solving.result_arrays import Out, allocate
 from symkin.runtime.solving.result_arrays import Run as _Run
 from symkin.runtime.solving.run_outcome import SolveFailure as SolveFailure
 from symkin.runtime.solving.run_outcome import SolveInterrupted as SolveInterrupted
-from symkin.runtime.solving.run_outcome import _fail, _point_size, refuse_reversed, rows_kept
+from symkin.runtime.solving.run_outcome import _fail, refuse_reversed, rows_kept
 from symkin.runtime.solving.run_outcome import _trajectory as _trajectory
 from symkin.runtime.solving.start import singular_start
 
@@ -136,7 +137,8 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         assembled at t[0], Newton does not converge, or Phi_q is singular. SolveError for a
         bad t, q0, params or out.
     """
-    if getattr(kernel, "moves_under_forces", False):  # forward dynamics: runtime.dynamics
+    plan = getattr(kernel, "call_plan", None) or call_plan.of(kernel)
+    if plan.moves_under_forces:  # forward dynamics: runtime.dynamics
         from symkin.runtime.dynamics import run as motion
 
         if options or sensitivities or out is not None or inputs is not None:
@@ -144,19 +146,21 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
                              "for a mechanism that its forces move")
         return motion.solve(kernel, t, q0, params, progress=progress,  # type: ignore[arg-type]
                             stop_at_singular=stop_at_singular)
-    options = options or default_options(kernel)
+    options = options or plan.options
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
     try:
-        trajectory = _solved(kernel, t, q0, params, options, progress, use_c_solver, out,
-                             (inputs, input_rates, input_accels), sensitivities)
+        trajectory = _solved(kernel, plan, t, q0, params, options, progress, use_c_solver,
+                             out, (inputs, input_rates, input_accels), sensitivities)
     except SolveFailure as failure:  # past a curve's range first: that is the cause to name
-        _stop_outside_range(kernel, failure.trajectory)
+        if plan.after_rows:
+            _stop_outside_range(kernel, failure.trajectory)
         raise
-    with rows_kept(trajectory, "the solved rows were checked"):
-        _stop_outside_range(kernel, trajectory)
-        trajectory = redundant.check(kernel, trajectory, options)
-        flag_flips(kernel, trajectory, trajectory.params)  # a jump off the assembly
+    if plan.after_rows:  # ranges, removed rows or senses: else each check has nothing to do
+        with rows_kept(trajectory, "the solved rows were checked"):
+            _stop_outside_range(kernel, trajectory)
+            trajectory = redundant.check(kernel, trajectory, options)
+            flag_flips(kernel, trajectory, trajectory.params)  # a jump off the assembly
     if sensitivities:
         from symkin.runtime.outputs.sensitivity import with_sensitivities
 
@@ -175,13 +179,13 @@ def _stop_outside_range(kernel: KinematicsKernel, trajectory: Trajectory) -> Non
                            math.nan, 0, reason="out of range")
 
 
-def _solved(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
+def _solved(kernel: KinematicsKernel, plan: Plan, t: ArrayLike | None, q0: ArrayLike | None,
             params: Mapping[str, float] | ArrayLike | None, options: Options,
             progress: Progress | None, use_c_solver: bool, out: Out | None,
             given: tuple[Any, Any, Any], sensitivities: bool) -> Trajectory:
     """The trajectory of the grid loop that fits: with input values, or the general one."""
     inputs, input_rates, input_accels = given
-    if getattr(kernel, "input_names", ()) or inputs is not None:
+    if plan.has_inputs or inputs is not None:
         if sensitivities:
             raise SolveError("sensitivities= is not supported for a mechanism with input "
                              "drivers (q_p would need the inputs at every point)")
@@ -190,10 +194,11 @@ def _solved(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
     if input_rates is not None or input_accels is not None:
         raise SolveError("input_rates= and input_accels= need inputs= (and a mechanism with "
                          "input drivers)")
-    return _solve_in_unit(kernel, t, q0, params, options, progress, use_c_solver, out)
+    return _solve_in_unit(kernel, plan, t, q0, params, options, progress, use_c_solver, out)
 
 
-def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike | None,
+def _solve_in_unit(kernel: KinematicsKernel, plan: Plan, t: ArrayLike | None,
+                   q0: ArrayLike | None,
                    params: Mapping[str, float] | ArrayLike | None, options: Options,
                    progress: Progress | None, use_c_solver: bool, out: Out | None
                    ) -> Trajectory:
@@ -203,13 +208,15 @@ def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike 
     times = time_points(kernel, t)
     p = parameter_values(kernel, params)
     q = first_guess(kernel, q0)
-    unit = units.unit_for(kernel, q, float(times[0]), p) if times.size else 1.0
+    p_bytes = p.tobytes()
+    unit = plan.unit(kernel, q, times.item(0), p, p_bytes)
     if unit == 1.0:
-        return _solve(kernel, times, q, p, options, progress, use_c_solver, out)
+        return _solve(kernel, times, q, p, options, progress, use_c_solver, out,
+                      (plan, unit, p_bytes))
     scaled = units.ScaledKernel(kernel, unit)
     try:
         trajectory = _solve(scaled, times, q / scaled.column, p, options, progress,
-                            use_c_solver, out)
+                            use_c_solver, out, (plan, unit, p_bytes))
     except (SolveFailure, SolveInterrupted) as stop:
         units.to_kernel_unit(scaled, stop.trajectory.q, stop.trajectory.dq, stop.trajectory.d2q)
         raise
@@ -218,30 +225,44 @@ def _solve_in_unit(kernel: KinematicsKernel, t: ArrayLike | None, q0: ArrayLike 
 
 
 def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: Options,
-           progress: Progress | None, use_c_solver: bool, out: Out | None) -> Trajectory:
+           progress: Progress | None, use_c_solver: bool, out: Out | None,
+           planned: tuple[Plan, float, bytes]) -> Trajectory:
     """The C grid loop over the whole grid; only where it stops (a failed assembly from q0, a
     singular point, a limit, a failure) or without the C solver, the general loop with the
     assembly and the edge treatments takes over. The arguments as _solve_in_unit checked
-    them (not checked again: a loop of calls pays for that once a call)."""
+    them (not checked again: a loop of calls pays for that once a call); ``planned``: the
+    kernel's call plan, the length unit ``kernel`` is seen in and the bytes of p.
+
+    A first row solved by C that the plan has judged genuine and regular before (the same row
+    to the bit, at the same t0, parameters, condition estimate, unit and options: the start
+    check is a function of these alone) is not judged again."""
+    plan, unit, p_bytes = planned
     run = allocate(times, q.size, out)
     solver = kernel.grid_solver(options, q, p) if use_c_solver and kernel.has_grid_solver \
         else None
     try:
         if solver is not None:
-            run.forces_out = forces.allocate(kernel, times.size)
+            if plan.has_dynamics:
+                run.forces_out = forces.allocate(kernel, times.size)
             solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
             solved = _c_run(run, solver, progress)
-            if run.done and not genuine(kernel, run.q[0], float(times[0]), p):
+            # What the start check's verdict depends on besides the options (call_plan).
+            key = (unit, run.q[0].tobytes(), times.item(0), p_bytes, run.cond.item(0)) \
+                if run.done else None
+            judged = key is not None and plan.judged_regular(key, options)
+            if run.done and not judged and plan.has_senses and \
+                    not genuine(kernel, run.q[0], times.item(0), p):
                 # Plain Newton in C found Phi = 0 where the mechanism is not assembled as
                 # meant (a revolute's axes reversed): the damped assembly looks for the one
                 # meant, as without C, and the grid is run again from it.
                 run.done, first = 0, None
             else:
-                _check_start(kernel, run, p, options)
+                if key is not None and not judged:
+                    _check_start(kernel, run, p, options)  # raises where it is not regular
+                    plan.remember_regular(key, options)
                 if run.done == times.size:  # the usual case: nothing left to treat
                     run.fallbacks = solver.fallbacks
-                    return _trajectory(kernel, run, p, solver.point_vectors(
-                        len(kernel.points), _point_size(kernel)))
+                    return _whole(kernel, plan, run, p, plan.point_vectors(p_bytes, solver))
                 first = _c_outcome(kernel, run, solver, p, solved)
         else:
             first = None
@@ -264,6 +285,17 @@ def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: 
                 _check_start(kernel, run, p, options, result.q)  # assembled, singular there
             _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
         return _trajectory(kernel, run, p)
+
+
+def _whole(kernel: KinematicsKernel, plan: Plan, run: _Run, p: Array, vectors: Array
+           ) -> Trajectory:
+    """The Trajectory of a grid solved whole by C: _trajectory's, built from the plan's
+    names where there are no efforts and reactions to attach."""
+    if plan.has_dynamics:
+        return _trajectory(kernel, run, p, vectors)
+    return Trajectory.solved(run.t, run.q, run.dq, run.d2q, plan.coordinates, plan.points,
+                             vectors, p, run.fallbacks, run.flagged, run.cond, (),
+                             space=plan.space)
 
 
 def _grid(kernel: KinematicsKernel, run: _Run, solver: GridSolver | None,

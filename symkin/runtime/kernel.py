@@ -118,6 +118,9 @@ class Kernel:
         # them below zero.
         self.input_lengths: tuple[str, ...] = tuple(meta.get("input_lengths", ()))
         self._functions = functions
+        # What symkin.solve works out once per kernel (runtime.solving.call_plan), made on
+        # its first call.
+        self.call_plan: Any = None
 
     @property
     def unchecked(self) -> _Functions:

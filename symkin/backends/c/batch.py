@@ -99,10 +99,24 @@ class Batch:
     def __init__(self, ffi: Any, lib: Any, name: str, real: str, scale_free: bool) -> None:
         self._c = (ffi, lib, name, real)
         self.scale_free = scale_free
+        # Looked up once: symkin.solve asks for a length scale or two on every call
+        # (runtime.solving.start.lever_arm), where the lookups cost more than the C.
+        self._length_scales = getattr(lib, f"{name}_length_scales")
+        self._real_array = f"{name}_real[]" if real == "double" else None
 
     def __call__(self, params: Array, t: Array, q0: Array, options: Options, q: Array,
                  dq: Array, d2q: Array, units: Array) -> BatchStatus:
         return solve(*self._c, params, t, q0, options, (q, dq, d2q), units)
 
     def length_scales(self, params: Array, q: Array, t: float) -> Array:
-        return length_scales(*self._c, params, q, t)
+        if self._real_array is None or params.shape[0] != 1 or q.ndim != 1:
+            return length_scales(*self._c, params, q, t)
+        # One set in double (a solve's unit or start check): the arrays as they are.
+        ffi, real = self._c[0], self._real_array
+        table = np.ascontiguousarray(params, dtype=np.float64)
+        rows = np.ascontiguousarray(q, dtype=np.float64)
+        scales = np.empty(1)
+        self._length_scales(1, ffi.from_buffer(real, table) if table.size else ffi.NULL,
+                            ffi.from_buffer(real, rows) if rows.size else ffi.NULL, 0, t,
+                            ffi.from_buffer(real, scales))
+        return scales

@@ -154,7 +154,7 @@ class GridSolver:
             t, q, dq, d2q = t + start, q + rows, dq + rows, d2q + rows
             cond, flagged = cond + start, flagged + start
         forces = tuple(pointer + start * width if start and width else pointer
-                       for pointer, width in self._forces)
+                       for pointer, width in self._forces) if self._forces else ()
         solved: int = self._solve_grid(self._options, self._p, stop - start, t, self._state,
                                        q, dq, d2q, cond, flagged, *forces, self._work,
                                        self._report)

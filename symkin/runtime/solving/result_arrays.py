@@ -66,9 +66,10 @@ class Run:
 def allocate(times: Array, n: int, out: Out | None) -> Run:
     """The run's arrays for the grid ``times`` and N = n coordinates: fresh, or ``out``'s."""
     if out is None:
-        size = times.size
-        return Run(times.copy(), np.empty((size, n)), np.empty((size, n)),
-                   np.empty((size, n)), np.empty(size), np.empty(size, dtype=np.bool_))
+        size, empty = times.size, np.empty
+        rows = (size, n)
+        return Run(times.copy(), empty(rows), empty(rows), empty(rows), empty(size),
+                   empty(size, np.bool_))
     return _reuse(times, n, out)
 
 

@@ -176,6 +176,9 @@ def lever_arms(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> tuple[
     return found
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
 def lever_arm(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> float:
     """L at (q, t, p), NaN where Phi_q is not finite there: one call of the generated
     ``<prefix>_length_scales`` (what sweeps use) where the kernel has a batch solver, with no
@@ -183,8 +186,10 @@ def lever_arm(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> float:
     batch = getattr(kernel, "batch_solver", None)
     if batch is None:
         return lever_arms(kernel, q, t, p)[1]
-    q = np.ascontiguousarray(q, dtype=np.float64)
-    p = np.ascontiguousarray(p, dtype=np.float64)
+    if type(q) is not np.ndarray or q.dtype is not _FLOAT64:  # (a key of the values' bytes)
+        q = np.asarray(q, dtype=np.float64)
+    if type(p) is not np.ndarray or p.dtype is not _FLOAT64:
+        p = np.asarray(p, dtype=np.float64)
     recent = _structure(kernel).recent_scales
     key = (q.tobytes(), float(t), p.tobytes())
     scale = recent.get(key)
