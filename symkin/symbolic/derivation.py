@@ -26,7 +26,7 @@ from symkin.spec import motion as motion_spec
 from symkin.spec import name_checks, validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
-from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
+from symkin.symbolic import dynamics, dynamics3d, pickling, redundancy, spatial
 from symkin.symbolic.derivatives import diff
 from symkin.symbolic.differentiation import parameter_jacobian, row_gamma, row_jacobian
 from symkin.symbolic.planar import TAU, Context, input_slot
@@ -168,6 +168,10 @@ class System:
     def name(self) -> str:
         return self.mechanism.name
 
+    def __reduce__(self) -> tuple[Any, tuple[bytes]]:
+        # Pickled fields are rebuilt with SymPy's evaluation off (symbolic.pickling).
+        return pickling.restore, (pickling.dumps(self),)
+
     @property
     def parameter_names(self) -> tuple[str, ...]:
         return tuple(symbol.name for symbol in self.p)
@@ -177,8 +181,9 @@ class System:
         return validate.degrees_of_freedom(self.mechanism)
 
     def pattern(self) -> list[tuple[int, int]]:
-        """Structural non-zeros of Phi_q as (row, column), row-major."""
-        return sorted(self.phi_q.todok())
+        """Structural non-zeros of Phi_q as (row, column), row-major. Plain ints: a matrix that
+        went through pickle keys its entries by SymPy Integers, which JSON refuses."""
+        return sorted((int(r), int(c)) for r, c in self.phi_q.todok())
 
 
 def derive(mech: Mechanism | str | Path) -> System:
