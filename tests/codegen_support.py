@@ -83,15 +83,30 @@ def compiled(path: Path, backend: str = "c", **options: str):
     if motion.moves_under_forces(system):
         return symkin.compile(system, backend, **options)
     chosen.require()
+    return chosen.build(sources(resolved, chosen.name, **options), open_cache())
 
-    def sources() -> dict[str, str]:
-        code = lower.lower(system, chosen, options, True)
+
+def sources(path: Path, backend: str, **options: str) -> dict[str, str]:
+    """{file name: text} that symkin.generate(derived(path), backend, **options) writes (the
+    same lower, render and manifest), generated once per run for every worker."""
+    resolved = Path(path).resolve()
+
+    def generate() -> dict[str, str]:
+        code = lower.lower(derived(resolved), backends.get(backend), options, True)
         files = render.render_sources(code)
         files[manifest_name(code.name)] = render.manifest(code, files)
         return files
 
-    key = (*shared_builds.file_key(resolved), chosen.name, sorted(options.items()))
-    return chosen.build(shared_builds.stored("sources", key, sources), open_cache())
+    key = (*shared_builds.file_key(resolved), backend, sorted(options.items()))
+    return shared_builds.stored("sources", key, generate)
+
+
+def write_sources(files: dict[str, str], folder: Path) -> Path:
+    """The files of :func:`sources` written into ``folder`` (created), as generate writes."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, text in files.items():
+        (folder / name).write_text(text, encoding="utf-8", newline="\n")
+    return folder
 
 
 def system(name: str):
