@@ -168,8 +168,7 @@ class System:
     def name(self) -> str:
         return self.mechanism.name
 
-    def __reduce__(self) -> tuple[Any, tuple[bytes]]:
-        # Pickled fields are rebuilt with SymPy's evaluation off (symbolic.pickling).
+    def __reduce__(self) -> tuple[Any, tuple[bytes]]:  # SymPy's evaluation off on load
         return pickling.restore, (pickling.dumps(self),)
 
     @property
@@ -181,8 +180,7 @@ class System:
         return validate.degrees_of_freedom(self.mechanism)
 
     def pattern(self) -> list[tuple[int, int]]:
-        """Structural non-zeros of Phi_q as (row, column), row-major. Plain ints: a matrix that
-        went through pickle keys its entries by SymPy Integers, which JSON refuses."""
+        """Structural non-zeros of Phi_q as (row, column), row-major, as ints (not Integers)."""
         return sorted((int(r), int(c)) for r, c in self.phi_q.todok())
 
 
