@@ -7,6 +7,7 @@ mpmath at 30 digits: an evaluation path that shares no code with the printers un
 from __future__ import annotations
 
 import functools
+import json
 import os
 import re
 import shutil
@@ -16,10 +17,17 @@ from pathlib import Path
 
 import mpmath
 import numpy as np
+import shared_builds
 import sympy as sp
 
 import symkin
+from symkin import backends
+from symkin.build import motion
+from symkin.build.cache import open_cache
+from symkin.codegen import lower, render
+from symkin.contract.manifest import manifest_name
 from symkin.spec import expressions
+from symkin.spec.motion import moves
 
 ROOT = Path(__file__).resolve().parent.parent
 ALL_EXAMPLES = sorted((ROOT / "examples").glob("*.yaml"))
@@ -42,11 +50,63 @@ def example_ids() -> list[str]:
 
 @functools.cache
 def derived(path: Path):
-    """The System of a mechanism file, derived once per test process: a System is plain data
+    """The System of a mechanism file, derived once per test run: a System is plain data
     that compile, generate and solve only read, and the heavy examples (stewart_legs_fk's 91
     coordinates) take SymPy a minute or more each. Tests that build from an example file take
-    it from here, so the files a worker runs share one derivation."""
-    return symkin.derive(Path(path).resolve())
+    it from here, so the files every worker runs share one derivation (shared_builds)."""
+    resolved = Path(path).resolve()
+    return shared_builds.stored("system", shared_builds.file_key(resolved),
+                                lambda: symkin.derive(resolved))
+
+
+def compiled(path: Path, backend: str = "c", **options: str):
+    """symkin.compile(derived(path), backend, **options) for the tests whose point is what a
+    kernel computes, not what the generator writes.
+
+    An example with the default options is built from its goldens (generated/<name>/<backend>),
+    which test_generated proves byte for byte equal to what symkin.generate writes now, the
+    manifest included: the kernel cache finds the same folder symkin.compile would build, and
+    no process derives or generates the example for it. Any other file or options: the sources
+    are generated once per run and shared by every worker, as the System is. A file its forces
+    move compiles as always."""
+    resolved = Path(path).resolve()
+    chosen = backends.resolve(backend)
+    golden = golden_folder(resolved.stem, chosen.name)
+    if not options and resolved.parent == ROOT / "examples" and golden.is_dir():
+        chosen.require()
+        files = {item.name: item.read_bytes().decode("utf-8")
+                 for item in sorted(golden.iterdir()) if item.is_file()}
+        meta = json.loads(files[manifest_name(resolved.stem)])
+        if not moves(len(meta["rows"]), meta["nq"]):  # else symkin.compile's MotionKernel
+            return chosen.build(files, open_cache())
+    system = derived(resolved)
+    if motion.moves_under_forces(system):
+        return symkin.compile(system, backend, **options)
+    chosen.require()
+    return chosen.build(sources(resolved, chosen.name, **options), open_cache())
+
+
+def sources(path: Path, backend: str, **options: str) -> dict[str, str]:
+    """{file name: text} that symkin.generate(derived(path), backend, **options) writes (the
+    same lower, render and manifest), generated once per run for every worker."""
+    resolved = Path(path).resolve()
+
+    def generate() -> dict[str, str]:
+        code = lower.lower(derived(resolved), backends.get(backend), options, True)
+        files = render.render_sources(code)
+        files[manifest_name(code.name)] = render.manifest(code, files)
+        return files
+
+    key = (*shared_builds.file_key(resolved), backend, sorted(options.items()))
+    return shared_builds.stored("sources", key, generate)
+
+
+def write_sources(files: dict[str, str], folder: Path) -> Path:
+    """The files of :func:`sources` written into ``folder`` (created), as generate writes."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, text in files.items():
+        (folder / name).write_text(text, encoding="utf-8", newline="\n")
+    return folder
 
 
 def system(name: str):

@@ -53,3 +53,19 @@ def shared_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
         os.environ.pop("SYMKIN_CACHE_DIR", None)
     else:
         os.environ["SYMKIN_CACHE_DIR"] = before
+
+
+@pytest.fixture(scope="session", autouse=True)
+def shared_builds_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """One folder of derived Systems and generated sources for the whole run, shared by the
+    xdist workers as the kernel cache is (tests/shared_builds.py)."""
+    import shared_builds
+
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        folder = tmp_path_factory.getbasetemp().parent / "symkin-shared-builds"
+        folder.mkdir(exist_ok=True)
+    else:
+        folder = tmp_path_factory.mktemp("symkin-shared-builds")
+    shared_builds.FOLDER[:] = [folder]
+    yield folder
+    shared_builds.FOLDER.clear()

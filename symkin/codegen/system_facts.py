@@ -19,7 +19,8 @@ def nonlinear_coordinates(system: System) -> tuple[int, ...]:
 
 def parameter_pattern(system: System) -> list[tuple[int, int]]:
     """Structural non-zeros of Phi_p as (row, parameter), row-major."""
-    return [] if system.phi_p is None else sorted(system.phi_p.todok())
+    return [] if system.phi_p is None else sorted((int(r), int(c))  # ints, as in System.pattern
+                                                  for r, c in system.phi_p.todok())
 
 
 def point_names(system: System) -> tuple[tuple[str, str], ...]:

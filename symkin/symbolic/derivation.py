@@ -25,7 +25,7 @@ from symkin.spec import motion as motion_spec
 from symkin.spec import name_checks, validate
 from symkin.spec.forces import has_dynamics
 from symkin.spec.validate import Mechanism
-from symkin.symbolic import dynamics, dynamics3d, redundancy, spatial
+from symkin.symbolic import dynamics, dynamics3d, pickling, redundancy, spatial
 from symkin.symbolic.derivatives import diff
 from symkin.symbolic.differentiation import Memory, parameter_jacobian, row_gamma, row_jacobian
 from symkin.symbolic.input_rows import at_tau, input_values, with_inputs
@@ -168,6 +168,9 @@ class System:
     def name(self) -> str:
         return self.mechanism.name
 
+    def __reduce__(self) -> tuple[Any, tuple[bytes]]:  # SymPy's evaluation off on load
+        return pickling.restore, (pickling.dumps(self),)
+
     @property
     def parameter_names(self) -> tuple[str, ...]:
         return tuple(symbol.name for symbol in self.p)
@@ -177,8 +180,8 @@ class System:
         return validate.degrees_of_freedom(self.mechanism)
 
     def pattern(self) -> list[tuple[int, int]]:
-        """Structural non-zeros of Phi_q as (row, column), row-major."""
-        return sorted(self.phi_q.todok())
+        """Structural non-zeros of Phi_q as (row, column), row-major, as ints (not Integers)."""
+        return sorted((int(r), int(c)) for r, c in self.phi_q.todok())
 
 
 def derive(mech: Mechanism | str | Path) -> System:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled
 
 import symkin
 from symkin.runtime.scanning.assemblies import Shape
@@ -26,7 +27,7 @@ def _configurations(report, shape: Shape) -> list[np.ndarray]:
 @pytest.mark.parametrize("name, inputs", [("crank_slider_input", (1.2,)),
                                           ("three_rrr_fk", (0.1, 0.2, -0.1))])
 def test_whole_turns_of_the_inputs_leave_the_assemblies_as_they_are(name: str, inputs) -> None:
-    kernel = symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"), backend="numpy")
+    kernel = compiled(ROOT / "examples" / f"{name}.yaml", "numpy")  # from its goldens
     shape = Shape(tuple(kernel.coordinates))
     base = _configurations(symkin.scan(kernel, inputs=list(inputs)), shape)
     assert len(base) >= 2

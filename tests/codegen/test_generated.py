@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 from codegen_support import (
-    BACKENDS,
     ALL_EXAMPLES,
+    BACKENDS,
     EXAMPLES,
     GENERATED,
     ROOT,
@@ -27,7 +27,9 @@ from codegen_support import (
     compilers,
     example_ids,
     golden_folder,
+    sources,
     system,
+    write_sources,
 )
 
 import symkin
@@ -155,8 +157,9 @@ def test_c_compiles_without_warnings(name: str, real: str, tmp_path: Path) -> No
     if real == "double":
         folder = golden_folder(name, "c")
     else:
-        folder = tmp_path / "src"
-        symkin.generate(system(name), backend="c", out_dir=folder, real="float")
+        # shared with test_embedded's float folder (codegen_support.sources)
+        folder = write_sources(sources(ROOT / "examples" / f"{name}.yaml", "c", real="float"),
+                               tmp_path / "src")
     extra = ["-Wdouble-promotion", "-Wshadow", "-Wstrict-prototypes"]
     for compiler in compilers():
         for source in sorted(folder.glob("*.c")):

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
-from codegen_support import derived
+from codegen_support import compiled, derived
 from driver_support import BACKENDS, kernel_for
 
 import symkin
@@ -188,9 +188,9 @@ def cam():
 
 @pytest.fixture(scope="module")
 def cam_kernel(cam):
-    """The cam's kernel of a backend, built once for the tests here (lowering its 600-character
-    profile takes many seconds)."""
-    return functools.cache(lambda backend: kernel_for(cam, backend))
+    """The cam's kernel of a backend, built once for the tests here and its sources generated
+    once per run (lowering its 600-character profile takes many seconds)."""
+    return functools.cache(lambda backend: compiled(EXAMPLES / "cam_cycloidal.yaml", backend))
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from codegen_support import derived
+from codegen_support import compiled
 
 import symkin
 from symkin.runtime.outputs.spatial import rotation
@@ -25,8 +25,9 @@ BACKENDS = ["c", "numpy"]
 
 
 def _solve(name: str, backend: str) -> symkin.Trajectory:
-    # one derivation per file for both backends (stewart's, delta's take many seconds)
-    return symkin.solve(symkin.compile(derived(EXAMPLES / name), backend=backend))
+    # one derivation and generation per run for both backends (stewart's, delta's take many
+    # seconds)
+    return symkin.solve(compiled(EXAMPLES / name, backend))
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

@@ -21,7 +21,7 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import pytest
-from codegen_support import derived
+from codegen_support import compiled, derived
 from octave_support import assert_octave_equals_numpy, needs_octave
 
 import symkin
@@ -77,9 +77,9 @@ def _euler_rotation(e: np.ndarray) -> np.ndarray:
 
 @functools.cache
 def _compiled(name: str, backend: str):
-    # one derivation per file for both backends and the Octave check (stewart_legs_fk's
-    # takes a minute), one kernel per backend for every test here
-    return symkin.compile(derived(ROOT / "examples" / f"{name}.yaml"), backend=backend)
+    # one derivation and generation per run for both backends and the Octave check
+    # (stewart_legs_fk's take a minute each), one kernel per backend for every test here
+    return compiled(ROOT / "examples" / f"{name}.yaml", backend)
 
 
 @pytest.fixture(scope="module", params=[(f, b) for f in FILES for b in BACKENDS],

@@ -12,12 +12,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 from codegen_support import (
+    ROOT,
     STRICT_FLAGS,
     compile_object,
     example_ids,
     golden_folder,
+    sources,
     system,
     undefined_symbols,
+    write_sources,
 )
 
 import symkin
@@ -60,8 +63,9 @@ def test_double_folder_needs_only_libm(name: str, tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("name", example_ids())
 def test_float_folder_needs_only_single_precision_libm(name: str, tmp_path: Path) -> None:
-    folder = tmp_path / "src"
-    symkin.generate(system(name), backend="c", out_dir=folder, real="float")
+    # shared with test_generated's float folder (codegen_support.sources)
+    folder = write_sources(sources(ROOT / "examples" / f"{name}.yaml", "c", real="float"),
+                           tmp_path / "src")
     undefined = _undefined(_cross_compile(folder, tmp_path))
     helpers = sorted(s for s in undefined if s.startswith("__aeabi_d"))
     assert not helpers, f"double-precision soft-float helpers in float mode: {helpers}"

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from codegen_support import derived
+from codegen_support import compiled, derived
 from octave_support import assert_octave_equals_numpy, needs_octave
 
 import symkin
@@ -139,8 +139,7 @@ def test_the_generated_driver_solves_as_numpy(generated: dict[str, Path], name: 
     script = (f"[T, Q, DQ, D2Q] = {name}_solve(); fprintf('%.17g\\n', [T; Q; DQ; D2Q]);")
     result = subprocess.run(["octave-cli", "--norc", "--quiet", "--eval", script], cwd=folder,
                             capture_output=True, text=True, timeout=120, check=True)
-    numpy = symkin.solve(symkin.compile(derived(ROOT / "examples" / f"{name}.yaml"),
-                                        backend="numpy"))
+    numpy = symkin.solve(compiled(ROOT / "examples" / f"{name}.yaml", "numpy"))
     values = np.array(result.stdout.split(), dtype=float)
     nq = numpy.q.shape[1]
     table = values.reshape(-1, 1 + 3 * nq)
@@ -156,8 +155,7 @@ def test_the_generated_driver_solves_as_numpy(generated: dict[str, Path], name: 
 def test_point_kinematics_equal_the_trajectorys(generated: dict[str, Path], name: str) -> None:
     """<prefix>_point_kinematics (r + R s and its derivatives; spatial: R from the Euler
     parameters) equals the runtime's points at a row of a NumPy run."""
-    numpy = symkin.solve(symkin.compile(derived(ROOT / "examples" / f"{name}.yaml"),
-                                        backend="numpy"))
+    numpy = symkin.solve(compiled(ROOT / "examples" / f"{name}.yaml", "numpy"))
     expected = numpy.point_arrays()
     row = 7
 
