@@ -36,3 +36,9 @@ def listed(items: Iterable[str], sep: str = ", ", most: int = MAX_LISTED) -> str
     shown = sep.join(names[:most])
     rest = len(names) - most
     return f"{shown} and {rest} more" if rest > 0 else shown
+
+
+def listed_groups(groups: Iterable[Iterable[str]]) -> str:
+    """Groups of names (rows that depend on each other) as ``{a, b}; {c}``, each group and
+    the list of groups bounded as :func:`listed` bounds one list."""
+    return listed(("{" + listed(g) + "}" for g in groups), "; ")

@@ -13,7 +13,7 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NamedTuple, TextIO
 
-from symkin.limits import listed
+from symkin.limits import listed, listed_groups
 
 # NumPy and the figures' series are imported where used: `symkin --help` builds this command's
 # parser and must not pay for them.
@@ -273,7 +273,7 @@ def flag_warnings(trajectory: Any) -> list[str]:
             continue
         detail = "".join(
             f"; a singular configuration is passed at t = {t:.10g} (Phi_q loses rank {rank}; "
-            f"dependent rows: {listed(('{' + listed(g) + '}' for g in groups), '; ')}), its "
+            f"dependent rows: {listed_groups(groups)}), its "
             "point(s) interpolated from both sides" for t, rank, groups in passed)
         lines.append(f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: "
                      f"the error model says q, dq, ddq may miss {targets.target_q:g}, "
@@ -294,7 +294,7 @@ def _dynamics_passage(count: int, where: str, worst: float, passed: list[Any]) -
     the motion is determinate there (its rows are integrated), only Phi_q is singular."""
     detail = "; ".join(
         f"t = {t:.10g} (Phi_q loses rank {rank}; dependent rows: "
-        f"{listed(('{' + listed(g) + '}' for g in groups), '; ')})" for t, rank, groups in passed)
+        f"{listed_groups(groups)})" for t, rank, groups in passed)
     return (f"warning: {count} point{'s' if count > 1 else ''} flagged at {where}: the motion "
             f"passes a singular configuration at {detail}; it went on through it on its "
             "branch, the rows integrated as any other (the equations of motion's condition "

@@ -16,7 +16,7 @@ from typing import Any
 from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
-from symkin.limits import listed
+from symkin.limits import listed, listed_groups
 
 
 def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -133,8 +133,7 @@ def text(report: Any, name: str, grid: str) -> str:
 def _motion_lines(motion: Any, t1: float) -> list[str]:
     lines = []
     for t, rank, groups in motion.singular:
-        joints = listed(("{" + listed(_short(row) for row in group) + "}"
-                         for group in groups), "; ")
+        joints = listed_groups((_short(row) for row in group) for group in groups)
         lines.append(f"singular configuration passed at t = {t:.10g} (Phi_q loses rank {rank}; "
                      f"dependent joints: {joints})")
     for first, last in motion.flagged:

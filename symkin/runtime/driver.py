@@ -137,7 +137,7 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
         assembled at t[0], Newton does not converge, or Phi_q is singular. SolveError for a
         bad t, q0, params or out.
     """
-    plan = getattr(kernel, "call_plan", None) or call_plan.of(kernel)
+    plan = getattr(kernel, "call_plan", None) or call_plan.of(kernel)  # of(): on the first call
     if plan.moves_under_forces:  # forward dynamics: runtime.dynamics
         from symkin.runtime.dynamics import run as motion
 

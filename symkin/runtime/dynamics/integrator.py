@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from symkin.limits import listed
+from symkin.limits import listed_groups
 from symkin.runtime.dynamics import passages
 from symkin.runtime.dynamics.equations import TRUNCATION, Singular, accelerations
 from symkin.runtime.dynamics.model import Model
@@ -108,10 +108,12 @@ class Stepper:
         found = accelerations(self.model, y[:n], y[n:2 * n], t, self.p, revealing=near)
         return np.concatenate([y[n:2 * n], found.d2q, [found.power]])
 
-    def watch(self, t: float, q: Array, dq: Array) -> None:
-        """Note an accepted state; a singular configuration passed just before it is
-        recorded, or with ``stop_at_singular`` stops the run there (StepFailure)."""
-        self.trail = [*self.trail[-2:], passages.watched(self.model, t, q, dq, self.p)]
+    def watch(self, t: float, q: Array, dq: Array, jacobian: Array | None = None) -> None:
+        """Note an accepted state (``jacobian``: Φ_q there, where known); a singular
+        configuration passed just before it is recorded, or with ``stop_at_singular`` stops
+        the run there (StepFailure)."""
+        self.trail = [*self.trail[-2:],
+                      passages.watched(self.model, t, q, dq, self.p, jacobian)]
         if len(self.trail) < 3:
             return
         passage = passages.search(self.model, self.p, (self.trail[0], self.trail[1],
@@ -148,8 +150,8 @@ class Stepper:
             factor = MAX_FACTOR if error == 0 else SAFETY * error ** (-1 / ORDER)
             if error <= 1.0:
                 t = t_end if h == t_end - t else t + h
-                y = self._project(t, y_new, n)
-                self.watch(t, y[:n], y[n:2 * n])
+                y, jacobian = self._project(t, y_new, n)
+                self.watch(t, y[:n], y[n:2 * n], jacobian)
                 proposal = h * min(MAX_FACTOR, max(MIN_FACTOR, factor))
                 # a step cut short to end on the output time says little about the next one
                 self.step = max(proposal, self.step) if h < self.step else proposal
@@ -165,7 +167,7 @@ class Stepper:
             return "the step size fell below its minimum: the motion is too fast or stiff to follow"
         rank, groups = lost
         return (f"a lock-up: Phi_q loses rank {rank} there (dependent rows: "
-                f"{listed(('{' + listed(g) + '}' for g in groups), '; ')}) and the motion "
+                f"{listed_groups(groups)}) and the motion "
                 "cannot continue through it (a limit position of a driver, or a mechanism "
                 "that jams); the steps shrank to nothing")
 
@@ -192,8 +194,9 @@ class Stepper:
         error = float(np.sqrt(np.mean((estimate[:2 * n] / scale) ** 2)))
         return y_new, error
 
-    def _project(self, t: float, y: Array, n: int) -> Array:
-        """q onto Φ(q, t) = 0, then q̇ onto Φ_q q̇ = -Φ_t (module docstring)."""
+    def _project(self, t: float, y: Array, n: int) -> tuple[Array, Array]:
+        """q onto Φ(q, t) = 0, then q̇ onto Φ_q q̇ = -Φ_t (module docstring); the projected
+        state and Φ_q at its q."""
         q, dq = y[:n].copy(), y[n:2 * n].copy()
         model, p = self.model, self.p
         for _ in range(PROJECTION_ITERATIONS):
@@ -213,7 +216,7 @@ class Stepper:
         jacobian = model.phi_q(q, t, p)
         dq -= np.linalg.lstsq(jacobian, jacobian @ dq + model.phi_t(q, t, p),
                               rcond=TRUNCATION)[0]
-        return np.concatenate([q, dq, y[2 * n:]])
+        return np.concatenate([q, dq, y[2 * n:]]), jacobian
 
     def _first_step(self, t: float, y: Array, t_end: float) -> float:
         """Hairer and Wanner's starting step from the sizes of y and its derivative."""

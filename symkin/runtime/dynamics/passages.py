@@ -56,15 +56,22 @@ class Passage:
     groups: tuple[tuple[str, ...], ...]
 
 
-def watched(model: Model, t: float, q: Array, dq: Array, p: Array) -> Watched:
+def watched(model: Model, t: float, q: Array, dq: Array, p: Array,
+            jacobian: Array | None = None) -> Watched:
     """The accepted state with the smallest singular value of Φ_q above the structural zero
-    (RANK_TOLERANCE) relative to the largest."""
-    values = _values(model, q, t, p)
+    (RANK_TOLERANCE) relative to the largest; ``jacobian``: Φ_q there, where the caller has
+    it already (the integrator's projection ends with it)."""
+    ratio, structural = _nearness(_values(model, q, t, p, jacobian))
+    return Watched(t, q.copy(), dq.copy(), ratio, structural)
+
+
+def _nearness(values: Array) -> tuple[float, int]:
+    """From Φ_q's singular values (descending): the smallest above the structural zero over
+    the largest, and how many are structural zeros (dependent rows to rounding)."""
     if values.size == 0 or values[0] <= 0.0:
-        return Watched(t, q.copy(), dq.copy(), 1.0, 0)
+        return 1.0, 0
     above = values[values > RANK_TOLERANCE * values[0]]
-    return Watched(t, q.copy(), dq.copy(), float(above[-1] / values[0]),
-                   int(values.size - above.size))
+    return float(above[-1] / values[0]), int(values.size - above.size)
 
 
 def search(model: Model, p: Array, trail: tuple[Watched, Watched, Watched]) -> Passage | None:
@@ -98,8 +105,10 @@ def search(model: Model, p: Array, trail: tuple[Watched, Watched, Watched]) -> P
     return Passage(t, rank_loss - structural, tuple(tuple(g) for g in groups))
 
 
-def _values(model: Model, q: Array, t: float, p: Array) -> Array:
-    jacobian = model.phi_q(q, t, p)
+def _values(model: Model, q: Array, t: float, p: Array, jacobian: Array | None = None
+            ) -> Array:
+    if jacobian is None:
+        jacobian = model.phi_q(q, t, p)
     if jacobian.size == 0:
         return np.zeros(0)
     return np.asarray(np.linalg.svd(jacobian, compute_uv=False), dtype=np.float64)
@@ -135,12 +144,12 @@ def lost_rank(model: Model, q: Array, t: float, p: Array
               ) -> tuple[int, tuple[tuple[str, ...], ...]] | None:
     """The rank Φ_q loses at (q, t) beyond its structural dependence and its groups of
     dependent rows, when its ratio is below SUSPECT (None otherwise)."""
-    state = watched(model, t, q, np.zeros_like(q), p)
-    if state.ratio >= SUSPECT:
-        return None
     jacobian = model.phi_q(q, t, p)
-    values = np.linalg.svd(jacobian, compute_uv=False)
-    rcond = max(PASSAGE, 2.0 * state.ratio)
+    values = _values(model, q, t, p, jacobian)
+    ratio, structural = _nearness(values)
+    if ratio >= SUSPECT:
+        return None
+    rcond = max(PASSAGE, 2.0 * ratio)
     _, groups = dependencies(jacobian, list(model.rows), rcond=rcond)
     count = int(np.count_nonzero(values <= rcond * values[0]))
-    return max(count - state.structural, 1), tuple(tuple(g) for g in groups)
+    return max(count - structural, 1), tuple(tuple(g) for g in groups)

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 from symkin.contract.options import defaults
 from symkin.contract.status import NO_CONVERGENCE, NOT_FINITE, SINGULAR
 from symkin.contract.tuning import EDGE_SUBSTEPS
-from symkin.limits import listed
+from symkin.limits import listed, listed_groups
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.solving.assembly import Assembly
 from symkin.runtime.solving.edges import Resolution
@@ -140,7 +140,7 @@ def explain_start(start: Singular, t: float) -> str:
     """Why the motion is not stepped from its assembled start at t."""
     aligned = listed(start.aligned) or "no joint"
     drivers = listed(start.drivers, " and ") or "no driver"
-    groups = listed(("{" + listed(group) + "}" for group in start.groups), "; ")
+    groups = listed_groups(start.groups)
     return (f"the mechanism is assembled at t = {t:.10g} in a singular or limit configuration "
             f"(condition of Phi_q {start.cond:.3g} in units of the mechanism's length scale "
             f"{start.scale:.3g}): {aligned} become aligned, the equations of {groups} are "
@@ -206,7 +206,7 @@ def _singular_rows(kernel: KinematicsKernel, last: tuple[float, Array] | None, p
 def _dependent(jacobian: Array, labels: Sequence[str]) -> list[str]:
     """What is singular, said first, then the dependent rows (a minimal set per lost rank)."""
     rank_loss, groups = dependencies(jacobian, labels)
-    said = listed(("{" + listed(group) + "}" for group in groups), "; ")
+    said = listed_groups(groups)
     summary = (f"it loses rank {rank_loss}; the equations of {said} are dependent"
                if len(groups) > 1 else f"the equations of {listed(groups[0], '; ')} are dependent")
     return [summary, *dict.fromkeys(row for group in groups for row in group)]
