@@ -102,7 +102,8 @@ class Batch:
         # Looked up once: symkin.solve asks for a length scale or two on every call
         # (runtime.solving.start.lever_arm), where the lookups cost more than the C.
         self._length_scales = getattr(lib, f"{name}_length_scales")
-        self._real_array = f"{name}_real[]" if real == "double" else None
+        # parsed once (from_buffer given the type's text parses it on every call)
+        self._real_array = ffi.typeof(f"{name}_real[]") if real == "double" else None
 
     def __call__(self, params: Array, t: Array, q0: Array, options: Options, q: Array,
                  dq: Array, d2q: Array, units: Array) -> BatchStatus:

@@ -68,7 +68,10 @@ class GridSolver:
         # inverse dynamics: the grid loop then takes lam_out and loads_out too
         self._dynamics = hasattr(lib, f"{name}_multipliers")
         self._points = getattr(lib, f"{name}_points")
-        self._real_array = f"{name}_real[]"
+        # The cffi types parsed once: from_buffer given a type's text parses it on every
+        # call, about a fifth of the cost of the call (six of them bind each run).
+        self._real_array = ffi.typeof(f"{name}_real[]")
+        self._bytes_array = ffi.typeof("unsigned char[]")
         self.dtype = np.float32 if real == "float" else np.float64
         # The bytes of q and p in the real type: they are copied into the structs as they are.
         self._q_bytes = q.size * np.dtype(self.dtype).itemsize
@@ -135,7 +138,7 @@ class GridSolver:
         self._pointers = (from_buffer(real, times), from_buffer(real, buffers[0]),
                           from_buffer(real, buffers[1]), from_buffer(real, buffers[2]),
                           from_buffer(real, buffers[3]),
-                          from_buffer("unsigned char[]", flagged_out))
+                          from_buffer(self._bytes_array, flagged_out))
         self._forces: tuple[Any, ...] = ()
         if self._dynamics:  # NULL: the loop skips them
             self._forces = tuple(

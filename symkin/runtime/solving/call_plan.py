@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from symkin.contract.options import Options
 from symkin.contract.options import defaults as newton_defaults
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
-from symkin.runtime.solving import units
+from symkin.runtime.solving import start, units
 
 Array = NDArray[np.float64]
 
@@ -87,11 +87,12 @@ class Plan:
 
     def unit(self, kernel: KinematicsKernel, q0: Array, t0: float, p: Array, p_bytes: bytes
              ) -> float:
-        """The unit to solve in from q0 at t0 with parameters p (units.unit_for on a miss)."""
+        """The unit to solve in from q0 at t0 with parameters p (units.unit_for on a miss,
+        its length scale measured afresh: this memory is the only one it is kept in)."""
         key = (q0.tobytes(), t0, p_bytes)
         found = self._units.get(key)
         if found is None:
-            found = units.unit_for(kernel, q0, t0, p)
+            found = units.unit_of(start.measured_lever_arm(kernel, q0, t0, p))
             if len(self._units) >= RECENT:
                 self._units.clear()
             self._units[key] = found

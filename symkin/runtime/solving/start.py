@@ -25,6 +25,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -182,27 +183,46 @@ _FLOAT64 = np.dtype(np.float64)
 def lever_arm(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> float:
     """L at (q, t, p), NaN where Phi_q is not finite there: one call of the generated
     ``<prefix>_length_scales`` (what sweeps use) where the kernel has a batch solver, with no
-    Phi_q through Python; else from Phi_q's non-zeros (lever_arms)."""
+    Phi_q through Python, kept for the RECENT last configurations; else from Phi_q's
+    non-zeros (lever_arms)."""
     batch = getattr(kernel, "batch_solver", None)
     if batch is None:
         return lever_arms(kernel, q, t, p)[1]
-    if type(q) is not np.ndarray or q.dtype is not _FLOAT64:  # (a key of the values' bytes)
-        q = np.asarray(q, dtype=np.float64)
-    if type(p) is not np.ndarray or p.dtype is not _FLOAT64:
-        p = np.asarray(p, dtype=np.float64)
+    q, p = _float64(q), _float64(p)
     recent = _structure(kernel).recent_scales
     key = (q.tobytes(), float(t), p.tobytes())
     scale = recent.get(key)
     if scale is None:
-        scale = float(batch.length_scales(p[None, :], q, float(t))[0])
-        if not math.isfinite(scale):
-            scale = math.nan
-        elif not scale > 0:
-            scale = 1.0  # no lever arm: Phi_q as it is, as length_scale says
+        scale = _generated_scale(batch, q, t, p)
         if len(recent) >= RECENT:
             recent.clear()
         recent[key] = scale
     return scale
+
+
+def measured_lever_arm(kernel: KinematicsKernel, q: Array, t: float, p: Array) -> float:
+    """lever_arm without its memory, for a caller that keeps the answer in its own
+    (runtime.solving.call_plan: one memory, not two)."""
+    batch = getattr(kernel, "batch_solver", None)
+    if batch is None:
+        return lever_arms(kernel, q, t, p)[1]
+    return _generated_scale(batch, _float64(q), t, _float64(p))
+
+
+def _float64(values: Array) -> Array:
+    """values as a float64 array (itself when it is one: its bytes are a key)."""
+    if type(values) is np.ndarray and values.dtype is _FLOAT64:
+        return values
+    return np.asarray(values, dtype=np.float64)
+
+
+def _generated_scale(batch: Any, q: Array, t: float, p: Array) -> float:
+    """L from one call of the generated ``<prefix>_length_scales``: NaN where Phi_q is not
+    finite, 1 where there is no lever arm (Phi_q as it is, as length_scale says)."""
+    scale = float(batch.length_scales(p[None, :], q, float(t))[0])
+    if not math.isfinite(scale):
+        return math.nan
+    return scale if scale > 0 else 1.0
 
 
 def scaled_nonzeros(kernel: KinematicsKernel, nz: Array) -> tuple[Array, float]:

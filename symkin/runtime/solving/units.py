@@ -45,7 +45,11 @@ NATURAL = (1e-2, 1e2)
 def unit_for(kernel: KinematicsKernel, q0: Array, t0: float, p: Array) -> float:
     """The unit u to solve in: 1 when L is in NATURAL (or cannot be told), else 10^floor(log10
     L)."""
-    scale = lever_arm(kernel, q0, t0, p)
+    return unit_of(lever_arm(kernel, q0, t0, p))
+
+
+def unit_of(scale: float) -> float:
+    """unit_for from the length scale L (runtime.solving.start.lever_arm)."""
     if not math.isfinite(scale):  # Phi_q not finite at q0
         return 1.0
     if NATURAL[0] <= scale <= NATURAL[1]:
