@@ -146,9 +146,10 @@ for _ in range(int(sys.argv[2])):
 
 def per_solve_call(spec: str, cache_dir: str | None = None) -> float:
     """Instructions of one ``symkin.solve(kernel, t=t)`` on a 31-point grid over 0..1.5 with
-    the C kernel of examples/<spec>.yaml: (a process of 201 calls - one of 101) / 100 (both
+    the C kernel of examples/<spec>.yaml: (a process of 1101 calls - one of 101) / 1000 (both
     past the first calls' one-time costs), the kernel built beforehand (outside the count)
-    and loaded from the cache by both."""
+    and loaded from the cache by both. A difference over 100 calls moved by up to 20 % between
+    runs (the interpreter's allocations and collections land unevenly); over 1000 by about 3 %."""
     import os
 
     from symkin import backends
@@ -172,7 +173,7 @@ def per_solve_call(spec: str, cache_dir: str | None = None) -> float:
             assert match, done.stderr[-500:]
             return int(match.group(1))
 
-        return (total(201) - total(101)) / 100
+        return (total(1101) - total(101)) / 1000
 
 
 def main() -> int:
