@@ -4,9 +4,11 @@ builds, and output folders that hold other people's files — each with its exac
 
 from __future__ import annotations
 
+import functools
 import json
 import multiprocessing
 import os
+import pickle
 import shutil
 import signal
 import stat
@@ -17,9 +19,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled, derived
 
 import symkin
-from symkin import backends
+from symkin import backends, cli
 from symkin.build import cache as build_cache
 from symkin.errors import SymkinWarning, UsageError
 
@@ -27,9 +30,11 @@ ROOT = Path(__file__).resolve().parents[2]
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
 
 
-def _reference(system: symkin.System) -> np.ndarray:
-    """q over the file's grid, from a NumPy kernel built in a cache of its own."""
-    return symkin.solve(symkin.compile(system, backend="numpy")).q
+@functools.cache
+def _reference() -> np.ndarray:
+    """q over the textbook file's grid, from its NumPy kernel (built once per run, from the
+    goldens: codegen_support.compiled)."""
+    return symkin.solve(compiled(TEXTBOOK, "numpy")).q
 
 
 def _kernel_folder(cache: Path, backend: str) -> Path:
@@ -41,7 +46,9 @@ def _kernel_folder(cache: Path, backend: str) -> Path:
 
 @pytest.fixture
 def system() -> symkin.System:
-    return symkin.derive(TEXTBOOK)
+    """The textbook crank-slider's System, derived once per run (plain data: the tests here
+    compile and generate from it, never change it)."""
+    return derived(TEXTBOOK)
 
 
 def test_a_planted_numpy_kernel_is_never_executed(system: symkin.System, tmp_path: Path) -> None:
@@ -58,7 +65,7 @@ def test_a_planted_numpy_kernel_is_never_executed(system: symkin.System, tmp_pat
     (planted / "crank_slider_manifest.json").write_text("{}")
     kernel = symkin.compile(system, backend="numpy", cache_dir=victim)
     assert not marker.exists()
-    np.testing.assert_allclose(symkin.solve(kernel).q, _reference(system), atol=1e-12)
+    np.testing.assert_allclose(symkin.solve(kernel).q, _reference(), atol=1e-12)
 
 
 @pytest.mark.parametrize("damage", ["truncate", "random", "edit"])
@@ -67,11 +74,13 @@ def test_a_damaged_kernel_is_rebuilt_not_loaded(damage: str, backend: str,
                                                 system: symkin.System, tmp_path: Path) -> None:
     cache = tmp_path / "cache"
     # Built and run in other processes: this one must not have the library mapped while the
-    # test rewrites it in place (that would crash this process, not symkin).
-    code = ("import symkin, numpy; s = symkin.derive({p!r}); "
-            "k = symkin.compile(s, backend={b!r}, cache_dir={c!r}); "
-            "print(k.backend, float(symkin.solve(k).q[-1, 6]))").format(
-                p=str(TEXTBOOK), b=backend, c=str(cache))
+    # test rewrites it in place (that would crash this process, not symkin). They load this
+    # run's System, pickled (a System pickles faithfully), instead of deriving it again.
+    pickled = tmp_path / "system.pickle"
+    pickled.write_bytes(pickle.dumps(system))
+    code = (f"import pickle, symkin; s = pickle.loads(open({str(pickled)!r}, 'rb').read()); "
+            f"k = symkin.compile(s, backend={backend!r}, cache_dir={str(cache)!r}); "
+            "print(k.backend, float(symkin.solve(k).q[-1, 6]))")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     subprocess.run([sys.executable, "-c", code], check=True, env=env, timeout=300)
     folder = _kernel_folder(cache, backend)
@@ -89,7 +98,7 @@ def test_a_damaged_kernel_is_rebuilt_not_loaded(damage: str, backend: str,
     assert result.returncode == 0, result.stderr
     loaded, slider_x = result.stdout.split()
     assert loaded == backend
-    assert abs(float(slider_x) - _reference(system)[-1, 6]) < 1e-12
+    assert abs(float(slider_x) - _reference()[-1, 6]) < 1e-12
     assert target.read_bytes() != data[:1000] and b"edited" not in target.read_bytes()
 
 
@@ -128,7 +137,10 @@ def test_a_build_killed_mid_way_leaves_nothing_that_outlives_it(system: symkin.S
     slow = tmp_path / "slow-cc"
     slow.write_text("#!/bin/sh\nsleep 60\nexec cc \"$@\"\n")
     slow.chmod(slow.stat().st_mode | stat.S_IXUSR)
-    code = f"import symkin; symkin.compile(symkin.derive({str(TEXTBOOK)!r}), cache_dir={str(cache)!r})"
+    pickled = tmp_path / "system.pickle"  # this run's System: the process need not derive it
+    pickled.write_bytes(pickle.dumps(system))
+    code = (f"import pickle, symkin; s = pickle.loads(open({str(pickled)!r}, 'rb').read()); "
+            f"symkin.compile(s, cache_dir={str(cache)!r})")
     process = subprocess.Popen([sys.executable, "-c", code], start_new_session=True,
                                env={**os.environ, "PYTHONPATH": str(ROOT), "CC": str(slow)})
     deadline = time.monotonic() + 120
@@ -143,7 +155,7 @@ def test_a_build_killed_mid_way_leaves_nothing_that_outlives_it(system: symkin.S
     kernel = symkin.compile(system, backend="c", cache_dir=cache)
     assert kernel.backend == "c"
     assert not any(p.exists() for p in left)
-    np.testing.assert_allclose(symkin.solve(kernel).q, _reference(system), atol=1e-12)
+    np.testing.assert_allclose(symkin.solve(kernel).q, _reference(), atol=1e-12)
 
 
 def _compile_variant(job: tuple[str, str, str]) -> float:
@@ -162,24 +174,23 @@ def test_eight_concurrent_cold_builds(distinct: bool, tmp_path: Path) -> None:
     names = [f"cs{k}" if distinct else "cs" for k in range(8)]
     with multiprocessing.get_context("fork").Pool(8) as pool:
         results = pool.map(_compile_variant, [(text, name, cache) for name in names])
-    reference = _reference(symkin.derive(TEXTBOOK))[-1, 6]
+    reference = _reference()[-1, 6]
     assert all(abs(value - reference) < 1e-12 for value in results)
     folders = [p for p in Path(cache).iterdir() if p.name.startswith("_symkin_")]
     assert len(folders) == len(set(names))
     assert not [p for p in Path(cache).iterdir() if p.name.startswith(".")]
 
 
-def test_cache_clear_removes_only_what_symkin_wrote(system: symkin.System, tmp_path: Path) -> None:
+def test_cache_clear_removes_only_what_symkin_wrote(system: symkin.System, tmp_path: Path,
+                                                    monkeypatch: pytest.MonkeyPatch,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
     cache = tmp_path / "cache"
     symkin.compile(system, backend="numpy", cache_dir=cache)
     (cache / "notes.txt").write_text("mine")
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(cache)}
-    info = subprocess.run([sys.executable, "-m", "symkin", "cache", "info"], env=env,
-                          capture_output=True, text=True, timeout=120)
-    assert info.returncode == 0 and "kernels: 1" in info.stdout
-    cleared = subprocess.run([sys.executable, "-m", "symkin", "cache", "clear"], env=env,
-                             capture_output=True, text=True, timeout=120)
-    assert cleared.returncode == 0
+    monkeypatch.setenv("SYMKIN_CACHE_DIR", str(cache))
+    assert cli.main(["cache", "info"]) == 0
+    assert "kernels: 1" in capsys.readouterr().out
+    assert cli.main(["cache", "clear"]) == 0
     assert [p.name for p in cache.iterdir()] == ["notes.txt"]
 
 
@@ -199,23 +210,22 @@ def test_generate_never_deletes_files_a_foreign_manifest_lists(system: symkin.Sy
     assert (out / "important.txt").read_text() == "keep me"
 
 
-def test_generate_refuses_a_folder_of_other_files_with_exit_2(tmp_path: Path) -> None:
+def test_generate_refuses_a_folder_of_other_files_with_exit_2(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "out"
     out.mkdir()
     (out / "thesis.tex").write_text("years of work")
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    command = [sys.executable, "-m", "symkin", "generate", str(TEXTBOOK), "-o", str(out)]
-    refused = subprocess.run(command, env=env, capture_output=True, text=True, timeout=300)
-    assert refused.returncode == 2 and "thesis.tex" in refused.stderr
+    command = ["generate", str(TEXTBOOK), "-o", str(out)]
+    assert cli.main(command) == 2
+    assert "thesis.tex" in capsys.readouterr().err
     assert [p.name for p in out.iterdir()] == ["thesis.tex"]
-    forced = subprocess.run([*command, "--force"], env=env, capture_output=True, text=True,
-                            timeout=300)
-    assert forced.returncode == 0 and (out / "thesis.tex").read_text() == "years of work"
+    assert cli.main([*command, "--force"]) == 0
+    assert (out / "thesis.tex").read_text() == "years of work"
 
 
 def test_two_mechanisms_share_a_folder(system: symkin.System, tmp_path: Path) -> None:
     out = tmp_path / "out"
-    four_bar = symkin.derive(ROOT / "examples" / "four_bar.yaml")
+    four_bar = derived(ROOT / "examples" / "four_bar.yaml")
     symkin.generate(system, backend="numpy", out_dir=out)
     symkin.generate(four_bar, backend="numpy", out_dir=out)
     symkin.generate(system, backend="numpy", out_dir=out)  # regenerate the first: no refusal

@@ -118,9 +118,7 @@ def test_manifest_has_the_declared_keys(tmp_path: Path) -> None:
 
 
 def test_a_spatial_manifest_says_its_space(tmp_path: Path) -> None:
-    import symkin
-
-    spatial = symkin.derive(ROOT / "examples" / "rssr.yaml")
+    spatial = system("rssr")
     written = render.generate(spatial, backends.get("c"), out_dir=tmp_path)[-1]
     data = json.loads(written.read_text(encoding="utf-8"))
     assert set(data) == manifest.KEYS - manifest.OPTIONAL_KEYS | {"space", "senses"}

@@ -13,15 +13,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import system
 
-import symkin
 from symkin.backends import get as get_backend
 from symkin.backends.c import context, lu_code, op_budget
-from symkin.codegen import lower
+from symkin.codegen import lower, render
 from symkin.codegen.op_count import KINDS, Flops, count
 from symkin.contract import tuning
-
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 # A real type that counts: each operation on it adds one to its kind. A literal's sign and an
 # operation of two literals stay double arithmetic (folded by the compiler), not counted.
@@ -286,8 +284,7 @@ def test_crank_slider_phi_by_hand():
     bodies x and y rows r_i + R_i s_A - r_j (2 additions each, R_i s_A = a (cos, sin) once
     per body: 2 calls and 2 products); the ground joint's rows are a negation each, the
     prismatic pair's a subtraction, the driver q - t^2 - pi/2 a product and 2 subtractions."""
-    system = symkin.derive(symkin.load(EXAMPLES / "crank_slider.yaml"))
-    code = lower.lower(system, get_backend("c"))
+    code = lower.lower(system("crank_slider"), get_backend("c"))
     by_hand = Flops(add=4 * 2 + 2 + 1 + 2, mul=2 * 2 + 1, call=4)
     assert op_budget._routine(code, "phi") == by_hand
 
@@ -313,12 +310,13 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
     Newton to its cap does exactly the predictor and iterations the budget counts (solve_inputs:
     the iterations exactly, its simplified Newton steps, which stop on the data, within their
     count)."""
-    system = symkin.derive(symkin.load(EXAMPLES / f"{name}.yaml"))
+    derived = system(name)  # derived once per run (codegen_support)
     if linalg == "tables":  # the sparse LU as loops over index tables, as for a large system
         monkeypatch.setattr(lu_code, "TABLE_FLOPS", 0)
         linalg = "sparse"
-    symkin.generate(system, backend="c", out_dir=tmp_path, linalg=linalg)
-    code = lower.lower(system, get_backend("c"), {"linalg": linalg})
+    # what symkin.generate(derived, "c", tmp_path, linalg=linalg) does, from one lowering
+    code = lower.lower(derived, get_backend("c"), {"linalg": linalg})
+    render.write(code, tmp_path)
     extra = context.template_context(code)
     if name == "stewart_fk":  # its file's q0 is the home pose; the inputs start there
         assert np.allclose(code.input_values, _home_legs(), rtol=1e-12, atol=0)
@@ -368,8 +366,8 @@ def test_budget_against_counted_run(tmp_path, monkeypatch, name, linalg):
     assert _arithmetic(measured["refined"]) == _arithmetic(refined)
     assert _within(measured["refined"], op_budget.refined(code, algebra, units=False))
     inputs = bool(code.input_names)
-    header = (tmp_path / f"{system.name}_solver.h").read_text()
-    stated = int(re.search(rf"{system.name.upper()}_OPS_STEP_WORST (\d+)", header)[1])
+    header = (tmp_path / f"{derived.name}_solver.h").read_text()
+    stated = int(re.search(rf"{derived.name.upper()}_OPS_STEP_WORST (\d+)", header)[1])
     budget = extra["ops_budget"]
     assert stated == budget["step"]
     for run in ("step", "flagged_step"):

@@ -1,6 +1,6 @@
 """Tether: point A of body i stays within reach of point B of body j (a pair type planted by
-tests/docs/test_docs_site.py, written as a pair module is: its model, equations and
-registry entry)."""
+the site fixture of tests/docs/conftest.py, written as a pair module is: its model,
+equations and registry entry)."""
 
 from __future__ import annotations
 

@@ -10,9 +10,6 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 import pytest
-from docs_support import build, sphinx_or_skip
-
-from symkin import pairs
 
 pytestmark = pytest.mark.slow  # one Sphinx build, about half a minute
 
@@ -111,15 +108,11 @@ def test_gallery_shows_each_example_with_its_command(site) -> None:
         assert (html / "auto" / src).stat().st_size > 10_000  # a figure, not an empty file
 
 
-def test_a_new_pair_type_documents_itself(tmp_path: Path, gallery_cache: Path,
-                                          monkeypatch: pytest.MonkeyPatch) -> None:
-    """A type registered (here by the test, as a module of its own) gets its page, with its
-    keys, their roles and defaults, its meaning and equation, and a line in the index."""
-    import planted_pair
-
-    sphinx_or_skip()
-    monkeypatch.setitem(pairs._FAMILY, "2d", (*pairs.TYPES, planted_pair.TYPE))
-    status, warnings, html = build(tmp_path, gallery_cache)
+def test_a_new_pair_type_documents_itself(site) -> None:
+    """A type registered (by the site's fixture, as a module of its own: planted_pair) gets its
+    page, with its keys, their roles and defaults, its meaning and equation, and a line in
+    the index."""
+    status, warnings, html = site
     assert status == 0 and warnings == "", warnings
     page = (html / "auto" / "types" / "planar-tether.html").read_text(encoding="utf-8")
     text = entities.unescape(re.sub(r"<[^>]+>", "", page))

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from codegen_support import compiled, derived
 
 import symkin
 from symkin import backends
@@ -45,7 +46,7 @@ def _solved_points(kernel: Any) -> list[tuple[float, np.ndarray, Any]]:
 
 @pytest.mark.parametrize("example", EXAMPLES)
 def test_exact_inverse_norm_at_solved_points(example: str) -> None:
-    kernel = symkin.compile(symkin.derive(EXAMPLES_DIR / f"{example}.yaml"), backend="c")
+    kernel = compiled(EXAMPLES_DIR / f"{example}.yaml", "c")  # the goldens' solver
     assert kernel.backend == "c"
     for _, a, report in _solved_points(kernel):
         norm = np.abs(a).sum(axis=0).max()
@@ -59,8 +60,8 @@ def test_exact_inverse_norm_at_solved_points(example: str) -> None:
 @pytest.mark.parametrize("example", ["crank_slider", "andrews_squeezer"])
 def test_hager_estimate_where_the_exact_code_would_be_long(
         example: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(inverse_code, "EXACT_OPS", 0)
-    kernel = symkin.compile(symkin.derive(EXAMPLES_DIR / f"{example}.yaml"), backend="c")
+    monkeypatch.setattr(inverse_code, "EXACT_OPS", 0)  # generated afresh, without the columns
+    kernel = symkin.compile(derived(EXAMPLES_DIR / f"{example}.yaml"), backend="c")
     assert kernel.backend == "c"
     points = same = 0
     for _, a, report in _solved_points(kernel):
@@ -84,7 +85,7 @@ def test_exact_code_is_refused_beyond_its_budget() -> None:
     estimate, so the generated solver keeps the estimator there."""
     from symkin.codegen import lower
 
-    system = symkin.derive(EXAMPLES_DIR / "crank_slider.yaml")
+    system = derived(EXAMPLES_DIR / "crank_slider.yaml")
     plan = lower.lower(system, backends.get("c")).lu_plan
     assert plan is not None
     values: list[float | None] = [None] * plan.n_lu

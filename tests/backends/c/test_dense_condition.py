@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import derived
 
 import symkin
 from symkin.contract import tuning
@@ -29,7 +30,7 @@ def test_dense_condition_on_a_fine_grid_is_bounded_by_the_exact_one() -> None:
     from the last fresh estimate A: at most 1 / (1 - theta) above ||A^-1||_1, which is itself
     at most 1 / (1 - theta) above the exact ||A'^-1||_1 (the lemma the other way): never
     stale beyond 1 / (1 - REESTIMATE_SHIFT)^2."""
-    system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
+    system = derived(ROOT / "examples" / "crank_slider.yaml")
     kernel = symkin.compile(system, backend="c", linalg="dense")
     trajectory = symkin.solve(kernel, t=np.linspace(0.0, 1.5, 1501))
     ratio = trajectory.cond / _exact_condition(kernel, trajectory)
@@ -42,7 +43,7 @@ def test_dense_condition_on_a_fine_grid_is_bounded_by_the_exact_one() -> None:
 @pytest.mark.parametrize("name", ["parallelogram", "toggle_press"])
 def test_dense_and_sparse_flag_the_same_points(name: str) -> None:
     """Near a singular configuration, on a grid fine enough for the estimate to be carried."""
-    system = symkin.derive(ROOT / "tests" / "mechanisms" / f"{name}.yaml")
+    system = derived(ROOT / "tests" / "mechanisms" / f"{name}.yaml")
     t0, t1, _ = system.time_grid
     times = np.linspace(t0, t1, 401)
     runs = [symkin.solve(symkin.compile(system, backend="c", linalg=linalg), t=times)

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import pytest
 from backends.c.test_dynamics_step import TUMBLING
+from codegen_support import compiled, derived
 from motion.test_motion_redundant import EXAMPLE, _falling, _reference
 from motion_support import PENDULUM, write
 from scipy.integrate import solve_ivp
@@ -102,8 +103,8 @@ def test_masses_in_any_unit_keep_the_sparse_path() -> None:
     masses in grams (x 1000) takes no dense fall-back, moves as before (bit for bit: the
     scaled matrix is the same) and its multipliers scale with the masses (the load of
     gravity and inertia; its spring and damper are not zero, so only to the ratio)."""
-    system = symkin.derive(ROOT / "examples" / "four_bar_dynamics.yaml")
-    kernel = symkin.compile(system, "c")
+    system = derived(ROOT / "examples" / "four_bar_dynamics.yaml")
+    kernel = compiled(ROOT / "examples" / "four_bar_dynamics.yaml", "c")  # from the goldens
     trajectory = symkin.solve(kernel, t=np.arange(0.0, 0.1 + 1e-12, 1e-3))
     p = np.asarray(system.p_values, float)
     heavy = p.copy()
@@ -255,7 +256,7 @@ def test_numpy_step_uses_the_same_rows(falling: Any, falling_c: Any, tmp_path: P
 def test_worst_case_within_three_kinematic_steps(example: str, tmp_path: Path) -> None:
     """Issue 37's goal for the budget the header states: one dynamics step at most 3 times
     the kinematic step of the same mechanism (both worst cases at the default caps)."""
-    symkin.generate(symkin.derive(ROOT / "examples" / f"{example}.yaml"), "c", tmp_path)
+    symkin.generate(derived(ROOT / "examples" / f"{example}.yaml"), "c", tmp_path)
     upper = example.upper()
 
     def macro(file: str, name: str) -> int:

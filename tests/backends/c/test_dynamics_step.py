@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from codegen_support import compiled, derived
 from scipy.integrate import solve_ivp
 
 import symkin
@@ -35,6 +36,7 @@ from symkin.contract.options import Options
 from symkin.contract.status import BAD_OPTIONS, OK
 
 ROOT = Path(__file__).resolve().parents[3]
+FOUR_BAR = ROOT / "examples" / "four_bar_dynamics.yaml"
 G, LENGTH, MASS = 9.81, 1.0, 1.0
 PENDULUM = """\
 name: pendulum
@@ -80,7 +82,13 @@ def pendulum_c(pendulum: Any) -> Any:
 
 @pytest.fixture(scope="module")
 def four_bar() -> Any:
-    return symkin.derive(ROOT / "examples" / "four_bar_dynamics.yaml")
+    return derived(FOUR_BAR)
+
+
+@pytest.fixture(scope="module")
+def four_bar_c() -> Any:
+    """Its C kernel, built once from the goldens (driven: a kinematic kernel)."""
+    return compiled(FOUR_BAR, "c")
 
 
 def _stepper(kernel: Any) -> DynamicsStepper:
@@ -157,10 +165,11 @@ def test_bad_step_length_is_refused_and_the_state_kept(pendulum_c: Any) -> None:
     assert motion.status == BAD_OPTIONS and motion.t.size == 0
 
 
-def test_driven_four_bar_follows_the_kinematic_solve(four_bar: Any, tmp_path: Path) -> None:
+def test_driven_four_bar_follows_the_kinematic_solve(four_bar: Any, four_bar_c: Any,
+                                                     tmp_path: Path) -> None:
     """Every freedom driven: the step's ddq comes from Phi_q ddq = Gamma, so it must track
     the kinematic solution; its lam must be the inverse dynamics' multipliers there."""
-    kernel = symkin.compile(four_bar, "c")
+    kernel = four_bar_c
     trajectory = symkin.solve(kernel, t=np.arange(0.0, 0.5 + 1e-12, 1e-3))
     motion = _stepper(kernel).run(Options(), np.asarray(four_bar.p_values, float), 0.0,
                                   trajectory.q[0], trajectory.dq[0], 1e-3, 500)
@@ -174,8 +183,8 @@ def test_driven_four_bar_follows_the_kinematic_solve(four_bar: Any, tmp_path: Pa
         assert np.allclose(motion.lam[k], lam, rtol=1e-8, atol=1e-8)
 
 
-def test_mass_and_applied_are_the_symbolic_ones(four_bar: Any) -> None:
-    kernel = symkin.compile(four_bar, "c")
+def test_mass_and_applied_are_the_symbolic_ones(four_bar: Any, four_bar_c: Any) -> None:
+    kernel = four_bar_c
     rng = np.random.default_rng(37)
     q, dq, t = rng.normal(size=9), rng.normal(size=9), 0.3
     p = np.asarray(four_bar.p_values, float)
@@ -200,15 +209,15 @@ def test_mass_and_applied_are_the_symbolic_ones(four_bar: Any) -> None:
     assert np.allclose(ffi.unpack(out, 9), applied, rtol=1e-12, atol=1e-12)
 
 
-def test_header_states_the_budget(four_bar: Any) -> None:
-    kernel = symkin.compile(four_bar, "c")
+def test_header_states_the_budget(four_bar: Any, four_bar_c: Any) -> None:
+    kernel = four_bar_c
     plan = dynamics_budget.budget(lower.lower(four_bar, backends.get("c")), 25)
     assert plan.step.total == kernel.lib.FOUR_BAR_DYNAMICS_OPS_DYNAMICS_STEP_WORST
     assert plan.step.total > 0
 
 
 def test_files_without_masses_get_no_dynamics(tmp_path: Path) -> None:
-    paths = symkin.generate(symkin.derive(ROOT / "examples" / "four_bar.yaml"), "c", tmp_path)
+    paths = symkin.generate(derived(ROOT / "examples" / "four_bar.yaml"), "c", tmp_path)
     assert not [p for p in paths if "dynamics" in p.name]
     assert "_mass(" not in (tmp_path / "four_bar.h").read_text()
 

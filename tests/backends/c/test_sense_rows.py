@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled
 
-import symkin
 from symkin.runtime.kernel import Kernel
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
@@ -17,7 +17,7 @@ pytestmark = pytest.mark.filterwarnings("ignore::symkin.errors.SymkinWarning")
 
 
 def _kernel(name: str) -> Kernel:
-    kernel = symkin.compile(symkin.derive(EXAMPLES / f"{name}.yaml"), backend="c")
+    kernel = compiled(EXAMPLES / f"{name}.yaml", "c")  # from the goldens
     assert kernel.backend == "c" and len(kernel.senses) >= 2
     return kernel
 
