@@ -80,9 +80,10 @@ def test_the_cli_exits_2_with_the_line(tmp_path: Path,
 
 def test_animate_of_a_spatial_file_is_drawn(tmp_path: Path,
                                             capsys: pytest.CaptureFixture[str]) -> None:
-    """Once refused (exit 2); now an isometric GIF (tests/present/test_view3d.py checks it)."""
+    """Once refused (exit 2); now an isometric GIF (tests/present/test_view3d.py checks it).
+    Eleven frames (--dt 0.1) draw it as well as the file's 101."""
     code = cli.main(["run", str(ROOT / "examples" / "rssr.yaml"), "--backend", "numpy",
-                     "--animate", str(tmp_path / "a.gif")])
+                     "--dt", "0.1", "--animate", str(tmp_path / "a.gif")])
     assert code == 0, capsys.readouterr().err
     assert (tmp_path / "a.gif").stat().st_size > 0
 
