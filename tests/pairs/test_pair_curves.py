@@ -11,9 +11,6 @@ import csv
 import functools
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +20,7 @@ from codegen_support import compiled, derived
 from driver_support import BACKENDS, kernel_for
 
 import symkin
+from symkin import cli
 from symkin.errors import MechanismError, SolveError
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -347,28 +345,29 @@ def test_cam_pressure_angle_and_curvature_radius_follow_the_law(cam, cam_kernel,
     assert np.array_equal(saved["k1.curvature_radius"], outputs["k1.curvature_radius"])
 
 
-def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    root = Path(__file__).resolve().parents[2]
-    env = {**os.environ, "PYTHONPATH": str(root)}
-    result = subprocess.run([sys.executable, "-m", "symkin", "run", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=600)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+def _cli(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str]:
+    """symkin run in this process (a real process's exit code is tests/cli's): code, stderr."""
+    code = cli.main(["run", *args])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err, err
+    return code, err
 
 
-def test_cli_undercut_exits_2_and_curve_end_exits_1(tmp_path: Path) -> None:
+def test_cli_undercut_exits_2_and_curve_end_exits_1(tmp_path: Path,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
     """Undercutting is a mistake in the file (exit 2, located, no traceback); the end of a
     curve met during the motion stops the run at its time naming the pair (exit 1), with the
     rows solved so far written (the CSV has the column c1.s)."""
     data = _cam({"polar": "2 + 0.4*cos(3*s)"}, {"roller": 1.5, "at": "R"})
     bad = tmp_path / "undercut.yaml"
     bad.write_text(json.dumps(data))
-    result = _cli(str(bad), "--backend", "numpy", cwd=tmp_path)
-    assert result.returncode == 2
-    assert "joints[2].profile.polar: undercutting" in result.stderr
+    code, err = _cli(capsys, str(bad), "--backend", "numpy")
+    assert code == 2
+    assert "joints[2].profile.polar: undercutting" in err
     mechanism = Path(__file__).resolve().parents[1] / "mechanisms" / "half_circle_end.yaml"
-    result = _cli(str(mechanism), "--backend", "numpy", "-o", "half.csv", cwd=tmp_path)
-    assert result.returncode == 1
-    assert "near t = 0.79999" in result.stderr and "c1 point_on_curve" in result.stderr
+    code, err = _cli(capsys, str(mechanism), "--backend", "numpy", "-o",
+                     str(tmp_path / "half.csv"))
+    assert code == 1
+    assert "near t = 0.79999" in err and "c1 point_on_curve" in err
     header = next(csv.reader((tmp_path / "half.csv").open()))
     assert "c1.s" in header

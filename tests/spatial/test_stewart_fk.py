@@ -135,12 +135,26 @@ def test_rates_and_accelerations_match_differences(kernel) -> None:
     assert np.max(np.abs((got.dq[2:] - got.dq[:-2]) / (2 * h) - got.d2q[1:-1])) < 1e-3
 
 
+@functools.cache
+def _exact_run(tilt: float, name: str) -> tuple[dict[str, np.ndarray], ...]:
+    """_exact on the grid of test_rates_and_accelerations_equal_the_motions_own, once per
+    file and tilt (both backends' kernels take the same)."""
+    home = _legs(np.array([0, 0, 1.0, 0, 0, 0])) * FILES[name]
+    return tuple(_exact(tilt, float(s), home) for s in np.linspace(0.0, 1.0, 33))
+
+
 def _exact(tilt: float, t: float, home: np.ndarray) -> dict[str, np.ndarray]:
     """The prescribed motion and its first two time derivatives at t, by mpmath (40 digits):
     the legs (less ``home``) and the platform's origin r and rotation R."""
     base, top = _geometry()
 
     def pose(s: mpmath.mpf) -> tuple[mpmath.matrix, mpmath.matrix]:
+        # every leg and entry is differentiated at the same points s, at the same working
+        # precision (mpmath.diff raises it): each pose computed once
+        return _pose(s, mpmath.mp.prec)
+
+    @functools.cache
+    def _pose(s: mpmath.mpf, prec: int) -> tuple[mpmath.matrix, mpmath.matrix]:
         w = 2 * mpmath.pi * s
         a, b, c = tilt * mpmath.sin(w), tilt * mpmath.cos(w), tilt / 2 * mpmath.sin(3 * w)
         rz = mpmath.matrix([[mpmath.cos(c), -mpmath.sin(c), 0], [mpmath.sin(c), mpmath.cos(c), 0],
@@ -184,9 +198,8 @@ def test_rates_and_accelerations_equal_the_motions_own(kernel, tilt: float) -> N
     the solved Euler parameters: A is quadratic in e, so A' = (A(e + e') - A(e - e')) / 2 and
     A'' = 2 (A(e') - A(0)) + (A(e + e'') - A(e - e'')) / 2, exactly)."""
     name, k = kernel
-    home = _legs(np.array([0, 0, 1.0, 0, 0, 0])) * FILES[name]
     t = np.linspace(0.0, 1.0, 33)  # close enough that Newton tracks one assembly
-    exact = [_exact(tilt, float(s), home) for s in t]
+    exact = _exact_run(tilt, name)
     got = symkin.solve(k, t=t, inputs=np.array([x["legs"] for x in exact]),
                        input_rates=np.array([x["legs_t"] for x in exact]),
                        input_accels=np.array([x["legs_tt"] for x in exact]))

@@ -14,6 +14,7 @@ taken from symkin; its derivatives are estimated numerically with 40-digit arith
 
 from __future__ import annotations
 
+import functools
 import random
 
 import mpmath
@@ -109,10 +110,16 @@ HIGHER_PAIRS = {
 }
 
 
+@functools.cache
+def _derived(name: str) -> System:
+    """Each mechanism derived once for every test here."""
+    return derive(from_dict({"every_constraint": EVERY_CONSTRAINT,
+                             "higher_pairs": HIGHER_PAIRS}[name]))
+
+
 @pytest.fixture(scope="module", params=["every_constraint", "higher_pairs"])
 def system(request) -> System:
-    return derive(from_dict({"every_constraint": EVERY_CONSTRAINT,
-                             "higher_pairs": HIGHER_PAIRS}[request.param]))
+    return _derived(request.param)
 
 
 @pytest.fixture(scope="module")
@@ -146,7 +153,7 @@ def _close(derived, estimate, what: str) -> None:
 
 def test_every_constraint_type_is_present() -> None:
     from symkin import pairs
-    systems = [derive(from_dict(mech)) for mech in (EVERY_CONSTRAINT, HIGHER_PAIRS)]
+    systems = [_derived(name) for name in ("every_constraint", "higher_pairs")]
     types = {row.type for system in systems for row in system.rows}
     assert types == {kind.name for kind in pairs.TYPES}
     assert [len(system.q) for system in systems] == [21, 33]

@@ -10,6 +10,7 @@ from its geometry, and for a slightly wrong extra bar the residual its removed r
 from __future__ import annotations
 
 import copy
+import functools
 import math
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from codegen_support import compiled, derived
 
 import symkin
 from symkin import cli
@@ -57,7 +59,7 @@ def _closed_form(t: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray, np.nd
 def test_parallelogram_with_an_extra_bar_loses_exactly_its_one_dependent_row() -> None:
     """13 equations (6 revolutes, 1 driver) on 12 coordinates; the linkage really moves with
     one freedom the driver fixes, so the rank is 12: one row removed, the last joint row."""
-    system = symkin.derive(EXAMPLE)
+    system = derived(EXAMPLE)
     assert len(system.q) == 12 and len(system.rows) == 12
     assert system.phi_q.shape == (12, 12)
     assert [str(r) for r in system.removed] == [REMOVED]
@@ -69,14 +71,14 @@ def test_parallelogram_with_an_extra_bar_loses_exactly_its_one_dependent_row() -
 
 
 def test_a_square_file_is_untouched() -> None:
-    system = symkin.derive(ROOT / "examples" / "four_bar.yaml")
+    system = derived(ROOT / "examples" / "four_bar.yaml")
     assert system.removed == () and system.mobility is None
 
 
 def test_joint_rows_are_removed_before_driver_rows() -> None:
     """A pendulum driven twice, consistently (angle t, tip on (cos t, sin t)): 5 rows on 3
     coordinates; the drivers' 3 rows are kept and the revolute's 2 removed."""
-    system = symkin.derive(ROOT / "tests" / "mechanisms" / "pendulum_two_drivers.yaml")
+    system = derived(ROOT / "tests" / "mechanisms" / "pendulum_two_drivers.yaml")
     assert [r.section for r in system.rows] == ["drivers"] * 3
     assert [str(r) for r in system.removed] == ["joints[0] revolute ground-crank (x)",
                                                 "joints[0] revolute ground-crank (y)"]
@@ -107,7 +109,7 @@ def test_a_drawing_rounded_to_17_digits_removes_the_same_row() -> None:
 
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_parallelogram_motion_matches_its_closed_form(backend: str) -> None:
-    kernel = symkin.compile(symkin.derive(EXAMPLE), backend=backend)
+    kernel = compiled(EXAMPLE, backend)
     assert kernel.removed == (REMOVED,)
     trajectory = symkin.solve(kernel)
     expected = _closed_form(trajectory.t)
@@ -125,7 +127,7 @@ def test_parallelogram_motion_matches_its_closed_form(backend: str) -> None:
 def test_the_c_kernel_runs_the_generated_removed_routine() -> None:
     """The compiled C routine against the removed row written out by hand: the y of C on the
     extra bar minus the y of C on the coupler, at random states."""
-    kernel = symkin.compile(symkin.derive(EXAMPLE), backend="c")
+    kernel = compiled(EXAMPLE, "c")
     assert hasattr(kernel.lib, "parallelogram_extra_bar_removed")
     rng = np.random.default_rng(3)
     names = kernel.coordinates
@@ -154,13 +156,19 @@ def _wrong_bar(delta: float) -> dict[str, Any]:
     return document
 
 
+@functools.cache
+def _wrong_bar_system(delta: float) -> symkin.System:
+    """_wrong_bar(delta) derived once for both backends."""
+    return symkin.derive(from_dict(_wrong_bar(delta)))
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_a_slightly_wrong_extra_bar_assembles_and_is_flagged_along_the_motion(
         backend: str) -> None:
     """delta = 1e-3: the drawing is consistent at t0, so the assembly passes and the same row
     is removed; along the motion the kept rows move the parallelogram, and the removed row's
     residual is what the extra bar's kept x-row leaves in y (derived here): flags raised."""
-    system = symkin.derive(from_dict(_wrong_bar(1e-3)))
+    system = _wrong_bar_system(1e-3)
     assert [str(r) for r in system.removed] == [REMOVED]
     assert system.mobility == 0  # the joints alone leave nothing for the driver: rigid
     trajectory = symkin.solve(symkin.compile(system, backend=backend))
@@ -331,7 +339,7 @@ def test_a_warm_run_from_the_cache_still_knows_the_removed_rows(
 def test_a_sweep_says_which_sets_break_the_removed_row(backend: str) -> None:
     """The extra bar's error as a parameter, nominal 0 (the row removed is found there): the
     set with delta = 1e-3 breaks it along the motion, the exact ones do not."""
-    system = symkin.derive(from_dict(_wrong_bar(0.0)))
+    system = _wrong_bar_system(0.0)
     kernel = symkin.compile(system, backend=backend)
     result = symkin.sweep(kernel, {"delta": [0.0, 1e-3, 0.0]}, workers=1)
     assert result.ok.all()
@@ -366,7 +374,7 @@ def test_scan_lists_only_assemblies_that_keep_the_removed_row() -> None:
     C's x but not its y. So the file has exactly one assembly at t0."""
     from symkin.runtime.scanning.scan import scan
 
-    kernel = symkin.compile(symkin.derive(EXAMPLE), backend="numpy")
+    kernel = compiled(EXAMPLE, "numpy")
     report = scan(kernel, t=np.array([0.0, 0.01]))
     assert len(report.branches) == 1 and report.branches[0].taken
     k = kernel.coordinates.index("coupler.phi")

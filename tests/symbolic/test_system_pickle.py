@@ -8,6 +8,7 @@ manifest is JSON).
 
 from __future__ import annotations
 
+import functools
 import pickle
 
 import pytest
@@ -19,10 +20,17 @@ import symkin
 CASES = ("crank_slider", "cardan", "four_bar_dynamics")
 
 
+@functools.cache
+def _derived(name: str) -> symkin.System:
+    """Derived here, once for both backends: not a copy from shared_builds, which is itself a
+    pickle's."""
+    return symkin.derive(ROOT / "examples" / f"{name}.yaml")
+
+
 @pytest.mark.parametrize("name", CASES)
 @pytest.mark.parametrize("backend", ["c", "numpy"])
 def test_a_pickled_system_generates_the_same_files(name: str, backend: str, tmp_path) -> None:
-    system = symkin.derive(ROOT / "examples" / f"{name}.yaml")
+    system = _derived(name)
     copy = pickle.loads(pickle.dumps(system))
     original = symkin.generate(system, backend, tmp_path / "original")
     again = symkin.generate(copy, backend, tmp_path / "copy")
@@ -32,7 +40,7 @@ def test_a_pickled_system_generates_the_same_files(name: str, backend: str, tmp_
 
 
 def test_the_pattern_of_a_pickled_system_is_plain_ints() -> None:
-    system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
+    system = _derived("crank_slider")
     copy = pickle.loads(pickle.dumps(system))
     assert copy.pattern() == system.pattern()
     assert {type(index) for entry in copy.pattern() for index in entry} == {int}

@@ -11,6 +11,7 @@ at s = t. The reported curvature_radius is that signed p + p'', negative past a 
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -42,10 +43,16 @@ def test_a_cusp_between_samples_is_refused_where_it_is() -> None:
     assert abs(at - math.acos(-2 / 3) / 2) <= 2 * math.pi / SAMPLES
 
 
+@functools.cache
+def _without_cusp(h: float) -> tuple[symkin.System, symkin.Trajectory]:
+    """The file with lift h derived, compiled (NumPy) and run once for the tests here."""
+    system = symkin.derive(from_dict(_document(h)))
+    return system, symkin.solve(symkin.compile(system, backend="numpy"))
+
+
 def test_the_same_law_without_a_cusp_runs_on_its_support_function() -> None:
     rb, h = 1.0, 0.5
-    system = symkin.derive(from_dict(_document(h)))
-    result = symkin.solve(symkin.compile(system, backend="numpy"))
+    _, result = _without_cusp(h)
     x = result.q[:, result.coordinates.index("follower.x")]
     expected = rb + h * (1 - np.cos(2 * result.t)) / 2
     assert np.abs(x - expected).max() < 1e-9
@@ -69,8 +76,7 @@ def _support_radius(rb: float, h: float, s: np.ndarray) -> np.ndarray:
 
 def test_a_flat_faced_cams_curvature_radius_is_p_plus_p_second_on_a_run() -> None:
     rb, h = 1.0, 0.5
-    system = symkin.derive(from_dict(_document(h)))
-    result = symkin.with_outputs(system, symkin.solve(symkin.compile(system, backend="numpy")))
+    result = symkin.with_outputs(*_without_cusp(h))
     s = result.q[:, result.coordinates.index("k1.s")]
     assert np.abs(s - result.t).max() < 1e-9
     radius = dict(result.outputs)["k1.curvature_radius"]

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from codegen_support import compiled
 
 import symkin
 from symkin import cli
@@ -34,7 +35,7 @@ def test_show_of_an_axis_written_exactly_runs(name: str,
 
 @pytest.mark.parametrize("name", FILES)
 def test_the_cardan_written_exactly_follows_its_closed_form(name: str) -> None:
-    assert_cardan(symkin.solve(symkin.compile(symkin.derive(HERE / name), backend="numpy")))
+    assert_cardan(symkin.solve(compiled(HERE / name, "numpy")))
 
 
 def assert_cardan(result: symkin.Trajectory) -> None:

@@ -12,6 +12,7 @@ import re
 from pathlib import Path
 
 import pytest
+from codegen_support import compiled
 
 import symkin
 from symkin import cli
@@ -38,4 +39,4 @@ def test_refused_at_its_line_with_exit_2(name: str, line: int, said: str, tmp_pa
 
 @pytest.mark.parametrize("name", ["universal_tiny_axes.yaml", "universal_huge_axes.yaml"])
 def test_a_cross_drawn_at_any_length_runs_as_the_cardan(name: str) -> None:
-    assert_cardan(symkin.solve(symkin.compile(symkin.derive(HERE / name), backend="numpy")))
+    assert_cardan(symkin.solve(compiled(HERE / name, "numpy")))

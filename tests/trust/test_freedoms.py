@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled, derived
 
 import symkin
 from symkin import cli
@@ -30,7 +31,7 @@ CHAIN = [("ground", "crank", [0, 0, 1]), ("crank", "coupler", [1, 0, 1]),
 @pytest.mark.parametrize("path", [HERE / "spherical_four_bar.yaml", EXAMPLES / "cardan.yaml"],
                          ids=["spherical_four_bar", "cardan"])
 def test_an_over_constrained_spatial_linkage_has_one_freedom(path: Path) -> None:
-    assert symkin.derive(path).mobility == 1
+    assert derived(path).mobility == 1
 
 
 def test_show_prints_one_freedom(capsys: pytest.CaptureFixture[str]) -> None:
@@ -43,8 +44,7 @@ def test_show_prints_one_freedom(capsys: pytest.CaptureFixture[str]) -> None:
 def test_the_spherical_four_bar_moves_as_one() -> None:
     """Each body's two joint axes, drawn at t0, stay where its neighbours' are: the crank's
     second axis is the coupler's first, and so on, as the crank turns by 0.5 rad."""
-    result = symkin.solve(symkin.compile(symkin.derive(HERE / "spherical_four_bar.yaml"),
-                                         backend="numpy"))
+    result = symkin.solve(compiled(HERE / "spherical_four_bar.yaml", "numpy"))
     turned = {name: rotation(result.body(name)[0][:, 3:]) for name in ("crank", "coupler",
                                                                          "rocker")}
     turned["ground"] = np.broadcast_to(np.eye(3), turned["crank"].shape)

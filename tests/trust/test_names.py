@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled
 
 import symkin
 from symkin.backends.c import toolchain
@@ -27,8 +28,7 @@ RENAMED = [("custom_named_input.yaml", "custom_driver.yaml", {"input": "crank"})
 
 
 def _q_at(path: Path, t: float) -> dict[str, float]:
-    system = symkin.derive(path)
-    result = symkin.solve(symkin.compile(system, backend="numpy"), t=np.array([t]))
+    result = symkin.solve(compiled(path, "numpy"), t=np.array([t]))
     return {name: float(result.q[0, k]) for k, name in enumerate(result.coordinates)}
 
 

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled
 
 import symkin
 from symkin.runtime.driver import SolveFailure
@@ -53,7 +54,7 @@ def rssr_input(tmp_path_factory) -> Path:
 
 @pytest.mark.parametrize("backend", ["numpy", "c"])
 def test_an_input_run_from_the_crank_half_a_turn_away_is_refused(rssr_input, backend) -> None:
-    kernel = symkin.compile(symkin.derive(rssr_input), backend=backend)
+    kernel = compiled(rssr_input, backend)  # one derivation for both backends
     q0 = _crank_turned_by_pi(kernel)
     assert np.abs(kernel.phi(q0, 0.0, np.r_[kernel.p_values, 0.0, 0.0, 0.0])).max() < 1e-12
     t = np.linspace(0.0, 0.1, 6)
@@ -66,7 +67,7 @@ def test_an_input_run_from_the_crank_half_a_turn_away_is_refused(rssr_input, bac
 
 
 def test_a_sweep_reports_a_set_started_half_a_turn_away_as_no_assembly() -> None:
-    kernel = symkin.compile(symkin.derive(EXAMPLES / "rssr.yaml"), backend="c")
+    kernel = compiled(EXAMPLES / "rssr.yaml", "c")
     assert kernel.batch_solver is not None  # the C batch solves the sets, not symkin.solve
     q0 = _crank_turned_by_pi(kernel)
     params = np.array([kernel.p_values, kernel.p_values])

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled
 
 import symkin
 from symkin import cli
@@ -33,14 +34,23 @@ drivers:
 time: {t0: 0, t1: 1, dt: 0.25}
 """
 STEP = "3*Heaviside(t - 0.6)"  # 0 up to t = 0.5, 3 from t = 0.75: one step of 3 rad
+FILE_NAMES = {STEP: "jumping", "3*t": "turning"}
 BACKENDS = ["numpy", pytest.param("c", marks=pytest.mark.skipif(
     shutil.which("gcc") is None, reason="gcc is not installed"))]
 
 
-def _kernel(tmp_path: Path, theta: str, backend: str):
-    path = tmp_path / "crank.yaml"
-    path.write_text(CRANK.replace("THETA", theta), encoding="utf-8")
-    return path, symkin.compile(symkin.derive(path), backend=backend)
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return tmp_path_factory.mktemp("senses")
+
+
+def _kernel(folder: Path, theta: str, backend: str):
+    """The crank driven by theta, written once per theta (its derivation and sources shared by
+    the backends and the CLI test: codegen_support.compiled)."""
+    path = folder / f"crank_{FILE_NAMES[theta]}.yaml"
+    if not path.exists():
+        path.write_text(CRANK.replace("THETA", theta), encoding="utf-8")
+    return path, compiled(path, backend)
 
 
 def _angle(trajectory) -> np.ndarray:
@@ -51,8 +61,8 @@ def _angle(trajectory) -> np.ndarray:
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-def test_a_jump_to_the_crank_half_a_turn_away_is_flagged_at_its_time(tmp_path, backend):
-    _, kernel = _kernel(tmp_path, STEP, backend)
+def test_a_jump_to_the_crank_half_a_turn_away_is_flagged_at_its_time(folder, backend):
+    _, kernel = _kernel(folder, STEP, backend)
     with pytest.warns(SymkinWarning, match=(
             r"the motion left the mechanism's assembly at row 3 \(t = 0.75\): drivers\[0\] "
             r"turn angle ground-crank \(sense\) reversed .*2 row\(s\) in all, flagged")):
@@ -63,8 +73,8 @@ def test_a_jump_to_the_crank_half_a_turn_away_is_flagged_at_its_time(tmp_path, b
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-def test_a_motion_newton_follows_is_not_flagged(tmp_path, backend):
-    _, kernel = _kernel(tmp_path, "3*t", backend)
+def test_a_motion_newton_follows_is_not_flagged(folder, backend):
+    _, kernel = _kernel(folder, "3*t", backend)
     with warnings.catch_warnings():
         warnings.simplefilter("error", SymkinWarning)
         trajectory = symkin.solve(kernel)
@@ -72,8 +82,8 @@ def test_a_motion_newton_follows_is_not_flagged(tmp_path, backend):
     assert not trajectory.flagged.any()
 
 
-def test_the_cli_says_where_and_flags_the_rows(tmp_path, capsys):
-    path, _ = _kernel(tmp_path, STEP, "numpy")
+def test_the_cli_says_where_and_flags_the_rows(folder, tmp_path, capsys):
+    path, _ = _kernel(folder, STEP, "numpy")
     out = tmp_path / "rows.csv"
     assert cli.main(["run", str(path), "--backend", "numpy", "-o", str(out)]) == 0
     err = capsys.readouterr().err
