@@ -5,8 +5,8 @@
   its 12 leg bodies (6-UPS): the leg lengths are the inverse kinematics of a pose path, so
   the solved pose must be that path (forward kinematics recovered);
 - the delta robot: each forearm's rods keep their length and the platform its orientation;
-- the Cardan shaft: tan(theta2) = tan(theta1) / cos(beta) with its exact derivatives (needs
-  the removal of redundant equations, built elsewhere: expected to fail here).
+- the Cardan shaft: tan(theta2) = tan(theta1) / cos(beta) with its exact derivatives (its
+  redundant equation removed by the derivation).
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ def test_spatial_slider_crank_against_the_rod_length(backend: str) -> None:
     th, w = 2 * np.pi * result.t, 2 * np.pi
     ay, az = h + r * np.cos(th), k + r * np.sin(th)  # the crank pin; the slider at (x, 0, 0)
     x = np.sqrt(L**2 - ay**2 - az**2)
-    g = ay**2 + az**2  # x^2 = L^2 - g; dg/dth = -2 r (h sin th - k cos th)
+    # x^2 = L^2 - g with g = ay^2 + az^2; dg/dth = -2 r (h sin th - k cos th)
     dg = -2 * r * (h * np.sin(th) - k * np.cos(th)) * w
     ddg = -2 * r * (h * np.cos(th) + k * np.sin(th)) * w**2
     dx = -dg / (2 * x)
