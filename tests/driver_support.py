@@ -7,11 +7,16 @@ System, bypassing codegen: a cross-check of the generated NumPy kernel. ``kernel
 
 from __future__ import annotations
 
+import hashlib
+import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+import shared_builds
 import sympy as sp
+from codegen_support import compiled
 
 import symkin
 
@@ -83,6 +88,24 @@ def kernel_for(system, backend: str):
 def derive(name: str):
     """The System of tests/mechanisms/<name>.yaml."""
     return symkin.derive(MECHANISMS / f"{name}.yaml")
+
+
+def mechanism_file(text: str) -> Path:
+    """``text`` as a YAML mechanism file at a place that depends on the text only: the run's
+    shared folder (tests/shared_builds.py), so that every test and backend that writes the same
+    text shares one derivation and one generation of it (codegen_support.derived, compiled)."""
+    folder = shared_builds.FOLDER[0] if shared_builds.FOLDER else Path(tempfile.gettempdir())
+    path = folder / f"text-{hashlib.sha256(text.encode()).hexdigest()[:24]}.yaml"
+    if not path.exists():
+        partial = path.with_name(f".{path.name}.{os.getpid()}")
+        partial.write_text(text, encoding="utf-8")
+        os.replace(partial, path)  # whole or absent, as shared_builds stores
+    return path
+
+
+def kernel_of(text: str, backend: str):
+    """symkin.compile(symkin.derive(symkin.load(file of text)), backend), built once per run."""
+    return compiled(mechanism_file(text), backend)
 
 
 

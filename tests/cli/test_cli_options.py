@@ -8,13 +8,11 @@ slider x = a cos phi1 + b cos phi2, and their time derivatives by hand.
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main, symkin_process
 
 import symkin
 from symkin.cli import overrides
@@ -24,13 +22,8 @@ ROOT = Path(__file__).resolve().parents[2]
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
 
 
-def symkin_cli(*args: str, cwd: Path, env: dict[str, str] | None = None
-               ) -> subprocess.CompletedProcess[str]:
-    environment = {**os.environ, "PYTHONPATH": str(ROOT), **(env or {})}
-    result = subprocess.run([sys.executable, "-m", "symkin", *args], cwd=cwd, env=environment,
-                            capture_output=True, text=True, timeout=300, check=False)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+def symkin_cli(*args: str, cwd: Path, env: dict[str, str] | None = None) -> Ran:
+    return symkin_main(*args, cwd=cwd, env=env)
 
 
 def closed_form(t: np.ndarray, a: float = 1.0, b: float = 5.0, c: float = 4.0) -> dict:
@@ -58,7 +51,7 @@ def test_version(tmp_path: Path) -> None:
 
     declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
     assert symkin.__version__ == declared
-    result = symkin_cli("--version", cwd=tmp_path)
+    result = symkin_process("--version", cwd=tmp_path)  # a real process: the shell's view
     assert result.returncode == 0 and result.stdout.strip() == f"symkin {declared}"
 
 

@@ -4,23 +4,17 @@ exits 0 with a `flagged` column; --stop-at-singular keeps the old stop; a limit 
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
+from cli_support import Ran, symkin_main
 
 ROOT = Path(__file__).resolve().parents[2]
 MECHANISMS = ROOT / "tests" / "mechanisms"
 
 
-def run(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([sys.executable, "-m", "symkin", "run", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=600)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+def run(*args: str, cwd: Path) -> Ran:
+    return symkin_main("run", *args, cwd=cwd)
 
 
 def test_change_point_is_warned_about_once_and_exits_0(tmp_path: Path) -> None:

@@ -11,12 +11,11 @@ slider moved from (4, 4) by sqrt(4^2 + 2^2), the rod turned from atan(3/4) to pi
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main
 
 import symkin
 from symkin.runtime.solving.start import FAR, far_from_guess
@@ -41,9 +40,8 @@ time: {t0: 0, t1: 0.5, dt: 0.05}
 """
 
 
-def _run(path: Path, backend: str = "numpy") -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "symkin", "run", str(path), "--backend",
-                           backend], capture_output=True, text=True, cwd=ROOT, timeout=600)
+def _run(path: Path, backend: str = "numpy") -> Ran:
+    return symkin_main("run", str(path), "--backend", backend, cwd=ROOT)
 
 
 @pytest.mark.parametrize("backend", ["numpy", "c"])

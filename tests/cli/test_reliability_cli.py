@@ -1,8 +1,9 @@
 """The command line at its boundaries (issue: nothing lost, nothing planted): unbounded inputs,
 hostile text, closed pipes, unwritable outputs and Ctrl-C, each with its exact outcome.
 
-Every case runs the real ``python -m symkin`` in a subprocess with a private cache, so the exit
-status, stdout and stderr are what a user sees.
+Each case runs the command as a user would (tests/cli_support.py): its exit status, stdout and
+stderr; the closed pipe and Ctrl-C in a real ``python -m symkin`` process, the others in this
+one. Every run uses the test run's shared kernel cache, which the Ctrl-C cases warm first.
 """
 
 from __future__ import annotations
@@ -18,22 +19,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main
 
 ROOT = Path(__file__).resolve().parents[2]
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
 
 
-def symkin(*args: str, cwd: Path, cache: Path, **extra: object) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(cache)}
-    result = subprocess.run([sys.executable, "-m", "symkin", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=300, **extra)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+def symkin(*args: str, cwd: Path, cache: Path) -> Ran:
+    return symkin_main(*args, cwd=cwd, env={"SYMKIN_CACHE_DIR": str(cache)})
 
 
 @pytest.fixture
-def cache(tmp_path: Path) -> Path:
-    return tmp_path / "cache"
+def cache(shared_cache: Path) -> Path:
+    return shared_cache
 
 
 @pytest.mark.parametrize("options, says", [

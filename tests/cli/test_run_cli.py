@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import io
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main, symkin_process
 from driver_support import MECHANISMS
 
 from symkin.cli.run_outputs import ProgressBar
@@ -20,12 +18,8 @@ COORDINATES = ["crank.x", "crank.y", "crank.phi", "rod.x", "rod.y", "rod.phi", "
                "slider.y", "slider.phi"]
 
 
-def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([sys.executable, "-m", "symkin", "run", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=300)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+def run(*args: str, cwd: Path) -> Ran:
+    return symkin_main("run", *args, cwd=cwd)
 
 
 def test_npz_csv_plot_and_animation(tmp_path: Path) -> None:
@@ -99,8 +93,9 @@ def test_bad_options_exit_2(args, message, tmp_path: Path) -> None:
 
 
 def test_bad_mechanism_file_exits_2(tmp_path: Path) -> None:
+    """In a real process: the exit status the shell sees."""
     (tmp_path / "bad.yaml").write_text(TEXTBOOK.read_text().replace("type: angle", "type: angel"))
-    result = run("bad.yaml", "-o", "x.npz", cwd=tmp_path)
+    result = symkin_process("run", "bad.yaml", "-o", "x.npz", cwd=tmp_path)
     assert result.returncode == 2 and "bad.yaml" in result.stderr
     assert not (tmp_path / "x.npz").exists()
 

@@ -7,13 +7,12 @@ from __future__ import annotations
 import base64
 import dataclasses
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main
+from codegen_support import compiled
 
 from symkin.present import view3d
 from tests.present.test_present import _browse, _console_lines
@@ -23,10 +22,8 @@ RSSR = ROOT / "examples" / "rssr.yaml"
 A = 0.1  # rssr.yaml: the crank pin's radius
 
 
-def _cli(*arguments: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}  # this checkout's symkin, from any folder
-    return subprocess.run([sys.executable, "-m", "symkin", "run", *arguments], cwd=cwd,
-                          env=env, capture_output=True, text=True, timeout=600, check=False)
+def _cli(*arguments: str, cwd: Path) -> Ran:
+    return symkin_main("run", *arguments, cwd=cwd)  # in this process: tests/cli_support.py
 
 
 def _numbers(value: object) -> np.ndarray:
@@ -142,8 +139,7 @@ def test_isometric_projection_of_the_axes() -> None:
 def test_many_time_points_are_thinned_to_max_frames(tmp_path: Path) -> None:
     import symkin
 
-    trajectory = symkin.solve(symkin.compile(symkin.derive(symkin.load(RSSR)),
-                                             backend="numpy"), t=np.linspace(0, 1, 1001))
+    trajectory = symkin.solve(compiled(RSSR, "numpy"), t=np.linspace(0, 1, 1001))
     frames = view3d.frame_indices(trajectory)
     assert frames.size == view3d.MAX_FRAMES and frames[0] == 0 and frames[-1] == 1000
     page = view3d.report(trajectory, tmp_path / "r.html")
@@ -158,7 +154,7 @@ def test_no_named_point_is_refused_with_a_message(tmp_path: Path) -> None:
     import symkin
     from symkin.errors import UsageError
 
-    trajectory = symkin.solve(symkin.compile(symkin.derive(symkin.load(RSSR)), backend="numpy"))
+    trajectory = symkin.solve(compiled(RSSR, "numpy"))
     bare = dataclasses.replace(trajectory, points=(), point_vectors=np.zeros((0, 3)))
     for draw, name in ((view3d.report, "r.html"), (view3d.animate, "a.gif")):
         with pytest.raises(UsageError, match="names no point on a moving body"):
@@ -172,7 +168,7 @@ def test_a_partial_run_draws_without_warnings(tmp_path: Path) -> None:
 
     import symkin
 
-    trajectory = symkin.solve(symkin.compile(symkin.derive(symkin.load(RSSR)), backend="numpy"))
+    trajectory = symkin.solve(compiled(RSSR, "numpy"))
     q = trajectory.q.copy()
     q[50:] = np.nan
     partial = dataclasses.replace(trajectory, q=q)
@@ -190,7 +186,7 @@ def test_a_body_with_more_than_two_points_is_a_closed_polygon(tmp_path: Path) ->
     import symkin
 
     spec = ROOT / "examples" / "stewart.yaml"
-    trajectory = symkin.solve(symkin.compile(symkin.derive(symkin.load(spec)), backend="numpy"))
+    trajectory = symkin.solve(compiled(spec, "numpy"))
     r, _, _ = trajectory.point_arrays()
     columns = [k for k, (body, _) in enumerate(trajectory.points) if body == "platform"]
     assert len(columns) == 6

@@ -9,13 +9,12 @@ times one scale, the largest of the run VECTOR_SHARE of the scene's cube.
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import symkin_main
+from codegen_support import compiled, derived
 
 from symkin.present import view3d
 from tests.present.test_view3d import RSSR, _cli, _figure, _numbers
@@ -93,7 +92,7 @@ def test_no_arrows_without_forces_or_without_the_joints_points(forces_run,
                                                                tmp_path: Path) -> None:
     import symkin
 
-    rssr = symkin.solve(symkin.compile(symkin.derive(symkin.load(RSSR)), backend="numpy"))
+    rssr = symkin.solve(compiled(RSSR, "numpy"))
     assert rssr.forces is None
     data, frames, _ = _figure(view3d.report(rssr, tmp_path / "rssr.html", outlines={}))
     assert not [trace for trace in data if trace.get("name") == ARROWS]
@@ -119,7 +118,7 @@ def test_gif_draws_the_arrows_and_only_with_them(forces_run, tmp_path: Path) -> 
     from symkin.symbolic import drawing
 
     _, _, gif = forces_run
-    system = symkin.derive(symkin.load(FORCES))
+    system = derived(FORCES)  # once per run
     trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
     bare = view3d.animate(trajectory, tmp_path / "bare.gif")
     drawn = view3d.animate(trajectory, tmp_path / "drawn.gif",
@@ -158,13 +157,11 @@ def test_report_force_column_is_the_npz_magnitudes(forces_run) -> None:
 def test_a_warm_run_draws_the_same_arrows(tmp_path: Path) -> None:
     """The joints' points travel in the index with the kernel (3-component rows): the run
     that reuses the cached kernel draws the arrows the deriving run drew."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "SYMKIN_CACHE_DIR": str(tmp_path / "cache")}
+    env = {"SYMKIN_CACHE_DIR": str(tmp_path / "cache")}
     pages = []
     for run in ("cold", "warm"):
-        result = subprocess.run(
-            [sys.executable, "-m", "symkin", "run", str(FORCES), "--backend", "numpy",
-             "--html", f"{run}.html"], cwd=tmp_path, env=env, capture_output=True, text=True,
-            timeout=600, check=False)
+        result = symkin_main("run", str(FORCES), "--backend", "numpy", "--html", f"{run}.html",
+                             cwd=tmp_path, env=env)
         assert result.returncode == 0, result.stderr
         assert ("cached kernel" in result.stdout) == (run == "warm"), result.stdout
         pages.append(_figure(tmp_path / f"{run}.html"))
@@ -183,7 +180,7 @@ def test_a_partial_run_with_forces_draws_without_warnings(tmp_path: Path) -> Non
     import symkin
     from symkin.symbolic import drawing
 
-    system = symkin.derive(symkin.load(FORCES))
+    system = derived(FORCES)  # once per run
     trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
     q, reaction = trajectory.q.copy(), trajectory.forces.reaction.copy()
     q[50:], reaction[50:] = np.nan, np.nan

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from codegen_support import ROOT
+from codegen_support import ROOT, derived
 
 import symkin
 
@@ -52,7 +52,7 @@ def benchmark_angles(phi: dict[str, float]) -> dict[str, float]:
 
 @pytest.fixture(scope="module")
 def mechanism():
-    return symkin.derive(symkin.load(ROOT / "examples" / "andrews_squeezer.yaml"))
+    return derived(ROOT / "examples" / "andrews_squeezer.yaml")  # once per test run
 
 
 @pytest.mark.parametrize("backend", ["c", "numpy"])

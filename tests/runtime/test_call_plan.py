@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import derived
 
 import symkin
 from symkin.runtime import driver
@@ -25,7 +26,7 @@ FIELDS = ("t", "q", "dq", "d2q", "cond", "flagged", "point_vectors", "params")
 
 @pytest.fixture(scope="module")
 def system():
-    return symkin.derive(symkin.load(ROOT / "examples" / "crank_slider.yaml"))
+    return derived(ROOT / "examples" / "crank_slider.yaml")  # once per test run
 
 
 @pytest.fixture(scope="module")

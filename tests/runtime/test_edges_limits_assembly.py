@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import derived
 from driver_support import BACKENDS, derive, kernel_for
 
-import symkin
 from symkin.contract.dense_solvers import levenberg_marquardt
 from symkin.contract.options import Options
 from symkin.errors import SolveError
@@ -79,7 +79,7 @@ def test_rod_too_short_for_the_whole_turn_is_a_limit_position(backend: str) -> N
     only while a sin(phi) >= c - b, phi = t**2 + pi/2. Near that fold Phi_q is only moderately
     ill-conditioned (sigma_min shrinks like the square root of the distance), so the limit is
     told by the condition's growth as the substeps close in, not by its size."""
-    system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
+    system = derived(ROOT / "examples" / "crank_slider.yaml")  # once per test run
     kernel = kernel_for(system, backend)
     assert kernel.backend == backend
     failure = _failure(kernel, params={"a": 1.1, "b": 3.5})

@@ -49,7 +49,7 @@ def tongs() -> symkin.System:
 
 def test_only_the_angles_of_the_tongs_enter_phi_q(tongs: symkin.System,
                                                   tmp_path: Path) -> None:
-    kernel = symkin.compile(tongs, backend="numpy", cache_dir=tmp_path)
+    kernel = symkin.compile(tongs, backend="numpy")  # built once (run cache)
     angles = [name.endswith(".phi") for name in kernel.coordinates]
     assert np.array_equal(kernel.nonlinear, angles)
 
@@ -57,7 +57,7 @@ def test_only_the_angles_of_the_tongs_enter_phi_q(tongs: symkin.System,
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_long_tongs_accurate_and_not_flagged(tongs: symkin.System, backend: str,
                                              tmp_path: Path) -> None:
-    kernel = symkin.compile(tongs, backend=backend, cache_dir=tmp_path)
+    kernel = symkin.compile(tongs, backend=backend)  # built once (run cache)
     assert kernel.backend == backend
     t = np.arange(301) * 0.001
     trajectory = symkin.solve(kernel, t=t)
@@ -72,7 +72,7 @@ def test_the_norm_bound_alone_flags_the_tongs(tongs: symkin.System, tmp_path: Pa
                                              monkeypatch: pytest.MonkeyPatch) -> None:
     """The contract broken on purpose: without the propagated model (the norm bound of the
     error alone decides), every point of the same accurate run is flagged."""
-    kernel = symkin.compile(tongs, backend="numpy", cache_dir=tmp_path)
+    kernel = symkin.compile(tongs, backend="numpy")  # built once (run cache)
     monkeypatch.setattr(newton, "_propagation", lambda *args: None)
     trajectory = symkin.solve(kernel, t=np.arange(301) * 0.001)
     assert trajectory.flagged.all()

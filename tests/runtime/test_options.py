@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled
 
 import symkin
 from symkin.contract.options import DEFAULTS, Options
@@ -49,8 +50,7 @@ def test_the_defaults_and_the_limits_of_what_is_allowed_are_accepted() -> None:
 def test_a_solve_with_no_limits_and_no_targets_runs_and_flags_nothing() -> None:
     """Targets of inf: nothing can miss them; the positions are still Newton's, to tol_phi:
     the crank's tip on its circle of radius a (examples/crank_slider.yaml)."""
-    kernel = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider.yaml"),
-                            backend="numpy")
+    kernel = compiled(ROOT / "examples" / "crank_slider.yaml", "numpy")  # from its goldens
     options = Options(max_cond=math.inf, tighten_cond=math.inf, target_q=math.inf,
                       target_dq=math.inf, target_ddq=math.inf)
     run = symkin.solve(kernel, t=np.linspace(0.0, 0.5, 6), options=options)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from driver_support import BACKENDS
+from driver_support import BACKENDS, kernel_of
 
 import symkin
 from symkin.errors import SolveError
@@ -59,9 +59,7 @@ time: {{t0: 0, t1: 2.5, dt: 0.05}}
 
 
 def _kernel(tmp_path: Path, text: str, backend: str):
-    path = tmp_path / "m.yaml"
-    path.write_text(text)
-    return symkin.compile(symkin.derive(symkin.load(path)), backend=backend)
+    return kernel_of(text, backend)  # one derivation of each drawing for both backends
 
 
 def _example_2_7(t: np.ndarray, s: float) -> dict[str, np.ndarray]:

@@ -9,15 +9,13 @@ driven angle 0.5 - t is zero.
 from __future__ import annotations
 
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main
+from codegen_support import compiled
 
-import symkin
 from symkin.runtime import driver
 from symkin.runtime.scanning.scan import scan
 
@@ -28,7 +26,7 @@ T_LIMIT = math.acos(-0.25)  # non_grashof.yaml: a = b = c = 2, d = 3; cos(theta*
 
 
 def _kernel(name: str, backend: str):
-    kernel = symkin.compile(symkin.derive(MECHANISMS / f"{name}.yaml"), backend=backend)
+    kernel = compiled(MECHANISMS / f"{name}.yaml", backend)  # built once per test run
     assert kernel.backend == backend
     return kernel
 
@@ -108,12 +106,8 @@ def test_parallelogram_change_point_is_passed_with_rank_loss_one(backend: str) -
     assert all(_angle_gap(e, f) < 1e-8 for e, f in zip(expected, found)), (expected, found)
 
 
-def _cli(*args: str) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([sys.executable, "-m", "symkin", "scan", *args], env=env,
-                            check=False, capture_output=True, text=True, timeout=600)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+def _cli(*args: str) -> Ran:
+    return symkin_main("scan", *args, cwd=ROOT)
 
 
 def test_cli_reports_branches_and_limit_position() -> None:

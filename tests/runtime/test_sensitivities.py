@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from codegen_support import compiled, derived
 
 import symkin
 from symkin.contract.options import Options
@@ -60,8 +61,8 @@ def test_crank_slider_q_p_matches_example_2_7(crank_slider_system, backend) -> N
 @pytest.mark.parametrize("example", ["four_bar", "crank_slider_general", "quick_return",
                                      "custom_driver", "andrews_squeezer"])
 def test_q_p_equals_central_differences(example) -> None:
-    system = symkin.derive(EXAMPLES / f"{example}.yaml")
-    kernel = symkin.compile(system, backend="c")
+    system = derived(EXAMPLES / f"{example}.yaml")  # once per test run
+    kernel = compiled(EXAMPLES / f"{example}.yaml", "c")  # from its goldens
     assert kernel.backend == "c"
     t = symkin.solve(kernel).t[:12]
     base = symkin.solve(kernel, t=t, options=TIGHT, sensitivities=True)

@@ -53,7 +53,7 @@ def tongs10() -> symkin.System:
 @pytest.mark.parametrize("backend", ["numpy", "c"])
 def test_points_the_model_would_flag_are_tightened(tongs10: symkin.System, backend: str,
                                                    tmp_path: Path) -> None:
-    kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+    kernel = symkin.compile(tongs10, backend=backend)  # built once (run cache)
     assert kernel.backend == backend
     t = np.arange(301) * 0.001
     trajectory = symkin.solve(kernel, t=t)
@@ -73,7 +73,7 @@ def test_tighten_cond_inf_turns_the_extra_iterations_off(tongs10: symkin.System,
     left them (q within 1e-9 relative, not to the rounding level). The model of every
     coordinate flagged most of them; only the angles move Phi_q, and theirs are accurate
     (dq, ddq within 2e-10): none is flagged (tests/runtime/test_flag_model.py)."""
-    kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+    kernel = symkin.compile(tongs10, backend=backend)  # built once (run cache)
     assert kernel.backend == backend
     t = np.arange(301) * 0.001
     options = dataclasses.replace(defaults("double"), tighten_cond=math.inf)
@@ -124,7 +124,7 @@ def test_c_estimate_at_tightened_points_bounds_the_exact_norm(tongs10: symkin.Sy
     measurably: the estimate after them is the Banach bound, at or above the exact
     ||Phi_q^-1||_1 at the new q (Hager's estimate before them is exact on these matrices) and
     at most REESTIMATE_SHIFT's few per cent above it."""
-    kernel = symkin.compile(tongs10, backend="c", cache_dir=tmp_path)
+    kernel = symkin.compile(tongs10, backend="c")  # built once (run cache)
     ffi, lib, name, n = kernel.ffi, kernel.lib, kernel.name, kernel.nq
     options, state = ffi.new(f"{name}_options *"), ffi.new(f"{name}_state *")
     work, report = ffi.new(f"{name}_workspace *"), ffi.new(f"{name}_report *")
@@ -176,7 +176,7 @@ def test_a_small_correction_clears_a_point_without_a_step(tongs10: symkin.System
     """The residual's bound s r would flag the point; the correction Phi_q^-1 Phi, solved
     for, is SHIFT, which the targets allow: the point is kept as Newton left it (no extra
     step) and not flagged."""
-    kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+    kernel = symkin.compile(tongs10, backend=backend)  # built once (run cache)
     q0, _ = _displaced(kernel, along_worst=False)
     if backend == "c":
         report, q = _c_first_point(kernel, q0)
@@ -199,7 +199,7 @@ def test_a_large_correction_is_stepped(tongs10: symkin.System, backend: str,
                                        tmp_path: Path) -> None:
     """A residual of the same size along the worst column of Phi_q^-1: the correction is
     much larger than SHIFT, so Newton steps on and q comes to the exact one."""
-    kernel = symkin.compile(tongs10, backend=backend, cache_dir=tmp_path)
+    kernel = symkin.compile(tongs10, backend=backend)  # built once (run cache)
     q0, displacement = _displaced(kernel, along_worst=True)
     assert np.abs(kernel.phi(q0, T_POINT)).max() <= 1.2 * SHIFT
     q_exact = q0 - displacement

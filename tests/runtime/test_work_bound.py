@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled, derived
 
 import symkin
 from symkin.contract.tuning import EDGE_SUBSTEPS
@@ -31,7 +32,7 @@ def fast_path(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def fast_kernel(fast_path):
-    return symkin.compile(symkin.derive(symkin.load(fast_path)), backend="numpy")
+    return symkin.compile(derived(fast_path), backend="numpy")  # derived once per run
 
 
 def test_a_driver_turning_thousands_of_times_a_step_stops_at_the_bound(fast_kernel,
@@ -53,7 +54,7 @@ def test_a_driver_turning_thousands_of_times_a_step_stops_at_the_bound(fast_kern
 
 
 def test_an_ordinary_edge_treatment_is_far_below_the_bound(crank_slider_path):
-    kernel = symkin.compile(symkin.derive(symkin.load(crank_slider_path)), backend="numpy")
+    kernel = compiled(crank_slider_path, "numpy")  # from its goldens
     solved = symkin.solve(kernel, t=np.linspace(0, 1.5, 4))  # steps of 0.5: substeps needed
     p = kernel.p_values
     previous = edges.State(0.0, edges.Point(solved.q[0], solved.dq[0], solved.d2q[0], 1.0,
@@ -68,7 +69,7 @@ def test_an_ordinary_edge_treatment_is_far_below_the_bound(crank_slider_path):
 def test_the_generated_solve_edge_has_the_same_bound(fast_path):
     """The C edge treatment (sweeps run it) takes at most EDGE_SUBSTEPS substeps, says so in
     its report, and the sweep names the stop 'too many substeps'."""
-    kernel = symkin.compile(symkin.derive(symkin.load(fast_path)), backend="c")
+    kernel = symkin.compile(derived(fast_path), backend="c")
     edge = kernel.edge_solver()
     assert edge is not None
     start = symkin.solve(kernel, t=np.array([0.0]))

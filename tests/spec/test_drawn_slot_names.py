@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from codegen_support import derived
 from driver_support import kernel_for
 
 import symkin
@@ -40,5 +41,5 @@ def test_the_slotted_copy_is_named_apart_and_stays_on_its_body(tmp_path: Path) -
 
 
 def test_without_the_copy_nothing_is_renamed() -> None:
-    system = symkin.derive(EXAMPLES / "whitworth_drawn.yaml")
+    system = derived(EXAMPLES / "whitworth_drawn.yaml")  # the run's shared derivation
     assert not any("@" in name for _, name, _ in system.points)

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from codegen_support import derived
 
 import symkin
 from symkin.spec.schema import equation_count
@@ -73,7 +74,7 @@ def assemble(system: System) -> Motion:
 
 @functools.cache
 def solved(name: str) -> tuple[System, Motion]:
-    system = symkin.derive(EXAMPLES / name)
+    system = derived(EXAMPLES / name)  # the run's shared derivation
     return system, assemble(system)
 
 

@@ -154,15 +154,13 @@ def test_compressed_npz_holds_the_same_arrays_deflated(c_kernel, tmp_path: Path)
 
 
 def test_cli_compress(tmp_path: Path) -> None:
-    import subprocess
-    import sys
     import zipfile
 
+    from cli_support import symkin_main
+
     out = tmp_path / "s.npz"
-    done = subprocess.run([sys.executable, "-m", "symkin", "sweep",
-                           str(EXAMPLES / "crank_slider.yaml"), "--vary", "b=4.5:5.5:5", "-o",
-                           str(out), "--compress"], capture_output=True, text=True,
-                          cwd=EXAMPLES.parent, timeout=600)
+    done = symkin_main("sweep", str(EXAMPLES / "crank_slider.yaml"), "--vary", "b=4.5:5.5:5",
+                       "-o", str(out), "--compress", cwd=EXAMPLES.parent)
     assert done.returncode == 0, done.stderr
     with zipfile.ZipFile(out) as archive:
         assert {info.compress_type for info in archive.infolist()} == {zipfile.ZIP_DEFLATED}

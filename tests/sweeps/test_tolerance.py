@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main
 
 import symkin
 from symkin.errors import UsageError
@@ -79,12 +80,10 @@ def test_table_design_and_its_errors(kernel, tmp_path: Path) -> None:
             tolerance.table_design(kernel, table)
 
 
-def sweep_cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([sys.executable, "-m", "symkin", "sweep", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=300)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+def sweep_cli(*args: str, cwd: Path) -> Ran:
+    """``symkin sweep ARGS`` in this process (tests/cli_support.py); the interrupt below runs in
+    a real one."""
+    return symkin_main("sweep", *args, cwd=cwd)
 
 
 def test_cli_grid_writes_npz_and_reports_failures(tmp_path: Path) -> None:

@@ -13,6 +13,7 @@ import math
 import sys
 from pathlib import Path
 
+import codegen_support
 import numpy as np
 import pytest
 
@@ -91,7 +92,7 @@ SLIPS = [
 
 @pytest.fixture(scope="module")
 def derived() -> dict[str, numeric.Derived]:
-    return {name: numeric.derived_functions(symkin.derive(path))
+    return {name: numeric.derived_functions(codegen_support.derived(path))  # shared per run
             for name, (path, _) in MECHANISMS.items()}
 
 
@@ -177,7 +178,7 @@ def test_derived_values_are_the_books_at_example_2_5(derived) -> None:
 
 
 def test_parameters_vary_around_the_nominal_design() -> None:
-    system = symkin.derive(TEXTBOOK)
+    system = codegen_support.derived(TEXTBOOK)  # the run's shared derivation
     states = sampling.sample_states(system, 200, seed=1, spread=0.3)
     p = np.array([s.p for s in states])
     nominal = np.array(system.p_values)
