@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import json
 import os
 import tempfile
 from pathlib import Path
@@ -80,6 +81,31 @@ def shared(name: str, text: str) -> Path:
         partial.write_text(text, encoding="utf-8")
         os.replace(partial, path)  # whole or absent for a worker reading it at once
     return path
+
+
+_SYSTEMS: dict[str, Any] = {}
+_KERNELS: dict[tuple[str, str, tuple[tuple[str, str], ...]], Any] = {}
+
+
+def derived_from(data: dict[str, Any]) -> Any:
+    """symkin.derive(from_dict(data)), kept for this process by the data's JSON text (its
+    keys in their order: the order of bodies is the order of the coordinates)."""
+    from symkin.spec.validate import from_dict
+
+    text = json.dumps(data)
+    if text not in _SYSTEMS:
+        _SYSTEMS[text] = symkin.derive(from_dict(data))
+    return _SYSTEMS[text]
+
+
+def kernel_from(data: dict[str, Any], backend: str, **options: str) -> Any:
+    """symkin.compile(derived_from(data), backend, **options), kept for this process: the
+    tests of one file that build the same mechanism (the same dictionary on each backend)
+    derive it once and generate each kernel once."""
+    key = (json.dumps(data), backend, tuple(sorted(options.items())))
+    if key not in _KERNELS:
+        _KERNELS[key] = symkin.compile(derived_from(data), backend, **options)
+    return _KERNELS[key]
 
 
 @functools.cache
