@@ -36,16 +36,22 @@ def _inputs() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return u, du, np.gradient(du, T, axis=0)
 
 
+# The reference's rows: every 20th point of the path. Full Newton converges to the same
+# rounding level from any nearby start, so its solution at a point does not depend on the
+# points solved before it; the C solver's simplified steps do, and it runs the whole path.
+EVERY = slice(None, None, 20)
+
+
 def test_simplified_steps_give_newtons_solution() -> None:
     u, du, ddu = _inputs()
-    runs = {backend: symkin.solve(_kernel("delta_fk", backend), t=T, inputs=u, input_rates=du,
-                                  input_accels=ddu) for backend in ("c", "numpy")}
-    c, reference = runs["c"], runs["numpy"]
+    c = symkin.solve(_kernel("delta_fk", "c"), t=T, inputs=u, input_rates=du, input_accels=ddu)
+    reference = symkin.solve(_kernel("delta_fk", "numpy"), t=T[EVERY], inputs=u[EVERY],
+                             input_rates=du[EVERY], input_accels=ddu[EVERY])
     names = _kernel("delta_fk", "c").coordinates
     at = [names.index(f"platform.{axis}") for axis in ("x", "y", "z")]
     assert np.max(np.abs(c.q[:, at] - _delta_centres(T))) < 1e-12
-    assert np.max(np.abs(c.q - reference.q)) < 1e-12
-    for got, want in ((c.dq, reference.dq), (c.d2q, reference.d2q)):
+    assert np.max(np.abs(c.q[EVERY] - reference.q)) < 1e-12
+    for got, want in ((c.dq[EVERY], reference.dq), (c.d2q[EVERY], reference.d2q)):
         assert np.max(np.abs(got - want)) < 1e-12 * max(1.0, np.max(np.abs(want)))
 
 
