@@ -1,12 +1,21 @@
 """Mechanisms that their forces move, shared by the forward-dynamics tests (each derived once
-per session: the derivation, not the integration, is the slow part)."""
+per session: the derivation, not the integration, is the slow part), and the helpers by which
+the tests of motion, dynamics, inputs and assemblies share a derivation and a kernel instead of
+deriving and generating the same file again in each test (``shared`` and ``kernel``)."""
 
 from __future__ import annotations
 
+import functools
+import hashlib
+import json
+import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
 import pytest
+import shared_builds
+from codegen_support import compiled
 
 import symkin
 
@@ -54,6 +63,57 @@ def write(tmp: Path, name: str, text: str) -> Path:
     path = tmp / name
     path.write_text(text, encoding="utf-8")
     return path
+
+
+def shared(name: str, text: str) -> Path:
+    """A mechanism file of ``text`` called ``name`` at a place that depends on the text alone,
+    in the run's shared folder (conftest's shared_builds_folder): every test and every worker
+    that writes the same file gets the same path, so codegen_support.derived and compiled (keyed
+    by path and bytes) derive and generate it once per run. ``write`` is for a file a test
+    means to have alone (its own folder, messages naming it)."""
+    digest = hashlib.sha256(f"{name}\0{text}".encode()).hexdigest()[:20]
+    root = shared_builds.FOLDER[0] if shared_builds.FOLDER else Path(tempfile.gettempdir())
+    folder = root / "files" / digest
+    path = folder / name
+    if not path.is_file():
+        folder.mkdir(parents=True, exist_ok=True)
+        partial = folder / f".{name}.{os.getpid()}"
+        partial.write_text(text, encoding="utf-8")
+        os.replace(partial, path)  # whole or absent for a worker reading it at once
+    return path
+
+
+_SYSTEMS: dict[str, Any] = {}
+_KERNELS: dict[tuple[str, str, tuple[tuple[str, str], ...]], Any] = {}
+
+
+def derived_from(data: dict[str, Any]) -> Any:
+    """symkin.derive(from_dict(data)), kept for this process by the data's JSON text (its
+    keys in their order: the order of bodies is the order of the coordinates)."""
+    from symkin.spec.validate import from_dict
+
+    text = json.dumps(data)
+    if text not in _SYSTEMS:
+        _SYSTEMS[text] = symkin.derive(from_dict(data))
+    return _SYSTEMS[text]
+
+
+def kernel_from(data: dict[str, Any], backend: str, **options: str) -> Any:
+    """symkin.compile(derived_from(data), backend, **options), kept for this process: the
+    tests of one file that build the same mechanism (the same dictionary on each backend)
+    derive it once and generate each kernel once."""
+    key = (json.dumps(data), backend, tuple(sorted(options.items())))
+    if key not in _KERNELS:
+        _KERNELS[key] = symkin.compile(derived_from(data), backend, **options)
+    return _KERNELS[key]
+
+
+@functools.cache
+def kernel(path: Path, backend: str, **options: str) -> Any:
+    """codegen_support.compiled(path, backend, **options), kept for this process: a kernel
+    is only read by solve, so the tests of one file or of several share it (a file its forces
+    move would otherwise generate its code again at each symkin.compile)."""
+    return compiled(path, backend, **options)
 
 
 @pytest.fixture(scope="session")

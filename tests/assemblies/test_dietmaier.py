@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from motion_support import kernel as built
 
-import symkin
 from symkin.runtime.scanning.scan import scan
 from tests.assemblies.test_every_assembly import _rotation
 
@@ -58,7 +58,7 @@ def test_the_file_holds_the_published_geometry() -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize("backend", ["c", "numpy"])
 def test_scan_finds_the_forty_real_assemblies(backend: str) -> None:
-    kernel = symkin.compile(symkin.derive(HERE / "dietmaier.yaml"), backend=backend)
+    kernel = built(HERE / "dietmaier.yaml", backend)
     found = scan(kernel, inputs=dict(zip(kernel.input_names, LEGS)))
     poses = _poses(found)
     assert len(poses) == 40

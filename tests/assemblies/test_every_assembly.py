@@ -15,15 +15,15 @@ from __future__ import annotations
 
 import math
 import re
-import subprocess
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
+from motion_support import kernel as built
+from motion_support import shared
 
-import symkin
+from symkin import cli
 from symkin.errors import SolveError
 from symkin.runtime.scanning.scan import scan
 
@@ -128,9 +128,7 @@ def _rrr_file(tmp_path: Path, pose: np.ndarray) -> Path:
     lines += [f"  - {{type: angle, name: theta{n}, i: prox{n}, j: ground, theta: input}}"
               for n in (1, 2, 3)]
     lines.append("time: {t0: 0, t1: 1, dt: 0.1}")
-    path = tmp_path / "rrr_six.yaml"
-    path.write_text("\n".join(lines) + "\n")
-    return path
+    return shared("rrr_six.yaml", "\n".join(lines) + "\n")  # one derivation per run
 
 
 def test_the_3rpr_sweep_counts_six() -> None:
@@ -146,7 +144,7 @@ def test_the_3rpr_sweep_counts_six() -> None:
 @pytest.mark.parametrize("backend", ["numpy", "c"])
 def test_3rrr_has_the_six_assemblies_counted_by_the_sweep(tmp_path: Path, backend: str) -> None:
     expected = rpr_poses()
-    kernel = symkin.compile(symkin.derive(_rrr_file(tmp_path, expected[0])), backend=backend)
+    kernel = built(_rrr_file(tmp_path, expected[0]), backend)
     report = scan(kernel, inputs={"theta1": 0.0, "theta2": 0.0, "theta3": 0.0})
     assert report.motions == () and dict(report.inputs) == {f"theta{n}": 0.0 for n in (1, 2, 3)}
     names = kernel.coordinates
@@ -235,12 +233,11 @@ def _stewart_file(tmp_path: Path, vertices: np.ndarray) -> Path:
     top = ", ".join(f"P{k + 1}: {_point(vertices[k])}" for k in range(3))
     legs = [f"  - {{type: distance, name: leg{2 * k + n + 1}, i: ground, j: platform, "
             f"A: B{ENDS[k][n] + 1}, B: P{k + 1}, f: input}}" for k in range(3) for n in (0, 1)]
-    path = tmp_path / "octahedral.yaml"
-    path.write_text("\n".join(["name: octahedral", "space: 3d", "layout: drawn", "bodies:",
-                               f"  ground: {{points: {{{ground}}}}}",
-                               f"  platform: {{points: {{{top}}}}}", "joints: []", "drivers:",
-                               *legs, "time: {t0: 0, t1: 1, dt: 0.1}"]) + "\n")
-    return path
+    text = "\n".join(["name: octahedral", "space: 3d", "layout: drawn", "bodies:",
+                      f"  ground: {{points: {{{ground}}}}}",
+                      f"  platform: {{points: {{{top}}}}}", "joints: []", "drivers:",
+                               *legs, "time: {t0: 0, t1: 1, dt: 0.1}"]) + "\n"
+    return shared("octahedral.yaml", text)  # one derivation per run
 
 
 def _rotation(e: np.ndarray) -> np.ndarray:
@@ -267,7 +264,7 @@ def test_the_octahedral_sweep_counts_twelve() -> None:
 def test_stewart_3_3_has_the_twelve_assemblies_counted_by_the_sweep(tmp_path: Path,
                                                                      backend: str) -> None:
     expected = stewart_vertices()
-    kernel = symkin.compile(symkin.derive(_stewart_file(tmp_path, expected[0])), backend=backend)
+    kernel = built(_stewart_file(tmp_path, expected[0]), backend)
     report = scan(kernel, inputs=LEGS)
     names = kernel.coordinates
     r = [names.index(f"platform.{c}") for c in ("x", "y", "z")]
@@ -283,30 +280,27 @@ def test_stewart_3_3_has_the_twelve_assemblies_counted_by_the_sweep(tmp_path: Pa
             assert abs(np.linalg.norm(vertices[k] - BASE[j]) - LEGS[2 * k + 1]) < 1e-10
 
 
-def _cli(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "symkin", "scan", *args], capture_output=True,
-                          text=True, timeout=600, cwd=ROOT)
-
-
-def test_cli_scan_at_inputs_lists_the_six_and_locates_bad_inputs(tmp_path: Path) -> None:
+def test_cli_scan_at_inputs_lists_the_six_and_locates_bad_inputs(
+        tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
+    """``symkin scan`` in this process (cli.main, what the console script runs; an exception
+    it let out would fail the test as a traceback would)."""
     path = str(_rrr_file(tmp_path, rpr_poses()[0]))
-    result = _cli(path, "--backend", "numpy", "--all-branches", "--input", "theta1=0",
-                  "--input", "theta2=0", "--input", "theta3=0")
-    assert result.returncode == 0, result.stderr
-    assert "theta3 = 0: 6\n" in result.stdout
+    status = cli.main(["scan", path, "--backend", "numpy", "--all-branches", "--input",
+                       "theta1=0", "--input", "theta2=0", "--input", "theta3=0"])
+    out, err = capfd.readouterr()
+    assert status == 0, err
+    assert "theta3 = 0: 6\n" in out
     for bad, said in ((["--input", "theta1=x"], "--input theta1=x: write NAME=VALUE"),
                       (["--input", "theta1=0"], "missing 'theta2', 'theta3'"),
                       ([], "a scan needs their values")):
-        result = _cli(path, "--backend", "numpy", *bad)
-        assert result.returncode == 2 and said in result.stderr and path in result.stderr
-        assert "Traceback" not in result.stderr
+        status = cli.main(["scan", path, "--backend", "numpy", *bad])
+        err = capfd.readouterr().err
+        assert status == 2 and said in err and path in err, err
 
 
 def test_scan_refuses_bad_inputs_with_what_is_wrong() -> None:
-    with_inputs = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider_input.yaml"),
-                                 backend="numpy")
-    without = symkin.compile(symkin.derive(ROOT / "tests" / "mechanisms" / "non_grashof.yaml"),
-                             backend="numpy")
+    with_inputs = built(ROOT / "examples" / "crank_slider_input.yaml", "numpy")
+    without = built(ROOT / "tests" / "mechanisms" / "non_grashof.yaml", "numpy")
     for kernel, inputs, said in (
             (with_inputs, [1.0, 2.0], "give 1 values (crank_angle), got 2"),
             (with_inputs, {"crank_angle": math.inf}, "crank_angle is inf"),
@@ -320,8 +314,7 @@ def test_crank_slider_at_an_input_angle_has_its_two_assemblies() -> None:
     """The textbook crank-slider with the crank angle an input: the slider slides on y = c = 4,
     the rod (b = 5) joins the crank tip A = (cos theta, sin theta) (a = 1) to it, so its x is
     cos(theta) +- sqrt(b^2 - (c - sin(theta))^2): two assemblies."""
-    kernel = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider_input.yaml"),
-                            backend="c")
+    kernel = built(ROOT / "examples" / "crank_slider_input.yaml", "c")
     theta = 1.2
     report = scan(kernel, inputs={"crank_angle": theta})
     reach = math.sqrt(25.0 - (4.0 - math.sin(theta))**2)

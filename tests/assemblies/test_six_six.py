@@ -17,8 +17,9 @@ import numpy as np
 import pytest
 import yaml
 from codegen_support import compiled
+from motion_support import kernel as built
+from motion_support import shared
 
-import symkin
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.scanning.scan import scan
 from tests.assemblies.planar_six import Platform, assemblies
@@ -56,13 +57,12 @@ def _six_six_file(tmp_path: Path, platform: Platform) -> Path:
     top = ", ".join(f"P{k + 1}: {_point([*platform.p[k], 1.0])}" for k in range(6))
     legs = [f"  - {{type: distance, name: leg{k + 1}, i: ground, j: platform, A: B{k + 1}, "
             f"B: P{k + 1}, f: input}}" for k in range(6)]
-    path = tmp_path / "six_six.yaml"
-    path.write_text("\n".join(["name: six_six", "space: 3d", "layout: drawn", "bodies:",
-                               f"  ground: {{points: {{{ground}}}}}",
-                               f"  platform: {{frame: {{origin: [0, 0, 1.0]}}, "
-                               f"points: {{{top}}}}}", "joints: []", "drivers:", *legs,
-                               "time: {t0: 0, t1: 1, dt: 0.1}"]) + "\n")
-    return path
+    text = "\n".join(["name: six_six", "space: 3d", "layout: drawn", "bodies:",
+                      f"  ground: {{points: {{{ground}}}}}",
+                      f"  platform: {{frame: {{origin: [0, 0, 1.0]}}, "
+                      f"points: {{{top}}}}}", "joints: []", "drivers:", *legs,
+                      "time: {t0: 0, t1: 1, dt: 0.1}"]) + "\n"
+    return shared("six_six.yaml", text)  # one derivation per run
 
 
 def _leg_gaps(platform: Platform, rotation: np.ndarray, origin: np.ndarray,
@@ -129,7 +129,7 @@ def test_scan_of_stewart_fk_at_legs_one_finds_the_eight(backend: str) -> None:
 @pytest.mark.parametrize("backend", ["c", "numpy"])
 def test_scan_of_a_general_six_six_finds_the_twelve(tmp_path: Path, backend: str) -> None:
     platform = Platform(MANY_BASE, MANY_PLATFORM)
-    kernel = symkin.compile(symkin.derive(_six_six_file(tmp_path, platform)), backend=backend)
+    kernel = built(_six_six_file(tmp_path, platform), backend)
     expected = assemblies(platform, MANY_LEGS).poses
     found = _scanned_poses(kernel, MANY_LEGS)
     _assert_the_same_poses(found, expected)

@@ -13,12 +13,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from codegen_support import compiled, derived
+from motion_support import derived_from, kernel_from
 from PIL import Image
 
 import symkin
 from symkin import cli
 from symkin.present import animation, html
-from symkin.spec.validate import from_dict
 from symkin.symbolic.drawing import outlines
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -74,8 +75,8 @@ def test_html_moment_panel_holds_the_moments_a_joint_carries(tmp_path: Path) -> 
     slide's M alone, in the last column's third panel."""
     data = yaml.safe_load((EXAMPLES / "crank_slider_load.yaml").read_text())
     next(j for j in data["joints"] if j["type"] == "prismatic")["sA"] = [0.3, 0.2]
-    system = symkin.derive(from_dict(data))
-    traj = symkin.solve(symkin.compile(system, backend="numpy"))
+    system = derived_from(data)
+    traj = symkin.solve(kernel_from(data, "numpy"))
     page = html.report(traj, tmp_path / "r.html", outlines(system))
     traces = _traces(page)
     last = max(int(t["yaxis"][1:]) for t in traces if t.get("yaxis", "y") != "y")
@@ -92,8 +93,8 @@ def _reaction_pixels(frame: Image.Image) -> int:
 
 
 def test_gif_frames_carry_the_reaction_arrows(run, tmp_path: Path) -> None:
-    system = symkin.derive(EXAMPLES / "parallelogram_extra_bar_loads.yaml")
-    traj = symkin.solve(symkin.compile(system, backend="numpy"))
+    system = derived(EXAMPLES / "parallelogram_extra_bar_loads.yaml")
+    traj = symkin.solve(compiled(EXAMPLES / "parallelogram_extra_bar_loads.yaml", "numpy"))
     shapes = outlines(system)
     bare = animation.animate(dataclasses.replace(traj, forces=None), tmp_path / "bare.gif",
                              shapes)

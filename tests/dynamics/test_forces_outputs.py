@@ -8,10 +8,11 @@ import csv
 from pathlib import Path
 
 import numpy as np
+from codegen_support import compiled, derived
+from motion_support import kernel_from
 
 import symkin
 from symkin import cli
-from symkin.spec.validate import from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -20,7 +21,7 @@ EXAMPLES = ROOT / "examples"
 def test_c_multipliers_per_step_use_the_solvers_factors() -> None:
     """<prefix>_solve_step then <prefix>_multipliers (one transposed solve with the factors
     the step left) give the multipliers of the grid solve, step by step, in compiled C."""
-    kernel = symkin.compile(symkin.derive(EXAMPLES / "four_bar_dynamics.yaml"), backend="c")
+    kernel = compiled(EXAMPLES / "four_bar_dynamics.yaml", "c")
     traj = symkin.solve(kernel)
     ffi, lib, name, n = kernel.ffi, kernel.lib, kernel.name, kernel.nq
     options = ffi.new(f"{name}_options *")
@@ -40,8 +41,8 @@ def test_c_multipliers_per_step_use_the_solvers_factors() -> None:
 
 
 def test_backends_agree_and_names_follow_the_file() -> None:
-    system = symkin.derive(EXAMPLES / "four_bar_dynamics.yaml")
-    c, numpy = (symkin.solve(symkin.compile(system, backend=b)) for b in ("c", "numpy"))
+    c, numpy = (symkin.solve(compiled(EXAMPLES / "four_bar_dynamics.yaml", b))
+                for b in ("c", "numpy"))
     scale = np.abs(c.reaction).max()
     np.testing.assert_allclose(c.reaction, numpy.reaction, rtol=0, atol=1e-10 * scale)
     np.testing.assert_allclose(c.effort, numpy.effort, rtol=0, atol=1e-10 * scale)
@@ -51,8 +52,7 @@ def test_backends_agree_and_names_follow_the_file() -> None:
 
 
 def test_npz_and_csv_carry_efforts_and_reactions(tmp_path: Path) -> None:
-    traj = symkin.solve(symkin.compile(symkin.derive(EXAMPLES / "crank_slider_load.yaml"),
-                                       backend="numpy"))
+    traj = symkin.solve(compiled(EXAMPLES / "crank_slider_load.yaml", "numpy"))
     data = np.load(traj.save(tmp_path / "run.npz"))
     assert list(data["driver_names"]) == ["motor"]
     assert list(data["joint_names"]) == ["O", "A", "B", "slide"]
@@ -74,8 +74,7 @@ def test_cli_run_writes_the_columns(tmp_path: Path) -> None:
 
 
 def test_file_without_masses_has_no_forces(tmp_path: Path) -> None:
-    traj = symkin.solve(symkin.compile(symkin.derive(EXAMPLES / "four_bar.yaml"),
-                                       backend="numpy"))
+    traj = symkin.solve(compiled(EXAMPLES / "four_bar.yaml", "numpy"))
     assert traj.forces is None and traj.effort is None
     assert "effort" not in np.load(traj.save(tmp_path / "run.npz")).files
 
@@ -97,8 +96,7 @@ PENDULUM_LOCAL = {
 
 def test_pendulum_closed_form() -> None:
     """One body about a fixed pivot: T = (J + m|c|^2) alpha - moment of gravity and the load."""
-    traj = symkin.solve(symkin.compile(symkin.derive(from_dict(PENDULUM_LOCAL)),
-                                       backend="numpy"))
+    traj = symkin.solve(kernel_from(PENDULUM_LOCAL, "numpy"))
     phi = 0.3 + 2 * traj.t
     c = np.array([1.0, 0.1])
     com_x = np.cos(phi) * c[0] - np.sin(phi) * c[1]
@@ -118,8 +116,8 @@ def test_drawn_layout_com_is_global_as_drawn() -> None:
                                 "com": [1.0 * c - 0.1 * s, 1.0 * s + 0.1 * c]}},
              "joints": [{"type": "revolute", "name": "pivot", "i": "ground", "j": "arm",
                          "at": "O"}]}
-    local = symkin.solve(symkin.compile(symkin.derive(from_dict(PENDULUM_LOCAL)), "numpy"))
-    from_drawing = symkin.solve(symkin.compile(symkin.derive(from_dict(drawn)), "numpy"))
+    local = symkin.solve(kernel_from(PENDULUM_LOCAL, "numpy"))
+    from_drawing = symkin.solve(kernel_from(drawn, "numpy"))
     np.testing.assert_allclose(from_drawing.effort, local.effort, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(from_drawing.reaction, local.reaction, rtol=1e-12, atol=1e-9)
 
@@ -128,7 +126,7 @@ def test_sweep_envelope_of_efforts_and_reactions(tmp_path: Path, capsys) -> None
     """The sweep's envelope is the min/max over the sets that symkin.solve gives set by set
     (the peak motor torque over a study), printed by the CLI and saved in its NPZ."""
     path = EXAMPLES / "crank_slider_load.yaml"
-    kernel = symkin.compile(symkin.derive(path), backend="c")
+    kernel = compiled(path, "c")
     loads = [100.0, 150.0, 200.0]
     result = symkin.sweep(kernel, {"F0": loads}, workers=1)
     efforts = [symkin.solve(kernel, params={"F0": f}).effort[:, 0] for f in loads]
@@ -159,11 +157,11 @@ def test_cli_plot_writes_the_forces_figure(tmp_path: Path) -> None:
 
 def test_float_and_dense_c_builds_agree() -> None:
     """The float build (its own tolerances) and the dense-LU build give the same efforts."""
-    system = symkin.derive(EXAMPLES / "four_bar_dynamics.yaml")
-    reference = symkin.solve(symkin.compile(system, "c")).effort
+    path = EXAMPLES / "four_bar_dynamics.yaml"
+    reference = symkin.solve(compiled(path, "c")).effort
     scale = np.abs(reference).max()
-    dense = symkin.solve(symkin.compile(system, "c", linalg="dense")).effort
-    single = symkin.solve(symkin.compile(system, "c", real="float")).effort
+    dense = symkin.solve(compiled(path, "c", linalg="dense")).effort
+    single = symkin.solve(compiled(path, "c", real="float")).effort
     np.testing.assert_allclose(dense, reference, rtol=0, atol=1e-12 * scale)
     np.testing.assert_allclose(single, reference, rtol=0, atol=1e-4 * scale)
 
@@ -178,7 +176,7 @@ def test_a_point_named_E_and_a_static_spring() -> None:
             "forces": [{"type": "spring", "name": "s", "i": "arm", "A": "E", "j": "ground",
                         "B": [2, 3], "k": 10, "length0": 1, "damping": 4}]}
     for backend in ("c", "numpy"):
-        traj = symkin.solve(symkin.compile(symkin.derive(from_dict(data)), backend))
+        traj = symkin.solve(kernel_from(data, backend))
         # tension 10 (3 - 1) = 20 pulls E = (2, 0) up towards (2, 3): moment 2 * 20 = 40 CCW,
         # so the motor holds with -40; the pivot takes the force: ground -> arm (0, -20)
         np.testing.assert_allclose(traj.effort[:, 0], -40.0, rtol=1e-13)
@@ -192,15 +190,15 @@ def test_reaction_arrows_start_at_the_joints_points(tmp_path: Path) -> None:
     from symkin.present.animation import joint_points
     from symkin.symbolic.drawing import outlines
 
-    system = symkin.derive(EXAMPLES / "four_bar_dynamics.yaml")
-    traj = symkin.solve(symkin.compile(system, "numpy"))
+    system = derived(EXAMPLES / "four_bar_dynamics.yaml")
+    traj = symkin.solve(compiled(EXAMPLES / "four_bar_dynamics.yaml", "numpy"))
     where = joint_points(traj, outlines(system))
     assert sorted(where) == sorted(traj.forces.joint_names)
     np.testing.assert_allclose(where["A"], traj.point("crank", "A")[0], atol=1e-12)
     np.testing.assert_allclose(where["B"], traj.point("coupler", "B")[0], atol=1e-12)
     np.testing.assert_allclose(where["O2"], 0.0, atol=1e-12)
     assert not any(key.startswith("joint:") for key in
-                   outlines(symkin.derive(EXAMPLES / "four_bar.yaml")))
+                   outlines(derived(EXAMPLES / "four_bar.yaml")))
     report = tmp_path / "report.html"
     assert cli.main(["run", str(EXAMPLES / "four_bar_dynamics.yaml"), "--html",
                      str(report)]) == 0

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from codegen_support import compiled
+from motion_support import kernel_from
 
 import symkin
-from symkin.spec.validate import from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -23,8 +24,11 @@ OMEGA = np.array([[0.0, -1.0], [1.0, 0.0]])
 
 
 def _solve(source, backend: str):
-    mech = from_dict(source) if isinstance(source, dict) else symkin.load(source)
-    return symkin.solve(symkin.compile(symkin.derive(mech), backend=backend))
+    """The run of a mechanism (a dictionary, or a file), its derivation and kernels shared by
+    the tests here."""
+    if isinstance(source, dict):
+        return symkin.solve(kernel_from(source, backend))
+    return symkin.solve(compiled(source, backend))
 
 
 def _rot(phi):

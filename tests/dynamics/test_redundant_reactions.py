@@ -24,10 +24,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from codegen_support import compiled
+from motion_support import kernel_from
 
 import symkin
 from symkin import cli
-from symkin.spec.validate import from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 MECHANISM = ROOT / "examples" / "parallelogram_extra_bar_loads.yaml"
@@ -107,7 +108,7 @@ def _symkin_unknowns(traj, k: int) -> np.ndarray:
 
 @pytest.fixture(scope="module", params=BACKENDS)
 def traj(request):
-    kernel = symkin.compile(symkin.derive(MECHANISM), backend=request.param)
+    kernel = compiled(MECHANISM, request.param)  # from its goldens
     return symkin.solve(kernel)
 
 
@@ -196,8 +197,7 @@ def test_drive_torque_by_the_power_balance(traj) -> None:
 
 
 def test_files_without_removed_rows_keep_their_outputs(tmp_path: Path) -> None:
-    kernel = symkin.compile(symkin.derive(ROOT / "examples" / "crank_slider_load.yaml"),
-                            backend="numpy")
+    kernel = compiled(ROOT / "examples" / "crank_slider_load.yaml", "numpy")
     traj = symkin.solve(kernel)
     assert traj.forces.determinate is None and traj.forces.indeterminate() == []
     traj.save(tmp_path / "run.npz")
@@ -228,9 +228,8 @@ def test_a_repeated_joint_and_driver_share_the_load_equally(backend: str) -> Non
     data = yaml.safe_load((ROOT / "examples" / "four_bar_dynamics.yaml").read_text())
     data["joints"].append(dict(data["joints"][3], name="O4bis"))
     data["drivers"].append(dict(data["drivers"][0], name="drive2"))
-    twice = symkin.solve(symkin.compile(symkin.derive(from_dict(data)), backend=backend))
-    once = symkin.solve(symkin.compile(
-        symkin.derive(ROOT / "examples" / "four_bar_dynamics.yaml"), backend=backend))
+    twice = symkin.solve(kernel_from(data, backend))
+    once = symkin.solve(compiled(ROOT / "examples" / "four_bar_dynamics.yaml", backend))
     assert len(twice.removed) == 3
     scale = max(np.abs(once.reaction).max(), np.abs(once.effort).max())
     for k in (0, 1):
@@ -248,7 +247,7 @@ def test_a_repeated_joint_and_driver_share_the_load_equally(backend: str) -> Non
 def test_a_sweep_reports_the_minimum_norm_reactions_too() -> None:
     """symkin.sweep over two lamp masses: each set's reactions are those symkin.solve gives
     that set (the minimum-norm ones), so its envelope is of the reported values."""
-    kernel = symkin.compile(symkin.derive(MECHANISM), backend="numpy")
+    kernel = compiled(MECHANISM, "numpy")
     result = symkin.sweep(kernel, {"ml": [2.0, 3.0]})
     effort, reaction = result.forces
     for j, mass in enumerate((2.0, 3.0)):

@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from motion_support import kernel_from
 
 import symkin
-from symkin.spec.validate import from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -30,7 +30,7 @@ G = np.array([0.0, 0.0, -9.81])
 
 
 def _solve(data: dict, backend: str):
-    return symkin.solve(symkin.compile(symkin.derive(from_dict(data)), backend=backend))
+    return symkin.solve(kernel_from(data, backend))  # derived once for both backends
 
 
 def _rotation(e):
@@ -312,7 +312,7 @@ def test_input_legs_hold_the_platform(backend: str) -> None:
     top = np.array([data["bodies"]["platform"]["points"][f"P{k}"] for k in range(1, 7)], float)
     data["bodies"]["platform"].update(mass=30, inertia=[1, 1, 1.5], com=[0.02, 0.03, 1.05])
     data["forces"] = [{"type": "gravity", "g": G.tolist()}]
-    kernel = symkin.compile(symkin.derive(from_dict(data)), backend=backend)
+    kernel = kernel_from(data, backend)
     t = np.linspace(0.0, 0.2, 3)
     lengths = np.tile(np.linalg.norm(top - base, axis=1), (t.size, 1))
     still = np.zeros_like(lengths)  # at rest: without rates dq and d2q are NaN
@@ -327,7 +327,7 @@ def test_input_legs_hold_the_platform(backend: str) -> None:
 def test_sweep_envelope_has_the_six_components() -> None:
     """A sweep over the rotor's speed: the bearing's radial force peaks at the largest ω,
     m ω² a (closed form), and the envelope names JOINT.Fx ... JOINT.Mz."""
-    kernel = symkin.compile(symkin.derive(from_dict(ROTOR)), backend="c")
+    kernel = kernel_from(ROTOR, "c")
     speeds = np.array([1.0, 2.0, 4.0])
     result = symkin.sweep(kernel, {"w": speeds}, workers=1)
     _, reaction = result.forces

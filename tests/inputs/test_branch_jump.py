@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled, derived
 
 import symkin
 from symkin.errors import SymkinWarning
@@ -23,7 +24,7 @@ BACKENDS = ["numpy"] + (["c"] if shutil.which("gcc") else [])
 
 @pytest.fixture(scope="module")
 def system():
-    return symkin.derive(symkin.load(ROOT / "examples" / "crank_slider_input.yaml"))
+    return derived(ROOT / "examples" / "crank_slider_input.yaml")
 
 
 def _assembly(theta: np.ndarray, slider_x: np.ndarray) -> np.ndarray:
@@ -37,7 +38,7 @@ def _assembly(theta: np.ndarray, slider_x: np.ndarray) -> np.ndarray:
 
 
 def _run(system, backend, theta):
-    kernel = symkin.compile(system, backend=backend)
+    kernel = compiled(ROOT / "examples" / "crank_slider_input.yaml", backend)
     t = np.arange(theta.size) * 0.05
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -73,6 +74,5 @@ def test_flags_are_the_rows_that_change_assembly(system):
 
 
 def test_time_driven_run_has_no_jump_rows(system):
-    kernel = symkin.compile(symkin.derive(symkin.load(ROOT / "examples" / "crank_slider.yaml")),
-                            backend="numpy")
+    kernel = compiled(ROOT / "examples" / "crank_slider.yaml", "numpy")
     assert symkin.solve(kernel).branch_jumps is None

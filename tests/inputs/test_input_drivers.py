@@ -13,6 +13,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import derived
+from motion_support import kernel as built
+from motion_support import shared
 
 import symkin
 from symkin.errors import MechanismError, SolveError
@@ -28,18 +31,17 @@ def _close(a: np.ndarray, b: np.ndarray, tol: float = 1e-12) -> float:
     return float(np.max(np.abs(a - b)) / max(1.0, float(np.max(np.abs(b)))))
 
 
-def _variant(tmp_path: Path, source: str, name: str, swaps: dict[str, str]) -> Path:
+def _variant(source: str, name: str, swaps: dict[str, str]) -> Path:
+    """The file ``source`` with ``swaps`` made, shared by the tests that build it."""
     text = (ROOT / source).read_text()
     for old, new in swaps.items():
         assert old in text, old
         text = text.replace(old, new)
-    path = tmp_path / f"{name}.yaml"
-    path.write_text(text)
-    return path
+    return shared(f"{name}.yaml", text)
 
 
-def _five_bar(tmp_path: Path) -> Path:
-    return _variant(tmp_path, "tests/mechanisms/five_bar.yaml", "five_bar_in", {
+def _five_bar() -> Path:
+    return _variant("tests/mechanisms/five_bar.yaml", "five_bar_in", {
         "name: five_bar": "name: five_bar_in",
         "{type: angle, i: left,  j: ground, theta: 0.4*sin(2*pi*t)}":
             "{type: angle, name: left_encoder, i: left, j: ground, theta: input}",
@@ -47,8 +49,8 @@ def _five_bar(tmp_path: Path) -> Path:
             "{type: angle, name: right_encoder, i: right, j: ground, theta: input}"})
 
 
-def _trajectory(tmp_path: Path) -> Path:
-    return _variant(tmp_path, "tests/mechanisms/point_trajectory.yaml", "trajectory_in", {
+def _trajectory() -> Path:
+    return _variant("tests/mechanisms/point_trajectory.yaml", "trajectory_in", {
         "name: point_trajectory": "name: trajectory_in",
         '{type: trajectory, j: rod, sB: tip, f: ["1 + t", "0.5*sin(t)"]}':
             '{type: trajectory, name: pen, j: rod, sB: tip, f: [input, "0.5*sin(t)"]}'})
@@ -60,9 +62,7 @@ def backend(request: pytest.FixtureRequest) -> str:
 
 
 def _pair(time_file: Path, input_file: Path, backend: str):
-    reference = symkin.compile(symkin.derive(time_file), backend=backend)
-    driven = symkin.compile(symkin.derive(input_file), backend=backend)
-    return reference, driven
+    return built(time_file, backend), built(input_file, backend)
 
 
 def test_crank_slider_inputs_equal_time_driven_run(backend: str) -> None:
@@ -79,9 +79,12 @@ def test_crank_slider_inputs_equal_time_driven_run(backend: str) -> None:
 
 
 def test_driven_coordinate_is_the_input_and_rates_match_differences(backend: str) -> None:
-    driven = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
-                            backend=backend)
-    t = np.linspace(0.0, 0.5, 2001)
+    driven = built(ROOT / "examples/crank_slider_input.yaml", backend)
+    # Central differences of step h = 2.5e-4 (O(h^2) ~ 1e-7) at 60 places over 0.5 s: each
+    # place solved at t - h, t, t + h, the differences taken within each triple (the rows of
+    # a 2001-point grid of the same step, some 13 times fewer to solve).
+    h = 0.5 / 2000
+    t = (np.linspace(h, 0.5 - h, 60)[:, None] + np.array([-h, 0.0, h])).ravel()
     u, du, ddu = 1.0 + np.sin(3 * t), 3 * np.cos(3 * t), -9 * np.sin(3 * t)
     got = symkin.solve(driven, t=t, q0=[0, 0, 1, 3, 0, 0, 0, -4, 0], inputs=u,
                        input_rates=du, input_accels=ddu)
@@ -89,13 +92,13 @@ def test_driven_coordinate_is_the_input_and_rates_match_differences(backend: str
     assert np.max(np.abs(got.q[:, phi] - u)) < 1e-12
     assert np.max(np.abs(got.dq[:, phi] - du)) < 1e-12
     assert np.max(np.abs(got.d2q[:, phi] - ddu)) < 1e-11
-    h = t[1] - t[0]  # central differences, O(h^2) ~ 1e-7
-    assert np.max(np.abs((got.q[2:] - got.q[:-2]) / (2 * h) - got.dq[1:-1])) < 1e-5
-    assert np.max(np.abs((got.dq[2:] - got.dq[:-2]) / (2 * h) - got.d2q[1:-1])) < 1e-4
+    q, dq, d2q = (values.reshape(60, 3, -1) for values in (got.q, got.dq, got.d2q))
+    assert np.max(np.abs((q[:, 2] - q[:, 0]) / (2 * h) - dq[:, 1])) < 1e-5
+    assert np.max(np.abs((dq[:, 2] - dq[:, 0]) / (2 * h) - d2q[:, 1])) < 1e-4
 
 
-def test_two_inputs_by_name_on_a_drawn_five_bar(tmp_path: Path, backend: str) -> None:
-    reference, driven = _pair(ROOT / "tests/mechanisms/five_bar.yaml", _five_bar(tmp_path),
+def test_two_inputs_by_name_on_a_drawn_five_bar(backend: str) -> None:
+    reference, driven = _pair(ROOT / "tests/mechanisms/five_bar.yaml", _five_bar(),
                               backend)
     expected = symkin.solve(reference, t=T)
     w = 2 * np.pi
@@ -108,11 +111,10 @@ def test_two_inputs_by_name_on_a_drawn_five_bar(tmp_path: Path, backend: str) ->
         assert _close(getattr(got, name), getattr(expected, name)) < 1e-12, name
 
 
-def test_one_component_of_a_trajectory_driver_is_an_input(tmp_path: Path,
-                                                           backend: str) -> None:
+def test_one_component_of_a_trajectory_driver_is_an_input(backend: str) -> None:
     """f: [input, 0.5*sin(t)]: the other component stays a function of t, taken at t."""
     reference, driven = _pair(ROOT / "tests/mechanisms/point_trajectory.yaml",
-                              _trajectory(tmp_path), backend)
+                              _trajectory(), backend)
     expected = symkin.solve(reference, t=T)
     got = symkin.solve(driven, t=T, q0=expected.q[0], inputs=1 + T, input_rates=np.ones(T.size),
                        input_accels=np.zeros(T.size))
@@ -144,36 +146,34 @@ def test_positions_only_and_rates_only(backend: str) -> None:
     ({"inputs": ["a"] * 51}, "must be numbers"),
 ])
 def test_bad_inputs_are_refused(kwargs: dict, message: str) -> None:
-    driven = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
-                            backend="numpy")
+    driven = built(ROOT / "examples/crank_slider_input.yaml", "numpy")
     with pytest.raises(SolveError) as error:
         symkin.solve(driven, t=T, **kwargs)
     assert message in str(error.value)
 
 
 def test_inputs_for_a_mechanism_without_input_drivers_are_refused() -> None:
-    kernel = symkin.compile(symkin.derive(ROOT / "examples/crank_slider.yaml"),
-                            backend="numpy")
+    kernel = built(ROOT / "examples/crank_slider.yaml", "numpy")
     with pytest.raises(SolveError, match="no input drivers"):
         symkin.solve(kernel, inputs=np.zeros((31, 1)))
     with pytest.raises(SolveError, match="need inputs="):
         symkin.solve(kernel, input_rates=np.zeros((31, 1)))
 
 
-def test_input_is_a_word_not_a_name(tmp_path: Path) -> None:
+def test_input_is_a_word_not_a_name() -> None:
     """A parameter cannot be called input; an expression using the word is refused."""
-    named = _variant(tmp_path, "examples/crank_slider.yaml", "named",
+    named = _variant("examples/crank_slider.yaml", "named",
                      {"parameters: {a: 1.0,": "parameters: {input: 2.0, a: 1.0,"})
     with pytest.raises(MechanismError, match="input"):
         symkin.derive(named)
-    mixed = _variant(tmp_path, "examples/crank_slider_input.yaml", "mixed",
+    mixed = _variant("examples/crank_slider_input.yaml", "mixed",
                      {"theta: input}": "theta: input + 1}"})
     with pytest.raises(MechanismError, match=r"drivers\[0\]\.theta"):
         symkin.derive(mixed)
 
 
 def test_the_generated_c_declares_the_contract(tmp_path: Path) -> None:
-    files = symkin.generate(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
+    files = symkin.generate(derived(ROOT / "examples/crank_slider_input.yaml"),
                             backend="c", out_dir=tmp_path)
     header = (tmp_path / "crank_slider_input.h").read_text()
     solver = (tmp_path / "crank_slider_input_solver.h").read_text()
@@ -187,8 +187,7 @@ def test_the_generated_c_declares_the_contract(tmp_path: Path) -> None:
 def test_sweep_and_scan_without_inputs_of_an_input_mechanism_are_refused() -> None:
     """A sweep runs over t alone; a scan needs the inputs' values: the generated functions
     would read inputs nobody gave."""
-    kernel = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
-                            backend="c")
+    kernel = built(ROOT / "examples/crank_slider_input.yaml", "c")
     with pytest.raises(SolveError, match="a sweep of a mechanism with input drivers"):
         symkin.sweep(kernel, {"a": [1.0, 1.1]})
     with pytest.raises(SolveError, match="a scan needs their values, inputs="):
@@ -196,16 +195,14 @@ def test_sweep_and_scan_without_inputs_of_an_input_mechanism_are_refused() -> No
 
 
 def test_sensitivities_of_an_input_run_are_refused() -> None:
-    kernel = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
-                            backend="numpy")
+    kernel = built(ROOT / "examples/crank_slider_input.yaml", "numpy")
     with pytest.raises(SolveError, match="sensitivities= is not supported"):
         symkin.solve(kernel, t=T, inputs=T + 1.5, sensitivities=True)
 
 
 def test_float_c_kernel_solves_inputs_to_float_accuracy() -> None:
-    reference = symkin.compile(symkin.derive(ROOT / "examples/crank_slider.yaml"), backend="c")
-    single = symkin.compile(symkin.derive(ROOT / "examples/crank_slider_input.yaml"),
-                            backend="c", real="float")
+    reference = built(ROOT / "examples/crank_slider.yaml", "c")
+    single = built(ROOT / "examples/crank_slider_input.yaml", "c", real="float")
     expected = symkin.solve(reference, t=T)
     got = symkin.solve(single, t=T, inputs=T**2 + np.pi / 2, input_rates=2 * T,
                        input_accels=np.full(T.size, 2.0))

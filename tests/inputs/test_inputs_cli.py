@@ -1,27 +1,56 @@
 """``symkin run MECH --inputs table.csv``: the table's run equals the time-driven run of the
-same motion; every mistake in the table or the command is refused, located, with exit 2."""
+same motion; every mistake in the table or the command is refused, located, with exit 2.
+
+The commands run in this process (``cli.main``, the code the console script calls): a fresh
+Python per command cost a second each in imports alone. One test runs a real process, so the
+exit status and the absence of a traceback are also seen from outside."""
 
 from __future__ import annotations
 
 import os
 import subprocess
 import sys
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from symkin import cli
 
 ROOT = Path(__file__).resolve().parents[2]
 INPUT = ROOT / "examples" / "crank_slider_input.yaml"
 TIMED = ROOT / "examples" / "crank_slider.yaml"
 
 
-def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([sys.executable, "-m", "symkin", "run", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=300)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+@dataclass
+class Done:
+    """What a command left: its exit status and what it wrote to stderr."""
+
+    returncode: int
+    stderr: str
+
+
+@pytest.fixture
+def symkin_cli(capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+               ) -> Callable[..., Done]:
+    """``symkin ARGS`` run in ``cwd`` in this process; an exception the command lets out
+    (a traceback for the user) fails the test."""
+
+    def call(*args: str, cwd: Path) -> Done:
+        monkeypatch.chdir(cwd)
+        capfd.readouterr()
+        status = cli.main(list(args))
+        return Done(status, capfd.readouterr().err)
+
+    return call
+
+
+@pytest.fixture
+def run(symkin_cli: Callable[..., Done]) -> Callable[..., Done]:
+    """``symkin run ARGS`` in ``cwd``."""
+    return lambda *args, cwd: symkin_cli("run", *args, cwd=cwd)
 
 
 def _table(path: Path, header: str, rows: list[str]) -> Path:
@@ -34,7 +63,8 @@ def _motion(t: np.ndarray) -> list[str]:
 
 
 @pytest.mark.parametrize("backend", ["c", "numpy"])
-def test_table_run_equals_the_time_driven_run(tmp_path: Path, backend: str) -> None:
+def test_table_run_equals_the_time_driven_run(run: Callable[..., Done], tmp_path: Path,
+                                               backend: str) -> None:
     t = np.linspace(0, 1.5, 31)
     table = _table(tmp_path / "u.csv", "t,crank_angle,crank_angle_t,crank_angle_tt", _motion(t))
     got = run(str(INPUT), "--backend", backend, "--inputs", str(table), "-o", "in.npz",
@@ -50,7 +80,7 @@ def test_table_run_equals_the_time_driven_run(tmp_path: Path, backend: str) -> N
         assert np.abs(a[name] - b[name]).max() / scale < 1e-12, name
 
 
-def test_positions_only_table_writes_nan_rates(tmp_path: Path) -> None:
+def test_positions_only_table_writes_nan_rates(run: Callable[..., Done], tmp_path: Path) -> None:
     t = np.linspace(0, 1, 11)
     rows = [f"{x!r},{x + 1.5!r}" for x in map(float, t)]
     table = _table(tmp_path / "u.csv", "t,crank_angle", rows)
@@ -80,15 +110,17 @@ GOOD = ["0,1.5", "0.1,1.6"]
     ("t,crank_angle", ["0,1_5"], "u.csv:2", "'1_5' is not a finite number"),  # not 15
     ("t,crank_angle", [], "u.csv", "no rows of values"),
 ])
-def test_bad_tables_are_refused_with_their_place(tmp_path: Path, header: str, rows: list[str],
-                                                 where: str, says: str) -> None:
+def test_bad_tables_are_refused_with_their_place(run: Callable[..., Done], tmp_path: Path,
+                                                 header: str, rows: list[str], where: str,
+                                                 says: str) -> None:
     table = _table(tmp_path / "u.csv", header, rows)
     got = run(str(INPUT), "--backend", "numpy", "--inputs", str(table), cwd=tmp_path)
     assert got.returncode == 2
     assert where in got.stderr and says in got.stderr, got.stderr
 
 
-def test_input_mechanism_without_table_and_table_without_inputs(tmp_path: Path) -> None:
+def test_input_mechanism_without_table_and_table_without_inputs(run: Callable[..., Done],
+                                                                 tmp_path: Path) -> None:
     got = run(str(INPUT), "--backend", "numpy", cwd=tmp_path)
     assert got.returncode == 2 and "--inputs TABLE.csv" in got.stderr
     assert "crank_angle_t" in got.stderr  # the columns it expects
@@ -102,7 +134,8 @@ def test_input_mechanism_without_table_and_table_without_inputs(tmp_path: Path) 
     assert got.returncode == 2 and "cannot read the input table" in got.stderr
 
 
-def test_a_table_with_a_byte_order_mark_reads_as_without(tmp_path: Path) -> None:
+def test_a_table_with_a_byte_order_mark_reads_as_without(run: Callable[..., Done],
+                                                          tmp_path: Path) -> None:
     """Spreadsheets write "CSV UTF-8" with a byte-order mark before the header."""
     plain = _table(tmp_path / "plain.csv", "t,crank_angle", GOOD)
     marked = tmp_path / "marked.csv"
@@ -115,7 +148,8 @@ def test_a_table_with_a_byte_order_mark_reads_as_without(tmp_path: Path) -> None
 
 
 @pytest.mark.parametrize("output", ["u.csv", "link.csv", "./sub/../u.csv"])
-def test_the_results_never_replace_the_input_table(tmp_path: Path, output: str) -> None:
+def test_the_results_never_replace_the_input_table(run: Callable[..., Done], tmp_path: Path,
+                                                    output: str) -> None:
     table = _table(tmp_path / "u.csv", "t,crank_angle", GOOD)
     (tmp_path / "sub").mkdir()
     (tmp_path / "link.csv").symlink_to(table)
@@ -126,21 +160,26 @@ def test_the_results_never_replace_the_input_table(tmp_path: Path, output: str) 
     assert table.read_bytes() == before
 
 
-def _symkin(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([sys.executable, "-m", "symkin", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=300)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
-
-
-def test_sweep_and_scan_mistakes_about_inputs_are_the_users(tmp_path: Path) -> None:
+def test_sweep_and_scan_mistakes_about_inputs_are_the_users(symkin_cli: Callable[..., Done],
+                                                            tmp_path: Path) -> None:
     """Exit 2, as run gives, and in the command line's words: a sweep of a mechanism with
     inputs (it exited 1, as for a design that failed), --input for a mechanism without
     (the message named Python's inputs= and told to give --input as well as to leave it out)."""
-    got = _symkin("sweep", str(INPUT), "--backend", "numpy", "--vary", "a=0.9:1.1:3",
+    got = symkin_cli("sweep", str(INPUT), "--backend", "numpy", "--vary", "a=0.9:1.1:3",
                   cwd=tmp_path)
     assert got.returncode == 2 and "input drivers (crank_angle)" in got.stderr, got.stderr
-    got = _symkin("scan", str(TIMED), "--backend", "numpy", "--input", "x=1", cwd=tmp_path)
+    got = symkin_cli("scan", str(TIMED), "--backend", "numpy", "--input", "x=1", cwd=tmp_path)
     assert got.returncode == 2 and "leave out --input" in got.stderr, got.stderr
     assert "inputs=" not in got.stderr and "give --input" not in got.stderr
+
+
+def test_a_real_process_exits_2_without_a_traceback(tmp_path: Path) -> None:
+    """The same refusal seen from outside: ``python -m symkin`` exits with status 2 and says
+    where, with no traceback."""
+    table = _table(tmp_path / "u.csv", "t,crank_angle", ["0,1.5", "0.1,nan"])
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    got = subprocess.run([sys.executable, "-m", "symkin", "run", str(INPUT), "--backend",
+                          "numpy", "--inputs", str(table)], cwd=tmp_path, env=env, check=False,
+                         capture_output=True, text=True, timeout=300)
+    assert got.returncode == 2, got.stderr
+    assert "Traceback" not in got.stderr and "u.csv:3" in got.stderr, got.stderr

@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from motion_support import kernel as built
+from motion_support import shared
 
 import symkin
 
@@ -22,7 +24,7 @@ MM = 1000.0
 SCALE = np.array([MM, MM, 1, MM, MM, 1, MM, MM, 1])
 
 
-def _in_millimetres(tmp_path: Path) -> Path:
+def _in_millimetres() -> Path:
     text = (ROOT / "examples" / "crank_slider_input.yaml").read_text()
     for old, new in (("name: crank_slider_input ", "name: crank_slider_input_mm "),
                      ("a: 1.0, b: 5.0, c: 4.0", "a: 1000.0, b: 5000.0, c: 4000.0"),
@@ -30,23 +32,19 @@ def _in_millimetres(tmp_path: Path) -> Path:
                      ("q0: [4, 4, 0]", "q0: [4000, 4000, 0]")):
         assert old in text
         text = text.replace(old, new)
-    path = tmp_path / "crank_slider_input_mm.yaml"
-    path.write_text(text)
-    return path
+    return shared("crank_slider_input_mm.yaml", text)
 
 
 @pytest.fixture(scope="module")
-def systems(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("mm")
-    return (symkin.derive(ROOT / "examples" / "crank_slider_input.yaml"),
-            symkin.derive(_in_millimetres(folder)))
+def mechanisms() -> tuple[Path, Path]:
+    return ROOT / "examples" / "crank_slider_input.yaml", _in_millimetres()
 
 
 @pytest.mark.parametrize("backend", ["numpy", "c"])
-def test_the_run_in_millimetres_is_the_run_in_metres_scaled(systems, backend: str) -> None:
+def test_the_run_in_millimetres_is_the_run_in_metres_scaled(mechanisms, backend: str) -> None:
     if backend == "c" and shutil.which("gcc") is None:
         pytest.skip("gcc is not installed")
-    metres, millimetres = (symkin.compile(s, backend=backend) for s in systems)
+    metres, millimetres = (built(m, backend) for m in mechanisms)
     t = np.linspace(0.0, 1.0, 21)
     u, du, ddu = 1.5708 + 0.4 * np.sin(t), 0.4 * np.cos(t), -0.4 * np.sin(t)
     a = symkin.solve(metres, t=t, inputs=u, input_rates=du, input_accels=ddu)
@@ -62,8 +60,8 @@ def test_the_run_in_millimetres_is_the_run_in_metres_scaled(systems, backend: st
 
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is not installed")
-def test_the_generated_solve_inputs_decides_in_options_unit(systems) -> None:
-    kernel = symkin.compile(systems[1], backend="c")
+def test_the_generated_solve_inputs_decides_in_options_unit(mechanisms) -> None:
+    kernel = built(mechanisms[1], "c")
     ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
     results = {}
     for unit in (1.0, MM):
@@ -94,7 +92,7 @@ def test_the_generated_solve_inputs_decides_in_options_unit(systems) -> None:
     assert dx == pytest.approx(MM * rate * 0.5, rel=1e-12)
 
 
-def test_through_the_dead_centre_in_millimetres_as_in_metres(systems) -> None:
+def test_through_the_dead_centre_in_millimetres_as_in_metres(mechanisms) -> None:
     """The rows kept on the dead centre and the branch test (made in the run's unit, as the
     generated C makes it) are the same for the drawing in millimetres."""
     import warnings
@@ -103,7 +101,7 @@ def test_through_the_dead_centre_in_millimetres_as_in_metres(systems) -> None:
     k = np.arange(65)
     theta = np.pi / 2 + k * 2 * np.pi / 64  # row 32 on the dead centre
     for backend in backends:
-        metres, millimetres = (symkin.compile(s, backend=backend) for s in systems)
+        metres, millimetres = (built(m, backend) for m in mechanisms)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             a, b = (symkin.solve(kernel, t=0.01 * k, inputs=theta,

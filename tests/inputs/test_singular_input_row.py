@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from motion_support import kernel as built
 
 import symkin
 
@@ -23,15 +24,15 @@ DEAD = TICKS // 2  # the row at theta = 3 pi / 2
 
 
 @pytest.fixture(scope="module")
-def system():
-    return symkin.derive(ROOT / "examples" / "crank_slider_input.yaml")
+def mechanism() -> Path:
+    return ROOT / "examples" / "crank_slider_input.yaml"
 
 
 @pytest.mark.parametrize("backend", ["c", "numpy"])
-def test_a_row_on_the_dead_centre_is_flagged_and_the_run_goes_on(system, backend: str) -> None:
+def test_a_row_on_the_dead_centre_is_flagged_and_the_run_goes_on(mechanism, backend: str) -> None:
     if backend == "c" and shutil.which("gcc") is None:
         pytest.skip("gcc is not installed")
-    kernel = symkin.compile(system, backend=backend)
+    kernel = built(mechanism, backend)
     k = np.arange(TICKS + 1)
     theta = np.pi / 2 + k * 2 * np.pi / TICKS
     with warnings.catch_warnings():
@@ -52,19 +53,19 @@ def test_a_row_on_the_dead_centre_is_flagged_and_the_run_goes_on(system, backend
     assert np.isfinite(run.dq[regular]).all()
 
 
-def _both(system):
+def _both(mechanism):
     backends = ["numpy"] + (["c"] if shutil.which("gcc") else [])
-    return [symkin.compile(system, backend=backend) for backend in backends]
+    return [built(mechanism, backend) for backend in backends]
 
 
-def test_consecutive_and_last_rows_on_the_dead_centre_and_progress(system) -> None:
+def test_consecutive_and_last_rows_on_the_dead_centre_and_progress(mechanism) -> None:
     """Inputs held on the dead centre for three rows, then again at the last row: each such
     row kept alike on both backends, the others on the loop closure, progress after every
     row (also the kept ones)."""
     dead = 3 * np.pi / 2
     theta = np.array([dead - 0.2, dead - 0.1, dead, dead, dead, dead + 0.1, dead])
     runs = []
-    for kernel in _both(system):
+    for kernel in _both(mechanism):
         calls: list[tuple[int, int]] = []
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -79,7 +80,7 @@ def test_consecutive_and_last_rows_on_the_dead_centre_and_progress(system) -> No
         assert np.array_equal(runs[0].branch_jumps, runs[1].branch_jumps)
 
 
-def test_a_first_row_on_the_dead_centre_and_a_failure_alike_on_both_backends(system) -> None:
+def test_a_first_row_on_the_dead_centre_and_a_failure_alike_on_both_backends(mechanism) -> None:
     """Row 0 is the assembly's (the C solve's own estimate there put it over max_cond, where
     the assembly had 6e6); a reading out of reach fails with the same message, Newton's own
     iterate explained (the C solve leaves its state at the last solution, which explained
@@ -88,7 +89,7 @@ def test_a_first_row_on_the_dead_centre_and_a_failure_alike_on_both_backends(sys
 
     dead = 3 * np.pi / 2
     firsts, messages = [], []
-    for kernel in _both(system):
+    for kernel in _both(mechanism):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             run = symkin.solve(kernel, t=[0.0, 0.1], inputs=[dead, dead + 0.05],
@@ -106,7 +107,7 @@ def test_a_first_row_on_the_dead_centre_and_a_failure_alike_on_both_backends(sys
         assert messages[0] == messages[1]
 
 
-def test_an_interrupt_while_assembling_hands_on_no_rows(system, monkeypatch) -> None:
+def test_an_interrupt_while_assembling_hands_on_no_rows(mechanism, monkeypatch) -> None:
     from symkin.runtime.driver import SolveInterrupted
     from symkin.runtime.input_driven import inputs
 
@@ -114,7 +115,7 @@ def test_an_interrupt_while_assembling_hands_on_no_rows(system, monkeypatch) -> 
         raise KeyboardInterrupt
 
     monkeypatch.setattr(inputs, "assemble", interrupted)
-    for kernel in _both(system):
+    for kernel in _both(mechanism):
         try:
             symkin.solve(kernel, t=[0.0, 0.1], inputs=[1.5, 1.6])
         except SolveInterrupted as stop:

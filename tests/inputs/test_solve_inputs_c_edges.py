@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import derived
+from motion_support import kernel as built
 
 import symkin
 
@@ -30,13 +32,13 @@ def _slider_x(theta: float) -> float:
 
 
 @pytest.fixture(scope="module")
-def system():
-    return symkin.derive(ROOT / "examples" / "crank_slider_input.yaml")
+def mechanism() -> Path:
+    return ROOT / "examples" / "crank_slider_input.yaml"
 
 
 @pytest.fixture(scope="module")
-def kernel(system):
-    return symkin.compile(system, backend="c")
+def kernel(mechanism):
+    return built(mechanism, "c")
 
 
 class _Controller:
@@ -123,8 +125,8 @@ def test_the_functions_over_t_read_each_sets_inputs_after_its_parameters(kernel)
         assert q[j, SLIDER_X] == pytest.approx(_slider_x(theta), abs=1e-12)
 
 
-def test_the_c_files_refuse_fast_math(system, tmp_path: Path) -> None:
-    symkin.generate(system, backend="c", out_dir=tmp_path)
+def test_the_c_files_refuse_fast_math(mechanism, tmp_path: Path) -> None:
+    symkin.generate(derived(mechanism), backend="c", out_dir=tmp_path)
     for source in ("crank_slider_input_solver.c", "crank_slider_input_sparse_lu.c",
                    "crank_slider_input_dense_lu.c"):
         for flags in (["-ffast-math"], ["-ffinite-math-only"]):
@@ -137,13 +139,13 @@ def test_the_c_files_refuse_fast_math(system, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("backend", ["c", "numpy"])
-def test_an_interrupted_input_run_hands_on_the_rows_it_solved(system, backend: str) -> None:
+def test_an_interrupted_input_run_hands_on_the_rows_it_solved(mechanism, backend: str) -> None:
     """Ctrl-C inside the loop over the inputs (raised here from the progress callback after the
     fifth row): SolveInterrupted carries those five rows, equal to the whole run's; before,
     a bare KeyboardInterrupt lost them (and the CLI wrote no file)."""
     from symkin.runtime.driver import SolveInterrupted
 
-    kernel = symkin.compile(system, backend=backend)
+    kernel = built(mechanism, backend)
     t = np.linspace(0.0, 1.0, 21)
     u = 1.5708 + 0.5 * t
     whole = symkin.solve(kernel, t=t, inputs=u)
@@ -170,14 +172,14 @@ def test_an_interrupted_input_run_hands_on_the_rows_it_solved(system, backend: s
 
 @pytest.mark.parametrize("backend", ["c", "numpy"])
 def test_absurd_rates_give_the_same_rows_on_both_backends_and_no_numpy_warning(
-        system, backend: str) -> None:
+        mechanism, backend: str) -> None:
     """Rates of 1e200 without accelerations: the accelerations are not evaluated (NumPy's
     Gamma overflowed, and the run failed on NumPy where C went on), and the points' arrays
     are NaN or inf where they must be, without NumPy's overflow warning (the CLI printed it
     as a note)."""
     import warnings
 
-    kernel = symkin.compile(system, backend=backend)
+    kernel = built(mechanism, backend)
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         run = symkin.solve(kernel, t=[0.0, 0.1], inputs=[1.5708, 1.6],
@@ -195,13 +197,13 @@ def _slider_x_theta(theta: float) -> float:
 
 
 @pytest.mark.parametrize("backend", ["c", "numpy"])
-def test_accelerations_not_given_are_not_judged_by_the_error_model(system, backend: str) -> None:
+def test_accelerations_not_given_are_not_judged_by_the_error_model(mechanism, backend: str) -> None:
     """Fast rates (1e10 rad/s) without accelerations, far from any singular configuration
     (condition about 21): the accelerations are not solved for, so the error model does not
     judge them. Before, it judged them as zeros against the growth |dq|^2 gives Gamma, flagged
     every row, and the command line blamed an ill-conditioned Phi_q. q and dq meet their
     targets (dq relative to its size): the closed form's slider velocity."""
-    kernel = symkin.compile(system, backend=backend)
+    kernel = built(mechanism, backend)
     theta = np.array([1.5708, 1.6])
     rate = 1e10
     run = symkin.solve(kernel, t=[0.0, 0.1], inputs=theta, input_rates=[rate, rate])

@@ -15,10 +15,9 @@ its motion stays smooth: every crank turns by the angle theta of the one-coordin
 from __future__ import annotations
 
 import math
-import os
 import re
-import subprocess
-import sys
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +27,7 @@ from scipy.integrate import solve_ivp
 from test_iftomm_benchmarks import _bench_script
 
 import symkin
+from symkin import cli
 
 ROOT = Path(__file__).resolve().parents[2]
 N, G = 2, 9.81
@@ -101,18 +101,34 @@ def test_each_passage_is_reported_where_the_bars_line_up(default_run: Any) -> No
     assert np.flatnonzero(default_run.flagged).tolist() == after.tolist()
 
 
-def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    result = subprocess.run([sys.executable, "-m", "symkin", "run", *args], cwd=cwd, env=env,
-                            check=False, capture_output=True, text=True, timeout=600)
-    assert "Traceback" not in result.stderr, result.stderr
-    return result
+@dataclass
+class Done:
+    """What ``symkin run`` left: its exit status and what it wrote to stderr."""
+
+    returncode: int
+    stderr: str
 
 
-def test_cli_warns_of_each_passage_and_stops_at_the_first_when_asked(tmp_path: Path) -> None:
+@pytest.fixture
+def symkin_run(capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+               ) -> Callable[..., Done]:
+    """``symkin run ARGS`` in ``cwd``, in this process (cli.main, what the console script
+    runs): an exception it let out fails the test, as a traceback would."""
+
+    def run(*args: str, cwd: Path) -> Done:
+        monkeypatch.chdir(cwd)
+        capfd.readouterr()
+        status = cli.main(["run", *args])
+        return Done(status, capfd.readouterr().err)
+
+    return run
+
+
+def test_cli_warns_of_each_passage_and_stops_at_the_first_when_asked(
+        tmp_path: Path, symkin_run: Callable[..., Done]) -> None:
     path = _chain(tmp_path, 1.5)
     first, second = _passage_times(1.5)
-    result = _cli(str(path), "--backend", "numpy", "-o", "out.csv", cwd=tmp_path)
+    result = symkin_run(str(path), "--backend", "numpy", "-o", "out.csv", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     warnings = [line for line in result.stderr.splitlines() if "warning:" in line]
     assert len(warnings) == 2
@@ -120,8 +136,8 @@ def test_cli_warns_of_each_passage_and_stops_at_the_first_when_asked(tmp_path: P
         said = re.search(r"passes a singular configuration at t = ([0-9.]+)", line)
         assert said is not None and abs(float(said.group(1)) - at) < 1e-6
         assert "loses rank 2" in line and "interpolated" not in line
-    stopped = _cli(str(path), "--backend", "numpy", "--stop-at-singular", "-o", "out.npz",
-                   cwd=tmp_path)
+    stopped = symkin_run(str(path), "--backend", "numpy", "--stop-at-singular", "-o",
+                         "out.npz", cwd=tmp_path)
     assert stopped.returncode == 1
     said = re.search(r"singular configuration is reached at t = ([0-9.]+)", stopped.stderr)
     assert said is not None and abs(float(said.group(1)) - first) < 1e-6
@@ -157,9 +173,10 @@ time: {t0: 0, t1: 2.5, dt: 0.05}
 """
 
 
-def test_a_lock_up_stops_at_the_limit_position_naming_it(tmp_path: Path) -> None:
+def test_a_lock_up_stops_at_the_limit_position_naming_it(
+        tmp_path: Path, symkin_run: Callable[..., Done]) -> None:
     (tmp_path / "lockup.yaml").write_text(LOCKUP, encoding="utf-8")
-    result = _cli("lockup.yaml", "--backend", "numpy", "-o", "out.npz", cwd=tmp_path)
+    result = symkin_run("lockup.yaml", "--backend", "numpy", "-o", "out.npz", cwd=tmp_path)
     assert result.returncode == 1
     said = re.search(r"the motion stops at t = ([0-9.]+): a lock-up: Phi_q loses rank 1",
                      result.stderr)

@@ -115,9 +115,15 @@ def _relative(trajectory: Any, row: int, values: np.ndarray) -> np.ndarray:
     return np.array([beta, rod - beta, gamma, eg - delta, delta, eh - eps, eps])
 
 
-def test_a03_starts_and_ends_as_the_published_solution() -> None:
+@pytest.fixture(scope="module")
+def a03() -> tuple[Any, Any]:
+    """The squeezer's file derived and its NumPy kernel, for both of its tests."""
     system = symkin.derive(BENCH / "a03_andrews_squeezer.yaml")
-    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    return system, symkin.compile(system, backend="numpy")
+
+
+def test_a03_starts_and_ends_as_the_published_solution(a03: tuple[Any, Any]) -> None:
+    trajectory = symkin.solve(a03[1])
     start = _relative(trajectory, 0, trajectory.d2q)
     assert start[:2] == pytest.approx(A03_ACCELERATIONS, rel=1e-10)
     assert np.abs(start[2:]).max() < 1e-6
@@ -126,12 +132,13 @@ def test_a03_starts_and_ends_as_the_published_solution() -> None:
 
 
 @needs_gcc
-def test_a03_c_step_ends_at_the_published_solution_without_dense_fall_back() -> None:
+def test_a03_c_step_ends_at_the_published_solution_without_dense_fall_back(
+        a03: tuple[Any, Any]) -> None:
     """600 steps of h = 5e-5 from the assembled start: the sparse LU with its run-time
     interchanges factors every time (the order planned on the start alone took the dense
     fall-back at about 2 % of them), and the angles at 0.03 s are the test set's."""
-    system = symkin.derive(BENCH / "a03_andrews_squeezer.yaml")
-    start = symkin.solve(symkin.compile(system, backend="numpy"), t=np.array([0.0, 1e-4]))
+    system, numpy_kernel = a03
+    start = symkin.solve(numpy_kernel, t=np.array([0.0, 1e-4]))
     kernel = build_compile(system, backends.get("c"))
     motion = DynamicsStepper(kernel.ffi, kernel.lib, kernel.name, kernel.real).run(
         Options(), np.array(system.p_values, dtype=float), 0.0, start.q[0], start.dq[0],
@@ -154,23 +161,25 @@ def test_a04_bricard_moves_under_gravity_keeping_its_energy() -> None:
 
 
 A05_END = 0.4  # the slider rises some 0.15 m and the shaft turns 0.8 turn
+A05_EVERY = np.linspace(0.0, A05_END, 41)  # every 0.01 s: the C step's rows compared
 
 
 @pytest.fixture(scope="module")
-def a05() -> tuple[Any, Any, Any]:
-    """The governor's file derived, its NumPy kernel (compiled once: some 9 s CPU), and the
-    bench script (its reference)."""
+def a05() -> tuple[Any, Any, Any, Any]:
+    """The governor's file derived, its NumPy kernel (compiled once: some 9 s CPU), the
+    bench script and its reference at every 0.01 s (the script derives its equations with
+    SymPy at each call: once here for both tests)."""
     system = symkin.derive(BENCH / "a05_flyball_governor.yaml")
-    return system, symkin.compile(system, backend="numpy"), _bench_script(
-        "a05_flyball_governor")
+    script = _bench_script("a05_flyball_governor")
+    return system, symkin.compile(system, backend="numpy"), script, script.reference(A05_EVERY)
 
 
 def test_a05_numpy_follows_the_minimal_coordinate_equations(
-        a05: tuple[Any, Any, Any]) -> None:
-    _, kernel, script = a05
-    t = np.linspace(0.0, A05_END, 21)
+        a05: tuple[Any, Any, Any, Any]) -> None:
+    _, kernel, script, every = a05
+    t = A05_EVERY[::2]
     trajectory = symkin.solve(kernel, t=t)
-    expected = script.reference(t)
+    expected = every[::2]
     points = script.symkin_points(list(trajectory.coordinates), trajectory.q)
     assert np.ptp(expected[:, 1]) > 0.1  # the slider moved
     # seen: 4e-12 m; the damping 1 % low in symkin's spring makes it 3e-7 m
@@ -186,8 +195,8 @@ def test_a05_numpy_follows_the_minimal_coordinate_equations(
 
 @needs_gcc
 def test_a05_c_step_follows_the_minimal_coordinate_equations(
-        a05: tuple[Any, Any, Any]) -> None:
-    system, numpy_kernel, script = a05
+        a05: tuple[Any, Any, Any, Any]) -> None:
+    system, numpy_kernel, script, reference = a05
     kernel = build_compile(system, backends.get("c"))
     start = symkin.solve(numpy_kernel, t=np.array([0.0, 0.01]))  # the consistent start
     h = 2.5e-4  # an explicit step: the damper's fastest mode (8117 1/s) bounds it
@@ -196,6 +205,7 @@ def test_a05_c_step_follows_the_minimal_coordinate_equations(
         round(A05_END / h))
     assert motion.status == OK
     every = slice(39, None, 40)  # every 0.01 s
-    expected = script.reference(np.concatenate([[0.0], motion.t[every]]))[1:]
+    assert np.allclose(motion.t[every], A05_EVERY[1:], rtol=0, atol=1e-12)
+    expected = reference[1:]
     points = script.symkin_points(list(start.coordinates), motion.q[every])
     assert script.largest_distance(points, script.reference_points(expected)) < 1e-8

@@ -6,6 +6,7 @@ angle ψ alone (the coupler translates on a circle of radius a), derived here.""
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import Any
@@ -13,7 +14,8 @@ from typing import Any
 import numpy as np
 import pytest
 import sympy as sp
-from motion_support import write
+from motion_support import kernel as built
+from motion_support import shared, write
 from scipy.integrate import solve_ivp
 
 import symkin
@@ -30,8 +32,10 @@ def _falling(text: str) -> str:
                      and not line.lstrip().startswith("- {type: angle")) + "\n"
 
 
+@functools.cache
 def _reference() -> Any:
-    """(θ, ψ, θ', ψ') -> (θ'', ψ'') of the example's numbers, by Lagrange's equations."""
+    """(θ, ψ, θ', ψ') -> (θ'', ψ'') of the example's numbers, by Lagrange's equations
+    (derived once for the tests here)."""
     th, ps, dth, dps = sp.symbols("theta psi dtheta dpsi")
     g, a, arm, mb, mc, ml, jl = 9.81, 1.0, 0.4, 1.0, 3.0, 2.0, 0.02
     pin = a * sp.Matrix([sp.cos(th), sp.sin(th)])  # P moves with the coupler
@@ -52,8 +56,7 @@ def _reference() -> Any:
 def test_a_parallelogram_with_an_extra_bar_falls_as_by_hand(tmp_path: Path,
                                                             backend: str) -> None:
     text = _falling(EXAMPLE.read_text(encoding="utf-8"))
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "falling.yaml", text)),
-                            backend=backend)
+    kernel = built(shared("falling.yaml", text), backend)
     trajectory = symkin.solve(kernel, t=np.linspace(0, 1, 11))
     accel = _reference()
     reference = solve_ivp(lambda t, y: [y[2], y[3], *np.ravel(accel(*y))], (0, 1),
@@ -90,8 +93,7 @@ def test_its_initial_velocities_and_tolerances_are_the_motions(
     keys = ("initial: {velocities: {crank.phi: 0.8, lamp.phi: 0.0}}\n"
             "integrator: {rtol: 1e-11, atol: 1e-12}\n")
     example = EXAMPLE.read_text(encoding="utf-8")
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "thrown.yaml",
-                                                _falling(example) + keys)), backend="numpy")
+    kernel = built(shared("thrown.yaml", _falling(example) + keys), "numpy")
     trajectory = symkin.solve(kernel, t=np.linspace(0, 0.5, 6))
     accel = _reference()
     reference = solve_ivp(lambda t, y: [y[2], y[3], *np.ravel(accel(*y))], (0, 0.5),

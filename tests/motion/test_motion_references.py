@@ -11,7 +11,8 @@ from typing import Any
 import numpy as np
 import pytest
 import sympy as sp
-from motion_support import CRANK_SLIDER, PENDULUM, write
+from motion_support import CRANK_SLIDER, PENDULUM, shared
+from motion_support import kernel as built
 from scipy.integrate import solve_ivp
 from scipy.special import ellipk
 
@@ -30,8 +31,8 @@ def test_a_pendulum_swings_with_the_period_of_the_elliptic_integral(tmp_path: Pa
                                                                     backend: str) -> None:
     amplitude = 2.0  # rad from the bottom: far from the small-angle period
     start = -math.pi / 2 + amplitude
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "p.yaml", PENDULUM.replace(
-        "PHI0", repr(start)))), backend=backend)
+    kernel = built(shared("p.yaml", PENDULUM.replace(
+        "PHI0", repr(start))), backend)
     assert kernel.backend == backend
     period = 4 * math.sqrt(1.3 / 9.81) * ellipk(math.sin(amplitude / 2) ** 2)
     # (the small-angle period 2 pi sqrt(L/g) differs by 30 %: the test sees the difference)
@@ -89,8 +90,8 @@ def test_every_row_satisfies_the_constraints_at_three_levels(crank_slider: Any) 
 
 
 def test_an_undamped_mechanism_keeps_its_energy_over_many_periods(tmp_path: Path) -> None:
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "p.yaml", PENDULUM.replace(
-        "PHI0", "0.3"))), backend="numpy")
+    kernel = built(shared("p.yaml", PENDULUM.replace(
+        "PHI0", "0.3")), "numpy")
     trajectory = symkin.solve(kernel, t=np.linspace(0, 60, 301))  # about 25 periods
     total, scale = _energy(trajectory)
     assert np.ptp(total) <= 1e-8 * scale
@@ -101,7 +102,7 @@ def test_an_undamped_mechanism_keeps_its_energy_over_many_periods(tmp_path: Path
 def test_a_damper_s_work_closes_the_energy_balance(tmp_path: Path) -> None:
     damped = CRANK_SLIDER.replace("SPRING", "20.0").replace("length0: 2.5}",
                                                              "length0: 2.5, damping: 3.0}")
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "d.yaml", damped)), backend="numpy")
+    kernel = built(shared("d.yaml", damped), "numpy")
     trajectory = symkin.solve(kernel)
     total, scale = _energy(trajectory)
     work = dict(trajectory.outputs)["work_nonconservative"]
@@ -139,7 +140,7 @@ def test_a_loose_tolerance_does_not_let_the_constraints_drift(tmp_path: Path) ->
     # projection after every step keeps each row on Φ = 0 and Φ_q q' = -Φ_t all the same
     loose = CRANK_SLIDER.replace("SPRING", "20.0").replace("rtol: 1e-11, atol: 1e-12",
                                                             "rtol: 1e-5, atol: 1e-7")
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "l.yaml", loose)), backend="numpy")
+    kernel = built(shared("l.yaml", loose), "numpy")
     trajectory = symkin.solve(kernel, t=np.linspace(0, 10, 21))
     p, model = kernel.p_values, kernel.model
     assert dict(trajectory.outputs)["constraint_residual"].max() <= 1e-10
@@ -153,7 +154,7 @@ def test_initial_velocities_take_the_parameters_the_run_is_given(tmp_path: Path)
     phi(t) = phi0 + w t (closed form), with the w the run is given, not the file's."""
     text = PENDULUM.replace("PHI0", "0.25").replace("g: 9.81}", "g: 9.81, w: 1.0}") + \
         "initial: {velocities: {rod.phi: 2*w}}\n"
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "w.yaml", text)), backend="numpy")
+    kernel = built(shared("w.yaml", text), "numpy")
     t = np.linspace(0.0, 1.0, 5)
     phi = kernel.coordinates.index("rod.phi")
     for w in (1.0, 3.0, -0.5):

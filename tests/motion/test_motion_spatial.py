@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from motion_support import write
+from motion_support import kernel as built
+from motion_support import shared
 
 import symkin
 
@@ -35,8 +36,7 @@ def _rotation(e: np.ndarray) -> np.ndarray:
 @pytest.mark.parametrize("backend", ["numpy", "c"])
 def test_a_free_body_keeps_its_energy_and_angular_momentum(tmp_path: Path,
                                                            backend: str) -> None:
-    kernel = symkin.compile(symkin.derive(write(tmp_path, "free.yaml", FREE_BODY)),
-                            backend=backend)
+    kernel = built(shared("free.yaml", FREE_BODY), backend)
     trajectory = symkin.solve(kernel)
     omega, _ = trajectory.angular()
     omega = omega[:, 0]
