@@ -8,8 +8,6 @@ System, bypassing codegen: a cross-check of the generated NumPy kernel. ``kernel
 from __future__ import annotations
 
 import hashlib
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -91,16 +89,10 @@ def derive(name: str):
 
 
 def mechanism_file(text: str) -> Path:
-    """``text`` as a YAML mechanism file at a place that depends on the text only: the run's
-    shared folder (tests/shared_builds.py), so that every test and backend that writes the same
-    text shares one derivation and one generation of it (codegen_support.derived, compiled)."""
-    folder = shared_builds.FOLDER[0] if shared_builds.FOLDER else Path(tempfile.gettempdir())
-    path = folder / f"text-{hashlib.sha256(text.encode()).hexdigest()[:24]}.yaml"
-    if not path.exists():
-        partial = path.with_name(f".{path.name}.{os.getpid()}")
-        partial.write_text(text, encoding="utf-8")
-        os.replace(partial, path)  # whole or absent, as shared_builds stores
-    return path
+    """``text`` as a YAML mechanism file shared by the run (shared_builds.text_file): every test
+    and backend that writes the same text shares one derivation and one generation of it."""
+    return shared_builds.text_file(f"text-{hashlib.sha256(text.encode()).hexdigest()[:24]}.yaml",
+                                   text)
 
 
 def kernel_of(text: str, backend: str):

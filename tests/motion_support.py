@@ -6,10 +6,7 @@ deriving and generating the same file again in each test (``shared`` and ``kerne
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -66,21 +63,9 @@ def write(tmp: Path, name: str, text: str) -> Path:
 
 
 def shared(name: str, text: str) -> Path:
-    """A mechanism file of ``text`` called ``name`` at a place that depends on the text alone,
-    in the run's shared folder (conftest's shared_builds_folder): every test and every worker
-    that writes the same file gets the same path, so codegen_support.derived and compiled (keyed
-    by path and bytes) derive and generate it once per run. ``write`` is for a file a test
-    means to have alone (its own folder, messages naming it)."""
-    digest = hashlib.sha256(f"{name}\0{text}".encode()).hexdigest()[:20]
-    root = shared_builds.FOLDER[0] if shared_builds.FOLDER else Path(tempfile.gettempdir())
-    folder = root / "files" / digest
-    path = folder / name
-    if not path.is_file():
-        folder.mkdir(parents=True, exist_ok=True)
-        partial = folder / f".{name}.{os.getpid()}"
-        partial.write_text(text, encoding="utf-8")
-        os.replace(partial, path)  # whole or absent for a worker reading it at once
-    return path
+    """A mechanism file of ``text`` called ``name``, shared by the run (shared_builds.text_file);
+    ``write`` is for a file a test means to have alone (its own folder, messages naming it)."""
+    return shared_builds.text_file(name, text)
 
 
 _SYSTEMS: dict[str, Any] = {}

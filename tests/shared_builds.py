@@ -20,6 +20,7 @@ import hashlib
 import os
 import pickle
 import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
@@ -66,3 +67,19 @@ def stored(kind: str, key: tuple[Any, ...], make: Callable[[], T]) -> T:
     partial.write_bytes(pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL))
     os.replace(partial, path)  # whole or absent: a reader never sees half a file
     return value
+
+
+def text_file(name: str, text: str) -> Path:
+    """A file of ``text`` called ``name`` at a place that depends on both alone, in the run's
+    folder: every test and every worker that writes the same file gets the same path, so
+    ``codegen_support.derived`` and ``compiled`` (keyed by path and bytes) derive and generate
+    it once per run. Outside a run, in the system's temporary folder."""
+    digest = hashlib.sha256(f"{name}\0{text}".encode()).hexdigest()[:20]
+    root = FOLDER[0] if FOLDER else Path(tempfile.gettempdir())
+    path = root / "files" / digest / name
+    if not path.is_file():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        partial = path.with_name(f".{name}.{os.getpid()}")
+        partial.write_text(text, encoding="utf-8")
+        os.replace(partial, path)  # whole or absent for a worker reading it at once
+    return path
