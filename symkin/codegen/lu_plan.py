@@ -28,7 +28,6 @@ lower part, multipliers) or U (upper part with the diagonal) of ``A[row_perm][:,
 
 from __future__ import annotations
 
-import bisect
 import dataclasses
 import math
 from collections.abc import Sequence
@@ -36,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from symkin.codegen.lu_search import Active, Search
 from symkin.errors import SolveError
 
 GENERATION_THRESHOLD = 0.1
@@ -101,80 +101,6 @@ class LUPlan:
     def solve_flops(self) -> int:
         """Multiply-adds of one forward + back substitution."""
         return sum(1 + len(s.lower) + len(s.upper) for s in self.steps)
-
-
-class _Active:
-    """The active submatrix during symbolic + numeric elimination of the sample.
-
-    Rows and columns are also kept in buckets by their entry count, so the Markowitz search
-    looks at the few sparsest ones first and the analysis stays near-linear in N.
-    """
-
-    def __init__(self, n: int, rows: Sequence[int], cols: Sequence[int],
-                 samples: np.ndarray) -> None:
-        # an entry's value is the array of its values in the samples (one column each)
-        self.row_entries: dict[int, dict[int, np.ndarray]] = {i: {} for i in range(n)}
-        self.col_rows: dict[int, set[int]] = {j: set() for j in range(n)}
-        self.slot: dict[tuple[int, int], int] = {}
-        self.width = samples.shape[1]
-        for e, (i, j) in enumerate(zip(rows, cols)):
-            self.row_entries[i][j] = samples[e].copy()
-            self.col_rows[j].add(i)
-            self.slot[(i, j)] = e
-        # count -> sorted indices, so the search visits them in a fixed order without sorting
-        self.row_bucket: dict[int, list[int]] = {}
-        self.col_bucket: dict[int, list[int]] = {}
-        for i, entries in self.row_entries.items():
-            self.row_bucket.setdefault(len(entries), []).append(i)
-        for j, members in self.col_rows.items():
-            self.col_bucket.setdefault(len(members), []).append(j)
-
-    def column_max(self, j: int) -> np.ndarray:
-        """max |a_.j| of the active column in each sample."""
-        entries = [np.abs(self.row_entries[i][j]) for i in self.col_rows[j]]
-        return np.max(entries, axis=0) if entries else np.zeros(self.width)
-
-    def cost(self, i: int, j: int) -> int:
-        """Markowitz cost: an upper bound on the fill-in this pivot can create."""
-        return (len(self.row_entries[i]) - 1) * (len(self.col_rows[j]) - 1)
-
-    def empty(self) -> bool:
-        """Whether some active row or column has no entry left (structural singularity)."""
-        return bool(self.row_bucket.get(0) or self.col_bucket.get(0))
-
-    def counts(self) -> list[int]:
-        return sorted({c for c, b in self.row_bucket.items() if b} |
-                      {c for c, b in self.col_bucket.items() if b})
-
-    @staticmethod
-    def _move(bucket: dict[int, list[int]], key: int, old: int, new: int | None) -> None:
-        members = bucket[old]
-        del members[bisect.bisect_left(members, key)]
-        if new is not None:
-            bisect.insort(bucket.setdefault(new, []), key)
-
-    def add(self, i: int, j: int, value: np.ndarray, slot: int) -> None:
-        """A new (fill-in) entry."""
-        self._move(self.row_bucket, i, len(self.row_entries[i]), len(self.row_entries[i]) + 1)
-        self._move(self.col_bucket, j, len(self.col_rows[j]), len(self.col_rows[j]) + 1)
-        self.row_entries[i][j] = value
-        self.col_rows[j].add(i)
-        self.slot[(i, j)] = slot
-
-    def remove_pivot(self, r: int, c: int
-                     ) -> tuple[dict[int, np.ndarray], np.ndarray, list[int]]:
-        """Take row r and column c out: (the rest of row r, the pivot, the other rows of c)."""
-        self._move(self.row_bucket, r, len(self.row_entries[r]), None)
-        self._move(self.col_bucket, c, len(self.col_rows[c]), None)
-        pivot_row = self.row_entries.pop(r)
-        pivot = pivot_row.pop(c)
-        others = sorted(self.col_rows.pop(c) - {r})
-        for j in pivot_row:
-            self._move(self.col_bucket, j, len(self.col_rows[j]), len(self.col_rows[j]) - 1)
-            self.col_rows[j].discard(r)
-        for i in others:
-            self._move(self.row_bucket, i, len(self.row_entries[i]), len(self.row_entries[i]) - 1)
-        return pivot_row, pivot, others
 
 
 def analyse(n: int, rows: Sequence[int], cols: Sequence[int], sample: Sequence[float],
@@ -254,10 +180,10 @@ def pivot_ratio(plan: LUPlan, rows: Sequence[int], cols: Sequence[int],
     """The smallest |pivot| / max |active column| of plan's order applied to ``sample``: the
     quantity the run-time pivot test compares with plan.tau."""
     values = _check_input(plan.n, rows, cols, [sample])
-    active = _Active(plan.n, [int(i) for i in rows], [int(j) for j in cols], values)
+    active = Active(plan.n, [int(i) for i in rows], [int(j) for j in cols], values)
     worst = math.inf
     for k, (i, j) in enumerate(zip(plan.row_perm, plan.col_perm)):
-        ratio = _Search(active, None).ratio(i, j)
+        ratio = Search(active, None).ratio(i, j)
         worst = min(worst, ratio)
         _eliminate(active, k, i, j, ratio, [], len(rows))
     return worst
@@ -269,7 +195,7 @@ def padded(plan: LUPlan, rows: Sequence[int], cols: Sequence[int],
     zeros (fill slots before any elimination), so that rows can share a pattern
     (lu_interchange); the sample ratios are not recomputed."""
     rows, cols = [int(i) for i in rows], [int(j) for j in cols]
-    active = _Active(plan.n, rows, cols, np.zeros((len(rows), 1)))
+    active = Active(plan.n, rows, cols, np.zeros((len(rows), 1)))
     fill: list[tuple[int, int]] = []
     for i, j in padding:
         active.add(i, j, np.zeros(1), len(rows) + len(fill))
@@ -283,7 +209,7 @@ def _order(n: int, rows: list[int], cols: list[int], values: np.ndarray,
            threshold: float | None, tau: float) -> LUPlan:
     """Eliminate pivot by pivot; ``threshold`` None chooses on structure alone, else only
     among entries that pass the threshold test on the sample (structure when none does)."""
-    active = _Active(n, rows, cols, values)
+    active = Active(n, rows, cols, values)
     steps: list[Step] = []
     fill: list[tuple[int, int]] = []
     unchecked: list[int] = []
@@ -315,53 +241,7 @@ def _check_input(n: int, rows: Sequence[int], cols: Sequence[int],
     return values
 
 
-class _Search:
-    """The state of one Markowitz search: the best candidate so far, and the cheapest entry."""
-
-    def __init__(self, active: _Active, u: float | None) -> None:
-        self.active = active
-        self.u = u  # None: every structural entry is a candidate
-        self.best: tuple[int, tuple[int, int]] | None = None  # (cost, (i, j))
-        self.structural: tuple[int, tuple[int, int]] | None = None  # (cost, (i, j))
-        self.column_max: dict[int, np.ndarray] = {}
-
-    def ratio(self, i: int, j: int) -> float:
-        """The least |a_ij| / max |a_.j| over the active samples (0 in a zero column)."""
-        if j not in self.column_max:
-            self.column_max[j] = self.active.column_max(j)
-        largest = self.column_max[j]
-        ratios = np.divide(np.abs(self.active.row_entries[i][j]), largest,
-                           out=np.zeros_like(largest), where=largest > 0)
-        return float(ratios.min())
-
-    def consider(self, i: int, j: int) -> bool:
-        """Record (i, j); True when nothing can beat it: a candidate creating no fill."""
-        cost = self.active.cost(i, j)
-        if self.structural is None or (cost, (i, j)) < self.structural:
-            self.structural = (cost, (i, j))
-        if self.u is not None:
-            ratio = self.ratio(i, j)
-            if ratio == 0.0 or ratio < self.u:
-                return False
-        if self.best is None or (cost, (i, j)) < self.best:
-            self.best = (cost, (i, j))
-        return cost == 0
-
-    def scan(self) -> None:
-        """Columns, then rows, of count 1, 2, ...; stop when nothing unseen can do better."""
-        active = self.active
-        for count in active.counts():
-            for j in active.col_bucket.get(count, ()):
-                if any(self.consider(i, j) for i in sorted(active.col_rows[j])):
-                    return
-            for i in active.row_bucket.get(count, ()):
-                if any(self.consider(i, j) for j in sorted(active.row_entries[i])):
-                    return
-            if self.best is not None and self.best[0] <= count * count:
-                return
-
-
-def _choose_pivot(active: _Active, u: float | None
+def _choose_pivot(active: Active, u: float | None
                   ) -> tuple[tuple[int, int], float, bool] | None:
     """Markowitz search over columns, then rows, of count 1, 2, ... (Zlatev's strategy).
 
@@ -378,7 +258,7 @@ def _choose_pivot(active: _Active, u: float | None
     """
     if active.empty():
         return None
-    search = _Search(active, u)
+    search = Search(active, u)
     search.scan()
     if search.best is not None:
         (i, j) = search.best[1]
@@ -386,7 +266,7 @@ def _choose_pivot(active: _Active, u: float | None
     if u is not None and u > RUNTIME_THRESHOLD:
         # No entry passes u in every sample (possible with several): one that passes the
         # run-time test in all of them still keeps the factorization off the dense path.
-        looser = _Search(active, RUNTIME_THRESHOLD)
+        looser = Search(active, RUNTIME_THRESHOLD)
         looser.scan()
         if looser.best is not None:
             (i, j) = looser.best[1]
@@ -397,7 +277,7 @@ def _choose_pivot(active: _Active, u: float | None
     return (i, j), search.ratio(i, j), False
 
 
-def _eliminate(active: _Active, k: int, r: int, c: int, ratio: float,
+def _eliminate(active: Active, k: int, r: int, c: int, ratio: float,
                fill: list[tuple[int, int]], nnz: int) -> Step:
     """Eliminate pivot (r, c) from the active submatrix, recording slots and fill-in."""
     pivot_row, pivot, others = active.remove_pivot(r, c)
@@ -434,7 +314,7 @@ def _permute(n: int, nnz: int, steps: list[Step], fill: list[tuple[int, int]], t
                   steps=permuted, fill=tuple(fill), tau=tau, unchecked=unchecked)
 
 
-def _structural_message(active: _Active) -> str:
+def _structural_message(active: Active) -> str:
     empty_cols = [j for j, r in active.col_rows.items() if not r]
     empty_rows = [i for i, r in active.row_entries.items() if not r]
     return ("the Jacobian's pattern is structurally singular: after eliminating what can be "
