@@ -141,6 +141,7 @@ int main()
          * is met, so both run through */
         @P@_options wide = o;
         wide.target_dq = wide.target_ddq = 1e300;
+        @P@_region_for(&wide, &w); /* other targets: as a call, without the run's region */
         MEASURE("flagged", @P@_flagged(&wide, &w, &r, 1e30, 1, 1, 2));
     }
     {   /* the refined model at its longest: the norm bound flags (ddq's target 0), the
@@ -150,6 +151,7 @@ int main()
         for (i = 0; i < @U@_NQ; ++i) ddq[i] = s.ddq[i];
         late.target_q = late.target_dq = 1e300;
         late.target_ddq = 0;
+        @P@_region_for(&late, &w);
         MEASURE("refined", @P@_flagged_refined(&late, &w, &r, 1, 1, 1, q, dq, ddq, 0.3,
                                                params));
     }
@@ -175,6 +177,7 @@ int main()
         @P@_phi_phi_q(q, s.t, params, w.phi, w.nz, w.shared);
         @P@_lu_factor(w.nz, &w.lu);
         r.residual = @P@_max_abs(w.phi);
+        @P@_region_for(&more, &w);
         MEASURE("converged", @P@_converged(&more, params, s.t, q, INFINITY, &w, &r));
     }
 #endif

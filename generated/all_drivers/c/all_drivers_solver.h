@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 627 (208 add/sub, 149 mul, 22 div, 0 sqrt, 9 other calls, 132 fabs, 107 compares)
  *   Phi, Phi_q, their factorization and tests: 487; the update (a solve): 140
- * Condition at the converged q: 470; an extra iteration there (at most 3): 801
- * Velocity: 112; acceleration: 189; per-point checks: 2145; predictor: 63
- * Step, worst case with the default cap of 25 iterations: 22110 (7584 add/sub, 5601 mul, 773 div, 10 sqrt, 280 other calls, 4306 fabs, 3556 compares)
+ * Condition at the converged q: 470; an extra iteration there (at most 3): 825
+ * Velocity: 112; acceleration: 189; per-point checks: 2257; predictor: 63
+ * Step, worst case with the default cap of 25 iterations: 22309 (7603 add/sub, 5636 mul, 789 div, 12 sqrt, 280 other calls, 4306 fabs, 3683 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 129994
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 130193
  */
 #define ALL_DRIVERS_OPS_ITERATION 627   /* one Newton iteration */
-#define ALL_DRIVERS_OPS_STEP_FIXED 6435  /* a step without its iterations */
-#define ALL_DRIVERS_OPS_STEP_WORST 22110  /* at the default cap, 25 */
-#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 129994  /* every factorization dense */
+#define ALL_DRIVERS_OPS_STEP_FIXED 6634  /* a step without its iterations */
+#define ALL_DRIVERS_OPS_STEP_WORST 22309  /* at the default cap, 25 */
+#define ALL_DRIVERS_OPS_STEP_DENSE_WORST 130193  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ALL_DRIVERS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     all_drivers_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     all_drivers_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     all_drivers_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    all_drivers_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     all_drivers_real column[ALL_DRIVERS_NQ]; /* options->unit where q_i is a length, else 1 */
     all_drivers_real inverse_column[ALL_DRIVERS_NQ]; /* 1 / column */
     all_drivers_real row[ALL_DRIVERS_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 585 (206 add/sub, 121 mul, 28 div, 0 sqrt, 14 other calls, 116 fabs, 100 compares)
  *   Phi, Phi_q, their factorization and tests: 417; the update (a solve): 168
- * Condition at the converged q: 447; an extra iteration there (at most 3): 765
- * Velocity: 104; acceleration: 148; per-point checks: 2488; predictor: 87
- * Step, worst case with the default cap of 25 iterations: 21154 (7698 add/sub, 4624 mul, 995 div, 10 sqrt, 434 other calls, 3954 fabs, 3439 compares)
+ * Condition at the converged q: 447; an extra iteration there (at most 3): 789
+ * Velocity: 104; acceleration: 148; per-point checks: 2610; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 21363 (7717 add/sub, 4669 mul, 1011 div, 12 sqrt, 434 other calls, 3954 fabs, 3566 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284320
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 284529
  */
 #define ANDREWS_SQUEEZER_OPS_ITERATION 585   /* one Newton iteration */
-#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6529  /* a step without its iterations */
-#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21154  /* at the default cap, 25 */
-#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284320  /* every factorization dense */
+#define ANDREWS_SQUEEZER_OPS_STEP_FIXED 6738  /* a step without its iterations */
+#define ANDREWS_SQUEEZER_OPS_STEP_WORST 21363  /* at the default cap, 25 */
+#define ANDREWS_SQUEEZER_OPS_STEP_DENSE_WORST 284529  /* every factorization dense */
 
 typedef struct {
     int status;                  /* ANDREWS_SQUEEZER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     andrews_squeezer_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     andrews_squeezer_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     andrews_squeezer_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    andrews_squeezer_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     andrews_squeezer_real column[ANDREWS_SQUEEZER_NQ]; /* options->unit where q_i is a length, else 1 */
     andrews_squeezer_real inverse_column[ANDREWS_SQUEEZER_NQ]; /* 1 / column */
     andrews_squeezer_real row[ANDREWS_SQUEEZER_NQ]; /* options->unit where Phi_i is a length, else 1 */

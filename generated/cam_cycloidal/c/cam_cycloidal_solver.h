@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 402 (142 add/sub, 170 mul, 16 div, 1 sqrt, 18 other calls, 23 fabs, 32 compares)
  *   Phi, Phi_q, their factorization and tests: 353; the update (a solve): 49
- * Condition at the converged q: 40; an extra iteration there (at most 3): 568
- * Velocity: 27; acceleration: 520; per-point checks: 1542; predictor: 31
- * Step, worst case with the default cap of 25 iterations: 14403 (5045 add/sub, 6113 mul, 554 div, 42 sqrt, 576 other calls, 813 fabs, 1260 compares)
+ * Condition at the converged q: 40; an extra iteration there (at most 3): 592
+ * Velocity: 27; acceleration: 520; per-point checks: 1660; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 14608 (5064 add/sub, 6154 mul, 570 div, 44 sqrt, 576 other calls, 813 fabs, 1387 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31440
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 31645
  */
 #define CAM_CYCLOIDAL_OPS_ITERATION 402   /* one Newton iteration */
-#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4353  /* a step without its iterations */
-#define CAM_CYCLOIDAL_OPS_STEP_WORST 14403  /* at the default cap, 25 */
-#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31440  /* every factorization dense */
+#define CAM_CYCLOIDAL_OPS_STEP_FIXED 4558  /* a step without its iterations */
+#define CAM_CYCLOIDAL_OPS_STEP_WORST 14608  /* at the default cap, 25 */
+#define CAM_CYCLOIDAL_OPS_STEP_DENSE_WORST 31645  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CAM_CYCLOIDAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     cam_cycloidal_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     cam_cycloidal_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     cam_cycloidal_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    cam_cycloidal_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     cam_cycloidal_real column[CAM_CYCLOIDAL_NQ]; /* options->unit where q_i is a length, else 1 */
     cam_cycloidal_real inverse_column[CAM_CYCLOIDAL_NQ]; /* 1 / column */
     cam_cycloidal_real row[CAM_CYCLOIDAL_NQ]; /* options->unit where Phi_i is a length, else 1 */

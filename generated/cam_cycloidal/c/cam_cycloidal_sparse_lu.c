@@ -56,10 +56,10 @@ static cam_cycloidal_real cam_cycloidal_lu_load(const cam_cycloidal_real nz[], c
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[5]); v[5] = nz[5]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[7]); v[7] = nz[7]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[9]); v[9] = nz[9]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[5]); v[5] = nz[5]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[7]); v[7] = nz[7]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[9]); v[9] = nz[9]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in cam_cycloidal_dense_lu_tiny. */
     return CAM_CYCLOIDAL_LU_TINY * amax + finite;
 }

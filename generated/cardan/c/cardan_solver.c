@@ -70,22 +70,25 @@ static int cardan_refused(cardan_report *report, cardan_real t)
 static cardan_real cardan_max_abs(const cardan_real v[])
 {
     cardan_real largest = 0, sum = 0;
-    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
-     * inf cannot occur) */
-    { const cardan_real a = fabs(v[0]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[1]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[2]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[3]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[4]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[5]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[6]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[7]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[8]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[9]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[10]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[11]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[12]); largest = a > largest ? a : largest; sum += a; }
-    { const cardan_real a = fabs(v[13]); largest = a > largest ? a : largest; sum += a; }
+    /* a branch-free max, written largest-first: x86's max instruction keeps its first
+     * operand where the other is not larger, so a, which the sum reads too, needs no copy (an
+     * instruction an entry fewer; a NaN a may or may not stay in largest, the sum finds it).
+     * The sum is NaN exactly when some |v_i| is (none is negative: inf - inf cannot occur).
+     * The passes below write their maxima alike. */
+    { const cardan_real a = fabs(v[0]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[1]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[2]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[3]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[4]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[5]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[6]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[7]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[8]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[9]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[10]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[11]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[12]); largest = largest > a ? largest : a; sum += a; }
+    { const cardan_real a = fabs(v[13]); largest = largest > a ? largest : a; sum += a; }
     return sum != sum ? (cardan_real)NAN : largest;
 }
 
@@ -118,6 +121,7 @@ static void cardan_prepare(cardan_real unit, cardan_workspace *work)
     cardan_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->region[0] = -1; /* no region of the error model's bound yet */
     work->scaled = unit != 1 && CARDAN_SCALE_FREE;
     if (!work->scaled) unit = 1;
     for (i = 0; i < CARDAN_NQ; ++i) {
@@ -414,15 +418,102 @@ static int cardan_within_bound(const cardan_options *options,
         && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
 }
 
-/* cardan_flagged with s and the residual's error `left` worked out. */
-static int cardan_flagged_at(const cardan_options *options,
-                                   const cardan_report *report, cardan_real s, cardan_real left,
-                                   cardan_real nq, cardan_real ndq, cardan_real nddq, int judged)
+/* The region the cheap bound was proven for (work->region, cardan_widen): the points
+ * whose Newton correction was not solved for, with ||Phi_q^-1||_1 <= region[0], residual
+ * <= region[1] and max |q|, |dq| <= region[corner], region[corner + 1], at the targets
+ * region[4..6] (each call checks those once, cardan_region_for); corner 2 for the last
+ * point's norms (within_bound is then taken at twice them plus one, as would_flag takes it),
+ * 7 for this point's. Every operation from these numbers to within_bound's tests (s, left,
+ * the widened norms, the tests) is monotone in each of them, also as rounded (products and
+ * sums of numbers >= 0, a max), and the region's corner is finite (no 0 * inf): the bound
+ * holds at every point of the region, and a few comparisons stand for it. A NaN fails them. */
+static int cardan_covered(const cardan_workspace *work,
+                                const cardan_report *report, cardan_real nq, cardan_real ndq,
+                                int corner)
+{
+    const cardan_real *r = work->region;
+    return work->correction < 0 && report->inv_norm <= r[0] && report->residual <= r[1]
+        && nq <= r[corner] && ndq <= r[corner + 1] && report->cond < (cardan_real)INFINITY;
+}
+
+/* The region holds at the targets it was proven for: a call that goes on from an earlier
+ * state with other targets starts without one (cardan_prepare clears it for a fresh
+ * start). Every entry point that steps on from a state calls this, once a call. */
+static void cardan_region_for(const cardan_options *options,
+                                    cardan_workspace *work)
+{
+    if (!(options->target_q == work->region[4] && options->target_dq == work->region[5]
+          && options->target_ddq == work->region[6])) {
+        work->region[0] = -1;
+    }
+}
+
+/* Prove the cheap bound for a region around a point whose correction was not solved for:
+ * its ||Phi_q^-1||_1 and the norms nq, ndq an eighth larger (norms at least 1), and the
+ * largest residual the targets allow there (within_bound's three tests solved for the error
+ * of q, halved for their rounding), kept in work->region where within_bound holds at that
+ * corner (the norms taken at twice them plus one, as would_flag takes them: region[7..8]).
+ * The points that follow lie in it until the condition or the motion grows by an eighth
+ * (a converged point's residual is anywhere below tol_phi: the corner leaves the bound's
+ * slack to it). 1 when the region holds the point. */
+static int cardan_widen(const cardan_options *options, cardan_workspace *work,
+                              const cardan_report *report, cardan_real nq, cardan_real ndq)
+{
+    const cardan_real u = CARDAN_UNIT_ROUNDOFF, margin = 2 * CARDAN_SAFETY;
+    const cardan_real grow = (cardan_real)1.125; /* 9 / 8: exact in binary */
+    const cardan_real inv_norm = grow * report->inv_norm;
+    /* norms below 1 grow up to 1 (the model takes max(1, norm) where it scales by them) */
+    const cardan_real wide_q = cardan_at_least_1(grow * nq);
+    const cardan_real wide_dq = cardan_at_least_1(grow * ndq);
+    const cardan_real s = inv_norm / sqrt((cardan_real)CARDAN_NQ);
+    const cardan_real corner_q = 2 * wide_q + 1, corner_dq = 2 * wide_dq + 1;
+    const cardan_real a = cardan_at_least_1(corner_dq);
+    const cardan_real x_dq = options->target_dq / margin;
+    const cardan_real x_ddq = options->target_ddq / (margin * (1 + a * a * (1 + 2 * s)));
+    cardan_real most = (x_dq < x_ddq ? x_dq : x_ddq) / s - u, residual, e_q;
+    most = (options->target_q / margin < most ? options->target_q / margin : most) / 2;
+    residual = most / s;
+    if (!(work->correction < 0 && residual >= 0 && s * residual < (cardan_real)INFINITY
+          && corner_q < (cardan_real)INFINITY && corner_dq < (cardan_real)INFINITY)
+        || !cardan_within_bound(options, report, s, s * residual, corner_q, corner_dq,
+                                      &e_q)) {
+        return 0;
+    }
+    work->region[0] = inv_norm;
+    work->region[1] = residual;
+    work->region[2] = wide_q;
+    work->region[3] = wide_dq;
+    work->region[4] = options->target_q;
+    work->region[5] = options->target_dq;
+    work->region[6] = options->target_ddq;
+    work->region[7] = corner_q;
+    work->region[8] = corner_dq;
+    return report->residual <= residual;
+}
+
+/* Where the last point's norms (work->norms) and this report lie in the region: the cheap
+ * bound holds at twice the norms plus one, so it clears the end of the step for norms up to
+ * the region's there (work->clear). 1 when they do. Inline: it is most steps' whole error
+ * model, a call would cost a third of it. */
+static inline int cardan_region_clears(cardan_workspace *work,
+                                             const cardan_report *report)
+{
+    if (!cardan_covered(work, report, work->norms[0], work->norms[1], 2)) {
+        return 0;
+    }
+    work->clear[0] = work->region[7];
+    work->clear[1] = work->region[8];
+    return 1;
+}
+
+/* The model where the cheap bound failed, with its e_q. */
+static int cardan_model_flags(const cardan_options *options,
+                                    const cardan_report *report, cardan_real s, cardan_real e_q,
+                                    cardan_real nq, cardan_real ndq, cardan_real nddq, int judged)
 {
     const cardan_real u = CARDAN_UNIT_ROUNDOFF;
     const cardan_real a = cardan_at_least_1(ndq);
-    cardan_real e_q, e_dq, e_ddq;
-    if (cardan_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    cardan_real e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
     e_dq = s * (u * ndq + e_q * a);
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
@@ -434,15 +525,21 @@ static int cardan_flagged_at(const cardan_options *options,
 /* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
- * decides first; the model runs where the bound fails. */
-static int cardan_flagged(const cardan_options *options,
-                                const cardan_workspace *work,
+ * decides first (by the region where it was proven, else evaluated, a region proven for the
+ * points to come where it holds); the model runs where the bound fails. */
+static int cardan_flagged(const cardan_options *options, cardan_workspace *work,
                                 const cardan_report *report, cardan_real nq, cardan_real ndq,
                                 cardan_real nddq, int judged)
 {
     const cardan_real s = report->inv_norm / sqrt((cardan_real)CARDAN_NQ);
     const cardan_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    return cardan_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
+    cardan_real e_q;
+    if (cardan_covered(work, report, nq, ndq, 7)) return 0;
+    if (cardan_within_bound(options, report, s, left, nq, ndq, &e_q)) {
+        cardan_widen(options, work, report, nq, ndq); /* for the points to come */
+        return 0;
+    }
+    return cardan_model_flags(options, report, s, e_q, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -554,7 +651,7 @@ static void cardan_propagated(const cardan_workspace *work, cardan_real size, ca
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int cardan_flagged_refined(const cardan_options *options,
-                                        const cardan_workspace *work,
+                                        cardan_workspace *work,
                                         const cardan_report *report, cardan_real nq,
                                         cardan_real ndq, cardan_real nddq, const cardan_real q[],
                                         const cardan_real dq[], const cardan_real ddq[], cardan_real t,
@@ -578,8 +675,9 @@ static int cardan_flagged_refined(const cardan_options *options,
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
  * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
- * at the end of the step too if the new norms are within those (work->clear; the residual,
- * condition and correction unchanged), and the model need not run again there. */
+ * at the end of the step too if the new norms are within those (work->clear, the region's
+ * where it holds there; the residual, condition and correction unchanged), and the model
+ * need not run again there. */
 static int cardan_would_flag(const cardan_options *options,
                                    cardan_workspace *work,
                                    const cardan_report *report)
@@ -591,13 +689,16 @@ static int cardan_would_flag(const cardan_options *options,
     cardan_real e_q;
     if (!(report->residual > CARDAN_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
     if (cardan_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
-        work->clear[0] = wide_q;
-        work->clear[1] = wide_dq;
+        if (!cardan_widen(options, work, report, norms[0], norms[1])
+            || !cardan_region_clears(work, report)) {
+            work->clear[0] = wide_q;
+            work->clear[1] = wide_dq;
+        }
         return 0;
     }
-    return cardan_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
+    if (cardan_within_bound(options, report, s, left, norms[0], norms[1], &e_q)) return 0;
+    return cardan_model_flags(options, report, s, e_q, norms[0], norms[1], norms[2], 2);
 }
-
 /* At a converged point: estimate the condition. Where the error model would flag the point
  * as Newton left it, solve for the Newton correction: its size is the error of q the residual
  * leaves (to first order), which judges the point instead of the model's bound from the
@@ -618,6 +719,7 @@ static int cardan_converged(const cardan_options *options, const cardan_real p[]
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (cardan_real)INFINITY
+                && !cardan_region_clears(work, report)
                 && cardan_would_flag(options, work, report))) {
         for (extra = 0; extra < CARDAN_TIGHTEN_STEPS; ++extra) {
             cardan_real size;
@@ -723,143 +825,148 @@ static void cardan_predict(cardan_real t, cardan_state *state)
     state->q[13] += state->dq[13] * h + state->ddq[13] * half_h2;
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
- * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. The
- * test is one addition an entry: the sum of |.| is NaN exactly when some entry is (none is
- * negative: inf - inf cannot occur), and an infinite entry is the largest. */
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
+ * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
+ * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
+ * largest), and dq in the kernel's unit. */
 static cardan_real cardan_rates_pass(const cardan_workspace *work, cardan_real dq[],
-                                       cardan_real *finite)
+                                       cardan_real *sum_abs)
 {
     cardan_real largest = 0, sum = 0;
-    { const cardan_real b = fabs(dq[0]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[0]); largest = largest > b ? largest : b; sum += b; }
     dq[0] = -dq[0];
-    { const cardan_real b = fabs(dq[1]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[1]); largest = largest > b ? largest : b; sum += b; }
     dq[1] = -dq[1];
-    { const cardan_real b = fabs(dq[2]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[2]); largest = largest > b ? largest : b; sum += b; }
     dq[2] = -dq[2];
-    { const cardan_real b = fabs(dq[3]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[3]); largest = largest > b ? largest : b; sum += b; }
     dq[3] = -dq[3];
-    { const cardan_real b = fabs(dq[4]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[4]); largest = largest > b ? largest : b; sum += b; }
     dq[4] = -dq[4];
-    { const cardan_real b = fabs(dq[5]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[5]); largest = largest > b ? largest : b; sum += b; }
     dq[5] = -dq[5];
-    { const cardan_real b = fabs(dq[6]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[6]); largest = largest > b ? largest : b; sum += b; }
     dq[6] = -dq[6];
-    { const cardan_real b = fabs(dq[7]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[7]); largest = largest > b ? largest : b; sum += b; }
     dq[7] = -dq[7];
-    { const cardan_real b = fabs(dq[8]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[8]); largest = largest > b ? largest : b; sum += b; }
     dq[8] = -dq[8];
-    { const cardan_real b = fabs(dq[9]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[9]); largest = largest > b ? largest : b; sum += b; }
     dq[9] = -dq[9];
-    { const cardan_real b = fabs(dq[10]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[10]); largest = largest > b ? largest : b; sum += b; }
     dq[10] = -dq[10];
-    { const cardan_real b = fabs(dq[11]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[11]); largest = largest > b ? largest : b; sum += b; }
     dq[11] = -dq[11];
-    { const cardan_real b = fabs(dq[12]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[12]); largest = largest > b ? largest : b; sum += b; }
     dq[12] = -dq[12];
-    { const cardan_real b = fabs(dq[13]); largest = b > largest ? b : largest; sum += b; }
+    { const cardan_real b = fabs(dq[13]); largest = largest > b ? largest : b; sum += b; }
     dq[13] = -dq[13];
     cardan_from_unit(work, dq);
-    *finite = sum != sum ? (cardan_real)NAN : largest - largest;
+    *sum_abs = sum;
     return largest;
 }
 
 /* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
- * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+ * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
+ * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
+ * then flags the point). */
 static cardan_real cardan_accelerations_pass(const cardan_workspace *work,
                                                const cardan_real q[], cardan_real ddq[],
-                                               cardan_real *finite, cardan_real *nq)
+                                               cardan_real *sum_abs, cardan_real *nq)
 {
-    cardan_real largest = 0, sum = 0, largest_q = 0, sum_q = 0;
+    cardan_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
     /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division) */
-    { const cardan_real c = fabs(ddq[0]); largest = c > largest ? c : largest; sum += c; }
+     * a coordinate that is no length is the same in every unit (no division); the lengths'
+     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
+     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
+    { const cardan_real c = fabs(ddq[0]); largest = largest > c ? largest : c; sum += c; }
     {
-        const cardan_real a = fabs(q[0]) * work->inverse_column[0];
-        largest_q = a > largest_q ? a : largest_q;
+        const cardan_real a = fabs(q[0]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[1]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[1]); largest = largest > c ? largest : c; sum += c; }
     {
-        const cardan_real a = fabs(q[1]) * work->inverse_column[1];
-        largest_q = a > largest_q ? a : largest_q;
+        const cardan_real a = fabs(q[1]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[2]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[2]); largest = largest > c ? largest : c; sum += c; }
     {
-        const cardan_real a = fabs(q[2]) * work->inverse_column[2];
-        largest_q = a > largest_q ? a : largest_q;
+        const cardan_real a = fabs(q[2]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[3]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[3]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[3]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[4]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[4]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[4]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[5]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[5]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[5]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[6]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[6]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[6]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[7]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[7]); largest = largest > c ? largest : c; sum += c; }
     {
-        const cardan_real a = fabs(q[7]) * work->inverse_column[7];
-        largest_q = a > largest_q ? a : largest_q;
+        const cardan_real a = fabs(q[7]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[8]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[8]); largest = largest > c ? largest : c; sum += c; }
     {
-        const cardan_real a = fabs(q[8]) * work->inverse_column[8];
-        largest_q = a > largest_q ? a : largest_q;
+        const cardan_real a = fabs(q[8]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[9]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[9]); largest = largest > c ? largest : c; sum += c; }
     {
-        const cardan_real a = fabs(q[9]) * work->inverse_column[9];
-        largest_q = a > largest_q ? a : largest_q;
+        const cardan_real a = fabs(q[9]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[10]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[10]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[10]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[11]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[11]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[11]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[12]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[12]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[12]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const cardan_real c = fabs(ddq[13]); largest = c > largest ? c : largest; sum += c; }
+    { const cardan_real c = fabs(ddq[13]); largest = largest > c ? largest : c; sum += c; }
     {
         const cardan_real a = fabs(q[13]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
+    largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
+    largest_q = largest_q > largest_length ? largest_q : largest_length;
     cardan_from_unit(work, ddq);
-    *finite = sum != sum ? (cardan_real)NAN : largest - largest;
+    *sum_abs = sum;
     *nq = sum_q != sum_q ? (cardan_real)NAN : largest_q;
     return largest;
 }
@@ -869,7 +976,7 @@ static int cardan_step(const cardan_options *options, const cardan_real p[],
                              cardan_real t, cardan_state *state,
                              cardan_workspace *work, cardan_report *report)
 {
-    cardan_real nq, ndq, nddq, finite_dq, finite_ddq;
+    cardan_real nq, ndq, nddq, sum_dq, sum_ddq, largest;
     report->flagged = 0;
     report->cond = (cardan_real)NAN;
     if (state->started) {
@@ -878,7 +985,7 @@ static int cardan_step(const cardan_options *options, const cardan_real p[],
         cardan_prepare(options->unit, work);
     }
     report->status = cardan_newton(options, p, t, state->q, work, report);
-    report->fallbacks = cardan_lu_fallbacks(&work->lu);
+    report->fallbacks = work->lu.fallbacks; /* cardan_lu_fallbacks, without a call */
     if (report->status != CARDAN_OK) {
         return report->status;
     }
@@ -888,12 +995,15 @@ static int cardan_step(const cardan_options *options, const cardan_real p[],
     cardan_phi_t_shared(state->q, t, p, work->shared, state->dq);
     cardan_rows_in_unit(work, state->dq);
     cardan_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = cardan_rates_pass(work, state->dq, &finite_dq);
+    ndq = cardan_rates_pass(work, state->dq, &sum_dq);
     cardan_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     cardan_rows_in_unit(work, state->ddq);
     cardan_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = cardan_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
-    if (finite_dq != 0 || finite_ddq != 0) {
+    nddq = cardan_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
+     * overflow harmlessly), infinite where the larger maximum is */
+    largest = ndq > nddq ? ndq : nddq;
+    if (sum_dq + sum_ddq != sum_dq + sum_ddq || largest - largest != 0) {
         report->status = CARDAN_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
@@ -915,6 +1025,7 @@ int cardan_solve_step(const cardan_options *options, const cardan_real p[], card
                             cardan_report *report)
 {
     if (cardan_check_options(options) != 0) return cardan_refused(report, t);
+    if (state->started) cardan_region_for(options, work); /* else prepared afresh */
     return cardan_step(options, p, t, state, work, report);
 }
 
@@ -941,6 +1052,7 @@ int cardan_solve_grid_checked(const cardan_options *options,
         cardan_refused(report, t[0]);
         return 0;
     }
+    if (n > 0 && state->started) cardan_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (cardan_step(options, p, t[k], state, work, report) != CARDAN_OK) {
             return k;

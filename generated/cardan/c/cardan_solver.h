@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 994 (359 add/sub, 312 mul, 23 div, 0 sqrt, 4 other calls, 164 fabs, 132 compares)
  *   Phi, Phi_q, their factorization and tests: 794; the update (a solve): 200
- * Condition at the converged q: 2542; an extra iteration there (at most 3): 1167
- * Velocity: 174; acceleration: 382; per-point checks: 3070; predictor: 59
- * Step, worst case with the default cap of 25 iterations: 38010 (14528 add/sub, 12270 mul, 796 div, 10 sqrt, 266 other calls, 5540 fabs, 4600 compares)
+ * Condition at the converged q: 2542; an extra iteration there (at most 3): 1191
+ * Velocity: 174; acceleration: 382; per-point checks: 3186; predictor: 59
+ * Step, worst case with the default cap of 25 iterations: 38213 (14547 add/sub, 12309 mul, 812 div, 12 sqrt, 266 other calls, 5540 fabs, 4727 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 122833
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123036
  */
 #define CARDAN_OPS_ITERATION 994   /* one Newton iteration */
-#define CARDAN_OPS_STEP_FIXED 13160  /* a step without its iterations */
-#define CARDAN_OPS_STEP_WORST 38010  /* at the default cap, 25 */
-#define CARDAN_OPS_STEP_DENSE_WORST 122833  /* every factorization dense */
+#define CARDAN_OPS_STEP_FIXED 13363  /* a step without its iterations */
+#define CARDAN_OPS_STEP_WORST 38213  /* at the default cap, 25 */
+#define CARDAN_OPS_STEP_DENSE_WORST 123036  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CARDAN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     cardan_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     cardan_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     cardan_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    cardan_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     cardan_real column[CARDAN_NQ]; /* options->unit where q_i is a length, else 1 */
     cardan_real inverse_column[CARDAN_NQ]; /* 1 / column */
     cardan_real row[CARDAN_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 190 (73 add/sub, 41 mul, 11 div, 1 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 126; the update (a solve): 64
- * Condition at the converged q: 44; an extra iteration there (at most 3): 358
- * Velocity: 37; acceleration: 56; per-point checks: 1022; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 7288 (2726 add/sub, 1715 mul, 406 div, 42 sqrt, 124 other calls, 969 fabs, 1306 compares)
+ * Condition at the converged q: 44; an extra iteration there (at most 3): 382
+ * Velocity: 37; acceleration: 56; per-point checks: 1138; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 7491 (2745 add/sub, 1754 mul, 422 div, 44 sqrt, 124 other calls, 969 fabs, 1433 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38076
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38279
  */
 #define CRANK_SLIDER_DRAWN_OPS_ITERATION 190   /* one Newton iteration */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2538  /* a step without its iterations */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7288  /* at the default cap, 25 */
-#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38076  /* every factorization dense */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_FIXED 2741  /* a step without its iterations */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_WORST 7491  /* at the default cap, 25 */
+#define CRANK_SLIDER_DRAWN_OPS_STEP_DENSE_WORST 38279  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     crank_slider_drawn_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_drawn_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     crank_slider_drawn_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    crank_slider_drawn_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     crank_slider_drawn_real column[CRANK_SLIDER_DRAWN_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_drawn_real inverse_column[CRANK_SLIDER_DRAWN_NQ]; /* 1 / column */
     crank_slider_drawn_real row[CRANK_SLIDER_DRAWN_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 366 (127 add/sub, 91 mul, 13 div, 0 sqrt, 6 other calls, 68 fabs, 61 compares)
  *   Phi, Phi_q, their factorization and tests: 285; the update (a solve): 81
- * Condition at the converged q: 187; an extra iteration there (at most 3): 534
- * Velocity: 54; acceleration: 113; per-point checks: 1311; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 13024 (4579 add/sub, 3419 mul, 464 div, 10 sqrt, 186 other calls, 2234 fabs, 2132 compares)
+ * Condition at the converged q: 187; an extra iteration there (at most 3): 558
+ * Velocity: 54; acceleration: 113; per-point checks: 1427; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 13227 (4598 add/sub, 3458 mul, 480 div, 12 sqrt, 186 other calls, 2234 fabs, 2259 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43267
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 43470
  */
 #define CRANK_SLIDER_GENERAL_OPS_ITERATION 366   /* one Newton iteration */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 3874  /* a step without its iterations */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13024  /* at the default cap, 25 */
-#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43267  /* every factorization dense */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_FIXED 4077  /* a step without its iterations */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_WORST 13227  /* at the default cap, 25 */
+#define CRANK_SLIDER_GENERAL_OPS_STEP_DENSE_WORST 43470  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_GENERAL_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     crank_slider_general_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_general_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     crank_slider_general_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    crank_slider_general_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     crank_slider_general_real column[CRANK_SLIDER_GENERAL_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_general_real inverse_column[CRANK_SLIDER_GENERAL_NQ]; /* 1 / column */
     crank_slider_general_real row[CRANK_SLIDER_GENERAL_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -70,19 +70,19 @@ static crank_slider_general_real crank_slider_general_lu_load(const crank_slider
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[1]); v[1] = nz[1]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[3]); v[3] = nz[3]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[5]); v[5] = nz[5]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[7]); v[7] = nz[7]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[9]); v[9] = nz[9]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[13]); v[13] = nz[13]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[15]); v[15] = nz[15]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[17]); v[17] = nz[17]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[19]); v[19] = nz[19]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[21]); v[21] = nz[21]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[22]); v[22] = nz[22]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[23]); v[23] = nz[23]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[1]); v[1] = nz[1]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[3]); v[3] = nz[3]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[5]); v[5] = nz[5]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[7]); v[7] = nz[7]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[9]); v[9] = nz[9]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[13]); v[13] = nz[13]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[15]); v[15] = nz[15]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[17]); v[17] = nz[17]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[19]); v[19] = nz[19]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[21]); v[21] = nz[21]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[22]); v[22] = nz[22]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[23]); v[23] = nz[23]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in crank_slider_general_dense_lu_tiny. */
     return CRANK_SLIDER_GENERAL_LU_TINY * amax + finite;
 }

@@ -58,21 +58,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 176 (66 add/sub, 35 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 112; the update (a solve): 64
- * Condition at the converged q: 44; an extra iteration there (at most 3): 344
- * Velocity: 37; acceleration: 44; per-point checks: 999; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 6847 (2507 add/sub, 1525 mul, 406 div, 10 sqrt, 124 other calls, 969 fabs, 1306 compares)
+ * Condition at the converged q: 44; an extra iteration there (at most 3): 368
+ * Velocity: 37; acceleration: 44; per-point checks: 1115; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 7050 (2526 add/sub, 1564 mul, 422 div, 12 sqrt, 124 other calls, 969 fabs, 1433 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 7553 (2824 add/sub, 1653 mul, 465 div, 10 sqrt, 148 other calls, 1032 fabs, 1421 compares)
- *   positions only (du, ddu NULL): 7398 (2777 add/sub, 1601 mul, 447 div, 10 sqrt, 148 other calls, 1014 fabs, 1401 compares)
+ * solve_inputs, worst case: 7760 (2842 add/sub, 1697 mul, 481 div, 12 sqrt, 148 other calls, 1032 fabs, 1548 compares)
+ *   positions only (du, ddu NULL): 7605 (2795 add/sub, 1645 mul, 463 div, 12 sqrt, 148 other calls, 1014 fabs, 1528 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 656
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37635
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37838
  */
 #define CRANK_SLIDER_INPUT_OPS_ITERATION 176   /* one Newton iteration */
-#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2447  /* a step without its iterations */
-#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 6847  /* at the default cap, 25 */
-#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37635  /* every factorization dense */
-#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7553  /* solve_inputs with du, ddu */
-#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7398  /* solve_inputs, du, ddu NULL */
+#define CRANK_SLIDER_INPUT_OPS_STEP_FIXED 2650  /* a step without its iterations */
+#define CRANK_SLIDER_INPUT_OPS_STEP_WORST 7050  /* at the default cap, 25 */
+#define CRANK_SLIDER_INPUT_OPS_STEP_DENSE_WORST 37838  /* every factorization dense */
+#define CRANK_SLIDER_INPUT_OPS_INPUTS_WORST 7760  /* solve_inputs with du, ddu */
+#define CRANK_SLIDER_INPUT_OPS_POSITIONS_WORST 7605  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_INPUT_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -111,6 +111,8 @@ typedef struct {
     crank_slider_input_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_input_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     crank_slider_input_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    crank_slider_input_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     crank_slider_input_real column[CRANK_SLIDER_INPUT_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_input_real inverse_column[CRANK_SLIDER_INPUT_NQ]; /* 1 / column */
     crank_slider_input_real row[CRANK_SLIDER_INPUT_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 177 (66 add/sub, 36 mul, 11 div, 0 sqrt, 4 other calls, 27 fabs, 33 compares)
  *   Phi, Phi_q, their factorization and tests: 113; the update (a solve): 64
- * Condition at the converged q: 44; an extra iteration there (at most 3): 345
- * Velocity: 37; acceleration: 44; per-point checks: 999; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 6876 (2505 add/sub, 1556 mul, 406 div, 10 sqrt, 124 other calls, 969 fabs, 1306 compares)
+ * Condition at the converged q: 44; an extra iteration there (at most 3): 369
+ * Velocity: 37; acceleration: 44; per-point checks: 1115; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 7079 (2524 add/sub, 1595 mul, 422 div, 12 sqrt, 124 other calls, 969 fabs, 1433 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37664
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 37867
  */
 #define CRANK_SLIDER_LOAD_OPS_ITERATION 177   /* one Newton iteration */
-#define CRANK_SLIDER_LOAD_OPS_STEP_FIXED 2451  /* a step without its iterations */
-#define CRANK_SLIDER_LOAD_OPS_STEP_WORST 6876  /* at the default cap, 25 */
-#define CRANK_SLIDER_LOAD_OPS_STEP_DENSE_WORST 37664  /* every factorization dense */
+#define CRANK_SLIDER_LOAD_OPS_STEP_FIXED 2654  /* a step without its iterations */
+#define CRANK_SLIDER_LOAD_OPS_STEP_WORST 7079  /* at the default cap, 25 */
+#define CRANK_SLIDER_LOAD_OPS_STEP_DENSE_WORST 37867  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CRANK_SLIDER_LOAD_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     crank_slider_load_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     crank_slider_load_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     crank_slider_load_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    crank_slider_load_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     crank_slider_load_real column[CRANK_SLIDER_LOAD_NQ]; /* options->unit where q_i is a length, else 1 */
     crank_slider_load_real inverse_column[CRANK_SLIDER_LOAD_NQ]; /* 1 / column */
     crank_slider_load_real row[CRANK_SLIDER_LOAD_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -62,10 +62,10 @@ static crank_slider_load_real crank_slider_load_lu_load(const crank_slider_load_
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[3]); v[3] = nz[3]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[6]); v[6] = nz[6]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[9]); v[9] = nz[9]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[12]); v[12] = nz[12]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[3]); v[3] = nz[3]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[6]); v[6] = nz[6]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[9]); v[9] = nz[9]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[12]); v[12] = nz[12]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in crank_slider_load_dense_lu_tiny. */
     return CRANK_SLIDER_LOAD_LU_TINY * amax + finite;
 }

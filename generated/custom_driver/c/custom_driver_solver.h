@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 220 (81 add/sub, 46 mul, 12 div, 0 sqrt, 7 other calls, 35 fabs, 39 compares)
  *   Phi, Phi_q, their factorization and tests: 151; the update (a solve): 69
- * Condition at the converged q: 98; an extra iteration there (at most 3): 388
- * Velocity: 55; acceleration: 98; per-point checks: 1150; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 8449 (3059 add/sub, 2002 mul, 435 div, 10 sqrt, 226 other calls, 1229 fabs, 1488 compares)
+ * Condition at the converged q: 98; an extra iteration there (at most 3): 412
+ * Velocity: 55; acceleration: 98; per-point checks: 1266; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8652 (3078 add/sub, 2041 mul, 451 div, 12 sqrt, 226 other calls, 1229 fabs, 1615 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38950
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39153
  */
 #define CUSTOM_DRIVER_OPS_ITERATION 220   /* one Newton iteration */
-#define CUSTOM_DRIVER_OPS_STEP_FIXED 2949  /* a step without its iterations */
-#define CUSTOM_DRIVER_OPS_STEP_WORST 8449  /* at the default cap, 25 */
-#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 38950  /* every factorization dense */
+#define CUSTOM_DRIVER_OPS_STEP_FIXED 3152  /* a step without its iterations */
+#define CUSTOM_DRIVER_OPS_STEP_WORST 8652  /* at the default cap, 25 */
+#define CUSTOM_DRIVER_OPS_STEP_DENSE_WORST 39153  /* every factorization dense */
 
 typedef struct {
     int status;                  /* CUSTOM_DRIVER_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     custom_driver_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     custom_driver_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     custom_driver_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    custom_driver_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     custom_driver_real column[CUSTOM_DRIVER_NQ]; /* options->unit where q_i is a length, else 1 */
     custom_driver_real inverse_column[CUSTOM_DRIVER_NQ]; /* 1 / column */
     custom_driver_real row[CUSTOM_DRIVER_NQ]; /* options->unit where Phi_i is a length, else 1 */

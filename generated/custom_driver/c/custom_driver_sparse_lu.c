@@ -60,13 +60,13 @@ static custom_driver_real custom_driver_lu_load(const custom_driver_real nz[], c
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[3]); v[3] = nz[3]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[6]); v[6] = nz[6]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[9]); v[9] = nz[9]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[12]); v[12] = nz[12]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[16]); v[16] = nz[16]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[17]); v[17] = nz[17]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[18]); v[18] = nz[18]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[3]); v[3] = nz[3]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[6]); v[6] = nz[6]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[9]); v[9] = nz[9]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[12]); v[12] = nz[12]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[16]); v[16] = nz[16]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[17]); v[17] = nz[17]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[18]); v[18] = nz[18]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in custom_driver_dense_lu_tiny. */
     return CUSTOM_DRIVER_LU_TINY * amax + finite;
 }

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 3602 (1360 add/sub, 1335 mul, 48 div, 0 sqrt, 9 other calls, 485 fabs, 365 compares)
  *   Phi, Phi_q, their factorization and tests: 3199; the update (a solve): 403
- * Condition at the converged q: 5260; an extra iteration there (at most 3): 3789
- * Velocity: 405; acceleration: 2639; per-point checks: 9194; predictor: 115
- * Step, worst case with the default cap of 25 iterations: 127585 (49860 add/sub, 47846 mul, 1633 div, 10 sqrt, 592 other calls, 15757 fabs, 11887 compares)
+ * Condition at the converged q: 5260; an extra iteration there (at most 3): 3813
+ * Velocity: 405; acceleration: 2639; per-point checks: 9316; predictor: 115
+ * Step, worst case with the default cap of 25 iterations: 127794 (49879 add/sub, 47891 mul, 1649 div, 12 sqrt, 592 other calls, 15757 fabs, 12014 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689209
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 689418
  */
 #define DELTA_OPS_ITERATION 3602   /* one Newton iteration */
-#define DELTA_OPS_STEP_FIXED 37535  /* a step without its iterations */
-#define DELTA_OPS_STEP_WORST 127585  /* at the default cap, 25 */
-#define DELTA_OPS_STEP_DENSE_WORST 689209  /* every factorization dense */
+#define DELTA_OPS_STEP_FIXED 37744  /* a step without its iterations */
+#define DELTA_OPS_STEP_WORST 127794  /* at the default cap, 25 */
+#define DELTA_OPS_STEP_DENSE_WORST 689418  /* every factorization dense */
 
 typedef struct {
     int status;                  /* DELTA_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     delta_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     delta_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     delta_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    delta_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     delta_real column[DELTA_NQ]; /* options->unit where q_i is a length, else 1 */
     delta_real inverse_column[DELTA_NQ]; /* 1 / column */
     delta_real row[DELTA_NQ]; /* options->unit where Phi_i is a length, else 1 */

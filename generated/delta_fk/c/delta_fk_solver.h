@@ -58,21 +58,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 3591 (1356 add/sub, 1331 mul, 48 div, 0 sqrt, 6 other calls, 485 fabs, 365 compares)
  *   Phi, Phi_q, their factorization and tests: 3188; the update (a solve): 403
- * Condition at the converged q: 5260; an extra iteration there (at most 3): 3778
- * Velocity: 395; acceleration: 2603; per-point checks: 9125; predictor: 115
- * Step, worst case with the default cap of 25 iterations: 127151 (49716 add/sub, 47676 mul, 1633 div, 10 sqrt, 472 other calls, 15757 fabs, 11887 compares)
+ * Condition at the converged q: 5260; an extra iteration there (at most 3): 3802
+ * Velocity: 395; acceleration: 2603; per-point checks: 9247; predictor: 115
+ * Step, worst case with the default cap of 25 iterations: 127360 (49735 add/sub, 47721 mul, 1649 div, 12 sqrt, 472 other calls, 15757 fabs, 12014 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 133667 (52630 add/sub, 50568 mul, 1806 div, 10 sqrt, 508 other calls, 15953 fabs, 12192 compares)
- *   positions only (du, ddu NULL): 130443 (51280 add/sub, 48864 mul, 1750 div, 10 sqrt, 508 other calls, 15897 fabs, 12134 compares)
+ * solve_inputs, worst case: 133874 (52648 add/sub, 50612 mul, 1822 div, 12 sqrt, 508 other calls, 15953 fabs, 12319 compares)
+ *   positions only (du, ddu NULL): 130650 (51298 add/sub, 48908 mul, 1766 div, 12 sqrt, 508 other calls, 15897 fabs, 12261 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 6374
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 688775
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 688984
  */
 #define DELTA_FK_OPS_ITERATION 3591   /* one Newton iteration */
-#define DELTA_FK_OPS_STEP_FIXED 37376  /* a step without its iterations */
-#define DELTA_FK_OPS_STEP_WORST 127151  /* at the default cap, 25 */
-#define DELTA_FK_OPS_STEP_DENSE_WORST 688775  /* every factorization dense */
-#define DELTA_FK_OPS_INPUTS_WORST 133667  /* solve_inputs with du, ddu */
-#define DELTA_FK_OPS_POSITIONS_WORST 130443  /* solve_inputs, du, ddu NULL */
+#define DELTA_FK_OPS_STEP_FIXED 37585  /* a step without its iterations */
+#define DELTA_FK_OPS_STEP_WORST 127360  /* at the default cap, 25 */
+#define DELTA_FK_OPS_STEP_DENSE_WORST 688984  /* every factorization dense */
+#define DELTA_FK_OPS_INPUTS_WORST 133874  /* solve_inputs with du, ddu */
+#define DELTA_FK_OPS_POSITIONS_WORST 130650  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* DELTA_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -111,6 +111,8 @@ typedef struct {
     delta_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     delta_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     delta_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    delta_fk_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     delta_fk_real column[DELTA_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     delta_fk_real inverse_column[DELTA_FK_NQ]; /* 1 / column */
     delta_fk_real row[DELTA_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -72,12 +72,12 @@ static four_bar_real four_bar_lu_load(const four_bar_real nz[], four_bar_real v[
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[3]); v[3] = nz[3]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[6]); v[6] = nz[6]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[9]); v[9] = nz[9]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[13]); v[13] = nz[13]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[15]); v[15] = nz[15]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[3]); v[3] = nz[3]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[6]); v[6] = nz[6]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[9]); v[9] = nz[9]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[13]); v[13] = nz[13]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[15]); v[15] = nz[15]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in four_bar_dense_lu_tiny. */
     return FOUR_BAR_LU_TINY * amax + finite;
 }

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 225 (76 add/sub, 46 mul, 12 div, 0 sqrt, 6 other calls, 42 fabs, 43 compares)
  *   Phi, Phi_q, their factorization and tests: 159; the update (a solve): 66
- * Condition at the converged q: 57; an extra iteration there (at most 3): 393
- * Velocity: 39; acceleration: 52; per-point checks: 1042; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 8345 (2816 add/sub, 1892 mul, 435 div, 10 sqrt, 186 other calls, 1408 fabs, 1598 compares)
+ * Condition at the converged q: 57; an extra iteration there (at most 3): 417
+ * Velocity: 39; acceleration: 52; per-point checks: 1158; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8548 (2835 add/sub, 1931 mul, 451 div, 12 sqrt, 186 other calls, 1408 fabs, 1725 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39045
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 39248
  */
 #define FOUR_BAR_DYNAMICS_OPS_ITERATION 225   /* one Newton iteration */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2720  /* a step without its iterations */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8345  /* at the default cap, 25 */
-#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39045  /* every factorization dense */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_FIXED 2923  /* a step without its iterations */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_WORST 8548  /* at the default cap, 25 */
+#define FOUR_BAR_DYNAMICS_OPS_STEP_DENSE_WORST 39248  /* every factorization dense */
 
 typedef struct {
     int status;                  /* FOUR_BAR_DYNAMICS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     four_bar_dynamics_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     four_bar_dynamics_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     four_bar_dynamics_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    four_bar_dynamics_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     four_bar_dynamics_real column[FOUR_BAR_DYNAMICS_NQ]; /* options->unit where q_i is a length, else 1 */
     four_bar_dynamics_real inverse_column[FOUR_BAR_DYNAMICS_NQ]; /* 1 / column */
     four_bar_dynamics_real row[FOUR_BAR_DYNAMICS_NQ]; /* options->unit where Phi_i is a length, else 1 */

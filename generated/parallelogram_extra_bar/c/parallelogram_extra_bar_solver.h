@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 314 (108 add/sub, 71 mul, 16 div, 0 sqrt, 10 other calls, 55 fabs, 54 compares)
  *   Phi, Phi_q, their factorization and tests: 224; the update (a solve): 90
- * Condition at the converged q: 124; an extra iteration there (at most 3): 485
- * Velocity: 53; acceleration: 93; per-point checks: 1412; predictor: 51
- * Step, worst case with the default cap of 25 iterations: 11482 (3992 add/sub, 2760 mul, 575 div, 10 sqrt, 310 other calls, 1869 fabs, 1966 compares)
+ * Condition at the converged q: 124; an extra iteration there (at most 3): 509
+ * Velocity: 53; acceleration: 93; per-point checks: 1526; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 11683 (4011 add/sub, 2797 mul, 591 div, 12 sqrt, 310 other calls, 1869 fabs, 2093 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73339
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73540
  */
 #define PARALLELOGRAM_EXTRA_BAR_OPS_ITERATION 314   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3632  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11482  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73339  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_FIXED 3833  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_WORST 11683  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_OPS_STEP_DENSE_WORST 73540  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     parallelogram_extra_bar_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     parallelogram_extra_bar_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     parallelogram_extra_bar_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    parallelogram_extra_bar_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     parallelogram_extra_bar_real column[PARALLELOGRAM_EXTRA_BAR_NQ]; /* options->unit where q_i is a length, else 1 */
     parallelogram_extra_bar_real inverse_column[PARALLELOGRAM_EXTRA_BAR_NQ]; /* 1 / column */
     parallelogram_extra_bar_real row[PARALLELOGRAM_EXTRA_BAR_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -78,14 +78,14 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_lu_load(const parall
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[5]); v[5] = nz[5]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[8]); v[8] = nz[8]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[13]); v[13] = nz[13]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[15]); v[15] = nz[15]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[17]); v[17] = nz[17]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[21]); v[21] = nz[21]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[23]); v[23] = nz[23]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[5]); v[5] = nz[5]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[8]); v[8] = nz[8]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[13]); v[13] = nz[13]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[15]); v[15] = nz[15]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[17]); v[17] = nz[17]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[21]); v[21] = nz[21]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[23]); v[23] = nz[23]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in parallelogram_extra_bar_dense_lu_tiny. */
     return PARALLELOGRAM_EXTRA_BAR_LU_TINY * amax + finite;
 }

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 381 (138 add/sub, 88 mul, 19 div, 0 sqrt, 11 other calls, 63 fabs, 62 compares)
  *   Phi, Phi_q, their factorization and tests: 267; the update (a solve): 114
- * Condition at the converged q: 197; an extra iteration there (at most 3): 555
- * Velocity: 73; acceleration: 113; per-point checks: 1755; predictor: 63
- * Step, worst case with the default cap of 25 iterations: 13951 (5106 add/sub, 3361 mul, 686 div, 10 sqrt, 342 other calls, 2207 fabs, 2239 compares)
+ * Condition at the converged q: 197; an extra iteration there (at most 3): 579
+ * Velocity: 73; acceleration: 113; per-point checks: 1867; predictor: 63
+ * Step, worst case with the default cap of 25 iterations: 14150 (5125 add/sub, 3396 mul, 702 div, 12 sqrt, 342 other calls, 2207 fabs, 2366 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123155
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 123354
  */
 #define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_ITERATION 381   /* one Newton iteration */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4426  /* a step without its iterations */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 13951  /* at the default cap, 25 */
-#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123155  /* every factorization dense */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_FIXED 4625  /* a step without its iterations */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_WORST 14150  /* at the default cap, 25 */
+#define PARALLELOGRAM_EXTRA_BAR_LOADS_OPS_STEP_DENSE_WORST 123354  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PARALLELOGRAM_EXTRA_BAR_LOADS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     parallelogram_extra_bar_loads_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     parallelogram_extra_bar_loads_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     parallelogram_extra_bar_loads_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    parallelogram_extra_bar_loads_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     parallelogram_extra_bar_loads_real column[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* options->unit where q_i is a length, else 1 */
     parallelogram_extra_bar_loads_real inverse_column[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* 1 / column */
     parallelogram_extra_bar_loads_real row[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -87,16 +87,16 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_lu_load(
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[5]); v[5] = nz[5]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[8]); v[8] = nz[8]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[13]); v[13] = nz[13]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[15]); v[15] = nz[15]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[17]); v[17] = nz[17]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[21]); v[21] = nz[21]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[23]); v[23] = nz[23]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[25]); v[25] = nz[25]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[28]); v[28] = nz[28]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[5]); v[5] = nz[5]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[8]); v[8] = nz[8]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[13]); v[13] = nz[13]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[15]); v[15] = nz[15]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[17]); v[17] = nz[17]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[21]); v[21] = nz[21]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[23]); v[23] = nz[23]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[25]); v[25] = nz[25]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[28]); v[28] = nz[28]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in parallelogram_extra_bar_loads_dense_lu_tiny. */
     return PARALLELOGRAM_EXTRA_BAR_LOADS_LU_TINY * amax + finite;
 }

@@ -70,17 +70,20 @@ static int planetary_refused(planetary_report *report, planetary_real t)
 static planetary_real planetary_max_abs(const planetary_real v[])
 {
     planetary_real largest = 0, sum = 0;
-    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
-     * inf cannot occur) */
-    { const planetary_real a = fabs(v[0]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[1]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[2]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[3]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[4]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[5]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[6]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[7]); largest = a > largest ? a : largest; sum += a; }
-    { const planetary_real a = fabs(v[8]); largest = a > largest ? a : largest; sum += a; }
+    /* a branch-free max, written largest-first: x86's max instruction keeps its first
+     * operand where the other is not larger, so a, which the sum reads too, needs no copy (an
+     * instruction an entry fewer; a NaN a may or may not stay in largest, the sum finds it).
+     * The sum is NaN exactly when some |v_i| is (none is negative: inf - inf cannot occur).
+     * The passes below write their maxima alike. */
+    { const planetary_real a = fabs(v[0]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[1]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[2]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[3]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[4]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[5]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[6]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[7]); largest = largest > a ? largest : a; sum += a; }
+    { const planetary_real a = fabs(v[8]); largest = largest > a ? largest : a; sum += a; }
     return sum != sum ? (planetary_real)NAN : largest;
 }
 
@@ -113,6 +116,7 @@ static void planetary_prepare(planetary_real unit, planetary_workspace *work)
     planetary_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->region[0] = -1; /* no region of the error model's bound yet */
     work->scaled = unit != 1 && PLANETARY_SCALE_FREE;
     if (!work->scaled) unit = 1;
     for (i = 0; i < PLANETARY_NQ; ++i) {
@@ -327,13 +331,13 @@ static planetary_real planetary_inverse_norm1_exact(const planetary_real v[], co
     (void)inv;
     s = fabs(w6) + fabs(w5) + fabs(w4) + fabs(w1) + 1.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(w12) + fabs(w11) + fabs(w10) + fabs(w7);
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(w16) + fabs(w15) + fabs(w14) + fabs(inv[8]);
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     return finite == 0 ? largest : (planetary_real)INFINITY;
 }
 
@@ -438,15 +442,102 @@ static int planetary_within_bound(const planetary_options *options,
         && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
 }
 
-/* planetary_flagged with s and the residual's error `left` worked out. */
-static int planetary_flagged_at(const planetary_options *options,
-                                   const planetary_report *report, planetary_real s, planetary_real left,
-                                   planetary_real nq, planetary_real ndq, planetary_real nddq, int judged)
+/* The region the cheap bound was proven for (work->region, planetary_widen): the points
+ * whose Newton correction was not solved for, with ||Phi_q^-1||_1 <= region[0], residual
+ * <= region[1] and max |q|, |dq| <= region[corner], region[corner + 1], at the targets
+ * region[4..6] (each call checks those once, planetary_region_for); corner 2 for the last
+ * point's norms (within_bound is then taken at twice them plus one, as would_flag takes it),
+ * 7 for this point's. Every operation from these numbers to within_bound's tests (s, left,
+ * the widened norms, the tests) is monotone in each of them, also as rounded (products and
+ * sums of numbers >= 0, a max), and the region's corner is finite (no 0 * inf): the bound
+ * holds at every point of the region, and a few comparisons stand for it. A NaN fails them. */
+static int planetary_covered(const planetary_workspace *work,
+                                const planetary_report *report, planetary_real nq, planetary_real ndq,
+                                int corner)
+{
+    const planetary_real *r = work->region;
+    return work->correction < 0 && report->inv_norm <= r[0] && report->residual <= r[1]
+        && nq <= r[corner] && ndq <= r[corner + 1] && report->cond < (planetary_real)INFINITY;
+}
+
+/* The region holds at the targets it was proven for: a call that goes on from an earlier
+ * state with other targets starts without one (planetary_prepare clears it for a fresh
+ * start). Every entry point that steps on from a state calls this, once a call. */
+static void planetary_region_for(const planetary_options *options,
+                                    planetary_workspace *work)
+{
+    if (!(options->target_q == work->region[4] && options->target_dq == work->region[5]
+          && options->target_ddq == work->region[6])) {
+        work->region[0] = -1;
+    }
+}
+
+/* Prove the cheap bound for a region around a point whose correction was not solved for:
+ * its ||Phi_q^-1||_1 and the norms nq, ndq an eighth larger (norms at least 1), and the
+ * largest residual the targets allow there (within_bound's three tests solved for the error
+ * of q, halved for their rounding), kept in work->region where within_bound holds at that
+ * corner (the norms taken at twice them plus one, as would_flag takes them: region[7..8]).
+ * The points that follow lie in it until the condition or the motion grows by an eighth
+ * (a converged point's residual is anywhere below tol_phi: the corner leaves the bound's
+ * slack to it). 1 when the region holds the point. */
+static int planetary_widen(const planetary_options *options, planetary_workspace *work,
+                              const planetary_report *report, planetary_real nq, planetary_real ndq)
+{
+    const planetary_real u = PLANETARY_UNIT_ROUNDOFF, margin = 2 * PLANETARY_SAFETY;
+    const planetary_real grow = (planetary_real)1.125; /* 9 / 8: exact in binary */
+    const planetary_real inv_norm = grow * report->inv_norm;
+    /* norms below 1 grow up to 1 (the model takes max(1, norm) where it scales by them) */
+    const planetary_real wide_q = planetary_at_least_1(grow * nq);
+    const planetary_real wide_dq = planetary_at_least_1(grow * ndq);
+    const planetary_real s = inv_norm / sqrt((planetary_real)PLANETARY_NQ);
+    const planetary_real corner_q = 2 * wide_q + 1, corner_dq = 2 * wide_dq + 1;
+    const planetary_real a = planetary_at_least_1(corner_dq);
+    const planetary_real x_dq = options->target_dq / margin;
+    const planetary_real x_ddq = options->target_ddq / (margin * (1 + a * a * (1 + 2 * s)));
+    planetary_real most = (x_dq < x_ddq ? x_dq : x_ddq) / s - u, residual, e_q;
+    most = (options->target_q / margin < most ? options->target_q / margin : most) / 2;
+    residual = most / s;
+    if (!(work->correction < 0 && residual >= 0 && s * residual < (planetary_real)INFINITY
+          && corner_q < (planetary_real)INFINITY && corner_dq < (planetary_real)INFINITY)
+        || !planetary_within_bound(options, report, s, s * residual, corner_q, corner_dq,
+                                      &e_q)) {
+        return 0;
+    }
+    work->region[0] = inv_norm;
+    work->region[1] = residual;
+    work->region[2] = wide_q;
+    work->region[3] = wide_dq;
+    work->region[4] = options->target_q;
+    work->region[5] = options->target_dq;
+    work->region[6] = options->target_ddq;
+    work->region[7] = corner_q;
+    work->region[8] = corner_dq;
+    return report->residual <= residual;
+}
+
+/* Where the last point's norms (work->norms) and this report lie in the region: the cheap
+ * bound holds at twice the norms plus one, so it clears the end of the step for norms up to
+ * the region's there (work->clear). 1 when they do. Inline: it is most steps' whole error
+ * model, a call would cost a third of it. */
+static inline int planetary_region_clears(planetary_workspace *work,
+                                             const planetary_report *report)
+{
+    if (!planetary_covered(work, report, work->norms[0], work->norms[1], 2)) {
+        return 0;
+    }
+    work->clear[0] = work->region[7];
+    work->clear[1] = work->region[8];
+    return 1;
+}
+
+/* The model where the cheap bound failed, with its e_q. */
+static int planetary_model_flags(const planetary_options *options,
+                                    const planetary_report *report, planetary_real s, planetary_real e_q,
+                                    planetary_real nq, planetary_real ndq, planetary_real nddq, int judged)
 {
     const planetary_real u = PLANETARY_UNIT_ROUNDOFF;
     const planetary_real a = planetary_at_least_1(ndq);
-    planetary_real e_q, e_dq, e_ddq;
-    if (planetary_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    planetary_real e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
     e_dq = s * (u * ndq + e_q * a);
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
@@ -458,15 +549,21 @@ static int planetary_flagged_at(const planetary_options *options,
 /* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
- * decides first; the model runs where the bound fails. */
-static int planetary_flagged(const planetary_options *options,
-                                const planetary_workspace *work,
+ * decides first (by the region where it was proven, else evaluated, a region proven for the
+ * points to come where it holds); the model runs where the bound fails. */
+static int planetary_flagged(const planetary_options *options, planetary_workspace *work,
                                 const planetary_report *report, planetary_real nq, planetary_real ndq,
                                 planetary_real nddq, int judged)
 {
     const planetary_real s = report->inv_norm / sqrt((planetary_real)PLANETARY_NQ);
     const planetary_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    return planetary_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
+    planetary_real e_q;
+    if (planetary_covered(work, report, nq, ndq, 7)) return 0;
+    if (planetary_within_bound(options, report, s, left, nq, ndq, &e_q)) {
+        planetary_widen(options, work, report, nq, ndq); /* for the points to come */
+        return 0;
+    }
+    return planetary_model_flags(options, report, s, e_q, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -578,7 +675,7 @@ static void planetary_propagated(const planetary_workspace *work, planetary_real
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int planetary_flagged_refined(const planetary_options *options,
-                                        const planetary_workspace *work,
+                                        planetary_workspace *work,
                                         const planetary_report *report, planetary_real nq,
                                         planetary_real ndq, planetary_real nddq, const planetary_real q[],
                                         const planetary_real dq[], const planetary_real ddq[], planetary_real t,
@@ -602,8 +699,9 @@ static int planetary_flagged_refined(const planetary_options *options,
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
  * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
- * at the end of the step too if the new norms are within those (work->clear; the residual,
- * condition and correction unchanged), and the model need not run again there. */
+ * at the end of the step too if the new norms are within those (work->clear, the region's
+ * where it holds there; the residual, condition and correction unchanged), and the model
+ * need not run again there. */
 static int planetary_would_flag(const planetary_options *options,
                                    planetary_workspace *work,
                                    const planetary_report *report)
@@ -615,13 +713,16 @@ static int planetary_would_flag(const planetary_options *options,
     planetary_real e_q;
     if (!(report->residual > PLANETARY_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
     if (planetary_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
-        work->clear[0] = wide_q;
-        work->clear[1] = wide_dq;
+        if (!planetary_widen(options, work, report, norms[0], norms[1])
+            || !planetary_region_clears(work, report)) {
+            work->clear[0] = wide_q;
+            work->clear[1] = wide_dq;
+        }
         return 0;
     }
-    return planetary_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
+    if (planetary_within_bound(options, report, s, left, norms[0], norms[1], &e_q)) return 0;
+    return planetary_model_flags(options, report, s, e_q, norms[0], norms[1], norms[2], 2);
 }
-
 /* At a converged point: estimate the condition. Where the error model would flag the point
  * as Newton left it, solve for the Newton correction: its size is the error of q the residual
  * leaves (to first order), which judges the point instead of the model's bound from the
@@ -642,6 +743,7 @@ static int planetary_converged(const planetary_options *options, const planetary
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (planetary_real)INFINITY
+                && !planetary_region_clears(work, report)
                 && planetary_would_flag(options, work, report))) {
         for (extra = 0; extra < PLANETARY_TIGHTEN_STEPS; ++extra) {
             planetary_real size;
@@ -737,103 +839,108 @@ static void planetary_predict(planetary_real t, planetary_state *state)
     state->q[8] += state->dq[8] * h + state->ddq[8] * half_h2;
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
- * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. The
- * test is one addition an entry: the sum of |.| is NaN exactly when some entry is (none is
- * negative: inf - inf cannot occur), and an infinite entry is the largest. */
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
+ * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
+ * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
+ * largest), and dq in the kernel's unit. */
 static planetary_real planetary_rates_pass(const planetary_workspace *work, planetary_real dq[],
-                                       planetary_real *finite)
+                                       planetary_real *sum_abs)
 {
     planetary_real largest = 0, sum = 0;
-    { const planetary_real b = fabs(dq[0]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[0]); largest = largest > b ? largest : b; sum += b; }
     dq[0] = -dq[0];
-    { const planetary_real b = fabs(dq[1]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[1]); largest = largest > b ? largest : b; sum += b; }
     dq[1] = -dq[1];
-    { const planetary_real b = fabs(dq[2]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[2]); largest = largest > b ? largest : b; sum += b; }
     dq[2] = -dq[2];
-    { const planetary_real b = fabs(dq[3]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[3]); largest = largest > b ? largest : b; sum += b; }
     dq[3] = -dq[3];
-    { const planetary_real b = fabs(dq[4]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[4]); largest = largest > b ? largest : b; sum += b; }
     dq[4] = -dq[4];
-    { const planetary_real b = fabs(dq[5]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[5]); largest = largest > b ? largest : b; sum += b; }
     dq[5] = -dq[5];
-    { const planetary_real b = fabs(dq[6]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[6]); largest = largest > b ? largest : b; sum += b; }
     dq[6] = -dq[6];
-    { const planetary_real b = fabs(dq[7]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[7]); largest = largest > b ? largest : b; sum += b; }
     dq[7] = -dq[7];
-    { const planetary_real b = fabs(dq[8]); largest = b > largest ? b : largest; sum += b; }
+    { const planetary_real b = fabs(dq[8]); largest = largest > b ? largest : b; sum += b; }
     dq[8] = -dq[8];
     planetary_from_unit(work, dq);
-    *finite = sum != sum ? (planetary_real)NAN : largest - largest;
+    *sum_abs = sum;
     return largest;
 }
 
 /* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
- * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+ * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
+ * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
+ * then flags the point). */
 static planetary_real planetary_accelerations_pass(const planetary_workspace *work,
                                                const planetary_real q[], planetary_real ddq[],
-                                               planetary_real *finite, planetary_real *nq)
+                                               planetary_real *sum_abs, planetary_real *nq)
 {
-    planetary_real largest = 0, sum = 0, largest_q = 0, sum_q = 0;
+    planetary_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
     /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division) */
-    { const planetary_real c = fabs(ddq[0]); largest = c > largest ? c : largest; sum += c; }
+     * a coordinate that is no length is the same in every unit (no division); the lengths'
+     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
+     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
+    { const planetary_real c = fabs(ddq[0]); largest = largest > c ? largest : c; sum += c; }
     {
-        const planetary_real a = fabs(q[0]) * work->inverse_column[0];
-        largest_q = a > largest_q ? a : largest_q;
+        const planetary_real a = fabs(q[0]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[1]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[1]); largest = largest > c ? largest : c; sum += c; }
     {
-        const planetary_real a = fabs(q[1]) * work->inverse_column[1];
-        largest_q = a > largest_q ? a : largest_q;
+        const planetary_real a = fabs(q[1]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[2]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[2]); largest = largest > c ? largest : c; sum += c; }
     {
         const planetary_real a = fabs(q[2]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[3]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[3]); largest = largest > c ? largest : c; sum += c; }
     {
-        const planetary_real a = fabs(q[3]) * work->inverse_column[3];
-        largest_q = a > largest_q ? a : largest_q;
+        const planetary_real a = fabs(q[3]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[4]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[4]); largest = largest > c ? largest : c; sum += c; }
     {
-        const planetary_real a = fabs(q[4]) * work->inverse_column[4];
-        largest_q = a > largest_q ? a : largest_q;
+        const planetary_real a = fabs(q[4]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[5]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[5]); largest = largest > c ? largest : c; sum += c; }
     {
         const planetary_real a = fabs(q[5]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[6]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[6]); largest = largest > c ? largest : c; sum += c; }
     {
-        const planetary_real a = fabs(q[6]) * work->inverse_column[6];
-        largest_q = a > largest_q ? a : largest_q;
+        const planetary_real a = fabs(q[6]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[7]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[7]); largest = largest > c ? largest : c; sum += c; }
     {
-        const planetary_real a = fabs(q[7]) * work->inverse_column[7];
-        largest_q = a > largest_q ? a : largest_q;
+        const planetary_real a = fabs(q[7]);
+        largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const planetary_real c = fabs(ddq[8]); largest = c > largest ? c : largest; sum += c; }
+    { const planetary_real c = fabs(ddq[8]); largest = largest > c ? largest : c; sum += c; }
     {
         const planetary_real a = fabs(q[8]);
-        largest_q = a > largest_q ? a : largest_q;
+        largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
+    largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
+    largest_q = largest_q > largest_length ? largest_q : largest_length;
     planetary_from_unit(work, ddq);
-    *finite = sum != sum ? (planetary_real)NAN : largest - largest;
+    *sum_abs = sum;
     *nq = sum_q != sum_q ? (planetary_real)NAN : largest_q;
     return largest;
 }
@@ -843,7 +950,7 @@ static int planetary_step(const planetary_options *options, const planetary_real
                              planetary_real t, planetary_state *state,
                              planetary_workspace *work, planetary_report *report)
 {
-    planetary_real nq, ndq, nddq, finite_dq, finite_ddq;
+    planetary_real nq, ndq, nddq, sum_dq, sum_ddq, largest;
     report->flagged = 0;
     report->cond = (planetary_real)NAN;
     if (state->started) {
@@ -852,7 +959,7 @@ static int planetary_step(const planetary_options *options, const planetary_real
         planetary_prepare(options->unit, work);
     }
     report->status = planetary_newton(options, p, t, state->q, work, report);
-    report->fallbacks = planetary_lu_fallbacks(&work->lu);
+    report->fallbacks = work->lu.fallbacks; /* planetary_lu_fallbacks, without a call */
     if (report->status != PLANETARY_OK) {
         return report->status;
     }
@@ -862,12 +969,15 @@ static int planetary_step(const planetary_options *options, const planetary_real
     planetary_phi_t_shared(state->q, t, p, work->shared, state->dq);
     planetary_rows_in_unit(work, state->dq);
     planetary_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = planetary_rates_pass(work, state->dq, &finite_dq);
+    ndq = planetary_rates_pass(work, state->dq, &sum_dq);
     planetary_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     planetary_rows_in_unit(work, state->ddq);
     planetary_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = planetary_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
-    if (finite_dq != 0 || finite_ddq != 0) {
+    nddq = planetary_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
+     * overflow harmlessly), infinite where the larger maximum is */
+    largest = ndq > nddq ? ndq : nddq;
+    if (sum_dq + sum_ddq != sum_dq + sum_ddq || largest - largest != 0) {
         report->status = PLANETARY_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
@@ -889,6 +999,7 @@ int planetary_solve_step(const planetary_options *options, const planetary_real 
                             planetary_report *report)
 {
     if (planetary_check_options(options) != 0) return planetary_refused(report, t);
+    if (state->started) planetary_region_for(options, work); /* else prepared afresh */
     return planetary_step(options, p, t, state, work, report);
 }
 
@@ -915,6 +1026,7 @@ int planetary_solve_grid_checked(const planetary_options *options,
         planetary_refused(report, t[0]);
         return 0;
     }
+    if (n > 0 && state->started) planetary_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (planetary_step(options, p, t[k], state, work, report) != PLANETARY_OK) {
             return k;

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 220 (78 add/sub, 44 mul, 12 div, 0 sqrt, 2 other calls, 41 fabs, 43 compares)
  *   Phi, Phi_q, their factorization and tests: 154; the update (a solve): 66
- * Condition at the converged q: 70; an extra iteration there (at most 3): 388
- * Velocity: 39; acceleration: 43; per-point checks: 1009; predictor: 39
- * Step, worst case with the default cap of 25 iterations: 8184 (2858 add/sub, 1832 mul, 435 div, 10 sqrt, 62 other calls, 1389 fabs, 1598 compares)
+ * Condition at the converged q: 70; an extra iteration there (at most 3): 412
+ * Velocity: 39; acceleration: 43; per-point checks: 1125; predictor: 39
+ * Step, worst case with the default cap of 25 iterations: 8387 (2877 add/sub, 1871 mul, 451 div, 12 sqrt, 62 other calls, 1389 fabs, 1725 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38583
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 38786
  */
 #define PLANETARY_OPS_ITERATION 220   /* one Newton iteration */
-#define PLANETARY_OPS_STEP_FIXED 2684  /* a step without its iterations */
-#define PLANETARY_OPS_STEP_WORST 8184  /* at the default cap, 25 */
-#define PLANETARY_OPS_STEP_DENSE_WORST 38583  /* every factorization dense */
+#define PLANETARY_OPS_STEP_FIXED 2887  /* a step without its iterations */
+#define PLANETARY_OPS_STEP_WORST 8387  /* at the default cap, 25 */
+#define PLANETARY_OPS_STEP_DENSE_WORST 38786  /* every factorization dense */
 
 typedef struct {
     int status;                  /* PLANETARY_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     planetary_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     planetary_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     planetary_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    planetary_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     planetary_real column[PLANETARY_NQ]; /* options->unit where q_i is a length, else 1 */
     planetary_real inverse_column[PLANETARY_NQ]; /* 1 / column */
     planetary_real row[PLANETARY_NQ]; /* options->unit where Phi_i is a length, else 1 */

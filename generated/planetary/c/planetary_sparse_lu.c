@@ -68,13 +68,13 @@ static planetary_real planetary_lu_load(const planetary_real nz[], planetary_rea
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[5]); v[5] = nz[5]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[8]); v[8] = nz[8]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[10]); v[10] = nz[10]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[12]); v[12] = nz[12]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[13]); v[13] = nz[13]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[14]); v[14] = nz[14]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[5]); v[5] = nz[5]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[8]); v[8] = nz[8]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[10]); v[10] = nz[10]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[12]); v[12] = nz[12]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[13]); v[13] = nz[13]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[14]); v[14] = nz[14]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in planetary_dense_lu_tiny. */
     return PLANETARY_LU_TINY * amax + finite;
 }

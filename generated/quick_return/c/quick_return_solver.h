@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 284 (110 add/sub, 61 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
  *   Phi, Phi_q, their factorization and tests: 192; the update (a solve): 92
- * Condition at the converged q: 173; an extra iteration there (at most 3): 455
- * Velocity: 56; acceleration: 97; per-point checks: 1427; predictor: 51
- * Step, worst case with the default cap of 25 iterations: 10730 (4112 add/sub, 2496 mul, 546 div, 10 sqrt, 186 other calls, 1580 fabs, 1800 compares)
+ * Condition at the converged q: 173; an extra iteration there (at most 3): 479
+ * Velocity: 56; acceleration: 97; per-point checks: 1541; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 10931 (4131 add/sub, 2533 mul, 562 div, 12 sqrt, 186 other calls, 1580 fabs, 1927 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72601
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 72802
  */
 #define QUICK_RETURN_OPS_ITERATION 284   /* one Newton iteration */
-#define QUICK_RETURN_OPS_STEP_FIXED 3630  /* a step without its iterations */
-#define QUICK_RETURN_OPS_STEP_WORST 10730  /* at the default cap, 25 */
-#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72601  /* every factorization dense */
+#define QUICK_RETURN_OPS_STEP_FIXED 3831  /* a step without its iterations */
+#define QUICK_RETURN_OPS_STEP_WORST 10931  /* at the default cap, 25 */
+#define QUICK_RETURN_OPS_STEP_DENSE_WORST 72802  /* every factorization dense */
 
 typedef struct {
     int status;                  /* QUICK_RETURN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     quick_return_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     quick_return_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     quick_return_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    quick_return_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     quick_return_real column[QUICK_RETURN_NQ]; /* options->unit where q_i is a length, else 1 */
     quick_return_real inverse_column[QUICK_RETURN_NQ]; /* 1 / column */
     quick_return_real row[QUICK_RETURN_NQ]; /* options->unit where Phi_i is a length, else 1 */

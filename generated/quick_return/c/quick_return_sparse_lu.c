@@ -66,16 +66,16 @@ static quick_return_real quick_return_lu_load(const quick_return_real nz[], quic
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[4]); v[4] = nz[4]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[5]); v[5] = nz[5]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[6]); v[6] = nz[6]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[7]); v[7] = nz[7]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[8]); v[8] = nz[8]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[9]); v[9] = nz[9]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[14]); v[14] = nz[14]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[17]); v[17] = nz[17]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[20]); v[20] = nz[20]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[4]); v[4] = nz[4]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[5]); v[5] = nz[5]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[6]); v[6] = nz[6]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[7]); v[7] = nz[7]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[8]); v[8] = nz[8]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[9]); v[9] = nz[9]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[14]); v[14] = nz[14]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[17]); v[17] = nz[17]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[20]); v[20] = nz[20]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in quick_return_dense_lu_tiny. */
     return QUICK_RETURN_LU_TINY * amax + finite;
 }

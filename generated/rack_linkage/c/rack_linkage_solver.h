@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 358 (118 add/sub, 75 mul, 16 div, 0 sqrt, 7 other calls, 73 fabs, 69 compares)
  *   Phi, Phi_q, their factorization and tests: 262; the update (a solve): 96
- * Condition at the converged q: 213; an extra iteration there (at most 3): 529
- * Velocity: 61; acceleration: 93; per-point checks: 1467; predictor: 51
- * Step, worst case with the default cap of 25 iterations: 12993 (4394 add/sub, 2958 mul, 575 div, 10 sqrt, 218 other calls, 2423 fabs, 2415 compares)
+ * Condition at the converged q: 213; an extra iteration there (at most 3): 553
+ * Velocity: 61; acceleration: 93; per-point checks: 1581; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 13194 (4413 add/sub, 2995 mul, 591 div, 12 sqrt, 218 other calls, 2423 fabs, 2542 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74640
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 74841
  */
 #define RACK_LINKAGE_OPS_ITERATION 358   /* one Newton iteration */
-#define RACK_LINKAGE_OPS_STEP_FIXED 4043  /* a step without its iterations */
-#define RACK_LINKAGE_OPS_STEP_WORST 12993  /* at the default cap, 25 */
-#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74640  /* every factorization dense */
+#define RACK_LINKAGE_OPS_STEP_FIXED 4244  /* a step without its iterations */
+#define RACK_LINKAGE_OPS_STEP_WORST 13194  /* at the default cap, 25 */
+#define RACK_LINKAGE_OPS_STEP_DENSE_WORST 74841  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RACK_LINKAGE_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     rack_linkage_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     rack_linkage_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     rack_linkage_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    rack_linkage_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     rack_linkage_real column[RACK_LINKAGE_NQ]; /* options->unit where q_i is a length, else 1 */
     rack_linkage_real inverse_column[RACK_LINKAGE_NQ]; /* 1 / column */
     rack_linkage_real row[RACK_LINKAGE_NQ]; /* options->unit where Phi_i is a length, else 1 */

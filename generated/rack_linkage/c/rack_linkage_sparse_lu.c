@@ -75,18 +75,18 @@ static rack_linkage_real rack_linkage_lu_load(const rack_linkage_real nz[], rack
     (void)nz;
     (void)v;
     (void)a;
-    a = fabs(nz[4]); v[4] = nz[4]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[5]); v[5] = nz[5]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[6]); v[6] = nz[6]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[7]); v[7] = nz[7]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[8]); v[8] = nz[8]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[9]); v[9] = nz[9]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[11]); v[11] = nz[11]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[14]); v[14] = nz[14]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[17]); v[17] = nz[17]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[19]); v[19] = nz[19]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[21]); v[21] = nz[21]; amax = a > amax ? a : amax; finite += a - a;
-    a = fabs(nz[23]); v[23] = nz[23]; amax = a > amax ? a : amax; finite += a - a;
+    a = fabs(nz[4]); v[4] = nz[4]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[5]); v[5] = nz[5]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[6]); v[6] = nz[6]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[7]); v[7] = nz[7]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[8]); v[8] = nz[8]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[9]); v[9] = nz[9]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[11]); v[11] = nz[11]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[14]); v[14] = nz[14]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[17]); v[17] = nz[17]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[19]); v[19] = nz[19]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[21]); v[21] = nz[21]; amax = amax > a ? amax : a; finite += a - a;
+    a = fabs(nz[23]); v[23] = nz[23]; amax = amax > a ? amax : a; finite += a - a;
     /* NaN when an entry is not finite, so that every pivot test fails, as in rack_linkage_dense_lu_tiny. */
     return RACK_LINKAGE_LU_TINY * amax + finite;
 }

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 914 (306 add/sub, 279 mul, 24 div, 1 sqrt, 2 other calls, 166 fabs, 136 compares)
  *   Phi, Phi_q, their factorization and tests: 761; the update (a solve): 153
- * Condition at the converged q: 628; an extra iteration there (at most 3): 1087
- * Velocity: 127; acceleration: 412; per-point checks: 2642; predictor: 59
- * Step, worst case with the default cap of 25 iterations: 31464 (10824 add/sub, 10010 mul, 826 div, 42 sqrt, 64 other calls, 5294 fabs, 4404 compares)
+ * Condition at the converged q: 628; an extra iteration there (at most 3): 1111
+ * Velocity: 127; acceleration: 412; per-point checks: 2758; predictor: 59
+ * Step, worst case with the default cap of 25 iterations: 31667 (10843 add/sub, 10049 mul, 842 div, 44 sqrt, 64 other calls, 5294 fabs, 4531 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121007
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121210
  */
 #define RSSR_OPS_ITERATION 914   /* one Newton iteration */
-#define RSSR_OPS_STEP_FIXED 8614  /* a step without its iterations */
-#define RSSR_OPS_STEP_WORST 31464  /* at the default cap, 25 */
-#define RSSR_OPS_STEP_DENSE_WORST 121007  /* every factorization dense */
+#define RSSR_OPS_STEP_FIXED 8817  /* a step without its iterations */
+#define RSSR_OPS_STEP_WORST 31667  /* at the default cap, 25 */
+#define RSSR_OPS_STEP_DENSE_WORST 121210  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RSSR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     rssr_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     rssr_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     rssr_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    rssr_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     rssr_real column[RSSR_NQ]; /* options->unit where q_i is a length, else 1 */
     rssr_real inverse_column[RSSR_NQ]; /* 1 / column */
     rssr_real row[RSSR_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -70,10 +70,13 @@ static int spatial_slider_crank_refused(spatial_slider_crank_report *report, spa
 static spatial_slider_crank_real spatial_slider_crank_max_abs(const spatial_slider_crank_real v[])
 {
     spatial_slider_crank_real largest = 0, sum = 0;
-    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
-     * inf cannot occur) */
+    /* a branch-free max, written largest-first: x86's max instruction keeps its first
+     * operand where the other is not larger, so a, which the sum reads too, needs no copy (an
+     * instruction an entry fewer; a NaN a may or may not stay in largest, the sum finds it).
+     * The sum is NaN exactly when some |v_i| is (none is negative: inf - inf cannot occur).
+     * The passes below write their maxima alike. */
     for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        { const spatial_slider_crank_real a = fabs(v[i]); largest = a > largest ? a : largest; sum += a; }
+        { const spatial_slider_crank_real a = fabs(v[i]); largest = largest > a ? largest : a; sum += a; }
     }
     return sum != sum ? (spatial_slider_crank_real)NAN : largest;
 }
@@ -107,6 +110,7 @@ static void spatial_slider_crank_prepare(spatial_slider_crank_real unit, spatial
     spatial_slider_crank_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->region[0] = -1; /* no region of the error model's bound yet */
     work->scaled = unit != 1 && SPATIAL_SLIDER_CRANK_SCALE_FREE;
     if (!work->scaled) unit = 1;
     for (i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
@@ -425,15 +429,102 @@ static int spatial_slider_crank_within_bound(const spatial_slider_crank_options 
         && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
 }
 
-/* spatial_slider_crank_flagged with s and the residual's error `left` worked out. */
-static int spatial_slider_crank_flagged_at(const spatial_slider_crank_options *options,
-                                   const spatial_slider_crank_report *report, spatial_slider_crank_real s, spatial_slider_crank_real left,
-                                   spatial_slider_crank_real nq, spatial_slider_crank_real ndq, spatial_slider_crank_real nddq, int judged)
+/* The region the cheap bound was proven for (work->region, spatial_slider_crank_widen): the points
+ * whose Newton correction was not solved for, with ||Phi_q^-1||_1 <= region[0], residual
+ * <= region[1] and max |q|, |dq| <= region[corner], region[corner + 1], at the targets
+ * region[4..6] (each call checks those once, spatial_slider_crank_region_for); corner 2 for the last
+ * point's norms (within_bound is then taken at twice them plus one, as would_flag takes it),
+ * 7 for this point's. Every operation from these numbers to within_bound's tests (s, left,
+ * the widened norms, the tests) is monotone in each of them, also as rounded (products and
+ * sums of numbers >= 0, a max), and the region's corner is finite (no 0 * inf): the bound
+ * holds at every point of the region, and a few comparisons stand for it. A NaN fails them. */
+static int spatial_slider_crank_covered(const spatial_slider_crank_workspace *work,
+                                const spatial_slider_crank_report *report, spatial_slider_crank_real nq, spatial_slider_crank_real ndq,
+                                int corner)
+{
+    const spatial_slider_crank_real *r = work->region;
+    return work->correction < 0 && report->inv_norm <= r[0] && report->residual <= r[1]
+        && nq <= r[corner] && ndq <= r[corner + 1] && report->cond < (spatial_slider_crank_real)INFINITY;
+}
+
+/* The region holds at the targets it was proven for: a call that goes on from an earlier
+ * state with other targets starts without one (spatial_slider_crank_prepare clears it for a fresh
+ * start). Every entry point that steps on from a state calls this, once a call. */
+static void spatial_slider_crank_region_for(const spatial_slider_crank_options *options,
+                                    spatial_slider_crank_workspace *work)
+{
+    if (!(options->target_q == work->region[4] && options->target_dq == work->region[5]
+          && options->target_ddq == work->region[6])) {
+        work->region[0] = -1;
+    }
+}
+
+/* Prove the cheap bound for a region around a point whose correction was not solved for:
+ * its ||Phi_q^-1||_1 and the norms nq, ndq an eighth larger (norms at least 1), and the
+ * largest residual the targets allow there (within_bound's three tests solved for the error
+ * of q, halved for their rounding), kept in work->region where within_bound holds at that
+ * corner (the norms taken at twice them plus one, as would_flag takes them: region[7..8]).
+ * The points that follow lie in it until the condition or the motion grows by an eighth
+ * (a converged point's residual is anywhere below tol_phi: the corner leaves the bound's
+ * slack to it). 1 when the region holds the point. */
+static int spatial_slider_crank_widen(const spatial_slider_crank_options *options, spatial_slider_crank_workspace *work,
+                              const spatial_slider_crank_report *report, spatial_slider_crank_real nq, spatial_slider_crank_real ndq)
+{
+    const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF, margin = 2 * SPATIAL_SLIDER_CRANK_SAFETY;
+    const spatial_slider_crank_real grow = (spatial_slider_crank_real)1.125; /* 9 / 8: exact in binary */
+    const spatial_slider_crank_real inv_norm = grow * report->inv_norm;
+    /* norms below 1 grow up to 1 (the model takes max(1, norm) where it scales by them) */
+    const spatial_slider_crank_real wide_q = spatial_slider_crank_at_least_1(grow * nq);
+    const spatial_slider_crank_real wide_dq = spatial_slider_crank_at_least_1(grow * ndq);
+    const spatial_slider_crank_real s = inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
+    const spatial_slider_crank_real corner_q = 2 * wide_q + 1, corner_dq = 2 * wide_dq + 1;
+    const spatial_slider_crank_real a = spatial_slider_crank_at_least_1(corner_dq);
+    const spatial_slider_crank_real x_dq = options->target_dq / margin;
+    const spatial_slider_crank_real x_ddq = options->target_ddq / (margin * (1 + a * a * (1 + 2 * s)));
+    spatial_slider_crank_real most = (x_dq < x_ddq ? x_dq : x_ddq) / s - u, residual, e_q;
+    most = (options->target_q / margin < most ? options->target_q / margin : most) / 2;
+    residual = most / s;
+    if (!(work->correction < 0 && residual >= 0 && s * residual < (spatial_slider_crank_real)INFINITY
+          && corner_q < (spatial_slider_crank_real)INFINITY && corner_dq < (spatial_slider_crank_real)INFINITY)
+        || !spatial_slider_crank_within_bound(options, report, s, s * residual, corner_q, corner_dq,
+                                      &e_q)) {
+        return 0;
+    }
+    work->region[0] = inv_norm;
+    work->region[1] = residual;
+    work->region[2] = wide_q;
+    work->region[3] = wide_dq;
+    work->region[4] = options->target_q;
+    work->region[5] = options->target_dq;
+    work->region[6] = options->target_ddq;
+    work->region[7] = corner_q;
+    work->region[8] = corner_dq;
+    return report->residual <= residual;
+}
+
+/* Where the last point's norms (work->norms) and this report lie in the region: the cheap
+ * bound holds at twice the norms plus one, so it clears the end of the step for norms up to
+ * the region's there (work->clear). 1 when they do. Inline: it is most steps' whole error
+ * model, a call would cost a third of it. */
+static inline int spatial_slider_crank_region_clears(spatial_slider_crank_workspace *work,
+                                             const spatial_slider_crank_report *report)
+{
+    if (!spatial_slider_crank_covered(work, report, work->norms[0], work->norms[1], 2)) {
+        return 0;
+    }
+    work->clear[0] = work->region[7];
+    work->clear[1] = work->region[8];
+    return 1;
+}
+
+/* The model where the cheap bound failed, with its e_q. */
+static int spatial_slider_crank_model_flags(const spatial_slider_crank_options *options,
+                                    const spatial_slider_crank_report *report, spatial_slider_crank_real s, spatial_slider_crank_real e_q,
+                                    spatial_slider_crank_real nq, spatial_slider_crank_real ndq, spatial_slider_crank_real nddq, int judged)
 {
     const spatial_slider_crank_real u = SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF;
     const spatial_slider_crank_real a = spatial_slider_crank_at_least_1(ndq);
-    spatial_slider_crank_real e_q, e_dq, e_ddq;
-    if (spatial_slider_crank_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    spatial_slider_crank_real e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
     e_dq = s * (u * ndq + e_q * a);
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
@@ -445,15 +536,21 @@ static int spatial_slider_crank_flagged_at(const spatial_slider_crank_options *o
 /* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
- * decides first; the model runs where the bound fails. */
-static int spatial_slider_crank_flagged(const spatial_slider_crank_options *options,
-                                const spatial_slider_crank_workspace *work,
+ * decides first (by the region where it was proven, else evaluated, a region proven for the
+ * points to come where it holds); the model runs where the bound fails. */
+static int spatial_slider_crank_flagged(const spatial_slider_crank_options *options, spatial_slider_crank_workspace *work,
                                 const spatial_slider_crank_report *report, spatial_slider_crank_real nq, spatial_slider_crank_real ndq,
                                 spatial_slider_crank_real nddq, int judged)
 {
     const spatial_slider_crank_real s = report->inv_norm / sqrt((spatial_slider_crank_real)SPATIAL_SLIDER_CRANK_NQ);
     const spatial_slider_crank_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    return spatial_slider_crank_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
+    spatial_slider_crank_real e_q;
+    if (spatial_slider_crank_covered(work, report, nq, ndq, 7)) return 0;
+    if (spatial_slider_crank_within_bound(options, report, s, left, nq, ndq, &e_q)) {
+        spatial_slider_crank_widen(options, work, report, nq, ndq); /* for the points to come */
+        return 0;
+    }
+    return spatial_slider_crank_model_flags(options, report, s, e_q, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -565,7 +662,7 @@ static void spatial_slider_crank_propagated(const spatial_slider_crank_workspace
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int spatial_slider_crank_flagged_refined(const spatial_slider_crank_options *options,
-                                        const spatial_slider_crank_workspace *work,
+                                        spatial_slider_crank_workspace *work,
                                         const spatial_slider_crank_report *report, spatial_slider_crank_real nq,
                                         spatial_slider_crank_real ndq, spatial_slider_crank_real nddq, const spatial_slider_crank_real q[],
                                         const spatial_slider_crank_real dq[], const spatial_slider_crank_real ddq[], spatial_slider_crank_real t,
@@ -589,8 +686,9 @@ static int spatial_slider_crank_flagged_refined(const spatial_slider_crank_optio
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
  * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
- * at the end of the step too if the new norms are within those (work->clear; the residual,
- * condition and correction unchanged), and the model need not run again there. */
+ * at the end of the step too if the new norms are within those (work->clear, the region's
+ * where it holds there; the residual, condition and correction unchanged), and the model
+ * need not run again there. */
 static int spatial_slider_crank_would_flag(const spatial_slider_crank_options *options,
                                    spatial_slider_crank_workspace *work,
                                    const spatial_slider_crank_report *report)
@@ -602,13 +700,16 @@ static int spatial_slider_crank_would_flag(const spatial_slider_crank_options *o
     spatial_slider_crank_real e_q;
     if (!(report->residual > SPATIAL_SLIDER_CRANK_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
     if (spatial_slider_crank_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
-        work->clear[0] = wide_q;
-        work->clear[1] = wide_dq;
+        if (!spatial_slider_crank_widen(options, work, report, norms[0], norms[1])
+            || !spatial_slider_crank_region_clears(work, report)) {
+            work->clear[0] = wide_q;
+            work->clear[1] = wide_dq;
+        }
         return 0;
     }
-    return spatial_slider_crank_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
+    if (spatial_slider_crank_within_bound(options, report, s, left, norms[0], norms[1], &e_q)) return 0;
+    return spatial_slider_crank_model_flags(options, report, s, e_q, norms[0], norms[1], norms[2], 2);
 }
-
 /* At a converged point: estimate the condition. Where the error model would flag the point
  * as Newton left it, solve for the Newton correction: its size is the error of q the residual
  * leaves (to first order), which judges the point instead of the model's bound from the
@@ -629,6 +730,7 @@ static int spatial_slider_crank_converged(const spatial_slider_crank_options *op
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (spatial_slider_crank_real)INFINITY
+                && !spatial_slider_crank_region_clears(work, report)
                 && spatial_slider_crank_would_flag(options, work, report))) {
         for (extra = 0; extra < SPATIAL_SLIDER_CRANK_TIGHTEN_STEPS; ++extra) {
             spatial_slider_crank_real size;
@@ -712,43 +814,48 @@ static void spatial_slider_crank_predict(spatial_slider_crank_real t, spatial_sl
     }
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
- * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. The
- * test is one addition an entry: the sum of |.| is NaN exactly when some entry is (none is
- * negative: inf - inf cannot occur), and an infinite entry is the largest. */
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
+ * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
+ * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
+ * largest), and dq in the kernel's unit. */
 static spatial_slider_crank_real spatial_slider_crank_rates_pass(const spatial_slider_crank_workspace *work, spatial_slider_crank_real dq[],
-                                       spatial_slider_crank_real *finite)
+                                       spatial_slider_crank_real *sum_abs)
 {
     spatial_slider_crank_real largest = 0, sum = 0;
     for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        { const spatial_slider_crank_real b = fabs(dq[i]); largest = b > largest ? b : largest; sum += b; }
+        { const spatial_slider_crank_real b = fabs(dq[i]); largest = largest > b ? largest : b; sum += b; }
         dq[i] = -dq[i];
     }
     spatial_slider_crank_from_unit(work, dq);
-    *finite = sum != sum ? (spatial_slider_crank_real)NAN : largest - largest;
+    *sum_abs = sum;
     return largest;
 }
 
 /* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
- * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+ * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
+ * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
+ * then flags the point). */
 static spatial_slider_crank_real spatial_slider_crank_accelerations_pass(const spatial_slider_crank_workspace *work,
                                                const spatial_slider_crank_real q[], spatial_slider_crank_real ddq[],
-                                               spatial_slider_crank_real *finite, spatial_slider_crank_real *nq)
+                                               spatial_slider_crank_real *sum_abs, spatial_slider_crank_real *nq)
 {
-    spatial_slider_crank_real largest = 0, sum = 0, largest_q = 0, sum_q = 0;
+    spatial_slider_crank_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
     /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division) */
+     * a coordinate that is no length is the same in every unit (no division); the lengths'
+     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
+     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
     for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        { const spatial_slider_crank_real c = fabs(ddq[i]); largest = c > largest ? c : largest; sum += c; }
+        { const spatial_slider_crank_real c = fabs(ddq[i]); largest = largest > c ? largest : c; sum += c; }
         {
             const spatial_slider_crank_real a = fabs(q[i]) * work->inverse_column[i];
-            largest_q = a > largest_q ? a : largest_q;
+            largest_q = largest_q > a ? largest_q : a;
             sum_q += a;
         }
     }
+    largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
+    largest_q = largest_q > largest_length ? largest_q : largest_length;
     spatial_slider_crank_from_unit(work, ddq);
-    *finite = sum != sum ? (spatial_slider_crank_real)NAN : largest - largest;
+    *sum_abs = sum;
     *nq = sum_q != sum_q ? (spatial_slider_crank_real)NAN : largest_q;
     return largest;
 }
@@ -758,7 +865,7 @@ static int spatial_slider_crank_step(const spatial_slider_crank_options *options
                              spatial_slider_crank_real t, spatial_slider_crank_state *state,
                              spatial_slider_crank_workspace *work, spatial_slider_crank_report *report)
 {
-    spatial_slider_crank_real nq, ndq, nddq, finite_dq, finite_ddq;
+    spatial_slider_crank_real nq, ndq, nddq, sum_dq, sum_ddq, largest;
     report->flagged = 0;
     report->cond = (spatial_slider_crank_real)NAN;
     if (state->started) {
@@ -767,7 +874,7 @@ static int spatial_slider_crank_step(const spatial_slider_crank_options *options
         spatial_slider_crank_prepare(options->unit, work);
     }
     report->status = spatial_slider_crank_newton(options, p, t, state->q, work, report);
-    report->fallbacks = spatial_slider_crank_lu_fallbacks(&work->lu);
+    report->fallbacks = work->lu.fallbacks; /* spatial_slider_crank_lu_fallbacks, without a call */
     if (report->status != SPATIAL_SLIDER_CRANK_OK) {
         return report->status;
     }
@@ -777,12 +884,15 @@ static int spatial_slider_crank_step(const spatial_slider_crank_options *options
     spatial_slider_crank_phi_t_shared(state->q, t, p, work->shared, state->dq);
     spatial_slider_crank_rows_in_unit(work, state->dq);
     spatial_slider_crank_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = spatial_slider_crank_rates_pass(work, state->dq, &finite_dq);
+    ndq = spatial_slider_crank_rates_pass(work, state->dq, &sum_dq);
     spatial_slider_crank_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     spatial_slider_crank_rows_in_unit(work, state->ddq);
     spatial_slider_crank_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = spatial_slider_crank_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
-    if (finite_dq != 0 || finite_ddq != 0) {
+    nddq = spatial_slider_crank_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
+     * overflow harmlessly), infinite where the larger maximum is */
+    largest = ndq > nddq ? ndq : nddq;
+    if (sum_dq + sum_ddq != sum_dq + sum_ddq || largest - largest != 0) {
         report->status = SPATIAL_SLIDER_CRANK_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
@@ -804,6 +914,7 @@ int spatial_slider_crank_solve_step(const spatial_slider_crank_options *options,
                             spatial_slider_crank_report *report)
 {
     if (spatial_slider_crank_check_options(options) != 0) return spatial_slider_crank_refused(report, t);
+    if (state->started) spatial_slider_crank_region_for(options, work); /* else prepared afresh */
     return spatial_slider_crank_step(options, p, t, state, work, report);
 }
 
@@ -830,6 +941,7 @@ int spatial_slider_crank_solve_grid_checked(const spatial_slider_crank_options *
         spatial_slider_crank_refused(report, t[0]);
         return 0;
     }
+    if (n > 0 && state->started) spatial_slider_crank_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (spatial_slider_crank_step(options, p, t[k], state, work, report) != SPATIAL_SLIDER_CRANK_OK) {
             return k;

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 1354 (492 add/sub, 407 mul, 34 div, 1 sqrt, 3 other calls, 232 fabs, 185 compares)
  *   Phi, Phi_q, their factorization and tests: 1085; the update (a solve): 269
- * Condition at the converged q: 3440; an extra iteration there (at most 3): 1534
- * Velocity: 222; acceleration: 532; per-point checks: 4182; predictor: 87
- * Step, worst case with the default cap of 25 iterations: 51536 (19845 add/sub, 15896 mul, 1173 div, 44 sqrt, 304 other calls, 7884 fabs, 6390 compares)
+ * Condition at the converged q: 3440; an extra iteration there (at most 3): 1558
+ * Velocity: 222; acceleration: 532; per-point checks: 4304; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 51745 (19864 add/sub, 15941 mul, 1189 div, 46 sqrt, 304 other calls, 7884 fabs, 6517 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 306891
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 307100
  */
 #define SPATIAL_SLIDER_CRANK_OPS_ITERATION 1354   /* one Newton iteration */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17686  /* a step without its iterations */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51536  /* at the default cap, 25 */
-#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 306891  /* every factorization dense */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_FIXED 17895  /* a step without its iterations */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_WORST 51745  /* at the default cap, 25 */
+#define SPATIAL_SLIDER_CRANK_OPS_STEP_DENSE_WORST 307100  /* every factorization dense */
 
 typedef struct {
     int status;                  /* SPATIAL_SLIDER_CRANK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     spatial_slider_crank_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     spatial_slider_crank_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     spatial_slider_crank_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    spatial_slider_crank_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     spatial_slider_crank_real column[SPATIAL_SLIDER_CRANK_NQ]; /* options->unit where q_i is a length, else 1 */
     spatial_slider_crank_real inverse_column[SPATIAL_SLIDER_CRANK_NQ]; /* 1 / column */
     spatial_slider_crank_real row[SPATIAL_SLIDER_CRANK_NQ]; /* options->unit where Phi_i is a length, else 1 */

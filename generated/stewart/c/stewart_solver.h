@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 1485 (624 add/sub, 586 mul, 21 div, 6 sqrt, 7 other calls, 128 fabs, 113 compares)
  *   Phi, Phi_q, their factorization and tests: 1364; the update (a solve): 121
- * Condition at the converged q: 612; an extra iteration there (at most 3): 1651
- * Velocity: 369; acceleration: 1579; per-point checks: 4037; predictor: 31
- * Step, worst case with the default cap of 25 iterations: 50778 (21505 add/sub, 20494 mul, 698 div, 202 sqrt, 233 other calls, 4028 fabs, 3618 compares)
+ * Condition at the converged q: 612; an extra iteration there (at most 3): 1675
+ * Velocity: 369; acceleration: 1579; per-point checks: 4156; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 50984 (21524 add/sub, 20536 mul, 714 div, 204 sqrt, 233 other calls, 4028 fabs, 3745 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66577
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 66783
  */
 #define STEWART_OPS_ITERATION 1485   /* one Newton iteration */
-#define STEWART_OPS_STEP_FIXED 13653  /* a step without its iterations */
-#define STEWART_OPS_STEP_WORST 50778  /* at the default cap, 25 */
-#define STEWART_OPS_STEP_DENSE_WORST 66577  /* every factorization dense */
+#define STEWART_OPS_STEP_FIXED 13859  /* a step without its iterations */
+#define STEWART_OPS_STEP_WORST 50984  /* at the default cap, 25 */
+#define STEWART_OPS_STEP_DENSE_WORST 66783  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     stewart_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     stewart_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    stewart_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     stewart_real column[STEWART_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_real inverse_column[STEWART_NQ]; /* 1 / column */
     stewart_real row[STEWART_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -59,21 +59,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 1395 (538 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 146 fabs, 122 compares)
  *   Phi, Phi_q, their factorization and tests: 1274; the update (a solve): 121
- * Condition at the converged q: 612; an extra iteration there (at most 3): 1561
- * Velocity: 111; acceleration: 996; per-point checks: 3220; predictor: 31
- * Step, worst case with the default cap of 25 iterations: 46510 (18240 add/sub, 19325 mul, 506 div, 10 sqrt, 0 other calls, 4550 fabs, 3879 compares)
+ * Condition at the converged q: 612; an extra iteration there (at most 3): 1585
+ * Velocity: 111; acceleration: 996; per-point checks: 3339; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 46716 (18259 add/sub, 19367 mul, 522 div, 12 sqrt, 0 other calls, 4550 fabs, 4006 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 48911 (19315 add/sub, 20454 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3980 compares)
- *   positions only (du, ddu NULL): 47746 (18770 add/sub, 19878 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3964 compares)
+ * solve_inputs, worst case: 49118 (19333 add/sub, 20498 mul, 569 div, 12 sqrt, 0 other calls, 4599 fabs, 4107 compares)
+ *   positions only (du, ddu NULL): 47953 (18788 add/sub, 19922 mul, 555 div, 12 sqrt, 0 other calls, 4585 fabs, 4091 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2354
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62309
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62515
  */
 #define STEWART_FK_OPS_ITERATION 1395   /* one Newton iteration */
-#define STEWART_FK_OPS_STEP_FIXED 11635  /* a step without its iterations */
-#define STEWART_FK_OPS_STEP_WORST 46510  /* at the default cap, 25 */
-#define STEWART_FK_OPS_STEP_DENSE_WORST 62309  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 48911  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 47746  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_STEP_FIXED 11841  /* a step without its iterations */
+#define STEWART_FK_OPS_STEP_WORST 46716  /* at the default cap, 25 */
+#define STEWART_FK_OPS_STEP_DENSE_WORST 62515  /* every factorization dense */
+#define STEWART_FK_OPS_INPUTS_WORST 49118  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 47953  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -112,6 +112,8 @@ typedef struct {
     stewart_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     stewart_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    stewart_fk_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     stewart_fk_real column[STEWART_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_fk_real inverse_column[STEWART_FK_NQ]; /* 1 / column */
     stewart_fk_real row[STEWART_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -70,10 +70,13 @@ static int stewart_legs_refused(stewart_legs_report *report, stewart_legs_real t
 static stewart_legs_real stewart_legs_max_abs(const stewart_legs_real v[])
 {
     stewart_legs_real largest = 0, sum = 0;
-    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
-     * inf cannot occur) */
+    /* a branch-free max, written largest-first: x86's max instruction keeps its first
+     * operand where the other is not larger, so a, which the sum reads too, needs no copy (an
+     * instruction an entry fewer; a NaN a may or may not stay in largest, the sum finds it).
+     * The sum is NaN exactly when some |v_i| is (none is negative: inf - inf cannot occur).
+     * The passes below write their maxima alike. */
     for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
-        { const stewart_legs_real a = fabs(v[i]); largest = a > largest ? a : largest; sum += a; }
+        { const stewart_legs_real a = fabs(v[i]); largest = largest > a ? largest : a; sum += a; }
     }
     return sum != sum ? (stewart_legs_real)NAN : largest;
 }
@@ -113,6 +116,7 @@ static void stewart_legs_prepare(stewart_legs_real unit, stewart_legs_workspace 
     stewart_legs_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->region[0] = -1; /* no region of the error model's bound yet */
     work->scaled = unit != 1 && STEWART_LEGS_SCALE_FREE;
     if (!work->scaled) unit = 1;
     for (i = 0; i < STEWART_LEGS_NQ; ++i) {
@@ -741,15 +745,102 @@ static int stewart_legs_within_bound(const stewart_legs_options *options,
         && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
 }
 
-/* stewart_legs_flagged with s and the residual's error `left` worked out. */
-static int stewart_legs_flagged_at(const stewart_legs_options *options,
-                                   const stewart_legs_report *report, stewart_legs_real s, stewart_legs_real left,
-                                   stewart_legs_real nq, stewart_legs_real ndq, stewart_legs_real nddq, int judged)
+/* The region the cheap bound was proven for (work->region, stewart_legs_widen): the points
+ * whose Newton correction was not solved for, with ||Phi_q^-1||_1 <= region[0], residual
+ * <= region[1] and max |q|, |dq| <= region[corner], region[corner + 1], at the targets
+ * region[4..6] (each call checks those once, stewart_legs_region_for); corner 2 for the last
+ * point's norms (within_bound is then taken at twice them plus one, as would_flag takes it),
+ * 7 for this point's. Every operation from these numbers to within_bound's tests (s, left,
+ * the widened norms, the tests) is monotone in each of them, also as rounded (products and
+ * sums of numbers >= 0, a max), and the region's corner is finite (no 0 * inf): the bound
+ * holds at every point of the region, and a few comparisons stand for it. A NaN fails them. */
+static int stewart_legs_covered(const stewart_legs_workspace *work,
+                                const stewart_legs_report *report, stewart_legs_real nq, stewart_legs_real ndq,
+                                int corner)
+{
+    const stewart_legs_real *r = work->region;
+    return work->correction < 0 && report->inv_norm <= r[0] && report->residual <= r[1]
+        && nq <= r[corner] && ndq <= r[corner + 1] && report->cond < (stewart_legs_real)INFINITY;
+}
+
+/* The region holds at the targets it was proven for: a call that goes on from an earlier
+ * state with other targets starts without one (stewart_legs_prepare clears it for a fresh
+ * start). Every entry point that steps on from a state calls this, once a call. */
+static void stewart_legs_region_for(const stewart_legs_options *options,
+                                    stewart_legs_workspace *work)
+{
+    if (!(options->target_q == work->region[4] && options->target_dq == work->region[5]
+          && options->target_ddq == work->region[6])) {
+        work->region[0] = -1;
+    }
+}
+
+/* Prove the cheap bound for a region around a point whose correction was not solved for:
+ * its ||Phi_q^-1||_1 and the norms nq, ndq an eighth larger (norms at least 1), and the
+ * largest residual the targets allow there (within_bound's three tests solved for the error
+ * of q, halved for their rounding), kept in work->region where within_bound holds at that
+ * corner (the norms taken at twice them plus one, as would_flag takes them: region[7..8]).
+ * The points that follow lie in it until the condition or the motion grows by an eighth
+ * (a converged point's residual is anywhere below tol_phi: the corner leaves the bound's
+ * slack to it). 1 when the region holds the point. */
+static int stewart_legs_widen(const stewart_legs_options *options, stewart_legs_workspace *work,
+                              const stewart_legs_report *report, stewart_legs_real nq, stewart_legs_real ndq)
+{
+    const stewart_legs_real u = STEWART_LEGS_UNIT_ROUNDOFF, margin = 2 * STEWART_LEGS_SAFETY;
+    const stewart_legs_real grow = (stewart_legs_real)1.125; /* 9 / 8: exact in binary */
+    const stewart_legs_real inv_norm = grow * report->inv_norm;
+    /* norms below 1 grow up to 1 (the model takes max(1, norm) where it scales by them) */
+    const stewart_legs_real wide_q = stewart_legs_at_least_1(grow * nq);
+    const stewart_legs_real wide_dq = stewart_legs_at_least_1(grow * ndq);
+    const stewart_legs_real s = inv_norm / sqrt((stewart_legs_real)STEWART_LEGS_NQ);
+    const stewart_legs_real corner_q = 2 * wide_q + 1, corner_dq = 2 * wide_dq + 1;
+    const stewart_legs_real a = stewart_legs_at_least_1(corner_dq);
+    const stewart_legs_real x_dq = options->target_dq / margin;
+    const stewart_legs_real x_ddq = options->target_ddq / (margin * (1 + a * a * (1 + 2 * s)));
+    stewart_legs_real most = (x_dq < x_ddq ? x_dq : x_ddq) / s - u, residual, e_q;
+    most = (options->target_q / margin < most ? options->target_q / margin : most) / 2;
+    residual = most / s;
+    if (!(work->correction < 0 && residual >= 0 && s * residual < (stewart_legs_real)INFINITY
+          && corner_q < (stewart_legs_real)INFINITY && corner_dq < (stewart_legs_real)INFINITY)
+        || !stewart_legs_within_bound(options, report, s, s * residual, corner_q, corner_dq,
+                                      &e_q)) {
+        return 0;
+    }
+    work->region[0] = inv_norm;
+    work->region[1] = residual;
+    work->region[2] = wide_q;
+    work->region[3] = wide_dq;
+    work->region[4] = options->target_q;
+    work->region[5] = options->target_dq;
+    work->region[6] = options->target_ddq;
+    work->region[7] = corner_q;
+    work->region[8] = corner_dq;
+    return report->residual <= residual;
+}
+
+/* Where the last point's norms (work->norms) and this report lie in the region: the cheap
+ * bound holds at twice the norms plus one, so it clears the end of the step for norms up to
+ * the region's there (work->clear). 1 when they do. Inline: it is most steps' whole error
+ * model, a call would cost a third of it. */
+static inline int stewart_legs_region_clears(stewart_legs_workspace *work,
+                                             const stewart_legs_report *report)
+{
+    if (!stewart_legs_covered(work, report, work->norms[0], work->norms[1], 2)) {
+        return 0;
+    }
+    work->clear[0] = work->region[7];
+    work->clear[1] = work->region[8];
+    return 1;
+}
+
+/* The model where the cheap bound failed, with its e_q. */
+static int stewart_legs_model_flags(const stewart_legs_options *options,
+                                    const stewart_legs_report *report, stewart_legs_real s, stewart_legs_real e_q,
+                                    stewart_legs_real nq, stewart_legs_real ndq, stewart_legs_real nddq, int judged)
 {
     const stewart_legs_real u = STEWART_LEGS_UNIT_ROUNDOFF;
     const stewart_legs_real a = stewart_legs_at_least_1(ndq);
-    stewart_legs_real e_q, e_dq, e_ddq;
-    if (stewart_legs_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    stewart_legs_real e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
     e_dq = s * (u * ndq + e_q * a);
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
@@ -761,15 +852,21 @@ static int stewart_legs_flagged_at(const stewart_legs_options *options,
 /* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
- * decides first; the model runs where the bound fails. */
-static int stewart_legs_flagged(const stewart_legs_options *options,
-                                const stewart_legs_workspace *work,
+ * decides first (by the region where it was proven, else evaluated, a region proven for the
+ * points to come where it holds); the model runs where the bound fails. */
+static int stewart_legs_flagged(const stewart_legs_options *options, stewart_legs_workspace *work,
                                 const stewart_legs_report *report, stewart_legs_real nq, stewart_legs_real ndq,
                                 stewart_legs_real nddq, int judged)
 {
     const stewart_legs_real s = report->inv_norm / sqrt((stewart_legs_real)STEWART_LEGS_NQ);
     const stewart_legs_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    return stewart_legs_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
+    stewart_legs_real e_q;
+    if (stewart_legs_covered(work, report, nq, ndq, 7)) return 0;
+    if (stewart_legs_within_bound(options, report, s, left, nq, ndq, &e_q)) {
+        stewart_legs_widen(options, work, report, nq, ndq); /* for the points to come */
+        return 0;
+    }
+    return stewart_legs_model_flags(options, report, s, e_q, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -881,7 +978,7 @@ static void stewart_legs_propagated(const stewart_legs_workspace *work, stewart_
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int stewart_legs_flagged_refined(const stewart_legs_options *options,
-                                        const stewart_legs_workspace *work,
+                                        stewart_legs_workspace *work,
                                         const stewart_legs_report *report, stewart_legs_real nq,
                                         stewart_legs_real ndq, stewart_legs_real nddq, const stewart_legs_real q[],
                                         const stewart_legs_real dq[], const stewart_legs_real ddq[], stewart_legs_real t,
@@ -905,8 +1002,9 @@ static int stewart_legs_flagged_refined(const stewart_legs_options *options,
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
  * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
- * at the end of the step too if the new norms are within those (work->clear; the residual,
- * condition and correction unchanged), and the model need not run again there. */
+ * at the end of the step too if the new norms are within those (work->clear, the region's
+ * where it holds there; the residual, condition and correction unchanged), and the model
+ * need not run again there. */
 static int stewart_legs_would_flag(const stewart_legs_options *options,
                                    stewart_legs_workspace *work,
                                    const stewart_legs_report *report)
@@ -918,13 +1016,16 @@ static int stewart_legs_would_flag(const stewart_legs_options *options,
     stewart_legs_real e_q;
     if (!(report->residual > STEWART_LEGS_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
     if (stewart_legs_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
-        work->clear[0] = wide_q;
-        work->clear[1] = wide_dq;
+        if (!stewart_legs_widen(options, work, report, norms[0], norms[1])
+            || !stewart_legs_region_clears(work, report)) {
+            work->clear[0] = wide_q;
+            work->clear[1] = wide_dq;
+        }
         return 0;
     }
-    return stewart_legs_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
+    if (stewart_legs_within_bound(options, report, s, left, norms[0], norms[1], &e_q)) return 0;
+    return stewart_legs_model_flags(options, report, s, e_q, norms[0], norms[1], norms[2], 2);
 }
-
 /* At a converged point: estimate the condition. Where the error model would flag the point
  * as Newton left it, solve for the Newton correction: its size is the error of q the residual
  * leaves (to first order), which judges the point instead of the model's bound from the
@@ -945,6 +1046,7 @@ static int stewart_legs_converged(const stewart_legs_options *options, const ste
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (stewart_legs_real)INFINITY
+                && !stewart_legs_region_clears(work, report)
                 && stewart_legs_would_flag(options, work, report))) {
         for (extra = 0; extra < STEWART_LEGS_TIGHTEN_STEPS; ++extra) {
             stewart_legs_real size;
@@ -1028,43 +1130,48 @@ static void stewart_legs_predict(stewart_legs_real t, stewart_legs_state *state)
     }
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
- * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. The
- * test is one addition an entry: the sum of |.| is NaN exactly when some entry is (none is
- * negative: inf - inf cannot occur), and an infinite entry is the largest. */
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
+ * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
+ * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
+ * largest), and dq in the kernel's unit. */
 static stewart_legs_real stewart_legs_rates_pass(const stewart_legs_workspace *work, stewart_legs_real dq[],
-                                       stewart_legs_real *finite)
+                                       stewart_legs_real *sum_abs)
 {
     stewart_legs_real largest = 0, sum = 0;
     for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
-        { const stewart_legs_real b = fabs(dq[i]); largest = b > largest ? b : largest; sum += b; }
+        { const stewart_legs_real b = fabs(dq[i]); largest = largest > b ? largest : b; sum += b; }
         dq[i] = -dq[i];
     }
     stewart_legs_from_unit(work, dq);
-    *finite = sum != sum ? (stewart_legs_real)NAN : largest - largest;
+    *sum_abs = sum;
     return largest;
 }
 
 /* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
- * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+ * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
+ * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
+ * then flags the point). */
 static stewart_legs_real stewart_legs_accelerations_pass(const stewart_legs_workspace *work,
                                                const stewart_legs_real q[], stewart_legs_real ddq[],
-                                               stewart_legs_real *finite, stewart_legs_real *nq)
+                                               stewart_legs_real *sum_abs, stewart_legs_real *nq)
 {
-    stewart_legs_real largest = 0, sum = 0, largest_q = 0, sum_q = 0;
+    stewart_legs_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
     /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division) */
+     * a coordinate that is no length is the same in every unit (no division); the lengths'
+     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
+     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
     for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
-        { const stewart_legs_real c = fabs(ddq[i]); largest = c > largest ? c : largest; sum += c; }
+        { const stewart_legs_real c = fabs(ddq[i]); largest = largest > c ? largest : c; sum += c; }
         {
             const stewart_legs_real a = fabs(q[i]) * work->inverse_column[i];
-            largest_q = a > largest_q ? a : largest_q;
+            largest_q = largest_q > a ? largest_q : a;
             sum_q += a;
         }
     }
+    largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
+    largest_q = largest_q > largest_length ? largest_q : largest_length;
     stewart_legs_from_unit(work, ddq);
-    *finite = sum != sum ? (stewart_legs_real)NAN : largest - largest;
+    *sum_abs = sum;
     *nq = sum_q != sum_q ? (stewart_legs_real)NAN : largest_q;
     return largest;
 }
@@ -1074,7 +1181,7 @@ static int stewart_legs_step(const stewart_legs_options *options, const stewart_
                              stewart_legs_real t, stewart_legs_state *state,
                              stewart_legs_workspace *work, stewart_legs_report *report)
 {
-    stewart_legs_real nq, ndq, nddq, finite_dq, finite_ddq;
+    stewart_legs_real nq, ndq, nddq, sum_dq, sum_ddq, largest;
     report->flagged = 0;
     report->cond = (stewart_legs_real)NAN;
     if (state->started) {
@@ -1083,7 +1190,7 @@ static int stewart_legs_step(const stewart_legs_options *options, const stewart_
         stewart_legs_prepare(options->unit, work);
     }
     report->status = stewart_legs_newton(options, p, t, state->q, work, report);
-    report->fallbacks = stewart_legs_lu_fallbacks(&work->lu);
+    report->fallbacks = work->lu.fallbacks; /* stewart_legs_lu_fallbacks, without a call */
     if (report->status != STEWART_LEGS_OK) {
         return report->status;
     }
@@ -1093,12 +1200,15 @@ static int stewart_legs_step(const stewart_legs_options *options, const stewart_
     stewart_legs_phi_t_shared(state->q, t, p, work->shared, state->dq);
     stewart_legs_rows_in_unit(work, state->dq);
     stewart_legs_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = stewart_legs_rates_pass(work, state->dq, &finite_dq);
+    ndq = stewart_legs_rates_pass(work, state->dq, &sum_dq);
     stewart_legs_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     stewart_legs_rows_in_unit(work, state->ddq);
     stewart_legs_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = stewart_legs_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
-    if (finite_dq != 0 || finite_ddq != 0) {
+    nddq = stewart_legs_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
+     * overflow harmlessly), infinite where the larger maximum is */
+    largest = ndq > nddq ? ndq : nddq;
+    if (sum_dq + sum_ddq != sum_dq + sum_ddq || largest - largest != 0) {
         report->status = STEWART_LEGS_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
@@ -1120,6 +1230,7 @@ int stewart_legs_solve_step(const stewart_legs_options *options, const stewart_l
                             stewart_legs_report *report)
 {
     if (stewart_legs_check_options(options) != 0) return stewart_legs_refused(report, t);
+    if (state->started) stewart_legs_region_for(options, work); /* else prepared afresh */
     return stewart_legs_step(options, p, t, state, work, report);
 }
 
@@ -1146,6 +1257,7 @@ int stewart_legs_solve_grid_checked(const stewart_legs_options *options,
         stewart_legs_refused(report, t[0]);
         return 0;
     }
+    if (n > 0 && state->started) stewart_legs_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (stewart_legs_step(options, p, t[k], state, work, report) != STEWART_LEGS_OK) {
             return k;

@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 15625 (6062 add/sub, 6101 mul, 165 div, 6 sqrt, 14 other calls, 1901 fabs, 1376 compares)
  *   Phi, Phi_q, their factorization and tests: 13861; the update (a solve): 1764
- * Condition at the converged q: 22622; an extra iteration there (at most 3): 15875
- * Velocity: 1794; acceleration: 10074; per-point checks: 36948; predictor: 367
- * Step, worst case with the default cap of 25 iterations: 546634 (218664 add/sub, 216256 mul, 5566 div, 208 sqrt, 1346 other calls, 61063 fabs, 43531 compares)
+ * Condition at the converged q: 22622; an extra iteration there (at most 3): 15899
+ * Velocity: 1794; acceleration: 10074; per-point checks: 37070; predictor: 367
+ * Step, worst case with the default cap of 25 iterations: 546843 (218683 add/sub, 216301 mul, 5582 div, 210 sqrt, 1346 other calls, 61063 fabs, 43658 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16596751
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16596960
  */
 #define STEWART_LEGS_OPS_ITERATION 15625   /* one Newton iteration */
-#define STEWART_LEGS_OPS_STEP_FIXED 156009  /* a step without its iterations */
-#define STEWART_LEGS_OPS_STEP_WORST 546634  /* at the default cap, 25 */
-#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16596751  /* every factorization dense */
+#define STEWART_LEGS_OPS_STEP_FIXED 156218  /* a step without its iterations */
+#define STEWART_LEGS_OPS_STEP_WORST 546843  /* at the default cap, 25 */
+#define STEWART_LEGS_OPS_STEP_DENSE_WORST 16596960  /* every factorization dense */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     stewart_legs_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_legs_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     stewart_legs_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    stewart_legs_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     stewart_legs_real column[STEWART_LEGS_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_legs_real inverse_column[STEWART_LEGS_NQ]; /* 1 / column */
     stewart_legs_real row[STEWART_LEGS_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -58,21 +58,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 15361 (5924 add/sub, 5995 mul, 165 div, 0 sqrt, 0 other calls, 1901 fabs, 1376 compares)
  *   Phi, Phi_q, their factorization and tests: 13597; the update (a solve): 1764
- * Condition at the converged q: 22622; an extra iteration there (at most 3): 15611
- * Velocity: 1496; acceleration: 9249; per-point checks: 35838; predictor: 367
- * Step, worst case with the default cap of 25 iterations: 536745 (213804 add/sub, 211897 mul, 5530 div, 10 sqrt, 910 other calls, 61063 fabs, 43531 compares)
+ * Condition at the converged q: 22622; an extra iteration there (at most 3): 15635
+ * Velocity: 1496; acceleration: 9249; per-point checks: 35960; predictor: 367
+ * Step, worst case with the default cap of 25 iterations: 536954 (213823 add/sub, 211942 mul, 5546 div, 12 sqrt, 910 other calls, 61063 fabs, 43658 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 569964 (228277 add/sub, 228520 mul, 6081 div, 10 sqrt, 910 other calls, 61700 fabs, 44466 compares)
- *   positions only (du, ddu NULL): 558489 (223640 add/sub, 222230 mul, 5899 div, 10 sqrt, 910 other calls, 61518 fabs, 44282 compares)
+ * solve_inputs, worst case: 570171 (228295 add/sub, 228564 mul, 6097 div, 12 sqrt, 910 other calls, 61700 fabs, 44593 compares)
+ *   positions only (du, ddu NULL): 558696 (223658 add/sub, 222274 mul, 5915 div, 12 sqrt, 910 other calls, 61518 fabs, 44409 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 32762
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16586862
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 16587071
  */
 #define STEWART_LEGS_FK_OPS_ITERATION 15361   /* one Newton iteration */
-#define STEWART_LEGS_FK_OPS_STEP_FIXED 152720  /* a step without its iterations */
-#define STEWART_LEGS_FK_OPS_STEP_WORST 536745  /* at the default cap, 25 */
-#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16586862  /* every factorization dense */
-#define STEWART_LEGS_FK_OPS_INPUTS_WORST 569964  /* solve_inputs with du, ddu */
-#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 558489  /* solve_inputs, du, ddu NULL */
+#define STEWART_LEGS_FK_OPS_STEP_FIXED 152929  /* a step without its iterations */
+#define STEWART_LEGS_FK_OPS_STEP_WORST 536954  /* at the default cap, 25 */
+#define STEWART_LEGS_FK_OPS_STEP_DENSE_WORST 16587071  /* every factorization dense */
+#define STEWART_LEGS_FK_OPS_INPUTS_WORST 570171  /* solve_inputs with du, ddu */
+#define STEWART_LEGS_FK_OPS_POSITIONS_WORST 558696  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_LEGS_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -111,6 +111,8 @@ typedef struct {
     stewart_legs_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     stewart_legs_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     stewart_legs_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    stewart_legs_fk_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     stewart_legs_fk_real column[STEWART_LEGS_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     stewart_legs_fk_real inverse_column[STEWART_LEGS_FK_NQ]; /* 1 / column */
     stewart_legs_fk_real row[STEWART_LEGS_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

@@ -71,10 +71,13 @@ static int three_rrr_fk_refused(three_rrr_fk_report *report, three_rrr_fk_real t
 static three_rrr_fk_real three_rrr_fk_max_abs(const three_rrr_fk_real v[])
 {
     three_rrr_fk_real largest = 0, sum = 0;
-    /* a branch-free max; the sum is NaN exactly when some |v_i| is (none is negative: inf -
-     * inf cannot occur) */
+    /* a branch-free max, written largest-first: x86's max instruction keeps its first
+     * operand where the other is not larger, so a, which the sum reads too, needs no copy (an
+     * instruction an entry fewer; a NaN a may or may not stay in largest, the sum finds it).
+     * The sum is NaN exactly when some |v_i| is (none is negative: inf - inf cannot occur).
+     * The passes below write their maxima alike. */
     for (int i = 0; i < THREE_RRR_FK_NQ; ++i) {
-        { const three_rrr_fk_real a = fabs(v[i]); largest = a > largest ? a : largest; sum += a; }
+        { const three_rrr_fk_real a = fabs(v[i]); largest = largest > a ? largest : a; sum += a; }
     }
     return sum != sum ? (three_rrr_fk_real)NAN : largest;
 }
@@ -108,6 +111,7 @@ static void three_rrr_fk_prepare(three_rrr_fk_real unit, three_rrr_fk_workspace 
     three_rrr_fk_lu_init(&work->lu); /* the caller's workspace may hold anything */
     work->norms[0] = work->norms[1] = work->norms[2] = 0;
     work->estimated_inv_norm = -1; /* no condition estimate to start from */
+    work->region[0] = -1; /* no region of the error model's bound yet */
     work->factored = 0; /* no factors of a solution yet */
     work->scaled = unit != 1 && THREE_RRR_FK_SCALE_FREE;
     if (!work->scaled) unit = 1;
@@ -502,31 +506,31 @@ static three_rrr_fk_real three_rrr_fk_inverse_norm1_exact(const three_rrr_fk_rea
     (void)inv;
     s = fabs(w20) + fabs(w16) + fabs(w13) + fabs(w10) + fabs(w6) + fabs(w3) + 2.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(w38) + fabs(w35) + fabs(w32) + fabs(w29) + fabs(w25) + fabs(w22) + 2.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(w56) + fabs(w53) + fabs(w49) + fabs(w46) + fabs(w43) + fabs(w40) + 2.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(w72) + fabs(w69) + fabs(w66) + fabs(w63) + fabs(w60) + fabs(w57) + 2.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(w86) + fabs(w83) + fabs(w80) + fabs(w77) + fabs(w74) + fabs(inv[20]) + 2.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(w102) + fabs(w99) + fabs(w96) + fabs(w92) + fabs(w89) + fabs(w87) + 2.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(v[3]) + fabs(v[6]) + fabs(w125) + fabs(w121) + fabs(w118) + fabs(w115) + fabs(w111) + fabs(w108) + 1.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(v[19]) + fabs(v[22]) + fabs(w145) + fabs(w142) + fabs(w138) + fabs(w135) + fabs(w132) + fabs(w129) + 1.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     s = fabs(v[35]) + fabs(v[38]) + fabs(w163) + fabs(w160) + fabs(w157) + fabs(w153) + fabs(w150) + fabs(w148) + 1.0;
     finite += s - s;
-    largest = s > largest ? s : largest;
+    largest = largest > s ? largest : s;
     return finite == 0 ? largest : (three_rrr_fk_real)INFINITY;
 }
 
@@ -631,15 +635,102 @@ static int three_rrr_fk_within_bound(const three_rrr_fk_options *options,
         && bound_dq <= options->target_dq && bound_ddq <= options->target_ddq;
 }
 
-/* three_rrr_fk_flagged with s and the residual's error `left` worked out. */
-static int three_rrr_fk_flagged_at(const three_rrr_fk_options *options,
-                                   const three_rrr_fk_report *report, three_rrr_fk_real s, three_rrr_fk_real left,
-                                   three_rrr_fk_real nq, three_rrr_fk_real ndq, three_rrr_fk_real nddq, int judged)
+/* The region the cheap bound was proven for (work->region, three_rrr_fk_widen): the points
+ * whose Newton correction was not solved for, with ||Phi_q^-1||_1 <= region[0], residual
+ * <= region[1] and max |q|, |dq| <= region[corner], region[corner + 1], at the targets
+ * region[4..6] (each call checks those once, three_rrr_fk_region_for); corner 2 for the last
+ * point's norms (within_bound is then taken at twice them plus one, as would_flag takes it),
+ * 7 for this point's. Every operation from these numbers to within_bound's tests (s, left,
+ * the widened norms, the tests) is monotone in each of them, also as rounded (products and
+ * sums of numbers >= 0, a max), and the region's corner is finite (no 0 * inf): the bound
+ * holds at every point of the region, and a few comparisons stand for it. A NaN fails them. */
+static int three_rrr_fk_covered(const three_rrr_fk_workspace *work,
+                                const three_rrr_fk_report *report, three_rrr_fk_real nq, three_rrr_fk_real ndq,
+                                int corner)
+{
+    const three_rrr_fk_real *r = work->region;
+    return work->correction < 0 && report->inv_norm <= r[0] && report->residual <= r[1]
+        && nq <= r[corner] && ndq <= r[corner + 1] && report->cond < (three_rrr_fk_real)INFINITY;
+}
+
+/* The region holds at the targets it was proven for: a call that goes on from an earlier
+ * state with other targets starts without one (three_rrr_fk_prepare clears it for a fresh
+ * start). Every entry point that steps on from a state calls this, once a call. */
+static void three_rrr_fk_region_for(const three_rrr_fk_options *options,
+                                    three_rrr_fk_workspace *work)
+{
+    if (!(options->target_q == work->region[4] && options->target_dq == work->region[5]
+          && options->target_ddq == work->region[6])) {
+        work->region[0] = -1;
+    }
+}
+
+/* Prove the cheap bound for a region around a point whose correction was not solved for:
+ * its ||Phi_q^-1||_1 and the norms nq, ndq an eighth larger (norms at least 1), and the
+ * largest residual the targets allow there (within_bound's three tests solved for the error
+ * of q, halved for their rounding), kept in work->region where within_bound holds at that
+ * corner (the norms taken at twice them plus one, as would_flag takes them: region[7..8]).
+ * The points that follow lie in it until the condition or the motion grows by an eighth
+ * (a converged point's residual is anywhere below tol_phi: the corner leaves the bound's
+ * slack to it). 1 when the region holds the point. */
+static int three_rrr_fk_widen(const three_rrr_fk_options *options, three_rrr_fk_workspace *work,
+                              const three_rrr_fk_report *report, three_rrr_fk_real nq, three_rrr_fk_real ndq)
+{
+    const three_rrr_fk_real u = THREE_RRR_FK_UNIT_ROUNDOFF, margin = 2 * THREE_RRR_FK_SAFETY;
+    const three_rrr_fk_real grow = (three_rrr_fk_real)1.125; /* 9 / 8: exact in binary */
+    const three_rrr_fk_real inv_norm = grow * report->inv_norm;
+    /* norms below 1 grow up to 1 (the model takes max(1, norm) where it scales by them) */
+    const three_rrr_fk_real wide_q = three_rrr_fk_at_least_1(grow * nq);
+    const three_rrr_fk_real wide_dq = three_rrr_fk_at_least_1(grow * ndq);
+    const three_rrr_fk_real s = inv_norm / sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
+    const three_rrr_fk_real corner_q = 2 * wide_q + 1, corner_dq = 2 * wide_dq + 1;
+    const three_rrr_fk_real a = three_rrr_fk_at_least_1(corner_dq);
+    const three_rrr_fk_real x_dq = options->target_dq / margin;
+    const three_rrr_fk_real x_ddq = options->target_ddq / (margin * (1 + a * a * (1 + 2 * s)));
+    three_rrr_fk_real most = (x_dq < x_ddq ? x_dq : x_ddq) / s - u, residual, e_q;
+    most = (options->target_q / margin < most ? options->target_q / margin : most) / 2;
+    residual = most / s;
+    if (!(work->correction < 0 && residual >= 0 && s * residual < (three_rrr_fk_real)INFINITY
+          && corner_q < (three_rrr_fk_real)INFINITY && corner_dq < (three_rrr_fk_real)INFINITY)
+        || !three_rrr_fk_within_bound(options, report, s, s * residual, corner_q, corner_dq,
+                                      &e_q)) {
+        return 0;
+    }
+    work->region[0] = inv_norm;
+    work->region[1] = residual;
+    work->region[2] = wide_q;
+    work->region[3] = wide_dq;
+    work->region[4] = options->target_q;
+    work->region[5] = options->target_dq;
+    work->region[6] = options->target_ddq;
+    work->region[7] = corner_q;
+    work->region[8] = corner_dq;
+    return report->residual <= residual;
+}
+
+/* Where the last point's norms (work->norms) and this report lie in the region: the cheap
+ * bound holds at twice the norms plus one, so it clears the end of the step for norms up to
+ * the region's there (work->clear). 1 when they do. Inline: it is most steps' whole error
+ * model, a call would cost a third of it. */
+static inline int three_rrr_fk_region_clears(three_rrr_fk_workspace *work,
+                                             const three_rrr_fk_report *report)
+{
+    if (!three_rrr_fk_covered(work, report, work->norms[0], work->norms[1], 2)) {
+        return 0;
+    }
+    work->clear[0] = work->region[7];
+    work->clear[1] = work->region[8];
+    return 1;
+}
+
+/* The model where the cheap bound failed, with its e_q. */
+static int three_rrr_fk_model_flags(const three_rrr_fk_options *options,
+                                    const three_rrr_fk_report *report, three_rrr_fk_real s, three_rrr_fk_real e_q,
+                                    three_rrr_fk_real nq, three_rrr_fk_real ndq, three_rrr_fk_real nddq, int judged)
 {
     const three_rrr_fk_real u = THREE_RRR_FK_UNIT_ROUNDOFF;
     const three_rrr_fk_real a = three_rrr_fk_at_least_1(ndq);
-    three_rrr_fk_real e_q, e_dq, e_ddq;
-    if (three_rrr_fk_within_bound(options, report, s, left, nq, ndq, &e_q)) return 0;
+    three_rrr_fk_real e_dq, e_ddq;
     if (report->cond - report->cond != 0) return 1;
     e_dq = s * (u * ndq + e_q * a);
     e_ddq = s * (u * nddq + e_q * (nddq + ndq * ndq) + 2 * e_dq * a);
@@ -651,15 +742,21 @@ static int three_rrr_fk_flagged_at(const three_rrr_fk_options *options,
 /* The error model of runtime.solving.accuracy: 1 when q, dq or ddq may miss its target. The error of q
  * the residual leaves is the size of the Newton correction where it was solved for
  * (work->correction), else ||Phi_q^-1||_1 / sqrt(NQ) times the residual. Its cheap bound
- * decides first; the model runs where the bound fails. */
-static int three_rrr_fk_flagged(const three_rrr_fk_options *options,
-                                const three_rrr_fk_workspace *work,
+ * decides first (by the region where it was proven, else evaluated, a region proven for the
+ * points to come where it holds); the model runs where the bound fails. */
+static int three_rrr_fk_flagged(const three_rrr_fk_options *options, three_rrr_fk_workspace *work,
                                 const three_rrr_fk_report *report, three_rrr_fk_real nq, three_rrr_fk_real ndq,
                                 three_rrr_fk_real nddq, int judged)
 {
     const three_rrr_fk_real s = report->inv_norm / sqrt((three_rrr_fk_real)THREE_RRR_FK_NQ);
     const three_rrr_fk_real left = work->correction >= 0 ? work->correction : s * report->residual;
-    return three_rrr_fk_flagged_at(options, report, s, left, nq, ndq, nddq, judged);
+    three_rrr_fk_real e_q;
+    if (three_rrr_fk_covered(work, report, nq, ndq, 7)) return 0;
+    if (three_rrr_fk_within_bound(options, report, s, left, nq, ndq, &e_q)) {
+        three_rrr_fk_widen(options, work, report, nq, ndq); /* for the points to come */
+        return 0;
+    }
+    return three_rrr_fk_model_flags(options, report, s, e_q, nq, ndq, nddq, judged);
 }
 
 /* e_q of runtime.solving.accuracy.position_error: the error of q the residual leaves (the Newton
@@ -771,7 +868,7 @@ static void three_rrr_fk_propagated(const three_rrr_fk_workspace *work, three_rr
  * rounding of their solves. q, dq, ddq in the kernel's unit, their max norms in the run's;
  * dq, ddq: NULL where not solved for (zero in the estimates, their own errors not judged). */
 static int three_rrr_fk_flagged_refined(const three_rrr_fk_options *options,
-                                        const three_rrr_fk_workspace *work,
+                                        three_rrr_fk_workspace *work,
                                         const three_rrr_fk_report *report, three_rrr_fk_real nq,
                                         three_rrr_fk_real ndq, three_rrr_fk_real nddq, const three_rrr_fk_real q[],
                                         const three_rrr_fk_real dq[], const three_rrr_fk_real ddq[], three_rrr_fk_real t,
@@ -795,8 +892,9 @@ static int three_rrr_fk_flagged_refined(const three_rrr_fk_options *options,
 /* Whether the error model would flag a point with this report's residual and condition and
  * the last point's max |q|, |dq|, |ddq| (work->norms), where a smaller residual could help.
  * The cheap bound is tried at twice the last norms plus one first: where it holds, it holds
- * at the end of the step too if the new norms are within those (work->clear; the residual,
- * condition and correction unchanged), and the model need not run again there. */
+ * at the end of the step too if the new norms are within those (work->clear, the region's
+ * where it holds there; the residual, condition and correction unchanged), and the model
+ * need not run again there. */
 static int three_rrr_fk_would_flag(const three_rrr_fk_options *options,
                                    three_rrr_fk_workspace *work,
                                    const three_rrr_fk_report *report)
@@ -808,13 +906,16 @@ static int three_rrr_fk_would_flag(const three_rrr_fk_options *options,
     three_rrr_fk_real e_q;
     if (!(report->residual > THREE_RRR_FK_UNIT_ROUNDOFF * (1 + norms[0]))) return 0;
     if (three_rrr_fk_within_bound(options, report, s, left, wide_q, wide_dq, &e_q)) {
-        work->clear[0] = wide_q;
-        work->clear[1] = wide_dq;
+        if (!three_rrr_fk_widen(options, work, report, norms[0], norms[1])
+            || !three_rrr_fk_region_clears(work, report)) {
+            work->clear[0] = wide_q;
+            work->clear[1] = wide_dq;
+        }
         return 0;
     }
-    return three_rrr_fk_flagged_at(options, report, s, left, norms[0], norms[1], norms[2], 2);
+    if (three_rrr_fk_within_bound(options, report, s, left, norms[0], norms[1], &e_q)) return 0;
+    return three_rrr_fk_model_flags(options, report, s, e_q, norms[0], norms[1], norms[2], 2);
 }
-
 /* At a converged point: estimate the condition. Where the error model would flag the point
  * as Newton left it, solve for the Newton correction: its size is the error of q the residual
  * leaves (to first order), which judges the point instead of the model's bound from the
@@ -835,6 +936,7 @@ static int three_rrr_fk_converged(const three_rrr_fk_options *options, const thr
     ill = report->cond > options->tighten_cond;
     /* tighten_cond = inf: no extra iterations at all (the same work at every step) */
     if (ill || (options->tighten_cond < (three_rrr_fk_real)INFINITY
+                && !three_rrr_fk_region_clears(work, report)
                 && three_rrr_fk_would_flag(options, work, report))) {
         for (extra = 0; extra < THREE_RRR_FK_TIGHTEN_STEPS; ++extra) {
             three_rrr_fk_real size;
@@ -918,43 +1020,48 @@ static void three_rrr_fk_predict(three_rrr_fk_real t, three_rrr_fk_state *state)
     }
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the finite test
- * (0, or NaN when some entry is inf or NaN) into *finite, and dq in the kernel's unit. The
- * test is one addition an entry: the sum of |.| is NaN exactly when some entry is (none is
- * negative: inf - inf cannot occur), and an infinite entry is the largest. */
+/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
+ * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
+ * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
+ * largest), and dq in the kernel's unit. */
 static three_rrr_fk_real three_rrr_fk_rates_pass(const three_rrr_fk_workspace *work, three_rrr_fk_real dq[],
-                                       three_rrr_fk_real *finite)
+                                       three_rrr_fk_real *sum_abs)
 {
     three_rrr_fk_real largest = 0, sum = 0;
     for (int i = 0; i < THREE_RRR_FK_NQ; ++i) {
-        { const three_rrr_fk_real b = fabs(dq[i]); largest = b > largest ? b : largest; sum += b; }
+        { const three_rrr_fk_real b = fabs(dq[i]); largest = largest > b ? largest : b; sum += b; }
         dq[i] = -dq[i];
     }
     three_rrr_fk_from_unit(work, dq);
-    *finite = sum != sum ? (three_rrr_fk_real)NAN : largest - largest;
+    *sum_abs = sum;
     return largest;
 }
 
 /* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the finite test of ddq, ddq in the kernel's unit, and max |q| in the run's unit into *nq
- * (NaN when some q_i is, as in max_abs: the error model then flags the point). */
+ * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
+ * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
+ * then flags the point). */
 static three_rrr_fk_real three_rrr_fk_accelerations_pass(const three_rrr_fk_workspace *work,
                                                const three_rrr_fk_real q[], three_rrr_fk_real ddq[],
-                                               three_rrr_fk_real *finite, three_rrr_fk_real *nq)
+                                               three_rrr_fk_real *sum_abs, three_rrr_fk_real *nq)
 {
-    three_rrr_fk_real largest = 0, sum = 0, largest_q = 0, sum_q = 0;
+    three_rrr_fk_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
     /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division) */
+     * a coordinate that is no length is the same in every unit (no division); the lengths'
+     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
+     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
     for (int i = 0; i < THREE_RRR_FK_NQ; ++i) {
-        { const three_rrr_fk_real c = fabs(ddq[i]); largest = c > largest ? c : largest; sum += c; }
+        { const three_rrr_fk_real c = fabs(ddq[i]); largest = largest > c ? largest : c; sum += c; }
         {
             const three_rrr_fk_real a = fabs(q[i]) * work->inverse_column[i];
-            largest_q = a > largest_q ? a : largest_q;
+            largest_q = largest_q > a ? largest_q : a;
             sum_q += a;
         }
     }
+    largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
+    largest_q = largest_q > largest_length ? largest_q : largest_length;
     three_rrr_fk_from_unit(work, ddq);
-    *finite = sum != sum ? (three_rrr_fk_real)NAN : largest - largest;
+    *sum_abs = sum;
     *nq = sum_q != sum_q ? (three_rrr_fk_real)NAN : largest_q;
     return largest;
 }
@@ -964,7 +1071,7 @@ static int three_rrr_fk_step(const three_rrr_fk_options *options, const three_rr
                              three_rrr_fk_real t, three_rrr_fk_state *state,
                              three_rrr_fk_workspace *work, three_rrr_fk_report *report)
 {
-    three_rrr_fk_real nq, ndq, nddq, finite_dq, finite_ddq;
+    three_rrr_fk_real nq, ndq, nddq, sum_dq, sum_ddq, largest;
     report->flagged = 0;
     report->cond = (three_rrr_fk_real)NAN;
     if (state->started) {
@@ -973,7 +1080,7 @@ static int three_rrr_fk_step(const three_rrr_fk_options *options, const three_rr
         three_rrr_fk_prepare(options->unit, work);
     }
     report->status = three_rrr_fk_newton(options, p, t, state->q, work, report);
-    report->fallbacks = three_rrr_fk_lu_fallbacks(&work->lu);
+    report->fallbacks = work->lu.fallbacks; /* three_rrr_fk_lu_fallbacks, without a call */
     if (report->status != THREE_RRR_FK_OK) {
         return report->status;
     }
@@ -983,12 +1090,15 @@ static int three_rrr_fk_step(const three_rrr_fk_options *options, const three_rr
     three_rrr_fk_phi_t_shared(state->q, t, p, work->shared, state->dq);
     three_rrr_fk_rows_in_unit(work, state->dq);
     three_rrr_fk_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = three_rrr_fk_rates_pass(work, state->dq, &finite_dq);
+    ndq = three_rrr_fk_rates_pass(work, state->dq, &sum_dq);
     three_rrr_fk_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     three_rrr_fk_rows_in_unit(work, state->ddq);
     three_rrr_fk_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = three_rrr_fk_accelerations_pass(work, state->q, state->ddq, &finite_ddq, &nq);
-    if (finite_dq != 0 || finite_ddq != 0) {
+    nddq = three_rrr_fk_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
+     * overflow harmlessly), infinite where the larger maximum is */
+    largest = ndq > nddq ? ndq : nddq;
+    if (sum_dq + sum_ddq != sum_dq + sum_ddq || largest - largest != 0) {
         report->status = THREE_RRR_FK_NOT_FINITE; /* Phi_t or Gamma singular at t */
         return report->status;
     }
@@ -1010,6 +1120,7 @@ int three_rrr_fk_solve_step(const three_rrr_fk_options *options, const three_rrr
                             three_rrr_fk_report *report)
 {
     if (three_rrr_fk_check_options(options) != 0) return three_rrr_fk_refused(report, t);
+    if (state->started) three_rrr_fk_region_for(options, work); /* else prepared afresh */
     return three_rrr_fk_step(options, p, t, state, work, report);
 }
 
@@ -1210,6 +1321,7 @@ int three_rrr_fk_solve_inputs(const three_rrr_fk_options *options, const three_r
                               three_rrr_fk_report *report)
 {
     if (three_rrr_fk_check_options(options) != 0) return three_rrr_fk_refused(report, state->t);
+    if (state->started) three_rrr_fk_region_for(options, work); /* else prepared afresh */
     return three_rrr_fk_inputs_step(options, p, u, du, ddu, state, work, report);
 }
 
@@ -1236,6 +1348,7 @@ int three_rrr_fk_solve_grid_checked(const three_rrr_fk_options *options,
         three_rrr_fk_refused(report, t[0]);
         return 0;
     }
+    if (n > 0 && state->started) three_rrr_fk_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (three_rrr_fk_step(options, p, t[k], state, work, report) != THREE_RRR_FK_OK) {
             return k;

@@ -58,21 +58,21 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 644 (238 add/sub, 148 mul, 27 div, 0 sqrt, 14 other calls, 115 fabs, 102 compares)
  *   Phi, Phi_q, their factorization and tests: 470; the update (a solve): 174
- * Condition at the converged q: 395; an extra iteration there (at most 3): 824
- * Velocity: 113; acceleration: 198; per-point checks: 2632; predictor: 87
- * Step, worst case with the default cap of 25 iterations: 22958 (8649 add/sub, 5545 mul, 966 div, 10 sqrt, 434 other calls, 3869 fabs, 3485 compares)
+ * Condition at the converged q: 395; an extra iteration there (at most 3): 848
+ * Velocity: 113; acceleration: 198; per-point checks: 2754; predictor: 87
+ * Step, worst case with the default cap of 25 iterations: 23167 (8668 add/sub, 5590 mul, 982 div, 12 sqrt, 434 other calls, 3869 fabs, 3612 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 25059 (9680 add/sub, 6018 mul, 1097 div, 10 sqrt, 518 other calls, 4016 fabs, 3720 compares)
- *   positions only (du, ddu NULL): 24578 (9515 add/sub, 5830 mul, 1055 div, 10 sqrt, 518 other calls, 3974 fabs, 3676 compares)
+ * solve_inputs, worst case: 25266 (9698 add/sub, 6062 mul, 1113 div, 12 sqrt, 518 other calls, 4016 fabs, 3847 compares)
+ *   positions only (du, ddu NULL): 24785 (9533 add/sub, 5874 mul, 1071 div, 12 sqrt, 518 other calls, 3974 fabs, 3803 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 1994
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286160
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 286369
  */
 #define THREE_RRR_FK_OPS_ITERATION 644   /* one Newton iteration */
-#define THREE_RRR_FK_OPS_STEP_FIXED 6858  /* a step without its iterations */
-#define THREE_RRR_FK_OPS_STEP_WORST 22958  /* at the default cap, 25 */
-#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286160  /* every factorization dense */
-#define THREE_RRR_FK_OPS_INPUTS_WORST 25059  /* solve_inputs with du, ddu */
-#define THREE_RRR_FK_OPS_POSITIONS_WORST 24578  /* solve_inputs, du, ddu NULL */
+#define THREE_RRR_FK_OPS_STEP_FIXED 7067  /* a step without its iterations */
+#define THREE_RRR_FK_OPS_STEP_WORST 23167  /* at the default cap, 25 */
+#define THREE_RRR_FK_OPS_STEP_DENSE_WORST 286369  /* every factorization dense */
+#define THREE_RRR_FK_OPS_INPUTS_WORST 25266  /* solve_inputs with du, ddu */
+#define THREE_RRR_FK_OPS_POSITIONS_WORST 24785  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* THREE_RRR_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -111,6 +111,8 @@ typedef struct {
     three_rrr_fk_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     three_rrr_fk_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     three_rrr_fk_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    three_rrr_fk_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     three_rrr_fk_real column[THREE_RRR_FK_NQ]; /* options->unit where q_i is a length, else 1 */
     three_rrr_fk_real inverse_column[THREE_RRR_FK_NQ]; /* 1 / column */
     three_rrr_fk_real row[THREE_RRR_FK_NQ]; /* options->unit where Phi_i is a length, else 1 */

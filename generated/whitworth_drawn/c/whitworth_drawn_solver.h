@@ -56,16 +56,16 @@ typedef struct {
  * call of tens of instructions, each other operation about one.
  * One Newton iteration: 304 (118 add/sub, 73 mul, 15 div, 0 sqrt, 6 other calls, 44 fabs, 48 compares)
  *   Phi, Phi_q, their factorization and tests: 212; the update (a solve): 92
- * Condition at the converged q: 173; an extra iteration there (at most 3): 475
- * Velocity: 56; acceleration: 117; per-point checks: 1463; predictor: 51
- * Step, worst case with the default cap of 25 iterations: 11366 (4376 add/sub, 2868 mul, 546 div, 10 sqrt, 186 other calls, 1580 fabs, 1800 compares)
+ * Condition at the converged q: 173; an extra iteration there (at most 3): 499
+ * Velocity: 56; acceleration: 117; per-point checks: 1577; predictor: 51
+ * Step, worst case with the default cap of 25 iterations: 11567 (4395 add/sub, 2905 mul, 562 div, 12 sqrt, 186 other calls, 1580 fabs, 1927 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73237
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 73438
  */
 #define WHITWORTH_DRAWN_OPS_ITERATION 304   /* one Newton iteration */
-#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3766  /* a step without its iterations */
-#define WHITWORTH_DRAWN_OPS_STEP_WORST 11366  /* at the default cap, 25 */
-#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73237  /* every factorization dense */
+#define WHITWORTH_DRAWN_OPS_STEP_FIXED 3967  /* a step without its iterations */
+#define WHITWORTH_DRAWN_OPS_STEP_WORST 11567  /* at the default cap, 25 */
+#define WHITWORTH_DRAWN_OPS_STEP_DENSE_WORST 73438  /* every factorization dense */
 
 typedef struct {
     int status;                  /* WHITWORTH_DRAWN_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
@@ -102,6 +102,8 @@ typedef struct {
     whitworth_drawn_real norms[3]; /* max |q|, |dq|, |ddq| of the last point solved */
     whitworth_drawn_real correction; /* max |Phi_q^-1 Phi| at the converged q, or -1: not solved for */
     whitworth_drawn_real clear[2]; /* max |q|, |dq| the error model's bound cleared this point for, or -1 */
+    whitworth_drawn_real region[9]; /* where the error model's bound was proven to hold (see the solver); */
+                                  /* region[0] < 0: nowhere yet */
     whitworth_drawn_real column[WHITWORTH_DRAWN_NQ]; /* options->unit where q_i is a length, else 1 */
     whitworth_drawn_real inverse_column[WHITWORTH_DRAWN_NQ]; /* 1 / column */
     whitworth_drawn_real row[WHITWORTH_DRAWN_NQ]; /* options->unit where Phi_i is a length, else 1 */

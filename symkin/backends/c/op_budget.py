@@ -148,13 +148,27 @@ UNROLLED = 16
 # <prefix>_within_bound, the model's cheap bound: the rounding floor, e_q, x = s (u + e_q),
 # max(1, |dq|), the three bounds and their four tests.
 BOUND = Flops(mul=10, add=4, cmp=6)
-# <prefix>_flagged: s = inv_norm / sqrt(NQ) and the residual's error, the bound, then (where it
-# fails) e_dq, e_ddq and the three comparisons with the targets.
-FLAGGED = Flops(sqrt=1, div=1, mul=1, cmp=1) + BOUND + Flops(mul=15, add=5, cmp=8)
+# <prefix>_covered: whether a point lies in the region where the bound was proven (the
+# correction, the norm of the inverse, the residual, two norms, the condition).
+REGION = Flops(cmp=6)
+# <prefix>_widen, where the bound held: the corner (the inverse's norm and two norms grown,
+# each norm at least 1, s, twice them plus one), the largest residual the three targets allow
+# there (the margin, its quotients, the smaller of two, the unit roundoff, halved), its tests
+# and the bound at the corner.
+WIDEN = (Flops(mul=3, cmp=2) + Flops(sqrt=1, div=1) + Flops(mul=2, add=2)
+         + Flops(cmp=1, mul=1) + Flops(div=2, mul=4, add=2) + Flops(cmp=2, div=5, add=1)
+         + Flops(cmp=6, mul=2) + BOUND)
+# <prefix>_region_for: the three targets against the region's, once a call.
+REGION_TARGETS = Flops(cmp=3)
+# <prefix>_flagged: s = inv_norm / sqrt(NQ) and the residual's error, the region, the bound,
+# then (where it fails) e_dq, e_ddq and the three comparisons with the targets; where it
+# holds, a region is proven instead (WIDEN, counted with the step's checks).
+FLAGGED = Flops(sqrt=1, div=1, mul=1, cmp=1) + REGION + BOUND + Flops(mul=15, add=5, cmp=8)
 # <prefix>_would_flag: the residual against the rounding level, s and the residual's error,
 # the bound at the widened norms (twice the last, plus one), then the model (its own bound
-# again).
-WOULD_FLAG = Flops(add=1, mul=1, cmp=1) + Flops(mul=2, add=2) + BOUND + FLAGGED
+# again); before it, once a step, whether the region clears the point (the region's
+# comparisons: counted here, at each call).
+WOULD_FLAG = Flops(add=1, mul=1, cmp=1) + Flops(mul=2, add=2) + BOUND + FLAGGED + REGION
 # <prefix>_position_error: s, the residual's error, the rounding floor and their max.
 POSITION_ERROR = Flops(sqrt=1, div=1, mul=3, add=1, cmp=2)
 # <prefix>_flagged_refined around its calls: s, e_dq, e_ddq, the three finite tests and the
@@ -294,19 +308,21 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
         norms = (_max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
                  + Flops(cmp=len(getattr(code, "input_lengths", ()))))
     else:  # a pass over dq as solved (max, sum, negation) and one over ddq as solved and
-        # q / column where q_i is a length (two maxima, two sums), the three sums' NaN tests
-        # and the two infinity tests; then whether Newton's bound cleared the point
-        # (work->clear)
-        divided = sum(1 for c in lengths.length_columns(code.coordinates) if c)
+        # q (two maxima, two sums; written out, the lengths' largest |q_i| divided by the unit
+        # once and taken into the max), q's NaN test, the finite test of dq and ddq (the
+        # larger maximum, the two sums added and tested, the infinity test); then whether
+        # Newton's bound cleared the point (work->clear)
+        divided = 1 if any(lengths.length_columns(code.coordinates)) else 0
         if n > UNROLLED:  # the loop divides every q_i
-            divided = n
-        norms = (Flops(abs=3 * n, mul=divided, cmp=3 * n, add=4 * n) + Flops(cmp=2, add=2)
-                 + Flops(cmp=3 + 2))
+            divided += n
+        norms = (Flops(abs=3 * n, mul=divided, cmp=3 * n, add=4 * n) + Flops(cmp=1)
+                 + Flops(cmp=1) + Flops(cmp=3, add=3) + Flops(cmp=2))
     prediction = Flops(add=1, mul=1, div=1) + Flops(mul=2, add=2) * n  # (2.76), h^2 / 2 once
     predictor = chord(code, algebra, units) if inputs else prediction
     return Pieces(evaluation=evaluation, update=update, estimate=estimate,
                   tighten=tighten, velocity=velocity, acceleration=acceleration,
-                  checks=norms + refined(code, algebra, units), predictor=predictor)
+                  checks=norms + refined(code, algebra, units) + WIDEN * 2,
+                  predictor=predictor)
 
 
 def step(parts: Pieces, cap: int, rates: bool = True) -> Flops:
@@ -314,8 +330,8 @@ def step(parts: Pieces, cap: int, rates: bool = True) -> Flops:
     positions only (``<prefix>_solve_inputs`` with du, ddu NULL)."""
     convergence = parts.converged(Flops(cmp=3) + WOULD_FLAG)
     kinematics = parts.velocity + parts.acceleration if rates else ZERO
-    return (OPTIONS_CHECK + parts.predictor + parts.newton(cap) + convergence + kinematics
-            + parts.checks)
+    return (OPTIONS_CHECK + REGION_TARGETS + parts.predictor + parts.newton(cap) + convergence
+            + kinematics + parts.checks)
 
 
 @dataclass(frozen=True)
