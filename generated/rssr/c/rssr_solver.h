@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 914 (306 add/sub, 279 mul, 24 div, 1 sqrt, 2 other calls, 166 fabs, 136 compares)
  *   Phi, Phi_q, their factorization and tests: 761; the update (a solve): 153
  * Condition at the converged q: 628; an extra iteration there (at most 3): 1087
- * Velocity: 127; acceleration: 412; per-point checks: 2642; predictor: 59
- * Step, worst case with the default cap of 25 iterations: 31464 (10824 add/sub, 10010 mul, 826 div, 42 sqrt, 64 other calls, 5294 fabs, 4404 compares)
+ * Velocity: 127; acceleration: 409; per-point checks: 2639; predictor: 59
+ * Step, worst case with the default cap of 25 iterations: 31458 (10818 add/sub, 10010 mul, 826 div, 42 sqrt, 64 other calls, 5294 fabs, 4404 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121007
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121001
  */
 #define RSSR_OPS_ITERATION 914   /* one Newton iteration */
-#define RSSR_OPS_STEP_FIXED 8614  /* a step without its iterations */
-#define RSSR_OPS_STEP_WORST 31464  /* at the default cap, 25 */
-#define RSSR_OPS_STEP_DENSE_WORST 121007  /* every factorization dense */
+#define RSSR_OPS_STEP_FIXED 8608  /* a step without its iterations */
+#define RSSR_OPS_STEP_WORST 31458  /* at the default cap, 25 */
+#define RSSR_OPS_STEP_DENSE_WORST 121001  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RSSR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

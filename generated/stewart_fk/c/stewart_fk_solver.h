@@ -60,20 +60,20 @@ typedef struct {
  * One Newton iteration: 1395 (538 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 146 fabs, 122 compares)
  *   Phi, Phi_q, their factorization and tests: 1274; the update (a solve): 121
  * Condition at the converged q: 612; an extra iteration there (at most 3): 1561
- * Velocity: 111; acceleration: 996; per-point checks: 3220; predictor: 31
- * Step, worst case with the default cap of 25 iterations: 46510 (18240 add/sub, 19325 mul, 506 div, 10 sqrt, 0 other calls, 4550 fabs, 3879 compares)
+ * Velocity: 111; acceleration: 1003; per-point checks: 3227; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 46524 (18252 add/sub, 19327 mul, 506 div, 10 sqrt, 0 other calls, 4550 fabs, 3879 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 48911 (19315 add/sub, 20454 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3980 compares)
- *   positions only (du, ddu NULL): 47746 (18770 add/sub, 19878 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3964 compares)
+ * solve_inputs, worst case: 48925 (19327 add/sub, 20456 mul, 553 div, 10 sqrt, 0 other calls, 4599 fabs, 3980 compares)
+ *   positions only (du, ddu NULL): 47753 (18776 add/sub, 19879 mul, 539 div, 10 sqrt, 0 other calls, 4585 fabs, 3964 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2354
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62309
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62323
  */
 #define STEWART_FK_OPS_ITERATION 1395   /* one Newton iteration */
-#define STEWART_FK_OPS_STEP_FIXED 11635  /* a step without its iterations */
-#define STEWART_FK_OPS_STEP_WORST 46510  /* at the default cap, 25 */
-#define STEWART_FK_OPS_STEP_DENSE_WORST 62309  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 48911  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 47746  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_STEP_FIXED 11649  /* a step without its iterations */
+#define STEWART_FK_OPS_STEP_WORST 46524  /* at the default cap, 25 */
+#define STEWART_FK_OPS_STEP_DENSE_WORST 62323  /* every factorization dense */
+#define STEWART_FK_OPS_INPUTS_WORST 48925  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 47753  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
