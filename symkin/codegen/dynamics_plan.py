@@ -48,6 +48,7 @@ import sympy as sp
 
 from symkin.codegen import lu_interchange, lu_plan, sample, symbol_printing
 from symkin.errors import BuildError, SolveError
+from symkin.spec import constants
 from symkin.symbolic import redundancy
 from symkin.symbolic.derivation import System
 
@@ -216,10 +217,11 @@ def _samples(system: System, pattern: Sequence[tuple[int, int]],
                  [internal[s] for s in system.code_parameters])
     mass = system.dynamics.mass_matrix if system.dynamics else sp.zeros(0, 0)
     functions = (sp.lambdify(arguments, [prepare(mass[r, c]) for r, c in m_pattern],
-                             modules="numpy"),
+                             modules=constants.numpy_modules()),
                  sp.lambdify(arguments, [prepare(system.phi_q[r, c]) for r, c in pattern],
-                             modules="numpy"),
-                 sp.lambdify(arguments, [prepare(e) for e in system.phi], modules="numpy"))
+                             modules=constants.numpy_modules()),
+                 sp.lambdify(arguments, [prepare(e) for e in system.phi],
+                             modules=constants.numpy_modules()))
     t0, p = np.float64(system.time_grid[0]), np.array(system.code_p_values, dtype=float)
     generator = np.random.default_rng(sample.STRUCTURE_SEED)
     with warnings.catch_warnings(), np.errstate(all="ignore"):

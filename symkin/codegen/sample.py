@@ -21,6 +21,7 @@ from symkin.codegen import lu_interchange, lu_plan, symbol_printing
 from symkin.contract import dense_solvers
 from symkin.contract.options import defaults
 from symkin.errors import BuildError, SolveError
+from symkin.spec import constants
 from symkin.symbolic.derivation import System
 
 # Assembly tolerances: the runtime's own Newton defaults (a tighter sample changes nothing).
@@ -248,9 +249,10 @@ class _SampleKernel:
         self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
         self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
         prepare = symbol_printing.Preparer(internal)
-        self._phi = sp.lambdify(arguments, [prepare(e) for e in system.phi], modules="numpy")
+        self._phi = sp.lambdify(arguments, [prepare(e) for e in system.phi],
+                                modules=constants.numpy_modules())
         self._nz = sp.lambdify(arguments, [prepare(system.phi_q[r, c]) for r, c in pattern],
-                               modules="numpy")
+                               modules=constants.numpy_modules())
         self._p = np.array(system.code_p_values, dtype=float)
 
     # t as a NumPy float: IEEE semantics as in the generated code (inf, NaN), never a Python

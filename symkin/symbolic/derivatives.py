@@ -146,6 +146,69 @@ class Differentiator:
         return sp.S.One if expr == self.symbol else ZERO
 
 
+class Directional(Differentiator):
+    """The derivative along a direction, D x = sum_k (dx/dq_k) v_k with v constant: each
+    node by the rule of its class as :class:`Differentiator` applies it, a symbol q_k giving
+    its v_k. D is a first derivative, so its rules need no ``Derivative`` of its own: applied
+    twice, D(D(x)) is x's second derivative along v (Gamma's convective part, v = dq). A
+    node's D is made once and kept for every row that meets it."""
+
+    def __init__(self, direction: dict[sp.Symbol, sp.Expr]) -> None:
+        super().__init__(sp.S.Zero)
+        self.direction = direction
+        self.variables = frozenset(direction)
+        self.touches: dict[Basic, bool] = {}
+
+    def diff(self, expr: sp.Expr, order: int = 1) -> sp.Expr:
+        """D(expr); ``order`` must be 1 (apply D again for the next).
+
+        Raises:
+            Unsupported: a node of ``expr`` has a derivative rule of its own.
+        """
+        found = self.memo.get((expr, 1))
+        if found is None:
+            found = self._n_times(expr, 1) if self._touches(expr) else ZERO
+            self.memo[expr, 1] = found
+        return found
+
+    def _touches(self, node: Basic) -> bool:
+        """Whether ``node`` holds one of the variables, remembered per subtree (SymPy walks
+        the whole subtree for free_symbols at every call)."""
+        found = self.touches.get(node)
+        if found is None:
+            if node.is_Symbol:
+                found = node in self.variables
+            elif _union_of_args(type(node)):
+                found = any(self._touches(arg) for arg in node.args)
+            else:
+                found = not self.variables.isdisjoint(node.free_symbols)
+            self.touches[node] = found
+        return found
+
+    def _n_times(self, expr: sp.Expr, order: int) -> sp.Expr:
+        if expr.is_Symbol:
+            return self.direction.get(expr, ZERO)
+        method = type(expr)._eval_derivative_n_times
+        if method is sp.Mul._eval_derivative_n_times:
+            return self._leibniz(expr.args, 1)
+        if method is not Basic._eval_derivative_n_times:
+            raise Unsupported(type(expr).__name__)
+        return self._once(expr)
+
+
+_UNION_OF_ARGS: dict[type, bool] = {}
+
+
+def _union_of_args(kind: type) -> bool:
+    """The class takes free_symbols from Basic (the union over its args). Looked up in the
+    classes' own dictionaries: a function class's metaclass has a free_symbols of its own."""
+    found = _UNION_OF_ARGS.get(kind)
+    if found is None:
+        owner = next(k for k in kind.__mro__ if "free_symbols" in k.__dict__)
+        found = _UNION_OF_ARGS[kind] = owner is sp.Basic
+    return found
+
+
 _RULES: dict[Callable[..., object], Callable[[Differentiator, sp.Expr], sp.Expr]] = {
     sp.Add._eval_derivative: Differentiator._add,
     sp.Mul._eval_derivative: Differentiator._product,

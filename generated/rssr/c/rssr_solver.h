@@ -57,15 +57,15 @@ typedef struct {
  * One Newton iteration: 914 (306 add/sub, 279 mul, 24 div, 1 sqrt, 2 other calls, 166 fabs, 136 compares)
  *   Phi, Phi_q, their factorization and tests: 761; the update (a solve): 153
  * Condition at the converged q: 628; an extra iteration there (at most 3): 1111
- * Velocity: 127; acceleration: 412; per-point checks: 2758; predictor: 59
- * Step, worst case with the default cap of 25 iterations: 31667 (10843 add/sub, 10049 mul, 842 div, 44 sqrt, 64 other calls, 5294 fabs, 4531 compares)
+ * Velocity: 127; acceleration: 409; per-point checks: 2755; predictor: 59
+ * Step, worst case with the default cap of 25 iterations: 31661 (10837 add/sub, 10049 mul, 842 div, 44 sqrt, 64 other calls, 5294 fabs, 4531 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121210
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 121204
  */
 #define RSSR_OPS_ITERATION 914   /* one Newton iteration */
-#define RSSR_OPS_STEP_FIXED 8817  /* a step without its iterations */
-#define RSSR_OPS_STEP_WORST 31667  /* at the default cap, 25 */
-#define RSSR_OPS_STEP_DENSE_WORST 121210  /* every factorization dense */
+#define RSSR_OPS_STEP_FIXED 8811  /* a step without its iterations */
+#define RSSR_OPS_STEP_WORST 31661  /* at the default cap, 25 */
+#define RSSR_OPS_STEP_DENSE_WORST 121204  /* every factorization dense */
 
 typedef struct {
     int status;                  /* RSSR_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */

@@ -60,20 +60,20 @@ typedef struct {
  * One Newton iteration: 1395 (538 add/sub, 574 mul, 15 div, 0 sqrt, 0 other calls, 146 fabs, 122 compares)
  *   Phi, Phi_q, their factorization and tests: 1274; the update (a solve): 121
  * Condition at the converged q: 612; an extra iteration there (at most 3): 1585
- * Velocity: 111; acceleration: 996; per-point checks: 3339; predictor: 31
- * Step, worst case with the default cap of 25 iterations: 46716 (18259 add/sub, 19367 mul, 522 div, 12 sqrt, 0 other calls, 4550 fabs, 4006 compares)
+ * Velocity: 111; acceleration: 1003; per-point checks: 3346; predictor: 31
+ * Step, worst case with the default cap of 25 iterations: 46730 (18271 add/sub, 19369 mul, 522 div, 12 sqrt, 0 other calls, 4550 fabs, 4006 compares)
  *   (another cap c: OPS_STEP_FIXED + c * OPS_ITERATION)
- * solve_inputs, worst case: 49118 (19333 add/sub, 20498 mul, 569 div, 12 sqrt, 0 other calls, 4599 fabs, 4107 compares)
- *   positions only (du, ddu NULL): 47953 (18788 add/sub, 19922 mul, 555 div, 12 sqrt, 0 other calls, 4585 fabs, 4091 compares)
+ * solve_inputs, worst case: 49132 (19345 add/sub, 20500 mul, 569 div, 12 sqrt, 0 other calls, 4599 fabs, 4107 compares)
+ *   positions only (du, ddu NULL): 47960 (18794 add/sub, 19923 mul, 555 div, 12 sqrt, 0 other calls, 4585 fabs, 4091 compares)
  *   its simplified Newton steps before Newton (at most 6, in place of the predictor): 2354
- * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62515
+ * On the dense LU (a fall-back at every factorization, or --linalg dense), worst case: 62529
  */
 #define STEWART_FK_OPS_ITERATION 1395   /* one Newton iteration */
-#define STEWART_FK_OPS_STEP_FIXED 11841  /* a step without its iterations */
-#define STEWART_FK_OPS_STEP_WORST 46716  /* at the default cap, 25 */
-#define STEWART_FK_OPS_STEP_DENSE_WORST 62515  /* every factorization dense */
-#define STEWART_FK_OPS_INPUTS_WORST 49118  /* solve_inputs with du, ddu */
-#define STEWART_FK_OPS_POSITIONS_WORST 47953  /* solve_inputs, du, ddu NULL */
+#define STEWART_FK_OPS_STEP_FIXED 11855  /* a step without its iterations */
+#define STEWART_FK_OPS_STEP_WORST 46730  /* at the default cap, 25 */
+#define STEWART_FK_OPS_STEP_DENSE_WORST 62529  /* every factorization dense */
+#define STEWART_FK_OPS_INPUTS_WORST 49132  /* solve_inputs with du, ddu */
+#define STEWART_FK_OPS_POSITIONS_WORST 47960  /* solve_inputs, du, ddu NULL */
 
 typedef struct {
     int status;                  /* STEWART_FK_OK, _NO_CONVERGENCE, _SINGULAR, _NOT_FINITE, */
