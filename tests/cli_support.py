@@ -78,6 +78,17 @@ def symkin_main(*args: str, cwd: Path, env: Mapping[str, str] | None = None) -> 
     return Ran(status, out.getvalue(), err.getvalue())
 
 
+def ctrl_c_as_at_a_terminal() -> None:
+    """Popen's preexec_fn for a child that is sent Ctrl-C: SIGINT at its default disposition,
+    as a shell starts a command. An ignored SIGINT is inherited through exec, and Python then
+    keeps ignoring it; in a fresh-clone CI run two such children ran to their end with exit 0
+    (the test-run process they were started from had SIGINT ignored at the C level; which
+    earlier test left it so was not found: none left Python's handler changed)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def symkin_process(*args: str, cwd: Path, env: Mapping[str, str] | None = None,
                    timeout: float = 300) -> subprocess.CompletedProcess[str]:
     """``python -m symkin ARGS`` in a new process: for what only a process shows."""

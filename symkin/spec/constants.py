@@ -320,7 +320,7 @@ def numpy_modules() -> list[Any]:
     return [{"I": 1j}, numpy]
 
 
-def lambdify_floats(arguments: Any, expressions: Any, modules: Any = "numpy",
+def lambdify_floats(arguments: Any, expressions: Any, modules: Any = None,
                     dummify: bool = False, cse: bool = False) -> Callable[..., Any]:
     """``sympy.lambdify`` of ``expressions`` (an expression, a sequence or a matrix of them)
     with every constant part folded to a double first (:func:`fold`).
@@ -342,7 +342,7 @@ def lambdify_floats(arguments: Any, expressions: Any, modules: Any = "numpy",
         folded = [fold(sp.sympify(e)) for e in expressions]
     if dummify:
         arguments, folded, dummify = _renamed(arguments, folded)
-    if modules == "numpy":
+    if modules is None:  # NumPy (numpy_modules: the module itself, not the string)
         modules = numpy_modules()
     function: Callable[..., Any] = sp.lambdify(arguments, folded, modules=modules,
                                                dummify=dummify, cse=cse)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cli_support import Ran, symkin_main
+from cli_support import Ran, ctrl_c_as_at_a_terminal, symkin_main
 
 ROOT = Path(__file__).resolve().parents[2]
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
@@ -146,7 +146,7 @@ def test_ctrl_c_writes_the_rows_solved_and_exits_130(backend: str, dt: str, tmp_
     process = subprocess.Popen(
         [sys.executable, "-m", "symkin", "run", str(TEXTBOOK), "--backend", backend, "--dt", dt,
          "-o", str(out)], cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=child_end,
-        text=True)
+        text=True, preexec_fn=ctrl_c_as_at_a_terminal)
     os.close(child_end)
     try:
         seen = _read_until(terminal, b"solving", deadline=time.monotonic() + 120)

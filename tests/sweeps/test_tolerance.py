@@ -156,6 +156,8 @@ def test_cli_interrupt_exits_130_without_a_traceback(tmp_path: Path) -> None:
     import signal
     import time
 
+    from cli_support import ctrl_c_as_at_a_terminal
+
     squeezer = str(ROOT / "examples" / "andrews_squeezer.yaml")
     warm = sweep_cli(squeezer, "--monte-carlo", "1", "--tolerance", "xa=±1e-5", cwd=tmp_path)
     assert warm.returncode == 0, warm.stderr  # the kernel is built: the wait below is solving
@@ -163,7 +165,7 @@ def test_cli_interrupt_exits_130_without_a_traceback(tmp_path: Path) -> None:
     process = subprocess.Popen(
         # Andrews' squeezer, 160000 sets x 61 points: far longer than the wait below
         [sys.executable, "-m", "symkin", "sweep", squeezer, "--monte-carlo", "160000", "--tolerance", "xa=±1e-5", "--workers", "1"], cwd=tmp_path,
-        env=env,
+        env=env, preexec_fn=ctrl_c_as_at_a_terminal,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(4)
     process.send_signal(signal.SIGINT)
