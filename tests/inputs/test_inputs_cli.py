@@ -1,9 +1,9 @@
 """``symkin run MECH --inputs table.csv``: the table's run equals the time-driven run of the
 same motion; every mistake in the table or the command is refused, located, with exit 2.
 
-The commands run in this process (``cli.main``, the code the console script calls): a fresh
-Python per command cost a second each in imports alone. One test runs a real process, so the
-exit status and the absence of a traceback are also seen from outside."""
+The commands run in this process (``cli_support.symkin_main``: ``cli.main``, what the console
+script calls): a fresh Python per command cost a second each in imports alone. One test runs
+a real process, so the exit status and the absence of a traceback are also seen from outside."""
 
 from __future__ import annotations
 
@@ -11,44 +11,32 @@ import os
 import subprocess
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
-
-from symkin import cli
+from cli_support import Ran, symkin_main
 
 ROOT = Path(__file__).resolve().parents[2]
 INPUT = ROOT / "examples" / "crank_slider_input.yaml"
 TIMED = ROOT / "examples" / "crank_slider.yaml"
 
 
-@dataclass
-class Done:
-    """What a command left: its exit status and what it wrote to stderr."""
-
-    returncode: int
-    stderr: str
-
-
 @pytest.fixture
-def symkin_cli(capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
-               ) -> Callable[..., Done]:
-    """``symkin ARGS`` run in ``cwd`` in this process; an exception the command lets out
-    (a traceback for the user) fails the test."""
+def symkin_cli() -> Callable[..., Ran]:
+    """``symkin ARGS`` run in ``cwd`` in this process (cli_support.symkin_main: an exception
+    the command lets out, a traceback for the user, fails the test)."""
 
-    def call(*args: str, cwd: Path) -> Done:
-        monkeypatch.chdir(cwd)
-        capfd.readouterr()
-        status = cli.main(list(args))
-        return Done(status, capfd.readouterr().err)
+    def call(*args: str, cwd: Path) -> Ran:
+        return symkin_main(*args, cwd=cwd)
+
+    return call
 
     return call
 
 
 @pytest.fixture
-def run(symkin_cli: Callable[..., Done]) -> Callable[..., Done]:
+def run(symkin_cli: Callable[..., Ran]) -> Callable[..., Ran]:
     """``symkin run ARGS`` in ``cwd``."""
     return lambda *args, cwd: symkin_cli("run", *args, cwd=cwd)
 
@@ -63,7 +51,7 @@ def _motion(t: np.ndarray) -> list[str]:
 
 
 @pytest.mark.parametrize("backend", ["c", "numpy"])
-def test_table_run_equals_the_time_driven_run(run: Callable[..., Done], tmp_path: Path,
+def test_table_run_equals_the_time_driven_run(run: Callable[..., Ran], tmp_path: Path,
                                                backend: str) -> None:
     t = np.linspace(0, 1.5, 31)
     table = _table(tmp_path / "u.csv", "t,crank_angle,crank_angle_t,crank_angle_tt", _motion(t))
@@ -80,7 +68,7 @@ def test_table_run_equals_the_time_driven_run(run: Callable[..., Done], tmp_path
         assert np.abs(a[name] - b[name]).max() / scale < 1e-12, name
 
 
-def test_positions_only_table_writes_nan_rates(run: Callable[..., Done], tmp_path: Path) -> None:
+def test_positions_only_table_writes_nan_rates(run: Callable[..., Ran], tmp_path: Path) -> None:
     t = np.linspace(0, 1, 11)
     rows = [f"{x!r},{x + 1.5!r}" for x in map(float, t)]
     table = _table(tmp_path / "u.csv", "t,crank_angle", rows)
@@ -110,7 +98,7 @@ GOOD = ["0,1.5", "0.1,1.6"]
     ("t,crank_angle", ["0,1_5"], "u.csv:2", "'1_5' is not a finite number"),  # not 15
     ("t,crank_angle", [], "u.csv", "no rows of values"),
 ])
-def test_bad_tables_are_refused_with_their_place(run: Callable[..., Done], tmp_path: Path,
+def test_bad_tables_are_refused_with_their_place(run: Callable[..., Ran], tmp_path: Path,
                                                  header: str, rows: list[str], where: str,
                                                  says: str) -> None:
     table = _table(tmp_path / "u.csv", header, rows)
@@ -119,7 +107,7 @@ def test_bad_tables_are_refused_with_their_place(run: Callable[..., Done], tmp_p
     assert where in got.stderr and says in got.stderr, got.stderr
 
 
-def test_input_mechanism_without_table_and_table_without_inputs(run: Callable[..., Done],
+def test_input_mechanism_without_table_and_table_without_inputs(run: Callable[..., Ran],
                                                                  tmp_path: Path) -> None:
     got = run(str(INPUT), "--backend", "numpy", cwd=tmp_path)
     assert got.returncode == 2 and "--inputs TABLE.csv" in got.stderr
@@ -134,7 +122,7 @@ def test_input_mechanism_without_table_and_table_without_inputs(run: Callable[..
     assert got.returncode == 2 and "cannot read the input table" in got.stderr
 
 
-def test_a_table_with_a_byte_order_mark_reads_as_without(run: Callable[..., Done],
+def test_a_table_with_a_byte_order_mark_reads_as_without(run: Callable[..., Ran],
                                                           tmp_path: Path) -> None:
     """Spreadsheets write "CSV UTF-8" with a byte-order mark before the header."""
     plain = _table(tmp_path / "plain.csv", "t,crank_angle", GOOD)
@@ -148,7 +136,7 @@ def test_a_table_with_a_byte_order_mark_reads_as_without(run: Callable[..., Done
 
 
 @pytest.mark.parametrize("output", ["u.csv", "link.csv", "./sub/../u.csv"])
-def test_the_results_never_replace_the_input_table(run: Callable[..., Done], tmp_path: Path,
+def test_the_results_never_replace_the_input_table(run: Callable[..., Ran], tmp_path: Path,
                                                     output: str) -> None:
     table = _table(tmp_path / "u.csv", "t,crank_angle", GOOD)
     (tmp_path / "sub").mkdir()
@@ -160,7 +148,7 @@ def test_the_results_never_replace_the_input_table(run: Callable[..., Done], tmp
     assert table.read_bytes() == before
 
 
-def test_sweep_and_scan_mistakes_about_inputs_are_the_users(symkin_cli: Callable[..., Done],
+def test_sweep_and_scan_mistakes_about_inputs_are_the_users(symkin_cli: Callable[..., Ran],
                                                             tmp_path: Path) -> None:
     """Exit 2, as run gives, and in the command line's words: a sweep of a mechanism with
     inputs (it exited 1, as for a design that failed), --input for a mechanism without

@@ -17,17 +17,16 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from cli_support import Ran, symkin_main
 from scipy.integrate import solve_ivp
 from test_iftomm_benchmarks import _bench_script
 
 import symkin
-from symkin import cli
 
 ROOT = Path(__file__).resolve().parents[2]
 N, G = 2, 9.81
@@ -101,31 +100,21 @@ def test_each_passage_is_reported_where_the_bars_line_up(default_run: Any) -> No
     assert np.flatnonzero(default_run.flagged).tolist() == after.tolist()
 
 
-@dataclass
-class Done:
-    """What ``symkin run`` left: its exit status and what it wrote to stderr."""
-
-    returncode: int
-    stderr: str
-
-
 @pytest.fixture
-def symkin_run(capfd: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
-               ) -> Callable[..., Done]:
-    """``symkin run ARGS`` in ``cwd``, in this process (cli.main, what the console script
-    runs): an exception it let out fails the test, as a traceback would."""
+def symkin_run() -> Callable[..., Ran]:
+    """``symkin run ARGS`` in ``cwd``, in this process (cli_support.symkin_main: an
+    exception it lets out fails the test, as a traceback would)."""
 
-    def run(*args: str, cwd: Path) -> Done:
-        monkeypatch.chdir(cwd)
-        capfd.readouterr()
-        status = cli.main(["run", *args])
-        return Done(status, capfd.readouterr().err)
+    def run(*args: str, cwd: Path) -> Ran:
+        return symkin_main("run", *args, cwd=cwd)
+
+    return run
 
     return run
 
 
 def test_cli_warns_of_each_passage_and_stops_at_the_first_when_asked(
-        tmp_path: Path, symkin_run: Callable[..., Done]) -> None:
+        tmp_path: Path, symkin_run: Callable[..., Ran]) -> None:
     path = _chain(tmp_path, 1.5)
     first, second = _passage_times(1.5)
     result = symkin_run(str(path), "--backend", "numpy", "-o", "out.csv", cwd=tmp_path)
@@ -174,7 +163,7 @@ time: {t0: 0, t1: 2.5, dt: 0.05}
 
 
 def test_a_lock_up_stops_at_the_limit_position_naming_it(
-        tmp_path: Path, symkin_run: Callable[..., Done]) -> None:
+        tmp_path: Path, symkin_run: Callable[..., Ran]) -> None:
     (tmp_path / "lockup.yaml").write_text(LOCKUP, encoding="utf-8")
     result = symkin_run("lockup.yaml", "--backend", "numpy", "-o", "out.npz", cwd=tmp_path)
     assert result.returncode == 1
