@@ -16,11 +16,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from cli_support import symkin_main
 from codegen_support import compiled, derived
 from driver_support import BACKENDS, kernel_for
 
 import symkin
-from symkin import cli
 from symkin.errors import MechanismError, SolveError
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -345,27 +345,26 @@ def test_cam_pressure_angle_and_curvature_radius_follow_the_law(cam, cam_kernel,
     assert np.array_equal(saved["k1.curvature_radius"], outputs["k1.curvature_radius"])
 
 
-def _cli(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str]:
-    """symkin run in this process (a real process's exit code is tests/cli's): code, stderr."""
-    code = cli.main(["run", *args])
-    err = capsys.readouterr().err
-    assert "Traceback" not in err, err
-    return code, err
+def _cli(cwd: Path, *args: str) -> tuple[int, str]:
+    """symkin run in this process (cli_support.symkin_main; a real process's exit code is
+    tests/cli's): code, stderr."""
+    ran = symkin_main("run", *args, cwd=cwd)
+    assert "Traceback" not in ran.stderr, ran.stderr
+    return ran.returncode, ran.stderr
 
 
-def test_cli_undercut_exits_2_and_curve_end_exits_1(tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_undercut_exits_2_and_curve_end_exits_1(tmp_path: Path) -> None:
     """Undercutting is a mistake in the file (exit 2, located, no traceback); the end of a
     curve met during the motion stops the run at its time naming the pair (exit 1), with the
     rows solved so far written (the CSV has the column c1.s)."""
     data = _cam({"polar": "2 + 0.4*cos(3*s)"}, {"roller": 1.5, "at": "R"})
     bad = tmp_path / "undercut.yaml"
     bad.write_text(json.dumps(data))
-    code, err = _cli(capsys, str(bad), "--backend", "numpy")
+    code, err = _cli(tmp_path, str(bad), "--backend", "numpy")
     assert code == 2
     assert "joints[2].profile.polar: undercutting" in err
     mechanism = Path(__file__).resolve().parents[1] / "mechanisms" / "half_circle_end.yaml"
-    code, err = _cli(capsys, str(mechanism), "--backend", "numpy", "-o",
+    code, err = _cli(tmp_path, str(mechanism), "--backend", "numpy", "-o",
                      str(tmp_path / "half.csv"))
     assert code == 1
     assert "near t = 0.79999" in err and "c1 point_on_curve" in err
