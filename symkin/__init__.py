@@ -6,9 +6,11 @@ already-compiled kernel does not pay for importing SymPy.
 
 from __future__ import annotations
 
-import importlib
-from pathlib import Path
-from typing import Any
+# Not `typing.TYPE_CHECKING`: every `symkin` command imports this package, `--help` included,
+# and typing alone would be a tenth of its cost (mypy takes any constant of this name as true).
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = [
     "BuildError",
@@ -50,6 +52,7 @@ def _version() -> str:
     """The installed distribution's version when this very file belongs to it; else the
     version in the source tree's pyproject.toml (a checkout on the path); else "unknown"."""
     from importlib import metadata
+    from pathlib import Path
 
     here = Path(__file__).resolve()
     try:
@@ -75,6 +78,8 @@ def __getattr__(name: str) -> Any:
         return _version()
     if name not in _EXPORTS:
         raise AttributeError(f"module 'symkin' has no attribute {name!r}")
+    import importlib
+
     module, attribute = _EXPORTS[name]
     value = getattr(importlib.import_module(module), attribute)
     globals()[name] = value  # found once: later lookups (symkin.solve in a loop) cost nothing

@@ -10,25 +10,42 @@ see ``symkin.build.backend.Backend`` objects and never name one. A backend is on
 
 from __future__ import annotations
 
-import warnings
-from pathlib import Path
-from typing import TYPE_CHECKING
-
-from symkin.backends import c, numpy, octave
-from symkin.build.backend import Backend
-from symkin.codegen.target import Option
 from symkin.errors import BuildError, SymkinWarning
 
-if TYPE_CHECKING:  # the CLI imports the registry for --backend: no NumPy at start-up
+# Not `typing.TYPE_CHECKING`: importing typing is a tenth of `symkin --help`, which reads the
+# names and flags below (mypy takes any constant of this name as true).
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from symkin.build.backend import Backend
+    from symkin.codegen.target import Option
     from symkin.runtime.kernel import Kernel
 
 AUTO = "auto"
 """The first registered backend that can build on this machine (C, else NumPy with a note)."""
 
-# in order of preference ("auto" takes the first that builds here; octave never: NumPy
-# always can)
-_BUILT_IN: tuple[Backend, ...] = (c.BACKEND, numpy.BACKEND, octave.BACKEND)
-_REGISTERED: dict[str, Backend] = {backend.name: backend for backend in _BUILT_IN}
+Flag = tuple[str, tuple[str, ...], str, str]
+"""An option as plain data: name, choices, default, help (the fields of ``Option``, which
+compares equal to it)."""
+
+# In order of preference ("auto" takes the first that builds here; octave never: NumPy always
+# can): each built-in's name, the module whose BACKEND it is, imported only when the backend is
+# first asked for, and the options it declares, written here too so that the command line's
+# flags cost no import (tests/backends/test_registry_light.py checks they are the backend's own).
+_BUILT_IN: tuple[tuple[str, str, tuple[Flag, ...]], ...] = (
+    ("c", "symkin.backends.c", (
+        ("real", ("double", "float"), "double", "C real type (default double)"),
+        ("linalg", ("sparse", "dense"), "sparse",
+         "LU behind the C solver: generated sparse LU with run-time pivot checks and a dense "
+         "fall-back (default), or dense partial pivoting"))),
+    ("numpy", "symkin.backends.numpy", (
+        ("real", ("double",), "double", "NumPy computes in double"),)),
+    ("octave", "symkin.backends.octave", (
+        ("real", ("double",), "double", "MATLAB and Octave compute in double"),)),
+)
+# name -> the backend; None for a built-in not imported yet
+_REGISTERED: dict[str, Backend | None] = {name: None for name, _, _ in _BUILT_IN}
 
 
 def names() -> tuple[str, ...]:
@@ -41,31 +58,52 @@ def choices() -> tuple[str, ...]:
     return (AUTO, *_REGISTERED)
 
 
-def declared_options() -> tuple[Option, ...]:
+def declared_flags() -> tuple[Flag, ...]:
     """Every option some registered backend declares, once by name (for the CLI's flags): the
     choices of all that declare it, the help and default of the first (in order of
     preference). Which backend takes which value is still checked by each backend
-    (``codegen.target.chosen_options``)."""
-    merged: dict[str, Option] = {}
-    for backend in _REGISTERED.values():
-        for option in backend.options:
-            first = merged.get(option.name, option)
-            choices = (*first.choices, *(c for c in option.choices if c not in first.choices))
-            merged[option.name] = Option(option.name, choices, first.default, first.help)
+    (``codegen.target.chosen_options``). Imports no backend that is not loaded yet."""
+    merged: dict[str, Flag] = {}
+    for options in _declarations():
+        for option in options:
+            first = merged.get(option[0], option)
+            choices = (*first[1], *(c for c in option[1] if c not in first[1]))
+            merged[option[0]] = (option[0], choices, first[2], first[3])
     return tuple(merged.values())
 
 
+def declared_options() -> tuple[Option, ...]:
+    """:func:`declared_flags` as ``Option`` values."""
+    from symkin.codegen.target import Option
+
+    return tuple(Option(*flag) for flag in declared_flags())
+
+
+def _declarations() -> list[tuple[Flag, ...]]:
+    """Each registered backend's options, in order of preference: a loaded one's own, a
+    built-in's not imported yet as :data:`_BUILT_IN` writes them."""
+    written = {name: options for name, _, options in _BUILT_IN}
+    return [written[name] if backend is None else tuple(backend.options)
+            for name, backend in _REGISTERED.items()]
+
+
 def get(name: str) -> Backend:
-    """The backend called ``name``.
+    """The backend called ``name`` (a built-in one imported the first time it is asked for).
 
     Raises:
         BuildError: no backend has that name (the message lists the known ones).
     """
     try:
-        return _REGISTERED[name]
+        backend = _REGISTERED[name]
     except (KeyError, TypeError):
         raise BuildError(f"unknown backend {name!r}; choose one of "
                          f"{', '.join(choices())}") from None
+    if backend is None:
+        import importlib
+
+        module = next(module for built_in, module, _ in _BUILT_IN if built_in == name)
+        backend = _REGISTERED[name] = importlib.import_module(module).BACKEND
+    return backend
 
 
 def resolve(name: str) -> Backend:
@@ -81,8 +119,10 @@ def resolve(name: str) -> Backend:
         backend = get(name)
         backend.require()
         return backend
+    import warnings
+
     notes: list[str] = []
-    for backend in _REGISTERED.values():
+    for backend in map(get, names()):
         note = backend.unavailable()
         if note is None:
             if notes:
@@ -107,7 +147,7 @@ def register(backend: Backend) -> None:
 
 def unregister(name: str) -> None:
     """Remove a backend added by :func:`register` (the built-in ones stay)."""
-    if any(name == backend.name for backend in _BUILT_IN):
+    if any(name == built_in for built_in, _, _ in _BUILT_IN):
         raise BuildError(f"the built-in backend {name!r} cannot be removed")
     _REGISTERED.pop(name, None)
 
@@ -119,6 +159,8 @@ def load(folder: str | Path, name: str | None = None) -> Kernel:
     several mechanisms needs ``name``); a C folder must also hold the compiled extension.
     Needs only NumPy (and cffi for C), never SymPy.
     """
+    from pathlib import Path
+
     from symkin.runtime.kernel import read_manifest
 
     folder = Path(folder)

@@ -10,156 +10,87 @@ import argparse
 import os
 import sys
 import warnings
-from collections.abc import Callable, Sequence
-from pathlib import Path
-from typing import Any, TextIO
 
-from symkin import backends
-from symkin.cli import messages, overrides
-from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
-from symkin.codegen.target import chosen_options
-from symkin.errors import BuildError, MechanismError, SymkinError, UsageError
+from symkin.cli import arguments, messages
+from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED
+from symkin.errors import MechanismError, SymkinError, UsageError
 
+# Not `typing.TYPE_CHECKING`: `symkin --help` imports neither typing nor a command's module
+# (tests/cli/test_help_is_light.py); mypy takes any constant of this name as true.
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+    from typing import Any, TextIO
 
-def _load(args: argparse.Namespace) -> Any:
-    """The validated mechanism of ``args.mechanism`` with the ``--set`` values."""
-    from symkin.spec import validate
-
-    return validate.load(args.mechanism, overrides.parse(args.overrides))
-
-
-def _show(args: argparse.Namespace) -> int:
-    from symkin.symbolic import derivation
-
-    if args.local:
-        from symkin.spec import drawn
-
-        print(drawn.dump(_load(args)), end="")
-        return EXIT_OK
-    from symkin.symbolic import show
-
-    system = derivation.derive(_load(args))
-    print(show.latex(system) if args.latex else show.text(system), end="")
-    return EXIT_OK
-
-
-def _schema(args: argparse.Namespace) -> int:
-    import json
-
-    from symkin.spec import validate
-
-    print(json.dumps(validate.json_schema(), indent=2))
-    return EXIT_OK
+# Every subcommand, in the order --help lists them: its name, its line in --help, the function
+# of symkin.cli.arguments that adds its arguments, and "module:function", what runs it, imported
+# only when it does (so --help and a mistyped command import no command's module).
+SUBCOMMANDS: tuple[tuple[str, str, Callable[[argparse.ArgumentParser], None], str], ...] = (
+    ("show", "print Phi, Phi_q, Phi_t, Gamma and the DOF count", arguments.show,
+     "symkin.cli.show:show"),
+    ("schema", "print the JSON Schema of mechanism files", arguments.schema,
+     "symkin.cli.show:schema"),
+    ("verify", "check hand-written phi, phi_q, phi_t, gamma against the derived ones",
+     arguments.verify, "symkin.cli.verify:handle"),
+    ("generate", "write the source of a mechanism in a backend's language (--backend)",
+     arguments.generate, "symkin.cli.generate:handle"),
+    ("run", "solve positions, velocities and accelerations over the time grid", arguments.run,
+     "symkin.cli.run:handle"),
+    ("scan", "list the assembly branches at t0, the singular configurations and the limit "
+             "positions over the driver range", arguments.scan, "symkin.cli.scan:handle"),
+    ("cache", "show or empty the kernel cache", arguments.cache,
+     "symkin.cli.cache_command:handle"),
+    ("sweep", "solve many parameter sets: grids, tables, Monte-Carlo tolerance analysis",
+     arguments.sweep, "symkin.cli.sweep:handle"),
+)
 
 
-def _add_show(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    show = commands.add_parser("show", help="print Phi, Phi_q, Phi_t, Gamma and the DOF count")
-    show.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    show.add_argument("--latex", action="store_true", help="print LaTeX instead of text")
-    show.add_argument("--local", action="store_true",
-                      help="print the mechanism in the local layout (local vectors, v, phi0, "
-                           "q0), as derived from a drawn file")
-    overrides.add_argument(show)
-    show.set_defaults(handler=_show)
-    schema = commands.add_parser("schema", help="print the JSON Schema of mechanism files")
-    schema.set_defaults(handler=_schema)
+class _Handler:
+    """A subcommand's implementation, named by "module:function" and imported when called."""
+
+    def __init__(self, where: str) -> None:
+        self.where = where
+
+    def __call__(self, args: argparse.Namespace) -> int:
+        import importlib
+
+        module, function = self.where.split(":")
+        status: int = getattr(importlib.import_module(module), function)(args)
+        return status
 
 
-def _verify(args: argparse.Namespace) -> int:
-    from symkin.cli import verify
-
-    return verify.command(args.mechanism, args.against, samples=args.samples, seed=args.seed,
-                          spread=args.spread, tolerance=args.tolerance)
-
-
-def _add_verify(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    check = commands.add_parser(
-        "verify", help="check hand-written phi, phi_q, phi_t, gamma against the derived ones")
-    check.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    check.add_argument("--against", type=Path, required=True, metavar="HAND.py",
-                       help="Python file defining phi(q, t, p), phi_q(q, t, p), phi_t(q, t, p) "
-                            "and/or gamma(q, dq, t, p) in the order `symkin show` prints")
-    check.add_argument("--samples", type=int, default=50, help="random states (default 50)")
-    check.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    check.add_argument("--spread", type=float, default=None,
-                       help="relative spread of parameters around the nominal design "
-                            "(default 0.3; 0 keeps them nominal; .m hand files take no "
-                            "parameters and are checked at the nominal design only)")
-    check.add_argument("--tolerance", type=float, default=1e-8,
-                       help="largest accepted relative error (default 1e-8)")
-    check.set_defaults(handler=_verify)
+def _columns() -> int:
+    """``shutil.get_terminal_size().columns``, which argparse asks for, without importing
+    shutil (and with it bz2, lzma and zlib: a tenth of ``symkin --help``)."""
+    try:
+        columns = int(os.environ["COLUMNS"])
+    except (KeyError, ValueError):
+        columns = 0
+    if columns > 0:
+        return columns
+    stdout = sys.__stdout__
+    try:
+        return (os.get_terminal_size(stdout.fileno()).columns or 80) if stdout else 80
+    except (AttributeError, ValueError, OSError):  # closed, detached, not a terminal
+        return 80
 
 
-# Each entry adds one subcommand; its handler returns the exit status.
-_OPTION_DEST = "backend_option_"  # a backend's option never shadows one of the command's own
+class _Formatter(argparse.HelpFormatter):
+    """argparse's own formatter, its width found as argparse finds it (see _columns)."""
+
+    def __init__(self, prog: str, indent_increment: int = 2, max_help_position: int = 24,
+                 width: int | None = None) -> None:
+        super().__init__(prog, indent_increment, max_help_position,
+                         _columns() - 2 if width is None else width)
 
 
-def _generate(args: argparse.Namespace) -> int:
-    from symkin.codegen import render
-    from symkin.symbolic import derivation
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser formatting with _Formatter; its subcommands' parsers are of this
+    class too (argparse makes them of the parent's)."""
 
-    # Writing source needs no compiler: only "auto" asks whether one can be built.
-    backend = (backends.resolve(args.backend) if args.backend == backends.AUTO
-               else backends.get(args.backend))
-    given = {option.name: value for option in backends.declared_options()
-             if (value := getattr(args, _OPTION_DEST + option.name)) is not None}
-    try:  # before the derivation: a wrong flag is said at once
-        chosen_options(backend, given, flags=True)
-    except BuildError as error:
-        return messages.error(str(error), EXIT_BAD_INPUT)
-    system = derivation.derive(_load(args))
-    paths = render.generate(system, backend, args.output, given, cse=not args.no_cse,
-                            force=args.force)
-    print("\n".join(str(path) for path in paths))
-    return EXIT_OK
-
-
-def _add_generate(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    generate = commands.add_parser(
-        "generate", help="write the source of a mechanism in a backend's language (--backend)")
-    generate.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    generate.add_argument("--backend", choices=backends.choices(), default="auto",
-                          help="source to write (default auto, as for run: C when a C compiler "
-                               "is found, else NumPy with a note)")
-    generate.add_argument("-o", "--output", type=Path, required=True, help="output folder")
-    for option in backends.declared_options():  # the backends' own options, as they declare
-        generate.add_argument(f"--{option.name}", choices=option.choices, default=None,
-                              dest=_OPTION_DEST + option.name, help=option.help)
-    generate.add_argument("--force", action="store_true",
-                          help="write into a folder that also holds files symkin did not "
-                               "write (they are left alone)")
-    generate.add_argument("--no-cse", action="store_true",
-                          help="do not eliminate common subexpressions")
-    overrides.add_argument(generate)
-    generate.set_defaults(handler=_generate)
-
-
-def _add_run(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from symkin.cli import run  # the `run` subcommand lives in its own module
-
-    run.add_parser(commands)
-
-
-def _add_sweep(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from symkin.cli import sweep
-
-    sweep.add_parser(commands)
-
-
-def _add_cache(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from symkin.cli import cache_command
-
-    cache_command.add_parser(commands)
-
-
-def _add_scan(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    from symkin.cli import scan
-
-    scan.add_parser(commands)
-
-
-SUBCOMMANDS: list[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]], None]] = [
-    _add_show, _add_verify, _add_generate, _add_run, _add_scan, _add_cache, _add_sweep]
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
 
 
 class _Version(argparse.Action):
@@ -175,13 +106,15 @@ class _Version(argparse.Action):
 
 
 def parser() -> argparse.ArgumentParser:
-    main_parser = argparse.ArgumentParser(
+    main_parser = _Parser(
         prog="symkin", description="Symbolic kinematics code generator for planar mechanisms.")
     main_parser.add_argument("--version", action=_Version, nargs=0,
                              help="print symkin's version and exit")
     commands = main_parser.add_subparsers(dest="command", required=True)
-    for add in SUBCOMMANDS:
-        add(commands)
+    for name, summary, add_arguments, where in SUBCOMMANDS:
+        command = commands.add_parser(name, help=summary)
+        add_arguments(command)
+        command.set_defaults(handler=_Handler(where))
     return main_parser
 
 
@@ -194,6 +127,8 @@ def _note_warning(message: Warning | str, category: type[Warning], filename: str
 def _located(error: MechanismError, args: argparse.Namespace) -> MechanismError:
     """A mistake found after loading (the rank of an over-constrained file at t0) placed in
     the file the command read."""
+    from pathlib import Path
+
     mechanism = getattr(args, "mechanism", None)
     if error.source is not None or not isinstance(mechanism, Path):
         return error

@@ -13,15 +13,6 @@ from symkin.cli import messages
 from symkin.cli.exits import EXIT_OK
 
 
-def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Add the ``cache`` subcommand."""
-    command = commands.add_parser("cache", help="show or empty the kernel cache")
-    command.add_argument("action", choices=("info", "clear"),
-                         help="info: where it is and what it holds; clear: remove symkin's "
-                              "kernels, index and temporaries")
-    command.set_defaults(handler=handle)
-
-
 def handle(args: argparse.Namespace) -> int:
     """Run the subcommand; returns the exit status."""
     import shutil

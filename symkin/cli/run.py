@@ -29,49 +29,6 @@ SUFFIXES = {"output": (".npz", ".csv"), "plot": (".png", ".svg", ".pdf"), "anima
 GRID_ONLY = ("t0", "t1", "dt", "plot", "animate", "html")
 
 
-def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Add the ``run`` subcommand."""
-    run = commands.add_parser(
-        "run", help="solve positions, velocities and accelerations over the time grid")
-    run.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    run.add_argument("--backend", choices=backends.choices(), default="auto",
-                     help="kernel to run (default auto: the generated C when a C compiler is "
-                          "found, else NumPy; c without a compiler is an error)")
-    run.add_argument("--t0", type=float, help="first time (default: the file's)")
-    run.add_argument("--t1", type=float, help="last time, included (default: the file's)")
-    run.add_argument("--dt", type=float, help="time step (default: the file's)")
-    run.add_argument("--at", type=float, metavar="T",
-                     help="solve the single configuration at time T and print q, dq, d2q and "
-                          "the named points (no grid)")
-    run.add_argument("--inputs", type=Path, metavar="TABLE.csv",
-                     help="values of the input drivers (functions written `input`): CSV "
-                          "columns t (the grid), then each input's name, optionally followed "
-                          "by NAME_t (rate) and NAME_tt (acceleration)")
-    run.add_argument("-o", "--output", type=Path, help="results file, .npz or .csv")
-    run.add_argument("--plot", type=Path,
-                     help="figure of position, velocity and acceleration against t: .png, "
-                          ".svg or .pdf")
-    run.add_argument("--select", metavar="NAMES",
-                     help="what --plot and --html show: coordinates and named points, e.g. "
-                          "crank.phi,coupler.P (default: the angles and the moving points)")
-    run.add_argument("--html", type=Path,
-                     help="interactive report: the mechanism moving under a time slider, with "
-                          "paths, velocity and acceleration vectors, and the selected plots "
-                          "(one self-contained file)")
-    run.add_argument("--animate", type=Path, help="GIF of the mechanism moving")
-    run.add_argument("--size", default="900x600", metavar="WxH",
-                     help="--animate picture size in pixels (default 900x600)")
-    run.add_argument("--fps", type=int, default=20,
-                     help="--animate frames per second (default 20)")
-    run.add_argument("-v", "--verbose", action="store_true",
-                     help="say more in notes (why pivot fall-backs cost no accuracy)")
-    overrides.add_argument(run)
-    run.add_argument("--stop-at-singular", action="store_true",
-                     help="stop at the first singular or ill-conditioned point instead of "
-                          "passing through it (and do not subdivide a failed step)")
-    run.set_defaults(handler=handle)
-
-
 def _bad_usage(args: argparse.Namespace) -> str | None:
     """What is wrong with the command line, before any work is done."""
     for option, suffixes in SUFFIXES.items():

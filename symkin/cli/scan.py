@@ -10,34 +10,12 @@ from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
 from typing import Any
 
 from symkin import backends
 from symkin.cli import messages, overrides
 from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK
 from symkin.limits import listed, listed_groups
-
-
-def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Add the ``scan`` subcommand."""
-    scan = commands.add_parser(
-        "scan", help="list the assembly branches at t0, the singular configurations and the "
-                     "limit positions over the driver range")
-    scan.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    scan.add_argument("--backend", choices=backends.choices(), default="auto",
-                      help="kernel to run (default auto, as for run)")
-    scan.add_argument("--t0", type=float, help="first time (default: the file's)")
-    scan.add_argument("--t1", type=float, help="last time, included (default: the file's)")
-    scan.add_argument("--dt", type=float, help="time step (default: the file's)")
-    scan.add_argument("--all-branches", action="store_true",
-                      help="follow the motion from every branch found at t0, not only from "
-                           "the one a run takes (reached from q0)")
-    scan.add_argument("--input", action="append", default=[], metavar="NAME=VALUE",
-                      dest="inputs", help="the value of input driver NAME (repeat for each): "
-                      "the branches are then the assemblies at these inputs")
-    overrides.add_argument(scan)
-    scan.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:

@@ -27,37 +27,6 @@ _TOLERANCE = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(?:±|\+-|\+/-)?\s*([^%\s]+)\
 SHOWN_FAILURES = 5
 
 
-def add_parser(commands: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Add the ``sweep`` subcommand."""
-    sweep = commands.add_parser("sweep", help="solve many parameter sets: grids, tables, "
-                                "Monte-Carlo tolerance analysis")
-    sweep.add_argument("mechanism", type=Path, help="mechanism file (.yaml or .toml)")
-    design = sweep.add_argument_group("the parameter sets (one of)")
-    design.add_argument("--vary", action="append", default=[], metavar="NAME=LO:HI:COUNT",
-                        help="COUNT values from LO to HI; several names form every combination")
-    design.add_argument("--params", type=Path, metavar="TABLE.csv",
-                        help="a CSV table: a header of parameter names, one set per row")
-    design.add_argument("--monte-carlo", type=int, metavar="N",
-                        help="N sets drawn within the --tolerance of each parameter")
-    sweep.add_argument("--tolerance", action="append", default=[], metavar="NAME=±X",
-                       help="half-width of a parameter's tolerance, absolute or with %% "
-                            "relative to the nominal value (a=±0.01, b=+-0.5%%)")
-    sweep.add_argument("--distribution", choices=("normal", "uniform"), default="normal",
-                       help="Monte-Carlo draws: normal with ±X as 3 sigma (default), or uniform")
-    sweep.add_argument("--seed", type=int, default=0, help="Monte-Carlo random seed (default 0)")
-    sweep.add_argument("--backend", choices=backends.choices(), default="auto")
-    sweep.add_argument("--workers", type=int, help="local processes (default: the cores, "
-                       "in this process for small sweeps)")
-    sweep.add_argument("--scheduler", metavar="ADDRESS",
-                       help="a Dask scheduler (tcp://host:8786): run the sweep on its cluster")
-    sweep.add_argument("-o", "--output", type=Path, help="results file, .npz")
-    sweep.add_argument("--compress", action="store_true",
-                       help="write the .npz compressed (smaller, slower to write)")
-    sweep.add_argument("--plot", type=Path, help="PNG of the named points' envelopes over t")
-    overrides.add_argument(sweep)
-    sweep.set_defaults(handler=handle)
-
-
 def handle(args: argparse.Namespace) -> int:
     """Run the subcommand; returns the exit status."""
     problem = _bad_usage(args)

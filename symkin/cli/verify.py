@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 from pathlib import Path
@@ -18,6 +19,12 @@ from symkin.verify.numeric import (
     derived_functions,
     verify,
 )
+
+
+def handle(args: argparse.Namespace) -> int:
+    """Run the subcommand from its parsed arguments; returns the exit status."""
+    return command(args.mechanism, args.against, samples=args.samples, seed=args.seed,
+                   spread=args.spread, tolerance=args.tolerance)
 
 
 def command(mechanism: str | Path, against: str | Path, *, samples: int = DEFAULT_SAMPLES,
