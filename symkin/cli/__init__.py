@@ -16,7 +16,7 @@ from symkin.cli.exits import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED
 from symkin.errors import MechanismError, SymkinError, UsageError
 
 # Not `typing.TYPE_CHECKING`: `symkin --help` imports neither typing nor a command's module
-# (tests/cli/test_help_is_light.py); mypy takes any constant of this name as true.
+# (tests/cli/test_light_start.py); mypy takes any constant of this name as true.
 TYPE_CHECKING = False
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
