@@ -108,9 +108,10 @@ class _Equations:
             entries = [row_jacobian(row, column, tuple(q)) for row in phi]
         at = [(r, k) for r, row in enumerate(entries) for k in sorted(row)]
         arguments = (list(q), t, list(p))
-        self._phi = constants.lambdify_floats(arguments, list(phi), dummify=True)
+        self._phi = constants.lambdify_floats(arguments, list(phi), dummify=True,
+                                              analysis=True)
         self._nonzeros = constants.lambdify_floats(
-            arguments, [entries[r][k] for r, k in at], dummify=True)
+            arguments, [entries[r][k] for r, k in at], dummify=True, analysis=True)
         self._rows = np.array([r for r, _ in at], dtype=np.intp)
         self._columns = np.array([k for _, k in at], dtype=np.intp)
         self.rows, self.size = len(phi), len(q)
