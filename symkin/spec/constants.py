@@ -19,6 +19,7 @@ from typing import Any, TypeAlias
 
 import mpmath
 import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
 
 from symkin.errors import ExpressionError
 
@@ -320,24 +321,38 @@ def numpy_modules() -> list[Any]:
     return [{"I": 1j}, numpy]
 
 
+class _AnalysisPrinter(NumPyPrinter):  # type: ignore[misc]  # SymPy is untyped
+    """SymPy's NumPy printer with every sum and product written as its arguments joined, in
+    parentheses, in the order SymPy keeps them: no sorting for display and no precedence
+    rules to consult (most of the printer's time)."""
+
+    def _print_Add(self, expr: sp.Expr, order: Any = None) -> str:
+        return "(" + " + ".join([self._print(arg) for arg in expr.args]) + ")"
+
+    def _print_Mul(self, expr: sp.Expr) -> str:
+        return "(" + "*".join([self._print(arg) for arg in expr.args]) + ")"
+
+
 def lambdify_analysis(arguments: Any, expressions: Any, dummify: bool = False
                       ) -> Callable[..., Any]:
     """``sympy.lambdify`` to NumPy for an analysis made at generation time (an assembly, a
-    rank, the samples of a pivot order), printed fast: sums and products in the order of
-    their arguments, which SymPy's printer would first sort for display (half its time), and
-    no walk of the expressions for implemented functions (a derivation has none). A sum may
-    round in the last bit otherwise than the generated code's; what these analyses decide
-    (pivots, ranks, removed rows) does not hang on that."""
-    from sympy.printing.numpy import NumPyPrinter
-
+    rank, the samples of a pivot order), printed fast (:class:`_AnalysisPrinter`; SymPy's own
+    printer where Python refuses the nesting), with no walk of the expressions for implemented
+    functions (a derivation has none). A sum may round in the last bit otherwise than the
+    generated code's; what these analyses decide (pivots, ranks, removed rows) does not hang
+    on that."""
     modules = numpy_modules()
     # the settings lambdify gives its own NumPy printer, and the names of the dict module
-    printer = NumPyPrinter({"fully_qualified_modules": False, "inline": True,
-                            "allow_unknown_functions": True, "order": "none",
-                            "user_functions": {name: name for name in modules[0]}})
-    function: Callable[..., Any] = sp.lambdify(arguments, expressions, modules=modules,
-                                               printer=printer, use_imps=False,
-                                               dummify=dummify)
+    settings = {"fully_qualified_modules": False, "inline": True,
+                "allow_unknown_functions": True, "order": "none",
+                "user_functions": {name: name for name in modules[0]}}
+    function: Callable[..., Any]
+    try:
+        function = sp.lambdify(arguments, expressions, modules=modules, use_imps=False,
+                               printer=_AnalysisPrinter(settings), dummify=dummify)
+    except (SyntaxError, RecursionError):  # parentheses nested deeper than Python takes
+        function = sp.lambdify(arguments, expressions, modules=modules, use_imps=False,
+                               printer=NumPyPrinter(settings), dummify=dummify)
     return function
 
 
