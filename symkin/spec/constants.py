@@ -357,11 +357,9 @@ def lambdify_analysis(arguments: Any, expressions: Any, dummify: bool = False
 
 
 def lambdify_floats(arguments: Any, expressions: Any, modules: Any = None,
-                    dummify: bool = False, cse: bool = False, analysis: bool = False
-                    ) -> Callable[..., Any]:
+                    dummify: bool = False, cse: bool = False) -> Callable[..., Any]:
     """``sympy.lambdify`` of ``expressions`` (an expression, a sequence or a matrix of them)
-    with every constant part folded to a double first (:func:`fold`); with ``analysis``,
-    printed as :func:`lambdify_analysis` prints (NumPy, no ``modules`` or ``cse``).
+    with every constant part folded to a double first (:func:`fold`).
 
     Without the folding an exact number reaches NumPy as it is: a long decimal read as a
     rational, or ``sqrt`` of an integer wider than 64 bits, becomes a Python int that NumPy
@@ -369,23 +367,17 @@ def lambdify_floats(arguments: Any, expressions: Any, modules: Any = None,
     evaluation of derived expressions goes through here, so each sees the doubles the
     generated code sees.
 
-    With ``dummify``, the argument symbols become plain identifiers ``_a0``, ``_a1``, ... in
-    the same pass as the folding (lambdify's own dummify walks the whole expression once per
-    argument: quadratic in a file's size); where a name could collide with another symbol of
-    the expressions, lambdify dummifies as before.
-
     Raises:
         ExpressionError: a constant part has no value (see :func:`value`).
     """
-    names = _plain_names(arguments) if dummify else None
-    folded, others = _folded(expressions, names or {})
-    if names is not None and any(s.name.startswith("_a") for s in others):
-        folded, _ = _folded(expressions, {})  # a collision: renamed by lambdify instead
-        names = None
-    if names is not None:
-        arguments, dummify = _renamed(arguments, names), False
-    if analysis:
-        return lambdify_analysis(arguments, folded, dummify)
+    if isinstance(expressions, sp.MatrixBase):
+        folded: Any = expressions.applyfunc(fold)
+    elif isinstance(expressions, sp.Basic):
+        folded = fold(expressions)
+    else:
+        folded = [fold(sp.sympify(e)) for e in expressions]
+    if dummify:
+        arguments, folded, dummify = _renamed(arguments, folded)
     if modules is None:  # NumPy (numpy_modules: the module itself, not the string)
         modules = numpy_modules()
     function: Callable[..., Any] = sp.lambdify(arguments, folded, modules=modules,
@@ -393,39 +385,35 @@ def lambdify_floats(arguments: Any, expressions: Any, modules: Any = None,
     return function
 
 
-def _folded(expressions: Any, names: dict[sp.Basic, sp.Basic]) -> tuple[Any, set[sp.Symbol]]:
-    """The expressions folded and renamed in one pass, and the other symbols they hold."""
-    from symkin.spec.substitution import Substitution  # (which folds with this module)
+def _renamed(arguments: Any, folded: Any) -> tuple[Any, Any, bool]:
+    """The argument symbols replaced by plain identifiers ``_a0``, ``_a1``, ... in one pass
+    over the expressions, which is what ``dummify`` asks of lambdify: lambdify itself walks
+    the whole expression once per argument (quadratic in a file's size). Where a name could
+    collide with another symbol of the expressions, lambdify dummifies as before."""
 
-    rebuild = Substitution(names, fold=True)
-    if isinstance(expressions, sp.MatrixBase):
-        folded: Any = expressions.applyfunc(rebuild)
-    elif isinstance(expressions, sp.Basic):
-        folded = rebuild(expressions)
-    else:
-        folded = [rebuild(sp.sympify(e)) for e in expressions]
-    return folded, rebuild.others()
+    def leaves(item: Any) -> list[Any]:
+        if isinstance(item, (list, tuple)):
+            return [leaf for part in item for leaf in leaves(part)]
+        return [item]
 
-
-def _leaves(item: Any) -> list[Any]:
-    if isinstance(item, (list, tuple)):
-        return [leaf for part in item for leaf in _leaves(part)]
-    return [item]
-
-
-def _plain_names(arguments: Any) -> dict[sp.Basic, sp.Basic] | None:
-    """Each argument symbol's plain identifier, or None unless they are distinct symbols."""
-    symbols = _leaves(arguments)
+    symbols = leaves(arguments)
     if not all(isinstance(s, sp.Symbol) for s in symbols) or len(set(symbols)) < len(symbols):
-        return None
-    return {s: sp.Symbol(f"_a{k}") for k, s in enumerate(symbols)}
+        return arguments, folded, True
+    names = {s: sp.Symbol(f"_a{k}") for k, s in enumerate(symbols)}
+    whole = isinstance(folded, (sp.Basic, sp.MatrixBase))
+    others = (folded.free_symbols if whole else
+              set().union(set(), *(sp.sympify(e).free_symbols for e in folded)))
+    if any(s.name.startswith("_a") for s in others if s not in names):
+        return arguments, folded, True
 
+    def rename(item: Any) -> Any:
+        if isinstance(item, (list, tuple)):
+            return type(item)(rename(part) for part in item)
+        return names[item]
 
-def _renamed(item: Any, names: dict[sp.Basic, sp.Basic]) -> Any:
-    """The arguments' structure (lists, tuples) with each symbol renamed."""
-    if isinstance(item, (list, tuple)):
-        return type(item)(_renamed(part, names) for part in item)
-    return names[item]
+    renamed = (folded.xreplace(names) if whole
+               else [sp.sympify(e).xreplace(names) for e in folded])
+    return rename(arguments), renamed, False
 
 
 def check_constants(expr: sp.Expr) -> None:
