@@ -216,12 +216,11 @@ def _samples(system: System, pattern: Sequence[tuple[int, int]],
     arguments = ([internal[s] for s in system.q], internal[system.t],
                  [internal[s] for s in system.code_parameters])
     mass = system.dynamics.mass_matrix if system.dynamics else sp.zeros(0, 0)
-    functions = (sp.lambdify(arguments, [prepare(mass[r, c]) for r, c in m_pattern],
-                             modules=constants.numpy_modules()),
-                 sp.lambdify(arguments, [prepare(system.phi_q[r, c]) for r, c in pattern],
-                             modules=constants.numpy_modules()),
-                 sp.lambdify(arguments, [prepare(e) for e in system.phi],
-                             modules=constants.numpy_modules()))
+    functions = (constants.lambdify_analysis(arguments,
+                                             [prepare(mass[r, c]) for r, c in m_pattern]),
+                 constants.lambdify_analysis(arguments,
+                                             [prepare(system.phi_q[r, c]) for r, c in pattern]),
+                 constants.lambdify_analysis(arguments, [prepare(e) for e in system.phi]))
     t0, p = np.float64(system.time_grid[0]), np.array(system.code_p_values, dtype=float)
     generator = np.random.default_rng(sample.STRUCTURE_SEED)
     with warnings.catch_warnings(), np.errstate(all="ignore"):

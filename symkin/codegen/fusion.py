@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 import sympy as sp
 
-from symkin.codegen import symbol_printing
+from symkin.spec.substitution import Substitution
 
 
 def fused_expressions(prepared: dict[str, list[sp.Expr]], dynamics_routines: Sequence[str]
@@ -35,7 +35,7 @@ def fused_expressions(prepared: dict[str, list[sp.Expr]], dynamics_routines: Seq
     shared = sorted(trig(("phi", "phi_q")) & trig(("phi_t", "gamma", *dynamics)),
                     key=sp.default_sort_key)
     # one memory of rebuilt subtrees: Gamma repeats Phi_t's piecewise parts
-    mapped = symbol_printing.Substitution({f: sp.Symbol(f"_shared{k}", real=True)
+    mapped = Substitution({f: sp.Symbol(f"_shared{k}", real=True)
                                            for k, f in enumerate(shared)})
     return {"phi_phi_q": [*prepared["phi"], *prepared["phi_q"], *shared],
             "phi_t_shared": [mapped(e) for e in prepared["phi_t"]],

@@ -19,7 +19,7 @@ import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
 from symkin.codegen import dynamics_plan, fusion, sample, symbol_printing
-from symkin.codegen.cse_tidy import _count_ops, _inline_trivial, _ops_before_cse
+from symkin.codegen.cse_tidy import OpCounter, _inline_trivial, _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.system_facts import (
@@ -262,7 +262,8 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
     sizes = {"phi_phi_q": (nphi, len(pattern), len(shared))}
     orders = {"phi_phi_q": fusion.fused_order(prepared, pattern, shared)}
     # Phi and Phi_q alone are the fused routine's pieces: its CSE and printing serve all three.
-    fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse,
+    count = OpCounter()  # one memory of subtrees' op counts for every routine
+    fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse, count,
                                  orders["phi_phi_q"])
     nnz = len(pattern)
     own = {"phi": _select("phi", fused_parts, {k: k for k in range(nphi)}, nphi),
@@ -273,11 +274,11 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
         fused["motion"] = [e for name in ("mass", "phi_q", "applied", "gamma")
                            for e in prepared[name]]
         own["motion"] = _assemble("motion", _lowered_parts("motion", fused["motion"], printer,
-                                                           cse), len(fused["motion"]),
+                                                           cse, count), len(fused["motion"]),
                                   (len(m_pattern), nnz, len(system.q), nphi))
     routines = tuple(
         own[name] if name in own else
-        _assemble(name, _lowered_parts(name, exprs, printer, cse), len(exprs))
+        _assemble(name, _lowered_parts(name, exprs, printer, cse, count), len(exprs))
         for name, exprs in {**prepared, **fused}.items())
     return Code(
         backend=backend, options=chosen, cse=cse, name=system.name,
@@ -288,9 +289,9 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
         time_grid=system.time_grid, rows=tuple(str(row) for row in system.rows),
         pattern_rows=tuple(r for r, _ in pattern), pattern_cols=tuple(c for _, c in pattern),
         points=point_names(system), routines=routines,
-        ops_before_cse=_ops_before_cse(expressions, fused, shared),
+        ops_before_cse=_ops_before_cse(expressions, fused, shared, count),
         phi_p_rows=tuple(r for r, _ in p_pattern), phi_p_cols=tuple(c for _, c in p_pattern),
-        lu_plan=(sample.sparse_lu_plan(system, pattern)
+        lu_plan=(sample.sparse_lu_plan(system, pattern, (prepared["phi"], prepared["phi_q"]))
                  if backend.plans_lu(chosen) and not free else None),
         shared=tuple(_print(printer, f) for f in shared),
         constant_nz=tuple(float(e) if e.is_Number else None for e in prepared["phi_q"]),
@@ -321,8 +322,9 @@ def _reads(expr: sp.Expr) -> frozenset[str]:
 
 
 def _lowered_parts(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
-                   order: Sequence[int] | None = None) -> list[_Lowered]:
-    """CSE and print ``exprs`` in parts of at most PART_OUTPUTS outputs (in ``order``)."""
+                   count: OpCounter, order: Sequence[int] | None = None) -> list[_Lowered]:
+    """CSE and print ``exprs`` in parts of at most PART_OUTPUTS outputs (in ``order``);
+    ``count`` counts the operations of each temporary and output."""
     positions = list(order) if order is not None else list(range(len(exprs)))
     chunks = [positions[i:i + PART_OUTPUTS] for i in range(0, len(positions), PART_OUTPUTS)]
     parts = []
@@ -334,10 +336,10 @@ def _lowered_parts(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
                                          order="canonical")
             temporaries, values = _inline_trivial(temporaries, values)
         parts.append(_Lowered(
-            temporaries=[(str(t), _print(printer, v), _reads(v), _count_ops([v]))
+            temporaries=[(str(t), _print(printer, v), _reads(v), count(v))
                          for t, v in temporaries],
             slots=list(chunk),
-            outputs=[(_print(printer, v), _reads(v), _count_ops([v])) for v in values]))
+            outputs=[(_print(printer, v), _reads(v), count(v)) for v in values]))
     del name
     return parts
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, TypeAlias
 
 import numpy as np
 import sympy as sp
@@ -23,6 +23,9 @@ from symkin.contract.options import defaults
 from symkin.errors import BuildError, SolveError
 from symkin.spec import constants
 from symkin.symbolic.derivation import System
+
+Prepared: TypeAlias = tuple[Sequence[sp.Expr], Sequence[sp.Expr]]
+"""Phi and the non-zeros of Phi_q as prepared for printing (codegen.symbol_printing)."""
 
 # Assembly tolerances: the runtime's own Newton defaults (a tighter sample changes nothing).
 NEWTON = defaults("double")
@@ -53,11 +56,14 @@ INPUT_SEED = 26
 STRUCTURE_SEED = 41
 
 
-def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_plan.LUPlan:
+def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]],
+                   prepared: Prepared | None = None) -> lu_plan.LUPlan:
     """The pivot order of the sparse LU, chosen on Phi_q at the assembled configuration and
     checked over the motion (lu_plan.analyse_over), with run-time interchanges of rows of one
-    pattern where no fixed order holds (lu_interchange), so that a step's cost is predictable."""
-    samples = _plan_samples(system, pattern)
+    pattern where no fixed order holds (lu_interchange), so that a step's cost is predictable.
+    ``prepared``: Phi and Phi_q's non-zeros (in ``pattern``'s order) as the lowering prepared
+    them for printing, where it has (else they are prepared here)."""
+    samples = _plan_samples(system, pattern, prepared)
     try:
         plan = lu_interchange.analyse_over(len(system.q), [r for r, _ in pattern],
                                     [c for _, c in pattern], samples)
@@ -66,14 +72,15 @@ def sparse_lu_plan(system: System, pattern: Sequence[tuple[int, int]]) -> lu_pla
     return plan
 
 
-def _plan_samples(system: System, pattern: Sequence[tuple[int, int]]) -> list[list[float]]:
+def _plan_samples(system: System, pattern: Sequence[tuple[int, int]],
+                  prepared: Prepared | None = None) -> list[list[float]]:
     """Phi_q's non-zeros along the motion, those with a non-finite entry left out: an
     expression singular where it is sampled (sqrt(t - 2) before t = 2) is the run's to
     report, where it happens, as the NumPy kernel does. Where no sample is finite, or SymPy
     cannot turn Phi into NumPy at all (its printer compares a constant that has no real
     value), one sample of seeded values on the pattern: a pivot order for the structure."""
     try:
-        kernel = _SampleKernel(system, pattern)
+        kernel = _SampleKernel(system, pattern, prepared=prepared)
     except (TypeError, ValueError):
         kernel = None
     found: list[np.ndarray] = []
@@ -141,7 +148,9 @@ def input_values(system: System) -> tuple[float, ...]:
     is assembled (a leg length, not the nominal 0 at which its row is flat)."""
     if not system.inputs:
         return ()
-    kernel = _SampleKernel(system, system.pattern())
+    # Printed to 17 digits: Phi with SymPy's printer as it sorts the sums (the roots' last
+    # digits depend on their rounding), and no Phi_q (the roots take numerical slopes).
+    kernel = _SampleKernel(system, (), _lambdify_sorted)
     with np.errstate(all="ignore"):
         # polished past Newton's tolerance: these are printed as the inputs' values
         p = start_inputs(system, kernel, np.array(system.q0, dtype=float), polish=2)
@@ -237,22 +246,29 @@ def sample_configuration(system: System, kernel: Any = None) -> tuple[float, ...
     return tuple(float(v) for v in q)
 
 
+def _lambdify_sorted(arguments: Any, expressions: list[Any]) -> Any:
+    return sp.lambdify(arguments, expressions, modules=constants.numpy_modules())
+
+
 class _SampleKernel:
     """Phi and the non-zeros of Phi_q as NumPy functions (sympy.lambdify over the internal
-    symbols), with the few Kernel attributes the driver's assembly reads."""
+    symbols, by ``lambdify``), with the few Kernel attributes the driver's assembly reads."""
 
-    def __init__(self, system: System, pattern: Sequence[tuple[int, int]]) -> None:
+    def __init__(self, system: System, pattern: Sequence[tuple[int, int]],
+                 lambdify: Any = constants.lambdify_analysis,
+                 prepared: Prepared | None = None) -> None:
         internal = symbol_printing.internal_symbols(system)
         arguments = ([internal[s] for s in system.q], internal[system.t],
                      [internal[s] for s in system.code_parameters])
         self.coordinates = system.coordinates
         self.pattern_rows = np.array([r for r, _ in pattern], dtype=np.intp)
         self.pattern_cols = np.array([c for _, c in pattern], dtype=np.intp)
-        prepare = symbol_printing.Preparer(internal)
-        self._phi = sp.lambdify(arguments, [prepare(e) for e in system.phi],
-                                modules=constants.numpy_modules())
-        self._nz = sp.lambdify(arguments, [prepare(system.phi_q[r, c]) for r, c in pattern],
-                               modules=constants.numpy_modules())
+        if prepared is None:
+            prepare = symbol_printing.Preparer(internal)
+            prepared = ([prepare(e) for e in system.phi],
+                        [prepare(system.phi_q[r, c]) for r, c in pattern])
+        self._phi = lambdify(arguments, list(prepared[0]))
+        self._nz = lambdify(arguments, list(prepared[1]))
         self._p = np.array(system.code_p_values, dtype=float)
 
     # t as a NumPy float: IEEE semantics as in the generated code (inf, NaN), never a Python

@@ -12,6 +12,7 @@ import sympy as sp
 
 from symkin.errors import BuildError, ExpressionError
 from symkin.spec import constants
+from symkin.spec.substitution import Substitution
 from symkin.symbolic.derivation import System
 
 _INTERNAL = re.compile(r"_(q|dq|ddq|lam|p|shared)(\d+)\Z")
@@ -87,45 +88,3 @@ class Preparer:
         except ExpressionError as error:
             raise BuildError(f"cannot generate code for {constants.describe(expr)}: "
                              f"{error.message}") from None
-
-
-class Substitution:
-    """``expr.xreplace(mapping)`` for many expressions with one memory of the subtrees
-    rebuilt; with ``fold``, also each largest constant part that is not a plain number
-    replaced by its correctly rounded value (as :func:`constants.fold`)."""
-
-    def __init__(self, mapping: dict[sp.Basic, sp.Basic], fold: bool = False) -> None:
-        self._mapping = mapping
-        self._fold = fold
-        self._done: dict[sp.Basic, sp.Basic] = {}
-        self._constant: dict[sp.Basic, bool] = {}
-
-    def __call__(self, expr: sp.Basic) -> sp.Basic:
-        return self._visit(expr)
-
-    def _visit(self, node: sp.Basic) -> sp.Basic:
-        done = self._done.get(node)
-        if done is not None:
-            return done
-        if node in self._mapping:
-            result = self._mapping[node]
-        elif self._fold and isinstance(node, sp.Expr) and self._is_constant(node):
-            result = (node if constants.is_plain_number(node)
-                      else sp.Float(constants.value(node), 17))
-        elif not node.args:
-            result = node
-        else:
-            args = [self._visit(arg) for arg in node.args]
-            changed = any(new is not old for new, old in zip(args, node.args))
-            result = node.func(*args) if changed else node
-        self._done[node] = result
-        return result
-
-    def _is_constant(self, node: sp.Basic) -> bool:
-        """No free symbols (remembered, so a deep tree is walked once)."""
-        known = self._constant.get(node)
-        if known is None:
-            known = (not isinstance(node, sp.Symbol) if not node.args
-                     else all(self._is_constant(arg) for arg in node.args))
-            self._constant[node] = known
-        return known

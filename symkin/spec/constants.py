@@ -19,6 +19,7 @@ from typing import Any, TypeAlias
 
 import mpmath
 import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
 
 from symkin.errors import ExpressionError
 
@@ -271,7 +272,7 @@ def fold(expr: sp.Expr) -> sp.Expr:
         if node in seen:  # a shared subtree: its replacements are made
             return
         seen.add(node)
-        if isinstance(node, sp.Expr) and not _has_symbols(node, symbolic):
+        if isinstance(node, sp.Expr) and not has_symbols(node, symbolic):
             if not is_plain_number(node):
                 replacements[node] = sp.Float(value(node), 17)
             return
@@ -295,7 +296,7 @@ def _union_of_args(kind: type) -> bool:
     return found
 
 
-def _has_symbols(node: sp.Basic, known: dict[sp.Basic, bool]) -> bool:
+def has_symbols(node: sp.Basic, known: dict[sp.Basic, bool]) -> bool:
     """``bool(node.free_symbols)``, remembered per subtree: SymPy recomputes free_symbols
     over the whole subtree at every call, so asking it at each node of a tree costs its size
     times its depth. A class with its own free_symbols (a symbol, a Derivative's bound
@@ -303,7 +304,7 @@ def _has_symbols(node: sp.Basic, known: dict[sp.Basic, bool]) -> bool:
     found = known.get(node)
     if found is None:
         if _union_of_args(type(node)):
-            found = any(_has_symbols(arg, known) for arg in node.args)
+            found = any(has_symbols(arg, known) for arg in node.args)
         else:
             found = bool(node.free_symbols)
         known[node] = found
@@ -318,6 +319,41 @@ def numpy_modules() -> list[Any]:
     import numpy
 
     return [{"I": 1j}, numpy]
+
+
+class _AnalysisPrinter(NumPyPrinter):  # type: ignore[misc]  # SymPy is untyped
+    """SymPy's NumPy printer with every sum and product written as its arguments joined, in
+    parentheses, in the order SymPy keeps them: no sorting for display and no precedence
+    rules to consult (most of the printer's time)."""
+
+    def _print_Add(self, expr: sp.Expr, order: Any = None) -> str:
+        return "(" + " + ".join([self._print(arg) for arg in expr.args]) + ")"
+
+    def _print_Mul(self, expr: sp.Expr) -> str:
+        return "(" + "*".join([self._print(arg) for arg in expr.args]) + ")"
+
+
+def lambdify_analysis(arguments: Any, expressions: Any, dummify: bool = False
+                      ) -> Callable[..., Any]:
+    """``sympy.lambdify`` to NumPy for an analysis made at generation time (an assembly, a
+    rank, the samples of a pivot order), printed fast (:class:`_AnalysisPrinter`; SymPy's own
+    printer where Python refuses the nesting), with no walk of the expressions for implemented
+    functions (a derivation has none). A sum may round in the last bit otherwise than the
+    generated code's; what these analyses decide (pivots, ranks, removed rows) does not hang
+    on that."""
+    modules = numpy_modules()
+    # the settings lambdify gives its own NumPy printer, and the names of the dict module
+    settings = {"fully_qualified_modules": False, "inline": True,
+                "allow_unknown_functions": True, "order": "none",
+                "user_functions": {name: name for name in modules[0]}}
+    function: Callable[..., Any]
+    try:
+        function = sp.lambdify(arguments, expressions, modules=modules, use_imps=False,
+                               printer=_AnalysisPrinter(settings), dummify=dummify)
+    except (SyntaxError, RecursionError):  # parentheses nested deeper than Python takes
+        function = sp.lambdify(arguments, expressions, modules=modules, use_imps=False,
+                               printer=NumPyPrinter(settings), dummify=dummify)
+    return function
 
 
 def lambdify_floats(arguments: Any, expressions: Any, modules: Any = None,

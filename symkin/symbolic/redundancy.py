@@ -47,7 +47,7 @@ import sympy as sp
 
 from symkin.contract import dense_solvers
 from symkin.contract.options import defaults
-from symkin.spec import constants
+from symkin.spec import substitution
 from symkin.symbolic.differentiation import row_jacobian
 
 RANK_TOLERANCE = 1e-8
@@ -108,9 +108,9 @@ class _Equations:
             entries = [row_jacobian(row, column, tuple(q)) for row in phi]
         at = [(r, k) for r, row in enumerate(entries) for k in sorted(row)]
         arguments = (list(q), t, list(p))
-        self._phi = constants.lambdify_floats(arguments, list(phi), dummify=True)
-        self._nonzeros = constants.lambdify_floats(
-            arguments, [entries[r][k] for r, k in at], dummify=True)
+        self._phi = substitution.lambdify_folded(arguments, list(phi))
+        self._nonzeros = substitution.lambdify_folded(arguments,
+                                                      [entries[r][k] for r, k in at])
         self._rows = np.array([r for r, _ in at], dtype=np.intp)
         self._columns = np.array([k for _, k in at], dtype=np.intp)
         self.rows, self.size = len(phi), len(q)
