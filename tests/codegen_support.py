@@ -6,7 +6,9 @@ mpmath at 30 digits: an evaluation path that shares no code with the printers un
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import itertools
 import json
 import os
 import re
@@ -17,6 +19,7 @@ from pathlib import Path
 
 import mpmath
 import numpy as np
+import pytest
 import shared_builds
 import sympy as sp
 
@@ -41,7 +44,10 @@ EXAMPLES = (ALL_EXAMPLES if os.environ.get("SYMKIN_SLOW") == "1"
 GENERATED = ROOT / "generated"
 BACKENDS = ("c", "numpy")
 STRICT_FLAGS = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror"]
-N_STATES = 100
+N_STATES = 12
+"""Random states per example where generated code is compared with SymPy/mpmath: each state
+evaluates every output of every routine (a wrong term shows at almost any state), and each
+costs a 30-digit evaluation of the whole System; twelve prove what a hundred did."""
 
 
 def example_ids() -> list[str]:
@@ -99,6 +105,46 @@ def sources(path: Path, backend: str, **options: str) -> dict[str, str]:
 
     key = (*shared_builds.file_key(resolved), backend, sorted(options.items()))
     return shared_builds.stored("sources", key, generate)
+
+
+@contextlib.contextmanager
+def one_cse(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    """While it is open, sympy.cse and sympy.count_ops remember their results by their whole
+    input, so that generating several backends of one System (test_generated) does the CSE once.
+
+    Lowering eliminates common subexpressions on SymPy expressions before any printer sees them,
+    and counts their operations: both are the same for every backend, and are about half of a
+    lowering's CPU. A call whose input differs in anything (the expressions, an option, the
+    name or assumptions of the first temporary) is computed afresh, so a backend that lowered
+    other expressions would still get its own CSE; the printers, templates and everything
+    after the CSE run for each backend as they always do."""
+    real_cse, real_count = sp.cse, sp.count_ops
+    results: dict[tuple[object, ...], tuple[list[object], list[object]]] = {}
+    counts: dict[object, object] = {}
+
+    def cse(exprs, symbols=None, **options):  # type: ignore[no-untyped-def]
+        if symbols is None or not isinstance(exprs, (list, tuple)):
+            return real_cse(exprs, symbols=symbols, **options)
+        first = next(symbols)  # numbered afresh per call: its name and assumptions key it
+        key = (tuple(exprs), first, tuple(sorted(first.assumptions0.items())),
+               tuple(sorted(options.items(), key=repr)))
+        if key not in results:
+            results[key] = real_cse(exprs, symbols=itertools.chain([first], symbols),
+                                    **options)
+        temporaries, reduced = results[key]
+        return list(temporaries), list(reduced)  # lower's own lists, never the cached ones
+
+    def count_ops(expr, visual=False):  # type: ignore[no-untyped-def]
+        if visual or not isinstance(expr, sp.Basic):
+            return real_count(expr, visual)
+        if expr not in counts:
+            counts[expr] = real_count(expr)
+        return counts[expr]
+
+    with monkeypatch.context() as patched:
+        patched.setattr(sp, "cse", cse)
+        patched.setattr(sp, "count_ops", count_ops)
+        yield
 
 
 def write_sources(files: dict[str, str], folder: Path) -> Path:

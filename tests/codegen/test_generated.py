@@ -29,6 +29,7 @@ from codegen_support import (
     BACKENDS,
     EXAMPLES,
     GENERATED,
+    HEAVY,
     ROOT,
     STRICT_FLAGS,
     code_without_comments,
@@ -36,6 +37,7 @@ from codegen_support import (
     compilers,
     example_ids,
     golden_folder,
+    one_cse,
     sources,
     system,
     write_sources,
@@ -58,34 +60,51 @@ OCTAVE_GOLDENS = ("crank_slider", "four_bar_dynamics", "crank_slider_input",
                   "parallelogram_extra_bar", "spatial_slider_crank")
 
 
-@pytest.mark.parametrize(("name", "backend"), [
-    *((path.stem, backend) for backend in BACKENDS for path in ALL_EXAMPLES),  # heavy ones too
-    *((name, "octave") for name in OCTAVE_GOLDENS)])
-def test_golden_matches_regeneration(name: str, backend: str, tmp_path: Path,
+def _golden_backends(name: str) -> tuple[str, ...]:
+    return (*BACKENDS, *(("octave",) if name in OCTAVE_GOLDENS else ()))
+
+
+@pytest.mark.parametrize("name", [  # the heavy ones too (a minute or more each)
+    pytest.param(path.stem, marks=[pytest.mark.slow] if path.stem in HEAVY else [])
+    for path in ALL_EXAMPLES])
+def test_golden_matches_regeneration(name: str, tmp_path: Path,
                                      monkeypatch: pytest.MonkeyPatch) -> None:
-    perturbed = backend == "c" and not UPDATE and name in PERTURBED
-    if perturbed:
-        monkeypatch.setattr(codegen_sample, "sample_configuration",
-                            _perturbed(codegen_sample.sample_configuration))
-    fresh = tmp_path / backend
-    symkin.generate(system(name), backend=backend, out_dir=fresh)
+    """Every backend's golden of the example, byte for byte, generated one backend after the
+    other from one CSE (codegen_support.one_cse: the CSE is the same for every printer)."""
+    stale = []
+    with one_cse(monkeypatch):
+        for backend in _golden_backends(name):
+            perturbed = backend == "c" and not UPDATE and name in PERTURBED
+            with monkeypatch.context() as moved:
+                if perturbed:
+                    moved.setattr(codegen_sample, "sample_configuration",
+                                  _perturbed(codegen_sample.sample_configuration))
+                fresh = tmp_path / backend
+                symkin.generate(system(name), backend=backend, out_dir=fresh)
+            stale += _stale_files(name, backend, fresh, perturbed)
+    assert not stale, "\n".join(stale)
+
+
+def _stale_files(name: str, backend: str, fresh: Path, perturbed: bool) -> list[str]:
+    """What differs between the golden folder and the fresh one (none: empty); with
+    SYMKIN_UPDATE_GOLDENS=1 the fresh folder replaces the golden first."""
     golden = golden_folder(name, backend)
     if UPDATE:
         shutil.rmtree(golden, ignore_errors=True)
         shutil.copytree(fresh, golden)
-    assert golden.is_dir(), f"no golden for {name}; run with SYMKIN_UPDATE_GOLDENS=1"
+    if not golden.is_dir():
+        return [f"no {backend} golden for {name}; run with SYMKIN_UPDATE_GOLDENS=1"]
     expected, actual = _files(golden), _files(fresh)
-    assert sorted(actual) == sorted(expected), (
-        f"file list differs: only golden {sorted(set(expected) - set(actual))}, "
-        f"only fresh {sorted(set(actual) - set(expected))}")
-    for file_name in expected:
-        assert actual[file_name] == expected[file_name], (
-            f"generated/{name}/{backend}/{file_name} is stale; rerun with "
+    if sorted(actual) != sorted(expected):
+        return [f"{name}/{backend}: file list differs: only golden "
+                f"{sorted(set(expected) - set(actual))}, only fresh "
+                f"{sorted(set(actual) - set(expected))}"]
+    return [f"generated/{name}/{backend}/{file_name} is stale; rerun with "
             "SYMKIN_UPDATE_GOLDENS=1 and review this diff"
             + (" (generated from a sample moved by 1e-6: if it stays after the goldens are "
                "rewritten, the bytes depend on the numeric sample)" if perturbed else "")
-            + ":\n"
-            + unified_diff(expected[file_name], actual[file_name], file_name))
+            + ":\n" + unified_diff(expected[file_name], actual[file_name], file_name)
+            for file_name in expected if actual[file_name] != expected[file_name]]
 
 
 # The examples whose C is generated from a moved sample (the heavy three are generated from
