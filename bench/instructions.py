@@ -11,7 +11,7 @@ The generated folder is compiled as a plain C program (gcc -O2) whose main calls
 instructions of 21 steps) / 100, so set-up and the first assembly cancel. Instruction
 counts do not depend on the load of a shared machine, unlike times. dt is 1.5/20000 for an
 example (the textbook grid), 0.001 for a family. The crank-slider's count is guarded by
-tests/test_performance_budget.py against bench/budgets.json (1057 when last lowered; the
+tests/test_performance_budget.py against bench/budgets.json (972 when last lowered; the
 table of where a step's instructions go is in bench/README.md, "The step given back").
 ``--tighten-cond C`` replaces the solver's default ``tighten_cond`` (``inf``: no extra Newton
 iterations at all, so every step does the same work at every size). ``--linalg dense``

@@ -103,6 +103,59 @@ void all_drivers_dense_lu_solve(const all_drivers_dense_lu *lu, all_drivers_real
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
+/* The solve, then its solution's max |x_i| (returned) and sum |x_i| (into *sum_abs); the
+ * _negated one then writes -x (exact): the norms the step takes (lu_solve_rates, negated,
+ * and lu_solve_accelerations). */
+all_drivers_real all_drivers_dense_lu_solve_max(const all_drivers_dense_lu *lu, all_drivers_real b[],
+        all_drivers_real *sum_abs)
+{
+    all_drivers_real largest = 0, total = 0;
+    all_drivers_dense_lu_solve(lu, b);
+    /* written out, as the solver's passes are (templates/_each.j2) */
+    { const all_drivers_real a = fabs(b[0]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[1]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[2]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[3]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[4]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[5]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[6]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[7]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[8]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[9]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[10]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[11]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[12]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[13]); largest = largest > a ? largest : a; total += a; }
+    { const all_drivers_real a = fabs(b[14]); largest = largest > a ? largest : a; total += a; }
+    *sum_abs = total;
+    return largest;
+}
+
+all_drivers_real all_drivers_dense_lu_solve_negated_max(const all_drivers_dense_lu *lu, all_drivers_real b[],
+        all_drivers_real *sum_abs)
+{
+    all_drivers_real largest = 0, total = 0;
+    all_drivers_dense_lu_solve(lu, b);
+    /* written out, as the solver's passes are (templates/_each.j2) */
+    { const all_drivers_real a = fabs(b[0]); largest = largest > a ? largest : a; total += a; b[0] = -b[0]; }
+    { const all_drivers_real a = fabs(b[1]); largest = largest > a ? largest : a; total += a; b[1] = -b[1]; }
+    { const all_drivers_real a = fabs(b[2]); largest = largest > a ? largest : a; total += a; b[2] = -b[2]; }
+    { const all_drivers_real a = fabs(b[3]); largest = largest > a ? largest : a; total += a; b[3] = -b[3]; }
+    { const all_drivers_real a = fabs(b[4]); largest = largest > a ? largest : a; total += a; b[4] = -b[4]; }
+    { const all_drivers_real a = fabs(b[5]); largest = largest > a ? largest : a; total += a; b[5] = -b[5]; }
+    { const all_drivers_real a = fabs(b[6]); largest = largest > a ? largest : a; total += a; b[6] = -b[6]; }
+    { const all_drivers_real a = fabs(b[7]); largest = largest > a ? largest : a; total += a; b[7] = -b[7]; }
+    { const all_drivers_real a = fabs(b[8]); largest = largest > a ? largest : a; total += a; b[8] = -b[8]; }
+    { const all_drivers_real a = fabs(b[9]); largest = largest > a ? largest : a; total += a; b[9] = -b[9]; }
+    { const all_drivers_real a = fabs(b[10]); largest = largest > a ? largest : a; total += a; b[10] = -b[10]; }
+    { const all_drivers_real a = fabs(b[11]); largest = largest > a ? largest : a; total += a; b[11] = -b[11]; }
+    { const all_drivers_real a = fabs(b[12]); largest = largest > a ? largest : a; total += a; b[12] = -b[12]; }
+    { const all_drivers_real a = fabs(b[13]); largest = largest > a ? largest : a; total += a; b[13] = -b[13]; }
+    { const all_drivers_real a = fabs(b[14]); largest = largest > a ? largest : a; total += a; b[14] = -b[14]; }
+    *sum_abs = total;
+    return largest;
+}
+
 void all_drivers_dense_lu_solve_transposed(const all_drivers_dense_lu *lu, all_drivers_real b[])
 {
     /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */

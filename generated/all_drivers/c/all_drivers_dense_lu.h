@@ -35,6 +35,13 @@ all_drivers_real all_drivers_dense_lu_pivot_ratio(const all_drivers_dense_lu *lu
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void all_drivers_dense_lu_solve(const all_drivers_dense_lu *lu, all_drivers_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+all_drivers_real all_drivers_dense_lu_solve_max(const all_drivers_dense_lu *lu, all_drivers_real b[],
+                                              all_drivers_real *sum_abs);
+all_drivers_real all_drivers_dense_lu_solve_negated_max(const all_drivers_dense_lu *lu,
+                                                      all_drivers_real b[], all_drivers_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void all_drivers_dense_lu_solve_transposed(const all_drivers_dense_lu *lu, all_drivers_real b[]);
 

@@ -994,11 +994,28 @@ static int all_drivers_newton(const all_drivers_options *options, const all_driv
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
     report->residual = (all_drivers_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        all_drivers_real residual;
+        all_drivers_real residual = 0, sum = 0;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         all_drivers_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
         all_drivers_in_unit(work);
-        residual = all_drivers_max_abs(work->phi);
+        /* max |Phi| as max_abs takes it, written out here: no call in the loop every step
+         * runs (a copy of max_abs the compiler would fold back into the call) */
+        { const all_drivers_real a = fabs(work->phi[0]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[1]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[2]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[3]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[4]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[5]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[6]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[7]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[8]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[9]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[10]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[11]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[12]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[13]); residual = residual > a ? residual : a; sum += a; }
+        { const all_drivers_real a = fabs(work->phi[14]); residual = residual > a ? residual : a; sum += a; }
+        residual = sum != sum ? (all_drivers_real)NAN : residual;
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
@@ -1058,147 +1075,85 @@ static void all_drivers_predict(all_drivers_real t, all_drivers_state *state)
     state->q[14] += state->dq[14] * h + state->ddq[14] * half_h2;
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
- * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
- * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
- * largest), and dq in the kernel's unit. */
-static all_drivers_real all_drivers_rates_pass(const all_drivers_workspace *work, all_drivers_real dq[],
-                                       all_drivers_real *sum_abs)
+/* max |q| in the run's unit (NaN when some q_i is, as in max_abs: the error model then flags
+ * the point). */
+static all_drivers_real all_drivers_positions_pass(const all_drivers_workspace *work, const all_drivers_real q[])
 {
-    all_drivers_real largest = 0, sum = 0;
-    { const all_drivers_real b = fabs(dq[0]); largest = largest > b ? largest : b; sum += b; }
-    dq[0] = -dq[0];
-    { const all_drivers_real b = fabs(dq[1]); largest = largest > b ? largest : b; sum += b; }
-    dq[1] = -dq[1];
-    { const all_drivers_real b = fabs(dq[2]); largest = largest > b ? largest : b; sum += b; }
-    dq[2] = -dq[2];
-    { const all_drivers_real b = fabs(dq[3]); largest = largest > b ? largest : b; sum += b; }
-    dq[3] = -dq[3];
-    { const all_drivers_real b = fabs(dq[4]); largest = largest > b ? largest : b; sum += b; }
-    dq[4] = -dq[4];
-    { const all_drivers_real b = fabs(dq[5]); largest = largest > b ? largest : b; sum += b; }
-    dq[5] = -dq[5];
-    { const all_drivers_real b = fabs(dq[6]); largest = largest > b ? largest : b; sum += b; }
-    dq[6] = -dq[6];
-    { const all_drivers_real b = fabs(dq[7]); largest = largest > b ? largest : b; sum += b; }
-    dq[7] = -dq[7];
-    { const all_drivers_real b = fabs(dq[8]); largest = largest > b ? largest : b; sum += b; }
-    dq[8] = -dq[8];
-    { const all_drivers_real b = fabs(dq[9]); largest = largest > b ? largest : b; sum += b; }
-    dq[9] = -dq[9];
-    { const all_drivers_real b = fabs(dq[10]); largest = largest > b ? largest : b; sum += b; }
-    dq[10] = -dq[10];
-    { const all_drivers_real b = fabs(dq[11]); largest = largest > b ? largest : b; sum += b; }
-    dq[11] = -dq[11];
-    { const all_drivers_real b = fabs(dq[12]); largest = largest > b ? largest : b; sum += b; }
-    dq[12] = -dq[12];
-    { const all_drivers_real b = fabs(dq[13]); largest = largest > b ? largest : b; sum += b; }
-    dq[13] = -dq[13];
-    { const all_drivers_real b = fabs(dq[14]); largest = largest > b ? largest : b; sum += b; }
-    dq[14] = -dq[14];
-    all_drivers_from_unit(work, dq);
-    *sum_abs = sum;
-    return largest;
-}
-
-/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
- * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
- * then flags the point). */
-static all_drivers_real all_drivers_accelerations_pass(const all_drivers_workspace *work,
-                                               const all_drivers_real q[], all_drivers_real ddq[],
-                                               all_drivers_real *sum_abs, all_drivers_real *nq)
-{
-    all_drivers_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
-    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division); the lengths'
-     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
-     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
-    { const all_drivers_real c = fabs(ddq[0]); largest = largest > c ? largest : c; sum += c; }
+    all_drivers_real largest_q = 0, sum_q = 0, largest_length = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs); a coordinate that is no length is
+     * the same in every unit (no division); the lengths' largest |q_i| is divided by the unit
+     * once, after the pass: rounding is monotone, so max (|q_i| / unit) and (max |q_i|) / unit
+     * are the same number (the unit is finite) */
     {
         const all_drivers_real a = fabs(q[0]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[1]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[1]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[2]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[2]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[3]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[3]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[4]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[4]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[5]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[5]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[6]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[6]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[7]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[7]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[8]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[8]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[9]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[9]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[10]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[10]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[11]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[11]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[12]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[12]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[13]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[13]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const all_drivers_real c = fabs(ddq[14]); largest = largest > c ? largest : c; sum += c; }
     {
         const all_drivers_real a = fabs(q[14]);
         largest_q = largest_q > a ? largest_q : a;
@@ -1206,10 +1161,8 @@ static all_drivers_real all_drivers_accelerations_pass(const all_drivers_workspa
     }
     largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
     largest_q = largest_q > largest_length ? largest_q : largest_length;
-    all_drivers_from_unit(work, ddq);
-    *sum_abs = sum;
-    *nq = sum_q != sum_q ? (all_drivers_real)NAN : largest_q;
-    return largest;
+    (void)work;
+    return sum_q != sum_q ? (all_drivers_real)NAN : largest_q;
 }
 
 /* all_drivers_solve_step with its options already checked. */
@@ -1231,16 +1184,19 @@ static int all_drivers_step(const all_drivers_options *options, const all_driver
         return report->status;
     }
     /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
-     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
-     * fused call, so the shared sines and cosines are this q's. */
+     * is -dq, written out negated. Each solve returns its solution's max |.| in the run's unit
+     * and the sum of |.| for the finite test, taken as it writes the solution (no pass over
+     * it again). Newton stopped at the q of its last fused call, so the shared sines and
+     * cosines are this q's. */
     all_drivers_phi_t_shared(state->q, t, p, work->shared, state->dq);
     all_drivers_rows_in_unit(work, state->dq);
-    all_drivers_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = all_drivers_rates_pass(work, state->dq, &sum_dq);
+    ndq = all_drivers_lu_solve_rates(&work->lu, state->dq, &sum_dq); /* (2.73) */
+    all_drivers_from_unit(work, state->dq);
     all_drivers_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     all_drivers_rows_in_unit(work, state->ddq);
-    all_drivers_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = all_drivers_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    nddq = all_drivers_lu_solve_accelerations(&work->lu, state->ddq, &sum_ddq); /* (2.74) */
+    all_drivers_from_unit(work, state->ddq);
+    nq = all_drivers_positions_pass(work, state->q);
     /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
      * overflow harmlessly), infinite where the larger maximum is */
     largest = ndq > nddq ? ndq : nddq;

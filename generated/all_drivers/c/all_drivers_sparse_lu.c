@@ -264,61 +264,6 @@ all_drivers_real all_drivers_lu_pivot_ratio(const all_drivers_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 4..13 */
-static void all_drivers_lu_forward_0(const all_drivers_real *v, all_drivers_real *x)
-{
-    (void)v;
-    x[7] += x[4];
-    x[6] += x[5];
-    x[7] -= v[3] * x[6];
-    x[10] += x[7];
-    x[11] -= v[10] * x[7];
-    x[12] -= v[19] * x[7];
-    x[9] -= v[18] * x[8];
-    x[10] -= v[16] * x[8];
-    x[11] -= v[12] * x[8];
-    x[10] -= v[42] * x[9];
-    x[11] -= v[11] * x[9];
-    x[12] -= v[20] * x[9];
-    x[11] -= v[43] * x[10];
-    x[12] -= v[23] * x[10];
-    x[13] -= v[26] * x[10];
-    x[14] -= v[31] * x[10];
-    x[12] -= v[21] * x[11];
-    x[13] -= v[24] * x[11];
-    x[14] -= v[29] * x[11];
-    x[13] -= v[25] * x[12];
-    x[14] -= v[30] * x[12];
-    x[14] -= v[33] * x[13];
-}
-
-/* U z = y, rows 14..0 */
-static void all_drivers_lu_backward_0(const all_drivers_real *v,
-        const all_drivers_real *inv, all_drivers_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[14] *= inv[14];
-    x[13] -= v[27] * x[14];
-    x[13] *= inv[13];
-    x[12] *= inv[12];
-    x[11] -= v[14] * x[12];
-    x[11] *= inv[11];
-    x[10] *= inv[10];
-    x[9] -= v[45] * x[10];
-    x[8] -= x[10];
-    x[8] = -x[8];
-    x[7] -= v[41] * x[9];
-    x[7] = -x[7];
-    x[6] += x[9];
-    x[6] *= inv[6];
-    x[5] = -x[5];
-    x[4] = -x[4];
-    x[2] += x[13];
-    x[1] += x[14];
-    x[0] += x[10];
-}
-
 void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
 {
     all_drivers_real x[ALL_DRIVERS_NQ];
@@ -342,8 +287,54 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
     x[12] = b[8];
     x[13] = b[9];
     x[14] = b[10];
-    all_drivers_lu_forward_0(lu->v, x);
-    all_drivers_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const all_drivers_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[4];
+        x[6] += x[5];
+        x[7] -= v[3] * x[6];
+        x[10] += x[7];
+        x[11] -= v[10] * x[7];
+        x[12] -= v[19] * x[7];
+        x[9] -= v[18] * x[8];
+        x[10] -= v[16] * x[8];
+        x[11] -= v[12] * x[8];
+        x[10] -= v[42] * x[9];
+        x[11] -= v[11] * x[9];
+        x[12] -= v[20] * x[9];
+        x[11] -= v[43] * x[10];
+        x[12] -= v[23] * x[10];
+        x[13] -= v[26] * x[10];
+        x[14] -= v[31] * x[10];
+        x[12] -= v[21] * x[11];
+        x[13] -= v[24] * x[11];
+        x[14] -= v[29] * x[11];
+        x[13] -= v[25] * x[12];
+        x[14] -= v[30] * x[12];
+        x[14] -= v[33] * x[13];
+        /* U z = y */
+        x[14] *= inv[14];
+        x[13] -= v[27] * x[14];
+        x[13] *= inv[13];
+        x[12] *= inv[12];
+        x[11] -= v[14] * x[12];
+        x[11] *= inv[11];
+        x[10] *= inv[10];
+        x[9] -= v[45] * x[10];
+        x[8] -= x[10];
+        x[8] = -x[8];
+        x[7] -= v[41] * x[9];
+        x[7] = -x[7];
+        x[6] += x[9];
+        x[6] *= inv[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[2] += x[13];
+        x[1] += x[14];
+        x[0] += x[10];
+    }
     b[11] = x[0];
     b[12] = x[1];
     b[13] = x[2];
@@ -359,6 +350,189 @@ void all_drivers_lu_solve(const all_drivers_lu *lu, all_drivers_real b[])
     b[7] = x[12];
     b[10] = x[13];
     b[9] = x[14];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+all_drivers_real all_drivers_lu_solve_rates(const all_drivers_lu *lu, all_drivers_real b[], all_drivers_real *sum_abs)
+{
+    all_drivers_real x[ALL_DRIVERS_NQ];
+    all_drivers_real largest = 0, total = 0;
+    if (lu->dense) return all_drivers_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[11];
+    x[1] = b[12];
+    x[2] = b[13];
+    x[3] = b[14];
+    x[4] = 0; /* b[0]: a zero row */
+    x[5] = 0; /* b[1]: a zero row */
+    x[6] = 0; /* b[3]: a zero row */
+    x[7] = 0; /* b[2]: a zero row */
+    x[8] = 0; /* b[4]: a zero row */
+    x[9] = b[7];
+    x[10] = b[6];
+    x[11] = 0; /* b[5]: a zero row */
+    x[12] = b[8];
+    x[13] = 0; /* b[9]: a zero row */
+    x[14] = b[10];
+    {
+        const all_drivers_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[4];
+        x[6] += x[5];
+        x[7] -= v[3] * x[6];
+        x[10] += x[7];
+        x[11] -= v[10] * x[7];
+        x[12] -= v[19] * x[7];
+        x[9] -= v[18] * x[8];
+        x[10] -= v[16] * x[8];
+        x[11] -= v[12] * x[8];
+        x[10] -= v[42] * x[9];
+        x[11] -= v[11] * x[9];
+        x[12] -= v[20] * x[9];
+        x[11] -= v[43] * x[10];
+        x[12] -= v[23] * x[10];
+        x[13] -= v[26] * x[10];
+        x[14] -= v[31] * x[10];
+        x[12] -= v[21] * x[11];
+        x[13] -= v[24] * x[11];
+        x[14] -= v[29] * x[11];
+        x[13] -= v[25] * x[12];
+        x[14] -= v[30] * x[12];
+        x[14] -= v[33] * x[13];
+        /* U z = y */
+        x[14] *= inv[14];
+        x[13] -= v[27] * x[14];
+        x[13] *= inv[13];
+        x[12] *= inv[12];
+        x[11] -= v[14] * x[12];
+        x[11] *= inv[11];
+        x[10] *= inv[10];
+        x[9] -= v[45] * x[10];
+        x[8] -= x[10];
+        x[8] = -x[8];
+        x[7] -= v[41] * x[9];
+        x[7] = -x[7];
+        x[6] += x[9];
+        x[6] *= inv[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[2] += x[13];
+        x[1] += x[14];
+        x[0] += x[10];
+    }
+    { const all_drivers_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[11] = -x[0]; }
+    { const all_drivers_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[12] = -x[1]; }
+    { const all_drivers_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[13] = -x[2]; }
+    { const all_drivers_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[14] = -x[3]; }
+    b[0] = -x[4]; /* +-0: no norm to take */
+    b[1] = -x[5]; /* +-0: no norm to take */
+    { const all_drivers_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[2] = -x[6]; }
+    { const all_drivers_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[3] = -x[7]; }
+    { const all_drivers_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[5] = -x[8]; }
+    { const all_drivers_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[4] = -x[9]; }
+    { const all_drivers_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[8] = -x[10]; }
+    { const all_drivers_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[6] = -x[11]; }
+    { const all_drivers_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[7] = -x[12]; }
+    { const all_drivers_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[10] = -x[13]; }
+    { const all_drivers_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[9] = -x[14]; }
+    *sum_abs = total;
+    return largest;
+}
+
+all_drivers_real all_drivers_lu_solve_accelerations(const all_drivers_lu *lu, all_drivers_real b[], all_drivers_real *sum_abs)
+{
+    all_drivers_real x[ALL_DRIVERS_NQ];
+    all_drivers_real largest = 0, total = 0;
+    if (lu->dense) return all_drivers_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[11];
+    x[1] = b[12];
+    x[2] = b[13];
+    x[3] = b[14];
+    x[4] = 0; /* b[0]: a zero row */
+    x[5] = 0; /* b[1]: a zero row */
+    x[6] = b[3];
+    x[7] = b[2];
+    x[8] = 0; /* b[4]: a zero row */
+    x[9] = b[7];
+    x[10] = b[6];
+    x[11] = b[5];
+    x[12] = b[8];
+    x[13] = b[9];
+    x[14] = b[10];
+    {
+        const all_drivers_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[4];
+        x[6] += x[5];
+        x[7] -= v[3] * x[6];
+        x[10] += x[7];
+        x[11] -= v[10] * x[7];
+        x[12] -= v[19] * x[7];
+        x[9] -= v[18] * x[8];
+        x[10] -= v[16] * x[8];
+        x[11] -= v[12] * x[8];
+        x[10] -= v[42] * x[9];
+        x[11] -= v[11] * x[9];
+        x[12] -= v[20] * x[9];
+        x[11] -= v[43] * x[10];
+        x[12] -= v[23] * x[10];
+        x[13] -= v[26] * x[10];
+        x[14] -= v[31] * x[10];
+        x[12] -= v[21] * x[11];
+        x[13] -= v[24] * x[11];
+        x[14] -= v[29] * x[11];
+        x[13] -= v[25] * x[12];
+        x[14] -= v[30] * x[12];
+        x[14] -= v[33] * x[13];
+        /* U z = y */
+        x[14] *= inv[14];
+        x[13] -= v[27] * x[14];
+        x[13] *= inv[13];
+        x[12] *= inv[12];
+        x[11] -= v[14] * x[12];
+        x[11] *= inv[11];
+        x[10] *= inv[10];
+        x[9] -= v[45] * x[10];
+        x[8] -= x[10];
+        x[8] = -x[8];
+        x[7] -= v[41] * x[9];
+        x[7] = -x[7];
+        x[6] += x[9];
+        x[6] *= inv[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[2] += x[13];
+        x[1] += x[14];
+        x[0] += x[10];
+    }
+    { const all_drivers_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[11] = x[0]; }
+    { const all_drivers_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[12] = x[1]; }
+    { const all_drivers_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[13] = x[2]; }
+    { const all_drivers_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[14] = x[3]; }
+    b[0] = x[4]; /* +-0: no norm to take */
+    b[1] = x[5]; /* +-0: no norm to take */
+    { const all_drivers_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[2] = x[6]; }
+    { const all_drivers_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[3] = x[7]; }
+    { const all_drivers_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[5] = x[8]; }
+    { const all_drivers_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[4] = x[9]; }
+    { const all_drivers_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[8] = x[10]; }
+    { const all_drivers_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[6] = x[11]; }
+    { const all_drivers_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[7] = x[12]; }
+    { const all_drivers_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[10] = x[13]; }
+    { const all_drivers_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[9] = x[14]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..14 of U^T (rows of U) */

@@ -103,6 +103,40 @@ void andrews_squeezer_dense_lu_solve(const andrews_squeezer_dense_lu *lu, andrew
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
+/* The solve, then its solution's max |x_i| (returned) and sum |x_i| (into *sum_abs); the
+ * _negated one then writes -x (exact): the norms the step takes (lu_solve_rates, negated,
+ * and lu_solve_accelerations). */
+andrews_squeezer_real andrews_squeezer_dense_lu_solve_max(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[],
+        andrews_squeezer_real *sum_abs)
+{
+    andrews_squeezer_real largest = 0, total = 0;
+    andrews_squeezer_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) {
+        const andrews_squeezer_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+    }
+    *sum_abs = total;
+    return largest;
+}
+
+andrews_squeezer_real andrews_squeezer_dense_lu_solve_negated_max(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[],
+        andrews_squeezer_real *sum_abs)
+{
+    andrews_squeezer_real largest = 0, total = 0;
+    andrews_squeezer_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < ANDREWS_SQUEEZER_NQ; ++k) {
+        const andrews_squeezer_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+        b[k] = -b[k];
+    }
+    *sum_abs = total;
+    return largest;
+}
+
 void andrews_squeezer_dense_lu_solve_transposed(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[])
 {
     /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */

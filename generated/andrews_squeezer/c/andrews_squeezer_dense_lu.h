@@ -35,6 +35,13 @@ andrews_squeezer_real andrews_squeezer_dense_lu_pivot_ratio(const andrews_squeez
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void andrews_squeezer_dense_lu_solve(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+andrews_squeezer_real andrews_squeezer_dense_lu_solve_max(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[],
+                                              andrews_squeezer_real *sum_abs);
+andrews_squeezer_real andrews_squeezer_dense_lu_solve_negated_max(const andrews_squeezer_dense_lu *lu,
+                                                      andrews_squeezer_real b[], andrews_squeezer_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void andrews_squeezer_dense_lu_solve_transposed(const andrews_squeezer_dense_lu *lu, andrews_squeezer_real b[]);
 

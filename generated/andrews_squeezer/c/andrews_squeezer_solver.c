@@ -976,11 +976,16 @@ static int andrews_squeezer_newton(const andrews_squeezer_options *options, cons
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
     report->residual = (andrews_squeezer_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        andrews_squeezer_real residual;
+        andrews_squeezer_real residual = 0, sum = 0;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         andrews_squeezer_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
         andrews_squeezer_in_unit(work);
-        residual = andrews_squeezer_max_abs(work->phi);
+        /* max |Phi| as max_abs takes it, written out here: no call in the loop every step
+         * runs (a copy of max_abs the compiler would fold back into the call) */
+        for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
+            { const andrews_squeezer_real a = fabs(work->phi[i]); residual = residual > a ? residual : a; sum += a; }
+        }
+        residual = sum != sum ? (andrews_squeezer_real)NAN : residual;
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
@@ -1016,38 +1021,16 @@ static void andrews_squeezer_predict(andrews_squeezer_real t, andrews_squeezer_s
     }
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
- * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
- * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
- * largest), and dq in the kernel's unit. */
-static andrews_squeezer_real andrews_squeezer_rates_pass(const andrews_squeezer_workspace *work, andrews_squeezer_real dq[],
-                                       andrews_squeezer_real *sum_abs)
+/* max |q| in the run's unit (NaN when some q_i is, as in max_abs: the error model then flags
+ * the point). */
+static andrews_squeezer_real andrews_squeezer_positions_pass(const andrews_squeezer_workspace *work, const andrews_squeezer_real q[])
 {
-    andrews_squeezer_real largest = 0, sum = 0;
+    andrews_squeezer_real largest_q = 0, sum_q = 0, largest_length = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs); a coordinate that is no length is
+     * the same in every unit (no division); the lengths' largest |q_i| is divided by the unit
+     * once, after the pass: rounding is monotone, so max (|q_i| / unit) and (max |q_i|) / unit
+     * are the same number (the unit is finite) */
     for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        { const andrews_squeezer_real b = fabs(dq[i]); largest = largest > b ? largest : b; sum += b; }
-        dq[i] = -dq[i];
-    }
-    andrews_squeezer_from_unit(work, dq);
-    *sum_abs = sum;
-    return largest;
-}
-
-/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
- * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
- * then flags the point). */
-static andrews_squeezer_real andrews_squeezer_accelerations_pass(const andrews_squeezer_workspace *work,
-                                               const andrews_squeezer_real q[], andrews_squeezer_real ddq[],
-                                               andrews_squeezer_real *sum_abs, andrews_squeezer_real *nq)
-{
-    andrews_squeezer_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
-    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division); the lengths'
-     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
-     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
-    for (int i = 0; i < ANDREWS_SQUEEZER_NQ; ++i) {
-        { const andrews_squeezer_real c = fabs(ddq[i]); largest = largest > c ? largest : c; sum += c; }
         {
             const andrews_squeezer_real a = fabs(q[i]) * work->inverse_column[i];
             largest_q = largest_q > a ? largest_q : a;
@@ -1056,10 +1039,8 @@ static andrews_squeezer_real andrews_squeezer_accelerations_pass(const andrews_s
     }
     largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
     largest_q = largest_q > largest_length ? largest_q : largest_length;
-    andrews_squeezer_from_unit(work, ddq);
-    *sum_abs = sum;
-    *nq = sum_q != sum_q ? (andrews_squeezer_real)NAN : largest_q;
-    return largest;
+    (void)work;
+    return sum_q != sum_q ? (andrews_squeezer_real)NAN : largest_q;
 }
 
 /* andrews_squeezer_solve_step with its options already checked. */
@@ -1081,16 +1062,19 @@ static int andrews_squeezer_step(const andrews_squeezer_options *options, const 
         return report->status;
     }
     /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
-     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
-     * fused call, so the shared sines and cosines are this q's. */
+     * is -dq, written out negated. Each solve returns its solution's max |.| in the run's unit
+     * and the sum of |.| for the finite test, taken as it writes the solution (no pass over
+     * it again). Newton stopped at the q of its last fused call, so the shared sines and
+     * cosines are this q's. */
     andrews_squeezer_phi_t_shared(state->q, t, p, work->shared, state->dq);
     andrews_squeezer_rows_in_unit(work, state->dq);
-    andrews_squeezer_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = andrews_squeezer_rates_pass(work, state->dq, &sum_dq);
+    ndq = andrews_squeezer_lu_solve_rates(&work->lu, state->dq, &sum_dq); /* (2.73) */
+    andrews_squeezer_from_unit(work, state->dq);
     andrews_squeezer_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     andrews_squeezer_rows_in_unit(work, state->ddq);
-    andrews_squeezer_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = andrews_squeezer_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    nddq = andrews_squeezer_lu_solve_accelerations(&work->lu, state->ddq, &sum_ddq); /* (2.74) */
+    andrews_squeezer_from_unit(work, state->ddq);
+    nq = andrews_squeezer_positions_pass(work, state->q);
     /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
      * overflow harmlessly), infinite where the larger maximum is */
     largest = ndq > nddq ? ndq : nddq;

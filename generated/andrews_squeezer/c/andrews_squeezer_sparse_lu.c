@@ -251,70 +251,6 @@ andrews_squeezer_real andrews_squeezer_lu_pivot_ratio(const andrews_squeezer_lu 
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..19 */
-static void andrews_squeezer_lu_forward_0(const andrews_squeezer_real *v, andrews_squeezer_real *x)
-{
-    (void)v;
-    x[9] += x[0];
-    x[10] += x[1];
-    x[11] -= x[2];
-    x[12] -= x[3];
-    x[17] -= x[4];
-    x[18] -= x[5];
-    x[19] -= x[6];
-    x[20] -= x[7];
-    x[9] -= v[3] * x[8];
-    x[10] -= v[6] * x[8];
-    x[11] += x[9];
-    x[13] += x[9];
-    x[15] += x[9];
-    x[12] += x[10];
-    x[14] += x[10];
-    x[16] += x[10];
-    x[12] -= v[15] * x[11];
-    x[13] -= v[17] * x[12];
-    x[14] -= v[20] * x[12];
-    x[15] -= v[23] * x[12];
-    x[16] -= v[26] * x[12];
-    x[17] += x[13];
-    x[18] += x[14];
-    x[19] += x[15];
-    x[20] += x[16];
-    x[18] -= v[35] * x[17];
-    x[20] -= v[45] * x[19];
-}
-
-/* U z = y, rows 20..0 */
-static void andrews_squeezer_lu_backward_0(const andrews_squeezer_real *v,
-        const andrews_squeezer_real *inv, andrews_squeezer_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[20] *= inv[20];
-    x[19] -= v[43] * x[20];
-    x[19] *= inv[19];
-    x[18] *= inv[18];
-    x[17] -= v[33] * x[18];
-    x[17] *= inv[17];
-    x[16] = -x[16];
-    x[15] = -x[15];
-    x[14] = -x[14];
-    x[13] = -x[13];
-    x[12] *= inv[12];
-    x[11] -= v[9] * x[12];
-    x[11] *= inv[11];
-    x[10] = -x[10];
-    x[9] = -x[9];
-    x[7] = -x[7];
-    x[6] = -x[6];
-    x[5] = -x[5];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] = -x[1];
-    x[0] = -x[0];
-}
-
 void andrews_squeezer_lu_solve(const andrews_squeezer_lu *lu, andrews_squeezer_real b[])
 {
     andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ];
@@ -344,8 +280,63 @@ void andrews_squeezer_lu_solve(const andrews_squeezer_lu *lu, andrews_squeezer_r
     x[18] = b[13];
     x[19] = b[16];
     x[20] = b[17];
-    andrews_squeezer_lu_forward_0(lu->v, x);
-    andrews_squeezer_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const andrews_squeezer_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[9] += x[0];
+        x[10] += x[1];
+        x[11] -= x[2];
+        x[12] -= x[3];
+        x[17] -= x[4];
+        x[18] -= x[5];
+        x[19] -= x[6];
+        x[20] -= x[7];
+        x[9] -= v[3] * x[8];
+        x[10] -= v[6] * x[8];
+        x[11] += x[9];
+        x[13] += x[9];
+        x[15] += x[9];
+        x[12] += x[10];
+        x[14] += x[10];
+        x[16] += x[10];
+        x[12] -= v[15] * x[11];
+        x[13] -= v[17] * x[12];
+        x[14] -= v[20] * x[12];
+        x[15] -= v[23] * x[12];
+        x[16] -= v[26] * x[12];
+        x[17] += x[13];
+        x[18] += x[14];
+        x[19] += x[15];
+        x[20] += x[16];
+        x[18] -= v[35] * x[17];
+        x[20] -= v[45] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[43] * x[20];
+        x[19] *= inv[19];
+        x[18] *= inv[18];
+        x[17] -= v[33] * x[18];
+        x[17] *= inv[17];
+        x[16] = -x[16];
+        x[15] = -x[15];
+        x[14] = -x[14];
+        x[13] = -x[13];
+        x[12] *= inv[12];
+        x[11] -= v[9] * x[12];
+        x[11] *= inv[11];
+        x[10] = -x[10];
+        x[9] = -x[9];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
     b[0] = x[0];
     b[1] = x[1];
     b[6] = x[2];
@@ -367,6 +358,231 @@ void andrews_squeezer_lu_solve(const andrews_squeezer_lu *lu, andrews_squeezer_r
     b[14] = x[18];
     b[17] = x[19];
     b[20] = x[20];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+andrews_squeezer_real andrews_squeezer_lu_solve_rates(const andrews_squeezer_lu *lu, andrews_squeezer_real b[], andrews_squeezer_real *sum_abs)
+{
+    andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ];
+    andrews_squeezer_real largest = 0, total = 0;
+    if (lu->dense) return andrews_squeezer_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[10]: a zero row */
+    x[3] = 0; /* b[11]: a zero row */
+    x[4] = 0; /* b[14]: a zero row */
+    x[5] = 0; /* b[15]: a zero row */
+    x[6] = 0; /* b[18]: a zero row */
+    x[7] = 0; /* b[19]: a zero row */
+    x[8] = b[20];
+    x[9] = 0; /* b[2]: a zero row */
+    x[10] = 0; /* b[3]: a zero row */
+    x[11] = 0; /* b[4]: a zero row */
+    x[12] = 0; /* b[5]: a zero row */
+    x[13] = 0; /* b[6]: a zero row */
+    x[14] = 0; /* b[7]: a zero row */
+    x[15] = 0; /* b[8]: a zero row */
+    x[16] = 0; /* b[9]: a zero row */
+    x[17] = 0; /* b[12]: a zero row */
+    x[18] = 0; /* b[13]: a zero row */
+    x[19] = 0; /* b[16]: a zero row */
+    x[20] = 0; /* b[17]: a zero row */
+    {
+        const andrews_squeezer_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[9] += x[0];
+        x[10] += x[1];
+        x[11] -= x[2];
+        x[12] -= x[3];
+        x[17] -= x[4];
+        x[18] -= x[5];
+        x[19] -= x[6];
+        x[20] -= x[7];
+        x[9] -= v[3] * x[8];
+        x[10] -= v[6] * x[8];
+        x[11] += x[9];
+        x[13] += x[9];
+        x[15] += x[9];
+        x[12] += x[10];
+        x[14] += x[10];
+        x[16] += x[10];
+        x[12] -= v[15] * x[11];
+        x[13] -= v[17] * x[12];
+        x[14] -= v[20] * x[12];
+        x[15] -= v[23] * x[12];
+        x[16] -= v[26] * x[12];
+        x[17] += x[13];
+        x[18] += x[14];
+        x[19] += x[15];
+        x[20] += x[16];
+        x[18] -= v[35] * x[17];
+        x[20] -= v[45] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[43] * x[20];
+        x[19] *= inv[19];
+        x[18] *= inv[18];
+        x[17] -= v[33] * x[18];
+        x[17] *= inv[17];
+        x[16] = -x[16];
+        x[15] = -x[15];
+        x[14] = -x[14];
+        x[13] = -x[13];
+        x[12] *= inv[12];
+        x[11] -= v[9] * x[12];
+        x[11] *= inv[11];
+        x[10] = -x[10];
+        x[9] = -x[9];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = -x[0]; /* +-0: no norm to take */
+    b[1] = -x[1]; /* +-0: no norm to take */
+    b[6] = -x[2]; /* +-0: no norm to take */
+    b[7] = -x[3]; /* +-0: no norm to take */
+    b[12] = -x[4]; /* +-0: no norm to take */
+    b[13] = -x[5]; /* +-0: no norm to take */
+    b[18] = -x[6]; /* +-0: no norm to take */
+    b[19] = -x[7]; /* +-0: no norm to take */
+    { const andrews_squeezer_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[2] = -x[8]; }
+    { const andrews_squeezer_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[3] = -x[9]; }
+    { const andrews_squeezer_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[4] = -x[10]; }
+    { const andrews_squeezer_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[8] = -x[11]; }
+    { const andrews_squeezer_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[5] = -x[12]; }
+    { const andrews_squeezer_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[9] = -x[13]; }
+    { const andrews_squeezer_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[10] = -x[14]; }
+    { const andrews_squeezer_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[15] = -x[15]; }
+    { const andrews_squeezer_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[16] = -x[16]; }
+    { const andrews_squeezer_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[11] = -x[17]; }
+    { const andrews_squeezer_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[14] = -x[18]; }
+    { const andrews_squeezer_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[17] = -x[19]; }
+    { const andrews_squeezer_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[20] = -x[20]; }
+    *sum_abs = total;
+    return largest;
+}
+
+andrews_squeezer_real andrews_squeezer_lu_solve_accelerations(const andrews_squeezer_lu *lu, andrews_squeezer_real b[], andrews_squeezer_real *sum_abs)
+{
+    andrews_squeezer_real x[ANDREWS_SQUEEZER_NQ];
+    andrews_squeezer_real largest = 0, total = 0;
+    if (lu->dense) return andrews_squeezer_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[10]: a zero row */
+    x[3] = 0; /* b[11]: a zero row */
+    x[4] = 0; /* b[14]: a zero row */
+    x[5] = 0; /* b[15]: a zero row */
+    x[6] = 0; /* b[18]: a zero row */
+    x[7] = 0; /* b[19]: a zero row */
+    x[8] = 0; /* b[20]: a zero row */
+    x[9] = b[2];
+    x[10] = b[3];
+    x[11] = b[4];
+    x[12] = b[5];
+    x[13] = b[6];
+    x[14] = b[7];
+    x[15] = b[8];
+    x[16] = b[9];
+    x[17] = b[12];
+    x[18] = b[13];
+    x[19] = b[16];
+    x[20] = b[17];
+    {
+        const andrews_squeezer_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[9] += x[0];
+        x[10] += x[1];
+        x[11] -= x[2];
+        x[12] -= x[3];
+        x[17] -= x[4];
+        x[18] -= x[5];
+        x[19] -= x[6];
+        x[20] -= x[7];
+        x[9] -= v[3] * x[8];
+        x[10] -= v[6] * x[8];
+        x[11] += x[9];
+        x[13] += x[9];
+        x[15] += x[9];
+        x[12] += x[10];
+        x[14] += x[10];
+        x[16] += x[10];
+        x[12] -= v[15] * x[11];
+        x[13] -= v[17] * x[12];
+        x[14] -= v[20] * x[12];
+        x[15] -= v[23] * x[12];
+        x[16] -= v[26] * x[12];
+        x[17] += x[13];
+        x[18] += x[14];
+        x[19] += x[15];
+        x[20] += x[16];
+        x[18] -= v[35] * x[17];
+        x[20] -= v[45] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[43] * x[20];
+        x[19] *= inv[19];
+        x[18] *= inv[18];
+        x[17] -= v[33] * x[18];
+        x[17] *= inv[17];
+        x[16] = -x[16];
+        x[15] = -x[15];
+        x[14] = -x[14];
+        x[13] = -x[13];
+        x[12] *= inv[12];
+        x[11] -= v[9] * x[12];
+        x[11] *= inv[11];
+        x[10] = -x[10];
+        x[9] = -x[9];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = x[0]; /* +-0: no norm to take */
+    b[1] = x[1]; /* +-0: no norm to take */
+    b[6] = x[2]; /* +-0: no norm to take */
+    b[7] = x[3]; /* +-0: no norm to take */
+    b[12] = x[4]; /* +-0: no norm to take */
+    b[13] = x[5]; /* +-0: no norm to take */
+    b[18] = x[6]; /* +-0: no norm to take */
+    b[19] = x[7]; /* +-0: no norm to take */
+    b[2] = x[8]; /* +-0: no norm to take */
+    { const andrews_squeezer_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[3] = x[9]; }
+    { const andrews_squeezer_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[4] = x[10]; }
+    { const andrews_squeezer_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[8] = x[11]; }
+    { const andrews_squeezer_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[5] = x[12]; }
+    { const andrews_squeezer_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[9] = x[13]; }
+    { const andrews_squeezer_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[10] = x[14]; }
+    { const andrews_squeezer_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[15] = x[15]; }
+    { const andrews_squeezer_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[16] = x[16]; }
+    { const andrews_squeezer_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[11] = x[17]; }
+    { const andrews_squeezer_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[14] = x[18]; }
+    { const andrews_squeezer_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[17] = x[19]; }
+    { const andrews_squeezer_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[20] = x[20]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..20 of U^T (rows of U) */

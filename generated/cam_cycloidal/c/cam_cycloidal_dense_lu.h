@@ -35,6 +35,13 @@ cam_cycloidal_real cam_cycloidal_dense_lu_pivot_ratio(const cam_cycloidal_dense_
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void cam_cycloidal_dense_lu_solve(const cam_cycloidal_dense_lu *lu, cam_cycloidal_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+cam_cycloidal_real cam_cycloidal_dense_lu_solve_max(const cam_cycloidal_dense_lu *lu, cam_cycloidal_real b[],
+                                              cam_cycloidal_real *sum_abs);
+cam_cycloidal_real cam_cycloidal_dense_lu_solve_negated_max(const cam_cycloidal_dense_lu *lu,
+                                                      cam_cycloidal_real b[], cam_cycloidal_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void cam_cycloidal_dense_lu_solve_transposed(const cam_cycloidal_dense_lu *lu, cam_cycloidal_real b[]);
 

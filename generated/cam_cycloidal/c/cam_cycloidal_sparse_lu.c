@@ -133,24 +133,6 @@ cam_cycloidal_real cam_cycloidal_lu_pivot_ratio(const cam_cycloidal_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* U z = y, rows 6..0 */
-static void cam_cycloidal_lu_backward_0(const cam_cycloidal_real *v,
-        const cam_cycloidal_real *inv, cam_cycloidal_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[6] = -x[6];
-    x[4] = -x[4];
-    x[3] += x[4];
-    x[3] -= v[9] * x[5];
-    x[3] -= x[6];
-    x[3] *= inv[3];
-    x[1] = -x[1];
-    x[0] += x[1];
-    x[0] -= v[7] * x[3];
-    x[0] -= v[5] * x[5];
-}
-
 void cam_cycloidal_lu_solve(const cam_cycloidal_lu *lu, cam_cycloidal_real b[])
 {
     cam_cycloidal_real x[CAM_CYCLOIDAL_NQ];
@@ -166,7 +148,22 @@ void cam_cycloidal_lu_solve(const cam_cycloidal_lu *lu, cam_cycloidal_real b[])
     x[4] = b[1];
     x[5] = b[6];
     x[6] = b[3];
-    cam_cycloidal_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const cam_cycloidal_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[6] = -x[6];
+        x[4] = -x[4];
+        x[3] += x[4];
+        x[3] -= v[9] * x[5];
+        x[3] -= x[6];
+        x[3] *= inv[3];
+        x[1] = -x[1];
+        x[0] += x[1];
+        x[0] -= v[7] * x[3];
+        x[0] -= v[5] * x[5];
+    }
     b[3] = x[0];
     b[0] = x[1];
     b[5] = x[2];
@@ -174,6 +171,93 @@ void cam_cycloidal_lu_solve(const cam_cycloidal_lu *lu, cam_cycloidal_real b[])
     b[1] = x[4];
     b[2] = x[5];
     b[4] = x[6];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+cam_cycloidal_real cam_cycloidal_lu_solve_rates(const cam_cycloidal_lu *lu, cam_cycloidal_real b[], cam_cycloidal_real *sum_abs)
+{
+    cam_cycloidal_real x[CAM_CYCLOIDAL_NQ];
+    cam_cycloidal_real largest = 0, total = 0;
+    if (lu->dense) return cam_cycloidal_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[4]: a zero row */
+    x[1] = 0; /* b[0]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[5]: a zero row */
+    x[4] = 0; /* b[1]: a zero row */
+    x[5] = b[6];
+    x[6] = 0; /* b[3]: a zero row */
+    {
+        const cam_cycloidal_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[6] = -x[6];
+        x[4] = -x[4];
+        x[3] += x[4];
+        x[3] -= v[9] * x[5];
+        x[3] -= x[6];
+        x[3] *= inv[3];
+        x[1] = -x[1];
+        x[0] += x[1];
+        x[0] -= v[7] * x[3];
+        x[0] -= v[5] * x[5];
+    }
+    { const cam_cycloidal_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[3] = -x[0]; }
+    b[0] = -x[1]; /* +-0: no norm to take */
+    b[5] = -x[2]; /* +-0: no norm to take */
+    { const cam_cycloidal_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[6] = -x[3]; }
+    b[1] = -x[4]; /* +-0: no norm to take */
+    { const cam_cycloidal_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[2] = -x[5]; }
+    b[4] = -x[6]; /* +-0: no norm to take */
+    *sum_abs = total;
+    return largest;
+}
+
+cam_cycloidal_real cam_cycloidal_lu_solve_accelerations(const cam_cycloidal_lu *lu, cam_cycloidal_real b[], cam_cycloidal_real *sum_abs)
+{
+    cam_cycloidal_real x[CAM_CYCLOIDAL_NQ];
+    cam_cycloidal_real largest = 0, total = 0;
+    if (lu->dense) return cam_cycloidal_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[4];
+    x[1] = 0; /* b[0]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = b[5];
+    x[4] = 0; /* b[1]: a zero row */
+    x[5] = 0; /* b[6]: a zero row */
+    x[6] = 0; /* b[3]: a zero row */
+    {
+        const cam_cycloidal_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[6] = -x[6];
+        x[4] = -x[4];
+        x[3] += x[4];
+        x[3] -= v[9] * x[5];
+        x[3] -= x[6];
+        x[3] *= inv[3];
+        x[1] = -x[1];
+        x[0] += x[1];
+        x[0] -= v[7] * x[3];
+        x[0] -= v[5] * x[5];
+    }
+    { const cam_cycloidal_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[3] = x[0]; }
+    b[0] = x[1]; /* +-0: no norm to take */
+    b[5] = x[2]; /* +-0: no norm to take */
+    { const cam_cycloidal_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[6] = x[3]; }
+    b[1] = x[4]; /* +-0: no norm to take */
+    b[2] = x[5]; /* +-0: no norm to take */
+    b[4] = x[6]; /* +-0: no norm to take */
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..6 of U^T (rows of U) */

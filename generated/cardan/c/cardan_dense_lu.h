@@ -35,6 +35,13 @@ cardan_real cardan_dense_lu_pivot_ratio(const cardan_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void cardan_dense_lu_solve(const cardan_dense_lu *lu, cardan_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+cardan_real cardan_dense_lu_solve_max(const cardan_dense_lu *lu, cardan_real b[],
+                                              cardan_real *sum_abs);
+cardan_real cardan_dense_lu_solve_negated_max(const cardan_dense_lu *lu,
+                                                      cardan_real b[], cardan_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void cardan_dense_lu_solve_transposed(const cardan_dense_lu *lu, cardan_real b[]);
 

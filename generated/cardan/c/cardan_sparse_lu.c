@@ -376,93 +376,6 @@ cardan_real cardan_lu_pivot_ratio(const cardan_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 2..12 */
-static void cardan_lu_forward_0(const cardan_real *v, cardan_real *x)
-{
-    (void)v;
-    x[4] += x[2];
-    x[5] += x[3];
-    x[8] -= v[37] * x[4];
-    x[9] -= v[64] * x[4];
-    x[8] -= v[63] * x[5];
-    x[9] -= v[42] * x[5];
-    x[7] -= v[33] * x[6];
-    x[8] -= v[38] * x[6];
-    x[9] -= v[43] * x[6];
-    x[8] -= v[39] * x[7];
-    x[9] -= v[44] * x[7];
-    x[9] -= v[46] * x[8];
-    x[11] -= v[9] * x[10];
-    x[12] -= v[49] * x[10];
-    x[13] -= v[53] * x[10];
-    x[12] -= v[50] * x[11];
-    x[13] -= v[54] * x[11];
-    x[13] -= v[52] * x[12];
-}
-
-/* U z = y, rows 13..0 */
-static void cardan_lu_backward_0(const cardan_real *v,
-        const cardan_real *inv, cardan_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[13] *= inv[13];
-    x[12] -= v[47] * x[13];
-    x[12] *= inv[12];
-    x[11] -= v[8] * x[12];
-    x[11] -= v[7] * x[13];
-    x[11] *= inv[11];
-    x[10] -= v[6] * x[11];
-    x[10] -= v[4] * x[12];
-    x[10] -= v[3] * x[13];
-    x[10] *= inv[10];
-    x[9] -= v[71] * x[10];
-    x[9] -= v[72] * x[11];
-    x[9] -= v[70] * x[12];
-    x[9] -= v[69] * x[13];
-    x[9] *= inv[9];
-    x[8] -= v[40] * x[9];
-    x[8] -= v[67] * x[10];
-    x[8] -= v[68] * x[11];
-    x[8] -= v[66] * x[12];
-    x[8] -= v[65] * x[13];
-    x[8] *= inv[8];
-    x[7] -= v[36] * x[8];
-    x[7] -= v[35] * x[9];
-    x[7] -= v[31] * x[10];
-    x[7] -= v[32] * x[11];
-    x[7] -= v[30] * x[12];
-    x[7] -= v[29] * x[13];
-    x[7] *= inv[7];
-    x[6] -= v[56] * x[7];
-    x[6] -= v[58] * x[8];
-    x[6] -= v[57] * x[9];
-    x[6] -= v[59] * x[10];
-    x[6] -= v[60] * x[11];
-    x[6] -= v[61] * x[12];
-    x[6] -= v[62] * x[13];
-    x[6] *= inv[6];
-    x[5] -= v[26] * x[10];
-    x[5] -= v[27] * x[11];
-    x[5] -= v[25] * x[12];
-    x[5] -= v[24] * x[13];
-    x[5] = -x[5];
-    x[4] -= v[14] * x[10];
-    x[4] -= v[15] * x[11];
-    x[4] -= v[13] * x[12];
-    x[4] -= v[12] * x[13];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] = -x[1];
-    x[0] -= x[1];
-    x[0] -= v[20] * x[10];
-    x[0] -= v[21] * x[11];
-    x[0] -= v[19] * x[12];
-    x[0] -= v[18] * x[13];
-    x[0] = -x[0];
-}
-
 void cardan_lu_solve(const cardan_lu *lu, cardan_real b[])
 {
     cardan_real x[CARDAN_NQ];
@@ -491,8 +404,86 @@ void cardan_lu_solve(const cardan_lu *lu, cardan_real b[])
     if (lu->swapped[3]) { const cardan_real w = x[10]; x[10] = x[12]; x[12] = w; }
     if (lu->swapped[4]) { const cardan_real w = x[10]; x[10] = x[13]; x[13] = w; }
     if (lu->swapped[5]) { const cardan_real w = x[12]; x[12] = x[13]; x[13] = w; }
-    cardan_lu_forward_0(lu->v, x);
-    cardan_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const cardan_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[4] += x[2];
+        x[5] += x[3];
+        x[8] -= v[37] * x[4];
+        x[9] -= v[64] * x[4];
+        x[8] -= v[63] * x[5];
+        x[9] -= v[42] * x[5];
+        x[7] -= v[33] * x[6];
+        x[8] -= v[38] * x[6];
+        x[9] -= v[43] * x[6];
+        x[8] -= v[39] * x[7];
+        x[9] -= v[44] * x[7];
+        x[9] -= v[46] * x[8];
+        x[11] -= v[9] * x[10];
+        x[12] -= v[49] * x[10];
+        x[13] -= v[53] * x[10];
+        x[12] -= v[50] * x[11];
+        x[13] -= v[54] * x[11];
+        x[13] -= v[52] * x[12];
+        /* U z = y */
+        x[13] *= inv[13];
+        x[12] -= v[47] * x[13];
+        x[12] *= inv[12];
+        x[11] -= v[8] * x[12];
+        x[11] -= v[7] * x[13];
+        x[11] *= inv[11];
+        x[10] -= v[6] * x[11];
+        x[10] -= v[4] * x[12];
+        x[10] -= v[3] * x[13];
+        x[10] *= inv[10];
+        x[9] -= v[71] * x[10];
+        x[9] -= v[72] * x[11];
+        x[9] -= v[70] * x[12];
+        x[9] -= v[69] * x[13];
+        x[9] *= inv[9];
+        x[8] -= v[40] * x[9];
+        x[8] -= v[67] * x[10];
+        x[8] -= v[68] * x[11];
+        x[8] -= v[66] * x[12];
+        x[8] -= v[65] * x[13];
+        x[8] *= inv[8];
+        x[7] -= v[36] * x[8];
+        x[7] -= v[35] * x[9];
+        x[7] -= v[31] * x[10];
+        x[7] -= v[32] * x[11];
+        x[7] -= v[30] * x[12];
+        x[7] -= v[29] * x[13];
+        x[7] *= inv[7];
+        x[6] -= v[56] * x[7];
+        x[6] -= v[58] * x[8];
+        x[6] -= v[57] * x[9];
+        x[6] -= v[59] * x[10];
+        x[6] -= v[60] * x[11];
+        x[6] -= v[61] * x[12];
+        x[6] -= v[62] * x[13];
+        x[6] *= inv[6];
+        x[5] -= v[26] * x[10];
+        x[5] -= v[27] * x[11];
+        x[5] -= v[25] * x[12];
+        x[5] -= v[24] * x[13];
+        x[5] = -x[5];
+        x[4] -= v[14] * x[10];
+        x[4] -= v[15] * x[11];
+        x[4] -= v[13] * x[12];
+        x[4] -= v[12] * x[13];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[20] * x[10];
+        x[0] -= v[21] * x[11];
+        x[0] -= v[19] * x[12];
+        x[0] -= v[18] * x[13];
+        x[0] = -x[0];
+    }
     b[8] = x[0];
     b[1] = x[1];
     b[0] = x[2];
@@ -507,6 +498,261 @@ void cardan_lu_solve(const cardan_lu *lu, cardan_real b[])
     b[6] = x[11];
     b[4] = x[12];
     b[3] = x[13];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+cardan_real cardan_lu_solve_rates(const cardan_lu *lu, cardan_real b[], cardan_real *sum_abs)
+{
+    cardan_real x[CARDAN_NQ];
+    cardan_real largest = 0, total = 0;
+    if (lu->dense) return cardan_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[6]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[0]: a zero row */
+    x[3] = 0; /* b[2]: a zero row */
+    x[4] = 0; /* b[5]: a zero row */
+    x[5] = 0; /* b[7]: a zero row */
+    x[6] = 0; /* b[13]: a zero row */
+    x[7] = 0; /* b[8]: a zero row */
+    x[8] = 0; /* b[9]: a zero row */
+    x[9] = 0; /* b[10]: a zero row */
+    x[10] = 0; /* b[3]: a zero row */
+    x[11] = 0; /* b[4]: a zero row */
+    x[12] = b[11];
+    x[13] = 0; /* b[12]: a zero row */
+    if (lu->swapped[0]) { const cardan_real w = x[6]; x[6] = x[7]; x[7] = w; }
+    if (lu->swapped[1]) { const cardan_real w = x[8]; x[8] = x[9]; x[9] = w; }
+    if (lu->swapped[2]) { const cardan_real w = x[10]; x[10] = x[11]; x[11] = w; }
+    if (lu->swapped[3]) { const cardan_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[4]) { const cardan_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[5]) { const cardan_real w = x[12]; x[12] = x[13]; x[13] = w; }
+    {
+        const cardan_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[4] += x[2];
+        x[5] += x[3];
+        x[8] -= v[37] * x[4];
+        x[9] -= v[64] * x[4];
+        x[8] -= v[63] * x[5];
+        x[9] -= v[42] * x[5];
+        x[7] -= v[33] * x[6];
+        x[8] -= v[38] * x[6];
+        x[9] -= v[43] * x[6];
+        x[8] -= v[39] * x[7];
+        x[9] -= v[44] * x[7];
+        x[9] -= v[46] * x[8];
+        x[11] -= v[9] * x[10];
+        x[12] -= v[49] * x[10];
+        x[13] -= v[53] * x[10];
+        x[12] -= v[50] * x[11];
+        x[13] -= v[54] * x[11];
+        x[13] -= v[52] * x[12];
+        /* U z = y */
+        x[13] *= inv[13];
+        x[12] -= v[47] * x[13];
+        x[12] *= inv[12];
+        x[11] -= v[8] * x[12];
+        x[11] -= v[7] * x[13];
+        x[11] *= inv[11];
+        x[10] -= v[6] * x[11];
+        x[10] -= v[4] * x[12];
+        x[10] -= v[3] * x[13];
+        x[10] *= inv[10];
+        x[9] -= v[71] * x[10];
+        x[9] -= v[72] * x[11];
+        x[9] -= v[70] * x[12];
+        x[9] -= v[69] * x[13];
+        x[9] *= inv[9];
+        x[8] -= v[40] * x[9];
+        x[8] -= v[67] * x[10];
+        x[8] -= v[68] * x[11];
+        x[8] -= v[66] * x[12];
+        x[8] -= v[65] * x[13];
+        x[8] *= inv[8];
+        x[7] -= v[36] * x[8];
+        x[7] -= v[35] * x[9];
+        x[7] -= v[31] * x[10];
+        x[7] -= v[32] * x[11];
+        x[7] -= v[30] * x[12];
+        x[7] -= v[29] * x[13];
+        x[7] *= inv[7];
+        x[6] -= v[56] * x[7];
+        x[6] -= v[58] * x[8];
+        x[6] -= v[57] * x[9];
+        x[6] -= v[59] * x[10];
+        x[6] -= v[60] * x[11];
+        x[6] -= v[61] * x[12];
+        x[6] -= v[62] * x[13];
+        x[6] *= inv[6];
+        x[5] -= v[26] * x[10];
+        x[5] -= v[27] * x[11];
+        x[5] -= v[25] * x[12];
+        x[5] -= v[24] * x[13];
+        x[5] = -x[5];
+        x[4] -= v[14] * x[10];
+        x[4] -= v[15] * x[11];
+        x[4] -= v[13] * x[12];
+        x[4] -= v[12] * x[13];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[20] * x[10];
+        x[0] -= v[21] * x[11];
+        x[0] -= v[19] * x[12];
+        x[0] -= v[18] * x[13];
+        x[0] = -x[0];
+    }
+    { const cardan_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[8] = -x[0]; }
+    b[1] = -x[1]; /* +-0: no norm to take */
+    b[0] = -x[2]; /* +-0: no norm to take */
+    b[2] = -x[3]; /* +-0: no norm to take */
+    { const cardan_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[7] = -x[4]; }
+    { const cardan_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[9] = -x[5]; }
+    { const cardan_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[10] = -x[6]; }
+    { const cardan_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[11] = -x[7]; }
+    { const cardan_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[13] = -x[8]; }
+    { const cardan_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[12] = -x[9]; }
+    { const cardan_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[5] = -x[10]; }
+    { const cardan_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[6] = -x[11]; }
+    { const cardan_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[4] = -x[12]; }
+    { const cardan_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[3] = -x[13]; }
+    *sum_abs = total;
+    return largest;
+}
+
+cardan_real cardan_lu_solve_accelerations(const cardan_lu *lu, cardan_real b[], cardan_real *sum_abs)
+{
+    cardan_real x[CARDAN_NQ];
+    cardan_real largest = 0, total = 0;
+    if (lu->dense) return cardan_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[6];
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[0]: a zero row */
+    x[3] = 0; /* b[2]: a zero row */
+    x[4] = b[5];
+    x[5] = b[7];
+    x[6] = b[13];
+    x[7] = b[8];
+    x[8] = b[9];
+    x[9] = b[10];
+    x[10] = b[3];
+    x[11] = b[4];
+    x[12] = b[11];
+    x[13] = b[12];
+    if (lu->swapped[0]) { const cardan_real w = x[6]; x[6] = x[7]; x[7] = w; }
+    if (lu->swapped[1]) { const cardan_real w = x[8]; x[8] = x[9]; x[9] = w; }
+    if (lu->swapped[2]) { const cardan_real w = x[10]; x[10] = x[11]; x[11] = w; }
+    if (lu->swapped[3]) { const cardan_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[4]) { const cardan_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[5]) { const cardan_real w = x[12]; x[12] = x[13]; x[13] = w; }
+    {
+        const cardan_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[4] += x[2];
+        x[5] += x[3];
+        x[8] -= v[37] * x[4];
+        x[9] -= v[64] * x[4];
+        x[8] -= v[63] * x[5];
+        x[9] -= v[42] * x[5];
+        x[7] -= v[33] * x[6];
+        x[8] -= v[38] * x[6];
+        x[9] -= v[43] * x[6];
+        x[8] -= v[39] * x[7];
+        x[9] -= v[44] * x[7];
+        x[9] -= v[46] * x[8];
+        x[11] -= v[9] * x[10];
+        x[12] -= v[49] * x[10];
+        x[13] -= v[53] * x[10];
+        x[12] -= v[50] * x[11];
+        x[13] -= v[54] * x[11];
+        x[13] -= v[52] * x[12];
+        /* U z = y */
+        x[13] *= inv[13];
+        x[12] -= v[47] * x[13];
+        x[12] *= inv[12];
+        x[11] -= v[8] * x[12];
+        x[11] -= v[7] * x[13];
+        x[11] *= inv[11];
+        x[10] -= v[6] * x[11];
+        x[10] -= v[4] * x[12];
+        x[10] -= v[3] * x[13];
+        x[10] *= inv[10];
+        x[9] -= v[71] * x[10];
+        x[9] -= v[72] * x[11];
+        x[9] -= v[70] * x[12];
+        x[9] -= v[69] * x[13];
+        x[9] *= inv[9];
+        x[8] -= v[40] * x[9];
+        x[8] -= v[67] * x[10];
+        x[8] -= v[68] * x[11];
+        x[8] -= v[66] * x[12];
+        x[8] -= v[65] * x[13];
+        x[8] *= inv[8];
+        x[7] -= v[36] * x[8];
+        x[7] -= v[35] * x[9];
+        x[7] -= v[31] * x[10];
+        x[7] -= v[32] * x[11];
+        x[7] -= v[30] * x[12];
+        x[7] -= v[29] * x[13];
+        x[7] *= inv[7];
+        x[6] -= v[56] * x[7];
+        x[6] -= v[58] * x[8];
+        x[6] -= v[57] * x[9];
+        x[6] -= v[59] * x[10];
+        x[6] -= v[60] * x[11];
+        x[6] -= v[61] * x[12];
+        x[6] -= v[62] * x[13];
+        x[6] *= inv[6];
+        x[5] -= v[26] * x[10];
+        x[5] -= v[27] * x[11];
+        x[5] -= v[25] * x[12];
+        x[5] -= v[24] * x[13];
+        x[5] = -x[5];
+        x[4] -= v[14] * x[10];
+        x[4] -= v[15] * x[11];
+        x[4] -= v[13] * x[12];
+        x[4] -= v[12] * x[13];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[20] * x[10];
+        x[0] -= v[21] * x[11];
+        x[0] -= v[19] * x[12];
+        x[0] -= v[18] * x[13];
+        x[0] = -x[0];
+    }
+    { const cardan_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[8] = x[0]; }
+    b[1] = x[1]; /* +-0: no norm to take */
+    b[0] = x[2]; /* +-0: no norm to take */
+    b[2] = x[3]; /* +-0: no norm to take */
+    { const cardan_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[7] = x[4]; }
+    { const cardan_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[9] = x[5]; }
+    { const cardan_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[10] = x[6]; }
+    { const cardan_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[11] = x[7]; }
+    { const cardan_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[13] = x[8]; }
+    { const cardan_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[12] = x[9]; }
+    { const cardan_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[5] = x[10]; }
+    { const cardan_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[6] = x[11]; }
+    { const cardan_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[4] = x[12]; }
+    { const cardan_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[3] = x[13]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..13 of U^T (rows of U) */

@@ -54,6 +54,15 @@ unsigned long cardan_lu_fallbacks(const cardan_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void cardan_lu_solve(const cardan_lu *lu, cardan_real b[]);
 
+/* The step's two solves, each with the norms of its solution: returns max |x_i| of the solution
+ * as solved and stores sum |x_i| in *sum_abs (NaN exactly when some x_i is). _rates solves b =
+ * Phi_t and writes -x (dq); _accelerations solves b = Gamma. A row where the generated Phi_t or
+ * Gamma is a literal 0 is taken as 0, not read. */
+cardan_real cardan_lu_solve_rates(const cardan_lu *lu, cardan_real b[],
+                                            cardan_real *sum_abs);
+cardan_real cardan_lu_solve_accelerations(const cardan_lu *lu, cardan_real b[],
+                                                    cardan_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
  * estimate of the solver). */
 void cardan_lu_solve_transposed(const cardan_lu *lu, cardan_real b[]);

@@ -35,6 +35,13 @@ crank_slider_general_real crank_slider_general_dense_lu_pivot_ratio(const crank_
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void crank_slider_general_dense_lu_solve(const crank_slider_general_dense_lu *lu, crank_slider_general_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+crank_slider_general_real crank_slider_general_dense_lu_solve_max(const crank_slider_general_dense_lu *lu, crank_slider_general_real b[],
+                                              crank_slider_general_real *sum_abs);
+crank_slider_general_real crank_slider_general_dense_lu_solve_negated_max(const crank_slider_general_dense_lu *lu,
+                                                      crank_slider_general_real b[], crank_slider_general_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void crank_slider_general_dense_lu_solve_transposed(const crank_slider_general_dense_lu *lu, crank_slider_general_real b[]);
 

@@ -188,44 +188,6 @@ crank_slider_general_real crank_slider_general_lu_pivot_ratio(const crank_slider
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..7 */
-static void crank_slider_general_lu_forward_0(const crank_slider_general_real *v, crank_slider_general_real *x)
-{
-    (void)v;
-    x[6] -= v[15] * x[0];
-    x[7] -= v[19] * x[0];
-    x[8] -= v[23] * x[0];
-    x[2] -= v[1] * x[1];
-    x[3] -= v[3] * x[1];
-    x[4] -= v[5] * x[1];
-    x[5] -= v[9] * x[1];
-    x[4] += x[2];
-    x[5] += x[3];
-    x[6] += x[4];
-    x[7] += x[5];
-    x[7] -= v[17] * x[6];
-    x[8] -= v[21] * x[7];
-}
-
-/* U z = y, rows 8..2 */
-static void crank_slider_general_lu_backward_0(const crank_slider_general_real *v,
-        const crank_slider_general_real *inv, crank_slider_general_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[8] *= inv[8];
-    x[7] += x[8];
-    x[7] *= inv[7];
-    x[6] += x[7];
-    x[6] *= inv[6];
-    x[5] -= v[11] * x[6];
-    x[5] = -x[5];
-    x[4] -= v[7] * x[6];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-}
-
 void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slider_general_real b[])
 {
     crank_slider_general_real x[CRANK_SLIDER_GENERAL_NQ];
@@ -243,8 +205,37 @@ void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slid
     x[6] = b[4];
     x[7] = b[5];
     x[8] = b[7];
-    crank_slider_general_lu_forward_0(lu->v, x);
-    crank_slider_general_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const crank_slider_general_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[6] -= v[15] * x[0];
+        x[7] -= v[19] * x[0];
+        x[8] -= v[23] * x[0];
+        x[2] -= v[1] * x[1];
+        x[3] -= v[3] * x[1];
+        x[4] -= v[5] * x[1];
+        x[5] -= v[9] * x[1];
+        x[4] += x[2];
+        x[5] += x[3];
+        x[6] += x[4];
+        x[7] += x[5];
+        x[7] -= v[17] * x[6];
+        x[8] -= v[21] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] += x[8];
+        x[7] *= inv[7];
+        x[6] += x[7];
+        x[6] *= inv[6];
+        x[5] -= v[11] * x[6];
+        x[5] = -x[5];
+        x[4] -= v[7] * x[6];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+    }
     b[8] = x[0];
     b[2] = x[1];
     b[0] = x[2];
@@ -254,6 +245,131 @@ void crank_slider_general_lu_solve(const crank_slider_general_lu *lu, crank_slid
     b[5] = x[6];
     b[6] = x[7];
     b[7] = x[8];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+crank_slider_general_real crank_slider_general_lu_solve_rates(const crank_slider_general_lu *lu, crank_slider_general_real b[], crank_slider_general_real *sum_abs)
+{
+    crank_slider_general_real x[CRANK_SLIDER_GENERAL_NQ];
+    crank_slider_general_real largest = 0, total = 0;
+    if (lu->dense) return crank_slider_general_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[6]: a zero row */
+    x[1] = b[8];
+    x[2] = 0; /* b[0]: a zero row */
+    x[3] = 0; /* b[1]: a zero row */
+    x[4] = 0; /* b[2]: a zero row */
+    x[5] = 0; /* b[3]: a zero row */
+    x[6] = 0; /* b[4]: a zero row */
+    x[7] = 0; /* b[5]: a zero row */
+    x[8] = 0; /* b[7]: a zero row */
+    {
+        const crank_slider_general_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[6] -= v[15] * x[0];
+        x[7] -= v[19] * x[0];
+        x[8] -= v[23] * x[0];
+        x[2] -= v[1] * x[1];
+        x[3] -= v[3] * x[1];
+        x[4] -= v[5] * x[1];
+        x[5] -= v[9] * x[1];
+        x[4] += x[2];
+        x[5] += x[3];
+        x[6] += x[4];
+        x[7] += x[5];
+        x[7] -= v[17] * x[6];
+        x[8] -= v[21] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] += x[8];
+        x[7] *= inv[7];
+        x[6] += x[7];
+        x[6] *= inv[6];
+        x[5] -= v[11] * x[6];
+        x[5] = -x[5];
+        x[4] -= v[7] * x[6];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+    }
+    b[8] = -x[0]; /* +-0: no norm to take */
+    { const crank_slider_general_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[2] = -x[1]; }
+    { const crank_slider_general_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[0] = -x[2]; }
+    { const crank_slider_general_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[1] = -x[3]; }
+    { const crank_slider_general_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[3] = -x[4]; }
+    { const crank_slider_general_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[4] = -x[5]; }
+    { const crank_slider_general_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[5] = -x[6]; }
+    { const crank_slider_general_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[6] = -x[7]; }
+    { const crank_slider_general_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[7] = -x[8]; }
+    *sum_abs = total;
+    return largest;
+}
+
+crank_slider_general_real crank_slider_general_lu_solve_accelerations(const crank_slider_general_lu *lu, crank_slider_general_real b[], crank_slider_general_real *sum_abs)
+{
+    crank_slider_general_real x[CRANK_SLIDER_GENERAL_NQ];
+    crank_slider_general_real largest = 0, total = 0;
+    if (lu->dense) return crank_slider_general_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[6]: a zero row */
+    x[1] = b[8];
+    x[2] = b[0];
+    x[3] = b[1];
+    x[4] = b[2];
+    x[5] = b[3];
+    x[6] = b[4];
+    x[7] = b[5];
+    x[8] = b[7];
+    {
+        const crank_slider_general_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[6] -= v[15] * x[0];
+        x[7] -= v[19] * x[0];
+        x[8] -= v[23] * x[0];
+        x[2] -= v[1] * x[1];
+        x[3] -= v[3] * x[1];
+        x[4] -= v[5] * x[1];
+        x[5] -= v[9] * x[1];
+        x[4] += x[2];
+        x[5] += x[3];
+        x[6] += x[4];
+        x[7] += x[5];
+        x[7] -= v[17] * x[6];
+        x[8] -= v[21] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] += x[8];
+        x[7] *= inv[7];
+        x[6] += x[7];
+        x[6] *= inv[6];
+        x[5] -= v[11] * x[6];
+        x[5] = -x[5];
+        x[4] -= v[7] * x[6];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+    }
+    b[8] = x[0]; /* +-0: no norm to take */
+    { const crank_slider_general_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[2] = x[1]; }
+    { const crank_slider_general_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[0] = x[2]; }
+    { const crank_slider_general_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[1] = x[3]; }
+    { const crank_slider_general_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[3] = x[4]; }
+    { const crank_slider_general_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[4] = x[5]; }
+    { const crank_slider_general_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[5] = x[6]; }
+    { const crank_slider_general_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[6] = x[7]; }
+    { const crank_slider_general_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[7] = x[8]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 2..8 of U^T (rows of U) */

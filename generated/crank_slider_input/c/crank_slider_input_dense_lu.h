@@ -39,6 +39,13 @@ int crank_slider_input_dense_lu_det_sign(const crank_slider_input_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void crank_slider_input_dense_lu_solve(const crank_slider_input_dense_lu *lu, crank_slider_input_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+crank_slider_input_real crank_slider_input_dense_lu_solve_max(const crank_slider_input_dense_lu *lu, crank_slider_input_real b[],
+                                              crank_slider_input_real *sum_abs);
+crank_slider_input_real crank_slider_input_dense_lu_solve_negated_max(const crank_slider_input_dense_lu *lu,
+                                                      crank_slider_input_real b[], crank_slider_input_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void crank_slider_input_dense_lu_solve_transposed(const crank_slider_input_dense_lu *lu, crank_slider_input_real b[]);
 

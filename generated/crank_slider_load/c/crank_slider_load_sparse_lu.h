@@ -50,6 +50,15 @@ unsigned long crank_slider_load_lu_fallbacks(const crank_slider_load_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void crank_slider_load_lu_solve(const crank_slider_load_lu *lu, crank_slider_load_real b[]);
 
+/* The step's two solves, each with the norms of its solution: returns max |x_i| of the solution
+ * as solved and stores sum |x_i| in *sum_abs (NaN exactly when some x_i is). _rates solves b =
+ * Phi_t and writes -x (dq); _accelerations solves b = Gamma. A row where the generated Phi_t or
+ * Gamma is a literal 0 is taken as 0, not read. */
+crank_slider_load_real crank_slider_load_lu_solve_rates(const crank_slider_load_lu *lu, crank_slider_load_real b[],
+                                            crank_slider_load_real *sum_abs);
+crank_slider_load_real crank_slider_load_lu_solve_accelerations(const crank_slider_load_lu *lu, crank_slider_load_real b[],
+                                                    crank_slider_load_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
  * estimate of the solver). */
 void crank_slider_load_lu_solve_transposed(const crank_slider_load_lu *lu, crank_slider_load_real b[]);

@@ -35,6 +35,13 @@ custom_driver_real custom_driver_dense_lu_pivot_ratio(const custom_driver_dense_
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void custom_driver_dense_lu_solve(const custom_driver_dense_lu *lu, custom_driver_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+custom_driver_real custom_driver_dense_lu_solve_max(const custom_driver_dense_lu *lu, custom_driver_real b[],
+                                              custom_driver_real *sum_abs);
+custom_driver_real custom_driver_dense_lu_solve_negated_max(const custom_driver_dense_lu *lu,
+                                                      custom_driver_real b[], custom_driver_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void custom_driver_dense_lu_solve_transposed(const custom_driver_dense_lu *lu, custom_driver_real b[]);
 

@@ -146,32 +146,6 @@ custom_driver_real custom_driver_lu_pivot_ratio(const custom_driver_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* U z = y, rows 7..0 */
-static void custom_driver_lu_backward_0(const custom_driver_real *v,
-        const custom_driver_real *inv, custom_driver_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[7] = -x[7];
-    x[6] = -x[6];
-    x[5] = -x[5];
-    x[4] -= v[16] * x[5];
-    x[4] -= v[17] * x[6];
-    x[4] *= inv[4];
-    x[3] -= v[6] * x[4];
-    x[3] -= x[6];
-    x[3] = -x[3];
-    x[2] -= x[3];
-    x[2] += x[7];
-    x[2] *= inv[2];
-    x[1] -= v[3] * x[4];
-    x[1] -= x[5];
-    x[1] = -x[1];
-    x[0] -= x[1];
-    x[0] -= v[9] * x[2];
-    x[0] = -x[0];
-}
-
 void custom_driver_lu_solve(const custom_driver_lu *lu, custom_driver_real b[])
 {
     custom_driver_real x[CUSTOM_DRIVER_NQ];
@@ -189,7 +163,30 @@ void custom_driver_lu_solve(const custom_driver_lu *lu, custom_driver_real b[])
     x[6] = b[1];
     x[7] = b[7];
     x[8] = b[6];
-    custom_driver_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const custom_driver_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] -= v[16] * x[5];
+        x[4] -= v[17] * x[6];
+        x[4] *= inv[4];
+        x[3] -= v[6] * x[4];
+        x[3] -= x[6];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] += x[7];
+        x[2] *= inv[2];
+        x[1] -= v[3] * x[4];
+        x[1] -= x[5];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[9] * x[2];
+        x[0] = -x[0];
+    }
     b[6] = x[0];
     b[3] = x[1];
     b[5] = x[2];
@@ -199,6 +196,117 @@ void custom_driver_lu_solve(const custom_driver_lu *lu, custom_driver_real b[])
     b[1] = x[6];
     b[7] = x[7];
     b[8] = x[8];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+custom_driver_real custom_driver_lu_solve_rates(const custom_driver_lu *lu, custom_driver_real b[], custom_driver_real *sum_abs)
+{
+    custom_driver_real x[CUSTOM_DRIVER_NQ];
+    custom_driver_real largest = 0, total = 0;
+    if (lu->dense) return custom_driver_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[4]: a zero row */
+    x[1] = 0; /* b[2]: a zero row */
+    x[2] = 0; /* b[5]: a zero row */
+    x[3] = 0; /* b[3]: a zero row */
+    x[4] = b[8];
+    x[5] = 0; /* b[0]: a zero row */
+    x[6] = 0; /* b[1]: a zero row */
+    x[7] = 0; /* b[7]: a zero row */
+    x[8] = 0; /* b[6]: a zero row */
+    {
+        const custom_driver_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] -= v[16] * x[5];
+        x[4] -= v[17] * x[6];
+        x[4] *= inv[4];
+        x[3] -= v[6] * x[4];
+        x[3] -= x[6];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] += x[7];
+        x[2] *= inv[2];
+        x[1] -= v[3] * x[4];
+        x[1] -= x[5];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[9] * x[2];
+        x[0] = -x[0];
+    }
+    { const custom_driver_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[6] = -x[0]; }
+    { const custom_driver_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[3] = -x[1]; }
+    { const custom_driver_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[5] = -x[2]; }
+    { const custom_driver_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[4] = -x[3]; }
+    { const custom_driver_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[2] = -x[4]; }
+    b[0] = -x[5]; /* +-0: no norm to take */
+    b[1] = -x[6]; /* +-0: no norm to take */
+    b[7] = -x[7]; /* +-0: no norm to take */
+    b[8] = -x[8]; /* +-0: no norm to take */
+    *sum_abs = total;
+    return largest;
+}
+
+custom_driver_real custom_driver_lu_solve_accelerations(const custom_driver_lu *lu, custom_driver_real b[], custom_driver_real *sum_abs)
+{
+    custom_driver_real x[CUSTOM_DRIVER_NQ];
+    custom_driver_real largest = 0, total = 0;
+    if (lu->dense) return custom_driver_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[4];
+    x[1] = b[2];
+    x[2] = b[5];
+    x[3] = b[3];
+    x[4] = b[8];
+    x[5] = 0; /* b[0]: a zero row */
+    x[6] = 0; /* b[1]: a zero row */
+    x[7] = 0; /* b[7]: a zero row */
+    x[8] = 0; /* b[6]: a zero row */
+    {
+        const custom_driver_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] -= v[16] * x[5];
+        x[4] -= v[17] * x[6];
+        x[4] *= inv[4];
+        x[3] -= v[6] * x[4];
+        x[3] -= x[6];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] += x[7];
+        x[2] *= inv[2];
+        x[1] -= v[3] * x[4];
+        x[1] -= x[5];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[9] * x[2];
+        x[0] = -x[0];
+    }
+    { const custom_driver_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[6] = x[0]; }
+    { const custom_driver_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[3] = x[1]; }
+    { const custom_driver_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[5] = x[2]; }
+    { const custom_driver_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[4] = x[3]; }
+    { const custom_driver_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[2] = x[4]; }
+    b[0] = x[5]; /* +-0: no norm to take */
+    b[1] = x[6]; /* +-0: no norm to take */
+    b[7] = x[7]; /* +-0: no norm to take */
+    b[8] = x[8]; /* +-0: no norm to take */
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..7 of U^T (rows of U) */

@@ -103,6 +103,40 @@ void delta_dense_lu_solve(const delta_dense_lu *lu, delta_real b[])
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
+/* The solve, then its solution's max |x_i| (returned) and sum |x_i| (into *sum_abs); the
+ * _negated one then writes -x (exact): the norms the step takes (lu_solve_rates, negated,
+ * and lu_solve_accelerations). */
+delta_real delta_dense_lu_solve_max(const delta_dense_lu *lu, delta_real b[],
+        delta_real *sum_abs)
+{
+    delta_real largest = 0, total = 0;
+    delta_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < DELTA_NQ; ++k) {
+        const delta_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+    }
+    *sum_abs = total;
+    return largest;
+}
+
+delta_real delta_dense_lu_solve_negated_max(const delta_dense_lu *lu, delta_real b[],
+        delta_real *sum_abs)
+{
+    delta_real largest = 0, total = 0;
+    delta_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < DELTA_NQ; ++k) {
+        const delta_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+        b[k] = -b[k];
+    }
+    *sum_abs = total;
+    return largest;
+}
+
 void delta_dense_lu_solve_transposed(const delta_dense_lu *lu, delta_real b[])
 {
     /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */

@@ -35,6 +35,13 @@ delta_real delta_dense_lu_pivot_ratio(const delta_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void delta_dense_lu_solve(const delta_dense_lu *lu, delta_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+delta_real delta_dense_lu_solve_max(const delta_dense_lu *lu, delta_real b[],
+                                              delta_real *sum_abs);
+delta_real delta_dense_lu_solve_negated_max(const delta_dense_lu *lu,
+                                                      delta_real b[], delta_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void delta_dense_lu_solve_transposed(const delta_dense_lu *lu, delta_real b[]);
 

@@ -820,11 +820,16 @@ static int delta_newton(const delta_options *options, const delta_real p[], delt
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
     report->residual = (delta_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        delta_real residual;
+        delta_real residual = 0, sum = 0;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         delta_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
         delta_in_unit(work);
-        residual = delta_max_abs(work->phi);
+        /* max |Phi| as max_abs takes it, written out here: no call in the loop every step
+         * runs (a copy of max_abs the compiler would fold back into the call) */
+        for (int i = 0; i < DELTA_NQ; ++i) {
+            { const delta_real a = fabs(work->phi[i]); residual = residual > a ? residual : a; sum += a; }
+        }
+        residual = sum != sum ? (delta_real)NAN : residual;
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
@@ -860,38 +865,16 @@ static void delta_predict(delta_real t, delta_state *state)
     }
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
- * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
- * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
- * largest), and dq in the kernel's unit. */
-static delta_real delta_rates_pass(const delta_workspace *work, delta_real dq[],
-                                       delta_real *sum_abs)
+/* max |q| in the run's unit (NaN when some q_i is, as in max_abs: the error model then flags
+ * the point). */
+static delta_real delta_positions_pass(const delta_workspace *work, const delta_real q[])
 {
-    delta_real largest = 0, sum = 0;
+    delta_real largest_q = 0, sum_q = 0, largest_length = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs); a coordinate that is no length is
+     * the same in every unit (no division); the lengths' largest |q_i| is divided by the unit
+     * once, after the pass: rounding is monotone, so max (|q_i| / unit) and (max |q_i|) / unit
+     * are the same number (the unit is finite) */
     for (int i = 0; i < DELTA_NQ; ++i) {
-        { const delta_real b = fabs(dq[i]); largest = largest > b ? largest : b; sum += b; }
-        dq[i] = -dq[i];
-    }
-    delta_from_unit(work, dq);
-    *sum_abs = sum;
-    return largest;
-}
-
-/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
- * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
- * then flags the point). */
-static delta_real delta_accelerations_pass(const delta_workspace *work,
-                                               const delta_real q[], delta_real ddq[],
-                                               delta_real *sum_abs, delta_real *nq)
-{
-    delta_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
-    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division); the lengths'
-     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
-     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
-    for (int i = 0; i < DELTA_NQ; ++i) {
-        { const delta_real c = fabs(ddq[i]); largest = largest > c ? largest : c; sum += c; }
         {
             const delta_real a = fabs(q[i]) * work->inverse_column[i];
             largest_q = largest_q > a ? largest_q : a;
@@ -900,10 +883,8 @@ static delta_real delta_accelerations_pass(const delta_workspace *work,
     }
     largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
     largest_q = largest_q > largest_length ? largest_q : largest_length;
-    delta_from_unit(work, ddq);
-    *sum_abs = sum;
-    *nq = sum_q != sum_q ? (delta_real)NAN : largest_q;
-    return largest;
+    (void)work;
+    return sum_q != sum_q ? (delta_real)NAN : largest_q;
 }
 
 /* delta_solve_step with its options already checked. */
@@ -925,16 +906,19 @@ static int delta_step(const delta_options *options, const delta_real p[],
         return report->status;
     }
     /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
-     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
-     * fused call, so the shared sines and cosines are this q's. */
+     * is -dq, written out negated. Each solve returns its solution's max |.| in the run's unit
+     * and the sum of |.| for the finite test, taken as it writes the solution (no pass over
+     * it again). Newton stopped at the q of its last fused call, so the shared sines and
+     * cosines are this q's. */
     delta_phi_t_shared(state->q, t, p, work->shared, state->dq);
     delta_rows_in_unit(work, state->dq);
-    delta_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = delta_rates_pass(work, state->dq, &sum_dq);
+    ndq = delta_lu_solve_rates(&work->lu, state->dq, &sum_dq); /* (2.73) */
+    delta_from_unit(work, state->dq);
     delta_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     delta_rows_in_unit(work, state->ddq);
-    delta_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = delta_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    nddq = delta_lu_solve_accelerations(&work->lu, state->ddq, &sum_ddq); /* (2.74) */
+    delta_from_unit(work, state->ddq);
+    nq = delta_positions_pass(work, state->q);
     /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
      * overflow harmlessly), infinite where the larger maximum is */
     largest = ndq > nddq ? ndq : nddq;

@@ -122,6 +122,40 @@ void delta_fk_dense_lu_solve(const delta_fk_dense_lu *lu, delta_fk_real b[])
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
+/* The solve, then its solution's max |x_i| (returned) and sum |x_i| (into *sum_abs); the
+ * _negated one then writes -x (exact): the norms the step takes (lu_solve_rates, negated,
+ * and lu_solve_accelerations). */
+delta_fk_real delta_fk_dense_lu_solve_max(const delta_fk_dense_lu *lu, delta_fk_real b[],
+        delta_fk_real *sum_abs)
+{
+    delta_fk_real largest = 0, total = 0;
+    delta_fk_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < DELTA_FK_NQ; ++k) {
+        const delta_fk_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+    }
+    *sum_abs = total;
+    return largest;
+}
+
+delta_fk_real delta_fk_dense_lu_solve_negated_max(const delta_fk_dense_lu *lu, delta_fk_real b[],
+        delta_fk_real *sum_abs)
+{
+    delta_fk_real largest = 0, total = 0;
+    delta_fk_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < DELTA_FK_NQ; ++k) {
+        const delta_fk_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+        b[k] = -b[k];
+    }
+    *sum_abs = total;
+    return largest;
+}
+
 void delta_fk_dense_lu_solve_transposed(const delta_fk_dense_lu *lu, delta_fk_real b[])
 {
     /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */

@@ -39,6 +39,13 @@ int delta_fk_dense_lu_det_sign(const delta_fk_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void delta_fk_dense_lu_solve(const delta_fk_dense_lu *lu, delta_fk_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+delta_fk_real delta_fk_dense_lu_solve_max(const delta_fk_dense_lu *lu, delta_fk_real b[],
+                                              delta_fk_real *sum_abs);
+delta_fk_real delta_fk_dense_lu_solve_negated_max(const delta_fk_dense_lu *lu,
+                                                      delta_fk_real b[], delta_fk_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void delta_fk_dense_lu_solve_transposed(const delta_fk_dense_lu *lu, delta_fk_real b[]);
 

@@ -751,165 +751,6 @@ delta_fk_real delta_fk_lu_pivot_ratio(const delta_fk_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..26 */
-static void delta_fk_lu_forward_0(const delta_fk_real *v, delta_fk_real *x)
-{
-    (void)v;
-    x[22] -= v[11] * x[0];
-    x[23] -= v[25] * x[0];
-    x[22] -= v[12] * x[1];
-    x[23] -= v[26] * x[1];
-    x[22] -= v[13] * x[2];
-    x[23] -= v[27] * x[2];
-    x[24] -= v[50] * x[3];
-    x[25] -= v[64] * x[3];
-    x[24] -= v[51] * x[4];
-    x[25] -= v[65] * x[4];
-    x[24] -= v[52] * x[5];
-    x[25] -= v[66] * x[5];
-    x[26] -= v[89] * x[6];
-    x[27] -= v[103] * x[6];
-    x[26] -= v[90] * x[7];
-    x[27] -= v[104] * x[7];
-    x[26] -= v[91] * x[8];
-    x[27] -= v[105] * x[8];
-    x[10] -= v[8] * x[9];
-    x[11] -= v[118] * x[9];
-    x[12] -= v[130] * x[9];
-    x[22] -= v[15] * x[9];
-    x[23] -= v[29] * x[9];
-    x[11] -= v[120] * x[10];
-    x[12] -= v[132] * x[10];
-    x[22] -= v[17] * x[10];
-    x[23] -= v[31] * x[10];
-    x[12] -= v[131] * x[11];
-    x[22] -= v[16] * x[11];
-    x[23] -= v[30] * x[11];
-    x[22] -= v[14] * x[12];
-    x[23] -= v[28] * x[12];
-    x[14] -= v[49] * x[13];
-    x[15] -= v[124] * x[13];
-    x[16] -= v[136] * x[13];
-    x[24] -= v[56] * x[13];
-    x[25] -= v[70] * x[13];
-    x[15] -= v[122] * x[14];
-    x[16] -= v[134] * x[14];
-    x[24] -= v[54] * x[14];
-    x[25] -= v[68] * x[14];
-    x[16] -= v[135] * x[15];
-    x[24] -= v[55] * x[15];
-    x[25] -= v[69] * x[15];
-    x[24] -= v[53] * x[16];
-    x[25] -= v[67] * x[16];
-    x[18] -= v[88] * x[17];
-    x[19] -= v[128] * x[17];
-    x[20] -= v[140] * x[17];
-    x[26] -= v[95] * x[17];
-    x[27] -= v[109] * x[17];
-    x[19] -= v[126] * x[18];
-    x[20] -= v[138] * x[18];
-    x[26] -= v[93] * x[18];
-    x[27] -= v[107] * x[18];
-    x[20] -= v[139] * x[19];
-    x[26] -= v[94] * x[19];
-    x[27] -= v[108] * x[19];
-    x[26] -= v[92] * x[20];
-    x[27] -= v[106] * x[20];
-    x[22] -= v[21] * x[21];
-    x[23] -= v[35] * x[21];
-    x[24] -= v[60] * x[21];
-    x[25] -= v[74] * x[21];
-    x[26] -= v[99] * x[21];
-    x[27] -= v[113] * x[21];
-    x[23] -= v[32] * x[22];
-    x[24] -= v[57] * x[22];
-    x[25] -= v[71] * x[22];
-    x[26] -= v[96] * x[22];
-    x[27] -= v[110] * x[22];
-    x[24] -= v[61] * x[23];
-    x[25] -= v[75] * x[23];
-    x[26] -= v[100] * x[23];
-    x[27] -= v[114] * x[23];
-    x[25] -= v[72] * x[24];
-    x[26] -= v[97] * x[24];
-    x[27] -= v[111] * x[24];
-    x[26] -= v[101] * x[25];
-    x[27] -= v[115] * x[25];
-    x[27] -= v[112] * x[26];
-}
-
-/* U z = y, rows 27..0 */
-static void delta_fk_lu_backward_0(const delta_fk_real *v,
-        const delta_fk_real *inv, delta_fk_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[27] *= inv[27];
-    x[26] -= v[102] * x[27];
-    x[26] *= inv[26];
-    x[25] -= v[73] * x[26];
-    x[25] -= v[77] * x[27];
-    x[25] *= inv[25];
-    x[24] -= v[62] * x[25];
-    x[24] -= v[59] * x[26];
-    x[24] -= v[63] * x[27];
-    x[24] *= inv[24];
-    x[23] -= v[33] * x[24];
-    x[23] -= v[37] * x[25];
-    x[23] -= v[34] * x[26];
-    x[23] -= v[38] * x[27];
-    x[23] *= inv[23];
-    x[22] -= v[22] * x[23];
-    x[22] -= v[19] * x[24];
-    x[22] -= v[23] * x[25];
-    x[22] -= v[20] * x[26];
-    x[22] -= v[24] * x[27];
-    x[22] *= inv[22];
-    x[21] -= v[142] * x[23];
-    x[21] -= v[143] * x[25];
-    x[21] -= v[144] * x[27];
-    x[21] *= inv[21];
-    x[20] *= inv[20];
-    x[19] -= v[125] * x[20];
-    x[19] *= inv[19];
-    x[18] -= v[87] * x[19];
-    x[18] -= v[85] * x[20];
-    x[18] *= inv[18];
-    x[17] -= v[82] * x[18];
-    x[17] -= v[83] * x[19];
-    x[17] -= v[81] * x[20];
-    x[17] *= inv[17];
-    x[16] *= inv[16];
-    x[15] -= v[121] * x[16];
-    x[15] *= inv[15];
-    x[14] -= v[48] * x[15];
-    x[14] -= v[46] * x[16];
-    x[14] *= inv[14];
-    x[13] -= v[43] * x[14];
-    x[13] -= v[44] * x[15];
-    x[13] -= v[42] * x[16];
-    x[13] *= inv[13];
-    x[12] *= inv[12];
-    x[11] -= v[117] * x[12];
-    x[11] *= inv[11];
-    x[10] -= v[9] * x[11];
-    x[10] -= v[7] * x[12];
-    x[10] *= inv[10];
-    x[9] -= v[6] * x[10];
-    x[9] -= v[5] * x[11];
-    x[9] -= v[3] * x[12];
-    x[9] *= inv[9];
-    x[8] = -x[8];
-    x[7] = -x[7];
-    x[6] = -x[6];
-    x[5] = -x[5];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] = -x[1];
-    x[0] = -x[0];
-}
-
 void delta_fk_lu_solve(const delta_fk_lu *lu, delta_fk_real b[])
 {
     delta_fk_real x[DELTA_FK_NQ];
@@ -946,8 +787,158 @@ void delta_fk_lu_solve(const delta_fk_lu *lu, delta_fk_real b[])
     x[25] = b[13];
     x[26] = b[19];
     x[27] = b[20];
-    delta_fk_lu_forward_0(lu->v, x);
-    delta_fk_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const delta_fk_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[22] -= v[11] * x[0];
+        x[23] -= v[25] * x[0];
+        x[22] -= v[12] * x[1];
+        x[23] -= v[26] * x[1];
+        x[22] -= v[13] * x[2];
+        x[23] -= v[27] * x[2];
+        x[24] -= v[50] * x[3];
+        x[25] -= v[64] * x[3];
+        x[24] -= v[51] * x[4];
+        x[25] -= v[65] * x[4];
+        x[24] -= v[52] * x[5];
+        x[25] -= v[66] * x[5];
+        x[26] -= v[89] * x[6];
+        x[27] -= v[103] * x[6];
+        x[26] -= v[90] * x[7];
+        x[27] -= v[104] * x[7];
+        x[26] -= v[91] * x[8];
+        x[27] -= v[105] * x[8];
+        x[10] -= v[8] * x[9];
+        x[11] -= v[118] * x[9];
+        x[12] -= v[130] * x[9];
+        x[22] -= v[15] * x[9];
+        x[23] -= v[29] * x[9];
+        x[11] -= v[120] * x[10];
+        x[12] -= v[132] * x[10];
+        x[22] -= v[17] * x[10];
+        x[23] -= v[31] * x[10];
+        x[12] -= v[131] * x[11];
+        x[22] -= v[16] * x[11];
+        x[23] -= v[30] * x[11];
+        x[22] -= v[14] * x[12];
+        x[23] -= v[28] * x[12];
+        x[14] -= v[49] * x[13];
+        x[15] -= v[124] * x[13];
+        x[16] -= v[136] * x[13];
+        x[24] -= v[56] * x[13];
+        x[25] -= v[70] * x[13];
+        x[15] -= v[122] * x[14];
+        x[16] -= v[134] * x[14];
+        x[24] -= v[54] * x[14];
+        x[25] -= v[68] * x[14];
+        x[16] -= v[135] * x[15];
+        x[24] -= v[55] * x[15];
+        x[25] -= v[69] * x[15];
+        x[24] -= v[53] * x[16];
+        x[25] -= v[67] * x[16];
+        x[18] -= v[88] * x[17];
+        x[19] -= v[128] * x[17];
+        x[20] -= v[140] * x[17];
+        x[26] -= v[95] * x[17];
+        x[27] -= v[109] * x[17];
+        x[19] -= v[126] * x[18];
+        x[20] -= v[138] * x[18];
+        x[26] -= v[93] * x[18];
+        x[27] -= v[107] * x[18];
+        x[20] -= v[139] * x[19];
+        x[26] -= v[94] * x[19];
+        x[27] -= v[108] * x[19];
+        x[26] -= v[92] * x[20];
+        x[27] -= v[106] * x[20];
+        x[22] -= v[21] * x[21];
+        x[23] -= v[35] * x[21];
+        x[24] -= v[60] * x[21];
+        x[25] -= v[74] * x[21];
+        x[26] -= v[99] * x[21];
+        x[27] -= v[113] * x[21];
+        x[23] -= v[32] * x[22];
+        x[24] -= v[57] * x[22];
+        x[25] -= v[71] * x[22];
+        x[26] -= v[96] * x[22];
+        x[27] -= v[110] * x[22];
+        x[24] -= v[61] * x[23];
+        x[25] -= v[75] * x[23];
+        x[26] -= v[100] * x[23];
+        x[27] -= v[114] * x[23];
+        x[25] -= v[72] * x[24];
+        x[26] -= v[97] * x[24];
+        x[27] -= v[111] * x[24];
+        x[26] -= v[101] * x[25];
+        x[27] -= v[115] * x[25];
+        x[27] -= v[112] * x[26];
+        /* U z = y */
+        x[27] *= inv[27];
+        x[26] -= v[102] * x[27];
+        x[26] *= inv[26];
+        x[25] -= v[73] * x[26];
+        x[25] -= v[77] * x[27];
+        x[25] *= inv[25];
+        x[24] -= v[62] * x[25];
+        x[24] -= v[59] * x[26];
+        x[24] -= v[63] * x[27];
+        x[24] *= inv[24];
+        x[23] -= v[33] * x[24];
+        x[23] -= v[37] * x[25];
+        x[23] -= v[34] * x[26];
+        x[23] -= v[38] * x[27];
+        x[23] *= inv[23];
+        x[22] -= v[22] * x[23];
+        x[22] -= v[19] * x[24];
+        x[22] -= v[23] * x[25];
+        x[22] -= v[20] * x[26];
+        x[22] -= v[24] * x[27];
+        x[22] *= inv[22];
+        x[21] -= v[142] * x[23];
+        x[21] -= v[143] * x[25];
+        x[21] -= v[144] * x[27];
+        x[21] *= inv[21];
+        x[20] *= inv[20];
+        x[19] -= v[125] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[87] * x[19];
+        x[18] -= v[85] * x[20];
+        x[18] *= inv[18];
+        x[17] -= v[82] * x[18];
+        x[17] -= v[83] * x[19];
+        x[17] -= v[81] * x[20];
+        x[17] *= inv[17];
+        x[16] *= inv[16];
+        x[15] -= v[121] * x[16];
+        x[15] *= inv[15];
+        x[14] -= v[48] * x[15];
+        x[14] -= v[46] * x[16];
+        x[14] *= inv[14];
+        x[13] -= v[43] * x[14];
+        x[13] -= v[44] * x[15];
+        x[13] -= v[42] * x[16];
+        x[13] *= inv[13];
+        x[12] *= inv[12];
+        x[11] -= v[117] * x[12];
+        x[11] *= inv[11];
+        x[10] -= v[9] * x[11];
+        x[10] -= v[7] * x[12];
+        x[10] *= inv[10];
+        x[9] -= v[6] * x[10];
+        x[9] -= v[5] * x[11];
+        x[9] -= v[3] * x[12];
+        x[9] *= inv[9];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
     b[0] = x[0];
     b[1] = x[1];
     b[2] = x[2];
@@ -976,6 +967,449 @@ void delta_fk_lu_solve(const delta_fk_lu *lu, delta_fk_real b[])
     b[26] = x[25];
     b[23] = x[26];
     b[27] = x[27];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+delta_fk_real delta_fk_lu_solve_rates(const delta_fk_lu *lu, delta_fk_real b[], delta_fk_real *sum_abs)
+{
+    delta_fk_real x[DELTA_FK_NQ];
+    delta_fk_real largest = 0, total = 0;
+    if (lu->dense) return delta_fk_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[7]: a zero row */
+    x[4] = 0; /* b[8]: a zero row */
+    x[5] = 0; /* b[9]: a zero row */
+    x[6] = 0; /* b[14]: a zero row */
+    x[7] = 0; /* b[15]: a zero row */
+    x[8] = 0; /* b[16]: a zero row */
+    x[9] = 0; /* b[3]: a zero row */
+    x[10] = 0; /* b[4]: a zero row */
+    x[11] = b[21];
+    x[12] = 0; /* b[24]: a zero row */
+    x[13] = 0; /* b[10]: a zero row */
+    x[14] = 0; /* b[11]: a zero row */
+    x[15] = b[22];
+    x[16] = 0; /* b[25]: a zero row */
+    x[17] = 0; /* b[17]: a zero row */
+    x[18] = 0; /* b[18]: a zero row */
+    x[19] = b[23];
+    x[20] = 0; /* b[26]: a zero row */
+    x[21] = 0; /* b[27]: a zero row */
+    x[22] = 0; /* b[5]: a zero row */
+    x[23] = 0; /* b[6]: a zero row */
+    x[24] = 0; /* b[12]: a zero row */
+    x[25] = 0; /* b[13]: a zero row */
+    x[26] = 0; /* b[19]: a zero row */
+    x[27] = 0; /* b[20]: a zero row */
+    {
+        const delta_fk_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[22] -= v[11] * x[0];
+        x[23] -= v[25] * x[0];
+        x[22] -= v[12] * x[1];
+        x[23] -= v[26] * x[1];
+        x[22] -= v[13] * x[2];
+        x[23] -= v[27] * x[2];
+        x[24] -= v[50] * x[3];
+        x[25] -= v[64] * x[3];
+        x[24] -= v[51] * x[4];
+        x[25] -= v[65] * x[4];
+        x[24] -= v[52] * x[5];
+        x[25] -= v[66] * x[5];
+        x[26] -= v[89] * x[6];
+        x[27] -= v[103] * x[6];
+        x[26] -= v[90] * x[7];
+        x[27] -= v[104] * x[7];
+        x[26] -= v[91] * x[8];
+        x[27] -= v[105] * x[8];
+        x[10] -= v[8] * x[9];
+        x[11] -= v[118] * x[9];
+        x[12] -= v[130] * x[9];
+        x[22] -= v[15] * x[9];
+        x[23] -= v[29] * x[9];
+        x[11] -= v[120] * x[10];
+        x[12] -= v[132] * x[10];
+        x[22] -= v[17] * x[10];
+        x[23] -= v[31] * x[10];
+        x[12] -= v[131] * x[11];
+        x[22] -= v[16] * x[11];
+        x[23] -= v[30] * x[11];
+        x[22] -= v[14] * x[12];
+        x[23] -= v[28] * x[12];
+        x[14] -= v[49] * x[13];
+        x[15] -= v[124] * x[13];
+        x[16] -= v[136] * x[13];
+        x[24] -= v[56] * x[13];
+        x[25] -= v[70] * x[13];
+        x[15] -= v[122] * x[14];
+        x[16] -= v[134] * x[14];
+        x[24] -= v[54] * x[14];
+        x[25] -= v[68] * x[14];
+        x[16] -= v[135] * x[15];
+        x[24] -= v[55] * x[15];
+        x[25] -= v[69] * x[15];
+        x[24] -= v[53] * x[16];
+        x[25] -= v[67] * x[16];
+        x[18] -= v[88] * x[17];
+        x[19] -= v[128] * x[17];
+        x[20] -= v[140] * x[17];
+        x[26] -= v[95] * x[17];
+        x[27] -= v[109] * x[17];
+        x[19] -= v[126] * x[18];
+        x[20] -= v[138] * x[18];
+        x[26] -= v[93] * x[18];
+        x[27] -= v[107] * x[18];
+        x[20] -= v[139] * x[19];
+        x[26] -= v[94] * x[19];
+        x[27] -= v[108] * x[19];
+        x[26] -= v[92] * x[20];
+        x[27] -= v[106] * x[20];
+        x[22] -= v[21] * x[21];
+        x[23] -= v[35] * x[21];
+        x[24] -= v[60] * x[21];
+        x[25] -= v[74] * x[21];
+        x[26] -= v[99] * x[21];
+        x[27] -= v[113] * x[21];
+        x[23] -= v[32] * x[22];
+        x[24] -= v[57] * x[22];
+        x[25] -= v[71] * x[22];
+        x[26] -= v[96] * x[22];
+        x[27] -= v[110] * x[22];
+        x[24] -= v[61] * x[23];
+        x[25] -= v[75] * x[23];
+        x[26] -= v[100] * x[23];
+        x[27] -= v[114] * x[23];
+        x[25] -= v[72] * x[24];
+        x[26] -= v[97] * x[24];
+        x[27] -= v[111] * x[24];
+        x[26] -= v[101] * x[25];
+        x[27] -= v[115] * x[25];
+        x[27] -= v[112] * x[26];
+        /* U z = y */
+        x[27] *= inv[27];
+        x[26] -= v[102] * x[27];
+        x[26] *= inv[26];
+        x[25] -= v[73] * x[26];
+        x[25] -= v[77] * x[27];
+        x[25] *= inv[25];
+        x[24] -= v[62] * x[25];
+        x[24] -= v[59] * x[26];
+        x[24] -= v[63] * x[27];
+        x[24] *= inv[24];
+        x[23] -= v[33] * x[24];
+        x[23] -= v[37] * x[25];
+        x[23] -= v[34] * x[26];
+        x[23] -= v[38] * x[27];
+        x[23] *= inv[23];
+        x[22] -= v[22] * x[23];
+        x[22] -= v[19] * x[24];
+        x[22] -= v[23] * x[25];
+        x[22] -= v[20] * x[26];
+        x[22] -= v[24] * x[27];
+        x[22] *= inv[22];
+        x[21] -= v[142] * x[23];
+        x[21] -= v[143] * x[25];
+        x[21] -= v[144] * x[27];
+        x[21] *= inv[21];
+        x[20] *= inv[20];
+        x[19] -= v[125] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[87] * x[19];
+        x[18] -= v[85] * x[20];
+        x[18] *= inv[18];
+        x[17] -= v[82] * x[18];
+        x[17] -= v[83] * x[19];
+        x[17] -= v[81] * x[20];
+        x[17] *= inv[17];
+        x[16] *= inv[16];
+        x[15] -= v[121] * x[16];
+        x[15] *= inv[15];
+        x[14] -= v[48] * x[15];
+        x[14] -= v[46] * x[16];
+        x[14] *= inv[14];
+        x[13] -= v[43] * x[14];
+        x[13] -= v[44] * x[15];
+        x[13] -= v[42] * x[16];
+        x[13] *= inv[13];
+        x[12] *= inv[12];
+        x[11] -= v[117] * x[12];
+        x[11] *= inv[11];
+        x[10] -= v[9] * x[11];
+        x[10] -= v[7] * x[12];
+        x[10] *= inv[10];
+        x[9] -= v[6] * x[10];
+        x[9] -= v[5] * x[11];
+        x[9] -= v[3] * x[12];
+        x[9] *= inv[9];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = -x[0]; /* +-0: no norm to take */
+    b[1] = -x[1]; /* +-0: no norm to take */
+    b[2] = -x[2]; /* +-0: no norm to take */
+    b[7] = -x[3]; /* +-0: no norm to take */
+    b[8] = -x[4]; /* +-0: no norm to take */
+    b[9] = -x[5]; /* +-0: no norm to take */
+    b[14] = -x[6]; /* +-0: no norm to take */
+    b[15] = -x[7]; /* +-0: no norm to take */
+    b[16] = -x[8]; /* +-0: no norm to take */
+    { const delta_fk_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[4] = -x[9]; }
+    { const delta_fk_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[6] = -x[10]; }
+    { const delta_fk_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[5] = -x[11]; }
+    { const delta_fk_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[3] = -x[12]; }
+    { const delta_fk_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[13] = -x[13]; }
+    { const delta_fk_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[11] = -x[14]; }
+    { const delta_fk_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[12] = -x[15]; }
+    { const delta_fk_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[10] = -x[16]; }
+    { const delta_fk_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[20] = -x[17]; }
+    { const delta_fk_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[18] = -x[18]; }
+    { const delta_fk_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[19] = -x[19]; }
+    { const delta_fk_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[17] = -x[20]; }
+    { const delta_fk_real a = fabs(x[21]); largest = largest > a ? largest : a; total += a; b[24] = -x[21]; }
+    { const delta_fk_real a = fabs(x[22]); largest = largest > a ? largest : a; total += a; b[21] = -x[22]; }
+    { const delta_fk_real a = fabs(x[23]); largest = largest > a ? largest : a; total += a; b[25] = -x[23]; }
+    { const delta_fk_real a = fabs(x[24]); largest = largest > a ? largest : a; total += a; b[22] = -x[24]; }
+    { const delta_fk_real a = fabs(x[25]); largest = largest > a ? largest : a; total += a; b[26] = -x[25]; }
+    { const delta_fk_real a = fabs(x[26]); largest = largest > a ? largest : a; total += a; b[23] = -x[26]; }
+    { const delta_fk_real a = fabs(x[27]); largest = largest > a ? largest : a; total += a; b[27] = -x[27]; }
+    *sum_abs = total;
+    return largest;
+}
+
+delta_fk_real delta_fk_lu_solve_accelerations(const delta_fk_lu *lu, delta_fk_real b[], delta_fk_real *sum_abs)
+{
+    delta_fk_real x[DELTA_FK_NQ];
+    delta_fk_real largest = 0, total = 0;
+    if (lu->dense) return delta_fk_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[7]: a zero row */
+    x[4] = 0; /* b[8]: a zero row */
+    x[5] = 0; /* b[9]: a zero row */
+    x[6] = 0; /* b[14]: a zero row */
+    x[7] = 0; /* b[15]: a zero row */
+    x[8] = 0; /* b[16]: a zero row */
+    x[9] = b[3];
+    x[10] = b[4];
+    x[11] = b[21];
+    x[12] = b[24];
+    x[13] = b[10];
+    x[14] = b[11];
+    x[15] = b[22];
+    x[16] = b[25];
+    x[17] = b[17];
+    x[18] = b[18];
+    x[19] = b[23];
+    x[20] = b[26];
+    x[21] = b[27];
+    x[22] = b[5];
+    x[23] = b[6];
+    x[24] = b[12];
+    x[25] = b[13];
+    x[26] = b[19];
+    x[27] = b[20];
+    {
+        const delta_fk_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[22] -= v[11] * x[0];
+        x[23] -= v[25] * x[0];
+        x[22] -= v[12] * x[1];
+        x[23] -= v[26] * x[1];
+        x[22] -= v[13] * x[2];
+        x[23] -= v[27] * x[2];
+        x[24] -= v[50] * x[3];
+        x[25] -= v[64] * x[3];
+        x[24] -= v[51] * x[4];
+        x[25] -= v[65] * x[4];
+        x[24] -= v[52] * x[5];
+        x[25] -= v[66] * x[5];
+        x[26] -= v[89] * x[6];
+        x[27] -= v[103] * x[6];
+        x[26] -= v[90] * x[7];
+        x[27] -= v[104] * x[7];
+        x[26] -= v[91] * x[8];
+        x[27] -= v[105] * x[8];
+        x[10] -= v[8] * x[9];
+        x[11] -= v[118] * x[9];
+        x[12] -= v[130] * x[9];
+        x[22] -= v[15] * x[9];
+        x[23] -= v[29] * x[9];
+        x[11] -= v[120] * x[10];
+        x[12] -= v[132] * x[10];
+        x[22] -= v[17] * x[10];
+        x[23] -= v[31] * x[10];
+        x[12] -= v[131] * x[11];
+        x[22] -= v[16] * x[11];
+        x[23] -= v[30] * x[11];
+        x[22] -= v[14] * x[12];
+        x[23] -= v[28] * x[12];
+        x[14] -= v[49] * x[13];
+        x[15] -= v[124] * x[13];
+        x[16] -= v[136] * x[13];
+        x[24] -= v[56] * x[13];
+        x[25] -= v[70] * x[13];
+        x[15] -= v[122] * x[14];
+        x[16] -= v[134] * x[14];
+        x[24] -= v[54] * x[14];
+        x[25] -= v[68] * x[14];
+        x[16] -= v[135] * x[15];
+        x[24] -= v[55] * x[15];
+        x[25] -= v[69] * x[15];
+        x[24] -= v[53] * x[16];
+        x[25] -= v[67] * x[16];
+        x[18] -= v[88] * x[17];
+        x[19] -= v[128] * x[17];
+        x[20] -= v[140] * x[17];
+        x[26] -= v[95] * x[17];
+        x[27] -= v[109] * x[17];
+        x[19] -= v[126] * x[18];
+        x[20] -= v[138] * x[18];
+        x[26] -= v[93] * x[18];
+        x[27] -= v[107] * x[18];
+        x[20] -= v[139] * x[19];
+        x[26] -= v[94] * x[19];
+        x[27] -= v[108] * x[19];
+        x[26] -= v[92] * x[20];
+        x[27] -= v[106] * x[20];
+        x[22] -= v[21] * x[21];
+        x[23] -= v[35] * x[21];
+        x[24] -= v[60] * x[21];
+        x[25] -= v[74] * x[21];
+        x[26] -= v[99] * x[21];
+        x[27] -= v[113] * x[21];
+        x[23] -= v[32] * x[22];
+        x[24] -= v[57] * x[22];
+        x[25] -= v[71] * x[22];
+        x[26] -= v[96] * x[22];
+        x[27] -= v[110] * x[22];
+        x[24] -= v[61] * x[23];
+        x[25] -= v[75] * x[23];
+        x[26] -= v[100] * x[23];
+        x[27] -= v[114] * x[23];
+        x[25] -= v[72] * x[24];
+        x[26] -= v[97] * x[24];
+        x[27] -= v[111] * x[24];
+        x[26] -= v[101] * x[25];
+        x[27] -= v[115] * x[25];
+        x[27] -= v[112] * x[26];
+        /* U z = y */
+        x[27] *= inv[27];
+        x[26] -= v[102] * x[27];
+        x[26] *= inv[26];
+        x[25] -= v[73] * x[26];
+        x[25] -= v[77] * x[27];
+        x[25] *= inv[25];
+        x[24] -= v[62] * x[25];
+        x[24] -= v[59] * x[26];
+        x[24] -= v[63] * x[27];
+        x[24] *= inv[24];
+        x[23] -= v[33] * x[24];
+        x[23] -= v[37] * x[25];
+        x[23] -= v[34] * x[26];
+        x[23] -= v[38] * x[27];
+        x[23] *= inv[23];
+        x[22] -= v[22] * x[23];
+        x[22] -= v[19] * x[24];
+        x[22] -= v[23] * x[25];
+        x[22] -= v[20] * x[26];
+        x[22] -= v[24] * x[27];
+        x[22] *= inv[22];
+        x[21] -= v[142] * x[23];
+        x[21] -= v[143] * x[25];
+        x[21] -= v[144] * x[27];
+        x[21] *= inv[21];
+        x[20] *= inv[20];
+        x[19] -= v[125] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[87] * x[19];
+        x[18] -= v[85] * x[20];
+        x[18] *= inv[18];
+        x[17] -= v[82] * x[18];
+        x[17] -= v[83] * x[19];
+        x[17] -= v[81] * x[20];
+        x[17] *= inv[17];
+        x[16] *= inv[16];
+        x[15] -= v[121] * x[16];
+        x[15] *= inv[15];
+        x[14] -= v[48] * x[15];
+        x[14] -= v[46] * x[16];
+        x[14] *= inv[14];
+        x[13] -= v[43] * x[14];
+        x[13] -= v[44] * x[15];
+        x[13] -= v[42] * x[16];
+        x[13] *= inv[13];
+        x[12] *= inv[12];
+        x[11] -= v[117] * x[12];
+        x[11] *= inv[11];
+        x[10] -= v[9] * x[11];
+        x[10] -= v[7] * x[12];
+        x[10] *= inv[10];
+        x[9] -= v[6] * x[10];
+        x[9] -= v[5] * x[11];
+        x[9] -= v[3] * x[12];
+        x[9] *= inv[9];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = x[0]; /* +-0: no norm to take */
+    b[1] = x[1]; /* +-0: no norm to take */
+    b[2] = x[2]; /* +-0: no norm to take */
+    b[7] = x[3]; /* +-0: no norm to take */
+    b[8] = x[4]; /* +-0: no norm to take */
+    b[9] = x[5]; /* +-0: no norm to take */
+    b[14] = x[6]; /* +-0: no norm to take */
+    b[15] = x[7]; /* +-0: no norm to take */
+    b[16] = x[8]; /* +-0: no norm to take */
+    { const delta_fk_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[4] = x[9]; }
+    { const delta_fk_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[6] = x[10]; }
+    { const delta_fk_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[5] = x[11]; }
+    { const delta_fk_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[3] = x[12]; }
+    { const delta_fk_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[13] = x[13]; }
+    { const delta_fk_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[11] = x[14]; }
+    { const delta_fk_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[12] = x[15]; }
+    { const delta_fk_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[10] = x[16]; }
+    { const delta_fk_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[20] = x[17]; }
+    { const delta_fk_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[18] = x[18]; }
+    { const delta_fk_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[19] = x[19]; }
+    { const delta_fk_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[17] = x[20]; }
+    { const delta_fk_real a = fabs(x[21]); largest = largest > a ? largest : a; total += a; b[24] = x[21]; }
+    { const delta_fk_real a = fabs(x[22]); largest = largest > a ? largest : a; total += a; b[21] = x[22]; }
+    { const delta_fk_real a = fabs(x[23]); largest = largest > a ? largest : a; total += a; b[25] = x[23]; }
+    { const delta_fk_real a = fabs(x[24]); largest = largest > a ? largest : a; total += a; b[22] = x[24]; }
+    { const delta_fk_real a = fabs(x[25]); largest = largest > a ? largest : a; total += a; b[26] = x[25]; }
+    { const delta_fk_real a = fabs(x[26]); largest = largest > a ? largest : a; total += a; b[23] = x[26]; }
+    { const delta_fk_real a = fabs(x[27]); largest = largest > a ? largest : a; total += a; b[27] = x[27]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..27 of U^T (rows of U) */

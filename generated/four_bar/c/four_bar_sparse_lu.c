@@ -166,36 +166,6 @@ four_bar_real four_bar_lu_pivot_ratio(const four_bar_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..7 */
-static void four_bar_lu_forward_0(const four_bar_real *v, four_bar_real *x)
-{
-    (void)v;
-    x[5] += x[0];
-    x[6] += x[1];
-    x[7] += x[2];
-    x[8] += x[3];
-    x[5] -= v[3] * x[4];
-    x[6] -= v[6] * x[4];
-    x[7] += x[5];
-    x[8] += x[6];
-    x[8] -= v[13] * x[7];
-}
-
-/* U z = y, rows 8..0 */
-static void four_bar_lu_backward_0(const four_bar_real *v,
-        const four_bar_real *inv, four_bar_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[8] *= inv[8];
-    x[7] -= v[11] * x[8];
-    x[7] *= inv[7];
-    x[6] = -x[6];
-    x[5] = -x[5];
-    x[1] = -x[1];
-    x[0] = -x[0];
-}
-
 void four_bar_lu_solve(const four_bar_lu *lu, four_bar_real b[])
 {
     four_bar_real x[FOUR_BAR_NQ];
@@ -213,8 +183,29 @@ void four_bar_lu_solve(const four_bar_lu *lu, four_bar_real b[])
     x[6] = b[3];
     x[7] = b[4];
     x[8] = b[5];
-    four_bar_lu_forward_0(lu->v, x);
-    four_bar_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const four_bar_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[5] += x[0];
+        x[6] += x[1];
+        x[7] += x[2];
+        x[8] += x[3];
+        x[5] -= v[3] * x[4];
+        x[6] -= v[6] * x[4];
+        x[7] += x[5];
+        x[8] += x[6];
+        x[8] -= v[13] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] -= v[11] * x[8];
+        x[7] *= inv[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
     b[0] = x[0];
     b[1] = x[1];
     b[6] = x[2];
@@ -224,6 +215,115 @@ void four_bar_lu_solve(const four_bar_lu *lu, four_bar_real b[])
     b[4] = x[6];
     b[5] = x[7];
     b[8] = x[8];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+four_bar_real four_bar_lu_solve_rates(const four_bar_lu *lu, four_bar_real b[], four_bar_real *sum_abs)
+{
+    four_bar_real x[FOUR_BAR_NQ];
+    four_bar_real largest = 0, total = 0;
+    if (lu->dense) return four_bar_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[6]: a zero row */
+    x[3] = 0; /* b[7]: a zero row */
+    x[4] = b[8];
+    x[5] = 0; /* b[2]: a zero row */
+    x[6] = 0; /* b[3]: a zero row */
+    x[7] = 0; /* b[4]: a zero row */
+    x[8] = 0; /* b[5]: a zero row */
+    {
+        const four_bar_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[5] += x[0];
+        x[6] += x[1];
+        x[7] += x[2];
+        x[8] += x[3];
+        x[5] -= v[3] * x[4];
+        x[6] -= v[6] * x[4];
+        x[7] += x[5];
+        x[8] += x[6];
+        x[8] -= v[13] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] -= v[11] * x[8];
+        x[7] *= inv[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = -x[0]; /* +-0: no norm to take */
+    b[1] = -x[1]; /* +-0: no norm to take */
+    b[6] = -x[2]; /* +-0: no norm to take */
+    b[7] = -x[3]; /* +-0: no norm to take */
+    { const four_bar_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[2] = -x[4]; }
+    { const four_bar_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[3] = -x[5]; }
+    { const four_bar_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[4] = -x[6]; }
+    { const four_bar_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[5] = -x[7]; }
+    { const four_bar_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[8] = -x[8]; }
+    *sum_abs = total;
+    return largest;
+}
+
+four_bar_real four_bar_lu_solve_accelerations(const four_bar_lu *lu, four_bar_real b[], four_bar_real *sum_abs)
+{
+    four_bar_real x[FOUR_BAR_NQ];
+    four_bar_real largest = 0, total = 0;
+    if (lu->dense) return four_bar_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[6]: a zero row */
+    x[3] = 0; /* b[7]: a zero row */
+    x[4] = 0; /* b[8]: a zero row */
+    x[5] = b[2];
+    x[6] = b[3];
+    x[7] = b[4];
+    x[8] = b[5];
+    {
+        const four_bar_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[5] += x[0];
+        x[6] += x[1];
+        x[7] += x[2];
+        x[8] += x[3];
+        x[5] -= v[3] * x[4];
+        x[6] -= v[6] * x[4];
+        x[7] += x[5];
+        x[8] += x[6];
+        x[8] -= v[13] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] -= v[11] * x[8];
+        x[7] *= inv[7];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = x[0]; /* +-0: no norm to take */
+    b[1] = x[1]; /* +-0: no norm to take */
+    b[6] = x[2]; /* +-0: no norm to take */
+    b[7] = x[3]; /* +-0: no norm to take */
+    b[2] = x[4]; /* +-0: no norm to take */
+    { const four_bar_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[3] = x[5]; }
+    { const four_bar_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[4] = x[6]; }
+    { const four_bar_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[5] = x[7]; }
+    { const four_bar_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[8] = x[8]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..8 of U^T (rows of U) */

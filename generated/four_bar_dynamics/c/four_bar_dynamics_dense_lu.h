@@ -35,6 +35,13 @@ four_bar_dynamics_real four_bar_dynamics_dense_lu_pivot_ratio(const four_bar_dyn
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void four_bar_dynamics_dense_lu_solve(const four_bar_dynamics_dense_lu *lu, four_bar_dynamics_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+four_bar_dynamics_real four_bar_dynamics_dense_lu_solve_max(const four_bar_dynamics_dense_lu *lu, four_bar_dynamics_real b[],
+                                              four_bar_dynamics_real *sum_abs);
+four_bar_dynamics_real four_bar_dynamics_dense_lu_solve_negated_max(const four_bar_dynamics_dense_lu *lu,
+                                                      four_bar_dynamics_real b[], four_bar_dynamics_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void four_bar_dynamics_dense_lu_solve_transposed(const four_bar_dynamics_dense_lu *lu, four_bar_dynamics_real b[]);
 

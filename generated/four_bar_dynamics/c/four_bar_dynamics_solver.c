@@ -782,11 +782,22 @@ static int four_bar_dynamics_newton(const four_bar_dynamics_options *options, co
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
     report->residual = (four_bar_dynamics_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        four_bar_dynamics_real residual;
+        four_bar_dynamics_real residual = 0, sum = 0;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         four_bar_dynamics_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
         four_bar_dynamics_in_unit(work);
-        residual = four_bar_dynamics_max_abs(work->phi);
+        /* max |Phi| as max_abs takes it, written out here: no call in the loop every step
+         * runs (a copy of max_abs the compiler would fold back into the call) */
+        { const four_bar_dynamics_real a = fabs(work->phi[0]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[1]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[2]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[3]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[4]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[5]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[6]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[7]); residual = residual > a ? residual : a; sum += a; }
+        { const four_bar_dynamics_real a = fabs(work->phi[8]); residual = residual > a ? residual : a; sum += a; }
+        residual = sum != sum ? (four_bar_dynamics_real)NAN : residual;
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
@@ -834,99 +845,55 @@ static void four_bar_dynamics_predict(four_bar_dynamics_real t, four_bar_dynamic
     state->q[8] += state->dq[8] * h + state->ddq[8] * half_h2;
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
- * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
- * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
- * largest), and dq in the kernel's unit. */
-static four_bar_dynamics_real four_bar_dynamics_rates_pass(const four_bar_dynamics_workspace *work, four_bar_dynamics_real dq[],
-                                       four_bar_dynamics_real *sum_abs)
+/* max |q| in the run's unit (NaN when some q_i is, as in max_abs: the error model then flags
+ * the point). */
+static four_bar_dynamics_real four_bar_dynamics_positions_pass(const four_bar_dynamics_workspace *work, const four_bar_dynamics_real q[])
 {
-    four_bar_dynamics_real largest = 0, sum = 0;
-    { const four_bar_dynamics_real b = fabs(dq[0]); largest = largest > b ? largest : b; sum += b; }
-    dq[0] = -dq[0];
-    { const four_bar_dynamics_real b = fabs(dq[1]); largest = largest > b ? largest : b; sum += b; }
-    dq[1] = -dq[1];
-    { const four_bar_dynamics_real b = fabs(dq[2]); largest = largest > b ? largest : b; sum += b; }
-    dq[2] = -dq[2];
-    { const four_bar_dynamics_real b = fabs(dq[3]); largest = largest > b ? largest : b; sum += b; }
-    dq[3] = -dq[3];
-    { const four_bar_dynamics_real b = fabs(dq[4]); largest = largest > b ? largest : b; sum += b; }
-    dq[4] = -dq[4];
-    { const four_bar_dynamics_real b = fabs(dq[5]); largest = largest > b ? largest : b; sum += b; }
-    dq[5] = -dq[5];
-    { const four_bar_dynamics_real b = fabs(dq[6]); largest = largest > b ? largest : b; sum += b; }
-    dq[6] = -dq[6];
-    { const four_bar_dynamics_real b = fabs(dq[7]); largest = largest > b ? largest : b; sum += b; }
-    dq[7] = -dq[7];
-    { const four_bar_dynamics_real b = fabs(dq[8]); largest = largest > b ? largest : b; sum += b; }
-    dq[8] = -dq[8];
-    four_bar_dynamics_from_unit(work, dq);
-    *sum_abs = sum;
-    return largest;
-}
-
-/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
- * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
- * then flags the point). */
-static four_bar_dynamics_real four_bar_dynamics_accelerations_pass(const four_bar_dynamics_workspace *work,
-                                               const four_bar_dynamics_real q[], four_bar_dynamics_real ddq[],
-                                               four_bar_dynamics_real *sum_abs, four_bar_dynamics_real *nq)
-{
-    four_bar_dynamics_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
-    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division); the lengths'
-     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
-     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
-    { const four_bar_dynamics_real c = fabs(ddq[0]); largest = largest > c ? largest : c; sum += c; }
+    four_bar_dynamics_real largest_q = 0, sum_q = 0, largest_length = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs); a coordinate that is no length is
+     * the same in every unit (no division); the lengths' largest |q_i| is divided by the unit
+     * once, after the pass: rounding is monotone, so max (|q_i| / unit) and (max |q_i|) / unit
+     * are the same number (the unit is finite) */
     {
         const four_bar_dynamics_real a = fabs(q[0]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[1]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[1]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[2]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[2]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[3]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[3]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[4]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[4]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[5]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[5]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[6]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[6]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[7]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[7]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const four_bar_dynamics_real c = fabs(ddq[8]); largest = largest > c ? largest : c; sum += c; }
     {
         const four_bar_dynamics_real a = fabs(q[8]);
         largest_q = largest_q > a ? largest_q : a;
@@ -934,10 +901,8 @@ static four_bar_dynamics_real four_bar_dynamics_accelerations_pass(const four_ba
     }
     largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
     largest_q = largest_q > largest_length ? largest_q : largest_length;
-    four_bar_dynamics_from_unit(work, ddq);
-    *sum_abs = sum;
-    *nq = sum_q != sum_q ? (four_bar_dynamics_real)NAN : largest_q;
-    return largest;
+    (void)work;
+    return sum_q != sum_q ? (four_bar_dynamics_real)NAN : largest_q;
 }
 
 /* four_bar_dynamics_solve_step with its options already checked. */
@@ -959,16 +924,19 @@ static int four_bar_dynamics_step(const four_bar_dynamics_options *options, cons
         return report->status;
     }
     /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
-     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
-     * fused call, so the shared sines and cosines are this q's. */
+     * is -dq, written out negated. Each solve returns its solution's max |.| in the run's unit
+     * and the sum of |.| for the finite test, taken as it writes the solution (no pass over
+     * it again). Newton stopped at the q of its last fused call, so the shared sines and
+     * cosines are this q's. */
     four_bar_dynamics_phi_t_shared(state->q, t, p, work->shared, state->dq);
     four_bar_dynamics_rows_in_unit(work, state->dq);
-    four_bar_dynamics_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = four_bar_dynamics_rates_pass(work, state->dq, &sum_dq);
+    ndq = four_bar_dynamics_lu_solve_rates(&work->lu, state->dq, &sum_dq); /* (2.73) */
+    four_bar_dynamics_from_unit(work, state->dq);
     four_bar_dynamics_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     four_bar_dynamics_rows_in_unit(work, state->ddq);
-    four_bar_dynamics_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = four_bar_dynamics_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    nddq = four_bar_dynamics_lu_solve_accelerations(&work->lu, state->ddq, &sum_ddq); /* (2.74) */
+    four_bar_dynamics_from_unit(work, state->ddq);
+    nq = four_bar_dynamics_positions_pass(work, state->q);
     /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
      * overflow harmlessly), infinite where the larger maximum is */
     largest = ndq > nddq ? ndq : nddq;

@@ -35,6 +35,13 @@ parallelogram_extra_bar_real parallelogram_extra_bar_dense_lu_pivot_ratio(const 
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void parallelogram_extra_bar_dense_lu_solve(const parallelogram_extra_bar_dense_lu *lu, parallelogram_extra_bar_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+parallelogram_extra_bar_real parallelogram_extra_bar_dense_lu_solve_max(const parallelogram_extra_bar_dense_lu *lu, parallelogram_extra_bar_real b[],
+                                              parallelogram_extra_bar_real *sum_abs);
+parallelogram_extra_bar_real parallelogram_extra_bar_dense_lu_solve_negated_max(const parallelogram_extra_bar_dense_lu *lu,
+                                                      parallelogram_extra_bar_real b[], parallelogram_extra_bar_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void parallelogram_extra_bar_dense_lu_solve_transposed(const parallelogram_extra_bar_dense_lu *lu, parallelogram_extra_bar_real b[]);
 

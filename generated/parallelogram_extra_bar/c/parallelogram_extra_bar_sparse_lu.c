@@ -181,44 +181,6 @@ parallelogram_extra_bar_real parallelogram_extra_bar_lu_pivot_ratio(const parall
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 3..10 */
-static void parallelogram_extra_bar_lu_forward_0(const parallelogram_extra_bar_real *v, parallelogram_extra_bar_real *x)
-{
-    (void)v;
-    x[8] += x[3];
-    x[9] += x[4];
-    x[10] -= x[5];
-    x[11] -= x[6];
-    x[8] -= v[5] * x[7];
-    x[9] -= v[8] * x[7];
-    x[10] += x[8];
-    x[11] += x[9];
-    x[11] -= v[15] * x[10];
-}
-
-/* U z = y, rows 11..0 */
-static void parallelogram_extra_bar_lu_backward_0(const parallelogram_extra_bar_real *v,
-        const parallelogram_extra_bar_real *inv, parallelogram_extra_bar_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[11] *= inv[11];
-    x[10] -= v[13] * x[11];
-    x[10] *= inv[10];
-    x[9] = -x[9];
-    x[8] = -x[8];
-    x[6] = -x[6];
-    x[5] = -x[5];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] -= x[2];
-    x[1] += x[8];
-    x[1] -= v[23] * x[11];
-    x[1] *= inv[1];
-    x[0] = -x[0];
-}
-
 void parallelogram_extra_bar_lu_solve(const parallelogram_extra_bar_lu *lu, parallelogram_extra_bar_real b[])
 {
     parallelogram_extra_bar_real x[PARALLELOGRAM_EXTRA_BAR_NQ];
@@ -239,8 +201,37 @@ void parallelogram_extra_bar_lu_solve(const parallelogram_extra_bar_lu *lu, para
     x[9] = b[5];
     x[10] = b[6];
     x[11] = b[7];
-    parallelogram_extra_bar_lu_forward_0(lu->v, x);
-    parallelogram_extra_bar_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const parallelogram_extra_bar_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[8] += x[3];
+        x[9] += x[4];
+        x[10] -= x[5];
+        x[11] -= x[6];
+        x[8] -= v[5] * x[7];
+        x[9] -= v[8] * x[7];
+        x[10] += x[8];
+        x[11] += x[9];
+        x[11] -= v[15] * x[10];
+        /* U z = y */
+        x[11] *= inv[11];
+        x[10] -= v[13] * x[11];
+        x[10] *= inv[10];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] += x[8];
+        x[1] -= v[23] * x[11];
+        x[1] *= inv[1];
+        x[0] = -x[0];
+    }
     b[7] = x[0];
     b[8] = x[1];
     b[6] = x[2];
@@ -253,6 +244,143 @@ void parallelogram_extra_bar_lu_solve(const parallelogram_extra_bar_lu *lu, para
     b[10] = x[9];
     b[5] = x[10];
     b[11] = x[11];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+parallelogram_extra_bar_real parallelogram_extra_bar_lu_solve_rates(const parallelogram_extra_bar_lu *lu, parallelogram_extra_bar_real b[], parallelogram_extra_bar_real *sum_abs)
+{
+    parallelogram_extra_bar_real x[PARALLELOGRAM_EXTRA_BAR_NQ];
+    parallelogram_extra_bar_real largest = 0, total = 0;
+    if (lu->dense) return parallelogram_extra_bar_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[9]: a zero row */
+    x[1] = 0; /* b[10]: a zero row */
+    x[2] = 0; /* b[8]: a zero row */
+    x[3] = 0; /* b[0]: a zero row */
+    x[4] = 0; /* b[1]: a zero row */
+    x[5] = 0; /* b[2]: a zero row */
+    x[6] = 0; /* b[3]: a zero row */
+    x[7] = b[11];
+    x[8] = 0; /* b[4]: a zero row */
+    x[9] = 0; /* b[5]: a zero row */
+    x[10] = 0; /* b[6]: a zero row */
+    x[11] = 0; /* b[7]: a zero row */
+    {
+        const parallelogram_extra_bar_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[8] += x[3];
+        x[9] += x[4];
+        x[10] -= x[5];
+        x[11] -= x[6];
+        x[8] -= v[5] * x[7];
+        x[9] -= v[8] * x[7];
+        x[10] += x[8];
+        x[11] += x[9];
+        x[11] -= v[15] * x[10];
+        /* U z = y */
+        x[11] *= inv[11];
+        x[10] -= v[13] * x[11];
+        x[10] *= inv[10];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] += x[8];
+        x[1] -= v[23] * x[11];
+        x[1] *= inv[1];
+        x[0] = -x[0];
+    }
+    b[7] = -x[0]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[8] = -x[1]; }
+    b[6] = -x[2]; /* +-0: no norm to take */
+    b[0] = -x[3]; /* +-0: no norm to take */
+    b[1] = -x[4]; /* +-0: no norm to take */
+    b[3] = -x[5]; /* +-0: no norm to take */
+    b[4] = -x[6]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[2] = -x[7]; }
+    { const parallelogram_extra_bar_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[9] = -x[8]; }
+    { const parallelogram_extra_bar_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[10] = -x[9]; }
+    { const parallelogram_extra_bar_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[5] = -x[10]; }
+    { const parallelogram_extra_bar_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[11] = -x[11]; }
+    *sum_abs = total;
+    return largest;
+}
+
+parallelogram_extra_bar_real parallelogram_extra_bar_lu_solve_accelerations(const parallelogram_extra_bar_lu *lu, parallelogram_extra_bar_real b[], parallelogram_extra_bar_real *sum_abs)
+{
+    parallelogram_extra_bar_real x[PARALLELOGRAM_EXTRA_BAR_NQ];
+    parallelogram_extra_bar_real largest = 0, total = 0;
+    if (lu->dense) return parallelogram_extra_bar_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[9]: a zero row */
+    x[1] = b[10];
+    x[2] = 0; /* b[8]: a zero row */
+    x[3] = 0; /* b[0]: a zero row */
+    x[4] = 0; /* b[1]: a zero row */
+    x[5] = 0; /* b[2]: a zero row */
+    x[6] = 0; /* b[3]: a zero row */
+    x[7] = 0; /* b[11]: a zero row */
+    x[8] = b[4];
+    x[9] = b[5];
+    x[10] = b[6];
+    x[11] = b[7];
+    {
+        const parallelogram_extra_bar_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[8] += x[3];
+        x[9] += x[4];
+        x[10] -= x[5];
+        x[11] -= x[6];
+        x[8] -= v[5] * x[7];
+        x[9] -= v[8] * x[7];
+        x[10] += x[8];
+        x[11] += x[9];
+        x[11] -= v[15] * x[10];
+        /* U z = y */
+        x[11] *= inv[11];
+        x[10] -= v[13] * x[11];
+        x[10] *= inv[10];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] += x[8];
+        x[1] -= v[23] * x[11];
+        x[1] *= inv[1];
+        x[0] = -x[0];
+    }
+    b[7] = x[0]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[8] = x[1]; }
+    b[6] = x[2]; /* +-0: no norm to take */
+    b[0] = x[3]; /* +-0: no norm to take */
+    b[1] = x[4]; /* +-0: no norm to take */
+    b[3] = x[5]; /* +-0: no norm to take */
+    b[4] = x[6]; /* +-0: no norm to take */
+    b[2] = x[7]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[9] = x[8]; }
+    { const parallelogram_extra_bar_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[10] = x[9]; }
+    { const parallelogram_extra_bar_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[5] = x[10]; }
+    { const parallelogram_extra_bar_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[11] = x[11]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..11 of U^T (rows of U) */

@@ -195,51 +195,6 @@ parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_lu_pivot_ratio(
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 6..13 */
-static void parallelogram_extra_bar_loads_lu_forward_0(const parallelogram_extra_bar_loads_real *v, parallelogram_extra_bar_loads_real *x)
-{
-    (void)v;
-    x[11] += x[6];
-    x[12] += x[7];
-    x[13] -= x[8];
-    x[14] -= x[9];
-    x[11] -= v[5] * x[10];
-    x[12] -= v[8] * x[10];
-    x[13] += x[11];
-    x[14] += x[12];
-    x[14] -= v[15] * x[13];
-}
-
-/* U z = y, rows 14..0 */
-static void parallelogram_extra_bar_loads_lu_backward_0(const parallelogram_extra_bar_loads_real *v,
-        const parallelogram_extra_bar_loads_real *inv, parallelogram_extra_bar_loads_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[14] *= inv[14];
-    x[13] -= v[13] * x[14];
-    x[13] *= inv[13];
-    x[12] = -x[12];
-    x[11] = -x[11];
-    x[9] = -x[9];
-    x[8] = -x[8];
-    x[7] = -x[7];
-    x[6] = -x[6];
-    x[5] += x[14];
-    x[4] -= x[12];
-    x[4] -= v[28] * x[14];
-    x[4] = -x[4];
-    x[3] -= x[11];
-    x[3] -= v[25] * x[14];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] -= x[2];
-    x[1] += x[11];
-    x[1] -= v[23] * x[14];
-    x[1] *= inv[1];
-    x[0] = -x[0];
-}
-
 void parallelogram_extra_bar_loads_lu_solve(const parallelogram_extra_bar_loads_lu *lu, parallelogram_extra_bar_loads_real b[])
 {
     parallelogram_extra_bar_loads_real x[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];
@@ -263,8 +218,44 @@ void parallelogram_extra_bar_loads_lu_solve(const parallelogram_extra_bar_loads_
     x[12] = b[5];
     x[13] = b[6];
     x[14] = b[7];
-    parallelogram_extra_bar_loads_lu_forward_0(lu->v, x);
-    parallelogram_extra_bar_loads_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const parallelogram_extra_bar_loads_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[11] += x[6];
+        x[12] += x[7];
+        x[13] -= x[8];
+        x[14] -= x[9];
+        x[11] -= v[5] * x[10];
+        x[12] -= v[8] * x[10];
+        x[13] += x[11];
+        x[14] += x[12];
+        x[14] -= v[15] * x[13];
+        /* U z = y */
+        x[14] *= inv[14];
+        x[13] -= v[13] * x[14];
+        x[13] *= inv[13];
+        x[12] = -x[12];
+        x[11] = -x[11];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] += x[14];
+        x[4] -= x[12];
+        x[4] -= v[28] * x[14];
+        x[4] = -x[4];
+        x[3] -= x[11];
+        x[3] -= v[25] * x[14];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] += x[11];
+        x[1] -= v[23] * x[14];
+        x[1] *= inv[1];
+        x[0] = -x[0];
+    }
     b[7] = x[0];
     b[8] = x[1];
     b[6] = x[2];
@@ -280,6 +271,169 @@ void parallelogram_extra_bar_loads_lu_solve(const parallelogram_extra_bar_loads_
     b[10] = x[12];
     b[5] = x[13];
     b[11] = x[14];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_lu_solve_rates(const parallelogram_extra_bar_loads_lu *lu, parallelogram_extra_bar_loads_real b[], parallelogram_extra_bar_loads_real *sum_abs)
+{
+    parallelogram_extra_bar_loads_real x[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];
+    parallelogram_extra_bar_loads_real largest = 0, total = 0;
+    if (lu->dense) return parallelogram_extra_bar_loads_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[9]: a zero row */
+    x[1] = 0; /* b[10]: a zero row */
+    x[2] = 0; /* b[8]: a zero row */
+    x[3] = 0; /* b[11]: a zero row */
+    x[4] = 0; /* b[12]: a zero row */
+    x[5] = b[14];
+    x[6] = 0; /* b[0]: a zero row */
+    x[7] = 0; /* b[1]: a zero row */
+    x[8] = 0; /* b[2]: a zero row */
+    x[9] = 0; /* b[3]: a zero row */
+    x[10] = b[13];
+    x[11] = 0; /* b[4]: a zero row */
+    x[12] = 0; /* b[5]: a zero row */
+    x[13] = 0; /* b[6]: a zero row */
+    x[14] = 0; /* b[7]: a zero row */
+    {
+        const parallelogram_extra_bar_loads_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[11] += x[6];
+        x[12] += x[7];
+        x[13] -= x[8];
+        x[14] -= x[9];
+        x[11] -= v[5] * x[10];
+        x[12] -= v[8] * x[10];
+        x[13] += x[11];
+        x[14] += x[12];
+        x[14] -= v[15] * x[13];
+        /* U z = y */
+        x[14] *= inv[14];
+        x[13] -= v[13] * x[14];
+        x[13] *= inv[13];
+        x[12] = -x[12];
+        x[11] = -x[11];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] += x[14];
+        x[4] -= x[12];
+        x[4] -= v[28] * x[14];
+        x[4] = -x[4];
+        x[3] -= x[11];
+        x[3] -= v[25] * x[14];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] += x[11];
+        x[1] -= v[23] * x[14];
+        x[1] *= inv[1];
+        x[0] = -x[0];
+    }
+    b[7] = -x[0]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_loads_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[8] = -x[1]; }
+    b[6] = -x[2]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_loads_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[12] = -x[3]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[13] = -x[4]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[14] = -x[5]; }
+    b[0] = -x[6]; /* +-0: no norm to take */
+    b[1] = -x[7]; /* +-0: no norm to take */
+    b[3] = -x[8]; /* +-0: no norm to take */
+    b[4] = -x[9]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_loads_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[2] = -x[10]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[9] = -x[11]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[10] = -x[12]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[5] = -x[13]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[11] = -x[14]; }
+    *sum_abs = total;
+    return largest;
+}
+
+parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_lu_solve_accelerations(const parallelogram_extra_bar_loads_lu *lu, parallelogram_extra_bar_loads_real b[], parallelogram_extra_bar_loads_real *sum_abs)
+{
+    parallelogram_extra_bar_loads_real x[PARALLELOGRAM_EXTRA_BAR_LOADS_NQ];
+    parallelogram_extra_bar_loads_real largest = 0, total = 0;
+    if (lu->dense) return parallelogram_extra_bar_loads_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[9]: a zero row */
+    x[1] = b[10];
+    x[2] = 0; /* b[8]: a zero row */
+    x[3] = b[11];
+    x[4] = b[12];
+    x[5] = b[14];
+    x[6] = 0; /* b[0]: a zero row */
+    x[7] = 0; /* b[1]: a zero row */
+    x[8] = 0; /* b[2]: a zero row */
+    x[9] = 0; /* b[3]: a zero row */
+    x[10] = 0; /* b[13]: a zero row */
+    x[11] = b[4];
+    x[12] = b[5];
+    x[13] = b[6];
+    x[14] = b[7];
+    {
+        const parallelogram_extra_bar_loads_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[11] += x[6];
+        x[12] += x[7];
+        x[13] -= x[8];
+        x[14] -= x[9];
+        x[11] -= v[5] * x[10];
+        x[12] -= v[8] * x[10];
+        x[13] += x[11];
+        x[14] += x[12];
+        x[14] -= v[15] * x[13];
+        /* U z = y */
+        x[14] *= inv[14];
+        x[13] -= v[13] * x[14];
+        x[13] *= inv[13];
+        x[12] = -x[12];
+        x[11] = -x[11];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[5] += x[14];
+        x[4] -= x[12];
+        x[4] -= v[28] * x[14];
+        x[4] = -x[4];
+        x[3] -= x[11];
+        x[3] -= v[25] * x[14];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] += x[11];
+        x[1] -= v[23] * x[14];
+        x[1] *= inv[1];
+        x[0] = -x[0];
+    }
+    b[7] = x[0]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_loads_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[8] = x[1]; }
+    b[6] = x[2]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_loads_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[12] = x[3]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[13] = x[4]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[14] = x[5]; }
+    b[0] = x[6]; /* +-0: no norm to take */
+    b[1] = x[7]; /* +-0: no norm to take */
+    b[3] = x[8]; /* +-0: no norm to take */
+    b[4] = x[9]; /* +-0: no norm to take */
+    b[2] = x[10]; /* +-0: no norm to take */
+    { const parallelogram_extra_bar_loads_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[9] = x[11]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[10] = x[12]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[5] = x[13]; }
+    { const parallelogram_extra_bar_loads_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[11] = x[14]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..14 of U^T (rows of U) */

@@ -35,6 +35,13 @@ planetary_real planetary_dense_lu_pivot_ratio(const planetary_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void planetary_dense_lu_solve(const planetary_dense_lu *lu, planetary_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+planetary_real planetary_dense_lu_solve_max(const planetary_dense_lu *lu, planetary_real b[],
+                                              planetary_real *sum_abs);
+planetary_real planetary_dense_lu_solve_negated_max(const planetary_dense_lu *lu,
+                                                      planetary_real b[], planetary_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void planetary_dense_lu_solve_transposed(const planetary_dense_lu *lu, planetary_real b[]);
 

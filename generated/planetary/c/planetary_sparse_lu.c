@@ -162,35 +162,6 @@ planetary_real planetary_lu_pivot_ratio(const planetary_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 6..7 */
-static void planetary_lu_forward_0(const planetary_real *v, planetary_real *x)
-{
-    (void)v;
-    x[7] -= v[10] * x[6];
-    x[8] -= v[13] * x[7];
-}
-
-/* U z = y, rows 8..0 */
-static void planetary_lu_backward_0(const planetary_real *v,
-        const planetary_real *inv, planetary_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[8] *= inv[8];
-    x[7] -= v[12] * x[8];
-    x[7] *= inv[7];
-    x[5] = -x[5];
-    x[4] -= x[5];
-    x[4] -= v[8] * x[7];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] -= x[3];
-    x[2] -= v[5] * x[7];
-    x[2] = -x[2];
-    x[1] = -x[1];
-    x[0] = -x[0];
-}
-
 void planetary_lu_solve(const planetary_lu *lu, planetary_real b[])
 {
     planetary_real x[PLANETARY_NQ];
@@ -208,8 +179,28 @@ void planetary_lu_solve(const planetary_lu *lu, planetary_real b[])
     x[6] = b[8];
     x[7] = b[6];
     x[8] = b[7];
-    planetary_lu_forward_0(lu->v, x);
-    planetary_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const planetary_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] -= v[10] * x[6];
+        x[8] -= v[13] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] -= v[12] * x[8];
+        x[7] *= inv[7];
+        x[5] = -x[5];
+        x[4] -= x[5];
+        x[4] -= v[8] * x[7];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] -= v[5] * x[7];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
     b[0] = x[0];
     b[1] = x[1];
     b[6] = x[2];
@@ -219,6 +210,113 @@ void planetary_lu_solve(const planetary_lu *lu, planetary_real b[])
     b[2] = x[6];
     b[5] = x[7];
     b[8] = x[8];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+planetary_real planetary_lu_solve_rates(const planetary_lu *lu, planetary_real b[], planetary_real *sum_abs)
+{
+    planetary_real x[PLANETARY_NQ];
+    planetary_real largest = 0, total = 0;
+    if (lu->dense) return planetary_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[4]: a zero row */
+    x[3] = 0; /* b[2]: a zero row */
+    x[4] = 0; /* b[5]: a zero row */
+    x[5] = 0; /* b[3]: a zero row */
+    x[6] = b[8];
+    x[7] = 0; /* b[6]: a zero row */
+    x[8] = 0; /* b[7]: a zero row */
+    {
+        const planetary_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] -= v[10] * x[6];
+        x[8] -= v[13] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] -= v[12] * x[8];
+        x[7] *= inv[7];
+        x[5] = -x[5];
+        x[4] -= x[5];
+        x[4] -= v[8] * x[7];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] -= v[5] * x[7];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = -x[0]; /* +-0: no norm to take */
+    b[1] = -x[1]; /* +-0: no norm to take */
+    { const planetary_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[6] = -x[2]; }
+    b[3] = -x[3]; /* +-0: no norm to take */
+    { const planetary_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[7] = -x[4]; }
+    b[4] = -x[5]; /* +-0: no norm to take */
+    { const planetary_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[2] = -x[6]; }
+    { const planetary_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[5] = -x[7]; }
+    { const planetary_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[8] = -x[8]; }
+    *sum_abs = total;
+    return largest;
+}
+
+planetary_real planetary_lu_solve_accelerations(const planetary_lu *lu, planetary_real b[], planetary_real *sum_abs)
+{
+    planetary_real x[PLANETARY_NQ];
+    planetary_real largest = 0, total = 0;
+    if (lu->dense) return planetary_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = b[4];
+    x[3] = 0; /* b[2]: a zero row */
+    x[4] = b[5];
+    x[5] = 0; /* b[3]: a zero row */
+    x[6] = 0; /* b[8]: a zero row */
+    x[7] = 0; /* b[6]: a zero row */
+    x[8] = 0; /* b[7]: a zero row */
+    {
+        const planetary_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] -= v[10] * x[6];
+        x[8] -= v[13] * x[7];
+        /* U z = y */
+        x[8] *= inv[8];
+        x[7] -= v[12] * x[8];
+        x[7] *= inv[7];
+        x[5] = -x[5];
+        x[4] -= x[5];
+        x[4] -= v[8] * x[7];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] -= v[5] * x[7];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = x[0]; /* +-0: no norm to take */
+    b[1] = x[1]; /* +-0: no norm to take */
+    { const planetary_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[6] = x[2]; }
+    b[3] = x[3]; /* +-0: no norm to take */
+    { const planetary_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[7] = x[4]; }
+    b[4] = x[5]; /* +-0: no norm to take */
+    b[2] = x[6]; /* +-0: no norm to take */
+    { const planetary_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[5] = x[7]; }
+    { const planetary_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[8] = x[8]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..8 of U^T (rows of U) */

@@ -35,6 +35,13 @@ quick_return_real quick_return_dense_lu_pivot_ratio(const quick_return_dense_lu 
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void quick_return_dense_lu_solve(const quick_return_dense_lu *lu, quick_return_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+quick_return_real quick_return_dense_lu_solve_max(const quick_return_dense_lu *lu, quick_return_real b[],
+                                              quick_return_real *sum_abs);
+quick_return_real quick_return_dense_lu_solve_negated_max(const quick_return_dense_lu *lu,
+                                                      quick_return_real b[], quick_return_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void quick_return_dense_lu_solve_transposed(const quick_return_dense_lu *lu, quick_return_real b[]);
 

@@ -158,37 +158,6 @@ quick_return_real quick_return_lu_pivot_ratio(const quick_return_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* U z = y, rows 10..0 */
-static void quick_return_lu_backward_0(const quick_return_real *v,
-        const quick_return_real *inv, quick_return_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[10] = -x[10];
-    x[9] = -x[9];
-    x[8] = -x[8];
-    x[6] = -x[6];
-    x[5] = -x[5];
-    x[4] -= v[4] * x[5];
-    x[4] -= v[5] * x[6];
-    x[4] -= v[6] * x[7];
-    x[4] -= v[7] * x[8];
-    x[4] -= v[8] * x[9];
-    x[4] *= inv[4];
-    x[3] -= v[14] * x[4];
-    x[3] -= x[9];
-    x[3] = -x[3];
-    x[2] -= x[3];
-    x[2] += x[10];
-    x[2] *= inv[2];
-    x[1] -= v[11] * x[4];
-    x[1] -= x[8];
-    x[1] = -x[1];
-    x[0] -= x[1];
-    x[0] -= v[17] * x[2];
-    x[0] = -x[0];
-}
-
 void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[])
 {
     quick_return_real x[QUICK_RETURN_NQ];
@@ -209,7 +178,35 @@ void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[])
     x[9] = b[3];
     x[10] = b[10];
     x[11] = b[9];
-    quick_return_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const quick_return_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[10] = -x[10];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] -= v[4] * x[5];
+        x[4] -= v[5] * x[6];
+        x[4] -= v[6] * x[7];
+        x[4] -= v[7] * x[8];
+        x[4] -= v[8] * x[9];
+        x[4] *= inv[4];
+        x[3] -= v[14] * x[4];
+        x[3] -= x[9];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] += x[10];
+        x[2] *= inv[2];
+        x[1] -= v[11] * x[4];
+        x[1] -= x[8];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[17] * x[2];
+        x[0] = -x[0];
+    }
     b[9] = x[0];
     b[6] = x[1];
     b[8] = x[2];
@@ -222,6 +219,139 @@ void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[])
     b[4] = x[9];
     b[10] = x[10];
     b[11] = x[11];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+quick_return_real quick_return_lu_solve_rates(const quick_return_lu *lu, quick_return_real b[], quick_return_real *sum_abs)
+{
+    quick_return_real x[QUICK_RETURN_NQ];
+    quick_return_real largest = 0, total = 0;
+    if (lu->dense) return quick_return_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[7]: a zero row */
+    x[1] = 0; /* b[5]: a zero row */
+    x[2] = 0; /* b[8]: a zero row */
+    x[3] = 0; /* b[6]: a zero row */
+    x[4] = 0; /* b[4]: a zero row */
+    x[5] = 0; /* b[0]: a zero row */
+    x[6] = 0; /* b[1]: a zero row */
+    x[7] = b[11];
+    x[8] = 0; /* b[2]: a zero row */
+    x[9] = 0; /* b[3]: a zero row */
+    x[10] = 0; /* b[10]: a zero row */
+    x[11] = 0; /* b[9]: a zero row */
+    {
+        const quick_return_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[10] = -x[10];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] -= v[4] * x[5];
+        x[4] -= v[5] * x[6];
+        x[4] -= v[6] * x[7];
+        x[4] -= v[7] * x[8];
+        x[4] -= v[8] * x[9];
+        x[4] *= inv[4];
+        x[3] -= v[14] * x[4];
+        x[3] -= x[9];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] += x[10];
+        x[2] *= inv[2];
+        x[1] -= v[11] * x[4];
+        x[1] -= x[8];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[17] * x[2];
+        x[0] = -x[0];
+    }
+    { const quick_return_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[9] = -x[0]; }
+    { const quick_return_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[6] = -x[1]; }
+    { const quick_return_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[8] = -x[2]; }
+    { const quick_return_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[7] = -x[3]; }
+    { const quick_return_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[5] = -x[4]; }
+    b[0] = -x[5]; /* +-0: no norm to take */
+    b[1] = -x[6]; /* +-0: no norm to take */
+    { const quick_return_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[2] = -x[7]; }
+    b[3] = -x[8]; /* +-0: no norm to take */
+    b[4] = -x[9]; /* +-0: no norm to take */
+    b[10] = -x[10]; /* +-0: no norm to take */
+    b[11] = -x[11]; /* +-0: no norm to take */
+    *sum_abs = total;
+    return largest;
+}
+
+quick_return_real quick_return_lu_solve_accelerations(const quick_return_lu *lu, quick_return_real b[], quick_return_real *sum_abs)
+{
+    quick_return_real x[QUICK_RETURN_NQ];
+    quick_return_real largest = 0, total = 0;
+    if (lu->dense) return quick_return_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[7];
+    x[1] = b[5];
+    x[2] = b[8];
+    x[3] = b[6];
+    x[4] = b[4];
+    x[5] = 0; /* b[0]: a zero row */
+    x[6] = 0; /* b[1]: a zero row */
+    x[7] = 0; /* b[11]: a zero row */
+    x[8] = 0; /* b[2]: a zero row */
+    x[9] = 0; /* b[3]: a zero row */
+    x[10] = 0; /* b[10]: a zero row */
+    x[11] = 0; /* b[9]: a zero row */
+    {
+        const quick_return_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* U z = y */
+        x[10] = -x[10];
+        x[9] = -x[9];
+        x[8] = -x[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] -= v[4] * x[5];
+        x[4] -= v[5] * x[6];
+        x[4] -= v[6] * x[7];
+        x[4] -= v[7] * x[8];
+        x[4] -= v[8] * x[9];
+        x[4] *= inv[4];
+        x[3] -= v[14] * x[4];
+        x[3] -= x[9];
+        x[3] = -x[3];
+        x[2] -= x[3];
+        x[2] += x[10];
+        x[2] *= inv[2];
+        x[1] -= v[11] * x[4];
+        x[1] -= x[8];
+        x[1] = -x[1];
+        x[0] -= x[1];
+        x[0] -= v[17] * x[2];
+        x[0] = -x[0];
+    }
+    { const quick_return_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[9] = x[0]; }
+    { const quick_return_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[6] = x[1]; }
+    { const quick_return_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[8] = x[2]; }
+    { const quick_return_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[7] = x[3]; }
+    { const quick_return_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[5] = x[4]; }
+    b[0] = x[5]; /* +-0: no norm to take */
+    b[1] = x[6]; /* +-0: no norm to take */
+    b[2] = x[7]; /* +-0: no norm to take */
+    b[3] = x[8]; /* +-0: no norm to take */
+    b[4] = x[9]; /* +-0: no norm to take */
+    b[10] = x[10]; /* +-0: no norm to take */
+    b[11] = x[11]; /* +-0: no norm to take */
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..10 of U^T (rows of U) */

@@ -50,6 +50,15 @@ unsigned long quick_return_lu_fallbacks(const quick_return_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void quick_return_lu_solve(const quick_return_lu *lu, quick_return_real b[]);
 
+/* The step's two solves, each with the norms of its solution: returns max |x_i| of the solution
+ * as solved and stores sum |x_i| in *sum_abs (NaN exactly when some x_i is). _rates solves b =
+ * Phi_t and writes -x (dq); _accelerations solves b = Gamma. A row where the generated Phi_t or
+ * Gamma is a literal 0 is taken as 0, not read. */
+quick_return_real quick_return_lu_solve_rates(const quick_return_lu *lu, quick_return_real b[],
+                                            quick_return_real *sum_abs);
+quick_return_real quick_return_lu_solve_accelerations(const quick_return_lu *lu, quick_return_real b[],
+                                                    quick_return_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
  * estimate of the solver). */
 void quick_return_lu_solve_transposed(const quick_return_lu *lu, quick_return_real b[]);

@@ -35,6 +35,13 @@ rack_linkage_real rack_linkage_dense_lu_pivot_ratio(const rack_linkage_dense_lu 
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void rack_linkage_dense_lu_solve(const rack_linkage_dense_lu *lu, rack_linkage_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+rack_linkage_real rack_linkage_dense_lu_solve_max(const rack_linkage_dense_lu *lu, rack_linkage_real b[],
+                                              rack_linkage_real *sum_abs);
+rack_linkage_real rack_linkage_dense_lu_solve_negated_max(const rack_linkage_dense_lu *lu,
+                                                      rack_linkage_real b[], rack_linkage_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void rack_linkage_dense_lu_solve_transposed(const rack_linkage_dense_lu *lu, rack_linkage_real b[]);
 

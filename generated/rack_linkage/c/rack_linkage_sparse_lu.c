@@ -201,45 +201,6 @@ rack_linkage_real rack_linkage_lu_pivot_ratio(const rack_linkage_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..10 */
-static void rack_linkage_lu_forward_0(const rack_linkage_real *v, rack_linkage_real *x)
-{
-    (void)v;
-    x[8] -= v[4] * x[0];
-    x[8] -= v[5] * x[1];
-    x[4] -= v[14] * x[2];
-    x[8] -= v[9] * x[2];
-    x[9] -= v[11] * x[2];
-    x[4] += x[3];
-    x[8] -= v[8] * x[3];
-    x[11] += x[4];
-    x[10] -= x[5];
-    x[11] -= x[6];
-    x[8] -= v[6] * x[7];
-    x[9] -= v[10] * x[8];
-    x[10] += x[9];
-    x[11] -= v[21] * x[10];
-}
-
-/* U z = y, rows 11..0 */
-static void rack_linkage_lu_backward_0(const rack_linkage_real *v,
-        const rack_linkage_real *inv, rack_linkage_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[11] *= inv[11];
-    x[10] -= v[19] * x[11];
-    x[10] *= inv[10];
-    x[9] = -x[9];
-    x[8] *= inv[8];
-    x[6] = -x[6];
-    x[5] = -x[5];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[1] = -x[1];
-    x[0] = -x[0];
-}
-
 void rack_linkage_lu_solve(const rack_linkage_lu *lu, rack_linkage_real b[])
 {
     rack_linkage_real x[RACK_LINKAGE_NQ];
@@ -260,8 +221,38 @@ void rack_linkage_lu_solve(const rack_linkage_lu *lu, rack_linkage_real b[])
     x[9] = b[5];
     x[10] = b[7];
     x[11] = b[8];
-    rack_linkage_lu_forward_0(lu->v, x);
-    rack_linkage_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const rack_linkage_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[8] -= v[4] * x[0];
+        x[8] -= v[5] * x[1];
+        x[4] -= v[14] * x[2];
+        x[8] -= v[9] * x[2];
+        x[9] -= v[11] * x[2];
+        x[4] += x[3];
+        x[8] -= v[8] * x[3];
+        x[11] += x[4];
+        x[10] -= x[5];
+        x[11] -= x[6];
+        x[8] -= v[6] * x[7];
+        x[9] -= v[10] * x[8];
+        x[10] += x[9];
+        x[11] -= v[21] * x[10];
+        /* U z = y */
+        x[11] *= inv[11];
+        x[10] -= v[19] * x[11];
+        x[10] *= inv[10];
+        x[9] = -x[9];
+        x[8] *= inv[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
     b[0] = x[0];
     b[1] = x[1];
     b[5] = x[2];
@@ -274,6 +265,145 @@ void rack_linkage_lu_solve(const rack_linkage_lu *lu, rack_linkage_real b[])
     b[6] = x[9];
     b[8] = x[10];
     b[11] = x[11];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+rack_linkage_real rack_linkage_lu_solve_rates(const rack_linkage_lu *lu, rack_linkage_real b[], rack_linkage_real *sum_abs)
+{
+    rack_linkage_real x[RACK_LINKAGE_NQ];
+    rack_linkage_real largest = 0, total = 0;
+    if (lu->dense) return rack_linkage_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[3]: a zero row */
+    x[4] = 0; /* b[6]: a zero row */
+    x[5] = 0; /* b[9]: a zero row */
+    x[6] = 0; /* b[10]: a zero row */
+    x[7] = b[11];
+    x[8] = 0; /* b[4]: a zero row */
+    x[9] = 0; /* b[5]: a zero row */
+    x[10] = 0; /* b[7]: a zero row */
+    x[11] = 0; /* b[8]: a zero row */
+    {
+        const rack_linkage_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[8] -= v[4] * x[0];
+        x[8] -= v[5] * x[1];
+        x[4] -= v[14] * x[2];
+        x[8] -= v[9] * x[2];
+        x[9] -= v[11] * x[2];
+        x[4] += x[3];
+        x[8] -= v[8] * x[3];
+        x[11] += x[4];
+        x[10] -= x[5];
+        x[11] -= x[6];
+        x[8] -= v[6] * x[7];
+        x[9] -= v[10] * x[8];
+        x[10] += x[9];
+        x[11] -= v[21] * x[10];
+        /* U z = y */
+        x[11] *= inv[11];
+        x[10] -= v[19] * x[11];
+        x[10] *= inv[10];
+        x[9] = -x[9];
+        x[8] *= inv[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = -x[0]; /* +-0: no norm to take */
+    b[1] = -x[1]; /* +-0: no norm to take */
+    b[5] = -x[2]; /* +-0: no norm to take */
+    b[4] = -x[3]; /* +-0: no norm to take */
+    { const rack_linkage_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[7] = -x[4]; }
+    b[9] = -x[5]; /* +-0: no norm to take */
+    b[10] = -x[6]; /* +-0: no norm to take */
+    { const rack_linkage_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[2] = -x[7]; }
+    { const rack_linkage_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[3] = -x[8]; }
+    { const rack_linkage_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[6] = -x[9]; }
+    { const rack_linkage_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[8] = -x[10]; }
+    { const rack_linkage_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[11] = -x[11]; }
+    *sum_abs = total;
+    return largest;
+}
+
+rack_linkage_real rack_linkage_lu_solve_accelerations(const rack_linkage_lu *lu, rack_linkage_real b[], rack_linkage_real *sum_abs)
+{
+    rack_linkage_real x[RACK_LINKAGE_NQ];
+    rack_linkage_real largest = 0, total = 0;
+    if (lu->dense) return rack_linkage_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[3]: a zero row */
+    x[4] = b[6];
+    x[5] = 0; /* b[9]: a zero row */
+    x[6] = 0; /* b[10]: a zero row */
+    x[7] = b[11];
+    x[8] = b[4];
+    x[9] = b[5];
+    x[10] = b[7];
+    x[11] = b[8];
+    {
+        const rack_linkage_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[8] -= v[4] * x[0];
+        x[8] -= v[5] * x[1];
+        x[4] -= v[14] * x[2];
+        x[8] -= v[9] * x[2];
+        x[9] -= v[11] * x[2];
+        x[4] += x[3];
+        x[8] -= v[8] * x[3];
+        x[11] += x[4];
+        x[10] -= x[5];
+        x[11] -= x[6];
+        x[8] -= v[6] * x[7];
+        x[9] -= v[10] * x[8];
+        x[10] += x[9];
+        x[11] -= v[21] * x[10];
+        /* U z = y */
+        x[11] *= inv[11];
+        x[10] -= v[19] * x[11];
+        x[10] *= inv[10];
+        x[9] = -x[9];
+        x[8] *= inv[8];
+        x[6] = -x[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = x[0]; /* +-0: no norm to take */
+    b[1] = x[1]; /* +-0: no norm to take */
+    b[5] = x[2]; /* +-0: no norm to take */
+    b[4] = x[3]; /* +-0: no norm to take */
+    { const rack_linkage_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[7] = x[4]; }
+    b[9] = x[5]; /* +-0: no norm to take */
+    b[10] = x[6]; /* +-0: no norm to take */
+    { const rack_linkage_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[2] = x[7]; }
+    { const rack_linkage_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[3] = x[8]; }
+    { const rack_linkage_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[6] = x[9]; }
+    { const rack_linkage_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[8] = x[10]; }
+    { const rack_linkage_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[11] = x[11]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..11 of U^T (rows of U) */

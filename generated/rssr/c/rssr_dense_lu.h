@@ -35,6 +35,13 @@ rssr_real rssr_dense_lu_pivot_ratio(const rssr_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void rssr_dense_lu_solve(const rssr_dense_lu *lu, rssr_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+rssr_real rssr_dense_lu_solve_max(const rssr_dense_lu *lu, rssr_real b[],
+                                              rssr_real *sum_abs);
+rssr_real rssr_dense_lu_solve_negated_max(const rssr_dense_lu *lu,
+                                                      rssr_real b[], rssr_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void rssr_dense_lu_solve_transposed(const rssr_dense_lu *lu, rssr_real b[]);
 

@@ -327,68 +327,6 @@ rssr_real rssr_lu_pivot_ratio(const rssr_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..12 */
-static void rssr_lu_forward_0(const rssr_real *v, rssr_real *x)
-{
-    (void)v;
-    x[9] -= v[22] * x[0];
-    x[9] -= v[23] * x[1];
-    x[9] -= v[24] * x[2];
-    x[9] -= v[29] * x[3];
-    x[9] -= v[30] * x[4];
-    x[9] -= v[31] * x[5];
-    x[7] -= v[20] * x[6];
-    x[8] -= v[46] * x[6];
-    x[9] -= v[34] * x[6];
-    x[8] -= v[47] * x[7];
-    x[9] -= v[35] * x[7];
-    x[9] -= v[32] * x[8];
-    x[11] -= v[8] * x[10];
-    x[12] -= v[37] * x[10];
-    x[13] -= v[41] * x[10];
-    x[12] -= v[38] * x[11];
-    x[13] -= v[42] * x[11];
-    x[13] -= v[43] * x[12];
-}
-
-/* U z = y, rows 13..0 */
-static void rssr_lu_backward_0(const rssr_real *v,
-        const rssr_real *inv, rssr_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[13] *= inv[13];
-    x[12] -= v[36] * x[13];
-    x[12] *= inv[12];
-    x[11] -= v[10] * x[12];
-    x[11] -= v[7] * x[13];
-    x[11] *= inv[11];
-    x[10] -= v[5] * x[11];
-    x[10] -= v[6] * x[12];
-    x[10] -= v[3] * x[13];
-    x[10] *= inv[10];
-    x[9] -= v[26] * x[10];
-    x[9] -= v[27] * x[11];
-    x[9] -= v[28] * x[12];
-    x[9] -= v[25] * x[13];
-    x[9] *= inv[9];
-    x[8] -= v[45] * x[9];
-    x[8] *= inv[8];
-    x[7] -= v[18] * x[8];
-    x[7] -= v[19] * x[9];
-    x[7] *= inv[7];
-    x[6] -= v[17] * x[7];
-    x[6] -= v[14] * x[8];
-    x[6] -= v[15] * x[9];
-    x[6] *= inv[6];
-    x[5] = -x[5];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] = -x[1];
-    x[0] = -x[0];
-}
-
 void rssr_lu_solve(const rssr_lu *lu, rssr_real b[])
 {
     rssr_real x[RSSR_NQ];
@@ -415,8 +353,61 @@ void rssr_lu_solve(const rssr_lu *lu, rssr_real b[])
     if (lu->swapped[1]) { const rssr_real w = x[10]; x[10] = x[12]; x[12] = w; }
     if (lu->swapped[2]) { const rssr_real w = x[10]; x[10] = x[13]; x[13] = w; }
     if (lu->swapped[3]) { const rssr_real w = x[12]; x[12] = x[13]; x[13] = w; }
-    rssr_lu_forward_0(lu->v, x);
-    rssr_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const rssr_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[9] -= v[22] * x[0];
+        x[9] -= v[23] * x[1];
+        x[9] -= v[24] * x[2];
+        x[9] -= v[29] * x[3];
+        x[9] -= v[30] * x[4];
+        x[9] -= v[31] * x[5];
+        x[7] -= v[20] * x[6];
+        x[8] -= v[46] * x[6];
+        x[9] -= v[34] * x[6];
+        x[8] -= v[47] * x[7];
+        x[9] -= v[35] * x[7];
+        x[9] -= v[32] * x[8];
+        x[11] -= v[8] * x[10];
+        x[12] -= v[37] * x[10];
+        x[13] -= v[41] * x[10];
+        x[12] -= v[38] * x[11];
+        x[13] -= v[42] * x[11];
+        x[13] -= v[43] * x[12];
+        /* U z = y */
+        x[13] *= inv[13];
+        x[12] -= v[36] * x[13];
+        x[12] *= inv[12];
+        x[11] -= v[10] * x[12];
+        x[11] -= v[7] * x[13];
+        x[11] *= inv[11];
+        x[10] -= v[5] * x[11];
+        x[10] -= v[6] * x[12];
+        x[10] -= v[3] * x[13];
+        x[10] *= inv[10];
+        x[9] -= v[26] * x[10];
+        x[9] -= v[27] * x[11];
+        x[9] -= v[28] * x[12];
+        x[9] -= v[25] * x[13];
+        x[9] *= inv[9];
+        x[8] -= v[45] * x[9];
+        x[8] *= inv[8];
+        x[7] -= v[18] * x[8];
+        x[7] -= v[19] * x[9];
+        x[7] *= inv[7];
+        x[6] -= v[17] * x[7];
+        x[6] -= v[14] * x[8];
+        x[6] -= v[15] * x[9];
+        x[6] *= inv[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
     b[0] = x[0];
     b[1] = x[1];
     b[2] = x[2];
@@ -431,6 +422,207 @@ void rssr_lu_solve(const rssr_lu *lu, rssr_real b[])
     b[5] = x[11];
     b[6] = x[12];
     b[3] = x[13];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+rssr_real rssr_lu_solve_rates(const rssr_lu *lu, rssr_real b[], rssr_real *sum_abs)
+{
+    rssr_real x[RSSR_NQ];
+    rssr_real largest = 0, total = 0;
+    if (lu->dense) return rssr_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[5]: a zero row */
+    x[4] = 0; /* b[6]: a zero row */
+    x[5] = 0; /* b[7]: a zero row */
+    x[6] = 0; /* b[8]: a zero row */
+    x[7] = 0; /* b[9]: a zero row */
+    x[8] = 0; /* b[13]: a zero row */
+    x[9] = 0; /* b[10]: a zero row */
+    x[10] = 0; /* b[3]: a zero row */
+    x[11] = 0; /* b[4]: a zero row */
+    x[12] = b[11];
+    x[13] = 0; /* b[12]: a zero row */
+    if (lu->swapped[0]) { const rssr_real w = x[10]; x[10] = x[11]; x[11] = w; }
+    if (lu->swapped[1]) { const rssr_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[2]) { const rssr_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[3]) { const rssr_real w = x[12]; x[12] = x[13]; x[13] = w; }
+    {
+        const rssr_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[9] -= v[22] * x[0];
+        x[9] -= v[23] * x[1];
+        x[9] -= v[24] * x[2];
+        x[9] -= v[29] * x[3];
+        x[9] -= v[30] * x[4];
+        x[9] -= v[31] * x[5];
+        x[7] -= v[20] * x[6];
+        x[8] -= v[46] * x[6];
+        x[9] -= v[34] * x[6];
+        x[8] -= v[47] * x[7];
+        x[9] -= v[35] * x[7];
+        x[9] -= v[32] * x[8];
+        x[11] -= v[8] * x[10];
+        x[12] -= v[37] * x[10];
+        x[13] -= v[41] * x[10];
+        x[12] -= v[38] * x[11];
+        x[13] -= v[42] * x[11];
+        x[13] -= v[43] * x[12];
+        /* U z = y */
+        x[13] *= inv[13];
+        x[12] -= v[36] * x[13];
+        x[12] *= inv[12];
+        x[11] -= v[10] * x[12];
+        x[11] -= v[7] * x[13];
+        x[11] *= inv[11];
+        x[10] -= v[5] * x[11];
+        x[10] -= v[6] * x[12];
+        x[10] -= v[3] * x[13];
+        x[10] *= inv[10];
+        x[9] -= v[26] * x[10];
+        x[9] -= v[27] * x[11];
+        x[9] -= v[28] * x[12];
+        x[9] -= v[25] * x[13];
+        x[9] *= inv[9];
+        x[8] -= v[45] * x[9];
+        x[8] *= inv[8];
+        x[7] -= v[18] * x[8];
+        x[7] -= v[19] * x[9];
+        x[7] *= inv[7];
+        x[6] -= v[17] * x[7];
+        x[6] -= v[14] * x[8];
+        x[6] -= v[15] * x[9];
+        x[6] *= inv[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = -x[0]; /* +-0: no norm to take */
+    b[1] = -x[1]; /* +-0: no norm to take */
+    b[2] = -x[2]; /* +-0: no norm to take */
+    b[7] = -x[3]; /* +-0: no norm to take */
+    b[8] = -x[4]; /* +-0: no norm to take */
+    b[9] = -x[5]; /* +-0: no norm to take */
+    { const rssr_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[12] = -x[6]; }
+    { const rssr_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[13] = -x[7]; }
+    { const rssr_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[10] = -x[8]; }
+    { const rssr_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[11] = -x[9]; }
+    { const rssr_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[4] = -x[10]; }
+    { const rssr_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[5] = -x[11]; }
+    { const rssr_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[6] = -x[12]; }
+    { const rssr_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[3] = -x[13]; }
+    *sum_abs = total;
+    return largest;
+}
+
+rssr_real rssr_lu_solve_accelerations(const rssr_lu *lu, rssr_real b[], rssr_real *sum_abs)
+{
+    rssr_real x[RSSR_NQ];
+    rssr_real largest = 0, total = 0;
+    if (lu->dense) return rssr_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[5]: a zero row */
+    x[4] = 0; /* b[6]: a zero row */
+    x[5] = 0; /* b[7]: a zero row */
+    x[6] = b[8];
+    x[7] = b[9];
+    x[8] = b[13];
+    x[9] = b[10];
+    x[10] = b[3];
+    x[11] = b[4];
+    x[12] = b[11];
+    x[13] = b[12];
+    if (lu->swapped[0]) { const rssr_real w = x[10]; x[10] = x[11]; x[11] = w; }
+    if (lu->swapped[1]) { const rssr_real w = x[10]; x[10] = x[12]; x[12] = w; }
+    if (lu->swapped[2]) { const rssr_real w = x[10]; x[10] = x[13]; x[13] = w; }
+    if (lu->swapped[3]) { const rssr_real w = x[12]; x[12] = x[13]; x[13] = w; }
+    {
+        const rssr_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[9] -= v[22] * x[0];
+        x[9] -= v[23] * x[1];
+        x[9] -= v[24] * x[2];
+        x[9] -= v[29] * x[3];
+        x[9] -= v[30] * x[4];
+        x[9] -= v[31] * x[5];
+        x[7] -= v[20] * x[6];
+        x[8] -= v[46] * x[6];
+        x[9] -= v[34] * x[6];
+        x[8] -= v[47] * x[7];
+        x[9] -= v[35] * x[7];
+        x[9] -= v[32] * x[8];
+        x[11] -= v[8] * x[10];
+        x[12] -= v[37] * x[10];
+        x[13] -= v[41] * x[10];
+        x[12] -= v[38] * x[11];
+        x[13] -= v[42] * x[11];
+        x[13] -= v[43] * x[12];
+        /* U z = y */
+        x[13] *= inv[13];
+        x[12] -= v[36] * x[13];
+        x[12] *= inv[12];
+        x[11] -= v[10] * x[12];
+        x[11] -= v[7] * x[13];
+        x[11] *= inv[11];
+        x[10] -= v[5] * x[11];
+        x[10] -= v[6] * x[12];
+        x[10] -= v[3] * x[13];
+        x[10] *= inv[10];
+        x[9] -= v[26] * x[10];
+        x[9] -= v[27] * x[11];
+        x[9] -= v[28] * x[12];
+        x[9] -= v[25] * x[13];
+        x[9] *= inv[9];
+        x[8] -= v[45] * x[9];
+        x[8] *= inv[8];
+        x[7] -= v[18] * x[8];
+        x[7] -= v[19] * x[9];
+        x[7] *= inv[7];
+        x[6] -= v[17] * x[7];
+        x[6] -= v[14] * x[8];
+        x[6] -= v[15] * x[9];
+        x[6] *= inv[6];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = x[0]; /* +-0: no norm to take */
+    b[1] = x[1]; /* +-0: no norm to take */
+    b[2] = x[2]; /* +-0: no norm to take */
+    b[7] = x[3]; /* +-0: no norm to take */
+    b[8] = x[4]; /* +-0: no norm to take */
+    b[9] = x[5]; /* +-0: no norm to take */
+    { const rssr_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[12] = x[6]; }
+    { const rssr_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[13] = x[7]; }
+    { const rssr_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[10] = x[8]; }
+    { const rssr_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[11] = x[9]; }
+    { const rssr_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[4] = x[10]; }
+    { const rssr_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[5] = x[11]; }
+    { const rssr_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[6] = x[12]; }
+    { const rssr_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[3] = x[13]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..13 of U^T (rows of U) */

@@ -54,6 +54,15 @@ unsigned long rssr_lu_fallbacks(const rssr_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void rssr_lu_solve(const rssr_lu *lu, rssr_real b[]);
 
+/* The step's two solves, each with the norms of its solution: returns max |x_i| of the solution
+ * as solved and stores sum |x_i| in *sum_abs (NaN exactly when some x_i is). _rates solves b =
+ * Phi_t and writes -x (dq); _accelerations solves b = Gamma. A row where the generated Phi_t or
+ * Gamma is a literal 0 is taken as 0, not read. */
+rssr_real rssr_lu_solve_rates(const rssr_lu *lu, rssr_real b[],
+                                            rssr_real *sum_abs);
+rssr_real rssr_lu_solve_accelerations(const rssr_lu *lu, rssr_real b[],
+                                                    rssr_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
  * estimate of the solver). */
 void rssr_lu_solve_transposed(const rssr_lu *lu, rssr_real b[]);

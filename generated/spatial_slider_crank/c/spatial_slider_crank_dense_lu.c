@@ -103,6 +103,40 @@ void spatial_slider_crank_dense_lu_solve(const spatial_slider_crank_dense_lu *lu
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
+/* The solve, then its solution's max |x_i| (returned) and sum |x_i| (into *sum_abs); the
+ * _negated one then writes -x (exact): the norms the step takes (lu_solve_rates, negated,
+ * and lu_solve_accelerations). */
+spatial_slider_crank_real spatial_slider_crank_dense_lu_solve_max(const spatial_slider_crank_dense_lu *lu, spatial_slider_crank_real b[],
+        spatial_slider_crank_real *sum_abs)
+{
+    spatial_slider_crank_real largest = 0, total = 0;
+    spatial_slider_crank_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < SPATIAL_SLIDER_CRANK_NQ; ++k) {
+        const spatial_slider_crank_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+    }
+    *sum_abs = total;
+    return largest;
+}
+
+spatial_slider_crank_real spatial_slider_crank_dense_lu_solve_negated_max(const spatial_slider_crank_dense_lu *lu, spatial_slider_crank_real b[],
+        spatial_slider_crank_real *sum_abs)
+{
+    spatial_slider_crank_real largest = 0, total = 0;
+    spatial_slider_crank_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < SPATIAL_SLIDER_CRANK_NQ; ++k) {
+        const spatial_slider_crank_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+        b[k] = -b[k];
+    }
+    *sum_abs = total;
+    return largest;
+}
+
 void spatial_slider_crank_dense_lu_solve_transposed(const spatial_slider_crank_dense_lu *lu, spatial_slider_crank_real b[])
 {
     /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */

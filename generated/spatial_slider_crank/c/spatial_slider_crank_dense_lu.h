@@ -35,6 +35,13 @@ spatial_slider_crank_real spatial_slider_crank_dense_lu_pivot_ratio(const spatia
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void spatial_slider_crank_dense_lu_solve(const spatial_slider_crank_dense_lu *lu, spatial_slider_crank_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+spatial_slider_crank_real spatial_slider_crank_dense_lu_solve_max(const spatial_slider_crank_dense_lu *lu, spatial_slider_crank_real b[],
+                                              spatial_slider_crank_real *sum_abs);
+spatial_slider_crank_real spatial_slider_crank_dense_lu_solve_negated_max(const spatial_slider_crank_dense_lu *lu,
+                                                      spatial_slider_crank_real b[], spatial_slider_crank_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void spatial_slider_crank_dense_lu_solve_transposed(const spatial_slider_crank_dense_lu *lu, spatial_slider_crank_real b[]);
 

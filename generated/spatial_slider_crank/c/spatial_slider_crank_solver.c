@@ -774,11 +774,16 @@ static int spatial_slider_crank_newton(const spatial_slider_crank_options *optio
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
     report->residual = (spatial_slider_crank_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        spatial_slider_crank_real residual;
+        spatial_slider_crank_real residual = 0, sum = 0;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         spatial_slider_crank_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
         spatial_slider_crank_in_unit(work);
-        residual = spatial_slider_crank_max_abs(work->phi);
+        /* max |Phi| as max_abs takes it, written out here: no call in the loop every step
+         * runs (a copy of max_abs the compiler would fold back into the call) */
+        for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
+            { const spatial_slider_crank_real a = fabs(work->phi[i]); residual = residual > a ? residual : a; sum += a; }
+        }
+        residual = sum != sum ? (spatial_slider_crank_real)NAN : residual;
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
@@ -814,38 +819,16 @@ static void spatial_slider_crank_predict(spatial_slider_crank_real t, spatial_sl
     }
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
- * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
- * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
- * largest), and dq in the kernel's unit. */
-static spatial_slider_crank_real spatial_slider_crank_rates_pass(const spatial_slider_crank_workspace *work, spatial_slider_crank_real dq[],
-                                       spatial_slider_crank_real *sum_abs)
+/* max |q| in the run's unit (NaN when some q_i is, as in max_abs: the error model then flags
+ * the point). */
+static spatial_slider_crank_real spatial_slider_crank_positions_pass(const spatial_slider_crank_workspace *work, const spatial_slider_crank_real q[])
 {
-    spatial_slider_crank_real largest = 0, sum = 0;
+    spatial_slider_crank_real largest_q = 0, sum_q = 0, largest_length = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs); a coordinate that is no length is
+     * the same in every unit (no division); the lengths' largest |q_i| is divided by the unit
+     * once, after the pass: rounding is monotone, so max (|q_i| / unit) and (max |q_i|) / unit
+     * are the same number (the unit is finite) */
     for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        { const spatial_slider_crank_real b = fabs(dq[i]); largest = largest > b ? largest : b; sum += b; }
-        dq[i] = -dq[i];
-    }
-    spatial_slider_crank_from_unit(work, dq);
-    *sum_abs = sum;
-    return largest;
-}
-
-/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
- * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
- * then flags the point). */
-static spatial_slider_crank_real spatial_slider_crank_accelerations_pass(const spatial_slider_crank_workspace *work,
-                                               const spatial_slider_crank_real q[], spatial_slider_crank_real ddq[],
-                                               spatial_slider_crank_real *sum_abs, spatial_slider_crank_real *nq)
-{
-    spatial_slider_crank_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
-    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division); the lengths'
-     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
-     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
-    for (int i = 0; i < SPATIAL_SLIDER_CRANK_NQ; ++i) {
-        { const spatial_slider_crank_real c = fabs(ddq[i]); largest = largest > c ? largest : c; sum += c; }
         {
             const spatial_slider_crank_real a = fabs(q[i]) * work->inverse_column[i];
             largest_q = largest_q > a ? largest_q : a;
@@ -854,10 +837,8 @@ static spatial_slider_crank_real spatial_slider_crank_accelerations_pass(const s
     }
     largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
     largest_q = largest_q > largest_length ? largest_q : largest_length;
-    spatial_slider_crank_from_unit(work, ddq);
-    *sum_abs = sum;
-    *nq = sum_q != sum_q ? (spatial_slider_crank_real)NAN : largest_q;
-    return largest;
+    (void)work;
+    return sum_q != sum_q ? (spatial_slider_crank_real)NAN : largest_q;
 }
 
 /* spatial_slider_crank_solve_step with its options already checked. */
@@ -879,16 +860,19 @@ static int spatial_slider_crank_step(const spatial_slider_crank_options *options
         return report->status;
     }
     /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
-     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
-     * fused call, so the shared sines and cosines are this q's. */
+     * is -dq, written out negated. Each solve returns its solution's max |.| in the run's unit
+     * and the sum of |.| for the finite test, taken as it writes the solution (no pass over
+     * it again). Newton stopped at the q of its last fused call, so the shared sines and
+     * cosines are this q's. */
     spatial_slider_crank_phi_t_shared(state->q, t, p, work->shared, state->dq);
     spatial_slider_crank_rows_in_unit(work, state->dq);
-    spatial_slider_crank_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = spatial_slider_crank_rates_pass(work, state->dq, &sum_dq);
+    ndq = spatial_slider_crank_lu_solve_rates(&work->lu, state->dq, &sum_dq); /* (2.73) */
+    spatial_slider_crank_from_unit(work, state->dq);
     spatial_slider_crank_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     spatial_slider_crank_rows_in_unit(work, state->ddq);
-    spatial_slider_crank_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = spatial_slider_crank_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    nddq = spatial_slider_crank_lu_solve_accelerations(&work->lu, state->ddq, &sum_ddq); /* (2.74) */
+    spatial_slider_crank_from_unit(work, state->ddq);
+    nq = spatial_slider_crank_positions_pass(work, state->q);
     /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
      * overflow harmlessly), infinite where the larger maximum is */
     largest = ndq > nddq ? ndq : nddq;

@@ -415,115 +415,6 @@ spatial_slider_crank_real spatial_slider_crank_lu_pivot_ratio(const spatial_slid
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 3..19 */
-static void spatial_slider_crank_lu_forward_0(const spatial_slider_crank_real *v, spatial_slider_crank_real *x)
-{
-    (void)v;
-    x[7] += x[3];
-    x[8] += x[4];
-    x[11] -= x[5];
-    x[10] += x[6];
-    x[10] -= x[7];
-    x[11] -= x[8];
-    x[10] -= v[36] * x[9];
-    x[11] -= v[42] * x[9];
-    x[12] -= v[47] * x[9];
-    x[11] -= v[43] * x[10];
-    x[12] -= v[48] * x[10];
-    x[12] -= v[49] * x[11];
-    x[14] -= v[9] * x[13];
-    x[15] -= v[71] * x[13];
-    x[16] -= v[75] * x[13];
-    x[15] -= v[72] * x[14];
-    x[16] -= v[76] * x[14];
-    x[16] -= v[74] * x[15];
-    x[18] -= v[61] * x[17];
-    x[19] -= v[67] * x[17];
-    x[20] -= v[83] * x[17];
-    x[19] -= v[68] * x[18];
-    x[20] -= v[84] * x[18];
-    x[20] -= v[82] * x[19];
-}
-
-/* U z = y, rows 20..0 */
-static void spatial_slider_crank_lu_backward_0(const spatial_slider_crank_real *v,
-        const spatial_slider_crank_real *inv, spatial_slider_crank_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[20] *= inv[20];
-    x[19] -= v[65] * x[20];
-    x[19] *= inv[19];
-    x[18] -= v[60] * x[19];
-    x[18] -= v[59] * x[20];
-    x[18] *= inv[18];
-    x[17] -= v[58] * x[18];
-    x[17] -= v[56] * x[19];
-    x[17] -= v[55] * x[20];
-    x[17] *= inv[17];
-    x[16] *= inv[16];
-    x[15] -= v[69] * x[16];
-    x[15] *= inv[15];
-    x[14] -= v[8] * x[15];
-    x[14] -= v[7] * x[16];
-    x[14] *= inv[14];
-    x[13] -= v[6] * x[14];
-    x[13] -= v[4] * x[15];
-    x[13] -= v[3] * x[16];
-    x[13] *= inv[13];
-    x[12] -= v[95] * x[13];
-    x[12] -= v[96] * x[14];
-    x[12] -= v[94] * x[15];
-    x[12] -= v[93] * x[16];
-    x[12] -= v[53] * x[17];
-    x[12] -= v[54] * x[18];
-    x[12] -= v[52] * x[19];
-    x[12] -= v[51] * x[20];
-    x[12] *= inv[12];
-    x[11] -= v[45] * x[12];
-    x[11] -= v[91] * x[13];
-    x[11] -= v[92] * x[14];
-    x[11] -= v[90] * x[15];
-    x[11] -= v[89] * x[16];
-    x[11] *= inv[11];
-    x[10] -= v[38] * x[11];
-    x[10] -= v[39] * x[12];
-    x[10] -= v[87] * x[13];
-    x[10] -= v[88] * x[14];
-    x[10] -= v[86] * x[15];
-    x[10] -= v[85] * x[16];
-    x[10] *= inv[10];
-    x[9] -= v[78] * x[10];
-    x[9] -= v[79] * x[11];
-    x[9] -= v[80] * x[12];
-    x[9] *= inv[9];
-    x[8] -= v[26] * x[13];
-    x[8] -= v[27] * x[14];
-    x[8] -= v[25] * x[15];
-    x[8] -= v[24] * x[16];
-    x[8] = -x[8];
-    x[7] -= v[20] * x[13];
-    x[7] -= v[21] * x[14];
-    x[7] -= v[19] * x[15];
-    x[7] -= v[18] * x[16];
-    x[7] = -x[7];
-    x[6] = -x[6];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] -= x[2];
-    x[1] -= v[14] * x[13];
-    x[1] -= v[15] * x[14];
-    x[1] -= v[13] * x[15];
-    x[1] -= v[12] * x[16];
-    x[1] = -x[1];
-    x[0] += x[1];
-    x[0] -= v[30] * x[9];
-    x[0] -= v[31] * x[10];
-    x[0] -= v[32] * x[11];
-    x[0] -= v[33] * x[12];
-}
-
 void spatial_slider_crank_lu_solve(const spatial_slider_crank_lu *lu, spatial_slider_crank_real b[])
 {
     spatial_slider_crank_real x[SPATIAL_SLIDER_CRANK_NQ];
@@ -557,8 +448,108 @@ void spatial_slider_crank_lu_solve(const spatial_slider_crank_lu *lu, spatial_sl
     if (lu->swapped[1]) { const spatial_slider_crank_real w = x[13]; x[13] = x[15]; x[15] = w; }
     if (lu->swapped[2]) { const spatial_slider_crank_real w = x[13]; x[13] = x[16]; x[16] = w; }
     if (lu->swapped[3]) { const spatial_slider_crank_real w = x[15]; x[15] = x[16]; x[16] = w; }
-    spatial_slider_crank_lu_forward_0(lu->v, x);
-    spatial_slider_crank_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const spatial_slider_crank_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[3];
+        x[8] += x[4];
+        x[11] -= x[5];
+        x[10] += x[6];
+        x[10] -= x[7];
+        x[11] -= x[8];
+        x[10] -= v[36] * x[9];
+        x[11] -= v[42] * x[9];
+        x[12] -= v[47] * x[9];
+        x[11] -= v[43] * x[10];
+        x[12] -= v[48] * x[10];
+        x[12] -= v[49] * x[11];
+        x[14] -= v[9] * x[13];
+        x[15] -= v[71] * x[13];
+        x[16] -= v[75] * x[13];
+        x[15] -= v[72] * x[14];
+        x[16] -= v[76] * x[14];
+        x[16] -= v[74] * x[15];
+        x[18] -= v[61] * x[17];
+        x[19] -= v[67] * x[17];
+        x[20] -= v[83] * x[17];
+        x[19] -= v[68] * x[18];
+        x[20] -= v[84] * x[18];
+        x[20] -= v[82] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[65] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[60] * x[19];
+        x[18] -= v[59] * x[20];
+        x[18] *= inv[18];
+        x[17] -= v[58] * x[18];
+        x[17] -= v[56] * x[19];
+        x[17] -= v[55] * x[20];
+        x[17] *= inv[17];
+        x[16] *= inv[16];
+        x[15] -= v[69] * x[16];
+        x[15] *= inv[15];
+        x[14] -= v[8] * x[15];
+        x[14] -= v[7] * x[16];
+        x[14] *= inv[14];
+        x[13] -= v[6] * x[14];
+        x[13] -= v[4] * x[15];
+        x[13] -= v[3] * x[16];
+        x[13] *= inv[13];
+        x[12] -= v[95] * x[13];
+        x[12] -= v[96] * x[14];
+        x[12] -= v[94] * x[15];
+        x[12] -= v[93] * x[16];
+        x[12] -= v[53] * x[17];
+        x[12] -= v[54] * x[18];
+        x[12] -= v[52] * x[19];
+        x[12] -= v[51] * x[20];
+        x[12] *= inv[12];
+        x[11] -= v[45] * x[12];
+        x[11] -= v[91] * x[13];
+        x[11] -= v[92] * x[14];
+        x[11] -= v[90] * x[15];
+        x[11] -= v[89] * x[16];
+        x[11] *= inv[11];
+        x[10] -= v[38] * x[11];
+        x[10] -= v[39] * x[12];
+        x[10] -= v[87] * x[13];
+        x[10] -= v[88] * x[14];
+        x[10] -= v[86] * x[15];
+        x[10] -= v[85] * x[16];
+        x[10] *= inv[10];
+        x[9] -= v[78] * x[10];
+        x[9] -= v[79] * x[11];
+        x[9] -= v[80] * x[12];
+        x[9] *= inv[9];
+        x[8] -= v[26] * x[13];
+        x[8] -= v[27] * x[14];
+        x[8] -= v[25] * x[15];
+        x[8] -= v[24] * x[16];
+        x[8] = -x[8];
+        x[7] -= v[20] * x[13];
+        x[7] -= v[21] * x[14];
+        x[7] -= v[19] * x[15];
+        x[7] -= v[18] * x[16];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] -= v[14] * x[13];
+        x[1] -= v[15] * x[14];
+        x[1] -= v[13] * x[15];
+        x[1] -= v[12] * x[16];
+        x[1] = -x[1];
+        x[0] += x[1];
+        x[0] -= v[30] * x[9];
+        x[0] -= v[31] * x[10];
+        x[0] -= v[32] * x[11];
+        x[0] -= v[33] * x[12];
+    }
     b[14] = x[0];
     b[7] = x[1];
     b[0] = x[2];
@@ -580,6 +571,329 @@ void spatial_slider_crank_lu_solve(const spatial_slider_crank_lu *lu, spatial_sl
     b[20] = x[18];
     b[18] = x[19];
     b[17] = x[20];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+spatial_slider_crank_real spatial_slider_crank_lu_solve_rates(const spatial_slider_crank_lu *lu, spatial_slider_crank_real b[], spatial_slider_crank_real *sum_abs)
+{
+    spatial_slider_crank_real x[SPATIAL_SLIDER_CRANK_NQ];
+    spatial_slider_crank_real largest = 0, total = 0;
+    if (lu->dense) return spatial_slider_crank_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[8]: a zero row */
+    x[1] = 0; /* b[5]: a zero row */
+    x[2] = 0; /* b[0]: a zero row */
+    x[3] = 0; /* b[1]: a zero row */
+    x[4] = 0; /* b[2]: a zero row */
+    x[5] = 0; /* b[14]: a zero row */
+    x[6] = 0; /* b[15]: a zero row */
+    x[7] = 0; /* b[6]: a zero row */
+    x[8] = 0; /* b[7]: a zero row */
+    x[9] = 0; /* b[19]: a zero row */
+    x[10] = 0; /* b[9]: a zero row */
+    x[11] = 0; /* b[10]: a zero row */
+    x[12] = 0; /* b[11]: a zero row */
+    x[13] = 0; /* b[3]: a zero row */
+    x[14] = 0; /* b[4]: a zero row */
+    x[15] = b[17];
+    x[16] = 0; /* b[18]: a zero row */
+    x[17] = 0; /* b[12]: a zero row */
+    x[18] = 0; /* b[13]: a zero row */
+    x[19] = 0; /* b[16]: a zero row */
+    x[20] = 0; /* b[20]: a zero row */
+    if (lu->swapped[0]) { const spatial_slider_crank_real w = x[13]; x[13] = x[14]; x[14] = w; }
+    if (lu->swapped[1]) { const spatial_slider_crank_real w = x[13]; x[13] = x[15]; x[15] = w; }
+    if (lu->swapped[2]) { const spatial_slider_crank_real w = x[13]; x[13] = x[16]; x[16] = w; }
+    if (lu->swapped[3]) { const spatial_slider_crank_real w = x[15]; x[15] = x[16]; x[16] = w; }
+    {
+        const spatial_slider_crank_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[3];
+        x[8] += x[4];
+        x[11] -= x[5];
+        x[10] += x[6];
+        x[10] -= x[7];
+        x[11] -= x[8];
+        x[10] -= v[36] * x[9];
+        x[11] -= v[42] * x[9];
+        x[12] -= v[47] * x[9];
+        x[11] -= v[43] * x[10];
+        x[12] -= v[48] * x[10];
+        x[12] -= v[49] * x[11];
+        x[14] -= v[9] * x[13];
+        x[15] -= v[71] * x[13];
+        x[16] -= v[75] * x[13];
+        x[15] -= v[72] * x[14];
+        x[16] -= v[76] * x[14];
+        x[16] -= v[74] * x[15];
+        x[18] -= v[61] * x[17];
+        x[19] -= v[67] * x[17];
+        x[20] -= v[83] * x[17];
+        x[19] -= v[68] * x[18];
+        x[20] -= v[84] * x[18];
+        x[20] -= v[82] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[65] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[60] * x[19];
+        x[18] -= v[59] * x[20];
+        x[18] *= inv[18];
+        x[17] -= v[58] * x[18];
+        x[17] -= v[56] * x[19];
+        x[17] -= v[55] * x[20];
+        x[17] *= inv[17];
+        x[16] *= inv[16];
+        x[15] -= v[69] * x[16];
+        x[15] *= inv[15];
+        x[14] -= v[8] * x[15];
+        x[14] -= v[7] * x[16];
+        x[14] *= inv[14];
+        x[13] -= v[6] * x[14];
+        x[13] -= v[4] * x[15];
+        x[13] -= v[3] * x[16];
+        x[13] *= inv[13];
+        x[12] -= v[95] * x[13];
+        x[12] -= v[96] * x[14];
+        x[12] -= v[94] * x[15];
+        x[12] -= v[93] * x[16];
+        x[12] -= v[53] * x[17];
+        x[12] -= v[54] * x[18];
+        x[12] -= v[52] * x[19];
+        x[12] -= v[51] * x[20];
+        x[12] *= inv[12];
+        x[11] -= v[45] * x[12];
+        x[11] -= v[91] * x[13];
+        x[11] -= v[92] * x[14];
+        x[11] -= v[90] * x[15];
+        x[11] -= v[89] * x[16];
+        x[11] *= inv[11];
+        x[10] -= v[38] * x[11];
+        x[10] -= v[39] * x[12];
+        x[10] -= v[87] * x[13];
+        x[10] -= v[88] * x[14];
+        x[10] -= v[86] * x[15];
+        x[10] -= v[85] * x[16];
+        x[10] *= inv[10];
+        x[9] -= v[78] * x[10];
+        x[9] -= v[79] * x[11];
+        x[9] -= v[80] * x[12];
+        x[9] *= inv[9];
+        x[8] -= v[26] * x[13];
+        x[8] -= v[27] * x[14];
+        x[8] -= v[25] * x[15];
+        x[8] -= v[24] * x[16];
+        x[8] = -x[8];
+        x[7] -= v[20] * x[13];
+        x[7] -= v[21] * x[14];
+        x[7] -= v[19] * x[15];
+        x[7] -= v[18] * x[16];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] -= v[14] * x[13];
+        x[1] -= v[15] * x[14];
+        x[1] -= v[13] * x[15];
+        x[1] -= v[12] * x[16];
+        x[1] = -x[1];
+        x[0] += x[1];
+        x[0] -= v[30] * x[9];
+        x[0] -= v[31] * x[10];
+        x[0] -= v[32] * x[11];
+        x[0] -= v[33] * x[12];
+    }
+    { const spatial_slider_crank_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[14] = -x[0]; }
+    { const spatial_slider_crank_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[7] = -x[1]; }
+    b[0] = -x[2]; /* +-0: no norm to take */
+    b[1] = -x[3]; /* +-0: no norm to take */
+    b[2] = -x[4]; /* +-0: no norm to take */
+    b[16] = -x[5]; /* +-0: no norm to take */
+    b[15] = -x[6]; /* +-0: no norm to take */
+    { const spatial_slider_crank_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[8] = -x[7]; }
+    { const spatial_slider_crank_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[9] = -x[8]; }
+    { const spatial_slider_crank_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[10] = -x[9]; }
+    { const spatial_slider_crank_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[11] = -x[10]; }
+    { const spatial_slider_crank_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[12] = -x[11]; }
+    { const spatial_slider_crank_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[13] = -x[12]; }
+    { const spatial_slider_crank_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[5] = -x[13]; }
+    { const spatial_slider_crank_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[6] = -x[14]; }
+    { const spatial_slider_crank_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[4] = -x[15]; }
+    { const spatial_slider_crank_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[3] = -x[16]; }
+    { const spatial_slider_crank_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[19] = -x[17]; }
+    { const spatial_slider_crank_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[20] = -x[18]; }
+    { const spatial_slider_crank_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[18] = -x[19]; }
+    { const spatial_slider_crank_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[17] = -x[20]; }
+    *sum_abs = total;
+    return largest;
+}
+
+spatial_slider_crank_real spatial_slider_crank_lu_solve_accelerations(const spatial_slider_crank_lu *lu, spatial_slider_crank_real b[], spatial_slider_crank_real *sum_abs)
+{
+    spatial_slider_crank_real x[SPATIAL_SLIDER_CRANK_NQ];
+    spatial_slider_crank_real largest = 0, total = 0;
+    if (lu->dense) return spatial_slider_crank_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[8];
+    x[1] = b[5];
+    x[2] = 0; /* b[0]: a zero row */
+    x[3] = 0; /* b[1]: a zero row */
+    x[4] = 0; /* b[2]: a zero row */
+    x[5] = 0; /* b[14]: a zero row */
+    x[6] = 0; /* b[15]: a zero row */
+    x[7] = b[6];
+    x[8] = b[7];
+    x[9] = b[19];
+    x[10] = b[9];
+    x[11] = b[10];
+    x[12] = b[11];
+    x[13] = b[3];
+    x[14] = b[4];
+    x[15] = b[17];
+    x[16] = b[18];
+    x[17] = b[12];
+    x[18] = b[13];
+    x[19] = b[16];
+    x[20] = b[20];
+    if (lu->swapped[0]) { const spatial_slider_crank_real w = x[13]; x[13] = x[14]; x[14] = w; }
+    if (lu->swapped[1]) { const spatial_slider_crank_real w = x[13]; x[13] = x[15]; x[15] = w; }
+    if (lu->swapped[2]) { const spatial_slider_crank_real w = x[13]; x[13] = x[16]; x[16] = w; }
+    if (lu->swapped[3]) { const spatial_slider_crank_real w = x[15]; x[15] = x[16]; x[16] = w; }
+    {
+        const spatial_slider_crank_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[3];
+        x[8] += x[4];
+        x[11] -= x[5];
+        x[10] += x[6];
+        x[10] -= x[7];
+        x[11] -= x[8];
+        x[10] -= v[36] * x[9];
+        x[11] -= v[42] * x[9];
+        x[12] -= v[47] * x[9];
+        x[11] -= v[43] * x[10];
+        x[12] -= v[48] * x[10];
+        x[12] -= v[49] * x[11];
+        x[14] -= v[9] * x[13];
+        x[15] -= v[71] * x[13];
+        x[16] -= v[75] * x[13];
+        x[15] -= v[72] * x[14];
+        x[16] -= v[76] * x[14];
+        x[16] -= v[74] * x[15];
+        x[18] -= v[61] * x[17];
+        x[19] -= v[67] * x[17];
+        x[20] -= v[83] * x[17];
+        x[19] -= v[68] * x[18];
+        x[20] -= v[84] * x[18];
+        x[20] -= v[82] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[65] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[60] * x[19];
+        x[18] -= v[59] * x[20];
+        x[18] *= inv[18];
+        x[17] -= v[58] * x[18];
+        x[17] -= v[56] * x[19];
+        x[17] -= v[55] * x[20];
+        x[17] *= inv[17];
+        x[16] *= inv[16];
+        x[15] -= v[69] * x[16];
+        x[15] *= inv[15];
+        x[14] -= v[8] * x[15];
+        x[14] -= v[7] * x[16];
+        x[14] *= inv[14];
+        x[13] -= v[6] * x[14];
+        x[13] -= v[4] * x[15];
+        x[13] -= v[3] * x[16];
+        x[13] *= inv[13];
+        x[12] -= v[95] * x[13];
+        x[12] -= v[96] * x[14];
+        x[12] -= v[94] * x[15];
+        x[12] -= v[93] * x[16];
+        x[12] -= v[53] * x[17];
+        x[12] -= v[54] * x[18];
+        x[12] -= v[52] * x[19];
+        x[12] -= v[51] * x[20];
+        x[12] *= inv[12];
+        x[11] -= v[45] * x[12];
+        x[11] -= v[91] * x[13];
+        x[11] -= v[92] * x[14];
+        x[11] -= v[90] * x[15];
+        x[11] -= v[89] * x[16];
+        x[11] *= inv[11];
+        x[10] -= v[38] * x[11];
+        x[10] -= v[39] * x[12];
+        x[10] -= v[87] * x[13];
+        x[10] -= v[88] * x[14];
+        x[10] -= v[86] * x[15];
+        x[10] -= v[85] * x[16];
+        x[10] *= inv[10];
+        x[9] -= v[78] * x[10];
+        x[9] -= v[79] * x[11];
+        x[9] -= v[80] * x[12];
+        x[9] *= inv[9];
+        x[8] -= v[26] * x[13];
+        x[8] -= v[27] * x[14];
+        x[8] -= v[25] * x[15];
+        x[8] -= v[24] * x[16];
+        x[8] = -x[8];
+        x[7] -= v[20] * x[13];
+        x[7] -= v[21] * x[14];
+        x[7] -= v[19] * x[15];
+        x[7] -= v[18] * x[16];
+        x[7] = -x[7];
+        x[6] = -x[6];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] -= x[2];
+        x[1] -= v[14] * x[13];
+        x[1] -= v[15] * x[14];
+        x[1] -= v[13] * x[15];
+        x[1] -= v[12] * x[16];
+        x[1] = -x[1];
+        x[0] += x[1];
+        x[0] -= v[30] * x[9];
+        x[0] -= v[31] * x[10];
+        x[0] -= v[32] * x[11];
+        x[0] -= v[33] * x[12];
+    }
+    { const spatial_slider_crank_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[14] = x[0]; }
+    { const spatial_slider_crank_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[7] = x[1]; }
+    b[0] = x[2]; /* +-0: no norm to take */
+    b[1] = x[3]; /* +-0: no norm to take */
+    b[2] = x[4]; /* +-0: no norm to take */
+    b[16] = x[5]; /* +-0: no norm to take */
+    b[15] = x[6]; /* +-0: no norm to take */
+    { const spatial_slider_crank_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[8] = x[7]; }
+    { const spatial_slider_crank_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[9] = x[8]; }
+    { const spatial_slider_crank_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[10] = x[9]; }
+    { const spatial_slider_crank_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[11] = x[10]; }
+    { const spatial_slider_crank_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[12] = x[11]; }
+    { const spatial_slider_crank_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[13] = x[12]; }
+    { const spatial_slider_crank_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[5] = x[13]; }
+    { const spatial_slider_crank_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[6] = x[14]; }
+    { const spatial_slider_crank_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[4] = x[15]; }
+    { const spatial_slider_crank_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[3] = x[16]; }
+    { const spatial_slider_crank_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[19] = x[17]; }
+    { const spatial_slider_crank_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[20] = x[18]; }
+    { const spatial_slider_crank_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[18] = x[19]; }
+    { const spatial_slider_crank_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[17] = x[20]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..20 of U^T (rows of U) */

@@ -103,6 +103,43 @@ void stewart_dense_lu_solve(const stewart_dense_lu *lu, stewart_real b[])
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
+/* The solve, then its solution's max |x_i| (returned) and sum |x_i| (into *sum_abs); the
+ * _negated one then writes -x (exact): the norms the step takes (lu_solve_rates, negated,
+ * and lu_solve_accelerations). */
+stewart_real stewart_dense_lu_solve_max(const stewart_dense_lu *lu, stewart_real b[],
+        stewart_real *sum_abs)
+{
+    stewart_real largest = 0, total = 0;
+    stewart_dense_lu_solve(lu, b);
+    /* written out, as the solver's passes are (templates/_each.j2) */
+    { const stewart_real a = fabs(b[0]); largest = largest > a ? largest : a; total += a; }
+    { const stewart_real a = fabs(b[1]); largest = largest > a ? largest : a; total += a; }
+    { const stewart_real a = fabs(b[2]); largest = largest > a ? largest : a; total += a; }
+    { const stewart_real a = fabs(b[3]); largest = largest > a ? largest : a; total += a; }
+    { const stewart_real a = fabs(b[4]); largest = largest > a ? largest : a; total += a; }
+    { const stewart_real a = fabs(b[5]); largest = largest > a ? largest : a; total += a; }
+    { const stewart_real a = fabs(b[6]); largest = largest > a ? largest : a; total += a; }
+    *sum_abs = total;
+    return largest;
+}
+
+stewart_real stewart_dense_lu_solve_negated_max(const stewart_dense_lu *lu, stewart_real b[],
+        stewart_real *sum_abs)
+{
+    stewart_real largest = 0, total = 0;
+    stewart_dense_lu_solve(lu, b);
+    /* written out, as the solver's passes are (templates/_each.j2) */
+    { const stewart_real a = fabs(b[0]); largest = largest > a ? largest : a; total += a; b[0] = -b[0]; }
+    { const stewart_real a = fabs(b[1]); largest = largest > a ? largest : a; total += a; b[1] = -b[1]; }
+    { const stewart_real a = fabs(b[2]); largest = largest > a ? largest : a; total += a; b[2] = -b[2]; }
+    { const stewart_real a = fabs(b[3]); largest = largest > a ? largest : a; total += a; b[3] = -b[3]; }
+    { const stewart_real a = fabs(b[4]); largest = largest > a ? largest : a; total += a; b[4] = -b[4]; }
+    { const stewart_real a = fabs(b[5]); largest = largest > a ? largest : a; total += a; b[5] = -b[5]; }
+    { const stewart_real a = fabs(b[6]); largest = largest > a ? largest : a; total += a; b[6] = -b[6]; }
+    *sum_abs = total;
+    return largest;
+}
+
 void stewart_dense_lu_solve_transposed(const stewart_dense_lu *lu, stewart_real b[])
 {
     /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */

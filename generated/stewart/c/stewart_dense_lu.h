@@ -35,6 +35,13 @@ stewart_real stewart_dense_lu_pivot_ratio(const stewart_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void stewart_dense_lu_solve(const stewart_dense_lu *lu, stewart_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+stewart_real stewart_dense_lu_solve_max(const stewart_dense_lu *lu, stewart_real b[],
+                                              stewart_real *sum_abs);
+stewart_real stewart_dense_lu_solve_negated_max(const stewart_dense_lu *lu,
+                                                      stewart_real b[], stewart_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void stewart_dense_lu_solve_transposed(const stewart_dense_lu *lu, stewart_real b[]);
 

@@ -300,66 +300,6 @@ stewart_real stewart_lu_pivot_ratio(const stewart_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..5 */
-static void stewart_lu_forward_0(const stewart_real *v, stewart_real *x)
-{
-    (void)v;
-    x[1] -= v[3] * x[0];
-    x[2] -= v[10] * x[0];
-    x[3] -= v[17] * x[0];
-    x[4] -= v[24] * x[0];
-    x[5] -= v[31] * x[0];
-    x[6] -= v[38] * x[0];
-    x[2] -= v[7] * x[1];
-    x[3] -= v[14] * x[1];
-    x[4] -= v[21] * x[1];
-    x[5] -= v[28] * x[1];
-    x[6] -= v[35] * x[1];
-    x[3] -= v[15] * x[2];
-    x[4] -= v[22] * x[2];
-    x[5] -= v[29] * x[2];
-    x[6] -= v[36] * x[2];
-    x[4] -= v[23] * x[3];
-    x[5] -= v[30] * x[3];
-    x[6] -= v[37] * x[3];
-    x[5] -= v[32] * x[4];
-    x[6] -= v[39] * x[4];
-    x[6] -= v[40] * x[5];
-}
-
-/* U z = y, rows 6..0 */
-static void stewart_lu_backward_0(const stewart_real *v,
-        const stewart_real *inv, stewart_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[6] *= inv[6];
-    x[5] -= v[34] * x[6];
-    x[5] *= inv[5];
-    x[4] -= v[26] * x[5];
-    x[4] -= v[27] * x[6];
-    x[4] *= inv[4];
-    x[3] -= v[18] * x[4];
-    x[3] -= v[19] * x[5];
-    x[3] -= v[20] * x[6];
-    x[3] *= inv[3];
-    x[2] -= v[9] * x[3];
-    x[2] -= v[11] * x[4];
-    x[2] -= v[12] * x[5];
-    x[2] -= v[13] * x[6];
-    x[2] *= inv[2];
-    x[1] -= v[1] * x[2];
-    x[1] -= v[2] * x[3];
-    x[1] -= v[4] * x[4];
-    x[1] -= v[5] * x[5];
-    x[1] -= v[6] * x[6];
-    x[1] *= inv[1];
-    x[0] -= v[43] * x[4];
-    x[0] -= v[44] * x[5];
-    x[0] -= v[45] * x[6];
-    x[0] *= inv[0];
-}
-
 void stewart_lu_solve(const stewart_lu *lu, stewart_real b[])
 {
     stewart_real x[STEWART_NQ];
@@ -375,8 +315,59 @@ void stewart_lu_solve(const stewart_lu *lu, stewart_real b[])
     x[4] = b[3];
     x[5] = b[4];
     x[6] = b[5];
-    stewart_lu_forward_0(lu->v, x);
-    stewart_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const stewart_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[1] -= v[3] * x[0];
+        x[2] -= v[10] * x[0];
+        x[3] -= v[17] * x[0];
+        x[4] -= v[24] * x[0];
+        x[5] -= v[31] * x[0];
+        x[6] -= v[38] * x[0];
+        x[2] -= v[7] * x[1];
+        x[3] -= v[14] * x[1];
+        x[4] -= v[21] * x[1];
+        x[5] -= v[28] * x[1];
+        x[6] -= v[35] * x[1];
+        x[3] -= v[15] * x[2];
+        x[4] -= v[22] * x[2];
+        x[5] -= v[29] * x[2];
+        x[6] -= v[36] * x[2];
+        x[4] -= v[23] * x[3];
+        x[5] -= v[30] * x[3];
+        x[6] -= v[37] * x[3];
+        x[5] -= v[32] * x[4];
+        x[6] -= v[39] * x[4];
+        x[6] -= v[40] * x[5];
+        /* U z = y */
+        x[6] *= inv[6];
+        x[5] -= v[34] * x[6];
+        x[5] *= inv[5];
+        x[4] -= v[26] * x[5];
+        x[4] -= v[27] * x[6];
+        x[4] *= inv[4];
+        x[3] -= v[18] * x[4];
+        x[3] -= v[19] * x[5];
+        x[3] -= v[20] * x[6];
+        x[3] *= inv[3];
+        x[2] -= v[9] * x[3];
+        x[2] -= v[11] * x[4];
+        x[2] -= v[12] * x[5];
+        x[2] -= v[13] * x[6];
+        x[2] *= inv[2];
+        x[1] -= v[1] * x[2];
+        x[1] -= v[2] * x[3];
+        x[1] -= v[4] * x[4];
+        x[1] -= v[5] * x[5];
+        x[1] -= v[6] * x[6];
+        x[1] *= inv[1];
+        x[0] -= v[43] * x[4];
+        x[0] -= v[44] * x[5];
+        x[0] -= v[45] * x[6];
+        x[0] *= inv[0];
+    }
     b[3] = x[0];
     b[0] = x[1];
     b[1] = x[2];
@@ -384,6 +375,167 @@ void stewart_lu_solve(const stewart_lu *lu, stewart_real b[])
     b[4] = x[4];
     b[5] = x[5];
     b[6] = x[6];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+stewart_real stewart_lu_solve_rates(const stewart_lu *lu, stewart_real b[], stewart_real *sum_abs)
+{
+    stewart_real x[STEWART_NQ];
+    stewart_real largest = 0, total = 0;
+    if (lu->dense) return stewart_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[6]: a zero row */
+    x[1] = b[0];
+    x[2] = b[1];
+    x[3] = b[2];
+    x[4] = b[3];
+    x[5] = b[4];
+    x[6] = b[5];
+    {
+        const stewart_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[1] -= v[3] * x[0];
+        x[2] -= v[10] * x[0];
+        x[3] -= v[17] * x[0];
+        x[4] -= v[24] * x[0];
+        x[5] -= v[31] * x[0];
+        x[6] -= v[38] * x[0];
+        x[2] -= v[7] * x[1];
+        x[3] -= v[14] * x[1];
+        x[4] -= v[21] * x[1];
+        x[5] -= v[28] * x[1];
+        x[6] -= v[35] * x[1];
+        x[3] -= v[15] * x[2];
+        x[4] -= v[22] * x[2];
+        x[5] -= v[29] * x[2];
+        x[6] -= v[36] * x[2];
+        x[4] -= v[23] * x[3];
+        x[5] -= v[30] * x[3];
+        x[6] -= v[37] * x[3];
+        x[5] -= v[32] * x[4];
+        x[6] -= v[39] * x[4];
+        x[6] -= v[40] * x[5];
+        /* U z = y */
+        x[6] *= inv[6];
+        x[5] -= v[34] * x[6];
+        x[5] *= inv[5];
+        x[4] -= v[26] * x[5];
+        x[4] -= v[27] * x[6];
+        x[4] *= inv[4];
+        x[3] -= v[18] * x[4];
+        x[3] -= v[19] * x[5];
+        x[3] -= v[20] * x[6];
+        x[3] *= inv[3];
+        x[2] -= v[9] * x[3];
+        x[2] -= v[11] * x[4];
+        x[2] -= v[12] * x[5];
+        x[2] -= v[13] * x[6];
+        x[2] *= inv[2];
+        x[1] -= v[1] * x[2];
+        x[1] -= v[2] * x[3];
+        x[1] -= v[4] * x[4];
+        x[1] -= v[5] * x[5];
+        x[1] -= v[6] * x[6];
+        x[1] *= inv[1];
+        x[0] -= v[43] * x[4];
+        x[0] -= v[44] * x[5];
+        x[0] -= v[45] * x[6];
+        x[0] *= inv[0];
+    }
+    { const stewart_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[3] = -x[0]; }
+    { const stewart_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[0] = -x[1]; }
+    { const stewart_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[1] = -x[2]; }
+    { const stewart_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[2] = -x[3]; }
+    { const stewart_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[4] = -x[4]; }
+    { const stewart_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[5] = -x[5]; }
+    { const stewart_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[6] = -x[6]; }
+    *sum_abs = total;
+    return largest;
+}
+
+stewart_real stewart_lu_solve_accelerations(const stewart_lu *lu, stewart_real b[], stewart_real *sum_abs)
+{
+    stewart_real x[STEWART_NQ];
+    stewart_real largest = 0, total = 0;
+    if (lu->dense) return stewart_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = b[6];
+    x[1] = b[0];
+    x[2] = b[1];
+    x[3] = b[2];
+    x[4] = b[3];
+    x[5] = b[4];
+    x[6] = b[5];
+    {
+        const stewart_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[1] -= v[3] * x[0];
+        x[2] -= v[10] * x[0];
+        x[3] -= v[17] * x[0];
+        x[4] -= v[24] * x[0];
+        x[5] -= v[31] * x[0];
+        x[6] -= v[38] * x[0];
+        x[2] -= v[7] * x[1];
+        x[3] -= v[14] * x[1];
+        x[4] -= v[21] * x[1];
+        x[5] -= v[28] * x[1];
+        x[6] -= v[35] * x[1];
+        x[3] -= v[15] * x[2];
+        x[4] -= v[22] * x[2];
+        x[5] -= v[29] * x[2];
+        x[6] -= v[36] * x[2];
+        x[4] -= v[23] * x[3];
+        x[5] -= v[30] * x[3];
+        x[6] -= v[37] * x[3];
+        x[5] -= v[32] * x[4];
+        x[6] -= v[39] * x[4];
+        x[6] -= v[40] * x[5];
+        /* U z = y */
+        x[6] *= inv[6];
+        x[5] -= v[34] * x[6];
+        x[5] *= inv[5];
+        x[4] -= v[26] * x[5];
+        x[4] -= v[27] * x[6];
+        x[4] *= inv[4];
+        x[3] -= v[18] * x[4];
+        x[3] -= v[19] * x[5];
+        x[3] -= v[20] * x[6];
+        x[3] *= inv[3];
+        x[2] -= v[9] * x[3];
+        x[2] -= v[11] * x[4];
+        x[2] -= v[12] * x[5];
+        x[2] -= v[13] * x[6];
+        x[2] *= inv[2];
+        x[1] -= v[1] * x[2];
+        x[1] -= v[2] * x[3];
+        x[1] -= v[4] * x[4];
+        x[1] -= v[5] * x[5];
+        x[1] -= v[6] * x[6];
+        x[1] *= inv[1];
+        x[0] -= v[43] * x[4];
+        x[0] -= v[44] * x[5];
+        x[0] -= v[45] * x[6];
+        x[0] *= inv[0];
+    }
+    { const stewart_real a = fabs(x[0]); largest = largest > a ? largest : a; total += a; b[3] = x[0]; }
+    { const stewart_real a = fabs(x[1]); largest = largest > a ? largest : a; total += a; b[0] = x[1]; }
+    { const stewart_real a = fabs(x[2]); largest = largest > a ? largest : a; total += a; b[1] = x[2]; }
+    { const stewart_real a = fabs(x[3]); largest = largest > a ? largest : a; total += a; b[2] = x[3]; }
+    { const stewart_real a = fabs(x[4]); largest = largest > a ? largest : a; total += a; b[4] = x[4]; }
+    { const stewart_real a = fabs(x[5]); largest = largest > a ? largest : a; total += a; b[5] = x[5]; }
+    { const stewart_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[6] = x[6]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..6 of U^T (rows of U) */

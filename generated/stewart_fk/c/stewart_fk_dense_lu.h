@@ -39,6 +39,13 @@ int stewart_fk_dense_lu_det_sign(const stewart_fk_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void stewart_fk_dense_lu_solve(const stewart_fk_dense_lu *lu, stewart_fk_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+stewart_fk_real stewart_fk_dense_lu_solve_max(const stewart_fk_dense_lu *lu, stewart_fk_real b[],
+                                              stewart_fk_real *sum_abs);
+stewart_fk_real stewart_fk_dense_lu_solve_negated_max(const stewart_fk_dense_lu *lu,
+                                                      stewart_fk_real b[], stewart_fk_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void stewart_fk_dense_lu_solve_transposed(const stewart_fk_dense_lu *lu, stewart_fk_real b[]);
 

@@ -103,6 +103,40 @@ void stewart_legs_dense_lu_solve(const stewart_legs_dense_lu *lu, stewart_legs_r
     for (i = 0; i < n; ++i) b[i] = x[i];
 }
 
+/* The solve, then its solution's max |x_i| (returned) and sum |x_i| (into *sum_abs); the
+ * _negated one then writes -x (exact): the norms the step takes (lu_solve_rates, negated,
+ * and lu_solve_accelerations). */
+stewart_legs_real stewart_legs_dense_lu_solve_max(const stewart_legs_dense_lu *lu, stewart_legs_real b[],
+        stewart_legs_real *sum_abs)
+{
+    stewart_legs_real largest = 0, total = 0;
+    stewart_legs_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < STEWART_LEGS_NQ; ++k) {
+        const stewart_legs_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+    }
+    *sum_abs = total;
+    return largest;
+}
+
+stewart_legs_real stewart_legs_dense_lu_solve_negated_max(const stewart_legs_dense_lu *lu, stewart_legs_real b[],
+        stewart_legs_real *sum_abs)
+{
+    stewart_legs_real largest = 0, total = 0;
+    stewart_legs_dense_lu_solve(lu, b);
+    int k;
+    for (k = 0; k < STEWART_LEGS_NQ; ++k) {
+        const stewart_legs_real a = fabs(b[k]);
+        largest = largest > a ? largest : a;
+        total += a;
+        b[k] = -b[k];
+    }
+    *sum_abs = total;
+    return largest;
+}
+
 void stewart_legs_dense_lu_solve_transposed(const stewart_legs_dense_lu *lu, stewart_legs_real b[])
 {
     /* P A = L U, so A^T = U^T L^T P: U^T w = b, L^T v = w, then x = P^T v. */

@@ -1090,11 +1090,16 @@ static int stewart_legs_newton(const stewart_legs_options *options, const stewar
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
     report->residual = (stewart_legs_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        stewart_legs_real residual;
+        stewart_legs_real residual = 0, sum = 0;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         stewart_legs_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
         stewart_legs_in_unit(work);
-        residual = stewart_legs_max_abs(work->phi);
+        /* max |Phi| as max_abs takes it, written out here: no call in the loop every step
+         * runs (a copy of max_abs the compiler would fold back into the call) */
+        for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
+            { const stewart_legs_real a = fabs(work->phi[i]); residual = residual > a ? residual : a; sum += a; }
+        }
+        residual = sum != sum ? (stewart_legs_real)NAN : residual;
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
@@ -1130,38 +1135,16 @@ static void stewart_legs_predict(stewart_legs_real t, stewart_legs_state *state)
     }
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
- * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
- * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
- * largest), and dq in the kernel's unit. */
-static stewart_legs_real stewart_legs_rates_pass(const stewart_legs_workspace *work, stewart_legs_real dq[],
-                                       stewart_legs_real *sum_abs)
+/* max |q| in the run's unit (NaN when some q_i is, as in max_abs: the error model then flags
+ * the point). */
+static stewart_legs_real stewart_legs_positions_pass(const stewart_legs_workspace *work, const stewart_legs_real q[])
 {
-    stewart_legs_real largest = 0, sum = 0;
+    stewart_legs_real largest_q = 0, sum_q = 0, largest_length = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs); a coordinate that is no length is
+     * the same in every unit (no division); the lengths' largest |q_i| is divided by the unit
+     * once, after the pass: rounding is monotone, so max (|q_i| / unit) and (max |q_i|) / unit
+     * are the same number (the unit is finite) */
     for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
-        { const stewart_legs_real b = fabs(dq[i]); largest = largest > b ? largest : b; sum += b; }
-        dq[i] = -dq[i];
-    }
-    stewart_legs_from_unit(work, dq);
-    *sum_abs = sum;
-    return largest;
-}
-
-/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
- * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
- * then flags the point). */
-static stewart_legs_real stewart_legs_accelerations_pass(const stewart_legs_workspace *work,
-                                               const stewart_legs_real q[], stewart_legs_real ddq[],
-                                               stewart_legs_real *sum_abs, stewart_legs_real *nq)
-{
-    stewart_legs_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
-    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division); the lengths'
-     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
-     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
-    for (int i = 0; i < STEWART_LEGS_NQ; ++i) {
-        { const stewart_legs_real c = fabs(ddq[i]); largest = largest > c ? largest : c; sum += c; }
         {
             const stewart_legs_real a = fabs(q[i]) * work->inverse_column[i];
             largest_q = largest_q > a ? largest_q : a;
@@ -1170,10 +1153,8 @@ static stewart_legs_real stewart_legs_accelerations_pass(const stewart_legs_work
     }
     largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
     largest_q = largest_q > largest_length ? largest_q : largest_length;
-    stewart_legs_from_unit(work, ddq);
-    *sum_abs = sum;
-    *nq = sum_q != sum_q ? (stewart_legs_real)NAN : largest_q;
-    return largest;
+    (void)work;
+    return sum_q != sum_q ? (stewart_legs_real)NAN : largest_q;
 }
 
 /* stewart_legs_solve_step with its options already checked. */
@@ -1195,16 +1176,19 @@ static int stewart_legs_step(const stewart_legs_options *options, const stewart_
         return report->status;
     }
     /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
-     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
-     * fused call, so the shared sines and cosines are this q's. */
+     * is -dq, written out negated. Each solve returns its solution's max |.| in the run's unit
+     * and the sum of |.| for the finite test, taken as it writes the solution (no pass over
+     * it again). Newton stopped at the q of its last fused call, so the shared sines and
+     * cosines are this q's. */
     stewart_legs_phi_t_shared(state->q, t, p, work->shared, state->dq);
     stewart_legs_rows_in_unit(work, state->dq);
-    stewart_legs_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = stewart_legs_rates_pass(work, state->dq, &sum_dq);
+    ndq = stewart_legs_lu_solve_rates(&work->lu, state->dq, &sum_dq); /* (2.73) */
+    stewart_legs_from_unit(work, state->dq);
     stewart_legs_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     stewart_legs_rows_in_unit(work, state->ddq);
-    stewart_legs_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = stewart_legs_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    nddq = stewart_legs_lu_solve_accelerations(&work->lu, state->ddq, &sum_ddq); /* (2.74) */
+    stewart_legs_from_unit(work, state->ddq);
+    nq = stewart_legs_positions_pass(work, state->q);
     /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
      * overflow harmlessly), infinite where the larger maximum is */
     largest = ndq > nddq ? ndq : nddq;

@@ -50,6 +50,15 @@ unsigned long stewart_legs_lu_fallbacks(const stewart_legs_lu *lu);
 /* Solve Phi_q x = b in place with the last successful factorization. */
 void stewart_legs_lu_solve(const stewart_legs_lu *lu, stewart_legs_real b[]);
 
+/* The step's two solves, each with the norms of its solution: returns max |x_i| of the solution
+ * as solved and stores sum |x_i| in *sum_abs (NaN exactly when some x_i is). _rates solves b =
+ * Phi_t and writes -x (dq); _accelerations solves b = Gamma. A row where the generated Phi_t or
+ * Gamma is a literal 0 is taken as 0, not read. */
+stewart_legs_real stewart_legs_lu_solve_rates(const stewart_legs_lu *lu, stewart_legs_real b[],
+                                            stewart_legs_real *sum_abs);
+stewart_legs_real stewart_legs_lu_solve_accelerations(const stewart_legs_lu *lu, stewart_legs_real b[],
+                                                    stewart_legs_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the last successful factorization (for the condition
  * estimate of the solver). */
 void stewart_legs_lu_solve_transposed(const stewart_legs_lu *lu, stewart_legs_real b[]);

@@ -3261,6 +3261,405 @@ void stewart_legs_fk_lu_solve(const stewart_legs_fk_lu *lu, stewart_legs_fk_real
     b[6] = x[90];
 }
 
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+stewart_legs_fk_real stewart_legs_fk_lu_solve_rates(const stewart_legs_fk_lu *lu, stewart_legs_fk_real b[], stewart_legs_fk_real *sum_abs)
+{
+    stewart_legs_fk_real x[STEWART_LEGS_FK_NQ];
+    stewart_legs_fk_real largest = 0, total = 0;
+    if (lu->dense) return stewart_legs_fk_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[12]: a zero row */
+    x[4] = 0; /* b[13]: a zero row */
+    x[5] = 0; /* b[14]: a zero row */
+    x[6] = 0; /* b[24]: a zero row */
+    x[7] = 0; /* b[25]: a zero row */
+    x[8] = 0; /* b[26]: a zero row */
+    x[9] = 0; /* b[36]: a zero row */
+    x[10] = 0; /* b[37]: a zero row */
+    x[11] = 0; /* b[38]: a zero row */
+    x[12] = 0; /* b[48]: a zero row */
+    x[13] = 0; /* b[49]: a zero row */
+    x[14] = 0; /* b[50]: a zero row */
+    x[15] = 0; /* b[60]: a zero row */
+    x[16] = 0; /* b[61]: a zero row */
+    x[17] = 0; /* b[62]: a zero row */
+    x[18] = 0; /* b[6]: a zero row */
+    x[19] = 0; /* b[7]: a zero row */
+    x[20] = b[72];
+    x[21] = 0; /* b[18]: a zero row */
+    x[22] = 0; /* b[19]: a zero row */
+    x[23] = b[73];
+    x[24] = 0; /* b[30]: a zero row */
+    x[25] = 0; /* b[31]: a zero row */
+    x[26] = b[74];
+    x[27] = 0; /* b[42]: a zero row */
+    x[28] = 0; /* b[43]: a zero row */
+    x[29] = b[75];
+    x[30] = 0; /* b[54]: a zero row */
+    x[31] = 0; /* b[55]: a zero row */
+    x[32] = b[76];
+    x[33] = 0; /* b[66]: a zero row */
+    x[34] = 0; /* b[67]: a zero row */
+    x[35] = b[77];
+    x[36] = 0; /* b[80]: a zero row */
+    x[37] = 0; /* b[82]: a zero row */
+    x[38] = 0; /* b[84]: a zero row */
+    x[39] = 0; /* b[86]: a zero row */
+    x[40] = 0; /* b[88]: a zero row */
+    x[41] = 0; /* b[90]: a zero row */
+    x[42] = 0; /* b[3]: a zero row */
+    x[43] = 0; /* b[79]: a zero row */
+    x[44] = 0; /* b[4]: a zero row */
+    x[45] = 0; /* b[5]: a zero row */
+    x[46] = 0; /* b[8]: a zero row */
+    x[47] = 0; /* b[9]: a zero row */
+    x[48] = 0; /* b[10]: a zero row */
+    x[49] = 0; /* b[15]: a zero row */
+    x[50] = 0; /* b[81]: a zero row */
+    x[51] = 0; /* b[16]: a zero row */
+    x[52] = 0; /* b[17]: a zero row */
+    x[53] = 0; /* b[20]: a zero row */
+    x[54] = 0; /* b[21]: a zero row */
+    x[55] = 0; /* b[22]: a zero row */
+    x[56] = 0; /* b[27]: a zero row */
+    x[57] = 0; /* b[83]: a zero row */
+    x[58] = 0; /* b[28]: a zero row */
+    x[59] = 0; /* b[29]: a zero row */
+    x[60] = 0; /* b[32]: a zero row */
+    x[61] = 0; /* b[33]: a zero row */
+    x[62] = 0; /* b[34]: a zero row */
+    x[63] = 0; /* b[39]: a zero row */
+    x[64] = 0; /* b[85]: a zero row */
+    x[65] = 0; /* b[40]: a zero row */
+    x[66] = 0; /* b[41]: a zero row */
+    x[67] = 0; /* b[44]: a zero row */
+    x[68] = 0; /* b[45]: a zero row */
+    x[69] = 0; /* b[46]: a zero row */
+    x[70] = 0; /* b[51]: a zero row */
+    x[71] = 0; /* b[87]: a zero row */
+    x[72] = 0; /* b[52]: a zero row */
+    x[73] = 0; /* b[53]: a zero row */
+    x[74] = 0; /* b[56]: a zero row */
+    x[75] = 0; /* b[57]: a zero row */
+    x[76] = 0; /* b[58]: a zero row */
+    x[77] = 0; /* b[63]: a zero row */
+    x[78] = 0; /* b[89]: a zero row */
+    x[79] = 0; /* b[64]: a zero row */
+    x[80] = 0; /* b[65]: a zero row */
+    x[81] = 0; /* b[68]: a zero row */
+    x[82] = 0; /* b[69]: a zero row */
+    x[83] = 0; /* b[70]: a zero row */
+    x[84] = 0; /* b[78]: a zero row */
+    x[85] = 0; /* b[11]: a zero row */
+    x[86] = 0; /* b[23]: a zero row */
+    x[87] = 0; /* b[35]: a zero row */
+    x[88] = 0; /* b[47]: a zero row */
+    x[89] = 0; /* b[59]: a zero row */
+    x[90] = 0; /* b[71]: a zero row */
+    stewart_legs_fk_lu_forward_0(lu->v, x);
+    stewart_legs_fk_lu_forward_1(lu->v, x);
+    stewart_legs_fk_lu_backward_0(lu->v, lu->inv, x);
+    stewart_legs_fk_lu_backward_1(lu->v, lu->inv, x);
+    b[7] = -x[0]; /* +-0: no norm to take */
+    b[8] = -x[1]; /* +-0: no norm to take */
+    b[9] = -x[2]; /* +-0: no norm to take */
+    b[21] = -x[3]; /* +-0: no norm to take */
+    b[22] = -x[4]; /* +-0: no norm to take */
+    b[23] = -x[5]; /* +-0: no norm to take */
+    b[35] = -x[6]; /* +-0: no norm to take */
+    b[36] = -x[7]; /* +-0: no norm to take */
+    b[37] = -x[8]; /* +-0: no norm to take */
+    b[49] = -x[9]; /* +-0: no norm to take */
+    b[50] = -x[10]; /* +-0: no norm to take */
+    b[51] = -x[11]; /* +-0: no norm to take */
+    b[63] = -x[12]; /* +-0: no norm to take */
+    b[64] = -x[13]; /* +-0: no norm to take */
+    b[65] = -x[14]; /* +-0: no norm to take */
+    b[77] = -x[15]; /* +-0: no norm to take */
+    b[78] = -x[16]; /* +-0: no norm to take */
+    b[79] = -x[17]; /* +-0: no norm to take */
+    { const stewart_legs_fk_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[14] = -x[18]; }
+    { const stewart_legs_fk_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[15] = -x[19]; }
+    { const stewart_legs_fk_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[16] = -x[20]; }
+    { const stewart_legs_fk_real a = fabs(x[21]); largest = largest > a ? largest : a; total += a; b[28] = -x[21]; }
+    { const stewart_legs_fk_real a = fabs(x[22]); largest = largest > a ? largest : a; total += a; b[29] = -x[22]; }
+    { const stewart_legs_fk_real a = fabs(x[23]); largest = largest > a ? largest : a; total += a; b[30] = -x[23]; }
+    { const stewart_legs_fk_real a = fabs(x[24]); largest = largest > a ? largest : a; total += a; b[43] = -x[24]; }
+    { const stewart_legs_fk_real a = fabs(x[25]); largest = largest > a ? largest : a; total += a; b[42] = -x[25]; }
+    { const stewart_legs_fk_real a = fabs(x[26]); largest = largest > a ? largest : a; total += a; b[44] = -x[26]; }
+    { const stewart_legs_fk_real a = fabs(x[27]); largest = largest > a ? largest : a; total += a; b[57] = -x[27]; }
+    { const stewart_legs_fk_real a = fabs(x[28]); largest = largest > a ? largest : a; total += a; b[56] = -x[28]; }
+    { const stewart_legs_fk_real a = fabs(x[29]); largest = largest > a ? largest : a; total += a; b[58] = -x[29]; }
+    { const stewart_legs_fk_real a = fabs(x[30]); largest = largest > a ? largest : a; total += a; b[70] = -x[30]; }
+    { const stewart_legs_fk_real a = fabs(x[31]); largest = largest > a ? largest : a; total += a; b[71] = -x[31]; }
+    { const stewart_legs_fk_real a = fabs(x[32]); largest = largest > a ? largest : a; total += a; b[72] = -x[32]; }
+    { const stewart_legs_fk_real a = fabs(x[33]); largest = largest > a ? largest : a; total += a; b[85] = -x[33]; }
+    { const stewart_legs_fk_real a = fabs(x[34]); largest = largest > a ? largest : a; total += a; b[84] = -x[34]; }
+    { const stewart_legs_fk_real a = fabs(x[35]); largest = largest > a ? largest : a; total += a; b[86] = -x[35]; }
+    { const stewart_legs_fk_real a = fabs(x[36]); largest = largest > a ? largest : a; total += a; b[17] = -x[36]; }
+    { const stewart_legs_fk_real a = fabs(x[37]); largest = largest > a ? largest : a; total += a; b[31] = -x[37]; }
+    { const stewart_legs_fk_real a = fabs(x[38]); largest = largest > a ? largest : a; total += a; b[45] = -x[38]; }
+    { const stewart_legs_fk_real a = fabs(x[39]); largest = largest > a ? largest : a; total += a; b[59] = -x[39]; }
+    { const stewart_legs_fk_real a = fabs(x[40]); largest = largest > a ? largest : a; total += a; b[73] = -x[40]; }
+    { const stewart_legs_fk_real a = fabs(x[41]); largest = largest > a ? largest : a; total += a; b[87] = -x[41]; }
+    { const stewart_legs_fk_real a = fabs(x[42]); largest = largest > a ? largest : a; total += a; b[11] = -x[42]; }
+    { const stewart_legs_fk_real a = fabs(x[43]); largest = largest > a ? largest : a; total += a; b[10] = -x[43]; }
+    { const stewart_legs_fk_real a = fabs(x[44]); largest = largest > a ? largest : a; total += a; b[12] = -x[44]; }
+    { const stewart_legs_fk_real a = fabs(x[45]); largest = largest > a ? largest : a; total += a; b[13] = -x[45]; }
+    { const stewart_legs_fk_real a = fabs(x[46]); largest = largest > a ? largest : a; total += a; b[18] = -x[46]; }
+    { const stewart_legs_fk_real a = fabs(x[47]); largest = largest > a ? largest : a; total += a; b[19] = -x[47]; }
+    { const stewart_legs_fk_real a = fabs(x[48]); largest = largest > a ? largest : a; total += a; b[20] = -x[48]; }
+    { const stewart_legs_fk_real a = fabs(x[49]); largest = largest > a ? largest : a; total += a; b[25] = -x[49]; }
+    { const stewart_legs_fk_real a = fabs(x[50]); largest = largest > a ? largest : a; total += a; b[24] = -x[50]; }
+    { const stewart_legs_fk_real a = fabs(x[51]); largest = largest > a ? largest : a; total += a; b[26] = -x[51]; }
+    { const stewart_legs_fk_real a = fabs(x[52]); largest = largest > a ? largest : a; total += a; b[27] = -x[52]; }
+    { const stewart_legs_fk_real a = fabs(x[53]); largest = largest > a ? largest : a; total += a; b[32] = -x[53]; }
+    { const stewart_legs_fk_real a = fabs(x[54]); largest = largest > a ? largest : a; total += a; b[33] = -x[54]; }
+    { const stewart_legs_fk_real a = fabs(x[55]); largest = largest > a ? largest : a; total += a; b[34] = -x[55]; }
+    { const stewart_legs_fk_real a = fabs(x[56]); largest = largest > a ? largest : a; total += a; b[40] = -x[56]; }
+    { const stewart_legs_fk_real a = fabs(x[57]); largest = largest > a ? largest : a; total += a; b[38] = -x[57]; }
+    { const stewart_legs_fk_real a = fabs(x[58]); largest = largest > a ? largest : a; total += a; b[39] = -x[58]; }
+    { const stewart_legs_fk_real a = fabs(x[59]); largest = largest > a ? largest : a; total += a; b[41] = -x[59]; }
+    { const stewart_legs_fk_real a = fabs(x[60]); largest = largest > a ? largest : a; total += a; b[47] = -x[60]; }
+    { const stewart_legs_fk_real a = fabs(x[61]); largest = largest > a ? largest : a; total += a; b[48] = -x[61]; }
+    { const stewart_legs_fk_real a = fabs(x[62]); largest = largest > a ? largest : a; total += a; b[46] = -x[62]; }
+    { const stewart_legs_fk_real a = fabs(x[63]); largest = largest > a ? largest : a; total += a; b[54] = -x[63]; }
+    { const stewart_legs_fk_real a = fabs(x[64]); largest = largest > a ? largest : a; total += a; b[52] = -x[64]; }
+    { const stewart_legs_fk_real a = fabs(x[65]); largest = largest > a ? largest : a; total += a; b[53] = -x[65]; }
+    { const stewart_legs_fk_real a = fabs(x[66]); largest = largest > a ? largest : a; total += a; b[55] = -x[66]; }
+    { const stewart_legs_fk_real a = fabs(x[67]); largest = largest > a ? largest : a; total += a; b[61] = -x[67]; }
+    { const stewart_legs_fk_real a = fabs(x[68]); largest = largest > a ? largest : a; total += a; b[62] = -x[68]; }
+    { const stewart_legs_fk_real a = fabs(x[69]); largest = largest > a ? largest : a; total += a; b[60] = -x[69]; }
+    { const stewart_legs_fk_real a = fabs(x[70]); largest = largest > a ? largest : a; total += a; b[67] = -x[70]; }
+    { const stewart_legs_fk_real a = fabs(x[71]); largest = largest > a ? largest : a; total += a; b[66] = -x[71]; }
+    { const stewart_legs_fk_real a = fabs(x[72]); largest = largest > a ? largest : a; total += a; b[68] = -x[72]; }
+    { const stewart_legs_fk_real a = fabs(x[73]); largest = largest > a ? largest : a; total += a; b[69] = -x[73]; }
+    { const stewart_legs_fk_real a = fabs(x[74]); largest = largest > a ? largest : a; total += a; b[74] = -x[74]; }
+    { const stewart_legs_fk_real a = fabs(x[75]); largest = largest > a ? largest : a; total += a; b[75] = -x[75]; }
+    { const stewart_legs_fk_real a = fabs(x[76]); largest = largest > a ? largest : a; total += a; b[76] = -x[76]; }
+    { const stewart_legs_fk_real a = fabs(x[77]); largest = largest > a ? largest : a; total += a; b[82] = -x[77]; }
+    { const stewart_legs_fk_real a = fabs(x[78]); largest = largest > a ? largest : a; total += a; b[80] = -x[78]; }
+    { const stewart_legs_fk_real a = fabs(x[79]); largest = largest > a ? largest : a; total += a; b[81] = -x[79]; }
+    { const stewart_legs_fk_real a = fabs(x[80]); largest = largest > a ? largest : a; total += a; b[83] = -x[80]; }
+    { const stewart_legs_fk_real a = fabs(x[81]); largest = largest > a ? largest : a; total += a; b[89] = -x[81]; }
+    { const stewart_legs_fk_real a = fabs(x[82]); largest = largest > a ? largest : a; total += a; b[90] = -x[82]; }
+    { const stewart_legs_fk_real a = fabs(x[83]); largest = largest > a ? largest : a; total += a; b[88] = -x[83]; }
+    { const stewart_legs_fk_real a = fabs(x[84]); largest = largest > a ? largest : a; total += a; b[3] = -x[84]; }
+    { const stewart_legs_fk_real a = fabs(x[85]); largest = largest > a ? largest : a; total += a; b[0] = -x[85]; }
+    { const stewart_legs_fk_real a = fabs(x[86]); largest = largest > a ? largest : a; total += a; b[5] = -x[86]; }
+    { const stewart_legs_fk_real a = fabs(x[87]); largest = largest > a ? largest : a; total += a; b[1] = -x[87]; }
+    { const stewart_legs_fk_real a = fabs(x[88]); largest = largest > a ? largest : a; total += a; b[2] = -x[88]; }
+    { const stewart_legs_fk_real a = fabs(x[89]); largest = largest > a ? largest : a; total += a; b[4] = -x[89]; }
+    { const stewart_legs_fk_real a = fabs(x[90]); largest = largest > a ? largest : a; total += a; b[6] = -x[90]; }
+    *sum_abs = total;
+    return largest;
+}
+
+stewart_legs_fk_real stewart_legs_fk_lu_solve_accelerations(const stewart_legs_fk_lu *lu, stewart_legs_fk_real b[], stewart_legs_fk_real *sum_abs)
+{
+    stewart_legs_fk_real x[STEWART_LEGS_FK_NQ];
+    stewart_legs_fk_real largest = 0, total = 0;
+    if (lu->dense) return stewart_legs_fk_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[2]: a zero row */
+    x[3] = 0; /* b[12]: a zero row */
+    x[4] = 0; /* b[13]: a zero row */
+    x[5] = 0; /* b[14]: a zero row */
+    x[6] = 0; /* b[24]: a zero row */
+    x[7] = 0; /* b[25]: a zero row */
+    x[8] = 0; /* b[26]: a zero row */
+    x[9] = 0; /* b[36]: a zero row */
+    x[10] = 0; /* b[37]: a zero row */
+    x[11] = 0; /* b[38]: a zero row */
+    x[12] = 0; /* b[48]: a zero row */
+    x[13] = 0; /* b[49]: a zero row */
+    x[14] = 0; /* b[50]: a zero row */
+    x[15] = 0; /* b[60]: a zero row */
+    x[16] = 0; /* b[61]: a zero row */
+    x[17] = 0; /* b[62]: a zero row */
+    x[18] = b[6];
+    x[19] = b[7];
+    x[20] = b[72];
+    x[21] = b[18];
+    x[22] = b[19];
+    x[23] = b[73];
+    x[24] = b[30];
+    x[25] = b[31];
+    x[26] = b[74];
+    x[27] = b[42];
+    x[28] = b[43];
+    x[29] = b[75];
+    x[30] = b[54];
+    x[31] = b[55];
+    x[32] = b[76];
+    x[33] = b[66];
+    x[34] = b[67];
+    x[35] = b[77];
+    x[36] = b[80];
+    x[37] = b[82];
+    x[38] = b[84];
+    x[39] = b[86];
+    x[40] = b[88];
+    x[41] = b[90];
+    x[42] = b[3];
+    x[43] = b[79];
+    x[44] = b[4];
+    x[45] = b[5];
+    x[46] = b[8];
+    x[47] = b[9];
+    x[48] = b[10];
+    x[49] = b[15];
+    x[50] = b[81];
+    x[51] = b[16];
+    x[52] = b[17];
+    x[53] = b[20];
+    x[54] = b[21];
+    x[55] = b[22];
+    x[56] = b[27];
+    x[57] = b[83];
+    x[58] = b[28];
+    x[59] = b[29];
+    x[60] = b[32];
+    x[61] = b[33];
+    x[62] = b[34];
+    x[63] = b[39];
+    x[64] = b[85];
+    x[65] = b[40];
+    x[66] = b[41];
+    x[67] = b[44];
+    x[68] = b[45];
+    x[69] = b[46];
+    x[70] = b[51];
+    x[71] = b[87];
+    x[72] = b[52];
+    x[73] = b[53];
+    x[74] = b[56];
+    x[75] = b[57];
+    x[76] = b[58];
+    x[77] = b[63];
+    x[78] = b[89];
+    x[79] = b[64];
+    x[80] = b[65];
+    x[81] = b[68];
+    x[82] = b[69];
+    x[83] = b[70];
+    x[84] = b[78];
+    x[85] = b[11];
+    x[86] = b[23];
+    x[87] = b[35];
+    x[88] = b[47];
+    x[89] = b[59];
+    x[90] = b[71];
+    stewart_legs_fk_lu_forward_0(lu->v, x);
+    stewart_legs_fk_lu_forward_1(lu->v, x);
+    stewart_legs_fk_lu_backward_0(lu->v, lu->inv, x);
+    stewart_legs_fk_lu_backward_1(lu->v, lu->inv, x);
+    b[7] = x[0]; /* +-0: no norm to take */
+    b[8] = x[1]; /* +-0: no norm to take */
+    b[9] = x[2]; /* +-0: no norm to take */
+    b[21] = x[3]; /* +-0: no norm to take */
+    b[22] = x[4]; /* +-0: no norm to take */
+    b[23] = x[5]; /* +-0: no norm to take */
+    b[35] = x[6]; /* +-0: no norm to take */
+    b[36] = x[7]; /* +-0: no norm to take */
+    b[37] = x[8]; /* +-0: no norm to take */
+    b[49] = x[9]; /* +-0: no norm to take */
+    b[50] = x[10]; /* +-0: no norm to take */
+    b[51] = x[11]; /* +-0: no norm to take */
+    b[63] = x[12]; /* +-0: no norm to take */
+    b[64] = x[13]; /* +-0: no norm to take */
+    b[65] = x[14]; /* +-0: no norm to take */
+    b[77] = x[15]; /* +-0: no norm to take */
+    b[78] = x[16]; /* +-0: no norm to take */
+    b[79] = x[17]; /* +-0: no norm to take */
+    { const stewart_legs_fk_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[14] = x[18]; }
+    { const stewart_legs_fk_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[15] = x[19]; }
+    { const stewart_legs_fk_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[16] = x[20]; }
+    { const stewart_legs_fk_real a = fabs(x[21]); largest = largest > a ? largest : a; total += a; b[28] = x[21]; }
+    { const stewart_legs_fk_real a = fabs(x[22]); largest = largest > a ? largest : a; total += a; b[29] = x[22]; }
+    { const stewart_legs_fk_real a = fabs(x[23]); largest = largest > a ? largest : a; total += a; b[30] = x[23]; }
+    { const stewart_legs_fk_real a = fabs(x[24]); largest = largest > a ? largest : a; total += a; b[43] = x[24]; }
+    { const stewart_legs_fk_real a = fabs(x[25]); largest = largest > a ? largest : a; total += a; b[42] = x[25]; }
+    { const stewart_legs_fk_real a = fabs(x[26]); largest = largest > a ? largest : a; total += a; b[44] = x[26]; }
+    { const stewart_legs_fk_real a = fabs(x[27]); largest = largest > a ? largest : a; total += a; b[57] = x[27]; }
+    { const stewart_legs_fk_real a = fabs(x[28]); largest = largest > a ? largest : a; total += a; b[56] = x[28]; }
+    { const stewart_legs_fk_real a = fabs(x[29]); largest = largest > a ? largest : a; total += a; b[58] = x[29]; }
+    { const stewart_legs_fk_real a = fabs(x[30]); largest = largest > a ? largest : a; total += a; b[70] = x[30]; }
+    { const stewart_legs_fk_real a = fabs(x[31]); largest = largest > a ? largest : a; total += a; b[71] = x[31]; }
+    { const stewart_legs_fk_real a = fabs(x[32]); largest = largest > a ? largest : a; total += a; b[72] = x[32]; }
+    { const stewart_legs_fk_real a = fabs(x[33]); largest = largest > a ? largest : a; total += a; b[85] = x[33]; }
+    { const stewart_legs_fk_real a = fabs(x[34]); largest = largest > a ? largest : a; total += a; b[84] = x[34]; }
+    { const stewart_legs_fk_real a = fabs(x[35]); largest = largest > a ? largest : a; total += a; b[86] = x[35]; }
+    { const stewart_legs_fk_real a = fabs(x[36]); largest = largest > a ? largest : a; total += a; b[17] = x[36]; }
+    { const stewart_legs_fk_real a = fabs(x[37]); largest = largest > a ? largest : a; total += a; b[31] = x[37]; }
+    { const stewart_legs_fk_real a = fabs(x[38]); largest = largest > a ? largest : a; total += a; b[45] = x[38]; }
+    { const stewart_legs_fk_real a = fabs(x[39]); largest = largest > a ? largest : a; total += a; b[59] = x[39]; }
+    { const stewart_legs_fk_real a = fabs(x[40]); largest = largest > a ? largest : a; total += a; b[73] = x[40]; }
+    { const stewart_legs_fk_real a = fabs(x[41]); largest = largest > a ? largest : a; total += a; b[87] = x[41]; }
+    { const stewart_legs_fk_real a = fabs(x[42]); largest = largest > a ? largest : a; total += a; b[11] = x[42]; }
+    { const stewart_legs_fk_real a = fabs(x[43]); largest = largest > a ? largest : a; total += a; b[10] = x[43]; }
+    { const stewart_legs_fk_real a = fabs(x[44]); largest = largest > a ? largest : a; total += a; b[12] = x[44]; }
+    { const stewart_legs_fk_real a = fabs(x[45]); largest = largest > a ? largest : a; total += a; b[13] = x[45]; }
+    { const stewart_legs_fk_real a = fabs(x[46]); largest = largest > a ? largest : a; total += a; b[18] = x[46]; }
+    { const stewart_legs_fk_real a = fabs(x[47]); largest = largest > a ? largest : a; total += a; b[19] = x[47]; }
+    { const stewart_legs_fk_real a = fabs(x[48]); largest = largest > a ? largest : a; total += a; b[20] = x[48]; }
+    { const stewart_legs_fk_real a = fabs(x[49]); largest = largest > a ? largest : a; total += a; b[25] = x[49]; }
+    { const stewart_legs_fk_real a = fabs(x[50]); largest = largest > a ? largest : a; total += a; b[24] = x[50]; }
+    { const stewart_legs_fk_real a = fabs(x[51]); largest = largest > a ? largest : a; total += a; b[26] = x[51]; }
+    { const stewart_legs_fk_real a = fabs(x[52]); largest = largest > a ? largest : a; total += a; b[27] = x[52]; }
+    { const stewart_legs_fk_real a = fabs(x[53]); largest = largest > a ? largest : a; total += a; b[32] = x[53]; }
+    { const stewart_legs_fk_real a = fabs(x[54]); largest = largest > a ? largest : a; total += a; b[33] = x[54]; }
+    { const stewart_legs_fk_real a = fabs(x[55]); largest = largest > a ? largest : a; total += a; b[34] = x[55]; }
+    { const stewart_legs_fk_real a = fabs(x[56]); largest = largest > a ? largest : a; total += a; b[40] = x[56]; }
+    { const stewart_legs_fk_real a = fabs(x[57]); largest = largest > a ? largest : a; total += a; b[38] = x[57]; }
+    { const stewart_legs_fk_real a = fabs(x[58]); largest = largest > a ? largest : a; total += a; b[39] = x[58]; }
+    { const stewart_legs_fk_real a = fabs(x[59]); largest = largest > a ? largest : a; total += a; b[41] = x[59]; }
+    { const stewart_legs_fk_real a = fabs(x[60]); largest = largest > a ? largest : a; total += a; b[47] = x[60]; }
+    { const stewart_legs_fk_real a = fabs(x[61]); largest = largest > a ? largest : a; total += a; b[48] = x[61]; }
+    { const stewart_legs_fk_real a = fabs(x[62]); largest = largest > a ? largest : a; total += a; b[46] = x[62]; }
+    { const stewart_legs_fk_real a = fabs(x[63]); largest = largest > a ? largest : a; total += a; b[54] = x[63]; }
+    { const stewart_legs_fk_real a = fabs(x[64]); largest = largest > a ? largest : a; total += a; b[52] = x[64]; }
+    { const stewart_legs_fk_real a = fabs(x[65]); largest = largest > a ? largest : a; total += a; b[53] = x[65]; }
+    { const stewart_legs_fk_real a = fabs(x[66]); largest = largest > a ? largest : a; total += a; b[55] = x[66]; }
+    { const stewart_legs_fk_real a = fabs(x[67]); largest = largest > a ? largest : a; total += a; b[61] = x[67]; }
+    { const stewart_legs_fk_real a = fabs(x[68]); largest = largest > a ? largest : a; total += a; b[62] = x[68]; }
+    { const stewart_legs_fk_real a = fabs(x[69]); largest = largest > a ? largest : a; total += a; b[60] = x[69]; }
+    { const stewart_legs_fk_real a = fabs(x[70]); largest = largest > a ? largest : a; total += a; b[67] = x[70]; }
+    { const stewart_legs_fk_real a = fabs(x[71]); largest = largest > a ? largest : a; total += a; b[66] = x[71]; }
+    { const stewart_legs_fk_real a = fabs(x[72]); largest = largest > a ? largest : a; total += a; b[68] = x[72]; }
+    { const stewart_legs_fk_real a = fabs(x[73]); largest = largest > a ? largest : a; total += a; b[69] = x[73]; }
+    { const stewart_legs_fk_real a = fabs(x[74]); largest = largest > a ? largest : a; total += a; b[74] = x[74]; }
+    { const stewart_legs_fk_real a = fabs(x[75]); largest = largest > a ? largest : a; total += a; b[75] = x[75]; }
+    { const stewart_legs_fk_real a = fabs(x[76]); largest = largest > a ? largest : a; total += a; b[76] = x[76]; }
+    { const stewart_legs_fk_real a = fabs(x[77]); largest = largest > a ? largest : a; total += a; b[82] = x[77]; }
+    { const stewart_legs_fk_real a = fabs(x[78]); largest = largest > a ? largest : a; total += a; b[80] = x[78]; }
+    { const stewart_legs_fk_real a = fabs(x[79]); largest = largest > a ? largest : a; total += a; b[81] = x[79]; }
+    { const stewart_legs_fk_real a = fabs(x[80]); largest = largest > a ? largest : a; total += a; b[83] = x[80]; }
+    { const stewart_legs_fk_real a = fabs(x[81]); largest = largest > a ? largest : a; total += a; b[89] = x[81]; }
+    { const stewart_legs_fk_real a = fabs(x[82]); largest = largest > a ? largest : a; total += a; b[90] = x[82]; }
+    { const stewart_legs_fk_real a = fabs(x[83]); largest = largest > a ? largest : a; total += a; b[88] = x[83]; }
+    { const stewart_legs_fk_real a = fabs(x[84]); largest = largest > a ? largest : a; total += a; b[3] = x[84]; }
+    { const stewart_legs_fk_real a = fabs(x[85]); largest = largest > a ? largest : a; total += a; b[0] = x[85]; }
+    { const stewart_legs_fk_real a = fabs(x[86]); largest = largest > a ? largest : a; total += a; b[5] = x[86]; }
+    { const stewart_legs_fk_real a = fabs(x[87]); largest = largest > a ? largest : a; total += a; b[1] = x[87]; }
+    { const stewart_legs_fk_real a = fabs(x[88]); largest = largest > a ? largest : a; total += a; b[2] = x[88]; }
+    { const stewart_legs_fk_real a = fabs(x[89]); largest = largest > a ? largest : a; total += a; b[4] = x[89]; }
+    { const stewart_legs_fk_real a = fabs(x[90]); largest = largest > a ? largest : a; total += a; b[6] = x[90]; }
+    *sum_abs = total;
+    return largest;
+}
+
 /* U^T z = w, columns 0..62 of U^T (rows of U) */
 static void stewart_legs_fk_lu_upper_t_0(const stewart_legs_fk_real *v,
         const stewart_legs_fk_real *inv, stewart_legs_fk_real *x)

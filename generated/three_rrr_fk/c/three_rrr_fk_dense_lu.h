@@ -39,6 +39,13 @@ int three_rrr_fk_dense_lu_det_sign(const three_rrr_fk_dense_lu *lu);
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void three_rrr_fk_dense_lu_solve(const three_rrr_fk_dense_lu *lu, three_rrr_fk_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+three_rrr_fk_real three_rrr_fk_dense_lu_solve_max(const three_rrr_fk_dense_lu *lu, three_rrr_fk_real b[],
+                                              three_rrr_fk_real *sum_abs);
+three_rrr_fk_real three_rrr_fk_dense_lu_solve_negated_max(const three_rrr_fk_dense_lu *lu,
+                                                      three_rrr_fk_real b[], three_rrr_fk_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void three_rrr_fk_dense_lu_solve_transposed(const three_rrr_fk_dense_lu *lu, three_rrr_fk_real b[]);
 

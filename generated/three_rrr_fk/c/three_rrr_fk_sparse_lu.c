@@ -277,71 +277,6 @@ three_rrr_fk_real three_rrr_fk_lu_pivot_ratio(const three_rrr_fk_lu *lu)
     return high > 0 ? low / high : 0;
 }
 
-/* L y = P b, columns 0..19 */
-static void three_rrr_fk_lu_forward_0(const three_rrr_fk_real *v, three_rrr_fk_real *x)
-{
-    (void)v;
-    x[7] += x[0];
-    x[8] += x[1];
-    x[10] += x[2];
-    x[11] += x[3];
-    x[13] += x[4];
-    x[14] += x[5];
-    x[7] -= v[3] * x[6];
-    x[8] -= v[6] * x[6];
-    x[15] += x[7];
-    x[18] += x[8];
-    x[10] -= v[19] * x[9];
-    x[11] -= v[22] * x[9];
-    x[16] += x[10];
-    x[19] += x[11];
-    x[13] -= v[35] * x[12];
-    x[14] -= v[38] * x[12];
-    x[20] += x[13];
-    x[17] += x[14];
-    x[18] -= v[13] * x[15];
-    x[19] -= v[29] * x[16];
-    x[20] -= v[41] * x[17];
-    x[19] -= x[18];
-    x[20] -= v[53] * x[18];
-    x[20] -= v[42] * x[19];
-}
-
-/* U z = y, rows 20..0 */
-static void three_rrr_fk_lu_backward_0(const three_rrr_fk_real *v,
-        const three_rrr_fk_real *inv, three_rrr_fk_real *x)
-{
-    (void)v;
-    (void)inv;
-    x[20] *= inv[20];
-    x[19] -= v[31] * x[20];
-    x[19] *= inv[19];
-    x[18] -= v[51] * x[19];
-    x[18] -= v[15] * x[20];
-    x[18] = -x[18];
-    x[17] += x[18];
-    x[17] -= v[47] * x[20];
-    x[17] *= inv[17];
-    x[16] += x[19];
-    x[16] -= v[27] * x[20];
-    x[16] *= inv[16];
-    x[15] += x[19];
-    x[15] -= v[11] * x[20];
-    x[15] *= inv[15];
-    x[14] = -x[14];
-    x[13] = -x[13];
-    x[11] = -x[11];
-    x[10] = -x[10];
-    x[8] = -x[8];
-    x[7] = -x[7];
-    x[5] = -x[5];
-    x[4] = -x[4];
-    x[3] = -x[3];
-    x[2] = -x[2];
-    x[1] = -x[1];
-    x[0] = -x[0];
-}
-
 void three_rrr_fk_lu_solve(const three_rrr_fk_lu *lu, three_rrr_fk_real b[])
 {
     three_rrr_fk_real x[THREE_RRR_FK_NQ];
@@ -371,8 +306,64 @@ void three_rrr_fk_lu_solve(const three_rrr_fk_lu *lu, three_rrr_fk_real b[])
     x[18] = b[5];
     x[19] = b[11];
     x[20] = b[16];
-    three_rrr_fk_lu_forward_0(lu->v, x);
-    three_rrr_fk_lu_backward_0(lu->v, lu->inv, x);
+    {
+        const three_rrr_fk_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[0];
+        x[8] += x[1];
+        x[10] += x[2];
+        x[11] += x[3];
+        x[13] += x[4];
+        x[14] += x[5];
+        x[7] -= v[3] * x[6];
+        x[8] -= v[6] * x[6];
+        x[15] += x[7];
+        x[18] += x[8];
+        x[10] -= v[19] * x[9];
+        x[11] -= v[22] * x[9];
+        x[16] += x[10];
+        x[19] += x[11];
+        x[13] -= v[35] * x[12];
+        x[14] -= v[38] * x[12];
+        x[20] += x[13];
+        x[17] += x[14];
+        x[18] -= v[13] * x[15];
+        x[19] -= v[29] * x[16];
+        x[20] -= v[41] * x[17];
+        x[19] -= x[18];
+        x[20] -= v[53] * x[18];
+        x[20] -= v[42] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[31] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[51] * x[19];
+        x[18] -= v[15] * x[20];
+        x[18] = -x[18];
+        x[17] += x[18];
+        x[17] -= v[47] * x[20];
+        x[17] *= inv[17];
+        x[16] += x[19];
+        x[16] -= v[27] * x[20];
+        x[16] *= inv[16];
+        x[15] += x[19];
+        x[15] -= v[11] * x[20];
+        x[15] *= inv[15];
+        x[14] = -x[14];
+        x[13] = -x[13];
+        x[11] = -x[11];
+        x[10] = -x[10];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
     b[0] = x[0];
     b[1] = x[1];
     b[3] = x[2];
@@ -394,6 +385,233 @@ void three_rrr_fk_lu_solve(const three_rrr_fk_lu *lu, three_rrr_fk_real b[])
     b[19] = x[18];
     b[18] = x[19];
     b[20] = x[20];
+}
+
+/* The step's two solves: the same solve with the norms of its solution (in b's unit) taken as
+ * each entry is written out, in registers (the solver's passes over dq and ddq, not a pass
+ * over memory again): max |x_i| returned, sum |x_i| into *sum_abs, NaN exactly when some x_i
+ * is (none is negative: inf - inf cannot occur); an infinite x_i is the largest. _rates
+ * solves Phi_t and writes -x (exact), dq; _accelerations solves Gamma. The rows where Phi_t or
+ * Gamma is a literal 0 are taken as 0, not read; an entry that is then +-0 whatever the factors
+ * (backends.c.rhs_zeros) adds nothing to the norms and is not taken. */
+three_rrr_fk_real three_rrr_fk_lu_solve_rates(const three_rrr_fk_lu *lu, three_rrr_fk_real b[], three_rrr_fk_real *sum_abs)
+{
+    three_rrr_fk_real x[THREE_RRR_FK_NQ];
+    three_rrr_fk_real largest = 0, total = 0;
+    if (lu->dense) return three_rrr_fk_dense_lu_solve_negated_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[6]: a zero row */
+    x[3] = 0; /* b[7]: a zero row */
+    x[4] = 0; /* b[12]: a zero row */
+    x[5] = 0; /* b[13]: a zero row */
+    x[6] = b[18];
+    x[7] = 0; /* b[2]: a zero row */
+    x[8] = 0; /* b[3]: a zero row */
+    x[9] = b[19];
+    x[10] = 0; /* b[8]: a zero row */
+    x[11] = 0; /* b[9]: a zero row */
+    x[12] = b[20];
+    x[13] = 0; /* b[14]: a zero row */
+    x[14] = 0; /* b[15]: a zero row */
+    x[15] = 0; /* b[4]: a zero row */
+    x[16] = 0; /* b[10]: a zero row */
+    x[17] = 0; /* b[17]: a zero row */
+    x[18] = 0; /* b[5]: a zero row */
+    x[19] = 0; /* b[11]: a zero row */
+    x[20] = 0; /* b[16]: a zero row */
+    {
+        const three_rrr_fk_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[0];
+        x[8] += x[1];
+        x[10] += x[2];
+        x[11] += x[3];
+        x[13] += x[4];
+        x[14] += x[5];
+        x[7] -= v[3] * x[6];
+        x[8] -= v[6] * x[6];
+        x[15] += x[7];
+        x[18] += x[8];
+        x[10] -= v[19] * x[9];
+        x[11] -= v[22] * x[9];
+        x[16] += x[10];
+        x[19] += x[11];
+        x[13] -= v[35] * x[12];
+        x[14] -= v[38] * x[12];
+        x[20] += x[13];
+        x[17] += x[14];
+        x[18] -= v[13] * x[15];
+        x[19] -= v[29] * x[16];
+        x[20] -= v[41] * x[17];
+        x[19] -= x[18];
+        x[20] -= v[53] * x[18];
+        x[20] -= v[42] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[31] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[51] * x[19];
+        x[18] -= v[15] * x[20];
+        x[18] = -x[18];
+        x[17] += x[18];
+        x[17] -= v[47] * x[20];
+        x[17] *= inv[17];
+        x[16] += x[19];
+        x[16] -= v[27] * x[20];
+        x[16] *= inv[16];
+        x[15] += x[19];
+        x[15] -= v[11] * x[20];
+        x[15] *= inv[15];
+        x[14] = -x[14];
+        x[13] = -x[13];
+        x[11] = -x[11];
+        x[10] = -x[10];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = -x[0]; /* +-0: no norm to take */
+    b[1] = -x[1]; /* +-0: no norm to take */
+    b[3] = -x[2]; /* +-0: no norm to take */
+    b[4] = -x[3]; /* +-0: no norm to take */
+    b[6] = -x[4]; /* +-0: no norm to take */
+    b[7] = -x[5]; /* +-0: no norm to take */
+    { const three_rrr_fk_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[2] = -x[6]; }
+    { const three_rrr_fk_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[9] = -x[7]; }
+    { const three_rrr_fk_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[10] = -x[8]; }
+    { const three_rrr_fk_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[5] = -x[9]; }
+    { const three_rrr_fk_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[12] = -x[10]; }
+    { const three_rrr_fk_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[13] = -x[11]; }
+    { const three_rrr_fk_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[8] = -x[12]; }
+    { const three_rrr_fk_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[15] = -x[13]; }
+    { const three_rrr_fk_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[16] = -x[14]; }
+    { const three_rrr_fk_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[11] = -x[15]; }
+    { const three_rrr_fk_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[14] = -x[16]; }
+    { const three_rrr_fk_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[17] = -x[17]; }
+    { const three_rrr_fk_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[19] = -x[18]; }
+    { const three_rrr_fk_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[18] = -x[19]; }
+    { const three_rrr_fk_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[20] = -x[20]; }
+    *sum_abs = total;
+    return largest;
+}
+
+three_rrr_fk_real three_rrr_fk_lu_solve_accelerations(const three_rrr_fk_lu *lu, three_rrr_fk_real b[], three_rrr_fk_real *sum_abs)
+{
+    three_rrr_fk_real x[THREE_RRR_FK_NQ];
+    three_rrr_fk_real largest = 0, total = 0;
+    if (lu->dense) return three_rrr_fk_dense_lu_solve_max(&lu->dense_lu, b, sum_abs);
+    /* the row permutation, baked in: no index table to load */
+    x[0] = 0; /* b[0]: a zero row */
+    x[1] = 0; /* b[1]: a zero row */
+    x[2] = 0; /* b[6]: a zero row */
+    x[3] = 0; /* b[7]: a zero row */
+    x[4] = 0; /* b[12]: a zero row */
+    x[5] = 0; /* b[13]: a zero row */
+    x[6] = b[18];
+    x[7] = b[2];
+    x[8] = b[3];
+    x[9] = b[19];
+    x[10] = b[8];
+    x[11] = b[9];
+    x[12] = b[20];
+    x[13] = b[14];
+    x[14] = b[15];
+    x[15] = b[4];
+    x[16] = b[10];
+    x[17] = b[17];
+    x[18] = b[5];
+    x[19] = b[11];
+    x[20] = b[16];
+    {
+        const three_rrr_fk_real *v = lu->v, *inv = lu->inv;
+        (void)v;
+        (void)inv;
+        /* L y = P b */
+        x[7] += x[0];
+        x[8] += x[1];
+        x[10] += x[2];
+        x[11] += x[3];
+        x[13] += x[4];
+        x[14] += x[5];
+        x[7] -= v[3] * x[6];
+        x[8] -= v[6] * x[6];
+        x[15] += x[7];
+        x[18] += x[8];
+        x[10] -= v[19] * x[9];
+        x[11] -= v[22] * x[9];
+        x[16] += x[10];
+        x[19] += x[11];
+        x[13] -= v[35] * x[12];
+        x[14] -= v[38] * x[12];
+        x[20] += x[13];
+        x[17] += x[14];
+        x[18] -= v[13] * x[15];
+        x[19] -= v[29] * x[16];
+        x[20] -= v[41] * x[17];
+        x[19] -= x[18];
+        x[20] -= v[53] * x[18];
+        x[20] -= v[42] * x[19];
+        /* U z = y */
+        x[20] *= inv[20];
+        x[19] -= v[31] * x[20];
+        x[19] *= inv[19];
+        x[18] -= v[51] * x[19];
+        x[18] -= v[15] * x[20];
+        x[18] = -x[18];
+        x[17] += x[18];
+        x[17] -= v[47] * x[20];
+        x[17] *= inv[17];
+        x[16] += x[19];
+        x[16] -= v[27] * x[20];
+        x[16] *= inv[16];
+        x[15] += x[19];
+        x[15] -= v[11] * x[20];
+        x[15] *= inv[15];
+        x[14] = -x[14];
+        x[13] = -x[13];
+        x[11] = -x[11];
+        x[10] = -x[10];
+        x[8] = -x[8];
+        x[7] = -x[7];
+        x[5] = -x[5];
+        x[4] = -x[4];
+        x[3] = -x[3];
+        x[2] = -x[2];
+        x[1] = -x[1];
+        x[0] = -x[0];
+    }
+    b[0] = x[0]; /* +-0: no norm to take */
+    b[1] = x[1]; /* +-0: no norm to take */
+    b[3] = x[2]; /* +-0: no norm to take */
+    b[4] = x[3]; /* +-0: no norm to take */
+    b[6] = x[4]; /* +-0: no norm to take */
+    b[7] = x[5]; /* +-0: no norm to take */
+    { const three_rrr_fk_real a = fabs(x[6]); largest = largest > a ? largest : a; total += a; b[2] = x[6]; }
+    { const three_rrr_fk_real a = fabs(x[7]); largest = largest > a ? largest : a; total += a; b[9] = x[7]; }
+    { const three_rrr_fk_real a = fabs(x[8]); largest = largest > a ? largest : a; total += a; b[10] = x[8]; }
+    { const three_rrr_fk_real a = fabs(x[9]); largest = largest > a ? largest : a; total += a; b[5] = x[9]; }
+    { const three_rrr_fk_real a = fabs(x[10]); largest = largest > a ? largest : a; total += a; b[12] = x[10]; }
+    { const three_rrr_fk_real a = fabs(x[11]); largest = largest > a ? largest : a; total += a; b[13] = x[11]; }
+    { const three_rrr_fk_real a = fabs(x[12]); largest = largest > a ? largest : a; total += a; b[8] = x[12]; }
+    { const three_rrr_fk_real a = fabs(x[13]); largest = largest > a ? largest : a; total += a; b[15] = x[13]; }
+    { const three_rrr_fk_real a = fabs(x[14]); largest = largest > a ? largest : a; total += a; b[16] = x[14]; }
+    { const three_rrr_fk_real a = fabs(x[15]); largest = largest > a ? largest : a; total += a; b[11] = x[15]; }
+    { const three_rrr_fk_real a = fabs(x[16]); largest = largest > a ? largest : a; total += a; b[14] = x[16]; }
+    { const three_rrr_fk_real a = fabs(x[17]); largest = largest > a ? largest : a; total += a; b[17] = x[17]; }
+    { const three_rrr_fk_real a = fabs(x[18]); largest = largest > a ? largest : a; total += a; b[19] = x[18]; }
+    { const three_rrr_fk_real a = fabs(x[19]); largest = largest > a ? largest : a; total += a; b[18] = x[19]; }
+    { const three_rrr_fk_real a = fabs(x[20]); largest = largest > a ? largest : a; total += a; b[20] = x[20]; }
+    *sum_abs = total;
+    return largest;
 }
 
 /* U^T z = w, columns 0..20 of U^T (rows of U) */

@@ -35,6 +35,13 @@ whitworth_drawn_real whitworth_drawn_dense_lu_pivot_ratio(const whitworth_drawn_
 /* Solve Phi_q x = b in place (b becomes x) with a complete factorization. */
 void whitworth_drawn_dense_lu_solve(const whitworth_drawn_dense_lu *lu, whitworth_drawn_real b[]);
 
+/* The same solve; returns max |x_i| of the solution and stores sum |x_i| in *sum_abs (NaN
+ * exactly when some x_i is); the _negated one then writes -x. */
+whitworth_drawn_real whitworth_drawn_dense_lu_solve_max(const whitworth_drawn_dense_lu *lu, whitworth_drawn_real b[],
+                                              whitworth_drawn_real *sum_abs);
+whitworth_drawn_real whitworth_drawn_dense_lu_solve_negated_max(const whitworth_drawn_dense_lu *lu,
+                                                      whitworth_drawn_real b[], whitworth_drawn_real *sum_abs);
+
 /* Solve Phi_q^T x = b in place with the same factors (for the condition estimate). */
 void whitworth_drawn_dense_lu_solve_transposed(const whitworth_drawn_dense_lu *lu, whitworth_drawn_real b[]);
 

@@ -841,11 +841,25 @@ static int whitworth_drawn_newton(const whitworth_drawn_options *options, const 
     report->iterations = 0; /* as they stand when max_iterations < 0 lets no iteration run */
     report->residual = (whitworth_drawn_real)NAN;
     for (iteration = 0; iteration <= options->max_iterations; ++iteration) {
-        whitworth_drawn_real residual;
+        whitworth_drawn_real residual = 0, sum = 0;
         /* Phi and Phi_q of this iterate in one fused call: each sine and cosine once */
         whitworth_drawn_phi_phi_q(q, t, p, work->phi, work->nz, work->shared);
         whitworth_drawn_in_unit(work);
-        residual = whitworth_drawn_max_abs(work->phi);
+        /* max |Phi| as max_abs takes it, written out here: no call in the loop every step
+         * runs (a copy of max_abs the compiler would fold back into the call) */
+        { const whitworth_drawn_real a = fabs(work->phi[0]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[1]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[2]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[3]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[4]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[5]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[6]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[7]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[8]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[9]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[10]); residual = residual > a ? residual : a; sum += a; }
+        { const whitworth_drawn_real a = fabs(work->phi[11]); residual = residual > a ? residual : a; sum += a; }
+        residual = sum != sum ? (whitworth_drawn_real)NAN : residual;
         report->residual = residual;
         report->iterations = iteration;
         if (residual - residual != 0) { /* inf or NaN: singular at t, or Newton diverged */
@@ -899,123 +913,70 @@ static void whitworth_drawn_predict(whitworth_drawn_real t, whitworth_drawn_stat
     state->q[11] += state->dq[11] * h + state->ddq[11] * half_h2;
 }
 
-/* The pass over -dq as solved (in the run's unit): its max |.| in that unit, the sum of |.|
- * into *sum for the finite test (one addition an entry: the sum is NaN exactly when some
- * entry is, none being negative so that inf - inf cannot occur; an infinite entry is the
- * largest), and dq in the kernel's unit. */
-static whitworth_drawn_real whitworth_drawn_rates_pass(const whitworth_drawn_workspace *work, whitworth_drawn_real dq[],
-                                       whitworth_drawn_real *sum_abs)
+/* max |q| in the run's unit (NaN when some q_i is, as in max_abs: the error model then flags
+ * the point). */
+static whitworth_drawn_real whitworth_drawn_positions_pass(const whitworth_drawn_workspace *work, const whitworth_drawn_real q[])
 {
-    whitworth_drawn_real largest = 0, sum = 0;
-    { const whitworth_drawn_real b = fabs(dq[0]); largest = largest > b ? largest : b; sum += b; }
-    dq[0] = -dq[0];
-    { const whitworth_drawn_real b = fabs(dq[1]); largest = largest > b ? largest : b; sum += b; }
-    dq[1] = -dq[1];
-    { const whitworth_drawn_real b = fabs(dq[2]); largest = largest > b ? largest : b; sum += b; }
-    dq[2] = -dq[2];
-    { const whitworth_drawn_real b = fabs(dq[3]); largest = largest > b ? largest : b; sum += b; }
-    dq[3] = -dq[3];
-    { const whitworth_drawn_real b = fabs(dq[4]); largest = largest > b ? largest : b; sum += b; }
-    dq[4] = -dq[4];
-    { const whitworth_drawn_real b = fabs(dq[5]); largest = largest > b ? largest : b; sum += b; }
-    dq[5] = -dq[5];
-    { const whitworth_drawn_real b = fabs(dq[6]); largest = largest > b ? largest : b; sum += b; }
-    dq[6] = -dq[6];
-    { const whitworth_drawn_real b = fabs(dq[7]); largest = largest > b ? largest : b; sum += b; }
-    dq[7] = -dq[7];
-    { const whitworth_drawn_real b = fabs(dq[8]); largest = largest > b ? largest : b; sum += b; }
-    dq[8] = -dq[8];
-    { const whitworth_drawn_real b = fabs(dq[9]); largest = largest > b ? largest : b; sum += b; }
-    dq[9] = -dq[9];
-    { const whitworth_drawn_real b = fabs(dq[10]); largest = largest > b ? largest : b; sum += b; }
-    dq[10] = -dq[10];
-    { const whitworth_drawn_real b = fabs(dq[11]); largest = largest > b ? largest : b; sum += b; }
-    dq[11] = -dq[11];
-    whitworth_drawn_from_unit(work, dq);
-    *sum_abs = sum;
-    return largest;
-}
-
-/* The pass over ddq as solved (in the run's unit) and q: max |ddq| in that unit (returned),
- * the sum of |ddq| for the finite test (as the rates' pass), ddq in the kernel's unit, and
- * max |q| in the run's unit into *nq (NaN when some q_i is, as in max_abs: the error model
- * then flags the point). */
-static whitworth_drawn_real whitworth_drawn_accelerations_pass(const whitworth_drawn_workspace *work,
-                                               const whitworth_drawn_real q[], whitworth_drawn_real ddq[],
-                                               whitworth_drawn_real *sum_abs, whitworth_drawn_real *nq)
-{
-    whitworth_drawn_real largest = 0, sum = 0, largest_q = 0, sum_q = 0, largest_length = 0;
-    /* sum, sum_q: NaN exactly when some ddq_i, q_i is (as in max_abs and the rates' pass);
-     * a coordinate that is no length is the same in every unit (no division); the lengths'
-     * largest |q_i| is divided by the unit once, after the pass: rounding is monotone, so
-     * max (|q_i| / unit) and (max |q_i|) / unit are the same number (the unit is finite) */
-    { const whitworth_drawn_real c = fabs(ddq[0]); largest = largest > c ? largest : c; sum += c; }
+    whitworth_drawn_real largest_q = 0, sum_q = 0, largest_length = 0;
+    /* sum_q: NaN exactly when some q_i is (as in max_abs); a coordinate that is no length is
+     * the same in every unit (no division); the lengths' largest |q_i| is divided by the unit
+     * once, after the pass: rounding is monotone, so max (|q_i| / unit) and (max |q_i|) / unit
+     * are the same number (the unit is finite) */
     {
         const whitworth_drawn_real a = fabs(q[0]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[1]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[1]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[2]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[2]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[3]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[3]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[4]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[4]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[5]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[5]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[6]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[6]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[7]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[7]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[8]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[8]);
         largest_q = largest_q > a ? largest_q : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[9]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[9]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[10]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[10]);
         largest_length = largest_length > a ? largest_length : a;
         sum_q += a;
     }
-    { const whitworth_drawn_real c = fabs(ddq[11]); largest = largest > c ? largest : c; sum += c; }
     {
         const whitworth_drawn_real a = fabs(q[11]);
         largest_q = largest_q > a ? largest_q : a;
@@ -1023,10 +984,8 @@ static whitworth_drawn_real whitworth_drawn_accelerations_pass(const whitworth_d
     }
     largest_length *= work->inverse_column[0]; /* every length's 1 / unit */
     largest_q = largest_q > largest_length ? largest_q : largest_length;
-    whitworth_drawn_from_unit(work, ddq);
-    *sum_abs = sum;
-    *nq = sum_q != sum_q ? (whitworth_drawn_real)NAN : largest_q;
-    return largest;
+    (void)work;
+    return sum_q != sum_q ? (whitworth_drawn_real)NAN : largest_q;
 }
 
 /* whitworth_drawn_solve_step with its options already checked. */
@@ -1048,16 +1007,19 @@ static int whitworth_drawn_step(const whitworth_drawn_options *options, const wh
         return report->status;
     }
     /* Both right-hand sides are solved in place in the state, no copies: the solve of Phi_t
-     * is -dq, negated in the pass that reads it anyway. Newton stopped at the q of its last
-     * fused call, so the shared sines and cosines are this q's. */
+     * is -dq, written out negated. Each solve returns its solution's max |.| in the run's unit
+     * and the sum of |.| for the finite test, taken as it writes the solution (no pass over
+     * it again). Newton stopped at the q of its last fused call, so the shared sines and
+     * cosines are this q's. */
     whitworth_drawn_phi_t_shared(state->q, t, p, work->shared, state->dq);
     whitworth_drawn_rows_in_unit(work, state->dq);
-    whitworth_drawn_lu_solve(&work->lu, state->dq); /* (2.73), -dq in the run's unit */
-    ndq = whitworth_drawn_rates_pass(work, state->dq, &sum_dq);
+    ndq = whitworth_drawn_lu_solve_rates(&work->lu, state->dq, &sum_dq); /* (2.73) */
+    whitworth_drawn_from_unit(work, state->dq);
     whitworth_drawn_gamma_shared(state->q, state->dq, t, p, work->shared, state->ddq);
     whitworth_drawn_rows_in_unit(work, state->ddq);
-    whitworth_drawn_lu_solve(&work->lu, state->ddq); /* (2.74), the same factors */
-    nddq = whitworth_drawn_accelerations_pass(work, state->q, state->ddq, &sum_ddq, &nq);
+    nddq = whitworth_drawn_lu_solve_accelerations(&work->lu, state->ddq, &sum_ddq); /* (2.74) */
+    whitworth_drawn_from_unit(work, state->ddq);
+    nq = whitworth_drawn_positions_pass(work, state->q);
     /* an entry of dq or ddq is NaN where a sum is (inf + inf is no NaN: the sums of |.| may
      * overflow harmlessly), infinite where the larger maximum is */
     largest = ndq > nddq ? ndq : nddq;

@@ -15,6 +15,7 @@ from symkin.backends.c import (
     norm_code,
     op_budget,
     real,
+    rhs_zeros,
 )
 from symkin.backends.c.printer import literal
 from symkin.codegen.lower import Code
@@ -33,6 +34,8 @@ def template_context(code: Code) -> dict[str, Any]:
                                               code.pattern_cols, code.coordinates)
     cap = int(options.c_defaults(kind)["max_iterations"])
     budget = op_budget.budget(code, lu, norm1, bool(scale_free), cap)
+    zeros = {"rates": rhs_zeros.zero_rows(code, "phi_t_shared"),
+             "accelerations": rhs_zeros.zero_rows(code, "gamma_shared")}
     return {
         "real": kind, "linalg": linalg(code),
         # fabs{{ libm_suffix }} is fabsf in float mode: no promotion to double in the runtime.
@@ -45,6 +48,11 @@ def template_context(code: Code) -> dict[str, Any]:
         "shared_constants": {name: _c_number(value)
                              for name, value in {**tuning.SHARED, **tuning.INPUTS}.items()},
         **({"lu": lu} if lu else {}),
+        # the step's rhs-sparse solves: the rows of Phi_t and Gamma that are a literal 0, and
+        # the solution's entries that are then +-0 (rhs_zeros)
+        "zero_rows": zeros,
+        "known_zeros": {key: rhs_zeros.known_zeros(lu, rows) if lu else []
+                        for key, rows in zeros.items()},
         # ||Phi_q||_1 straight-line, or a loop where the LU itself is table-driven
         "norm1": norm1,
         # the scale-free solve (options->unit): which columns and rows are lengths

@@ -301,17 +301,18 @@ def pieces(code: Any, algebra: LinearAlgebra, norm: Flops, scaled: bool,
                + fused + factor)
     estimate = _estimate(algebra, norm, n, nnz)
     solve = rows_in_unit + algebra.solve + from_unit
-    velocity = _routine(code, "phi_t_shared") + solve  # negated in the norms' pass
+    velocity = _routine(code, "phi_t_shared") + solve  # negated as the solve writes it
     acceleration = _routine(code, "gamma_shared") + solve
     if inputs:  # max |q|, |dq|, |ddq| (norm_if: each when solved for), the finite tests;
         # solve_inputs' first test: no length input below zero
         norms = (_max_in_unit(n) * (1 + 2 * rates) + Flops(add=2, cmp=2) + branch_jump(n)
                  + Flops(cmp=len(getattr(code, "input_lengths", ()))))
-    else:  # a pass over dq as solved (max, sum, negation) and one over ddq as solved and
-        # q (two maxima, two sums; written out, the lengths' largest |q_i| divided by the unit
-        # once and taken into the max), q's NaN test, the finite test of dq and ddq (the
-        # larger maximum, the two sums added and tested, the infinity test); then whether
-        # Newton's bound cleared the point (work->clear)
+    else:  # the norms of dq and ddq, taken by the two solves as they write them (max, sum;
+        # dq negated; at most: an entry that is +-0 whatever the factors is not taken,
+        # rhs_zeros), a pass over q (max, sum; written out, the lengths' largest |q_i|
+        # divided by the unit once and taken into the max), q's NaN test, the finite test of
+        # dq and ddq (the larger maximum, the two sums added and tested, the infinity test);
+        # then whether Newton's bound cleared the point (work->clear)
         divided = 1 if any(lengths.length_columns(code.coordinates)) else 0
         if n > UNROLLED:  # the loop divides every q_i
             divided += n
