@@ -42,6 +42,7 @@ from symkin.runtime.arguments import parameter_values as parameter_values
 from symkin.runtime.arguments import time_points as time_points
 from symkin.runtime.input_driven import input_runs
 from symkin.runtime.input_driven.inputs import InputValues
+from symkin.runtime.kernel import Kernel
 from symkin.runtime.loads import forces
 from symkin.runtime.outputs import ranges, redundant
 from symkin.runtime.outputs.results import Trajectory
@@ -58,7 +59,7 @@ from symkin.runtime.solving.run_outcome import SolveFailure as SolveFailure
 from symkin.runtime.solving.run_outcome import SolveInterrupted as SolveInterrupted
 from symkin.runtime.solving.run_outcome import _fail, refuse_reversed, rows_kept
 from symkin.runtime.solving.run_outcome import _trajectory as _trajectory
-from symkin.runtime.solving.start import singular_start
+from symkin.runtime.solving.start import cleared, factored_lever_arm, singular_start
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -86,6 +87,8 @@ def _python_loop(kernel: KinematicsKernel, run: _Run, q: Array, p: Array, option
         if point is None:
             return Newton(result.q, NOT_FINITE, result.iterations, result.residual, None)
         run.store(k, point)
+        if k == 0 and isinstance(kernel, Kernel):  # its Phi_q is phi_q_nz's (not a view's)
+            run.lever_arm = factored_lever_arm(kernel, result.factors)
         if progress is not None:
             progress(k + 1, run.t.size)
     return result
@@ -209,14 +212,23 @@ def _solve_in_unit(kernel: KinematicsKernel, plan: Plan, t: ArrayLike | None,
     p = parameter_values(kernel, params)
     q = first_guess(kernel, q0)
     p_bytes = p.tobytes()
-    unit = plan.unit(kernel, q, times.item(0), p, p_bytes)
+    # The solver is taken first: started from q with p, it measures the unit's length scale
+    # on its own arrays, and it runs the grid in the usual case, the kernel's own unit.
+    solver = kernel.grid_solver(options, q, p) if use_c_solver and kernel.has_grid_solver \
+        else None
+    unit = plan.unit(kernel, q, times.item(0), p, p_bytes, solver)
     if unit == 1.0:
-        return _solve(kernel, times, q, p, options, progress, use_c_solver, out,
+        return _solve(kernel, times, q, p, options, progress, solver, out,
                       (plan, unit, p_bytes))
+    if solver is not None:
+        solver.release()
     scaled = units.ScaledKernel(kernel, unit)
+    q = q / scaled.column
+    solver = scaled.grid_solver(options, q, p) if use_c_solver and scaled.has_grid_solver \
+        else None
     try:
-        trajectory = _solve(scaled, times, q / scaled.column, p, options, progress,
-                            use_c_solver, out, (plan, unit, p_bytes))
+        trajectory = _solve(scaled, times, q, p, options, progress, solver, out,
+                            (plan, unit, p_bytes))
     except (SolveFailure, SolveInterrupted) as stop:
         units.to_kernel_unit(scaled, stop.trajectory.q, stop.trajectory.dq, stop.trajectory.d2q)
         raise
@@ -225,41 +237,28 @@ def _solve_in_unit(kernel: KinematicsKernel, plan: Plan, t: ArrayLike | None,
 
 
 def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: Options,
-           progress: Progress | None, use_c_solver: bool, out: Out | None,
+           progress: Progress | None, solver: GridSolver | None, out: Out | None,
            planned: tuple[Plan, float, bytes]) -> Trajectory:
-    """The C grid loop over the whole grid; only where it stops (a failed assembly from q0, a
-    singular point, a limit, a failure) or without the C solver, the general loop with the
-    assembly and the edge treatments takes over. The arguments as _solve_in_unit checked
-    them (not checked again: a loop of calls pays for that once a call); ``planned``: the
-    kernel's call plan, the length unit ``kernel`` is seen in and the bytes of p.
-
-    A first row solved by C that the plan has judged genuine and regular before (the same row
-    to the bit, at the same t0, parameters, condition estimate, unit and options: the start
-    check is a function of these alone) is not judged again."""
-    plan, unit, p_bytes = planned
+    """The C grid loop over the whole grid (``solver``, started from q with p; None: no C);
+    only where it stops (a failed assembly from q0, a singular point, a limit, a failure) or
+    without the C solver, the general loop with the assembly and the edge treatments takes
+    over. The arguments as _solve_in_unit checked them (not checked again: a loop of calls
+    pays for that once a call); ``planned``: the kernel's call plan, the length unit
+    ``kernel`` is seen in and the bytes of p."""
+    plan, _, p_bytes = planned
     run = allocate(times, q.size, out)
-    solver = kernel.grid_solver(options, q, p) if use_c_solver and kernel.has_grid_solver \
-        else None
     try:
         if solver is not None:
             if plan.has_dynamics:
                 run.forces_out = forces.allocate(kernel, times.size)
             solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
             solved = _c_run(run, solver, progress)
-            # What the start check's verdict depends on besides the options (call_plan).
-            key = (unit, run.q[0].tobytes(), times.item(0), p_bytes, run.cond.item(0)) \
-                if run.done else None
-            judged = key is not None and plan.judged_regular(key, options)
-            if run.done and not judged and plan.has_senses and \
-                    not genuine(kernel, run.q[0], times.item(0), p):
+            if run.done and not _first_row_stands(kernel, run, p, options, planned):
                 # Plain Newton in C found Phi = 0 where the mechanism is not assembled as
                 # meant (a revolute's axes reversed): the damped assembly looks for the one
                 # meant, as without C, and the grid is run again from it.
                 run.done, first = 0, None
             else:
-                if key is not None and not judged:
-                    _check_start(kernel, run, p, options)  # raises where it is not regular
-                    plan.remember_regular(key, options)
                 if run.done == times.size:  # the usual case: nothing left to treat
                     run.fallbacks = solver.fallbacks
                     return _whole(kernel, plan, run, p, plan.point_vectors(p_bytes, solver))
@@ -285,6 +284,32 @@ def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: 
                 _check_start(kernel, run, p, options, result.q)  # assembled, singular there
             _fail(kernel, run, p, result, float(times[run.done]), assembling=run.done == 0)
         return _trajectory(kernel, run, p)
+
+
+def _first_row_stands(kernel: KinematicsKernel, run: _Run, p: Array, options: Options,
+                      planned: tuple[Plan, float, bytes]) -> bool:
+    """Whether the first row the C grid loop solved stands. Raises SolveFailure where it is
+    a singular start (_check_start); False where it solves Phi = 0 but is no assembly
+    (assembly.genuine).
+
+    The solver's own condition estimate and lever arm there settle the usual case, a clearly
+    regular start of a mechanism without senses, with a few multiplications
+    (runtime.solving.start.cleared). Else the verdict depends on the row to the bit, t0, the
+    parameters, the condition estimate, the unit and the options alone, and a row the plan
+    has judged before is not judged again."""
+    plan, unit, p_bytes = planned
+    estimate = run.cond.item(0)
+    if not plan.has_senses and cleared(kernel, options, estimate, run.lever_arm):
+        return True
+    t0 = run.t.item(0)
+    key = (unit, run.q[0].tobytes(), t0, p_bytes, estimate)
+    if plan.judged_regular(key, options):
+        return True
+    if plan.has_senses and not genuine(kernel, run.q[0], t0, p):
+        return False
+    _check_start(kernel, run, p, options)  # raises where it is not regular
+    plan.remember_regular(key, options)
+    return True
 
 
 def _whole(kernel: KinematicsKernel, plan: Plan, run: _Run, p: Array, vectors: Array
@@ -354,9 +379,10 @@ def _check_start(kernel: KinematicsKernel, run: _Run, p: Array, options: Options
     t0 = float(run.t[0])
     first = run.q[0] if assembled is None else assembled
     refuse_reversed(kernel, run, first, t0, p)
-    # The solver's condition estimate at the first row, from the factors it made there.
+    # The solver's condition estimate and lever arm at the first row, from the Phi_q there.
     estimate = float(run.cond[0]) if assembled is None else math.nan
-    singular = singular_start(kernel, first, t0, p, options, estimate)
+    singular = singular_start(kernel, first, t0, p, options, estimate,
+                              run.lever_arm if assembled is None else None)
     if singular is None:
         return
     run.done = 0 if assembled is not None else 1

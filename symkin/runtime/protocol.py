@@ -67,6 +67,18 @@ class GridSolver(Protocol):
         """The last call's report, with the count it returned."""
         ...
 
+    def start_lever_arm(self, t: float) -> float | None:
+        """The length scale (runtime.solving.start.lever_arm, raw: 0 where there is no lever
+        arm, NaN where Phi_q is not finite) at the run's first guess and parameters at t;
+        None where the solver cannot tell."""
+        ...
+
+    @property
+    def first_lever_arm(self) -> float | None:
+        """The same at the run's first row, as the solver found it there (NaN: no row);
+        None where the solver does not report it."""
+        ...
+
     def point_vectors(self, count: int, size: int = 2) -> Array:
         """The local vectors of the named points at the run's parameters, (count, size)."""
         ...

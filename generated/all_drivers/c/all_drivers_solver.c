@@ -183,15 +183,21 @@ static all_drivers_real all_drivers_lever_arm(const all_drivers_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (all_drivers_length_scales of one set). */
+static all_drivers_real all_drivers_lever_arm_at(const all_drivers_real q[], all_drivers_real t, const all_drivers_real p[])
+{
+    all_drivers_real nz[ALL_DRIVERS_NNZ];
+    all_drivers_phi_q(q, t, p, nz);
+    return all_drivers_lever_arm(nz);
+}
+
 void all_drivers_length_scales(int m, const all_drivers_real p[], const all_drivers_real q[],
                                 int q_stride, all_drivers_real t, all_drivers_real scales[])
 {
-    all_drivers_real nz[ALL_DRIVERS_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        all_drivers_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * ALL_DRIVERS_NP : p, nz);
-        scales[j] = all_drivers_lever_arm(nz);
+        scales[j] = all_drivers_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * ALL_DRIVERS_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1243,6 +1249,7 @@ int all_drivers_solve_grid_checked(const all_drivers_options *options,
                                     all_drivers_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = ALL_DRIVERS_OK;
     /* the options once per call, not at every step */
     if (n > 0 && all_drivers_check_options(options) != 0) {
@@ -1252,7 +1259,7 @@ int all_drivers_solve_grid_checked(const all_drivers_options *options,
     if (n > 0 && state->started) all_drivers_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (all_drivers_step(options, p, t[k], state, work, report) != ALL_DRIVERS_OK) {
-            return k;
+            break;
         }
         all_drivers_store(q_out, k, state->q);
         all_drivers_store(dq_out, k, state->dq);
@@ -1260,7 +1267,11 @@ int all_drivers_solve_grid_checked(const all_drivers_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? all_drivers_lever_arm_at(q_out, t[0], p)
+                                           : (all_drivers_real)NAN;
+    }
+    return k;
 }
 
 int all_drivers_solve_grid(const all_drivers_options *options, const all_drivers_real p[], int n,

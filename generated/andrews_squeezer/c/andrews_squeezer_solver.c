@@ -171,15 +171,21 @@ static andrews_squeezer_real andrews_squeezer_lever_arm(const andrews_squeezer_r
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (andrews_squeezer_length_scales of one set). */
+static andrews_squeezer_real andrews_squeezer_lever_arm_at(const andrews_squeezer_real q[], andrews_squeezer_real t, const andrews_squeezer_real p[])
+{
+    andrews_squeezer_real nz[ANDREWS_SQUEEZER_NNZ];
+    andrews_squeezer_phi_q(q, t, p, nz);
+    return andrews_squeezer_lever_arm(nz);
+}
+
 void andrews_squeezer_length_scales(int m, const andrews_squeezer_real p[], const andrews_squeezer_real q[],
                                 int q_stride, andrews_squeezer_real t, andrews_squeezer_real scales[])
 {
-    andrews_squeezer_real nz[ANDREWS_SQUEEZER_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        andrews_squeezer_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * ANDREWS_SQUEEZER_NP : p, nz);
-        scales[j] = andrews_squeezer_lever_arm(nz);
+        scales[j] = andrews_squeezer_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * ANDREWS_SQUEEZER_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1121,6 +1127,7 @@ int andrews_squeezer_solve_grid_checked(const andrews_squeezer_options *options,
                                     andrews_squeezer_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = ANDREWS_SQUEEZER_OK;
     /* the options once per call, not at every step */
     if (n > 0 && andrews_squeezer_check_options(options) != 0) {
@@ -1130,7 +1137,7 @@ int andrews_squeezer_solve_grid_checked(const andrews_squeezer_options *options,
     if (n > 0 && state->started) andrews_squeezer_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (andrews_squeezer_step(options, p, t[k], state, work, report) != ANDREWS_SQUEEZER_OK) {
-            return k;
+            break;
         }
         andrews_squeezer_store(q_out, k, state->q);
         andrews_squeezer_store(dq_out, k, state->dq);
@@ -1138,7 +1145,11 @@ int andrews_squeezer_solve_grid_checked(const andrews_squeezer_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? andrews_squeezer_lever_arm_at(q_out, t[0], p)
+                                           : (andrews_squeezer_real)NAN;
+    }
+    return k;
 }
 
 int andrews_squeezer_solve_grid(const andrews_squeezer_options *options, const andrews_squeezer_real p[], int n,

@@ -175,15 +175,21 @@ static cam_cycloidal_real cam_cycloidal_lever_arm(const cam_cycloidal_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (cam_cycloidal_length_scales of one set). */
+static cam_cycloidal_real cam_cycloidal_lever_arm_at(const cam_cycloidal_real q[], cam_cycloidal_real t, const cam_cycloidal_real p[])
+{
+    cam_cycloidal_real nz[CAM_CYCLOIDAL_NNZ];
+    cam_cycloidal_phi_q(q, t, p, nz);
+    return cam_cycloidal_lever_arm(nz);
+}
+
 void cam_cycloidal_length_scales(int m, const cam_cycloidal_real p[], const cam_cycloidal_real q[],
                                 int q_stride, cam_cycloidal_real t, cam_cycloidal_real scales[])
 {
-    cam_cycloidal_real nz[CAM_CYCLOIDAL_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        cam_cycloidal_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * CAM_CYCLOIDAL_NP : p, nz);
-        scales[j] = cam_cycloidal_lever_arm(nz);
+        scales[j] = cam_cycloidal_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * CAM_CYCLOIDAL_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -952,6 +958,7 @@ int cam_cycloidal_solve_grid_checked(const cam_cycloidal_options *options,
                                     cam_cycloidal_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = CAM_CYCLOIDAL_OK;
     /* the options once per call, not at every step */
     if (n > 0 && cam_cycloidal_check_options(options) != 0) {
@@ -961,7 +968,7 @@ int cam_cycloidal_solve_grid_checked(const cam_cycloidal_options *options,
     if (n > 0 && state->started) cam_cycloidal_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (cam_cycloidal_step(options, p, t[k], state, work, report) != CAM_CYCLOIDAL_OK) {
-            return k;
+            break;
         }
         cam_cycloidal_store(q_out, k, state->q);
         cam_cycloidal_store(dq_out, k, state->dq);
@@ -969,7 +976,11 @@ int cam_cycloidal_solve_grid_checked(const cam_cycloidal_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? cam_cycloidal_lever_arm_at(q_out, t[0], p)
+                                           : (cam_cycloidal_real)NAN;
+    }
+    return k;
 }
 
 int cam_cycloidal_solve_grid(const cam_cycloidal_options *options, const cam_cycloidal_real p[], int n,

@@ -79,6 +79,9 @@ typedef struct {
     cam_cycloidal_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
     cam_cycloidal_real cond;      /* estimate of the 1-norm condition of Phi_q there */
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
+    cam_cycloidal_real lever_arm; /* cam_cycloidal_solve_grid: the length scale of the run's */
+                                 /* first row (as cam_cycloidal_length_scales), set by the */
+                                 /* call that starts the run; NaN: no row or no q_out */
 } cam_cycloidal_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0

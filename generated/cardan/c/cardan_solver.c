@@ -182,15 +182,21 @@ static cardan_real cardan_lever_arm(const cardan_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (cardan_length_scales of one set). */
+static cardan_real cardan_lever_arm_at(const cardan_real q[], cardan_real t, const cardan_real p[])
+{
+    cardan_real nz[CARDAN_NNZ];
+    cardan_phi_q(q, t, p, nz);
+    return cardan_lever_arm(nz);
+}
+
 void cardan_length_scales(int m, const cardan_real p[], const cardan_real q[],
                                 int q_stride, cardan_real t, cardan_real scales[])
 {
-    cardan_real nz[CARDAN_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        cardan_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * CARDAN_NP : p, nz);
-        scales[j] = cardan_lever_arm(nz);
+        scales[j] = cardan_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * CARDAN_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1004,6 +1010,7 @@ int cardan_solve_grid_checked(const cardan_options *options,
                                     cardan_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = CARDAN_OK;
     /* the options once per call, not at every step */
     if (n > 0 && cardan_check_options(options) != 0) {
@@ -1013,7 +1020,7 @@ int cardan_solve_grid_checked(const cardan_options *options,
     if (n > 0 && state->started) cardan_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (cardan_step(options, p, t[k], state, work, report) != CARDAN_OK) {
-            return k;
+            break;
         }
         cardan_store(q_out, k, state->q);
         cardan_store(dq_out, k, state->dq);
@@ -1021,7 +1028,11 @@ int cardan_solve_grid_checked(const cardan_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? cardan_lever_arm_at(q_out, t[0], p)
+                                           : (cardan_real)NAN;
+    }
+    return k;
 }
 
 int cardan_solve_grid(const cardan_options *options, const cardan_real p[], int n,

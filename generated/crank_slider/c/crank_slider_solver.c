@@ -177,15 +177,21 @@ static crank_slider_real crank_slider_lever_arm(const crank_slider_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (crank_slider_length_scales of one set). */
+static crank_slider_real crank_slider_lever_arm_at(const crank_slider_real q[], crank_slider_real t, const crank_slider_real p[])
+{
+    crank_slider_real nz[CRANK_SLIDER_NNZ];
+    crank_slider_phi_q(q, t, p, nz);
+    return crank_slider_lever_arm(nz);
+}
+
 void crank_slider_length_scales(int m, const crank_slider_real p[], const crank_slider_real q[],
                                 int q_stride, crank_slider_real t, crank_slider_real scales[])
 {
-    crank_slider_real nz[CRANK_SLIDER_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        crank_slider_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * CRANK_SLIDER_NP : p, nz);
-        scales[j] = crank_slider_lever_arm(nz);
+        scales[j] = crank_slider_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * CRANK_SLIDER_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -974,6 +980,7 @@ int crank_slider_solve_grid_checked(const crank_slider_options *options,
                                     crank_slider_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = CRANK_SLIDER_OK;
     /* the options once per call, not at every step */
     if (n > 0 && crank_slider_check_options(options) != 0) {
@@ -983,7 +990,7 @@ int crank_slider_solve_grid_checked(const crank_slider_options *options,
     if (n > 0 && state->started) crank_slider_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (crank_slider_step(options, p, t[k], state, work, report) != CRANK_SLIDER_OK) {
-            return k;
+            break;
         }
         crank_slider_store(q_out, k, state->q);
         crank_slider_store(dq_out, k, state->dq);
@@ -991,7 +998,11 @@ int crank_slider_solve_grid_checked(const crank_slider_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? crank_slider_lever_arm_at(q_out, t[0], p)
+                                           : (crank_slider_real)NAN;
+    }
+    return k;
 }
 
 int crank_slider_solve_grid(const crank_slider_options *options, const crank_slider_real p[], int n,

@@ -179,15 +179,21 @@ static crank_slider_input_real crank_slider_input_lever_arm(const crank_slider_i
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (crank_slider_input_length_scales of one set). */
+static crank_slider_input_real crank_slider_input_lever_arm_at(const crank_slider_input_real q[], crank_slider_input_real t, const crank_slider_input_real p[])
+{
+    crank_slider_input_real nz[CRANK_SLIDER_INPUT_NNZ];
+    crank_slider_input_phi_q(q, t, p, nz);
+    return crank_slider_input_lever_arm(nz);
+}
+
 void crank_slider_input_length_scales(int m, const crank_slider_input_real p[], const crank_slider_input_real q[],
                                 int q_stride, crank_slider_input_real t, crank_slider_input_real scales[])
 {
-    crank_slider_input_real nz[CRANK_SLIDER_INPUT_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        crank_slider_input_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * CRANK_SLIDER_INPUT_NPU : p, nz);
-        scales[j] = crank_slider_input_lever_arm(nz);
+        scales[j] = crank_slider_input_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * CRANK_SLIDER_INPUT_NPU : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1177,6 +1183,7 @@ int crank_slider_input_solve_grid_checked(const crank_slider_input_options *opti
                                     crank_slider_input_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = CRANK_SLIDER_INPUT_OK;
     /* the options once per call, not at every step */
     if (n > 0 && crank_slider_input_check_options(options) != 0) {
@@ -1186,7 +1193,7 @@ int crank_slider_input_solve_grid_checked(const crank_slider_input_options *opti
     if (n > 0 && state->started) crank_slider_input_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (crank_slider_input_step(options, p, t[k], state, work, report) != CRANK_SLIDER_INPUT_OK) {
-            return k;
+            break;
         }
         crank_slider_input_store(q_out, k, state->q);
         crank_slider_input_store(dq_out, k, state->dq);
@@ -1194,7 +1201,11 @@ int crank_slider_input_solve_grid_checked(const crank_slider_input_options *opti
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? crank_slider_input_lever_arm_at(q_out, t[0], p)
+                                           : (crank_slider_input_real)NAN;
+    }
+    return k;
 }
 
 int crank_slider_input_solve_grid(const crank_slider_input_options *options, const crank_slider_input_real p[], int n,

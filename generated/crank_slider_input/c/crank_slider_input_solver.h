@@ -88,6 +88,9 @@ typedef struct {
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
     int branch_jump;             /* crank_slider_input_solve_inputs: 1 when the solution may lie */
                                  /* on another assembly than the last one (see there) */
+    crank_slider_input_real lever_arm; /* crank_slider_input_solve_grid: the length scale of the run's */
+                                 /* first row (as crank_slider_input_length_scales), set by the */
+                                 /* call that starts the run; NaN: no row or no q_out */
 } crank_slider_input_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0

@@ -177,15 +177,21 @@ static crank_slider_load_real crank_slider_load_lever_arm(const crank_slider_loa
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (crank_slider_load_length_scales of one set). */
+static crank_slider_load_real crank_slider_load_lever_arm_at(const crank_slider_load_real q[], crank_slider_load_real t, const crank_slider_load_real p[])
+{
+    crank_slider_load_real nz[CRANK_SLIDER_LOAD_NNZ];
+    crank_slider_load_phi_q(q, t, p, nz);
+    return crank_slider_load_lever_arm(nz);
+}
+
 void crank_slider_load_length_scales(int m, const crank_slider_load_real p[], const crank_slider_load_real q[],
                                 int q_stride, crank_slider_load_real t, crank_slider_load_real scales[])
 {
-    crank_slider_load_real nz[CRANK_SLIDER_LOAD_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        crank_slider_load_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * CRANK_SLIDER_LOAD_NP : p, nz);
-        scales[j] = crank_slider_load_lever_arm(nz);
+        scales[j] = crank_slider_load_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * CRANK_SLIDER_LOAD_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -988,6 +994,7 @@ int crank_slider_load_solve_grid_checked(const crank_slider_load_options *option
                                     crank_slider_load_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = CRANK_SLIDER_LOAD_OK;
     /* the options once per call, not at every step */
     if (n > 0 && crank_slider_load_check_options(options) != 0) {
@@ -997,7 +1004,7 @@ int crank_slider_load_solve_grid_checked(const crank_slider_load_options *option
     if (n > 0 && state->started) crank_slider_load_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (crank_slider_load_step(options, p, t[k], state, work, report) != CRANK_SLIDER_LOAD_OK) {
-            return k;
+            break;
         }
         crank_slider_load_store(q_out, k, state->q);
         crank_slider_load_store(dq_out, k, state->dq);
@@ -1013,7 +1020,11 @@ int crank_slider_load_solve_grid_checked(const crank_slider_load_options *option
             }
         }
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? crank_slider_load_lever_arm_at(q_out, t[0], p)
+                                           : (crank_slider_load_real)NAN;
+    }
+    return k;
 }
 
 int crank_slider_load_solve_grid(const crank_slider_load_options *options, const crank_slider_load_real p[], int n,

@@ -177,15 +177,21 @@ static custom_driver_real custom_driver_lever_arm(const custom_driver_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (custom_driver_length_scales of one set). */
+static custom_driver_real custom_driver_lever_arm_at(const custom_driver_real q[], custom_driver_real t, const custom_driver_real p[])
+{
+    custom_driver_real nz[CUSTOM_DRIVER_NNZ];
+    custom_driver_phi_q(q, t, p, nz);
+    return custom_driver_lever_arm(nz);
+}
+
 void custom_driver_length_scales(int m, const custom_driver_real p[], const custom_driver_real q[],
                                 int q_stride, custom_driver_real t, custom_driver_real scales[])
 {
-    custom_driver_real nz[CUSTOM_DRIVER_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        custom_driver_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * CUSTOM_DRIVER_NP : p, nz);
-        scales[j] = custom_driver_lever_arm(nz);
+        scales[j] = custom_driver_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * CUSTOM_DRIVER_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1000,6 +1006,7 @@ int custom_driver_solve_grid_checked(const custom_driver_options *options,
                                     custom_driver_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = CUSTOM_DRIVER_OK;
     /* the options once per call, not at every step */
     if (n > 0 && custom_driver_check_options(options) != 0) {
@@ -1009,7 +1016,7 @@ int custom_driver_solve_grid_checked(const custom_driver_options *options,
     if (n > 0 && state->started) custom_driver_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (custom_driver_step(options, p, t[k], state, work, report) != CUSTOM_DRIVER_OK) {
-            return k;
+            break;
         }
         custom_driver_store(q_out, k, state->q);
         custom_driver_store(dq_out, k, state->dq);
@@ -1017,7 +1024,11 @@ int custom_driver_solve_grid_checked(const custom_driver_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? custom_driver_lever_arm_at(q_out, t[0], p)
+                                           : (custom_driver_real)NAN;
+    }
+    return k;
 }
 
 int custom_driver_solve_grid(const custom_driver_options *options, const custom_driver_real p[], int n,

@@ -171,15 +171,21 @@ static delta_real delta_lever_arm(const delta_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (delta_length_scales of one set). */
+static delta_real delta_lever_arm_at(const delta_real q[], delta_real t, const delta_real p[])
+{
+    delta_real nz[DELTA_NNZ];
+    delta_phi_q(q, t, p, nz);
+    return delta_lever_arm(nz);
+}
+
 void delta_length_scales(int m, const delta_real p[], const delta_real q[],
                                 int q_stride, delta_real t, delta_real scales[])
 {
-    delta_real nz[DELTA_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        delta_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * DELTA_NP : p, nz);
-        scales[j] = delta_lever_arm(nz);
+        scales[j] = delta_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * DELTA_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -965,6 +971,7 @@ int delta_solve_grid_checked(const delta_options *options,
                                     delta_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = DELTA_OK;
     /* the options once per call, not at every step */
     if (n > 0 && delta_check_options(options) != 0) {
@@ -974,7 +981,7 @@ int delta_solve_grid_checked(const delta_options *options,
     if (n > 0 && state->started) delta_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (delta_step(options, p, t[k], state, work, report) != DELTA_OK) {
-            return k;
+            break;
         }
         delta_store(q_out, k, state->q);
         delta_store(dq_out, k, state->dq);
@@ -982,7 +989,11 @@ int delta_solve_grid_checked(const delta_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? delta_lever_arm_at(q_out, t[0], p)
+                                           : (delta_real)NAN;
+    }
+    return k;
 }
 
 int delta_solve_grid(const delta_options *options, const delta_real p[], int n,

@@ -79,6 +79,9 @@ typedef struct {
     delta_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
     delta_real cond;      /* estimate of the 1-norm condition of Phi_q there */
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
+    delta_real lever_arm; /* delta_solve_grid: the length scale of the run's */
+                                 /* first row (as delta_length_scales), set by the */
+                                 /* call that starts the run; NaN: no row or no q_out */
 } delta_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0

@@ -173,15 +173,21 @@ static delta_fk_real delta_fk_lever_arm(const delta_fk_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (delta_fk_length_scales of one set). */
+static delta_fk_real delta_fk_lever_arm_at(const delta_fk_real q[], delta_fk_real t, const delta_fk_real p[])
+{
+    delta_fk_real nz[DELTA_FK_NNZ];
+    delta_fk_phi_q(q, t, p, nz);
+    return delta_fk_lever_arm(nz);
+}
+
 void delta_fk_length_scales(int m, const delta_fk_real p[], const delta_fk_real q[],
                                 int q_stride, delta_fk_real t, delta_fk_real scales[])
 {
-    delta_fk_real nz[DELTA_FK_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        delta_fk_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * DELTA_FK_NPU : p, nz);
-        scales[j] = delta_fk_lever_arm(nz);
+        scales[j] = delta_fk_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * DELTA_FK_NPU : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1168,6 +1174,7 @@ int delta_fk_solve_grid_checked(const delta_fk_options *options,
                                     delta_fk_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = DELTA_FK_OK;
     /* the options once per call, not at every step */
     if (n > 0 && delta_fk_check_options(options) != 0) {
@@ -1177,7 +1184,7 @@ int delta_fk_solve_grid_checked(const delta_fk_options *options,
     if (n > 0 && state->started) delta_fk_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (delta_fk_step(options, p, t[k], state, work, report) != DELTA_FK_OK) {
-            return k;
+            break;
         }
         delta_fk_store(q_out, k, state->q);
         delta_fk_store(dq_out, k, state->dq);
@@ -1185,7 +1192,11 @@ int delta_fk_solve_grid_checked(const delta_fk_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? delta_fk_lever_arm_at(q_out, t[0], p)
+                                           : (delta_fk_real)NAN;
+    }
+    return k;
 }
 
 int delta_fk_solve_grid(const delta_fk_options *options, const delta_fk_real p[], int n,

@@ -88,6 +88,9 @@ typedef struct {
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
     int branch_jump;             /* delta_fk_solve_inputs: 1 when the solution may lie */
                                  /* on another assembly than the last one (see there) */
+    delta_fk_real lever_arm; /* delta_fk_solve_grid: the length scale of the run's */
+                                 /* first row (as delta_fk_length_scales), set by the */
+                                 /* call that starts the run; NaN: no row or no q_out */
 } delta_fk_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0

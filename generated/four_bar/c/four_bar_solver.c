@@ -177,15 +177,21 @@ static four_bar_real four_bar_lever_arm(const four_bar_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (four_bar_length_scales of one set). */
+static four_bar_real four_bar_lever_arm_at(const four_bar_real q[], four_bar_real t, const four_bar_real p[])
+{
+    four_bar_real nz[FOUR_BAR_NNZ];
+    four_bar_phi_q(q, t, p, nz);
+    return four_bar_lever_arm(nz);
+}
+
 void four_bar_length_scales(int m, const four_bar_real p[], const four_bar_real q[],
                                 int q_stride, four_bar_real t, four_bar_real scales[])
 {
-    four_bar_real nz[FOUR_BAR_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        four_bar_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * FOUR_BAR_NP : p, nz);
-        scales[j] = four_bar_lever_arm(nz);
+        scales[j] = four_bar_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * FOUR_BAR_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -983,6 +989,7 @@ int four_bar_solve_grid_checked(const four_bar_options *options,
                                     four_bar_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = FOUR_BAR_OK;
     /* the options once per call, not at every step */
     if (n > 0 && four_bar_check_options(options) != 0) {
@@ -992,7 +999,7 @@ int four_bar_solve_grid_checked(const four_bar_options *options,
     if (n > 0 && state->started) four_bar_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (four_bar_step(options, p, t[k], state, work, report) != FOUR_BAR_OK) {
-            return k;
+            break;
         }
         four_bar_store(q_out, k, state->q);
         four_bar_store(dq_out, k, state->dq);
@@ -1000,7 +1007,11 @@ int four_bar_solve_grid_checked(const four_bar_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? four_bar_lever_arm_at(q_out, t[0], p)
+                                           : (four_bar_real)NAN;
+    }
+    return k;
 }
 
 int four_bar_solve_grid(const four_bar_options *options, const four_bar_real p[], int n,

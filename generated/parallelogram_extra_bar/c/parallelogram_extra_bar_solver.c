@@ -180,15 +180,21 @@ static parallelogram_extra_bar_real parallelogram_extra_bar_lever_arm(const para
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (parallelogram_extra_bar_length_scales of one set). */
+static parallelogram_extra_bar_real parallelogram_extra_bar_lever_arm_at(const parallelogram_extra_bar_real q[], parallelogram_extra_bar_real t, const parallelogram_extra_bar_real p[])
+{
+    parallelogram_extra_bar_real nz[PARALLELOGRAM_EXTRA_BAR_NNZ];
+    parallelogram_extra_bar_phi_q(q, t, p, nz);
+    return parallelogram_extra_bar_lever_arm(nz);
+}
+
 void parallelogram_extra_bar_length_scales(int m, const parallelogram_extra_bar_real p[], const parallelogram_extra_bar_real q[],
                                 int q_stride, parallelogram_extra_bar_real t, parallelogram_extra_bar_real scales[])
 {
-    parallelogram_extra_bar_real nz[PARALLELOGRAM_EXTRA_BAR_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        parallelogram_extra_bar_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * PARALLELOGRAM_EXTRA_BAR_NP : p, nz);
-        scales[j] = parallelogram_extra_bar_lever_arm(nz);
+        scales[j] = parallelogram_extra_bar_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * PARALLELOGRAM_EXTRA_BAR_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1049,6 +1055,7 @@ int parallelogram_extra_bar_solve_grid_checked(const parallelogram_extra_bar_opt
                                     parallelogram_extra_bar_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = PARALLELOGRAM_EXTRA_BAR_OK;
     /* the options once per call, not at every step */
     if (n > 0 && parallelogram_extra_bar_check_options(options) != 0) {
@@ -1058,7 +1065,7 @@ int parallelogram_extra_bar_solve_grid_checked(const parallelogram_extra_bar_opt
     if (n > 0 && state->started) parallelogram_extra_bar_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (parallelogram_extra_bar_step(options, p, t[k], state, work, report) != PARALLELOGRAM_EXTRA_BAR_OK) {
-            return k;
+            break;
         }
         parallelogram_extra_bar_store(q_out, k, state->q);
         parallelogram_extra_bar_store(dq_out, k, state->dq);
@@ -1066,7 +1073,11 @@ int parallelogram_extra_bar_solve_grid_checked(const parallelogram_extra_bar_opt
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? parallelogram_extra_bar_lever_arm_at(q_out, t[0], p)
+                                           : (parallelogram_extra_bar_real)NAN;
+    }
+    return k;
 }
 
 int parallelogram_extra_bar_solve_grid(const parallelogram_extra_bar_options *options, const parallelogram_extra_bar_real p[], int n,

@@ -183,15 +183,21 @@ static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_lever_ar
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (parallelogram_extra_bar_loads_length_scales of one set). */
+static parallelogram_extra_bar_loads_real parallelogram_extra_bar_loads_lever_arm_at(const parallelogram_extra_bar_loads_real q[], parallelogram_extra_bar_loads_real t, const parallelogram_extra_bar_loads_real p[])
+{
+    parallelogram_extra_bar_loads_real nz[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ];
+    parallelogram_extra_bar_loads_phi_q(q, t, p, nz);
+    return parallelogram_extra_bar_loads_lever_arm(nz);
+}
+
 void parallelogram_extra_bar_loads_length_scales(int m, const parallelogram_extra_bar_loads_real p[], const parallelogram_extra_bar_loads_real q[],
                                 int q_stride, parallelogram_extra_bar_loads_real t, parallelogram_extra_bar_loads_real scales[])
 {
-    parallelogram_extra_bar_loads_real nz[PARALLELOGRAM_EXTRA_BAR_LOADS_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        parallelogram_extra_bar_loads_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * PARALLELOGRAM_EXTRA_BAR_LOADS_NP : p, nz);
-        scales[j] = parallelogram_extra_bar_loads_lever_arm(nz);
+        scales[j] = parallelogram_extra_bar_loads_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * PARALLELOGRAM_EXTRA_BAR_LOADS_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1113,6 +1119,7 @@ int parallelogram_extra_bar_loads_solve_grid_checked(const parallelogram_extra_b
                                     parallelogram_extra_bar_loads_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = PARALLELOGRAM_EXTRA_BAR_LOADS_OK;
     /* the options once per call, not at every step */
     if (n > 0 && parallelogram_extra_bar_loads_check_options(options) != 0) {
@@ -1122,7 +1129,7 @@ int parallelogram_extra_bar_loads_solve_grid_checked(const parallelogram_extra_b
     if (n > 0 && state->started) parallelogram_extra_bar_loads_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (parallelogram_extra_bar_loads_step(options, p, t[k], state, work, report) != PARALLELOGRAM_EXTRA_BAR_LOADS_OK) {
-            return k;
+            break;
         }
         parallelogram_extra_bar_loads_store(q_out, k, state->q);
         parallelogram_extra_bar_loads_store(dq_out, k, state->dq);
@@ -1138,7 +1145,11 @@ int parallelogram_extra_bar_loads_solve_grid_checked(const parallelogram_extra_b
             }
         }
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? parallelogram_extra_bar_loads_lever_arm_at(q_out, t[0], p)
+                                           : (parallelogram_extra_bar_loads_real)NAN;
+    }
+    return k;
 }
 
 int parallelogram_extra_bar_loads_solve_grid(const parallelogram_extra_bar_loads_options *options, const parallelogram_extra_bar_loads_real p[], int n,

@@ -177,15 +177,21 @@ static planetary_real planetary_lever_arm(const planetary_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (planetary_length_scales of one set). */
+static planetary_real planetary_lever_arm_at(const planetary_real q[], planetary_real t, const planetary_real p[])
+{
+    planetary_real nz[PLANETARY_NNZ];
+    planetary_phi_q(q, t, p, nz);
+    return planetary_lever_arm(nz);
+}
+
 void planetary_length_scales(int m, const planetary_real p[], const planetary_real q[],
                                 int q_stride, planetary_real t, planetary_real scales[])
 {
-    planetary_real nz[PLANETARY_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        planetary_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * PLANETARY_NP : p, nz);
-        scales[j] = planetary_lever_arm(nz);
+        scales[j] = planetary_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * PLANETARY_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -988,6 +994,7 @@ int planetary_solve_grid_checked(const planetary_options *options,
                                     planetary_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = PLANETARY_OK;
     /* the options once per call, not at every step */
     if (n > 0 && planetary_check_options(options) != 0) {
@@ -997,7 +1004,7 @@ int planetary_solve_grid_checked(const planetary_options *options,
     if (n > 0 && state->started) planetary_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (planetary_step(options, p, t[k], state, work, report) != PLANETARY_OK) {
-            return k;
+            break;
         }
         planetary_store(q_out, k, state->q);
         planetary_store(dq_out, k, state->dq);
@@ -1005,7 +1012,11 @@ int planetary_solve_grid_checked(const planetary_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? planetary_lever_arm_at(q_out, t[0], p)
+                                           : (planetary_real)NAN;
+    }
+    return k;
 }
 
 int planetary_solve_grid(const planetary_options *options, const planetary_real p[], int n,

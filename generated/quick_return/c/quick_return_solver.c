@@ -180,15 +180,21 @@ static quick_return_real quick_return_lever_arm(const quick_return_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (quick_return_length_scales of one set). */
+static quick_return_real quick_return_lever_arm_at(const quick_return_real q[], quick_return_real t, const quick_return_real p[])
+{
+    quick_return_real nz[QUICK_RETURN_NNZ];
+    quick_return_phi_q(q, t, p, nz);
+    return quick_return_lever_arm(nz);
+}
+
 void quick_return_length_scales(int m, const quick_return_real p[], const quick_return_real q[],
                                 int q_stride, quick_return_real t, quick_return_real scales[])
 {
-    quick_return_real nz[QUICK_RETURN_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        quick_return_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * QUICK_RETURN_NP : p, nz);
-        scales[j] = quick_return_lever_arm(nz);
+        scales[j] = quick_return_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * QUICK_RETURN_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1066,6 +1072,7 @@ int quick_return_solve_grid_checked(const quick_return_options *options,
                                     quick_return_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = QUICK_RETURN_OK;
     /* the options once per call, not at every step */
     if (n > 0 && quick_return_check_options(options) != 0) {
@@ -1075,7 +1082,7 @@ int quick_return_solve_grid_checked(const quick_return_options *options,
     if (n > 0 && state->started) quick_return_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (quick_return_step(options, p, t[k], state, work, report) != QUICK_RETURN_OK) {
-            return k;
+            break;
         }
         quick_return_store(q_out, k, state->q);
         quick_return_store(dq_out, k, state->dq);
@@ -1083,7 +1090,11 @@ int quick_return_solve_grid_checked(const quick_return_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? quick_return_lever_arm_at(q_out, t[0], p)
+                                           : (quick_return_real)NAN;
+    }
+    return k;
 }
 
 int quick_return_solve_grid(const quick_return_options *options, const quick_return_real p[], int n,

@@ -180,15 +180,21 @@ static rack_linkage_real rack_linkage_lever_arm(const rack_linkage_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (rack_linkage_length_scales of one set). */
+static rack_linkage_real rack_linkage_lever_arm_at(const rack_linkage_real q[], rack_linkage_real t, const rack_linkage_real p[])
+{
+    rack_linkage_real nz[RACK_LINKAGE_NNZ];
+    rack_linkage_phi_q(q, t, p, nz);
+    return rack_linkage_lever_arm(nz);
+}
+
 void rack_linkage_length_scales(int m, const rack_linkage_real p[], const rack_linkage_real q[],
                                 int q_stride, rack_linkage_real t, rack_linkage_real scales[])
 {
-    rack_linkage_real nz[RACK_LINKAGE_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        rack_linkage_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * RACK_LINKAGE_NP : p, nz);
-        scales[j] = rack_linkage_lever_arm(nz);
+        scales[j] = rack_linkage_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * RACK_LINKAGE_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1090,6 +1096,7 @@ int rack_linkage_solve_grid_checked(const rack_linkage_options *options,
                                     rack_linkage_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = RACK_LINKAGE_OK;
     /* the options once per call, not at every step */
     if (n > 0 && rack_linkage_check_options(options) != 0) {
@@ -1099,7 +1106,7 @@ int rack_linkage_solve_grid_checked(const rack_linkage_options *options,
     if (n > 0 && state->started) rack_linkage_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (rack_linkage_step(options, p, t[k], state, work, report) != RACK_LINKAGE_OK) {
-            return k;
+            break;
         }
         rack_linkage_store(q_out, k, state->q);
         rack_linkage_store(dq_out, k, state->dq);
@@ -1107,7 +1114,11 @@ int rack_linkage_solve_grid_checked(const rack_linkage_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? rack_linkage_lever_arm_at(q_out, t[0], p)
+                                           : (rack_linkage_real)NAN;
+    }
+    return k;
 }
 
 int rack_linkage_solve_grid(const rack_linkage_options *options, const rack_linkage_real p[], int n,

@@ -79,6 +79,9 @@ typedef struct {
     rack_linkage_real inv_norm;  /* estimate of ||Phi_q^-1||_1 at the converged q */
     rack_linkage_real cond;      /* estimate of the 1-norm condition of Phi_q there */
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
+    rack_linkage_real lever_arm; /* rack_linkage_solve_grid: the length scale of the run's */
+                                 /* first row (as rack_linkage_length_scales), set by the */
+                                 /* call that starts the run; NaN: no row or no q_out */
 } rack_linkage_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0

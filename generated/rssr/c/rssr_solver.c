@@ -182,15 +182,21 @@ static rssr_real rssr_lever_arm(const rssr_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (rssr_length_scales of one set). */
+static rssr_real rssr_lever_arm_at(const rssr_real q[], rssr_real t, const rssr_real p[])
+{
+    rssr_real nz[RSSR_NNZ];
+    rssr_phi_q(q, t, p, nz);
+    return rssr_lever_arm(nz);
+}
+
 void rssr_length_scales(int m, const rssr_real p[], const rssr_real q[],
                                 int q_stride, rssr_real t, rssr_real scales[])
 {
-    rssr_real nz[RSSR_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        rssr_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * RSSR_NP : p, nz);
-        scales[j] = rssr_lever_arm(nz);
+        scales[j] = rssr_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * RSSR_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1369,6 +1375,7 @@ int rssr_solve_grid_checked(const rssr_options *options,
                                     rssr_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = RSSR_OK;
     /* the options once per call, not at every step */
     if (n > 0 && rssr_check_options(options) != 0) {
@@ -1378,7 +1385,7 @@ int rssr_solve_grid_checked(const rssr_options *options,
     if (n > 0 && state->started) rssr_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (rssr_step(options, p, t[k], state, work, report) != RSSR_OK) {
-            return k;
+            break;
         }
         rssr_store(q_out, k, state->q);
         rssr_store(dq_out, k, state->dq);
@@ -1386,7 +1393,11 @@ int rssr_solve_grid_checked(const rssr_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? rssr_lever_arm_at(q_out, t[0], p)
+                                           : (rssr_real)NAN;
+    }
+    return k;
 }
 
 int rssr_solve_grid(const rssr_options *options, const rssr_real p[], int n,

@@ -171,15 +171,21 @@ static spatial_slider_crank_real spatial_slider_crank_lever_arm(const spatial_sl
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (spatial_slider_crank_length_scales of one set). */
+static spatial_slider_crank_real spatial_slider_crank_lever_arm_at(const spatial_slider_crank_real q[], spatial_slider_crank_real t, const spatial_slider_crank_real p[])
+{
+    spatial_slider_crank_real nz[SPATIAL_SLIDER_CRANK_NNZ];
+    spatial_slider_crank_phi_q(q, t, p, nz);
+    return spatial_slider_crank_lever_arm(nz);
+}
+
 void spatial_slider_crank_length_scales(int m, const spatial_slider_crank_real p[], const spatial_slider_crank_real q[],
                                 int q_stride, spatial_slider_crank_real t, spatial_slider_crank_real scales[])
 {
-    spatial_slider_crank_real nz[SPATIAL_SLIDER_CRANK_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        spatial_slider_crank_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * SPATIAL_SLIDER_CRANK_NP : p, nz);
-        scales[j] = spatial_slider_crank_lever_arm(nz);
+        scales[j] = spatial_slider_crank_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * SPATIAL_SLIDER_CRANK_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -919,6 +925,7 @@ int spatial_slider_crank_solve_grid_checked(const spatial_slider_crank_options *
                                     spatial_slider_crank_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = SPATIAL_SLIDER_CRANK_OK;
     /* the options once per call, not at every step */
     if (n > 0 && spatial_slider_crank_check_options(options) != 0) {
@@ -928,7 +935,7 @@ int spatial_slider_crank_solve_grid_checked(const spatial_slider_crank_options *
     if (n > 0 && state->started) spatial_slider_crank_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (spatial_slider_crank_step(options, p, t[k], state, work, report) != SPATIAL_SLIDER_CRANK_OK) {
-            return k;
+            break;
         }
         spatial_slider_crank_store(q_out, k, state->q);
         spatial_slider_crank_store(dq_out, k, state->dq);
@@ -936,7 +943,11 @@ int spatial_slider_crank_solve_grid_checked(const spatial_slider_crank_options *
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? spatial_slider_crank_lever_arm_at(q_out, t[0], p)
+                                           : (spatial_slider_crank_real)NAN;
+    }
+    return k;
 }
 
 int spatial_slider_crank_solve_grid(const spatial_slider_crank_options *options, const spatial_slider_crank_real p[], int n,

@@ -175,15 +175,21 @@ static stewart_real stewart_lever_arm(const stewart_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (stewart_length_scales of one set). */
+static stewart_real stewart_lever_arm_at(const stewart_real q[], stewart_real t, const stewart_real p[])
+{
+    stewart_real nz[STEWART_NNZ];
+    stewart_phi_q(q, t, p, nz);
+    return stewart_lever_arm(nz);
+}
+
 void stewart_length_scales(int m, const stewart_real p[], const stewart_real q[],
                                 int q_stride, stewart_real t, stewart_real scales[])
 {
-    stewart_real nz[STEWART_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        stewart_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * STEWART_NP : p, nz);
-        scales[j] = stewart_lever_arm(nz);
+        scales[j] = stewart_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * STEWART_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1318,6 +1324,7 @@ int stewart_solve_grid_checked(const stewart_options *options,
                                     stewart_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = STEWART_OK;
     /* the options once per call, not at every step */
     if (n > 0 && stewart_check_options(options) != 0) {
@@ -1327,7 +1334,7 @@ int stewart_solve_grid_checked(const stewart_options *options,
     if (n > 0 && state->started) stewart_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (stewart_step(options, p, t[k], state, work, report) != STEWART_OK) {
-            return k;
+            break;
         }
         stewart_store(q_out, k, state->q);
         stewart_store(dq_out, k, state->dq);
@@ -1335,7 +1342,11 @@ int stewart_solve_grid_checked(const stewart_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? stewart_lever_arm_at(q_out, t[0], p)
+                                           : (stewart_real)NAN;
+    }
+    return k;
 }
 
 int stewart_solve_grid(const stewart_options *options, const stewart_real p[], int n,

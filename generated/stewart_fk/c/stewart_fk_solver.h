@@ -89,6 +89,9 @@ typedef struct {
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
     int branch_jump;             /* stewart_fk_solve_inputs: 1 when the solution may lie */
                                  /* on another assembly than the last one (see there) */
+    stewart_fk_real lever_arm; /* stewart_fk_solve_grid: the length scale of the run's */
+                                 /* first row (as stewart_fk_length_scales), set by the */
+                                 /* call that starts the run; NaN: no row or no q_out */
 } stewart_fk_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0

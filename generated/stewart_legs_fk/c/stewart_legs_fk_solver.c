@@ -179,15 +179,21 @@ static stewart_legs_fk_real stewart_legs_fk_lever_arm(const stewart_legs_fk_real
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (stewart_legs_fk_length_scales of one set). */
+static stewart_legs_fk_real stewart_legs_fk_lever_arm_at(const stewart_legs_fk_real q[], stewart_legs_fk_real t, const stewart_legs_fk_real p[])
+{
+    stewart_legs_fk_real nz[STEWART_LEGS_FK_NNZ];
+    stewart_legs_fk_phi_q(q, t, p, nz);
+    return stewart_legs_fk_lever_arm(nz);
+}
+
 void stewart_legs_fk_length_scales(int m, const stewart_legs_fk_real p[], const stewart_legs_fk_real q[],
                                 int q_stride, stewart_legs_fk_real t, stewart_legs_fk_real scales[])
 {
-    stewart_legs_fk_real nz[STEWART_LEGS_FK_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        stewart_legs_fk_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * STEWART_LEGS_FK_NPU : p, nz);
-        scales[j] = stewart_legs_fk_lever_arm(nz);
+        scales[j] = stewart_legs_fk_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * STEWART_LEGS_FK_NPU : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1438,6 +1444,7 @@ int stewart_legs_fk_solve_grid_checked(const stewart_legs_fk_options *options,
                                     stewart_legs_fk_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = STEWART_LEGS_FK_OK;
     /* the options once per call, not at every step */
     if (n > 0 && stewart_legs_fk_check_options(options) != 0) {
@@ -1447,7 +1454,7 @@ int stewart_legs_fk_solve_grid_checked(const stewart_legs_fk_options *options,
     if (n > 0 && state->started) stewart_legs_fk_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (stewart_legs_fk_step(options, p, t[k], state, work, report) != STEWART_LEGS_FK_OK) {
-            return k;
+            break;
         }
         stewart_legs_fk_store(q_out, k, state->q);
         stewart_legs_fk_store(dq_out, k, state->dq);
@@ -1455,7 +1462,11 @@ int stewart_legs_fk_solve_grid_checked(const stewart_legs_fk_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? stewart_legs_fk_lever_arm_at(q_out, t[0], p)
+                                           : (stewart_legs_fk_real)NAN;
+    }
+    return k;
 }
 
 int stewart_legs_fk_solve_grid(const stewart_legs_fk_options *options, const stewart_legs_fk_real p[], int n,

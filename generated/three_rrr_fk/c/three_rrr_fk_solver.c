@@ -173,15 +173,21 @@ static three_rrr_fk_real three_rrr_fk_lever_arm(const three_rrr_fk_real nz[])
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (three_rrr_fk_length_scales of one set). */
+static three_rrr_fk_real three_rrr_fk_lever_arm_at(const three_rrr_fk_real q[], three_rrr_fk_real t, const three_rrr_fk_real p[])
+{
+    three_rrr_fk_real nz[THREE_RRR_FK_NNZ];
+    three_rrr_fk_phi_q(q, t, p, nz);
+    return three_rrr_fk_lever_arm(nz);
+}
+
 void three_rrr_fk_length_scales(int m, const three_rrr_fk_real p[], const three_rrr_fk_real q[],
                                 int q_stride, three_rrr_fk_real t, three_rrr_fk_real scales[])
 {
-    three_rrr_fk_real nz[THREE_RRR_FK_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        three_rrr_fk_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * THREE_RRR_FK_NPU : p, nz);
-        scales[j] = three_rrr_fk_lever_arm(nz);
+        scales[j] = three_rrr_fk_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * THREE_RRR_FK_NPU : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1326,6 +1332,7 @@ int three_rrr_fk_solve_grid_checked(const three_rrr_fk_options *options,
                                     three_rrr_fk_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = THREE_RRR_FK_OK;
     /* the options once per call, not at every step */
     if (n > 0 && three_rrr_fk_check_options(options) != 0) {
@@ -1335,7 +1342,7 @@ int three_rrr_fk_solve_grid_checked(const three_rrr_fk_options *options,
     if (n > 0 && state->started) three_rrr_fk_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (three_rrr_fk_step(options, p, t[k], state, work, report) != THREE_RRR_FK_OK) {
-            return k;
+            break;
         }
         three_rrr_fk_store(q_out, k, state->q);
         three_rrr_fk_store(dq_out, k, state->dq);
@@ -1343,7 +1350,11 @@ int three_rrr_fk_solve_grid_checked(const three_rrr_fk_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? three_rrr_fk_lever_arm_at(q_out, t[0], p)
+                                           : (three_rrr_fk_real)NAN;
+    }
+    return k;
 }
 
 int three_rrr_fk_solve_grid(const three_rrr_fk_options *options, const three_rrr_fk_real p[], int n,

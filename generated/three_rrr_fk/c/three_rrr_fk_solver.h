@@ -88,6 +88,9 @@ typedef struct {
     int flagged;                 /* 1 when q, dq or ddq may miss the targets      */
     int branch_jump;             /* three_rrr_fk_solve_inputs: 1 when the solution may lie */
                                  /* on another assembly than the last one (see there) */
+    three_rrr_fk_real lever_arm; /* three_rrr_fk_solve_grid: the length scale of the run's */
+                                 /* first row (as three_rrr_fk_length_scales), set by the */
+                                 /* call that starts the run; NaN: no row or no q_out */
 } three_rrr_fk_report;
 
 /* The solution carried from step to step. Set q to the first guess and started to 0

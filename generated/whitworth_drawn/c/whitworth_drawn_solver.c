@@ -180,15 +180,21 @@ static whitworth_drawn_real whitworth_drawn_lever_arm(const whitworth_drawn_real
     return scale;
 }
 
+/* The largest lever arm in Phi_q at (q, t) (whitworth_drawn_length_scales of one set). */
+static whitworth_drawn_real whitworth_drawn_lever_arm_at(const whitworth_drawn_real q[], whitworth_drawn_real t, const whitworth_drawn_real p[])
+{
+    whitworth_drawn_real nz[WHITWORTH_DRAWN_NNZ];
+    whitworth_drawn_phi_q(q, t, p, nz);
+    return whitworth_drawn_lever_arm(nz);
+}
+
 void whitworth_drawn_length_scales(int m, const whitworth_drawn_real p[], const whitworth_drawn_real q[],
                                 int q_stride, whitworth_drawn_real t, whitworth_drawn_real scales[])
 {
-    whitworth_drawn_real nz[WHITWORTH_DRAWN_NNZ];
     int j;
     for (j = 0; j < m; ++j) {
-        whitworth_drawn_phi_q(q + (size_t)j * (size_t)q_stride, t,
-                           p ? p + (size_t)j * WHITWORTH_DRAWN_NP : p, nz);
-        scales[j] = whitworth_drawn_lever_arm(nz);
+        scales[j] = whitworth_drawn_lever_arm_at(q + (size_t)j * (size_t)q_stride, t,
+                                              p ? p + (size_t)j * WHITWORTH_DRAWN_NP : p);
     }
 }
 /* The estimator's two fixed vectors, worked out by the compiler (constant expressions in the
@@ -1066,6 +1072,7 @@ int whitworth_drawn_solve_grid_checked(const whitworth_drawn_options *options,
                                     whitworth_drawn_report *report)
 {
     int k;
+    const int starting = !state->started; /* this call solves the run's first row */
     report->status = WHITWORTH_DRAWN_OK;
     /* the options once per call, not at every step */
     if (n > 0 && whitworth_drawn_check_options(options) != 0) {
@@ -1075,7 +1082,7 @@ int whitworth_drawn_solve_grid_checked(const whitworth_drawn_options *options,
     if (n > 0 && state->started) whitworth_drawn_region_for(options, work); /* else prepared */
     for (k = 0; k < n; ++k) {
         if (whitworth_drawn_step(options, p, t[k], state, work, report) != WHITWORTH_DRAWN_OK) {
-            return k;
+            break;
         }
         whitworth_drawn_store(q_out, k, state->q);
         whitworth_drawn_store(dq_out, k, state->dq);
@@ -1083,7 +1090,11 @@ int whitworth_drawn_solve_grid_checked(const whitworth_drawn_options *options,
         if (cond_out) cond_out[k] = report->cond;
         if (flagged_out) flagged_out[k] = (unsigned char)report->flagged;
     }
-    return n;
+    if (starting) { /* the start check's lever arm, once a run, from the row as stored */
+        report->lever_arm = k > 0 && q_out ? whitworth_drawn_lever_arm_at(q_out, t[0], p)
+                                           : (whitworth_drawn_real)NAN;
+    }
+    return k;
 }
 
 int whitworth_drawn_solve_grid(const whitworth_drawn_options *options, const whitworth_drawn_real p[], int n,

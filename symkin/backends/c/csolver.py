@@ -68,6 +68,15 @@ class GridSolver:
         # inverse dynamics: the grid loop then takes lam_out and loads_out too
         self._dynamics = hasattr(lib, f"{name}_multipliers")
         self._points = getattr(lib, f"{name}_points")
+        # The lever arms the start check reads (runtime.solving.start): at the run's first
+        # guess from <prefix>_length_scales on the structs as they are, at its first row from
+        # the report (None: a kernel built before them).
+        self._length_scales = getattr(lib, f"{name}_length_scales", None)
+        if getattr(lib, f"{name.upper()}_NPU", p.size) != p.size:  # it reads the inputs too
+            self._length_scales = None
+        self._scale = ffi.new(f"{name}_real[1]")
+        self._state_q = self._state.q  # a field's cdata is made anew on each access
+        self._reports_lever_arm = "lever_arm" in dict(ffi.typeof(f"{name}_report").fields)
         # The cffi types parsed once: from_buffer given a type's text parses it on every
         # call, about a fifth of the cost of the call (six of them bind each run).
         self._real_array = ffi.typeof(f"{name}_real[]")
@@ -97,7 +106,7 @@ class GridSolver:
         # Copied as bytes in the real type: no Python list of floats on the way.
         memmove, dtype = self._ffi.memmove, self.dtype
         memmove(self._p, np.ascontiguousarray(p, dtype=dtype), self._p_bytes)
-        memmove(self._state.q, np.ascontiguousarray(q, dtype=dtype), self._q_bytes)
+        memmove(self._state_q, np.ascontiguousarray(q, dtype=dtype), self._q_bytes)
         self._state.started = 0
         return self
 
@@ -175,6 +184,22 @@ class GridSolver:
     def fallbacks(self) -> int:
         """The sparse LU's fall-backs to dense LU since :meth:`start`."""
         return int(self._report.fallbacks)
+
+    def start_lever_arm(self, t: float) -> float | None:
+        """The length scale at the q and p the run was started with, at time t, raw as
+        ``<prefix>_length_scales`` gives it (0: no lever arm; NaN: Phi_q not finite there);
+        None for a kernel without that function."""
+        if self._length_scales is None:
+            return None
+        self._length_scales(1, self._p, self._state_q, 0, t, self._scale)
+        return float(self._scale[0])
+
+    @property
+    def first_lever_arm(self) -> float | None:
+        """The length scale at the run's first row as the call that solved it reported it,
+        raw as :meth:`start_lever_arm` (NaN: no row solved); None for a kernel built before
+        the report had it. Valid once a call has solved the first row."""
+        return float(self._report.lever_arm) if self._reports_lever_arm else None
 
     def outcome(self, solved: int) -> ChunkResult:
         """The last call's report, with the count it returned."""

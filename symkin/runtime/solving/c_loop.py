@@ -45,6 +45,8 @@ def _c_run(run: _Run, solver: GridSolver, progress: Progress | None) -> int:
     if progress is None and total - start <= _Chunks.FIRST:
         solved = solver.advance(start, total)
         run.done = start + solved
+        if start == 0:
+            run.lever_arm = solver.first_lever_arm
         return solved
     chunks = _Chunks(total, progress is not None)
     solved = 0
@@ -53,6 +55,8 @@ def _c_run(run: _Run, solver: GridSolver, progress: Progress | None) -> int:
         began = time.perf_counter()
         solved = solver.advance(start, stop)
         chunks.took(time.perf_counter() - began)
+        if start == 0:  # the call that solved the first row reports its lever arm
+            run.lever_arm = solver.first_lever_arm
         run.done = start + solved
         if solver.status != OK:
             break

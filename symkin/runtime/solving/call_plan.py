@@ -85,14 +85,18 @@ class Plan:
         self._point_vectors[p_bytes] = kept
         return fresh
 
-    def unit(self, kernel: KinematicsKernel, q0: Array, t0: float, p: Array, p_bytes: bytes
-             ) -> float:
-        """The unit to solve in from q0 at t0 with parameters p (units.unit_for on a miss,
-        its length scale measured afresh: this memory is the only one it is kept in)."""
+    def unit(self, kernel: KinematicsKernel, q0: Array, t0: float, p: Array, p_bytes: bytes,
+             solver: GridSolver | None = None) -> float:
+        """The unit to solve in from q0 at t0 with parameters p (units.unit_for), from this
+        memory (the only one it is kept in); on a miss its length scale is measured afresh,
+        by the grid ``solver`` started from q0 with p on its own arrays where there is one
+        (a third of the cost of the generated function called on arrays)."""
         key = (q0.tobytes(), t0, p_bytes)
         found = self._units.get(key)
         if found is None:
-            found = units.unit_of(start.measured_lever_arm(kernel, q0, t0, p))
+            raw = None if solver is None else solver.start_lever_arm(t0)
+            found = units.unit_of(start.measured_lever_arm(kernel, q0, t0, p) if raw is None
+                                  else start.from_raw(raw))
             if len(self._units) >= RECENT:
                 self._units.clear()
             self._units[key] = found

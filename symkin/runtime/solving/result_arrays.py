@@ -36,10 +36,13 @@ class Run:
         passages: the singular configurations passed through.
         caller_owned: the arrays are the caller's (``out=``): a partial result views them
             rather than copying its rows out.
+        lever_arm: the length scale at the first row (runtime.solving.start.lever_arm, raw),
+            as the solver that solved it found it from its own Phi_q there, in the kernel's
+            own unit; None where it was not reported (then the start check works it out).
     """
 
     __slots__ = ("caller_owned", "cond", "d2q", "done", "dq", "fallbacks", "flagged",
-                 "forces_out", "passages", "q", "t")
+                 "forces_out", "lever_arm", "passages", "q", "t")
 
     def __init__(self, t: Array, q: Array, dq: Array, d2q: Array, cond: Array,
                  flagged: NDArray[np.bool_], caller_owned: bool = False) -> None:
@@ -49,6 +52,7 @@ class Run:
         self.fallbacks = 0
         self.passages: list[Passage] = []
         self.caller_owned = caller_owned
+        self.lever_arm: float | None = None
         # inverse dynamics: (lam, loads) rows the C grid loop fills (NaN: not filled there)
         self.forces_out: tuple[Array, Array] | None = None
 

@@ -217,12 +217,29 @@ def _float64(values: Array) -> Array:
 
 
 def _generated_scale(batch: Any, q: Array, t: float, p: Array) -> float:
-    """L from one call of the generated ``<prefix>_length_scales``: NaN where Phi_q is not
-    finite, 1 where there is no lever arm (Phi_q as it is, as length_scale says)."""
-    scale = float(batch.length_scales(p[None, :], q, float(t))[0])
+    """L from one call of the generated ``<prefix>_length_scales``."""
+    return from_raw(float(batch.length_scales(p[None, :], q, float(t))[0]))
+
+
+def from_raw(scale: float) -> float:
+    """L from a raw length scale as a solver gives it (``<prefix>_length_scales``): NaN where
+    Phi_q is not finite, 1 where there is no lever arm (Phi_q as it is, as length_scale
+    says); an L as lever_arm gives it is returned as it is."""
     if not math.isfinite(scale):
         return math.nan
     return scale if scale > 0 else 1.0
+
+
+def factored_lever_arm(kernel: KinematicsKernel, factors: Any) -> float | None:
+    """L at the point whose Phi_q ``factors`` (runtime.solving.linalg) factored, from the
+    matrix they keep: lever_arm's value there for a kernel whose dense Phi_q is its
+    phi_q_nz scattered (runtime.kernel.Kernel's), as the runtime's Newton factors it below
+    SPARSE_FROM coordinates; None for sparse factors."""
+    matrix = getattr(factors, "matrix", None)
+    if type(matrix) is not np.ndarray:
+        return None
+    nz = matrix[kernel.pattern_rows, kernel.pattern_cols]
+    return length_scale(kernel, nz) if np.isfinite(nz).all() else math.nan
 
 
 def scaled_nonzeros(kernel: KinematicsKernel, nz: Array) -> tuple[Array, float]:
@@ -279,15 +296,30 @@ def clearly_regular(estimate: float, scale: float, threshold: float) -> bool:
     return math.isfinite(bound) and bound * SAFETY <= threshold
 
 
+def cleared(kernel: KinematicsKernel, options: Options, estimate: float,
+            scale: float | None) -> bool:
+    """Whether a solver's condition ``estimate`` of Phi_q at a start and the length scale
+    ``scale`` there (raw or as lever_arm gives it; None: not known) show the start clearly
+    regular (clearly_regular): singular_start's first test, which needs nothing else."""
+    if scale is None or not math.isfinite(estimate):
+        return False
+    arm = from_raw(scale)
+    return math.isfinite(arm) and clearly_regular(
+        estimate, arm, start_threshold(options, len(kernel.coordinates)))
+
+
 def singular_start(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options,
-                   estimate: float = math.nan) -> Singular | None:
+                   estimate: float = math.nan, scale: float | None = None
+                   ) -> Singular | None:
     """The start (q at t) judged before the first step: None when Phi_q is regular there.
     ``estimate``: the solver's condition estimate of Phi_q at q, from the factors it made
-    there (NaN: none), which spares the check its own factorisation where it suffices."""
+    there (NaN: none), which spares the check its own factorisation where it suffices;
+    ``scale``: the length scale at q as that solver found it (raw, Run.lever_arm; None: it
+    is worked out here, lever_arm)."""
     threshold = start_threshold(options, len(kernel.coordinates))
     if math.isfinite(estimate):
-        scale = lever_arm(kernel, q, t, p)
-        if math.isfinite(scale) and clearly_regular(estimate, scale, threshold):
+        arm = lever_arm(kernel, q, t, p) if scale is None else scale
+        if cleared(kernel, options, estimate, arm):
             return None
     nz, _ = lever_arms(kernel, q, t, p)
     scaled, scale = scaled_nonzeros(kernel, nz)

@@ -193,6 +193,16 @@ class ScaledGridSolver:
     def point_vectors(self, count: int, size: int = 2) -> Array:
         return self.solver.point_vectors(count, size)
 
+    def start_lever_arm(self, t: float) -> float | None:
+        """None: the kernel's solver reports lever arms in the kernel's unit, not this view's
+        (start.lever_arm of this view is worked out from its own Phi_q)."""
+        del t
+        return None
+
+    @property
+    def first_lever_arm(self) -> float | None:
+        return None
+
     def set_state(self, t: float, q: Array, dq: Array, ddq: Array) -> None:
         length = self.scaled.to_length
         self.solver.set_state(t, length(q), length(dq), length(ddq))
