@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import derived
 from driver_support import BACKENDS, kernel_for
 
 import symkin
@@ -22,7 +23,7 @@ RS, RP, W = 1.0, 0.5, 2.0
 
 @pytest.fixture(scope="module")
 def planetary():
-    return symkin.derive(EXAMPLES / "planetary.yaml")
+    return derived(EXAMPLES / "planetary.yaml")  # the run's shared derivation
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -128,7 +129,7 @@ R_, L_, C_, DX, DY, P_ = 0.5, 2.0, 1.0, 1.5, 1.5, 0.5
 
 @pytest.fixture(scope="module")
 def rack_linkage():
-    return symkin.derive(EXAMPLES / "rack_linkage.yaml")
+    return derived(EXAMPLES / "rack_linkage.yaml")
 
 
 def _rocker_tip(pin: np.ndarray, near: np.ndarray) -> np.ndarray:

@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from codegen_support import derived
 from driver_support import kernel_for
 
 import symkin
@@ -17,14 +18,16 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def test_gears_are_pitch_circles_whose_mark_turns(tmp_path: Path) -> None:
-    system = symkin.derive(EXAMPLES / "planetary.yaml")
+    system = derived(EXAMPLES / "planetary.yaml")  # the run's shared derivation
     outlines = drawing.outlines(system)
     keys = [k for k in outlines if k.startswith("curve:")]
     assert [k.split(":")[1] for k in keys] == ["sun", "sun", "planet", "planet", "planet",
                                                "planet", "ground", "ground"]
     circle = outlines[keys[0]]
     assert np.abs(np.hypot(*circle.T) - 1.0).max() < 1e-12  # the sun's pitch radius
-    run = symkin.solve(kernel_for(system, "numpy"))
+    # 31 points of the file's 0..3 s (every 0.1 s, half its dt): the GIF draws a frame per
+    # point, and the mark turns through the same angles
+    run = symkin.solve(kernel_for(system, "numpy"), t=np.linspace(0.0, 3.0, 31))
     found = dict((f"{k}", p) for k, (_, p) in zip(keys, animation.marks(run, outlines)))
     radius = found[keys[1]]  # the sun's turning radius, [0, 0] to [rs, 0] in its frame
     tip = radius[:, -1]
@@ -36,7 +39,7 @@ def test_gears_are_pitch_circles_whose_mark_turns(tmp_path: Path) -> None:
 
 
 def test_rack_line_curve_and_cam_profile_are_drawn() -> None:
-    rack = drawing.outlines(symkin.derive(EXAMPLES / "rack_linkage.yaml"))
+    rack = drawing.outlines(derived(EXAMPLES / "rack_linkage.yaml"))
     (key, line), = [(k, v) for k, v in rack.items() if k.startswith("curve:")]
     assert key.startswith("curve:rack:rack:")
     assert np.abs(line[:, 1]).max() == 0 and line[0, 0] == -5.0 and line[-1, 0] == 5.0
