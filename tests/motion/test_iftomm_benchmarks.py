@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from codegen_support import derived
 from scipy.integrate import solve_ivp
 
 import symkin
@@ -149,7 +150,7 @@ def test_a03_c_step_ends_at_the_published_solution_without_dense_fall_back(
 
 
 def test_a04_bricard_moves_under_gravity_keeping_its_energy() -> None:
-    system = symkin.derive(BENCH / "a04_bricard.yaml")
+    system = derived(BENCH / "a04_bricard.yaml")  # shared with tests/symbolic's checks of it
     assert len(system.removed) == 1  # square, one row dependent: one freedom
     trajectory = symkin.solve(symkin.compile(system, backend="numpy"),
                               t=np.linspace(0.0, 2.0, 41))
