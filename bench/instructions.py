@@ -128,6 +128,7 @@ def per_step(spec: str, tighten_cond: str | None = None, linalg: str = "sparse"
 
 
 SOLVE_CALLS = r"""
+import os
 import sys
 from pathlib import Path
 
@@ -139,17 +140,27 @@ from symkin.build import index
 
 kernel = index.prepare(Path(sys.argv[1]), index.Options(backend=backends.resolve("c"))).kernel
 t = np.linspace(0.0, 1.5, 31)
-for _ in range(int(sys.argv[2])):
+for _ in range(int(sys.argv[2])):  # past the first calls' one-time costs
     symkin.solve(kernel, t=t)
+os.getppid()  # the marker: callgrind writes what it counted so far, and counts afresh
+for _ in range(int(sys.argv[3])):
+    symkin.solve(kernel, t=t)
+os.getppid()
 """
+
+# The libc function the script above calls only around its counted calls.
+MARKER = "getppid"
+WARM_CALLS, COUNTED_CALLS = 101, 1000
 
 
 def per_solve_call(spec: str, cache_dir: str | None = None) -> float:
     """Instructions of one ``symkin.solve(kernel, t=t)`` on a 31-point grid over 0..1.5 with
-    the C kernel of examples/<spec>.yaml: (a process of 1101 calls - one of 101) / 1000 (both
-    past the first calls' one-time costs), the kernel built beforehand (outside the count)
-    and loaded from the cache by both. A difference over 100 calls moved by up to 20 % between
-    runs (the interpreter's allocations and collections land unevenly); over 1000 by about 3 %."""
+    the C kernel of examples/<spec>.yaml: the count of 1000 calls / 1000 in one process, after
+    101 calls that pay the first calls' one-time costs, the kernel built beforehand (outside
+    the count) and loaded from the cache. callgrind writes its counts out and starts afresh
+    each time the script enters the marker (``--dump-before``), so the 1000 calls are
+    counted alone. A count over 100 calls moved by up to 20 % between runs (the
+    interpreter's allocations and collections land unevenly); over 1000 by about 3 %."""
     import os
 
     from symkin import backends
@@ -164,16 +175,19 @@ def per_solve_call(spec: str, cache_dir: str | None = None) -> float:
     with tempfile.TemporaryDirectory() as folder:
         script = Path(folder) / "calls.py"
         script.write_text(SOLVE_CALLS)
-
-        def total(calls: int) -> int:
-            done = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
-                                   sys.executable, str(script), str(path), str(calls)],
-                                  capture_output=True, text=True, check=True, env=env)
-            match = re.search(r"Collected : (\d+)", done.stderr)
-            assert match, done.stderr[-500:]
-            return int(match.group(1))
-
-        return (total(1101) - total(101)) / 1000
+        counts = Path(folder) / "callgrind.out"
+        subprocess.run(["valgrind", "--tool=callgrind", f"--dump-before={MARKER}",
+                        f"--callgrind-out-file={counts}", sys.executable, str(script),
+                        str(path), str(WARM_CALLS), str(COUNTED_CALLS)],
+                       capture_output=True, text=True, check=True, env=env)
+        # Part 1: up to the first marker; part 2: the counted calls; the file without a
+        # number: from the second marker to the exit. More parts: something else called it.
+        parts = sorted(p.name for p in Path(folder).glob("callgrind.out*"))
+        assert parts == ["callgrind.out", "callgrind.out.1", "callgrind.out.2"], parts
+        match = re.search(r"^summary: (\d+)", (Path(folder) / "callgrind.out.2").read_text(),
+                          re.MULTILINE)
+        assert match, "no summary line in the counted part"
+        return int(match.group(1)) / COUNTED_CALLS
 
 
 def main() -> int:
