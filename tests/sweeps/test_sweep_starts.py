@@ -248,7 +248,7 @@ run = symkin.solve(kernel, t=np.linspace(0.0, 0.05, 6), params=p)
 edge = EdgeSolver(kernel.ffi, kernel.lib, kernel.name, kernel.nq)
 found = edge(Options(), p, (float(run.t[-1]), run.q[-1], run.dq[-1], run.d2q[-1]),
              float(run.cond[-1]), 1.0, {h_min!r}, {h_min!r})
-print(found.outcome, kernel.lib.CRANK_SLIDER_EDGE_STOPPED, found.t, found.failed)
+print(found.outcome, kernel.lib.CRANK_SLIDER_EDGE_STOPPED, found.t, found.failed, kernel.real)
 """
 
 
@@ -268,7 +268,8 @@ def _edge_search(tmp_path: Path, real: str, h_min: float) -> tuple[int, int, flo
                           text=True, timeout=240, check=False,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert done.returncode == 0, done.stderr
-    outcome, stopped, t, failed = done.stdout.split()
+    outcome, stopped, t, failed, built = done.stdout.split()
+    assert built == real  # the files were generated with the precision asked for
     return int(outcome), int(stopped), float(t), float(failed)
 
 
