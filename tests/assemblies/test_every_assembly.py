@@ -13,6 +13,7 @@ the four branch pairs count the assemblies. The four-bar: two (circle intersecti
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Callable
@@ -85,6 +86,7 @@ def _rpr_residual(phi: np.ndarray, sign: int) -> np.ndarray:
     return np.sum((joint - ELBOWS[2])**2, axis=1) - DISTAL[2]**2
 
 
+@functools.cache  # the same sweep for every test of the module (read, never changed)
 def rpr_poses() -> list[np.ndarray]:
     """Every (x, y, phi) of the platform, by the sweep of the module docstring."""
     phis = np.linspace(-math.pi, math.pi, SWEEP, endpoint=False)
@@ -208,6 +210,7 @@ def _third_side(theta: np.ndarray, s2: int, s3: int) -> tuple[np.ndarray, np.nda
     return np.sum((_on(1, a2) - _on(2, a3))**2, axis=1) - SIDES[2]**2, ok2 & ok3
 
 
+@functools.cache  # the same sweep for every test of the module (read, never changed)
 def stewart_vertices() -> list[np.ndarray]:
     """The platform's vertices (3, 3) in every assembly, by the sweep of the docstring."""
     thetas = np.linspace(-math.pi, math.pi, SWEEP, endpoint=False)

@@ -11,6 +11,7 @@ assemblies of a general 6-6 platform, which checks that the homotopy lost no pat
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,7 @@ from motion_support import shared
 
 from symkin.runtime.protocol import KinematicsKernel
 from symkin.runtime.scanning.scan import scan
-from tests.assemblies.planar_six import Platform, assemblies
+from tests.assemblies.planar_six import Count, Platform, assemblies
 from tests.assemblies.test_every_assembly import _rotation
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -45,6 +46,19 @@ def _example_platform() -> Platform:
     top = np.array([body["points"][f"P{k}"] for k in range(1, 7)], dtype=float)
     assert np.all(top[:, 2] == height)
     return Platform(base, top[:, :2])
+
+
+@functools.cache
+def _general_count() -> Count:
+    """The independent count of the general platform at MANY_LEGS, once for the module's
+    tests (a total-degree homotopy: seconds)."""
+    return assemblies(Platform(MANY_BASE, MANY_PLATFORM), MANY_LEGS)
+
+
+@functools.cache
+def _example_count() -> Count:
+    """The independent count of stewart_fk's platform at all legs 1.0, once for the module."""
+    return assemblies(_example_platform(), np.ones(6))
 
 
 def _point(values: np.ndarray) -> str:
@@ -94,7 +108,7 @@ def test_the_independent_count_of_a_general_platform_is_complete() -> None:
     """20 complex solutions (the 40 complex assemblies in mirror pairs): no path was lost; two
     homotopy constants give the same real assemblies, each closing every leg."""
     platform = Platform(MANY_BASE, MANY_PLATFORM)
-    count = assemblies(platform, MANY_LEGS)
+    count = _general_count()
     other = assemblies(platform, MANY_LEGS, gamma=complex(-0.3127, 0.9498))
     assert count.complex == other.complex == 20
     assert len(count.poses) == 12
@@ -106,8 +120,7 @@ def test_the_independent_count_of_a_general_platform_is_complete() -> None:
 
 
 def test_the_example_platform_counts_eight_at_legs_one() -> None:
-    platform = _example_platform()
-    count = assemblies(platform, np.ones(6))
+    count = _example_count()
     assert len(count.poses) == 8
     heights = sorted(origin[2] for _, origin in count.poses)
     assert heights == pytest.approx([-h for h in reversed(heights)], abs=1e-12)  # mirrors
@@ -118,7 +131,7 @@ def test_the_example_platform_counts_eight_at_legs_one() -> None:
 def test_scan_of_stewart_fk_at_legs_one_finds_the_eight(backend: str) -> None:
     platform = _example_platform()
     kernel = compiled(ROOT / "examples" / "stewart_fk.yaml", backend)  # from its goldens
-    expected = assemblies(platform, np.ones(6)).poses
+    expected = _example_count().poses
     found = _scanned_poses(kernel, np.ones(6))
     _assert_the_same_poses(found, expected)
     for rotation, origin in found:
@@ -130,7 +143,7 @@ def test_scan_of_stewart_fk_at_legs_one_finds_the_eight(backend: str) -> None:
 def test_scan_of_a_general_six_six_finds_the_twelve(tmp_path: Path, backend: str) -> None:
     platform = Platform(MANY_BASE, MANY_PLATFORM)
     kernel = built(_six_six_file(tmp_path, platform), backend)
-    expected = assemblies(platform, MANY_LEGS).poses
+    expected = _general_count().poses
     found = _scanned_poses(kernel, MANY_LEGS)
     _assert_the_same_poses(found, expected)
     assert len(found) == 12

@@ -6,7 +6,10 @@ examples/ (as a reader at the repository's root would). A console block's ``$`` 
 such a folder too, in bash (so ``cd dir && ...`` and redirections work as a reader types them),
 ``symkin`` standing for this tree's ``python -m symkin``; each must exit 0
 (or the status a ``% exit: N`` line just above the block gives), and every output line the
-block shows must appear in what the command printed (a line ``...`` stands for lines left out)."""
+block shows must appear in what the command printed (a line ``...`` stands for lines left out).
+A line that is one plain ``symkin ...`` command (no shell syntax) runs in this process
+(cli_support.symkin_main: the same main, exit status and output, without a new interpreter's
+imports); any other line runs in bash."""
 
 from __future__ import annotations
 
@@ -19,9 +22,11 @@ import sys
 from pathlib import Path
 
 import pytest
+from cli_support import Ran, symkin_main
 from docs_support import DOCS, ROOT
 
 FENCE = re.compile(r"^(?:% exit: (\d+)\n)?```(python|console)\n(.*?)^```", re.M | re.S)
+SHELL = re.compile(r"[|&;<>()$`*?~\\'\"]")  # a line with any of these needs bash
 
 
 def blocks(page: Path) -> list[tuple[str, str, int]]:
@@ -48,10 +53,14 @@ def run_console(code: str, status: int, cwd: Path) -> list[str]:
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
     for command in commands:
         line, *shown = command.splitlines()
-        script = f'symkin() {{ {shlex.quote(sys.executable)} -m symkin "$@"; }}\n{line}'
-        done = subprocess.run(["bash", "-c", script], cwd=cwd, env=env, capture_output=True,
-                              text=True,
-                              timeout=900, check=False)
+        words = line.split()
+        if words[0] == "symkin" and not SHELL.search(line):
+            done: subprocess.CompletedProcess[str] | Ran = symkin_main(
+                *words[1:], cwd=cwd, env={"MPLBACKEND": "Agg"})
+        else:
+            script = f'symkin() {{ {shlex.quote(sys.executable)} -m symkin "$@"; }}\n{line}'
+            done = subprocess.run(["bash", "-c", script], cwd=cwd, env=env, capture_output=True,
+                                  text=True, timeout=900, check=False)
         printed = " ".join((done.stdout + done.stderr).split())
         if done.returncode != status:
             problems.append(f"{line}: exit {done.returncode}, not {status}: {printed[-400:]}")
@@ -91,9 +100,13 @@ def test_pages_with_examples_are_found() -> None:
             "guides/testing.md", "guides/design.md", "reference/api.md"} <= names
 
 
-def test_a_console_block_that_lies_is_caught(tmp_path: Path) -> None:
-    """The harness can fail: a wrong exit status and output the command never prints."""
-    block = "$ symkin run examples/four_bar.yaml --at 0\nthis line is never printed\n"
+@pytest.mark.parametrize("line", ["symkin run examples/four_bar.yaml --at 0",
+                                  "cd . && symkin run examples/four_bar.yaml --at 0"],
+                         ids=["in-process", "bash"])
+def test_a_console_block_that_lies_is_caught(line: str, tmp_path: Path) -> None:
+    """The harness can fail, on either path: a wrong exit status and output the command never
+    prints."""
+    block = f"$ {line}\nthis line is never printed\n"
     problems = run_console(block, 1, _reader_folder(tmp_path))
     assert len(problems) == 2 and "exit 0, not 1" in problems[0], problems
     assert "never printed" in problems[1]

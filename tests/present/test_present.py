@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled, derived
 
 import symkin
 from symkin.errors import MechanismError, UsageError
@@ -30,10 +31,10 @@ SIX_BAR = MECHANISMS / "watt_six_bar.yaml"
 
 
 def _run(path: Path, backend: str = "numpy"):
-    system = symkin.derive(symkin.load(path))
-    kernel = symkin.compile(system, backend=backend)
+    """The file's trajectory and outlines, its System and kernel shared by the run."""
+    kernel = compiled(path, backend)
     assert kernel.backend == backend
-    return symkin.solve(kernel), drawing.outlines(system)
+    return symkin.solve(kernel), drawing.outlines(derived(path))
 
 
 @pytest.fixture(scope="module")
@@ -228,15 +229,13 @@ def test_report_in_headless_chromium(six_bar, tmp_path: Path) -> None:
     trajectory, outlines = six_bar
     page = html.report(trajectory, tmp_path / "six.html", outlines, units=Units(length="m"),
                        title="watt_six_bar")
-    loaded = _browse(page, "--dump-dom")
-    assert loaded.returncode == 0, loaded.stderr
+    shot = tmp_path / "six.png"
+    loaded = _browse(page, "--dump-dom", f"--screenshot={shot}")  # one browser for both
+    assert loaded.returncode == 0 and shot.exists(), loaded.stderr
     assert _console_lines(loaded.stderr) == [], loaded.stderr
     dom = loaded.stdout
     # plotly drew the figure: its SVG layers, the slider and play buttons are in the DOM
     assert 'class="main-svg"' in dom and "slider-container" in dom and "updatemenu" in dom
-    shot = tmp_path / "six.png"
-    taken = _browse(page, f"--screenshot={shot}")
-    assert taken.returncode == 0 and shot.exists(), taken.stderr
     pixels = np.asarray(Image.open(shot).convert("RGB"), dtype=int)
     mechanism = pixels[80:650, 60:560]  # the left part of the page: the mechanism's view
     for colour in series.palette(5):  # the five moving bodies, each in its own colour

@@ -10,6 +10,7 @@ times one scale, the largest of the run VECTOR_SHARE of the scene's cube.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -17,7 +18,7 @@ from cli_support import symkin_main
 from codegen_support import compiled, derived
 
 from symkin.present import view3d
-from tests.present.test_view3d import RSSR, _cli, _figure, _numbers
+from tests.present.test_view3d import RSSR, _figure, _numbers
 
 ROOT = Path(__file__).resolve().parents[2]
 FORCES = ROOT / "bench" / "spatial_slider_crank_forces.yaml"
@@ -27,14 +28,37 @@ ARROWS = "joint reactions (i on j)"
 MAGENTA = np.array([0xC2, 0x00, 0x8F])  # animation.REACTION
 
 
+STEP = ("--dt", "0.05")  # 21 time points: each a frame of the page and of the GIF
+POINTS = 21
+
+
 @pytest.fixture(scope="module")
-def forces_run(tmp_path_factory) -> tuple[Path, Path, Path]:
-    """The loaded spatial slider-crank solved by the CLI (NumPy backend): npz, html, gif."""
+def forces_cache(tmp_path_factory) -> dict[str, str]:
+    """A kernel cache of this module's own: the first run in it derives, the next reuses."""
+    return {"SYMKIN_CACHE_DIR": str(tmp_path_factory.mktemp("forces_cache"))}
+
+
+@pytest.fixture(scope="module")
+def forces_run(tmp_path_factory, forces_cache) -> tuple[Path, Path, Path]:
+    """The loaded spatial slider-crank solved by the CLI (NumPy backend) in an empty kernel
+    cache, so deriving (the cold run of test_a_warm_run_draws_the_same_arrows): npz, html,
+    gif."""
     folder = tmp_path_factory.mktemp("spatial_forces")
-    result = _cli(str(FORCES), "--backend", "numpy", "-o", "f.npz", "--html", "f.html",
-                  "--animate", "f.gif", cwd=folder)
+    result = symkin_main("run", str(FORCES), "--backend", "numpy", *STEP, "-o", "f.npz",
+                         "--html", "f.html", "--animate", "f.gif", cwd=folder, env=forces_cache)
     assert result.returncode == 0, result.stderr
+    assert "cached kernel" not in result.stdout, result.stdout
     return folder / "f.npz", folder / "f.html", folder / "f.gif"
+
+
+@pytest.fixture(scope="module")
+def solved(forces_run) -> tuple[Any, Any]:
+    """The file's System and its NumPy trajectory at the CLI run's time points (the API)."""
+    import symkin
+
+    system = derived(FORCES)  # once per run
+    kernel = symkin.compile(system, backend="numpy")
+    return system, symkin.solve(kernel, t=np.load(forces_run[0])["t"])
 
 
 def _tails_and_heads(frame: dict, first: int, count: int = 4) -> tuple[np.ndarray, np.ndarray]:
@@ -56,7 +80,7 @@ def test_report_arrows_are_the_npz_reactions_at_the_joints_points(forces_run) ->
     arrows = [k for k, trace in enumerate(data) if trace.get("name") == ARROWS]
     assert len(arrows) == 4 and sum(data[k]["showlegend"] for k in arrows) == 1
     first = arrows[0]
-    assert len(frames) == saved["t"].size == 101
+    assert len(frames) == saved["t"].size == POINTS
     # the file's geometry: the bearing and the guide on the ground, the pin on the crank (its
     # point A), the cross on the slider (its point B)
     ground = np.array([[0.0, H, K], [B0, 0.0, 0.0]])
@@ -113,17 +137,15 @@ def _magenta(pixels: np.ndarray) -> int:
     return int((np.abs(pixels[:, :700] - MAGENTA).sum(axis=2) < 40).sum())
 
 
-def test_gif_draws_the_arrows_and_only_with_them(forces_run, tmp_path: Path) -> None:
-    import symkin
+def test_gif_draws_the_arrows_and_only_with_them(forces_run, solved, tmp_path: Path) -> None:
     from symkin.symbolic import drawing
 
     _, _, gif = forces_run
-    system = derived(FORCES)  # once per run
-    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    system, trajectory = solved
     bare = view3d.animate(trajectory, tmp_path / "bare.gif")
     drawn = view3d.animate(trajectory, tmp_path / "drawn.gif",
                            outlines=drawing.spatial_outlines(system))
-    for k in (0, 25, 60):
+    for k in (0, 5, 12):
         with_arrows, without = _frame(drawn, k), _frame(bare, k)
         assert _magenta(with_arrows) > 50 and _magenta(without) == 0
         assert (np.abs(with_arrows - without).sum(axis=2) > 0).sum() > 50
@@ -150,40 +172,36 @@ def test_report_force_column_is_the_npz_magnitudes(forces_run) -> None:
     cursors = [k for k, trace in enumerate(data) if trace["type"] == "scatter"
                and not trace.get("name")]
     assert len(cursors) == 3 and set(cursors) <= set(frames[0]["traces"])
-    own = frames[40]["traces"].index(cursors[0])
-    assert _numbers(frames[40]["data"][own]["x"]) == pytest.approx([saved["t"][40]] * 2)
+    own = frames[8]["traces"].index(cursors[0])
+    assert _numbers(frames[8]["data"][own]["x"]) == pytest.approx([saved["t"][8]] * 2)
 
 
-def test_a_warm_run_draws_the_same_arrows(tmp_path: Path) -> None:
+def test_a_warm_run_draws_the_same_arrows(forces_run, forces_cache, tmp_path: Path) -> None:
     """The joints' points travel in the index with the kernel (3-component rows): the run
-    that reuses the cached kernel draws the arrows the deriving run drew."""
-    env = {"SYMKIN_CACHE_DIR": str(tmp_path / "cache")}
-    pages = []
-    for run in ("cold", "warm"):
-        result = symkin_main("run", str(FORCES), "--backend", "numpy", "--html", f"{run}.html",
-                             cwd=tmp_path, env=env)
-        assert result.returncode == 0, result.stderr
-        assert ("cached kernel" in result.stdout) == (run == "warm"), result.stdout
-        pages.append(_figure(tmp_path / f"{run}.html"))
-    (cold, cold_frames, _), (warm, warm_frames, _) = pages
+    that reuses the cached kernel draws the arrows the deriving run (forces_run) drew."""
+    _, page, _ = forces_run
+    result = symkin_main("run", str(FORCES), "--backend", "numpy", *STEP, "--html", "warm.html",
+                         cwd=tmp_path, env=forces_cache)
+    assert result.returncode == 0, result.stderr
+    assert "cached kernel" in result.stdout, result.stdout
+    (cold, cold_frames, _), (warm, warm_frames, _) = _figure(page), _figure(tmp_path / "warm.html")
     assert [t.get("name") for t in warm] == [t.get("name") for t in cold]
+    assert len(warm_frames) == len(cold_frames) == POINTS
     first = next(k for k, trace in enumerate(cold) if trace.get("name") == ARROWS)
     for a, b in zip(cold_frames, warm_frames):
         np.testing.assert_array_equal(_tails_and_heads(a, first), _tails_and_heads(b, first))
 
 
-def test_a_partial_run_with_forces_draws_without_warnings(tmp_path: Path) -> None:
+def test_a_partial_run_with_forces_draws_without_warnings(solved, tmp_path: Path) -> None:
     """Rows a run did not solve (NaN positions and loads) draw no arrow and warn nothing."""
     import dataclasses
     import warnings
 
-    import symkin
     from symkin.symbolic import drawing
 
-    system = derived(FORCES)  # once per run
-    trajectory = symkin.solve(symkin.compile(system, backend="numpy"))
+    system, trajectory = solved
     q, reaction = trajectory.q.copy(), trajectory.forces.reaction.copy()
-    q[50:], reaction[50:] = np.nan, np.nan
+    q[10:], reaction[10:] = np.nan, np.nan
     partial = dataclasses.replace(trajectory, q=q, forces=dataclasses.replace(
         trajectory.forces, reaction=reaction))
     with warnings.catch_warnings():
@@ -193,10 +211,10 @@ def test_a_partial_run_with_forces_draws_without_warnings(tmp_path: Path) -> Non
         view3d.animate(partial, tmp_path / "p.gif", outlines=outlines)
     data, frames, _ = _figure(page)
     first = next(k for k, trace in enumerate(data) if trace.get("name") == ARROWS)
-    tails, heads = _tails_and_heads(frames[20], first)
+    tails, heads = _tails_and_heads(frames[4], first)
     assert np.isfinite(tails).all() and (np.linalg.norm(heads - tails, axis=1) > 0).all()
-    assert _magenta(_frame(tmp_path / "p.gif", 20)) > 50
-    assert _magenta(_frame(tmp_path / "p.gif", 80)) == 0  # nothing solved, nothing drawn
+    assert _magenta(_frame(tmp_path / "p.gif", 4)) > 50
+    assert _magenta(_frame(tmp_path / "p.gif", 16)) == 0  # nothing solved, nothing drawn
 
 
 def test_report_with_forces_in_headless_chromium(forces_run, tmp_path: Path) -> None:

@@ -13,6 +13,7 @@ pi/2 at every scale. Each set is also compared with its own symkin.solve, both b
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -233,27 +234,42 @@ def test_a_float_kernel_sweep_with_a_limit_ends_as_per_set_solve(crank_slider_sy
 
 
 _EDGE = """
-import numpy as np, symkin
+import json, sys
+import numpy as np
+import symkin
+from symkin import backends
 from symkin.backends.c.edge import EdgeSolver
+from symkin.build.cache import open_cache
 from symkin.contract.options import Options
-kernel = symkin.compile(symkin.derive({path!r}), backend="c", real={real!r})
+files = json.loads(open(sys.argv[1], encoding="utf-8").read())
+kernel = backends.get("c").build(files, open_cache())
 p = np.array([1.0, 5.0, 5.9])
 run = symkin.solve(kernel, t=np.linspace(0.0, 0.05, 6), params=p)
 edge = EdgeSolver(kernel.ffi, kernel.lib, kernel.name, kernel.nq)
 found = edge(Options(), p, (float(run.t[-1]), run.q[-1], run.dq[-1], run.d2q[-1]),
              float(run.cond[-1]), 1.0, {h_min!r}, {h_min!r})
-print(found.outcome, kernel.lib.CRANK_SLIDER_EDGE_STOPPED, found.t, found.failed)
+print(found.outcome, kernel.lib.CRANK_SLIDER_EDGE_STOPPED, found.t, found.failed, kernel.real)
 """
 
 
 def _edge_search(tmp_path: Path, real: str, h_min: float) -> tuple[int, int, float, float]:
+    """The search in a process of its own (a search that never ends meets the timeout). The
+    generated files come from this run's shared System and sources (codegen_support), so the
+    process builds, or finds in the kernel cache, what symkin.compile would: no derivation."""
+    from codegen_support import sources
+
+    options = {} if real == "double" else {"real": real}
+    files = tmp_path / f"edge_{real}.json"
+    files.write_text(json.dumps(sources(ROOT / "examples" / "crank_slider.yaml", "c", **options)),
+                     encoding="utf-8")
     script = tmp_path / f"edge_{real}.py"
-    path = str(ROOT / "examples" / "crank_slider.yaml")
-    script.write_text(_EDGE.format(path=path, real=real, h_min=h_min))
-    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
-                          timeout=240, check=False, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    script.write_text(_EDGE.format(h_min=h_min))
+    done = subprocess.run([sys.executable, str(script), str(files)], capture_output=True,
+                          text=True, timeout=240, check=False,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert done.returncode == 0, done.stderr
-    outcome, stopped, t, failed = done.stdout.split()
+    outcome, stopped, t, failed, built = done.stdout.split()
+    assert built == real  # the files were generated with the precision asked for
     return int(outcome), int(stopped), float(t), float(failed)
 
 

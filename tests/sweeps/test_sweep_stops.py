@@ -66,7 +66,11 @@ def _bisected(message: str) -> tuple[float, float]:
 
 
 def test_limit_sets_end_without_rerun_and_equal_per_set_solve(crank_slider, reruns) -> None:
-    designs = _designs(200)
+    # 200 draws hold five sets that reach their limit; swept: those five among the first 40
+    # (each set is its own solve, so the other 155 passing sets prove nothing more)
+    drawn = _designs(200)
+    reach = np.flatnonzero([_limit_time(p) <= T[-1] for p in drawn])
+    designs = drawn[np.union1d(np.arange(40), reach)]
     limits = np.array([_limit_time(p) for p in designs])
     failing = np.flatnonzero(limits <= T[-1])
     assert failing.size >= 3, "the draw must hold sets that reach their limit"
