@@ -80,6 +80,9 @@ def _popped(a: sp.Basic) -> tuple[int, tuple[sp.Basic, ...]]:
         if _coeff_isneg(a):
             own += 1  # NEG
             a = a.as_two_terms()[1] if a.args[0] is sp.S.NegativeOne else -a
+        if _numerator_only(a):
+            rest, pushed = _rest(a)
+            return own + rest, pushed
         n, d = fraction(a)
         if n.is_Integer:
             return own + 1 + (1 if n < 0 else 0), (d,)  # DIV, and NEG for a negative numerator
@@ -94,6 +97,21 @@ def _popped(a: sp.Basic) -> tuple[int, tuple[sp.Basic, ...]]:
         own = len(args) - 1 + int(all(negative))
         return own, tuple(-arg if neg else arg for arg, neg in zip(args, negative))
     return _rest(a)
+
+
+def _numerator_only(a: sp.Basic) -> bool:
+    """``fraction(a)`` is ``(a, 1)``: no factor goes to a denominator (no power with an
+    exponent that is not a positive number, no exp, no fraction). Most products of a
+    derivation are such, and ``fraction`` rebuilds both products to say so."""
+    if a.is_Integer:
+        return False
+    for term in sp.Mul.make_args(a):
+        if term.is_Pow:
+            if not (term.exp.is_Number and term.exp.is_positive):
+                return False
+        elif isinstance(term, sp.exp) or (term.is_Rational and not term.is_Integer):
+            return False
+    return True
 
 
 def _rest(a: sp.Basic) -> tuple[int, tuple[sp.Basic, ...]]:

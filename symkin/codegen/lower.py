@@ -18,8 +18,8 @@ from typing import Any
 import sympy as sp
 from sympy.printing.codeprinter import CodePrinter
 
-from symkin.codegen import dynamics_plan, fusion, sample, symbol_printing
-from symkin.codegen.cse_tidy import OpCounter, _inline_trivial, _ops_before_cse
+from symkin.codegen import dynamics_plan, fusion, neutral, sample, symbol_printing
+from symkin.codegen.cse_tidy import _ops_before_cse
 from symkin.codegen.lu_plan import LUPlan
 from symkin.codegen.symbol_printing import symbol_text
 from symkin.codegen.system_facts import (
@@ -248,22 +248,20 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
     if free and not mass_pattern(system):
         raise BuildError("the mechanism has fewer driving equations than freedoms and no "
                          "masses: its motion is not determined; give its bodies masses")
-    internal = symbol_printing.internal_symbols(system)
     pattern = system.pattern()
     p_pattern = parameter_pattern(system)
     m_pattern = mass_pattern(system)
-    expressions = routine_expressions(system, pattern, p_pattern, m_pattern)
+    kept = neutral.of(system, lambda: _neutral(system, pattern, p_pattern, m_pattern))
+    expressions, prepared, fused, shared = kept.expressions, kept.prepared, kept.fused, kept.shared
+    fused = dict(fused)  # "motion" is added below
     printer: CodePrinter = backend.printer(chosen)
-    prepare = symbol_printing.Preparer(internal)  # one memory of subtrees for all routines
-    prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
-    fused, shared = fusion.fused_expressions(prepared, DYNAMICS)
     # Phi's rows: as many as coordinates, or fewer where the dynamics moves the rest
     nphi = len(system.phi)
     sizes = {"phi_phi_q": (nphi, len(pattern), len(shared))}
     orders = {"phi_phi_q": fusion.fused_order(prepared, pattern, shared)}
     # Phi and Phi_q alone are the fused routine's pieces: its CSE and printing serve all three.
-    count = OpCounter()  # one memory of subtrees' op counts for every routine
-    fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, cse, count,
+    count = kept.count
+    fused_parts = _lowered_parts("phi_phi_q", fused["phi_phi_q"], printer, kept, cse,
                                  orders["phi_phi_q"])
     nnz = len(pattern)
     own = {"phi": _select("phi", fused_parts, {k: k for k in range(nphi)}, nphi),
@@ -274,11 +272,11 @@ def lower(system: System, backend: Target, options: Mapping[str, str] | None = N
         fused["motion"] = [e for name in ("mass", "phi_q", "applied", "gamma")
                            for e in prepared[name]]
         own["motion"] = _assemble("motion", _lowered_parts("motion", fused["motion"], printer,
-                                                           cse, count), len(fused["motion"]),
+                                                           kept, cse), len(fused["motion"]),
                                   (len(m_pattern), nnz, len(system.q), nphi))
     routines = tuple(
         own[name] if name in own else
-        _assemble(name, _lowered_parts(name, exprs, printer, cse, count), len(exprs))
+        _assemble(name, _lowered_parts(name, exprs, printer, kept, cse), len(exprs))
         for name, exprs in {**prepared, **fused}.items())
     return Code(
         backend=backend, options=chosen, cse=cse, name=system.name,
@@ -321,26 +319,31 @@ def _reads(expr: sp.Expr) -> frozenset[str]:
     return frozenset(s.name for s in expr.free_symbols)
 
 
-def _lowered_parts(name: str, exprs: list[sp.Expr], printer: Any, cse: bool,
-                   count: OpCounter, order: Sequence[int] | None = None) -> list[_Lowered]:
-    """CSE and print ``exprs`` in parts of at most PART_OUTPUTS outputs (in ``order``);
-    ``count`` counts the operations of each temporary and output."""
+def _neutral(system: System, pattern: Sequence[tuple[int, int]],
+             p_pattern: Sequence[tuple[int, int]], m_pattern: Sequence[tuple[int, int]]
+             ) -> neutral.Neutral:
+    """The routines' expressions, prepared and fused: the same for every backend."""
+    expressions = routine_expressions(system, pattern, p_pattern, m_pattern)
+    prepare = symbol_printing.Preparer(symbol_printing.internal_symbols(system))
+    prepared = {name: [prepare(e) for e in exprs] for name, exprs in expressions.items()}
+    fused, shared = fusion.fused_expressions(prepared, DYNAMICS)
+    return neutral.Neutral(expressions, prepared, fused, shared)
+
+
+def _lowered_parts(name: str, exprs: list[sp.Expr], printer: Any, kept: neutral.Neutral,
+                   cse: bool, order: Sequence[int] | None = None) -> list[_Lowered]:
+    """CSE (``kept``'s, made once for every backend) and print ``exprs`` in parts of at most
+    PART_OUTPUTS outputs (in ``order``), each temporary and output with its operations."""
     positions = list(order) if order is not None else list(range(len(exprs)))
     chunks = [positions[i:i + PART_OUTPUTS] for i in range(0, len(positions), PART_OUTPUTS)]
-    parts = []
+    parts, count = [], kept.count
     for chunk in chunks or [[]]:
-        temporaries: list[tuple[sp.Symbol, sp.Expr]] = []
-        values = [exprs[k] for k in chunk]
-        if cse and values:
-            temporaries, values = sp.cse(values, symbols=sp.numbered_symbols("w", real=True),
-                                         order="canonical")
-            temporaries, values = _inline_trivial(temporaries, values)
+        temporaries, values = kept.part(name, chunk, [exprs[k] for k in chunk], cse)
         parts.append(_Lowered(
             temporaries=[(str(t), _print(printer, v), _reads(v), count(v))
                          for t, v in temporaries],
             slots=list(chunk),
             outputs=[(_print(printer, v), _reads(v), count(v)) for v in values]))
-    del name
     return parts
 
 

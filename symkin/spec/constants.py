@@ -332,6 +332,30 @@ class _AnalysisPrinter(NumPyPrinter):  # type: ignore[misc]  # SymPy is untyped
     def _print_Mul(self, expr: sp.Expr) -> str:
         return "(" + "*".join([self._print(arg) for arg in expr.args]) + ")"
 
+    def _print_Piecewise(self, expr: sp.Expr) -> str:
+        """Python's conditional expression, which evaluates the piece whose condition holds:
+        NumPy's ``select`` evaluates every piece and costs microseconds even on scalars (a
+        cam profile's Phi_q holds a thousand of them; its sample's Newton took seconds). The
+        analyses call with scalars only (q[i], t, p[k]), for which both give the same value.
+        A constant piece and the NaN past the last condition are made NumPy doubles, so that
+        arithmetic on them keeps IEEE semantics (no ZeroDivisionError), as ``select``'s."""
+        double = self._module_format("numpy.float64")
+        text = f"{double}({self._print(sp.S.NaN)})"
+        for piece, condition in reversed(expr.args):
+            value = self._print(piece)
+            if not piece.free_symbols:
+                value = f"{double}({value})"
+            text = (value if condition is sp.true
+                    else f"(({value}) if ({self._condition(condition)}) else ({text}))")
+        return text
+
+    def _condition(self, condition: sp.Basic) -> str:
+        """A piece's condition as NumPy's printer writes it for ``select`` (an ITE in it
+        simplified first)."""
+        if condition.has(sp.ITE):
+            return str(self._print(sp.simplify_logic(condition)))
+        return str(self._print(condition))
+
 
 def lambdify_analysis(arguments: Any, expressions: Any, dummify: bool = False
                       ) -> Callable[..., Any]:

@@ -8,8 +8,9 @@ arithmetic, was the cost: 5-10 ms a row of a planar revolute, three quarters of 
 of a long chain. :class:`Differentiator` applies the same per-class rules SymPy would reach
 (``Add``, ``Mul``'s Leibniz rule and product rule, ``Pow``, a ``Function``'s ``fdiff``, a
 symbol), in the same order and with the same arithmetic, and differentiates a sub-expression
-met twice once. A node whose class brings a rule of its own (``Abs``, ``Piecewise``, ``Min``,
-an unevaluated ``Derivative``, ...) raises :class:`Unsupported`, and the caller differentiates
+met twice once; a ``Piecewise`` by its own rule (each piece, the conditions kept). A node whose
+class brings another rule of its own (``Abs``, ``Min``, an unevaluated ``Derivative``, ...)
+raises :class:`Unsupported`, and the caller differentiates
 the whole expression with ``sympy.diff``: it is never a different result, only a slower one.
 """
 
@@ -145,6 +146,11 @@ class Differentiator:
     def _atom(self, expr: sp.Expr) -> sp.Expr:
         return sp.S.One if expr == self.symbol else ZERO
 
+    def _piecewise(self, expr: sp.Expr) -> sp.Expr:
+        """``Piecewise._eval_derivative``: each piece differentiated, the conditions kept (a
+        cam profile's; ``sympy.diff`` built a ``Derivative`` at every node of its pieces)."""
+        return expr.func(*[(self.diff(piece), condition) for piece, condition in expr.args])
+
 
 class Directional(Differentiator):
     """The derivative along a direction, D x = sum_k (dx/dq_k) v_k with v constant: each
@@ -215,6 +221,7 @@ _RULES: dict[Callable[..., object], Callable[[Differentiator, sp.Expr], sp.Expr]
     sp.Pow._eval_derivative: Differentiator._power,
     Function._eval_derivative: Differentiator._function,
     AtomicExpr._eval_derivative: Differentiator._atom,
+    sp.Piecewise._eval_derivative: Differentiator._piecewise,
 }
 """The classes whose rule is SymPy's own, keyed by the method (a subclass that overrides it,
 such as Abs, is not found here)."""

@@ -22,7 +22,8 @@ f = sp.Function("f")
 # One or more of each branch: rationals (negative, fractions, 1), a product with a negative
 # coefficient and with a denominator (integer or not), sums all negative and starting with a
 # negative term, 1/x, E and exp, Min/Max (LatticeOp), functions, an undefined function, a
-# Derivative, Piecewise with relational conditions, Abs, a relational and a boolean on top.
+# Derivative, Piecewise with relational conditions, Abs, a relational and a boolean on top,
+# products of powers.
 BRANCHES = [
     sp.Rational(-3, 4), sp.S.One, sp.Integer(-2), sp.Float(-0.5), -x, -2 * x * y,
     x / 3, -x / 3, x / y, -x / (y + 1), (x + 1) / (2 * y), 2 / (x + y), -3 / x,
@@ -31,6 +32,9 @@ BRANCHES = [
     sp.Derivative(f(x), x), sp.Piecewise((x ** 2, x < 1), (-x, True)), sp.Abs(x - y),
     sp.Heaviside(x - 1), sp.sqrt(x ** 2 + y ** 2), sp.atan2(y, -x), x < y,
     sp.And(x < y, y < 1), sp.Eq(x, 2 * y),
+    # products whose factors are powers (numerators only, or not: the shortcut's edges)
+    x ** 2 * y, sp.sqrt(x) * y, -x ** 3 * sp.sin(y), x ** sp.Float(1.5) * y, x ** y * z,
+    x ** (-y) * z, x ** (2 * y) * z, 2 * x ** 2 * y / 3,
 ]
 
 FILES = ["examples/all_drivers.yaml", "examples/crank_slider_load.yaml", "examples/rssr.yaml"]

@@ -6,6 +6,8 @@ parenthesised form is printed by SymPy's printer instead."""
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -50,3 +52,20 @@ def test_a_symbol_named_like_a_renamed_argument_is_not_captured() -> None:
     function = substitution.lambdify_folded([q], [q + stray])
     with pytest.raises(NameError):
         function(2.0)
+
+
+def test_a_piecewise_evaluates_as_numpys_select_at_scalars() -> None:
+    """Each piece where its condition holds, NaN past the last condition, a constant piece a
+    NumPy double (1/0 is inf, not ZeroDivisionError): bit for bit what SymPy's NumPy printer's
+    ``select`` gives, with only the chosen piece evaluated."""
+    pieces = sp.Piecewise((x**2 * sp.sin(y), x < y), (2, x < 2 * y), (x / y, (x < 5) & (y > 0)))
+    entries = [3 * pieces + 1 / (pieces - 2), sp.Piecewise((sp.cos(x), x > 0), (0, True))]
+    ours = constants.lambdify_analysis([x, y], entries)
+    reference = constants.lambdify_floats([x, y], entries)
+    with np.errstate(all="ignore"):
+        for u in (-1.5, 0.25, 1.0, 1.5, 4.0, 7.0, float("nan")):
+            values = (np.float64(u), np.float64(1.0))
+            a = np.array(ours(*values), dtype=float)
+            b = np.array(reference(*values), dtype=float)
+            assert np.array_equal(a, b, equal_nan=True), (u, a, b)
+    assert "select" not in inspect.getsource(ours)

@@ -68,3 +68,21 @@ def test_a_node_with_a_rule_of_its_own_goes_to_sympy() -> None:
         pass
     else:
         raise AssertionError("Abs has a derivative rule of its own")
+
+
+def test_a_cam_profile_is_differentiated_by_its_piecewise_rule() -> None:
+    """A cam row's Piecewise profile (its pieces, its derivative in the roller's offset and a
+    square root of both, as examples/cam_cycloidal.yaml writes them): differentiated here,
+    piece by piece (no fallback to sympy.diff), and still the same expression, node for node,
+    to order two."""
+    s, phi, x, h, a = sp.symbols("s phi x h a", real=True)
+    lift = sp.Piecewise((h * (s / a - sp.sin(2 * sp.pi * s / a) / (2 * sp.pi)), s < a),
+                        (h, s < 2 * a), (0, True))
+    slope = sp.Piecewise((h / a * (1 - sp.cos(2 * sp.pi * s / a)), s < a), (0, True))
+    radius = 3 + lift
+    row = (x + sp.cos(phi) * (radius * sp.cos(s) - (radius * sp.cos(s) + slope * sp.sin(s))
+                              / (2 * sp.sqrt(radius**2 + slope**2))))
+    for symbol in (s, phi, x):
+        ours = Differentiator(symbol).diff(row)  # raises Unsupported on a missing rule
+        assert sp.srepr(ours) == sp.srepr(sp.diff(row, symbol)), symbol
+        assert sp.srepr(diff(row, symbol, 2)) == sp.srepr(sp.diff(row, symbol, 2)), symbol
