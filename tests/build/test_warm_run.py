@@ -205,7 +205,8 @@ def test_editing_a_template_misses(tmp_path: Path, snapshot: Path, kernels: Path
                         check_crank_slider(tmp_path / "b.npz"))
 
 
-def test_corrupt_index_entry_is_rebuilt(snapshot: Path, kernels: Path, tmp_path: Path) -> None:
+def test_corrupt_index_entry_is_rebuilt(snapshot: Path, kernels: Path,
+                                       tmp_path: Path) -> None:
     from symkin import backends
     from symkin.build import index as cache
 
