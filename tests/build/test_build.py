@@ -65,7 +65,7 @@ def test_key_covers_the_options(cache: Path) -> None:
 
 
 def _build_in_child(cache: str, barrier, queue) -> None:
-    barrier.wait()  # all eight start compiling at the same moment
+    barrier.wait()  # all start compiling at the same moment
     try:
         k = symkin.compile(system("crank_slider"), "c", cache_dir=cache)
         queue.put(("ok", k.phi(np.full(9, 0.5), 0.1).tolist()))
@@ -75,13 +75,15 @@ def _build_in_child(cache: str, barrier, queue) -> None:
 
 @pytest.mark.slow
 @needs_cc
-def test_eight_processes_building_the_same_kernel_all_succeed(tmp_path: Path) -> None:
+def test_three_processes_building_the_same_kernel_all_succeed(tmp_path: Path) -> None:
+    """Three processes released at one barrier build one kernel into one cache: two of them
+    lose the rename, as seven of eight did (each costs a C compile)."""
     system("crank_slider")  # derived once, inherited by the forked children
     context = multiprocessing.get_context("fork")
-    barrier, queue = context.Barrier(8), context.Queue()
+    barrier, queue = context.Barrier(3), context.Queue()
     cache = str(tmp_path / "shared")
     children = [context.Process(target=_build_in_child, args=(cache, barrier, queue))
-                for _ in range(8)]
+                for _ in range(3)]
     for child in children:
         child.start()
     results = [queue.get(timeout=120) for _ in children]

@@ -1,7 +1,9 @@
 """Warm `symkin run`: the kernel index (symkin/build/index.py) skips SymPy and never serves a stale or
 damaged kernel.
 
-Every run is a real `python -m symkin`-style subprocess with its own cache folder. A wrapper
+Every run is a real `python -m symkin`-style subprocess with its own cache folder (the tests
+about the index start from a copy of one cache with the textbook's C kernel built, so that
+their cold runs miss the index without compiling C again). A wrapper
 reports which heavy modules the process had loaded when it ended, so "no SymPy on a warm run"
 is checked on the process itself. The code runs from a snapshot of the package: the index is
 keyed on symkin's own source, so edits made elsewhere in the tree while the suite runs would
@@ -10,6 +12,7 @@ keyed on symkin's own source, so edits made elsewhere in the tree while the suit
 
 from __future__ import annotations
 
+import compileall
 import json
 import os
 import shutil
@@ -38,12 +41,32 @@ sys.exit(status)
 
 @pytest.fixture(scope="module")
 def snapshot(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A copy of the package and its templates, with the wrapper script next to them."""
+    """A copy of the package and its templates, with the wrapper script next to them, its
+    bytecode compiled once here (where PYTHONDONTWRITEBYTECODE is set, every run would
+    otherwise compile the whole package again)."""
     root = tmp_path_factory.mktemp("symkin-snapshot")
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc")
     shutil.copytree(ROOT / "symkin", root / "symkin", ignore=ignore)
     (root / "wrapper.py").write_text(WRAPPER)
+    assert compileall.compile_dir(root / "symkin", quiet=1)
     return root
+
+
+@pytest.fixture(scope="module")
+def kernels(snapshot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A kernel cache holding the textbook's C kernel, from one cold run of the snapshot."""
+    cache = tmp_path_factory.mktemp("kernels") / "cache"
+    run = symkin_run(snapshot, cache, TEXTBOOK, "-o", "seed.npz", cwd=cache.parent)
+    assert run.returncode == 0 and not run.hit, run.stderr
+    return cache
+
+
+def seeded(kernels: Path, folder: Path) -> Path:
+    """``folder`` as a cache that already holds the built kernels but no index: its first run
+    misses the index (derives, generates, and finds the kernel by its sources' hash) without
+    compiling C again. For the tests whose subject is the index, not the compile."""
+    shutil.copytree(kernels, folder, ignore=shutil.ignore_patterns("index"))
+    return folder
 
 
 class Run:
@@ -147,11 +170,11 @@ def test_warm_cam_run_writes_its_outputs_without_deriving_again(snapshot: Path,
     assert same_results(first, second)
 
 
-def test_editing_the_file_misses(snapshot: Path, tmp_path: Path) -> None:
+def test_editing_the_file_misses(snapshot: Path, kernels: Path, tmp_path: Path) -> None:
     mechanism = tmp_path / "mechanism.yaml"
     text = TEXTBOOK.read_text()
     mechanism.write_text(text)
-    cache = tmp_path / "cache"
+    cache = seeded(kernels, tmp_path / "cache")
     assert not symkin_run(snapshot, cache, mechanism, "-o", "a.npz", cwd=tmp_path).hit
     assert symkin_run(snapshot, cache, mechanism, "-o", "a.npz", cwd=tmp_path).hit
 
@@ -168,10 +191,10 @@ def test_editing_the_file_misses(snapshot: Path, tmp_path: Path) -> None:
     assert len(entries(cache)) == 3
 
 
-def test_editing_a_template_misses(tmp_path: Path, snapshot: Path) -> None:
+def test_editing_a_template_misses(tmp_path: Path, snapshot: Path, kernels: Path) -> None:
     own = tmp_path / "snapshot"
     shutil.copytree(snapshot, own)
-    cache = tmp_path / "cache"
+    cache = seeded(kernels, tmp_path / "cache")
     assert not symkin_run(own, cache, TEXTBOOK, "-o", "a.npz", cwd=tmp_path).hit
     assert symkin_run(own, cache, TEXTBOOK, "-o", "a.npz", cwd=tmp_path).hit
     with (own / "symkin" / "backends" / "numpy" / "templates" / "kernel.py.j2").open("a") as template:
@@ -182,11 +205,12 @@ def test_editing_a_template_misses(tmp_path: Path, snapshot: Path) -> None:
                         check_crank_slider(tmp_path / "b.npz"))
 
 
-def test_corrupt_index_entry_is_rebuilt(snapshot: Path, tmp_path: Path) -> None:
+def test_corrupt_index_entry_is_rebuilt(snapshot: Path, kernels: Path,
+                                       tmp_path: Path) -> None:
     from symkin import backends
     from symkin.build import index as cache
 
-    folder = tmp_path / "cache"
+    folder = seeded(kernels, tmp_path / "cache")
     symkin_run(snapshot, folder, TEXTBOOK, "-o", "a.npz", cwd=tmp_path)
     (entry,) = entries(folder)
     valid = entry.read_bytes()
@@ -209,8 +233,9 @@ def test_corrupt_index_entry_is_rebuilt(snapshot: Path, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("backend", ["numpy", "c"])
-def test_damaged_kernel_is_never_loaded(snapshot: Path, tmp_path: Path, backend: str) -> None:
-    cache = tmp_path / "cache"
+def test_damaged_kernel_is_never_loaded(snapshot: Path, kernels: Path, tmp_path: Path,
+                                       backend: str) -> None:
+    cache = seeded(kernels, tmp_path / "cache")
     symkin_run(snapshot, cache, TEXTBOOK, "--backend", backend, "-o", "a.npz", cwd=tmp_path)
     (entry,) = entries(cache)
     recorded = json.loads(entry.read_text())
@@ -289,8 +314,11 @@ def test_default_options_are_the_compilers() -> None:
     assert defaults["options"].default is None
 
 
-def test_concurrent_cold_runs_leave_one_good_entry(snapshot: Path, tmp_path: Path) -> None:
-    cache = tmp_path / "cache"
+def test_concurrent_cold_runs_leave_one_good_entry(snapshot: Path, kernels: Path,
+                                                   tmp_path: Path) -> None:
+    """Three runs miss the index at once and each records its entry: one good entry is left.
+    (Their kernel is already built: concurrent compiles are tests/build/test_build.py's.)"""
+    cache = seeded(kernels, tmp_path / "cache")
     env = {**os.environ, "PYTHONPATH": str(snapshot), "SYMKIN_CACHE_DIR": str(cache)}
     runs = [subprocess.Popen([sys.executable, str(snapshot / "wrapper.py"), "run", str(TEXTBOOK),
                               "-o", f"{k}.npz"], cwd=tmp_path, env=env, stdout=subprocess.PIPE,

@@ -78,14 +78,16 @@ def system() -> System:
 
 @pytest.fixture(scope="module")
 def functions(system: System):
-    values = {p: sp.Float(v, DIGITS) for p, v in zip(system.p, system.p_values)}
-    arguments = (system.q, system.dq, system.t)
+    # The parameters are an argument, given as the 40-digit values of their floats (what
+    # substituting sp.Float(v, 40) into the matrices gave, without walking them to do it).
+    values = [mpmath.mpf(v) for v in system.p_values]
+    arguments = (system.q, system.dq, system.t, system.p)
 
     def compile_(matrix: sp.MatrixBase):
         # cse: the printer walks each shared subexpression once (the 49 x 49 Phi_q lambdified
         # 4x faster); the same expressions, evaluated at 40 digits
-        return sp.lambdify(arguments, sp.Matrix(matrix).subs(values), modules="mpmath",
-                           cse=True)
+        function = sp.lambdify(arguments, sp.Matrix(matrix), modules="mpmath", cse=True)
+        return lambda q, dq, t: function(q, dq, t, values)
 
     return {name: compile_(getattr(system, name)) for name in ("phi", "phi_q", "phi_t", "gamma")}
 
@@ -154,11 +156,13 @@ def test_gamma_matches_second_difference_along_a_path(system: System, functions,
         _close(_column(functions["gamma"](q, dq, t)), estimate, "Gamma")
 
 
-def test_the_drawing_satisfies_every_joint(system: System) -> None:
+def test_the_drawing_satisfies_every_joint(system: System, functions) -> None:
     """At the drawn q0 (identity Euler parameters) every joint row is zero: the conversion
-    put each joint's points and axes where they were drawn."""
-    values = dict(zip(system.p, system.p_values))
-    q0 = dict(zip(system.q, system.q0))
-    for row, label in zip(system.phi, system.rows):
+    put each joint's points and axes where they were drawn (Phi at 40 digits; the joint rows
+    do not read t or dq)."""
+    with mpmath.workdps(DIGITS):
+        q0 = [mpmath.mpf(float(x)) for x in system.q0]
+        phi = _column(functions["phi"](q0, [mpmath.mpf(0)] * len(q0), mpmath.mpf(0)))
+    for value, label in zip(phi, system.rows, strict=True):
         if label.section == "joints" and label.type != "custom" and label.name != "given":
-            assert abs(float(row.subs(q0).subs(values))) < 1e-14, str(label)
+            assert abs(float(value)) < 1e-14, str(label)

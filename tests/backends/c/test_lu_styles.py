@@ -59,7 +59,12 @@ class Tongs:
         return a
 
 
-@pytest.fixture(scope="module", params=[5, 50], ids=["tongs5", "tongs50"])
+# 30 units (180 coordinates) is the smallest size at which every straight-line routine
+# (factor, forward, backward and both transposed) is split into parts, as at 50.
+SPLIT = 30
+
+
+@pytest.fixture(scope="module", params=[5, SPLIT], ids=["tongs5", f"tongs{SPLIT}"])
 def tongs(request, tmp_path_factory) -> Tongs:
     return Tongs(request.param, tmp_path_factory.mktemp(f"tongs{request.param}"))
 
@@ -70,6 +75,10 @@ def test_the_plan_has_fill_in_and_both_styles_are_what_they_say(tongs: Tongs) ->
         lu = lu_code.template_context(tongs.plan, style=style, constants=tongs.constants,
                                       prefix="tongs")
         assert lu["style"] == style
+        if style == "straight":
+            parts = {key: len(value) for key, value in lu.items() if key.endswith("_parts")}
+            assert len(parts) == 5
+            assert all(count >= 2 for count in parts.values()) == (tongs.n > 100), parts
 
 
 def test_solves_agree_to_1e_12(tongs: Tongs) -> None:
