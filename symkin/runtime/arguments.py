@@ -96,7 +96,10 @@ def parameter_values(kernel: KinematicsKernel,
     """Nominal parameter values, overridden by name (a mapping) or replaced (a sequence);
     always a new array, which the caller may keep."""
     if params is None:
-        return np.array(kernel.p_values, dtype=float)
+        nominal = kernel.p_values
+        if type(nominal) is np.ndarray and nominal.dtype is _FLOAT64:  # a kernel's own
+            return nominal.copy()
+        return np.array(nominal, dtype=float)
     # An array is the common case in a loop; the Mapping test (an ABC) is the costlier one.
     if not isinstance(params, np.ndarray) and isinstance(params, Mapping):
         values = np.array(kernel.p_values, dtype=float)
@@ -119,7 +122,9 @@ def parameter_values(kernel: KinematicsKernel,
 
 def first_guess(kernel: KinematicsKernel, q0: ArrayLike | None) -> Array:
     """The first guess at t[0]: the file's q0, or q0 checked (read, never written)."""
-    q = _floats(kernel.q0 if q0 is None else q0, "q0")
+    q = kernel.q0 if q0 is None else q0
+    if not (type(q) is np.ndarray and q.dtype is _FLOAT64):  # else as it is (_floats)
+        q = _floats(q, "q0")
     if q.shape != (len(kernel.coordinates),):
         raise SolveError(f"q0 has {q.size} values; the mechanism has "
                          f"{len(kernel.coordinates)} coordinates")

@@ -48,6 +48,7 @@ from symkin.runtime.outputs import ranges, redundant
 from symkin.runtime.outputs.results import Trajectory
 from symkin.runtime.protocol import GridSolver, KinematicsKernel
 from symkin.runtime.solving import call_plan, failures, units
+from symkin.runtime.solving import start as start_check
 from symkin.runtime.solving.assembly import assemble, flag_flips, genuine
 from symkin.runtime.solving.c_loop import _c_loop, _c_outcome, _c_run
 from symkin.runtime.solving.call_plan import Plan
@@ -59,7 +60,7 @@ from symkin.runtime.solving.run_outcome import SolveFailure as SolveFailure
 from symkin.runtime.solving.run_outcome import SolveInterrupted as SolveInterrupted
 from symkin.runtime.solving.run_outcome import _fail, refuse_reversed, rows_kept
 from symkin.runtime.solving.run_outcome import _trajectory as _trajectory
-from symkin.runtime.solving.start import cleared, factored_lever_arm, singular_start
+from symkin.runtime.solving.start import factored_lever_arm, singular_start, start_threshold
 
 Array = NDArray[np.float64]
 Progress = Callable[[int, int], None]
@@ -153,8 +154,13 @@ def solve(kernel: KinematicsKernel, t: ArrayLike | None = None, q0: ArrayLike | 
     if stop_at_singular:
         options = dataclasses.replace(options, stop_at_singular=True)
     try:
-        trajectory = _solved(kernel, plan, t, q0, params, options, progress, use_c_solver,
-                             out, (inputs, input_rates, input_accels), sensitivities)
+        if plan.has_inputs or inputs is not None or input_rates is not None \
+                or input_accels is not None:
+            trajectory = _solved(kernel, plan, t, q0, params, options, progress, use_c_solver,
+                                 out, (inputs, input_rates, input_accels), sensitivities)
+        else:  # the usual case, straight on (a loop of calls pays for every call made)
+            trajectory = _solve_in_unit(kernel, plan, t, q0, params, options, progress,
+                                        use_c_solver, out)
     except SolveFailure as failure:  # past a curve's range first: that is the cause to name
         if plan.after_rows:
             _stop_outside_range(kernel, failure.trajectory)
@@ -214,7 +220,7 @@ def _solve_in_unit(kernel: KinematicsKernel, plan: Plan, t: ArrayLike | None,
     p_bytes = p.tobytes()
     # The solver is taken first: started from q with p, it measures the unit's length scale
     # on its own arrays, and it runs the grid in the usual case, the kernel's own unit.
-    solver = kernel.grid_solver(options, q, p) if use_c_solver and kernel.has_grid_solver \
+    solver = kernel.grid_solver(options, q, p) if use_c_solver and plan.has_grid_solver \
         else None
     unit = plan.unit(kernel, q, times.item(0), p, p_bytes, solver)
     if unit == 1.0:
@@ -253,7 +259,14 @@ def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: 
                 run.forces_out = forces.allocate(kernel, times.size)
             solver.bind(run.t, run.q, run.dq, run.d2q, run.cond, run.flagged, run.forces_out)
             solved = _c_run(run, solver, progress)
-            if run.done and not _first_row_stands(kernel, run, p, options, planned):
+            # The usual first row, a clearly regular start of a mechanism without senses, is
+            # settled here by the solver's condition estimate and lever arm there with a few
+            # multiplications (clears); any other, by _first_row_stands.
+            if run.done and (plan.has_senses or not start_check.clears(
+                    run.cond.item(0), run.lever_arm, plan.start_threshold
+                    if options is plan.options
+                    else start_threshold(options, len(plan.coordinates)))) \
+                    and not _first_row_stands(kernel, run, p, options, planned):
                 # Plain Newton in C found Phi = 0 where the mechanism is not assembled as
                 # meant (a revolute's axes reversed): the damped assembly looks for the one
                 # meant, as without C, and the grid is run again from it.
@@ -288,19 +301,16 @@ def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: 
 
 def _first_row_stands(kernel: KinematicsKernel, run: _Run, p: Array, options: Options,
                       planned: tuple[Plan, float, bytes]) -> bool:
-    """Whether the first row the C grid loop solved stands. Raises SolveFailure where it is
-    a singular start (_check_start); False where it solves Phi = 0 but is no assembly
-    (assembly.genuine).
+    """Whether the first row the C grid loop solved stands, where _solve's test of the
+    solver's estimate did not clear it (or the mechanism has senses). Raises SolveFailure
+    where it is a singular start (_check_start); False where it solves Phi = 0 but is no
+    assembly (assembly.genuine).
 
-    The solver's own condition estimate and lever arm there settle the usual case, a clearly
-    regular start of a mechanism without senses, with a few multiplications
-    (runtime.solving.start.cleared). Else the verdict depends on the row to the bit, t0, the
-    parameters, the condition estimate, the unit and the options alone, and a row the plan
-    has judged before is not judged again."""
+    The verdict depends on the row to the bit, t0, the parameters, the condition estimate,
+    the unit and the options alone, and a row the plan has judged before is not judged
+    again."""
     plan, unit, p_bytes = planned
     estimate = run.cond.item(0)
-    if not plan.has_senses and cleared(kernel, options, estimate, run.lever_arm):
-        return True
     t0 = run.t.item(0)
     key = (unit, run.q[0].tobytes(), t0, p_bytes, estimate)
     if plan.judged_regular(key, options):

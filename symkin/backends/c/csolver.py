@@ -86,6 +86,7 @@ class GridSolver:
         self._q_bytes = q.size * np.dtype(self.dtype).itemsize
         self._p_bytes = p.size * np.dtype(self.dtype).itemsize
         self._set_options: tuple[Options, float] | None = None
+        self._double = self.dtype is np.float64  # outputs written in place (bind)
         self._pointers: tuple[Any, ...] | None = None  # of the run's arrays (bind)
         self._size = 0  # their time points
         # (float64 target, buffer of the real type) pairs, for a float kernel only.
@@ -113,8 +114,9 @@ class GridSolver:
     def release(self) -> None:
         """Forget the run's arrays and hand the solver back to its pool (if it has one)."""
         self._pointers = self._copies = None
-        if self.pool is not None:
-            self.pool.put(self)
+        pool = self.pool
+        if pool is not None and len(pool.idle) < pool.KEEP:  # SolverPool.put, written out
+            pool.idle.append(self)
 
     def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
              cond_out: Array, flagged_out: NDArray[np.bool_],
@@ -130,17 +132,11 @@ class GridSolver:
         if not (q_out.size == dq_out.size == d2q_out.size == size * self._n
                 and cond_out.size == flagged_out.size == size):
             raise ValueError(f"GridSolver.bind: arrays of {size} points x {self._n} expected")
-        outputs: tuple[NDArray[Any], ...] = (q_out, dq_out, d2q_out, cond_out)
-        # lam (T, N) and loads (T, NLOADS), written by the grid loop of a dynamics kernel
-        if self._dynamics and forces_out is not None:
-            outputs += forces_out
-        if self.dtype is np.float64:
-            self._copies = None
-            buffers = outputs
-        else:
-            buffers = tuple(np.empty(a.shape, dtype=self.dtype) for a in outputs)
-            self._copies = list(zip(outputs, buffers))
-            times = np.ascontiguousarray(times, dtype=self.dtype)
+        buffers: tuple[NDArray[Any], ...] = (q_out, dq_out, d2q_out, cond_out)
+        if self._dynamics or not self._double:
+            buffers = self._buffers(buffers, forces_out)
+            if not self._double:
+                times = np.ascontiguousarray(times, dtype=self.dtype)
         # cffi keeps each array alive for as long as its pointer lives.
         from_buffer, real = self._ffi.from_buffer, self._real_array
         self._size = size
@@ -154,6 +150,19 @@ class GridSolver:
                 (from_buffer(real, b) if b.size else self._ffi.NULL, b.shape[1])
                 for b in buffers[4:6]) or ((self._ffi.NULL, 0), (self._ffi.NULL, 0))
 
+    def _buffers(self, outputs: tuple[NDArray[Any], ...],
+                 forces_out: tuple[Array, Array] | None) -> tuple[NDArray[Any], ...]:
+        """What the C writes for ``outputs`` (with lam (T, N) and loads (T, NLOADS) of a
+        dynamics kernel): the arrays themselves for a double kernel, else buffers of its
+        real type copied over after each call (``_copies``)."""
+        if self._dynamics and forces_out is not None:
+            outputs += forces_out
+        if self._double:
+            return outputs
+        buffers = tuple(np.empty(a.shape, dtype=self.dtype) for a in outputs)
+        self._copies = list(zip(outputs, buffers))
+        return buffers
+
     def advance(self, start: int, stop: int) -> int:
         """Solve the bound grid's points start..stop-1 (after those already solved, which
         the state continues from); returns how many were solved. :meth:`status` and
@@ -165,11 +174,15 @@ class GridSolver:
             rows = start * self._n
             t, q, dq, d2q = t + start, q + rows, dq + rows, d2q + rows
             cond, flagged = cond + start, flagged + start
-        forces = tuple(pointer + start * width if start and width else pointer
-                       for pointer, width in self._forces) if self._forces else ()
-        solved: int = self._solve_grid(self._options, self._p, stop - start, t, self._state,
-                                       q, dq, d2q, cond, flagged, *forces, self._work,
-                                       self._report)
+        if self._forces:  # inverse dynamics: lam_out and loads_out too
+            forces = tuple(pointer + start * width if start and width else pointer
+                           for pointer, width in self._forces)
+            solved: int = self._solve_grid(self._options, self._p, stop - start, t,
+                                           self._state, q, dq, d2q, cond, flagged, *forces,
+                                           self._work, self._report)
+        else:  # a call without a star: the arguments are not gathered into a tuple first
+            solved = self._solve_grid(self._options, self._p, stop - start, t, self._state,
+                                      q, dq, d2q, cond, flagged, self._work, self._report)
         if self._copies is not None:
             for target, source in self._copies:
                 target[start:start + solved] = source[start:start + solved]
@@ -239,11 +252,14 @@ class SolverPool:
 
     def __init__(self, ffi: Any, lib: Any, name: str, real: str) -> None:
         self._arguments = (ffi, lib, name, real)
-        self._idle: list[GridSolver] = []
+        self.idle: list[GridSolver] = []
+
+    KEEP = 8
+    """Idle solvers kept at most."""
 
     def take(self, options: Options, q: Array, p: Array, unit: float = 1.0) -> GridSolver:
         try:
-            solver = self._idle.pop()  # atomic under the GIL
+            solver = self.idle.pop()  # atomic under the GIL
         except IndexError:
             solver = GridSolver(*self._arguments, options, q, p, unit)
             solver.pool = self
@@ -251,5 +267,5 @@ class SolverPool:
         return solver.start(options, q, p, unit)
 
     def put(self, solver: GridSolver) -> None:
-        if len(self._idle) < 8:
-            self._idle.append(solver)
+        if len(self.idle) < self.KEEP:
+            self.idle.append(solver)

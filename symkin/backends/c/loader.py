@@ -63,11 +63,12 @@ class CKernel(Kernel):
         1, one that cannot honour it)."""
         if unit != 1.0 and not self.scale_free:
             return None
-        if self._solvers is None:
+        solvers = self._solvers
+        if solvers is None:
             if not self.has_grid_solver:
                 return None
-            self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
-        return self._solvers.take(options, q, p, unit)
+            solvers = self._solvers = SolverPool(self.ffi, self.lib, self.name, self.real)
+        return solvers.take(options, q, p, unit)
 
     def multipliers_grid(self, t: Array, q: Array, dq: Array, d2q: Array,
                          p: Array) -> tuple[Array, Array]:

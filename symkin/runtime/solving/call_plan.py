@@ -48,8 +48,10 @@ class Plan:
         after_rows: ranges, removed rows or senses: the checks after the loop apply.
         has_dynamics: efforts and reactions are computed for a run's rows.
         has_senses: a first row may solve Phi = 0 and be no assembly (solving.assembly).
+        has_grid_solver: the kernel's generated code runs whole grids (the C solver).
         coordinates, points, space, point_size: what every Trajectory carries.
         options: the Newton options of the kernel's real type (symkin.solve's default).
+        start_threshold: start.start_threshold under those options for this kernel's size.
     """
 
     moves_under_forces: bool
@@ -57,11 +59,13 @@ class Plan:
     after_rows: bool
     has_dynamics: bool
     has_senses: bool
+    has_grid_solver: bool
     coordinates: tuple[str, ...]
     points: tuple[tuple[str, str], ...]
     space: str
     point_size: int
     options: Options
+    start_threshold: float
     # The named points' local vectors by the parameters' bytes (read-only: copied per run).
     _point_vectors: dict[bytes, Array] = field(default_factory=dict)
     # The length unit to solve in (runtime.solving.units) by (q0's bytes, t0, p's bytes).
@@ -125,6 +129,8 @@ def of(kernel: KinematicsKernel) -> Plan:
 
 def _make(kernel: KinematicsKernel) -> Plan:
     space = str(getattr(kernel, "space", "2d"))
+    coordinates = tuple(getattr(kernel, "coordinates", ()))
+    options = newton_defaults(getattr(kernel, "real", "double"))
     return Plan(
         moves_under_forces=bool(getattr(kernel, "moves_under_forces", False)),
         has_inputs=bool(getattr(kernel, "input_names", ())),
@@ -132,9 +138,11 @@ def _make(kernel: KinematicsKernel) -> Plan:
                         or getattr(kernel, "senses", ())),
         has_dynamics=bool(getattr(kernel, "has_dynamics", False)),
         has_senses=bool(getattr(kernel, "senses", ())),
-        coordinates=tuple(getattr(kernel, "coordinates", ())),
+        has_grid_solver=bool(getattr(kernel, "has_grid_solver", False)),
+        coordinates=coordinates,
         points=tuple(getattr(kernel, "points", ())),
         space=space,
         point_size=3 if space == "3d" else 2,
-        options=newton_defaults(getattr(kernel, "real", "double")),
+        options=options,
+        start_threshold=start.start_threshold(options, len(coordinates)),
     )

@@ -301,11 +301,17 @@ def cleared(kernel: KinematicsKernel, options: Options, estimate: float,
     """Whether a solver's condition ``estimate`` of Phi_q at a start and the length scale
     ``scale`` there (raw or as lever_arm gives it; None: not known) show the start clearly
     regular (clearly_regular): singular_start's first test, which needs nothing else."""
-    if scale is None or not math.isfinite(estimate):
+    return clears(estimate, scale, start_threshold(options, len(kernel.coordinates)))
+
+
+def clears(estimate: float, scale: float | None, threshold: float) -> bool:
+    """cleared with the start's threshold already worked out (a loop of solves keeps it in
+    its call plan): from_raw and clearly_regular written out, one function call in all."""
+    if scale is None or not math.isfinite(scale):  # from_raw's NaN: not cleared
         return False
-    arm = from_raw(scale)
-    return math.isfinite(arm) and clearly_regular(
-        estimate, arm, start_threshold(options, len(kernel.coordinates)))
+    arm = scale if scale > 0 else 1.0
+    bound = estimate * (arm if arm >= 1.0 else 1.0 / arm) ** 2  # max(arm, 1 / arm) ** 2
+    return math.isfinite(bound) and bound * SAFETY <= threshold
 
 
 def singular_start(kernel: KinematicsKernel, q: Array, t: float, p: Array, options: Options,
