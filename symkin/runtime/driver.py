@@ -262,10 +262,10 @@ def _solve(kernel: KinematicsKernel, times: Array, q: Array, p: Array, options: 
             # The usual first row, a clearly regular start of a mechanism without senses, is
             # settled here by the solver's condition estimate and lever arm there with a few
             # multiplications (clears); any other, by _first_row_stands.
+            threshold = plan.start_threshold if options is plan.options \
+                else start_threshold(options, len(plan.coordinates))
             if run.done and (plan.has_senses or not start_check.clears(
-                    run.cond.item(0), run.lever_arm, plan.start_threshold
-                    if options is plan.options
-                    else start_threshold(options, len(plan.coordinates)))) \
+                    run.cond.item(0), run.lever_arm, threshold)) \
                     and not _first_row_stands(kernel, run, p, options, planned):
                 # Plain Newton in C found Phi = 0 where the mechanism is not assembled as
                 # meant (a revolute's axes reversed): the damped assembly looks for the one

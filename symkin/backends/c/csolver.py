@@ -114,8 +114,8 @@ class GridSolver:
     def release(self) -> None:
         """Forget the run's arrays and hand the solver back to its pool (if it has one)."""
         self._pointers = self._copies = None
-        pool = self.pool
-        if pool is not None and len(pool.idle) < pool.KEEP:  # SolverPool.put, written out
+        pool = self.pool  # the pool's own bookkeeping, here: one call less per solve
+        if pool is not None and len(pool.idle) < pool.KEEP:
             pool.idle.append(self)
 
     def bind(self, times: Array, q_out: Array, dq_out: Array, d2q_out: Array,
@@ -265,7 +265,3 @@ class SolverPool:
             solver.pool = self
             return solver
         return solver.start(options, q, p, unit)
-
-    def put(self, solver: GridSolver) -> None:
-        if len(self.idle) < self.KEEP:
-            self.idle.append(solver)
