@@ -25,7 +25,13 @@ from symkin.contract.manifest import manifest_name
 # Plain -O2: -ffast-math would break the NaN checks of the solver and reorder sums, and
 # -march=native would make a cached binary non-portable.
 C_FLAGS = ("-std=c99", "-O2", "-fPIC")
-WRAPPER_FLAGS = ("-O2", "-fPIC")
+# The cffi wrapper is glue (argument conversion through cffi's backend, one Python-callable
+# and one direct entry point per declared function), and the largest file of a small kernel's
+# build (143 kB for the crank-slider): at -O2 it took more than half of that build's gcc time
+# (0.8 of 1.4 s), at -O0 0.25 s. Only one of its functions runs per symkin.solve call
+# (callgrind: 269 instructions at -O0 against 201 at -O2, of about 180,000 a call); the
+# generated solver, kernel and LU that it calls keep C_FLAGS and the per-file flags below.
+WRAPPER_FLAGS = ("-O0", "-fPIC")
 # Per file: the straight-line sparse LU gains nothing from GCC's SLP vectoriser (scattered
 # slots), which took most of GCC's time and memory on large mechanisms (at 1001 bodies 46 s
 # and 2.3 GB for that file alone; without it 30 s and 0.4 GB).

@@ -1,6 +1,7 @@
-"""The flags that only save compile time on large mechanisms change no result: the kernel's
-(no dead-store elimination) give the same machine code, and a large sparse LU file at -O1
-gives the same numbers to the bit as at -O2."""
+"""The flags that only save compile time change no result: the kernel's (no dead-store
+elimination) give the same machine code, a large sparse LU file at -O1 gives the same numbers
+to the bit as at -O2, and the cffi wrapper (glue) is built without optimisation while every
+generated file keeps its own level."""
 
 from __future__ import annotations
 
@@ -57,4 +58,34 @@ def test_a_large_sparse_lu_at_o1_gives_the_same_numbers(tmp_path: Path,
     large = symkin.solve(symkin.compile(system, backend="c", cache_dir=tmp_path / "b"), t=t)
     assert seen and "-O1" in seen[0] and seen[0].index("-O1") > seen[0].index("-O2")
     for a, b in ((default.q, large.q), (default.dq, large.dq), (default.d2q, large.d2q)):
+        assert np.array_equal(a, b)
+
+
+def test_only_the_wrapper_is_built_without_optimisation(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch
+                                                        ) -> None:
+    system = symkin.derive(ROOT / "examples" / "crank_slider.yaml")
+    t = np.linspace(0.0, 1.5, 31)
+    levels: dict[str, str] = {}
+    compile_unit = cffi_build._object
+
+    def record(compiler: list[str], flags: list[str], source: Path) -> Path:
+        levels[source.name] = [flag for flag in flags if flag.startswith("-O")][-1]
+        return compile_unit(compiler, flags, source)
+
+    monkeypatch.setattr(cffi_build, "_object", record)
+    glue = symkin.solve(symkin.compile(system, backend="c", cache_dir=tmp_path / "a"), t=t)
+    wrapper = [name for name in levels if name.startswith("_symkin_crank_slider_")]
+    assert len(wrapper) == 1 and levels.pop(wrapper[0]) == "-O0"
+    # the solver's step and the LU run at -O2 (the kernel at -O1: the same instructions)
+    assert levels == {"crank_slider.c": "-O1", "crank_slider_solver.c": "-O2",
+                      "crank_slider_sparse_lu.c": "-O2", "crank_slider_dense_lu.c": "-O2"}
+    monkeypatch.setattr(cffi_build, "WRAPPER_FLAGS", ("-O2", "-fPIC"))
+    optimised = symkin.solve(symkin.compile(system, backend="c", cache_dir=tmp_path / "b"),
+                             t=t)
+    # a module of its own: the cache key covers the wrapper's flags
+    assert [levels[name] for name in levels if name.startswith("_symkin_crank_slider_")
+            and name != wrapper[0]] == ["-O2"]
+    for a, b in ((glue.q, optimised.q), (glue.dq, optimised.dq), (glue.d2q, optimised.d2q),
+                 (glue.cond, optimised.cond)):
         assert np.array_equal(a, b)
