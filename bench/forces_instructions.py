@@ -82,16 +82,24 @@ def _total(program: Path, steps: int, kind: str) -> int:
     return int(found.group(1))
 
 
-def per_step(name: str) -> tuple[int, float, float]:
-    """(NQ, kinematic, with forces) instructions per step of the mechanism ``name``."""
+def per_step(name: str, system: Any = None, files: dict[str, str] | None = None
+             ) -> tuple[int, float, float]:
+    """(NQ, kinematic, with forces) instructions per step of the mechanism ``name``; its
+    System and C files (what symkin.generate writes) when the caller has them already."""
     import symkin
     from symkin.spec import validate as model
 
-    system = symkin.derive(model.from_dict(mechanism(name)))
+    if system is None:
+        system = symkin.derive(model.from_dict(mechanism(name)))
     t0, t1, _ = system.time_grid
     with tempfile.TemporaryDirectory() as folder:
         build = Path(folder)
-        symkin.generate(system, backend="c", out_dir=build / "c")
+        if files is None:
+            symkin.generate(system, backend="c", out_dir=build / "c")
+        else:
+            (build / "c").mkdir()
+            for file_name, text in files.items():
+                (build / "c" / file_name).write_text(text, encoding="utf-8")
         prefix = system.name
         (build / "main.c").write_text(
             MAIN.replace("@P@", prefix).replace("@U@", prefix.upper())

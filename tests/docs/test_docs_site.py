@@ -4,6 +4,7 @@ render in headless Chromium without console errors, and a new pair type document
 from __future__ import annotations
 
 import html as entities
+import json
 import re
 from html.parser import HTMLParser
 from pathlib import Path
@@ -86,15 +87,66 @@ PAGES = ["index.html", "getting-started.html", "guides/design.html",
          "search.html"]
 
 
-@pytest.mark.parametrize("name", PAGES)
-def test_page_renders_without_console_errors(site, name: str) -> None:
+PLANTED = "<html><body><script>console.error('planted');undefinedCall();</script></body></html>"
+HARNESS = """<html><body>{frames}<script>
+window.addEventListener("load", () => {{
+  const seen = {{}};
+  for (const frame of document.querySelectorAll("iframe")) {{
+    const page = frame.contentDocument;
+    seen[frame.src] = page !== null && page.readyState === "complete"
+                      && page.querySelector(".body") !== null;
+  }}
+  const out = document.createElement("pre");
+  out.id = "laid-out";
+  out.textContent = JSON.stringify(seen);
+  document.body.appendChild(out);
+}});
+</script></body></html>"""
+
+
+@pytest.fixture(scope="module")
+def browsed(site, tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, bool], list[str]]:
+    """Every page of PAGES loaded in one headless Chromium (a launch costs a CPU-second): a
+    page of frames holds each at the window's size, and a page that logs an error beside them
+    (PLANTED), so that an error in a frame is seen to reach the console lines. Chromium lets
+    file pages read each other only with --allow-file-access-from-files: the frames' DOM is
+    then read by the holding page, which writes whether the theme laid each out. Returns
+    {page URL: laid out} and the console lines."""
     from tests.present.test_present import _browse, _console_lines
 
     _, _, html = site
-    loaded = _browse(html / name, "--dump-dom")
+    folder = tmp_path_factory.mktemp("browsed")
+    (folder / "planted.html").write_text(PLANTED, encoding="utf-8")
+    urls = [(html / name).as_uri() for name in PAGES] + [(folder / "planted.html").as_uri()]
+    frames = "".join(f'<iframe src="{url}" width="1400" height="900"></iframe>' for url in urls)
+    holder = folder / "pages.html"
+    holder.write_text(HARNESS.format(frames=frames), encoding="utf-8")
+    loaded = _browse(holder, "--allow-file-access-from-files", "--dump-dom")
     assert loaded.returncode == 0, loaded.stderr
-    assert _console_lines(loaded.stderr) == [], loaded.stderr
-    assert 'class="body"' in loaded.stdout  # the theme laid the page out
+    found = re.search(r'<pre id="laid-out">(.*?)</pre>', loaded.stdout, re.S)
+    assert found is not None, loaded.stdout[-2000:]
+    return json.loads(entities.unescape(found.group(1))), _console_lines(loaded.stderr)
+
+
+def test_an_error_in_a_browsed_page_is_seen(browsed) -> None:
+    """The checks below can fail: the planted page's error reaches the console lines, and the
+    planted page, which the theme did not lay out, is not taken for laid out."""
+    laid_out, lines = browsed
+    assert any("planted" in line and "planted.html" in line for line in lines), lines
+    assert [done for url, done in laid_out.items() if url.endswith("/planted.html")] == [False]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_page_renders_without_console_errors(site, browsed, name: str) -> None:
+    _, _, html = site
+    laid_out, lines = browsed
+    url = (html / name).as_uri()
+    assert laid_out[url]  # the theme laid the page out
+    # a line from this page, or from none of the pages (a shared script, the browser), fails
+    pages = [(html / other).as_uri() for other in PAGES if other != name]
+    own = [line for line in lines if "planted.html" not in line
+           and not any(f"source: {other}" in line for other in pages)]
+    assert own == [], lines
 
 
 def test_gallery_shows_each_example_with_its_command(site) -> None:

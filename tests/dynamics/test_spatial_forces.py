@@ -9,7 +9,10 @@ symkin's derivation (Euler parameters, the kinetic energy and Lagrange's equatio
 - the Stewart platform at rest under its weight: leg forces f = J^-T w, J from the legs'
   directions;
 - the power balance (effort power + applied power = dT/dt).
-Both backends; the C runs compiled code.
+Both backends; the C runs compiled code. The slider-crank is the file
+bench/spatial_slider_crank_forces.yaml (checked here to be the example with this module's
+masses and loads), so that this module, the 3D report's tests and the forces' instruction
+budget derive and generate it once per run.
 """
 
 from __future__ import annotations
@@ -19,12 +22,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from motion_support import kernel as shared_kernel
 from motion_support import kernel_from
 
 import symkin
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
+FORCES = ROOT / "bench" / "spatial_slider_crank_forces.yaml"
 BACKENDS = ("c", "numpy")
 G = np.array([0.0, 0.0, -9.81])
 
@@ -77,12 +82,15 @@ class Body:
 
 ROTOR = {
     "name": "rotor", "space": "3d", "layout": "drawn",
-    "parameters": {"a": 0.3, "h": 0.2, "m": 2.0, "w": 3.0, "P": 0.02},
+    "parameters": {"a": 0.3, "h": 0.2, "m": 2.0, "w": 3.0, "P": 0.02, "beta": 0.0},
     "bodies": {"arm": {"points": {"O": [0, 0, 0], "C": ["a", 0, "h"]}, "mass": "m",
                        "inertia": [[0.1, 0, "P"], [0, 0.2, 0], ["P", 0, 0.15]], "com": "C"}},
     "joints": [{"type": "revolute", "name": "shaft", "i": "ground", "j": "arm", "at": "O",
                 "axis": [0, 0, 1]}],
-    "drivers": [{"type": "angle", "name": "motor", "joint": "shaft", "theta": "w*t"}],
+    # θ = ωt + ½βt²: turning at a constant ω (β = 0, the file's), or speeding up (ω = 0); one
+    # kernel for both, the parameters given at run time
+    "drivers": [{"type": "angle", "name": "motor", "joint": "shaft",
+                 "theta": "w*t + beta*t**2/2"}],
     "forces": [{"type": "gravity", "g": [0, 0, -9.81]}],
     "time": {"t0": 0, "t1": 2, "dt": 0.05},
 }
@@ -110,9 +118,11 @@ def test_rotor_bearing_loads_in_closed_form(backend: str) -> None:
 
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_rotor_speeding_up_needs_the_torque_about_the_axis(backend: str) -> None:
-    """θ = ½ β t²: the motor's torque about z on the arm is (J_zz + m a²) β."""
-    data = {**ROTOR, "drivers": [{**ROTOR["drivers"][0], "theta": "t**2"}]}
-    traj = _solve(data, backend)
+    """θ = ½ β t² (ω = 0, β = 2: θ = t²): the motor's torque about z on the arm is
+    (J_zz + m a²) β."""
+    traj = symkin.solve(kernel_from(ROTOR, backend), params={"w": 0.0, "beta": 2.0})
+    e3 = traj.q[:, traj.coordinates.index("arm.e3")]
+    np.testing.assert_allclose(e3, np.sin(traj.t**2 / 2), atol=1e-12)  # it turned by t²
     np.testing.assert_allclose(traj.effort[:, 0], (0.15 + 2.0 * 0.3**2) * 2.0, atol=1e-9)
 
 
@@ -149,8 +159,19 @@ def _slider_crank() -> dict:
         {"type": "spring", "name": "s1", "i": "rod", "A": ORIGIN["rod"].tolist(),
          "j": "ground", "B": SPRING_END.tolist(), "k": 300, "length0": 0.1, "damping": 4},
     ]
-    data["time"] = {"t0": 0, "t1": 1, "dt": 0.02}
     return data
+
+
+def test_the_bench_file_is_this_slider_crank() -> None:
+    """bench/spatial_slider_crank_forces.yaml is the example with the masses, tensors,
+    centres and loads written above, but for its name and time step."""
+    bench = yaml.safe_load(FORCES.read_text(encoding="utf-8"))
+    assert {**_slider_crank(), "name": bench["name"], "time": bench["time"]} == bench
+
+
+def _solved_slider_crank(backend: str):
+    """The bench file (above) on 51 points of its second (its own file's grid has 101)."""
+    return symkin.solve(shared_kernel(FORCES, backend), t=np.linspace(0.0, 1.0, 51))
 
 
 def _external(traj, bodies):
@@ -185,7 +206,7 @@ def _external(traj, bodies):
 
 @pytest.mark.parametrize("backend", BACKENDS)
 def test_slider_crank_newton_euler_per_body(backend: str) -> None:
-    traj = _solve(_slider_crank(), backend)
+    traj = _solved_slider_crank(backend)
     assert traj.forces.joint_names == tuple(JOINTS)
     assert traj.forces.driver_names == ("driver0",)
     bodies = {name: Body(traj, name) for name in MASS}
@@ -217,7 +238,7 @@ def test_slider_crank_newton_euler_per_body(backend: str) -> None:
 def test_slider_crank_power_balance(backend: str) -> None:
     """Effort power (torque x 2π rad/s) + applied power = dT/dt, with
     dT/dt = Σ m v_c·a_c + ω·(J alpha) (the J-rate term vanishes: ωᵀ J̇ ω = 0)."""
-    traj = _solve(_slider_crank(), backend)
+    traj = _solved_slider_crank(backend)
     bodies = {name: Body(traj, name) for name in MASS}
     _, applied = _external(traj, bodies)
     rate = np.zeros(traj.t.size)

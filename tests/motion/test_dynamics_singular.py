@@ -23,8 +23,9 @@ from typing import Any
 import numpy as np
 import pytest
 from cli_support import Ran, symkin_main
+from motion_support import kernel
 from scipy.integrate import solve_ivp
-from test_iftomm_benchmarks import _bench_script
+from test_iftomm_benchmarks import _bench_script, a02_chain
 
 import symkin
 
@@ -73,9 +74,10 @@ def _check_follows(run: Any) -> None:
 
 
 @pytest.fixture(scope="module")
-def default_run(tmp_path_factory: pytest.TempPathFactory) -> Any:
-    path = _chain(tmp_path_factory.mktemp("a02_default"), 7.0)
-    return symkin.solve(symkin.compile(symkin.derive(path), backend="numpy"))
+def default_run() -> Any:
+    """The chain at the file's (default) tolerances on its grid of 0.01 s, to t = 7: the
+    kernel of test_iftomm_benchmarks.py's A02 tests (the run's one derivation of the chain)."""
+    return symkin.solve(kernel(a02_chain(), "numpy"), t=np.linspace(0.0, 7.0, 701))
 
 
 def test_default_tolerances_pass_seven_passages_on_the_cranks_equation(default_run: Any) -> None:

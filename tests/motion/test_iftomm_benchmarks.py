@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import pytest
 from codegen_support import derived
+from motion_support import kernel, shared
 from scipy.integrate import solve_ivp
 
 import symkin
@@ -63,11 +64,15 @@ def _cranks_theta(t: np.ndarray) -> np.ndarray:
     return np.asarray(solution.y[0])
 
 
+def a02_chain() -> Path:
+    """The script's N = 2 chain, a file of the run's (motion_support.shared): this module and
+    test_dynamics_singular.py derive it and build its NumPy kernel once."""
+    return shared("a02_chain.yaml", _bench_script("a02_n_four_bar").mechanism(N))
+
+
 @pytest.fixture(scope="module")
-def a02(tmp_path_factory: pytest.TempPathFactory) -> Any:
-    path = tmp_path_factory.mktemp("a02") / "a02.yaml"
-    path.write_text(_bench_script("a02_n_four_bar").mechanism(N), encoding="utf-8")
-    return symkin.derive(path)
+def a02() -> Any:
+    return derived(a02_chain())
 
 
 def test_a02_file_is_the_scripts() -> None:
@@ -75,9 +80,8 @@ def test_a02_file_is_the_scripts() -> None:
     assert text == _bench_script("a02_n_four_bar").mechanism(10)
 
 
-def test_a02_numpy_follows_the_cranks_equation_through_the_horizontal(a02: Any) -> None:
-    trajectory = symkin.solve(symkin.compile(a02, backend="numpy"),
-                              t=np.linspace(0.0, 1.0, 101))
+def test_a02_numpy_follows_the_cranks_equation_through_the_horizontal() -> None:
+    trajectory = symkin.solve(kernel(a02_chain(), "numpy"), t=np.linspace(0.0, 1.0, 101))
     theta = _cranks_theta(trajectory.t)
     assert theta.min() < -0.5  # the horizontal (theta = 0) was passed
     cranks = [trajectory.coordinates.index(f"crank{k}.phi") for k in range(N + 1)]

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from cli_support import symkin_main
 from codegen_support import compiled, derived
+from motion_support import kernel
 
 from symkin.present import view3d
 from tests.present.test_view3d import RSSR, _figure, _numbers
@@ -53,12 +54,13 @@ def forces_run(tmp_path_factory, forces_cache) -> tuple[Path, Path, Path]:
 
 @pytest.fixture(scope="module")
 def solved(forces_run) -> tuple[Any, Any]:
-    """The file's System and its NumPy trajectory at the CLI run's time points (the API)."""
+    """The file's System and its NumPy trajectory at the CLI run's time points (the API):
+    derived and generated once per run (tests/dynamics/test_spatial_forces.py solves the same
+    file)."""
     import symkin
 
-    system = derived(FORCES)  # once per run
-    kernel = symkin.compile(system, backend="numpy")
-    return system, symkin.solve(kernel, t=np.load(forces_run[0])["t"])
+    system = derived(FORCES)
+    return system, symkin.solve(kernel(FORCES, "numpy"), t=np.load(forces_run[0])["t"])
 
 
 def _tails_and_heads(frame: dict, first: int, count: int = 4) -> tuple[np.ndarray, np.ndarray]:
