@@ -25,6 +25,17 @@ def crank_slider_system(crank_slider_path: Path):
     return symkin.derive(crank_slider_path)
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    """One BLAS thread per test process (unless the caller chose otherwise): pytest-xdist
+    already runs a process per core, and OpenBLAS's own threads, woken for every small LAPACK
+    call of the NumPy driver (a 9 x 9 getrs), spin for CPU the other workers need — 1.5 ms of
+    CPU per call against 3 us with one thread, measured on 2 loaded cores. Set before any test
+    module imports NumPy, so this process, the xdist workers it starts and the subprocesses of
+    the tests all inherit it."""
+    for variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
+        os.environ.setdefault(variable, "1")
+
+
 def pytest_sessionstart(session: pytest.Session) -> None:
     """Under CI, a tool it installed (SYMKIN_REQUIRE_TOOLS) must be found: the tests that need
     it would otherwise skip, and a C test that skips proves nothing."""

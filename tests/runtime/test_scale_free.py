@@ -10,11 +10,13 @@ flagged.
 from __future__ import annotations
 
 import math
-from pathlib import Path
+import re
+from typing import Any
 
 import numpy as np
 import pytest
-from driver_support import BACKENDS, kernel_of
+from codegen_support import derived, sources
+from driver_support import BACKENDS, kernel_of, mechanism_file
 
 import symkin
 from symkin.errors import SolveError
@@ -58,8 +60,94 @@ time: {{t0: 0, t1: 2.5, dt: 0.05}}
 """
 
 
-def _kernel(tmp_path: Path, text: str, backend: str):
-    return kernel_of(text, backend)  # one derivation of each drawing for both backends
+PARALLELOGRAM = """
+name: parallelogram_scaled
+parameters: {{L: {L!r}}}
+bodies:
+  r0: {{q0: [0, 0, 0.5], points: {{tip: [L, 0]}}}}
+  r1: {{q0: [L, 0, 0.5], points: {{tip: [L, 0]}}}}
+  c0: {{q0: [0.88*L, 0.48*L, 0]}}
+joints:
+  - {{type: revolute, name: O0, i: ground, j: r0, sA: [0, 0], sB: [0, 0]}}
+  - {{type: revolute, name: O1, i: ground, j: r1, sA: [L, 0], sB: [0, 0]}}
+  - {{type: revolute, name: A0, i: r0, j: c0, sA: tip, sB: [0, 0]}}
+  - {{type: revolute, name: B0, i: c0, j: r1, sA: [L, 0], sB: tip}}
+drivers:
+  - {{type: angle, name: drive, i: r0, j: ground, theta: "0.5 - t"}}
+time: {{t0: 0, t1: 1, dt: 0.05}}
+"""
+
+
+# Every parameter of the three drawings is a length; the drawing at scale s is the one at
+# scale 1 with every parameter and every position of q0 times s (the angles unchanged).
+UNIT = {CRANK_SLIDER: {"a": 1.0, "b": 5.0, "c": 4.0},
+        NON_GRASHOF: {"a": 2.0, "d": 3.0, "x2": 2.0, "x3": 3.0},
+        PARALLELOGRAM: {"L": 1.0}}
+# The drawings whose C at every scale differs from the C at scale 1 in its nominal values
+# only. Not the four-bars: their sparse LU's pivot order, chosen at generation time from the
+# numbers of the sample configuration, changes with the scale (so each scale of theirs is
+# built from its own file).
+SAME_C = (CRANK_SLIDER,)
+
+
+def _drawn(template: str, s: float) -> str:
+    return template.format(**{name: s * value for name, value in UNIT[template].items()})
+
+
+def _in_c(template: str, s: float) -> tuple[Any, dict[str, Any]]:
+    """The C kernel of the drawing at scale s, and the solve arguments that make it so: the
+    drawing at scale 1, compiled once for every scale, run with the scaled file's own
+    parameters and q0 — its nominal values, all its C holds otherwise
+    (test_a_drawing_at_any_scale_generates_the_same_c_but_its_values; one C build instead of
+    one per scale, 1.7 s of gcc each). Only for a drawing in SAME_C."""
+    assert template in SAME_C
+    drawn = derived(mechanism_file(_drawn(template, s)))
+    return kernel_of(_drawn(template, 1.0), "c"), {
+        "params": np.array(drawn.p_values, dtype=float), "q0": np.array(drawn.q0, dtype=float)}
+
+
+def _at_scale(template: str, s: float, backend: str) -> tuple[Any, dict[str, Any]]:
+    """The kernel of the drawing at scale s and symkin.solve's arguments for it: built from
+    the scaled file itself, but a C kernel of a drawing in SAME_C (_in_c)."""
+    if backend == "c" and template in SAME_C:
+        return _in_c(template, s)
+    return kernel_of(_drawn(template, s), backend), {}
+
+
+def _as_scaled(line: str, values: dict[str, str]) -> str:
+    """A generated line with its digests blanked and the nominal values written as in
+    ``values`` (their text at scale 1 -> at s)."""
+    digests = re.sub(r"\b[0-9a-f]{64}\b", "<sha256>", line)
+    number = re.compile(r"(?<![\w.])-?\d+(?:\.\d*)?(?:e[-+]?\d+)?(?![\w.])")
+    return number.sub(lambda m: values.get(m.group(0), m.group(0)), digests)
+
+
+SCALED = [(CRANK_SLIDER, s) for s in SCALES if s != 1.0]
+
+
+@pytest.mark.parametrize(("template", "s"), SCALED, ids=[f"{s:g}" for _, s in SCALED])
+def test_a_drawing_at_any_scale_generates_the_same_c_but_its_values(template: str,
+                                                                   s: float) -> None:
+    """The C sources of the file drawn at scale s equal those of the file at scale 1 line for
+    line, but for the lines that hold its nominal values (written scaled) and the digests:
+    so the C runs here of the scale-1 kernel with the scaled file's parameters and q0 are
+    the scaled file's own runs."""
+    files = [mechanism_file(_drawn(template, k)) for k in (1.0, s)]
+    unit, scaled = (sources(file, "c") for file in files)
+    values: dict[str, str] = {}
+    for one, other in zip(*((*derived(f).p_values, *derived(f).q0) for f in files)):
+        assert values.setdefault(repr(one), repr(other)) == repr(other)  # one text each
+    assert sorted(unit) == sorted(scaled)
+    changed = 0
+    for name in unit:
+        ours, theirs = unit[name].splitlines(), scaled[name].splitlines()
+        assert len(ours) == len(theirs), name
+        for line, (mine, other) in enumerate(zip(ours, theirs)):
+            if mine != other:  # only where the values (or the digests) are
+                assert _as_scaled(mine, values) == _as_scaled(other, {}), \
+                    f"{name}:{line + 1}: {mine!r} -> {other!r}"
+                changed += 1
+    assert changed  # the values are in the sources, and were mapped
 
 
 def _example_2_7(t: np.ndarray, s: float) -> dict[str, np.ndarray]:
@@ -75,8 +163,8 @@ def _example_2_7(t: np.ndarray, s: float) -> dict[str, np.ndarray]:
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("s", SCALES)
 def test_crank_slider_at_any_scale_follows_the_scaled_closed_form(tmp_path, backend, s):
-    kernel = _kernel(tmp_path, CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s), backend)
-    trajectory = symkin.solve(kernel)
+    kernel, scaled = _at_scale(CRANK_SLIDER, s, backend)
+    trajectory = symkin.solve(kernel, **scaled)
     assert trajectory.t.size == 31
     assert not trajectory.flagged.any()  # as at s = 1: no point flagged
     for name, expected in _example_2_7(trajectory.t, s).items():
@@ -96,10 +184,9 @@ def test_crank_slider_at_any_scale_follows_the_scaled_closed_form(tmp_path, back
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("s", (1e-6, 1.0, 1e3, 1e6))
 def test_the_limit_position_is_found_at_the_same_time_at_any_scale(tmp_path, backend, s):
-    text = NON_GRASHOF.format(a=2 * s, d=3 * s, x2=2 * s, x3=3 * s)
-    kernel = _kernel(tmp_path, text, backend)
+    kernel, scaled = _at_scale(NON_GRASHOF, s, backend)
     with pytest.raises(SolveError) as caught:
-        symkin.solve(kernel)
+        symkin.solve(kernel, **scaled)
     failure = caught.value
     assert isinstance(failure, driver.SolveFailure) and failure.reason == "limit position"
     assert failure.reached == pytest.approx(math.acos(-0.25), abs=1e-8)
@@ -109,22 +196,6 @@ def test_the_limit_position_is_found_at_the_same_time_at_any_scale(tmp_path, bac
     np.testing.assert_allclose(crank_x, 2 * s * np.cos(failure.trajectory.t), atol=1e-10 * s)
 
 
-PARALLELOGRAM = """
-name: parallelogram_scaled
-parameters: {{L: {L!r}}}
-bodies:
-  r0: {{q0: [0, 0, 0.5], points: {{tip: [L, 0]}}}}
-  r1: {{q0: [L, 0, 0.5], points: {{tip: [L, 0]}}}}
-  c0: {{q0: [0.88*L, 0.48*L, 0]}}
-joints:
-  - {{type: revolute, name: O0, i: ground, j: r0, sA: [0, 0], sB: [0, 0]}}
-  - {{type: revolute, name: O1, i: ground, j: r1, sA: [L, 0], sB: [0, 0]}}
-  - {{type: revolute, name: A0, i: r0, j: c0, sA: tip, sB: [0, 0]}}
-  - {{type: revolute, name: B0, i: c0, j: r1, sA: [L, 0], sB: tip}}
-drivers:
-  - {{type: angle, name: drive, i: r0, j: ground, theta: "0.5 - t"}}
-time: {{t0: 0, t1: 1, dt: 0.05}}
-"""
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -134,8 +205,8 @@ def test_a_singular_passage_is_flagged_alike_at_any_scale(tmp_path, backend):
     the crank angle 0.5 - t."""
     flags = {}
     for scale in (1e-6, 1.0, 1e3, 1e6):
-        kernel = _kernel(tmp_path, PARALLELOGRAM.format(L=scale), backend)
-        trajectory = symkin.solve(kernel)
+        kernel, scaled = _at_scale(PARALLELOGRAM, scale, backend)
+        trajectory = symkin.solve(kernel, **scaled)
         flags[scale] = trajectory.flagged.tolist()
         assert [round(t, 6) for t, _, _ in trajectory.singular] == [0.5]
         theta = 0.5 - trajectory.t
@@ -161,7 +232,7 @@ def test_scan_finds_the_same_branches_at_any_scale(tmp_path, s):
     a)^2) = +-4 s, the rod at atan(3/4) or pi - atan(3/4)."""
     from symkin.runtime.scanning.scan import scan
 
-    kernel = _kernel(tmp_path, CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s), "numpy")
+    kernel, _ = _at_scale(CRANK_SLIDER, s, "numpy")
     report = scan(kernel)
     x = sorted(float(b.q[kernel.coordinates.index("slider.x")]) for b in report.branches)
     np.testing.assert_allclose(x, [-4 * s, 4 * s], rtol=1e-9)
@@ -176,8 +247,8 @@ def test_c_solves_any_scale_in_its_generated_loop_with_the_decisions_of_numpy(
     """A C run in another unit runs the generated grid loop deciding in that unit (the C
     options' ``unit``), never the Python loop, and takes NumPy's decisions: the same flags and
     condition estimates, the motion equal to rounding (the closed form is checked above)."""
-    text = CRANK_SLIDER.format(a=s, b=5 * s, c=4 * s)
-    c_kernel, numpy_kernel = (_kernel(tmp_path, text, b) for b in ("c", "numpy"))
+    (c_kernel, scaled), (numpy_kernel, _) = (_at_scale(CRANK_SLIDER, s, b)
+                                             for b in ("c", "numpy"))
     assert c_kernel.scale_free
 
     def refuse(*args):
@@ -188,7 +259,7 @@ def test_c_solves_any_scale_in_its_generated_loop_with_the_decisions_of_numpy(
     monkeypatch.setattr(driver, "_python_loop", refuse)
     monkeypatch.setattr(units.ScaledGridSolver, "advance",
                         lambda self, a, b: advanced.append((a, b)) or advance(self, a, b))
-    in_c = symkin.solve(c_kernel)
+    in_c = symkin.solve(c_kernel, **scaled)
     assert advanced == [(0, 31)]  # one call of the generated loop, in the unit
     monkeypatch.undo()
     in_numpy = symkin.solve(numpy_kernel)
@@ -205,15 +276,14 @@ def test_the_c_option_unit_decides_a_millimetre_drawing_as_one_in_metres(tmp_pat
     in millimetres: in its own unit the Jacobian's condition is a million times that in
     metres, and the point is counted singular; in unit 1000 the 31 points solve, with the
     condition estimates of the drawing in metres."""
-    metres = _kernel(tmp_path, CRANK_SLIDER.format(a=1.0, b=5.0, c=4.0), "c")
-    millimetres = _kernel(tmp_path, CRANK_SLIDER.format(a=1e3, b=5e3, c=4e3), "c")
+    metres, _ = _in_c(CRANK_SLIDER, 1.0)
+    millimetres, drawn = _in_c(CRANK_SLIDER, 1e3)
     options = driver.default_options(millimetres)
     t = np.linspace(0.0, 1.5, 31)
     reference = symkin.solve(metres, t=t)
     conds = {}
     for unit in (1.0, 1e3):
-        q0 = np.asarray(millimetres.q0, dtype=float)
-        solver = millimetres.grid_solver(options, q0, millimetres.p_values, unit)
+        solver = millimetres.grid_solver(options, drawn["q0"], drawn["params"], unit)
         rows = [np.zeros((31, 9)) for _ in range(3)]
         cond, flagged = np.zeros(31), np.zeros(31, dtype=bool)
         solver.bind(t, *rows, cond, flagged)
