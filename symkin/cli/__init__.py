@@ -168,11 +168,13 @@ def leave(status: int) -> None:
     (0.3-0.4 s of the spherical four-bar's 3 s), and the process is ending anyway. What exit
     does that matters still happens: the streams are flushed and the exit functions run
     (temporary folders removed, worker pools joined). Where a thread other than the main one is
-    still running, or a stream cannot be flushed, Python's own exit decides as before."""
+    still running, a profiler or tracer is attached (``python -m cProfile -m symkin`` writes its
+    report after the command returns), or a stream cannot be flushed, Python's own exit decides
+    as before."""
     import atexit
     import threading
 
-    if threading.active_count() > 1:
+    if threading.active_count() > 1 or sys.getprofile() or sys.gettrace():
         sys.exit(status)
     atexit._run_exitfuncs()
     try:  # after the exit functions, which may write too

@@ -20,6 +20,8 @@ _SCRIPT = textwrap.dedent("""
 
     held = Held()  # freed only by the interpreter's teardown
     atexit.register(lambda: print("exit function"))
+    if sys.argv[1] == "profiled":
+        sys.setprofile(lambda *_: None)  # as cProfile: its report is written after exit
     if sys.argv[1] == "thread":
         threading.Thread(target=lambda: (time.sleep(0.2), print("thread done"))).start()
     print("written", end="")  # no newline: still in the buffer at leave()
@@ -44,3 +46,9 @@ def test_leave_with_a_running_thread_exits_as_python_does() -> None:
     done = _run("thread", 0)
     assert done.returncode == 0
     assert "thread done" in done.stdout and "exit function" in done.stdout
+
+
+def test_leave_under_a_profiler_exits_as_python_does() -> None:
+    done = _run("profiled", 2)
+    assert done.returncode == 2
+    assert done.stdout.startswith("writtenexit function\n") and "torn down" in done.stdout
