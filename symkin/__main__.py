@@ -1,7 +1,5 @@
 """``python -m symkin`` runs the command line."""
 
-import sys
+from symkin.cli import console
 
-from symkin.cli import main
-
-sys.exit(main())
+console()

@@ -15,19 +15,20 @@ other way), and so does a row whose derivative along dq SymPy leaves unevaluated
 The second derivative is D(D(row)), D the derivative along dq (symbolic.derivatives.Directional:
 D q_k = dq_k), with no symbol e substituted and removed, and SymPy's tidying of a second
 derivative, factor_terms(signsimp(...)), applied once to the row instead of at every node of
-order two: the spherical four-bar's Gamma 1.1 s -> 0.4 s, stewart_fk's 1.5 s -> 0.4 s, the same
-operations after CSE but on delta and delta_fk (+24, 1.3 %: CSE meets other signs of the same
-factors). A row with a node that has a derivative rule of its own (Abs) is taken along e.
+order two (factor_terms as symbolic.tidy makes it: each subtree's once for all the rows): the
+spherical four-bar's Gamma 1.1 s -> 0.4 s, stewart_fk's 1.5 s -> 0.4 s, the same operations
+after CSE but on delta and delta_fk (+24, 1.3 %: CSE meets other signs of the same factors).
+A row with a node that has a derivative rule of its own (Abs) is taken along e.
 """
 
 from __future__ import annotations
 
 import sympy as sp
-from sympy.core.exprtools import factor_terms
 from sympy.simplify.simplify import signsimp
 
 from symkin.symbolic.derivatives import Differentiator, Directional, Unsupported, diff
 from symkin.symbolic.symbols import Symbols
+from symkin.symbolic.tidy import Factored
 
 
 def row_jacobian(row: sp.Expr, column: dict[sp.Symbol, int],
@@ -60,6 +61,7 @@ class Memory:
         self.along = sp.Dummy("along", real=True)  # as q and dq: Abs(x + e v) has a sign
         self.differentiators: dict[sp.Symbol, Differentiator] = {}
         self.directional: Directional | None = None
+        self.factored = Factored()  # factor_terms, each subtree's result kept for every row
 
     def direction(self, symbols: Symbols) -> Directional:
         """D along dq, made on first use."""
@@ -85,7 +87,7 @@ def convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols,
     q, dq = symbols.q, symbols.dq
     if not row.has(sp.Piecewise):
         memory = memory or Memory()
-        second = _twice_along(row, memory.direction(symbols))
+        second = _twice_along(row, memory.direction(symbols), memory.factored)
         if second is not None:
             return second
         # a node with a rule of its own (Abs, ...): d^2/de^2 Phi(q + e dq, t) by SymPy's
@@ -98,7 +100,7 @@ def convective(row: sp.Expr, entries: dict[int, sp.Expr], symbols: Symbols,
     return sp.Add(*(diff(velocity, q[k]) * dq[k] for k in entries))
 
 
-def _twice_along(row: sp.Expr, along: Directional) -> sp.Expr | None:
+def _twice_along(row: sp.Expr, along: Directional, factored: Factored) -> sp.Expr | None:
     """D(D(row)), tidied once as SymPy tidies a second derivative (common factors and signs
     taken out of the sums: fewer operations after CSE); None where a node of the row has a
     derivative rule of its own or SymPy leaves a derivative unevaluated."""
@@ -108,4 +110,4 @@ def _twice_along(row: sp.Expr, along: Directional) -> sp.Expr | None:
         return None
     if second.has(sp.Derivative, sp.Subs):
         return None
-    return second if second.is_zero else factor_terms(signsimp(second))
+    return second if second.is_zero else factored(signsimp(second))
