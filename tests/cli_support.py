@@ -97,3 +97,14 @@ def symkin_process(*args: str, cwd: Path, env: Mapping[str, str] | None = None,
                             capture_output=True, text=True, timeout=timeout, check=False)
     assert "Traceback" not in result.stderr, result.stderr
     return result
+
+
+def unreachable_crank_slider(folder: Path) -> Path:
+    """``folder/short.yaml``: the textbook crank-slider with the slide's offset c = 9, beyond
+    crank and rod together (a + b = 6), so it cannot be assembled at t = 0. The tests of a run
+    that solves no row all write these same bytes: the first run builds the kernel, the others
+    find it in the shared cache's index (symkin.build.index is keyed by the file's bytes)."""
+    text = (ROOT / "examples" / "crank_slider.yaml").read_text(encoding="utf-8")
+    path = folder / "short.yaml"
+    path.write_text(text.replace("c: 4.0}", "c: 9.0}"), encoding="utf-8")
+    return path

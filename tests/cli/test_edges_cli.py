@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from cli_support import Ran, symkin_main
+from cli_support import Ran, symkin_main, unreachable_crank_slider
 
 ROOT = Path(__file__).resolve().parents[2]
 MECHANISMS = ROOT / "tests" / "mechanisms"
@@ -48,10 +48,9 @@ def test_limit_position_exits_1_and_says_how_to_go_on(tmp_path: Path) -> None:
 
 
 def test_a_run_that_stops_before_its_first_row_writes_the_header(tmp_path: Path) -> None:
-    """The textbook crank-slider with a rod b = 2 that cannot reach the slide (c - a = 3):
+    """The textbook crank-slider with its slide out of the reach of crank and rod (c = 9):
     no row is solved, and -o out.csv still writes the columns (was a traceback, no file)."""
-    text = (ROOT / "examples" / "crank_slider.yaml").read_text().replace("b: 5.0", "b: 2.0")
-    (tmp_path / "short.yaml").write_text(text)
+    unreachable_crank_slider(tmp_path)
     result = run("short.yaml", "-o", "out.csv", cwd=tmp_path)
     assert result.returncode == 1 and "cannot be assembled" in result.stderr
     lines = (tmp_path / "out.csv").read_text().splitlines()

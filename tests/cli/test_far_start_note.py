@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cli_support import Ran, symkin_main
+from driver_support import kernel_of
 
 import symkin
 from symkin.runtime.solving.start import FAR, far_from_guess
@@ -45,10 +46,8 @@ def _run(path: Path, backend: str = "numpy") -> Ran:
 
 
 @pytest.mark.parametrize("backend", ["numpy", "c"])
-def test_the_far_bodies_and_how_far_match_the_loop_closure(tmp_path, backend):
-    path = tmp_path / "guide.yaml"
-    path.write_text(GUIDE_BY_DIRECTION.replace("V", "1, 0"))
-    kernel = symkin.compile(symkin.derive(symkin.load(path)), backend=backend)
+def test_the_far_bodies_and_how_far_match_the_loop_closure(backend):
+    kernel = kernel_of(GUIDE_BY_DIRECTION.replace("V", "1, 0"), backend)  # one derivation
     trajectory = symkin.solve(kernel)
     moved, scale = far_from_guess(kernel, np.asarray(kernel.q0, dtype=float), trajectory.q[0],
                                   0.0, trajectory.params)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from codegen_support import compiled
 
 import symkin
 from symkin import cli
@@ -97,8 +98,7 @@ def test_ctrl_c_while_a_motions_forces_are_computed_writes_every_row(tmp_path, c
 
 
 def test_the_api_hands_on_the_rows_without_the_efforts(monkeypatch):
-    kernel = symkin.compile(symkin.derive(EXAMPLES / "crank_slider_load.yaml"),
-                            backend="numpy")
+    kernel = compiled(EXAMPLES / "crank_slider_load.yaml", "numpy")  # one derivation a run
     monkeypatch.setattr(forces, "compute", _interrupt)
     t = np.linspace(0, 0.5, ROWS)
     with pytest.raises(SolveInterrupted) as caught:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cli_support import Ran, ctrl_c_as_at_a_terminal, symkin_main
+from cli_support import Ran, ctrl_c_as_at_a_terminal, symkin_main, unreachable_crank_slider
 
 ROOT = Path(__file__).resolve().parents[2]
 TEXTBOOK = ROOT / "examples" / "crank_slider.yaml"
@@ -95,8 +95,7 @@ def test_a_closed_pipe_ends_quietly(tmp_path: Path, cache: Path) -> None:
 
 def test_failed_solve_says_why_even_when_its_output_cannot_be_written(tmp_path: Path,
                                                                        cache: Path) -> None:
-    short = tmp_path / "short.yaml"  # the slider's offset c is longer than crank + rod
-    short.write_text(TEXTBOOK.read_text().replace("c: 4.0", "c: 9.0"))
+    short = unreachable_crank_slider(tmp_path)  # the slide's offset c beyond crank + rod
     assert "c: 9.0" in short.read_text()
     (tmp_path / "a_file").write_text("not a folder")
     result = symkin("run", str(short), "-o", str(tmp_path / "a_file" / "out.csv"),
@@ -108,8 +107,7 @@ def test_failed_solve_says_why_even_when_its_output_cannot_be_written(tmp_path: 
 
 
 def test_no_claim_of_written_rows_without_an_output(tmp_path: Path, cache: Path) -> None:
-    short = tmp_path / "short.yaml"
-    short.write_text(TEXTBOOK.read_text().replace("c: 4.0", "c: 9.0"))
+    short = unreachable_crank_slider(tmp_path)
     result = symkin("run", str(short), cwd=tmp_path, cache=cache)
     assert result.returncode == 1
     assert "are written" not in result.stderr and "those are" not in result.stderr

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cli_support import Ran, symkin_main, symkin_process
+from cli_support import Ran, symkin_main, symkin_process, unreachable_crank_slider
 from driver_support import MECHANISMS
 
 from symkin.cli.run_outputs import ProgressBar
@@ -72,8 +72,7 @@ def test_failed_solve_writes_partial_results_and_exits_1(tmp_path: Path) -> None
 
 
 def test_cannot_assemble_exits_1_and_writes_an_empty_table(tmp_path: Path) -> None:
-    text = (MECHANISMS / "four_bar_test.yaml").read_text().replace("d: 3.0", "d: 10.0")
-    (tmp_path / "short.yaml").write_text(text)
+    unreachable_crank_slider(tmp_path)  # 3 bodies, 9 coordinates
     result = run("short.yaml", "-o", "s.npz", cwd=tmp_path)
     assert result.returncode == 1 and "cannot be assembled at t = 0" in result.stderr
     assert np.load(tmp_path / "s.npz")["q"].shape == (0, 9)
