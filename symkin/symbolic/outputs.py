@@ -1,6 +1,7 @@
 """What pairs report along a motion beyond the coordinates — a cam's pressure angle and
 radius of curvature at the contact — as named expressions of q, dq, t and the parameters, and
-their values on a solved Trajectory (NumPy functions made once per System).
+their values on a solved Trajectory (NumPy functions made at each call: 0.5 s of CPU for the
+cam example, whose outputs SymPy builds unevaluated, see ``pairs.planar.cam.outputs``).
 
 Each pair type says what it reports (:attr:`symkin.pairs.kit.PairType.outputs`); they are
 named ``NAME.key`` after the pair, and written with the Trajectory (CSV columns after the

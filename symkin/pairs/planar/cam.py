@@ -153,8 +153,12 @@ def outputs(c: Cam, geometry: kit.Geometry) -> dict[str, tuple[sp.Expr, sp.Expr 
     velocity = geometry.rate(follower.point(geometry.local(c.j, c.follower.at)))
     across = normal[0] * velocity[1] - normal[1] * velocity[0]
     along = (normal.T * velocity)[0]
-    return {"pressure_angle": (sp.atan2(sp.Abs(across), sp.Abs(along)),
-                               sp.sqrt((velocity.T * velocity)[0])),
+    # Unevaluated: SymPy's Abs and atan2 would expand the long profile's terms to look for
+    # signs and factors (10 of 13 s of the cam example's outputs), for a function evaluated
+    # numerically anyway.
+    angle = sp.atan2(sp.Abs(across, evaluate=False), sp.Abs(along, evaluate=False),
+                     evaluate=False)
+    return {"pressure_angle": (angle, sp.sqrt((velocity.T * velocity)[0])),
             "curvature_radius": (_radius(c, t, t2, sense, geometry), None),
             **kit.contact_outputs(cam.point(curve))}
 
