@@ -32,10 +32,14 @@ def _inputs(system: symkin.System, times: np.ndarray) -> dict[str, np.ndarray]:
             "input_accels": 0 * steps}
 
 
-def assert_octave_equals_numpy(system: symkin.System, numpy: Kernel, name: str) -> None:
+def assert_octave_equals_numpy(system: symkin.System, numpy: Kernel, name: str,
+                               octave: Kernel | None = None) -> None:
     """symkin.solve with the octave kernel gives NumPy's rows to 1e-12 (the first steps of
-    the file's grid: Octave evaluates each call in a running process)."""
-    octave = symkin.compile(system, backend="octave")
+    the file's grid: Octave evaluates each call in a running process). ``octave``: a kernel
+    built from the example's committed .m goldens (test_generated proves them equal to a fresh
+    generation); without one, symkin.compile generates and builds it here."""
+    if octave is None:
+        octave = symkin.compile(system, backend="octave")
     assert octave.backend == "octave" and numpy.backend == "numpy"
     t0, t1, dt = system.time_grid
     times = t0 + dt * np.arange(min(6, round((t1 - t0) / dt) + 1))

@@ -93,9 +93,10 @@ def kernel(request: pytest.FixtureRequest):
 @pytest.mark.slow
 def test_octave_runs_equal_numpy() -> None:
     """stewart_legs_fk's part of tests/backends/octave's check on every example, here where
-    its derivation and NumPy kernel are built anyway."""
+    its derivation and NumPy kernel are built anyway; its .m files are the goldens."""
     assert_octave_equals_numpy(derived(ROOT / "examples" / "stewart_legs_fk.yaml"),
-                               _compiled("stewart_legs_fk", "numpy"), "stewart_legs_fk")
+                               _compiled("stewart_legs_fk", "numpy"), "stewart_legs_fk",
+                               _compiled("stewart_legs_fk", "octave"))
 
 
 @pytest.mark.parametrize("tilt", [0.05, 0.5])
