@@ -51,13 +51,9 @@ def _system(spec: str) -> Any:
 def _files(system: Any) -> tuple[Any, dict[str, str]]:
     from symkin import backends
     from symkin.codegen import lower, render
-    from symkin.contract.manifest import manifest_name
 
     backend = backends.get("c")
-    code = lower.lower(system, backend, None, True)
-    files = render.render_sources(code)
-    files[manifest_name(code.name)] = render.manifest(code, files)
-    return backend, files
+    return backend, render.rendered(lower.lower(system, backend, None, True))
 
 
 def _recording(per_file: dict[str, float], compile_unit: Callable[..., Path]

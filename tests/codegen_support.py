@@ -98,10 +98,8 @@ def sources(path: Path, backend: str, **options: str) -> dict[str, str]:
     resolved = Path(path).resolve()
 
     def generate() -> dict[str, str]:
-        code = lower.lower(derived(resolved), backends.get(backend), options, True)
-        files = render.render_sources(code)
-        files[manifest_name(code.name)] = render.manifest(code, files)
-        return files
+        return render.rendered(lower.lower(derived(resolved), backends.get(backend), options,
+                                           True))
 
     key = (*shared_builds.file_key(resolved), backend, sorted(options.items()))
     return shared_builds.stored("sources", key, generate)

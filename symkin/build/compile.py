@@ -15,7 +15,6 @@ from pathlib import Path
 from symkin.build.backend import Backend
 from symkin.build.cache import open_cache
 from symkin.codegen import lower, render
-from symkin.contract.manifest import manifest_name
 from symkin.runtime.kernel import Kernel
 from symkin.symbolic.derivation import System
 
@@ -40,7 +39,4 @@ def compile(system: System, backend: Backend, options: Mapping[str, str] | None 
     """
     backend.require()
     cache = open_cache(cache_dir)
-    code = lower.lower(system, backend, options, cse)
-    files = render.render_sources(code)
-    files[manifest_name(code.name)] = render.manifest(code, files)
-    return backend.build(files, cache)
+    return backend.build(render.rendered(lower.lower(system, backend, options, cse)), cache)

@@ -117,13 +117,19 @@ def generate(system: System, backend: Target, out_dir: str | Path = "generated",
     return write(code, Path(out_dir), force=force)
 
 
+def rendered(code: Code) -> dict[str, str]:
+    """Every file of ``code`` by name, as written and built: its rendered sources, then its
+    manifest (which records their digests)."""
+    files = render_sources(code)
+    files[manifest_name(code.name)] = manifest(code, files)
+    return files
+
+
 def write(code: Code, out_dir: Path, force: bool = False) -> list[Path]:
     """Write the rendered files of ``code`` and its manifest into ``out_dir``: symkin's own
     earlier output of this mechanism is replaced (files it no longer has are removed), and a
     file symkin did not write (or that was edited since) is never deleted."""
-    files = render_sources(code)
-    manifest_file = manifest_name(code.name)
-    files[manifest_file] = manifest(code, files)
+    files = rendered(code)
     paths = [out_dir / name for name in files]
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
